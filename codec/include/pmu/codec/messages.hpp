@@ -1,0 +1,120 @@
+#pragma once
+// Typed contents of every PMU packet, in SI units (volts, amperes, degrees Celsius, rpm,
+// mAh). Field names follow interface.md so the service and pmuctl map them one to one.
+
+#include <cstdint>
+#include <limits>
+#include <variant>
+
+#include "pmu/codec/firmware.hpp"
+#include "pmu/codec/parameters.hpp"
+
+namespace pmu::codec {
+
+// Output bits shared by 0x04 flag register 2, 0x18, 0x20, 0x21 and 0x22.
+namespace output_bit {
+inline constexpr std::uint8_t AvionicsServo = 1u << 0;
+inline constexpr std::uint8_t Payload = 1u << 1;
+inline constexpr std::uint8_t ChargerA = 1u << 2;
+inline constexpr std::uint8_t ChargerB = 1u << 3;
+inline constexpr std::uint8_t All = 0x0F;
+}  // namespace output_bit
+
+// Measurement group bits shared by 0x0F (MR) and 0x15 (PS).
+namespace group_bit {
+inline constexpr std::uint8_t Voltages = 1u << 0;
+inline constexpr std::uint8_t Currents = 1u << 1;
+inline constexpr std::uint8_t BatteryEnergy = 1u << 2;
+inline constexpr std::uint8_t Temperatures = 1u << 3;
+inline constexpr std::uint8_t Status = 1u << 4;
+inline constexpr std::uint8_t All = 0x1F;
+}  // namespace group_bit
+
+// S0 bits (table 16). Bits 4 and 6 exist only on newer firmware, see firmware.hpp.
+namespace power_up_bit {
+inline constexpr std::uint8_t AvionicsServo = 1u << 0;
+inline constexpr std::uint8_t Payload = 1u << 1;
+inline constexpr std::uint8_t ChargerA = 1u << 2;
+inline constexpr std::uint8_t ChargerB = 1u << 3;
+inline constexpr std::uint8_t BatteryDisconnectDetect = 1u << 4;
+inline constexpr std::uint8_t PayloadShedding = 1u << 5;
+inline constexpr std::uint8_t SoaManagement = 1u << 6;
+}  // namespace power_up_bit
+
+inline constexpr double kNoSensor = std::numeric_limits<double>::quiet_NaN();
+
+struct Voltages {  // 0x00, table 2
+  double avionics = 0, output_28v = 0, payload = 0, servo = 0, battery_a = 0, battery_b = 0,
+         generator = 0;
+};
+
+struct Currents {  // 0x01, table 3
+  double avionics = 0, output_28v = 0, payload = 0, servo = 0, battery_a = 0, battery_b = 0;
+};
+
+struct BatteryEnergy {  // 0x02, table 4
+  std::int16_t battery_a_mah = 0, battery_b_mah = 0;
+};
+
+struct Temperatures {  // 0x03, table 5; NaN = "no sensor" (-128 on the wire)
+  double internal = 0, battery_a = kNoSensor, battery_b = kNoSensor, generator = kNoSensor,
+         starter = 0;
+};
+
+struct Status {  // 0x04 "Miscellaneous", table 6
+  std::uint16_t generator_rpm = 0;
+  bool generation_enabled = false;
+  bool thermal_shutdown = false;
+  bool soa_shutdown = false;  // bit 6 from firmware 1.16
+  bool start_button = false;  // bit 6 before firmware 1.16
+  bool payload_shed = false;
+  bool starter_ready = false;
+  std::uint8_t outputs = 0;  // flag register 2, output_bit::*
+  FlagInterpretation interpretation{Bit6Meaning::SoaShutdown, false};
+
+  bool avionics_servo_on() const noexcept { return outputs & output_bit::AvionicsServo; }
+  bool payload_on() const noexcept { return outputs & output_bit::Payload; }
+  bool charger_a_on() const noexcept { return outputs & output_bit::ChargerA; }
+  bool charger_b_on() const noexcept { return outputs & output_bit::ChargerB; }
+};
+
+struct MeasurementRequest {  // 0x0F, table 7
+  std::uint8_t groups = group_bit::All;
+};
+
+struct ParameterValue {  // 0x10..0x1B: a set, or the device's answer to a get
+  Parameter parameter = Parameter::AvionicsVoltage;
+  std::uint32_t raw = 0;
+  double value = 0;  // engineering units of spec_of(parameter).unit
+};
+
+struct OutputStates {  // 0x20, table 19
+  std::uint8_t mask = 0;
+};
+struct EnableOutputs {  // 0x21, table 20
+  std::uint8_t mask = 0;
+};
+struct DisableOutputs {  // 0x22, table 21
+  std::uint8_t mask = 0;
+};
+struct GenerationState {  // 0x23, table 22
+  bool enabled = false;
+};
+struct SerialNumber {  // 0x30, table 23
+  std::uint16_t serial_number = 0;
+};
+struct FirmwareInfo {  // 0x31, table 24
+  std::uint8_t firmware_major = 0, firmware_minor = 0, build_day = 0, build_month = 0;
+  std::uint16_t build_year = 0;
+  FirmwareVersion version() const noexcept { return {firmware_major, firmware_minor}; }
+};
+
+// A frame with no payload: a zero-length get, the 0x0F "all measurements" form, or the
+// data-less commands 0x24..0x26.
+struct NoPayload {};
+
+using Payload = std::variant<NoPayload, Voltages, Currents, BatteryEnergy, Temperatures, Status,
+                             MeasurementRequest, ParameterValue, OutputStates, EnableOutputs,
+                             DisableOutputs, GenerationState, SerialNumber, FirmwareInfo>;
+
+}  // namespace pmu::codec

@@ -1,0 +1,217 @@
+#include "pmu/codec/canopen.hpp"
+
+#include <cstdio>
+
+#include "bytes.hpp"
+
+namespace pmu::codec::canopen {
+namespace {
+
+enum class Type : std::uint8_t { U8, I8, U16, I16, U32, Bool, U8x4 };
+
+constexpr std::uint8_t size_of(Type t) noexcept {
+  switch (t) {
+    case Type::U8:
+    case Type::I8:
+    case Type::Bool: return 1;
+    case Type::U16:
+    case Type::I16: return 2;
+    case Type::U32:
+    case Type::U8x4: return 4;
+  }
+  return 4;
+}
+
+constexpr std::int32_t kAnyIndex = -1;
+constexpr std::int32_t kAnySubindex = -1;
+
+struct Entry {
+  std::uint16_t cob_offset;  // battery: the COB-ID; MPPT: offset from the device base id
+  std::int32_t index;        // kAnyIndex: "Don't Care" in the document
+  std::int32_t subindex;     // kAnySubindex: the subindex is a number (cell), not a selector
+  std::string_view name;
+  Type type;
+  double divisor;
+  std::string_view unit;
+};
+
+constexpr std::uint16_t kMpptBase = 0x4E6;
+constexpr std::uint16_t kMpptStride = 8;
+constexpr std::uint8_t kMpptDevices = 8;
+
+// Battery (MG) table.
+constexpr Entry kBattery[] = {
+    {0x302, 0x2005, 0x01, "voltage", Type::U16, 1000, "V"},
+    {0x302, 0x2005, 0x02, "current", Type::I16, 100, "A"},
+    {0x302, 0x2005, 0x03, "current_discharge", Type::I16, 100, "A"},
+    {0x302, 0x2005, 0x04, "current_charge", Type::I16, 100, "A"},
+    {0x302, 0x2005, 0x05, "state_of_charge", Type::I8, 1, "%"},
+    {0x302, 0x2005, 0x07, "time_to_go", Type::U16, 1, "min"},
+    {0x402, 0x2005, 0x09, "cell_temperature_high", Type::I8, 1, "degC"},
+    {0x402, 0x2005, 0x0B, "cell_temperature_low", Type::I8, 1, "degC"},
+    {0x402, 0x2005, 0x0C, "cell_voltage_high", Type::U16, 1000, "V"},
+    {0x402, 0x2005, 0x0D, "cell_voltage_low", Type::U16, 1000, "V"},
+    {0x402, 0x2005, 0x0E, "bms_state", Type::U32, 1, ""},
+    {0x402, 0x2005, 0x0F, "temperature_collection", Type::U8x4, 1, "degC"},
+    {0x482, 0x2000, kAnySubindex, "cell_voltage", Type::U16, 1000, "V"},
+    {0x202, kAnyIndex, kAnySubindex, "power_level", Type::U8, 1, "%"},
+};
+
+// MPPT table, offsets from 0x4E6 + 8 * device.
+constexpr Entry kMppt[] = {
+    {0, kAnyIndex, 0x00, "voltage_output_raw", Type::I16, 1, ""},
+    {0, kAnyIndex, 0x01, "current_output_raw", Type::I16, 1, ""},
+    {0, kAnyIndex, 0x02, "voltage_out_sw_raw", Type::I16, 1, ""},
+    {0, kAnyIndex, 0x03, "mppt_state", Type::U8, 1, ""},
+    {0, kAnyIndex, 0x04, "safety_enabled", Type::Bool, 1, ""},
+    {0, kAnyIndex, 0x05, "pwm_enabled", Type::Bool, 1, ""},
+    {0, kAnyIndex, 0x06, "temperature", Type::I8, 1, "degC"},
+    {0, kAnyIndex, 0x08, "voltage_panel_1_raw", Type::I16, 1, ""},
+    {0, kAnyIndex, 0x09, "current_panel_1_raw", Type::I16, 1, ""},
+    {0, kAnyIndex, 0x0A, "voltage_panel_2_raw", Type::I16, 1, ""},
+    {0, kAnyIndex, 0x0B, "current_panel_2_raw", Type::I16, 1, ""},
+    {0, kAnyIndex, 0x0C, "voltage_panel_3_raw", Type::I16, 1, ""},
+    {0, kAnyIndex, 0x0D, "current_panel_3_raw", Type::I16, 1, ""},
+    {0, kAnyIndex, 0x0E, "voltage_panel_4_raw", Type::I16, 1, ""},
+    {0, kAnyIndex, 0x0F, "current_panel_4_raw", Type::I16, 1, ""},
+    {1, kAnyIndex, 0x01, "duty_cycle_panel_1", Type::U8, 1, "%"},
+    {1, kAnyIndex, 0x02, "duty_cycle_panel_2", Type::U8, 1, "%"},
+    {1, kAnyIndex, 0x03, "duty_cycle_panel_3", Type::U8, 1, "%"},
+    {1, kAnyIndex, 0x04, "duty_cycle_panel_4", Type::U8, 1, "%"},
+    {1, kAnyIndex, 0x05, "channel_active_map", Type::U8x4, 1, ""},
+};
+
+constexpr std::uint8_t kHeader = 4;  // Data[0] command byte, Data[1..2] index, Data[3] subindex
+
+bool is_battery_id(std::uint32_t id) noexcept { return id == 0x202 || id == 0x302 || id == 0x402 || id == 0x482; }
+
+bool mppt_slot(std::uint32_t id, std::uint8_t& device, std::uint16_t& offset) noexcept {
+  if (id < kMpptBase || id >= kMpptBase + kMpptStride * kMpptDevices) return false;
+  device = static_cast<std::uint8_t>((id - kMpptBase) / kMpptStride);
+  offset = static_cast<std::uint16_t>((id - kMpptBase) % kMpptStride);
+  return offset <= 1;  // the rest of each block is unassigned
+}
+
+double scalar(Type t, const std::uint8_t* p) noexcept {
+  switch (t) {
+    case Type::U8: return p[0];
+    case Type::I8: return as_signed(p[0]);
+    case Type::Bool: return p[0] != 0 ? 1 : 0;
+    case Type::U16: return le16(p);
+    case Type::I16: return as_signed16(le16(p));
+    case Type::U32: return le32(p);
+    case Type::U8x4: return p[0];
+  }
+  return 0;
+}
+
+}  // namespace
+
+bool is_canopen_id(std::uint32_t id, bool extended) noexcept {
+  if (extended) return false;
+  std::uint8_t device = 0;
+  std::uint16_t offset = 0;
+  return is_battery_id(id) || mppt_slot(id, device, offset);
+}
+
+Result<CanOpenMessage, Error> decode(const CanFrame& frame) noexcept {
+  Error err;
+  err.cob_id = static_cast<std::uint16_t>(frame.id & 0xFFFF);
+  err.length = frame.length;
+  CanOpenMessage m;
+  std::uint16_t offset = 0;
+  const Entry* table = nullptr;
+  std::size_t table_size = 0;
+  if (!frame.extended && is_battery_id(frame.id)) {
+    m.source = Source::Battery;
+    table = kBattery;
+    table_size = std::size(kBattery);
+    offset = static_cast<std::uint16_t>(frame.id);
+  } else if (!frame.extended && mppt_slot(frame.id, m.device, offset)) {
+    m.source = Source::Mppt;
+    table = kMppt;
+    table_size = std::size(kMppt);
+  } else {
+    err.kind = ErrorKind::NotOurs;
+    return Unexpected{err};
+  }
+  m.cob_id = static_cast<std::uint16_t>(frame.id);
+  if (frame.remote) {
+    err.kind = ErrorKind::RemoteFrame;
+    return Unexpected{err};
+  }
+  const std::uint8_t len = frame.length > kMaxDataLength ? kMaxDataLength : frame.length;
+  if (len < kHeader + 1) {
+    err.kind = ErrorKind::TooShort;
+    err.needed = kHeader + 1;
+    return Unexpected{err};
+  }
+  const std::uint8_t* d = frame.data.data();
+  m.command_byte = d[0];
+  m.index = le16(d + 1);
+  m.subindex = d[3];
+  err.index = m.index;
+  err.subindex = m.subindex;
+
+  const Entry* hit = nullptr;
+  bool index_seen = false;
+  for (std::size_t i = 0; i < table_size; ++i) {
+    const Entry& e = table[i];
+    if (e.cob_offset != offset) continue;
+    if (e.index != kAnyIndex && e.index != m.index) continue;
+    index_seen = true;
+    if (e.subindex != kAnySubindex && e.subindex != m.subindex) continue;
+    hit = &e;
+    break;
+  }
+  if (!hit) {
+    err.kind = index_seen ? ErrorKind::UnknownSubindex : ErrorKind::UnknownIndex;
+    return Unexpected{err};
+  }
+  const std::uint8_t need = static_cast<std::uint8_t>(kHeader + size_of(hit->type));
+  if (len < need) {
+    err.kind = ErrorKind::TooShort;
+    err.needed = need;
+    return Unexpected{err};
+  }
+  const std::uint8_t* v = d + kHeader;
+  if (frame.id == 0x482) m.fields[m.field_count++] = Field{"cell", static_cast<double>(m.subindex), ""};
+  if (hit->type == Type::U8x4) {
+    // Four values, one per byte; the names are fixed so no string is built at run time.
+    static constexpr std::string_view kTemps[4] = {"temperature_1", "temperature_2", "temperature_3",
+                                                   "temperature_4"};
+    static constexpr std::string_view kChannels[4] = {"channel_1_active", "channel_2_active",
+                                                      "channel_3_active", "channel_4_active"};
+    const auto* names = hit->name == "temperature_collection" ? kTemps : kChannels;
+    for (std::size_t i = 0; i < 4; ++i) m.fields[i] = Field{names[i], static_cast<double>(v[i]), hit->unit};
+    m.field_count = 4;
+  } else {
+    m.fields[m.field_count++] = Field{hit->name, scalar(hit->type, v) / hit->divisor, hit->unit};
+  }
+  return m;
+}
+
+std::string Error::describe() const {
+  char buf[160];
+  switch (kind) {
+    case ErrorKind::NotOurs:
+      std::snprintf(buf, sizeof buf, "id %03X is not a battery or MPPT frame", cob_id);
+      break;
+    case ErrorKind::TooShort:
+      std::snprintf(buf, sizeof buf, "CANopen frame %03X too short: length %u, needs %u", cob_id, length, needed);
+      break;
+    case ErrorKind::UnknownIndex:
+      std::snprintf(buf, sizeof buf, "CANopen frame %03X: unknown index 0x%04X", cob_id, index);
+      break;
+    case ErrorKind::UnknownSubindex:
+      std::snprintf(buf, sizeof buf, "CANopen frame %03X: unknown subindex 0x%02X of index 0x%04X", cob_id,
+                    subindex, index);
+      break;
+    case ErrorKind::RemoteFrame:
+      std::snprintf(buf, sizeof buf, "remote frame %03X carries no data", cob_id);
+      break;
+  }
+  return buf;
+}
+
+}  // namespace pmu::codec::canopen
