@@ -146,6 +146,8 @@ Result<CandumpLine, CandumpError> parse_candump_line(std::string_view line) noex
     tok = next_token(rest);
   }
   if (tok.empty()) return fail("missing interface");
+  // A frame where the interface belongs ("(1.0) 123#00"): the interface is what is missing.
+  if (tok.find('#') != std::string_view::npos) return fail("missing interface");
   out.interface = tok;
   const std::string_view frame_tok = next_token(rest);
   if (frame_tok.empty()) return fail("missing frame");

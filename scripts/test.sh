@@ -1,0 +1,37 @@
+#!/usr/bin/env bash
+# The one test command (README, .ci/run): installs what is missing, builds, runs every test.
+#   1. release build (-Werror): unit, CLI, transport, simulator tests, benchmark smoke runs
+#   2. ASan+UBSan build: the same tests under the sanitizers
+#   3. clang libFuzzer build: each fuzz target for a bounded time over its kept corpus
+# Set PMU_FUZZ_SECONDS to change the fuzz time per target (default 30).
+set -euo pipefail
+root=$(cd "$(dirname "$0")/.." && pwd)
+cd "$root"
+jobs=$(nproc)
+
+"$root/scripts/setup.sh"
+
+step() { printf '\n=== %s ===\n' "$*"; }
+
+step "release build"
+cmake -S . -B build/release -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DPMU_WERROR=ON >/dev/null
+cmake --build build/release -j"$jobs"
+
+step "ASan+UBSan build"
+cmake -S . -B build/asan -G Ninja -DCMAKE_BUILD_TYPE=Debug -DPMU_SANITIZE=ON -DPMU_BUILD_BENCH=OFF >/dev/null
+cmake --build build/asan -j"$jobs"
+
+step "libFuzzer build (clang-14)"
+CC=clang-14 CXX=clang++-14 cmake -S . -B build/fuzz -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo \
+  -DPMU_FUZZ=ON -DPMU_BUILD_BENCH=OFF >/dev/null
+cmake --build build/fuzz -j"$jobs"
+
+step "sanitizer tests"
+ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
+  ctest --test-dir build/asan --output-on-failure -j"$jobs" -LE 'fuzz|bench'
+
+step "fuzz runs"
+ctest --test-dir build/fuzz --output-on-failure -L fuzz
+
+step "release tests"
+ctest --test-dir build/release --output-on-failure -j"$jobs"
