@@ -1,6 +1,5 @@
-// pmuctl: the operator's command line (interface.md section 2). This build carries the
-// offline decoder; the DDS verbs (watch, list, info, health, config, outputs, ...) are
-// added by the service issues.
+// pmuctl: the operator's command line (interface.md section 2): the DDS verbs that read
+// what pmu-service publishes, and the offline decoder for candump logs.
 
 #include <sys/types.h>
 
@@ -14,6 +13,7 @@
 #include <string>
 
 #include "pmu/codec/firmware.hpp"
+#include "pmuctl/dds_verbs.hpp"
 #include "pmuctl/log_decoder.hpp"
 
 namespace {
@@ -65,8 +65,29 @@ int run_decode(const std::string& path, const pmu::tools::DecodeOptions& options
 int main(int argc, char** argv) {
   CLI::App app{"pmuctl: operate and inspect Millswood 250W PMUs served by pmu-service"};
   app.require_subcommand(1);
-  bool json = false;
-  app.add_flag("--json", json, "Machine-readable output: one JSON object per line");
+  app.fallthrough();  // global options may follow the verb: `pmuctl decode --json`
+  pmu::tools::GlobalOptions g;
+  int address = -1;
+  double timeout = -1;
+  app.add_option("--domain", g.domain, "DDS domain id")->check(CLI::Range(0, 232));
+  app.add_option("--bus", g.bus, "Only this bus (the service's name for it, e.g. can0)");
+  app.add_option("--address", address, "Only the PMU at this CAN address")->check(CLI::Range(0, 65534));
+  app.add_flag("--json", g.json, "Machine-readable output: one JSON object per line");
+  app.add_option("--timeout", timeout, "Seconds to wait (state verbs: default 3; watch: forever)")
+      ->check(CLI::PositiveNumber);
+  app.add_option("--qos-file", g.qos_file, "QoS profiles (default: $PMU_QOS_FILE or /etc/pmu-dds/qos.xml)");
+
+  auto* watch = app.add_subcommand("watch", "Live telemetry: a refreshing table, or one JSON object per sample");
+  long count = 0;
+  watch->add_option("--count", count, "Stop after N samples")->check(CLI::PositiveNumber);
+  app.add_subcommand("list", "PMUs the service knows, with health");
+  app.add_subcommand("info", "Serial number, firmware and features");
+  app.add_subcommand("health", "Link, bus and device health");
+  auto* config = app.add_subcommand("config", "Stored parameters");
+  config->require_subcommand(1);
+  auto* config_get = config->add_subcommand("get", "Show the stored parameters (or one)");
+  std::string parameter;
+  config_get->add_option("param", parameter, "A parameter name, e.g. avionics_voltage");
 
   auto* decode = app.add_subcommand("decode", "Decode a candump log (-L or screen format) offline");
   std::string path = "-";
@@ -77,10 +98,12 @@ int main(int argc, char** argv) {
                      "(default: current, 1.17)");
 
   CLI11_PARSE(app, argc, argv);
+  if (address >= 0) g.address = static_cast<std::uint16_t>(address);
+  if (timeout > 0) g.timeout = timeout;
 
   if (*decode) {
     pmu::tools::DecodeOptions options;
-    options.json = json;
+    options.json = g.json;
     if (!firmware.empty()) {
       options.firmware = pmu::codec::parse_firmware(firmware);
       if (!options.firmware) {
@@ -89,6 +112,16 @@ int main(int argc, char** argv) {
       }
     }
     return run_decode(path, options);
+  }
+  try {
+    if (*watch) return pmu::tools::run_watch(g, count);
+    if (app.got_subcommand("list")) return pmu::tools::run_list(g);
+    if (app.got_subcommand("info")) return pmu::tools::run_info(g);
+    if (app.got_subcommand("health")) return pmu::tools::run_health(g);
+    if (*config_get) return pmu::tools::run_config_get(g, parameter);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "pmuctl: %s\n", e.what());
+    return 2;
   }
   return 2;
 }

@@ -1,0 +1,27 @@
+#pragma once
+// Topic and QoS profile names of interface.md section 1, in one place for the service,
+// pmuctl and the tests.
+
+namespace pmu::topics {
+
+inline constexpr const char* kVoltages = "pmu/voltages";
+inline constexpr const char* kCurrents = "pmu/currents";
+inline constexpr const char* kBatteryEnergy = "pmu/battery_energy";
+inline constexpr const char* kTemperatures = "pmu/temperatures";
+inline constexpr const char* kStatus = "pmu/status";
+inline constexpr const char* kConfig = "pmu/config";
+inline constexpr const char* kInfo = "pmu/info";
+inline constexpr const char* kHealth = "pmu/health";
+inline constexpr const char* kCommand = "pmu/command";
+inline constexpr const char* kCommandReply = "pmu/command_reply";
+
+}  // namespace pmu::topics
+
+namespace pmu::qos_profiles {
+
+// deploy/qos.xml defines each as both a <data_writer> and a <data_reader> profile.
+inline constexpr const char* kTelemetry = "telemetry";
+inline constexpr const char* kState = "state";
+inline constexpr const char* kCommand = "command";
+
+}  // namespace pmu::qos_profiles

@@ -1,0 +1,83 @@
+#pragma once
+// BusWorker: one CAN bus and the PMUs on it, driven by one thread.
+//
+// Each wakeup drains every pending frame from the bus (transport contract), hands each to
+// the session of its address, then ticks every session (timeouts, polling, health). Work
+// from other threads (commands, shutdown) arrives through post(), which wakes the loop via
+// an eventfd, so sessions are only ever touched on the worker's thread.
+//
+// Discovery: when the bus config asks for it, a broadcast firmware request (0x31 to 0xFFFF)
+// is sent at start and every 10 s; every address that answers
+// gets a session with the bus's discovery settings. New units plugged in later are found
+// by the same periodic broadcast.
+
+#include <atomic>
+#include <chrono>
+#include <functional>
+#include <map>
+#include <memory>
+#include <mutex>
+#include <vector>
+
+#include "pmu/service/config.hpp"
+#include "pmu/service/device_session.hpp"
+#include "pmu/transport/can_bus.hpp"
+#include "pmu/transport/clock.hpp"
+#include "pmu/transport/unique_fd.hpp"
+
+namespace pmu::service {
+
+class BusWorker final : private transport::BusHandler {
+ public:
+  // Throws std::system_error when the wake fd or epoll cannot be created (start-up).
+  BusWorker(BusConfig config, std::unique_ptr<transport::CanBus> bus, const transport::Clock& clock,
+            const Timeouts& timeouts, StateSink& sink);
+  ~BusWorker();
+  BusWorker(const BusWorker&) = delete;
+  BusWorker& operator=(const BusWorker&) = delete;
+
+  // One turn of the loop: waits up to `max_wait` for the bus or posted work, then drains,
+  // runs posted work, ticks sessions and maintains the bus. Returns the number of frames.
+  std::size_t run_once(std::chrono::milliseconds max_wait);
+  // Runs turns until stop() is called (from any thread).
+  void run();
+  void stop();
+
+  // Runs `fn` on the worker's thread at its next turn. Thread-safe.
+  void post(std::function<void()> fn);
+
+  // Worker thread only (or before run()):
+  DeviceSession* session(std::uint16_t address);
+  std::vector<std::uint16_t> addresses() const;
+  const BusConfig& config() const noexcept { return config_; }
+  transport::CanBus& bus() noexcept { return *bus_; }
+
+  // Incremented every turn: the watchdog feeds only while this moves. Thread-safe.
+  std::uint64_t progress() const noexcept { return progress_.load(std::memory_order_relaxed); }
+
+ private:
+  void on_frame(const transport::ReceivedFrame& frame) override;
+  void on_event(const transport::BusEvent& event) override;
+  DeviceSession& add_session(const DeviceConfig& device);
+  void discover(std::chrono::steady_clock::time_point now);
+  void run_posted();
+
+  BusConfig config_;
+  std::unique_ptr<transport::CanBus> bus_;
+  const transport::Clock& clock_;
+  Timeouts timeouts_;
+  StateSink& sink_;
+  std::map<std::uint16_t, std::unique_ptr<DeviceSession>> sessions_;
+
+  transport::UniqueFd epoll_;
+  transport::UniqueFd wake_;
+  std::mutex posted_mutex_;
+  std::vector<std::function<void()>> posted_;
+  std::atomic<bool> stop_{false};
+  std::atomic<std::uint64_t> progress_{0};
+  std::chrono::steady_clock::time_point next_maintain_{};
+  std::chrono::steady_clock::time_point next_discovery_{};
+  std::uint64_t foreign_frames_ = 0;
+};
+
+}  // namespace pmu::service

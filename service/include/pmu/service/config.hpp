@@ -1,0 +1,81 @@
+#pragma once
+// pmu-service configuration: a YAML file (deploy/pmu-service.yaml documents every key)
+// with command-line overrides. Loading is start-up, so errors throw ConfigError whose
+// message is "FILE:LINE: what is wrong"; main prints it and exits non-zero before anything
+// is opened, so a bad config never sends a frame.
+
+#include <chrono>
+#include <cstdint>
+#include <optional>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace pmu::service {
+
+class ConfigError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+enum class TelemetryMode : std::uint8_t {
+  Streaming,  // the PMU streams what its PS selects every PP; the service listens
+  Polling,    // the service asks: 0x0F from firmware 1.14, single gets before
+};
+
+struct DeviceConfig {
+  std::uint16_t address = 1;
+  TelemetryMode mode = TelemetryMode::Streaming;
+  // Polling: the poll period. Streaming: the packet period expected (PP); with
+  // `configure_streaming` it is written to the PMU when the PMU's own PP differs.
+  std::chrono::milliseconds period{1000};
+  std::uint8_t groups = 0x1F;  // measurement groups: voltages(0) .. status(4)
+  // Streaming only: write PP and PS to the PMU when they differ from period/groups. Off by
+  // default: they live in the PMU's non-volatile memory and belong to whoever set it up.
+  bool configure_streaming = false;
+};
+
+struct BusConfig {
+  std::string name;       // the DDS key `bus`; at most 15 characters
+  std::string interface;  // SocketCAN interface, or "sim" for the built-in simulated PMU
+  std::uint32_t bitrate = 1000000;  // what the link runs at (checked against the firmware)
+  std::vector<DeviceConfig> devices;
+  bool discover = false;  // find PMUs by a broadcast firmware request at start
+  DeviceConfig discovered_defaults;  // settings for PMUs found by discovery
+  std::string source_line;           // "FILE:LINE" of the bus entry, for later messages
+};
+
+struct Timeouts {
+  std::chrono::milliseconds reply{250};     // wait for an answer to one get
+  unsigned retries = 2;                     // extra tries of an idempotent get
+  double stale_periods = 3;                 // no frame for this many periods -> STALE
+  double offline_periods = 10;              // -> OFFLINE (and re-read info/config on return)
+  std::chrono::milliseconds send{100};      // wait for room in the transmit queue
+};
+
+struct Config {
+  std::string source = "<defaults>";  // the file it came from
+  int domain = 0;
+  std::string qos_file;  // empty: the installed deploy/qos.xml, found by the service
+  std::string log_level = "info";
+  std::vector<BusConfig> buses;
+  Timeouts timeouts;
+};
+
+// Parses `path`. Throws ConfigError("path:line: ...") for every problem: unknown keys,
+// wrong types, values out of range, duplicate names/addresses.
+Config load_config(const std::string& path);
+// Parses YAML text; `source` names it in messages.
+Config parse_config(const std::string& text, const std::string& source);
+
+// What `pmu-service --bus sim` with no config runs: one simulated PMU at address 1 on a bus
+// named "sim0", streaming every packet every 0.5 s.
+Config default_sim_config();
+
+bool is_log_level(const std::string& level);
+
+// Applies `--bus sim|socketcan:IFACE`: replaces the buses with one bus on that interface
+// (keeping the devices of the first configured bus, if any). Throws ConfigError.
+void override_bus(Config& config, const std::string& spec);
+
+}  // namespace pmu::service

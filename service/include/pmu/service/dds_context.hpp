@@ -1,0 +1,59 @@
+#pragma once
+// DdsContext: one Fast DDS participant with the contract's topics and named QoS profiles
+// (deploy/qos.xml), shared by pmu-service, pmuctl and the tests so every program creates
+// entities the same way.
+//
+// Start-up only throws (DdsError: "cannot load QoS profiles from X", "cannot create
+// participant on domain N"); afterwards calls return null or a ReturnCode like Fast DDS.
+
+#include <fastdds/dds/domain/DomainParticipant.hpp>
+#include <fastdds/dds/publisher/DataWriter.hpp>
+#include <fastdds/dds/publisher/Publisher.hpp>
+#include <fastdds/dds/subscriber/DataReader.hpp>
+#include <fastdds/dds/subscriber/Subscriber.hpp>
+#include <fastdds/dds/topic/Topic.hpp>
+#include <fastdds/dds/topic/TypeSupport.hpp>
+#include <map>
+#include <stdexcept>
+#include <string>
+
+namespace pmu::dds {
+
+class DdsError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+// The installed qos.xml: $PMU_QOS_FILE, else /etc/pmu-dds/qos.xml, else the source tree's
+// deploy/qos.xml (for runs from a build directory). Empty when none exists.
+std::string default_qos_file();
+
+class DdsContext {
+ public:
+  DdsContext(int domain, const std::string& qos_file, const std::string& participant_name);
+  ~DdsContext();
+  DdsContext(const DdsContext&) = delete;
+  DdsContext& operator=(const DdsContext&) = delete;
+
+  eprosima::fastdds::dds::DomainParticipant& participant() { return *participant_; }
+  int domain() const noexcept { return domain_; }
+
+  // Registers the type (once) and creates the topic (once). `type` is e.g.
+  // new pmu::VoltagesPubSubType(). Throws DdsError at start-up when it fails.
+  eprosima::fastdds::dds::Topic& topic(const std::string& name, eprosima::fastdds::dds::TypeSupport type);
+
+  // A writer/reader with the named profile of qos.xml. Throws DdsError when it fails.
+  eprosima::fastdds::dds::DataWriter& writer(eprosima::fastdds::dds::Topic& topic, const std::string& profile,
+                                             eprosima::fastdds::dds::DataWriterListener* listener = nullptr);
+  eprosima::fastdds::dds::DataReader& reader(eprosima::fastdds::dds::Topic& topic, const std::string& profile,
+                                             eprosima::fastdds::dds::DataReaderListener* listener = nullptr);
+
+ private:
+  int domain_;
+  eprosima::fastdds::dds::DomainParticipant* participant_ = nullptr;
+  eprosima::fastdds::dds::Publisher* publisher_ = nullptr;
+  eprosima::fastdds::dds::Subscriber* subscriber_ = nullptr;
+  std::map<std::string, eprosima::fastdds::dds::Topic*> topics_;
+};
+
+}  // namespace pmu::dds

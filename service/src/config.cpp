@@ -1,0 +1,259 @@
+#include "pmu/service/config.hpp"
+
+#include <yaml-cpp/yaml.h>
+
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+#include <initializer_list>
+#include <set>
+#include <sstream>
+
+#include "pmu/codec/firmware.hpp"
+
+namespace pmu::service {
+namespace {
+
+constexpr std::size_t kMaxBusName = 15;  // the IDL key is string<15>; IFNAMSIZ - 1 too
+
+struct Ctx {
+  std::string source;
+
+  [[noreturn]] void fail(const YAML::Node& at, const std::string& what) const {
+    // yaml-cpp marks are 0-based; editors count from 1.
+    const int line = at.IsDefined() && at.Mark().line >= 0 ? at.Mark().line + 1 : 1;
+    throw ConfigError(source + ":" + std::to_string(line) + ": " + what);
+  }
+
+  void only_keys(const YAML::Node& map, const char* where, std::initializer_list<const char*> keys) const {
+    if (!map.IsMap()) fail(map, std::string(where) + " must be a mapping of key: value");
+    for (const auto& kv : map) {
+      const auto key = kv.first.as<std::string>();
+      if (std::none_of(keys.begin(), keys.end(), [&](const char* k) { return key == k; })) {
+        std::string known;
+        for (const char* k : keys) known += std::string(known.empty() ? "" : ", ") + k;
+        fail(kv.first, "unknown key '" + key + "' in " + where + " (known: " + known + ")");
+      }
+    }
+  }
+
+  template <class T>
+  T scalar(const YAML::Node& n, const char* name, const char* type) const {
+    if (!n.IsScalar()) fail(n, std::string(name) + " must be " + type);
+    try {
+      return n.as<T>();
+    } catch (const YAML::Exception&) {
+      fail(n, std::string(name) + " must be " + type + ", not '" + n.Scalar() + "'");
+    }
+  }
+
+  double number(const YAML::Node& n, const char* name, double lo, double hi) const {
+    const auto v = scalar<double>(n, name, "a number");
+    if (!std::isfinite(v) || v < lo || v > hi) {
+      std::ostringstream s;
+      s << name << " " << n.Scalar() << " out of range " << lo << ".." << hi;
+      fail(n, s.str());
+    }
+    return v;
+  }
+
+  long integer(const YAML::Node& n, const char* name, long lo, long hi) const {
+    const auto v = scalar<long>(n, name, "an integer");
+    if (v < lo || v > hi)
+      fail(n, std::string(name) + " " + n.Scalar() + " out of range " + std::to_string(lo) + ".." +
+                  std::to_string(hi));
+    return v;
+  }
+
+  std::string line_of(const YAML::Node& n) const { return source + ":" + std::to_string(n.Mark().line + 1); }
+};
+
+const char* const kGroupNames[] = {"voltages", "currents", "battery_energy", "temperatures", "status"};
+
+std::uint8_t parse_groups(const Ctx& c, const YAML::Node& n) {
+  if (!n.IsSequence()) c.fail(n, "packets must be a list, e.g. [voltages, status]");
+  std::uint8_t mask = 0;
+  for (const auto& item : n) {
+    const auto name = c.scalar<std::string>(item, "packet", "a name");
+    const auto* it = std::find(std::begin(kGroupNames), std::end(kGroupNames), name);
+    if (it == std::end(kGroupNames))
+      c.fail(item, "unknown packet '" + name +
+                       "' (known: voltages, currents, battery_energy, temperatures, status)");
+    mask = static_cast<std::uint8_t>(mask | (1u << (it - std::begin(kGroupNames))));
+  }
+  if (mask == 0) c.fail(n, "packets must name at least one packet");
+  return mask;
+}
+
+std::chrono::milliseconds period_of(const Ctx& c, const YAML::Node& n, const char* name) {
+  // PP is 0.1..25.5 s in 0.1 s steps (protocol table 12); a poll period follows the same rule.
+  const double s = c.number(n, name, 0.1, 25.5);
+  const double tenths = s * 10;
+  if (std::fabs(tenths - std::round(tenths)) > 1e-6) c.fail(n, std::string(name) + " must be a multiple of 0.1 s");
+  return std::chrono::milliseconds(std::lround(tenths) * 100);
+}
+
+void parse_device_settings(const Ctx& c, const YAML::Node& n, DeviceConfig& d) {
+  if (const auto m = n["mode"]) {
+    const auto mode = c.scalar<std::string>(m, "mode", "streaming or polling");
+    if (mode == "streaming")
+      d.mode = TelemetryMode::Streaming;
+    else if (mode == "polling")
+      d.mode = TelemetryMode::Polling;
+    else
+      c.fail(m, "mode must be streaming or polling, not '" + mode + "'");
+  }
+  if (const auto p = n["period"]) d.period = period_of(c, p, "period");
+  if (const auto p = n["packets"]) d.groups = parse_groups(c, p);
+  if (const auto p = n["configure_streaming"]) d.configure_streaming = c.scalar<bool>(p, "configure_streaming", "true or false");
+}
+
+DeviceConfig parse_device(const Ctx& c, const YAML::Node& n) {
+  c.only_keys(n, "device", {"address", "mode", "period", "packets", "configure_streaming"});
+  DeviceConfig d;
+  const auto a = n["address"];
+  if (!a) c.fail(n, "device needs an address (0..65534)");
+  d.address = static_cast<std::uint16_t>(c.integer(a, "address", 0, 65534));
+  parse_device_settings(c, n, d);
+  return d;
+}
+
+BusConfig parse_bus(const Ctx& c, const YAML::Node& n) {
+  c.only_keys(n, "bus", {"name", "interface", "bitrate", "devices", "discover"});
+  BusConfig b;
+  b.source_line = c.line_of(n);
+  const auto iface = n["interface"];
+  if (!iface) c.fail(n, "bus needs an interface (a SocketCAN interface such as can0, or sim)");
+  b.interface = c.scalar<std::string>(iface, "interface", "a name");
+  if (b.interface.empty() || b.interface.size() > kMaxBusName || b.interface.find('/') != std::string::npos)
+    c.fail(iface, "interface '" + b.interface + "' is not a valid interface name (1..15 characters, no '/')");
+  b.name = b.interface;
+  if (const auto name = n["name"]) {
+    b.name = c.scalar<std::string>(name, "name", "a name");
+    if (b.name.empty() || b.name.size() > kMaxBusName)
+      c.fail(name, "bus name '" + b.name + "' must be 1..15 characters (it is a DDS key)");
+  }
+  if (const auto r = n["bitrate"]) {
+    b.bitrate = static_cast<std::uint32_t>(c.integer(r, "bitrate", 1, 1000000));
+    if (!codec::supports_bitrate(std::nullopt, b.bitrate))
+      c.fail(r, "bitrate " + r.Scalar() + " is not one the PMU supports (125000, 250000, 500000, 1000000)");
+  }
+  if (const auto d = n["discover"]) {
+    if (d.IsScalar()) {
+      b.discover = c.scalar<bool>(d, "discover", "true, false or a mapping of device settings");
+    } else {
+      c.only_keys(d, "discover", {"mode", "period", "packets", "configure_streaming"});
+      b.discover = true;
+      parse_device_settings(c, d, b.discovered_defaults);
+    }
+  }
+  if (const auto devs = n["devices"]) {
+    if (!devs.IsSequence()) c.fail(devs, "devices must be a list");
+    std::set<std::uint16_t> seen;
+    for (const auto& dn : devs) {
+      DeviceConfig d = parse_device(c, dn);
+      if (!seen.insert(d.address).second)
+        c.fail(dn, "address " + std::to_string(d.address) + " appears twice on bus " + b.name);
+      b.devices.push_back(d);
+    }
+  }
+  if (b.devices.empty() && !b.discover) c.fail(n, "bus " + b.name + " has no devices and discover is off");
+  return b;
+}
+
+void parse_timeouts(const Ctx& c, const YAML::Node& n, Timeouts& t) {
+  c.only_keys(n, "timeouts", {"reply", "retries", "stale_periods", "offline_periods", "send"});
+  if (const auto v = n["reply"]) t.reply = std::chrono::milliseconds(std::lround(c.number(v, "reply", 0.01, 10) * 1000));
+  if (const auto v = n["retries"]) t.retries = static_cast<unsigned>(c.integer(v, "retries", 0, 10));
+  if (const auto v = n["stale_periods"]) t.stale_periods = c.number(v, "stale_periods", 1.5, 100);
+  if (const auto v = n["offline_periods"]) t.offline_periods = c.number(v, "offline_periods", 2, 1000);
+  if (const auto v = n["send"]) t.send = std::chrono::milliseconds(std::lround(c.number(v, "send", 0, 5) * 1000));
+  if (t.offline_periods <= t.stale_periods)
+    c.fail(n["offline_periods"] ? n["offline_periods"] : n, "offline_periods must be greater than stale_periods");
+}
+
+const char* const kLogLevels[] = {"trace", "debug", "info", "warn", "error", "critical", "off"};
+
+}  // namespace
+
+bool is_log_level(const std::string& level) {
+  return std::find(std::begin(kLogLevels), std::end(kLogLevels), level) != std::end(kLogLevels);
+}
+
+Config parse_config(const std::string& text, const std::string& source) {
+  const Ctx c{source};
+  YAML::Node root;
+  try {
+    root = YAML::Load(text);
+  } catch (const YAML::ParserException& e) {
+    throw ConfigError(source + ":" + std::to_string(e.mark.line + 1) + ": YAML syntax error: " + e.msg);
+  }
+  Config cfg;
+  cfg.source = source;
+  if (root.IsNull()) throw ConfigError(source + ":1: the file is empty");
+  c.only_keys(root, "the top level", {"domain", "qos_file", "log_level", "buses", "timeouts"});
+  if (const auto v = root["domain"]) cfg.domain = static_cast<int>(c.integer(v, "domain", 0, 232));
+  if (const auto v = root["qos_file"]) cfg.qos_file = c.scalar<std::string>(v, "qos_file", "a path");
+  if (const auto v = root["log_level"]) {
+    cfg.log_level = c.scalar<std::string>(v, "log_level", "a level");
+    if (!is_log_level(cfg.log_level))
+      c.fail(v, "log_level '" + cfg.log_level + "' is not one of trace, debug, info, warn, error, critical, off");
+  }
+  if (const auto v = root["timeouts"]) parse_timeouts(c, v, cfg.timeouts);
+  const auto buses = root["buses"];
+  if (!buses) c.fail(root, "no buses: the service needs at least one bus");
+  if (!buses.IsSequence() || buses.size() == 0) c.fail(buses, "buses must be a non-empty list");
+  std::set<std::string> names, interfaces;
+  for (const auto& bn : buses) {
+    BusConfig b = parse_bus(c, bn);
+    if (!names.insert(b.name).second) c.fail(bn, "bus name '" + b.name + "' appears twice");
+    if (b.interface != "sim" && !interfaces.insert(b.interface).second)
+      c.fail(bn, "interface '" + b.interface + "' is used by two buses (the service owns each bus alone)");
+    cfg.buses.push_back(std::move(b));
+  }
+  return cfg;
+}
+
+Config load_config(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw ConfigError(path + ": cannot open the config file");
+  std::stringstream text;
+  text << in.rdbuf();
+  if (in.bad()) throw ConfigError(path + ": cannot read the config file");
+  return parse_config(text.str(), path);
+}
+
+Config default_sim_config() {
+  Config cfg;
+  cfg.source = "<built-in simulator>";
+  BusConfig b;
+  b.name = "sim0";
+  b.interface = "sim";
+  b.source_line = cfg.source;
+  DeviceConfig d;
+  d.address = 1;
+  d.period = std::chrono::milliseconds(500);
+  b.devices.push_back(d);
+  cfg.buses.push_back(b);
+  return cfg;
+}
+
+void override_bus(Config& config, const std::string& spec) {
+  std::string iface;
+  if (spec == "sim") {
+    iface = "sim";
+  } else if (spec.rfind("socketcan:", 0) == 0) {
+    iface = spec.substr(10);
+    if (iface.empty() || iface.size() > kMaxBusName || iface == "sim")
+      throw ConfigError("--bus " + spec + ": '" + iface + "' is not a valid interface name");
+  } else {
+    throw ConfigError("--bus " + spec + ": expected sim or socketcan:IFACE");
+  }
+  BusConfig b = config.buses.empty() ? default_sim_config().buses.front() : config.buses.front();
+  b.interface = iface;
+  b.name = iface == "sim" ? "sim0" : iface;
+  b.source_line = "--bus " + spec;
+  config.buses.assign(1, b);
+}
+
+}  // namespace pmu::service

@@ -1,0 +1,82 @@
+#include "pmu/service/dds_context.hpp"
+
+#include <fastdds/dds/domain/DomainParticipantFactory.hpp>
+#include <cstdlib>
+#include <fstream>
+#include <mutex>
+
+namespace pmu::dds {
+namespace {
+
+using namespace eprosima::fastdds::dds;
+
+bool readable(const std::string& path) { return std::ifstream(path).good(); }
+
+// Fast DDS keeps loaded profiles in a process-wide registry: load each file once.
+void load_profiles_once(const std::string& file) {
+  static std::mutex mutex;
+  static std::map<std::string, bool> loaded;
+  std::lock_guard<std::mutex> lock(mutex);
+  if (loaded[file]) return;
+  if (!readable(file)) throw DdsError("QoS profile file " + file + " cannot be read");
+  if (DomainParticipantFactory::get_instance()->load_XML_profiles_file(file) != ReturnCode_t::RETCODE_OK)
+    throw DdsError("cannot load QoS profiles from " + file + " (see the Fast DDS XML error above)");
+  loaded[file] = true;
+}
+
+}  // namespace
+
+std::string default_qos_file() {
+  if (const char* env = std::getenv("PMU_QOS_FILE"); env && *env) return env;
+  for (const char* p : {"/etc/pmu-dds/qos.xml", PMU_SOURCE_QOS_FILE})
+    if (readable(p)) return p;
+  return {};
+}
+
+DdsContext::DdsContext(int domain, const std::string& qos_file, const std::string& participant_name)
+    : domain_(domain) {
+  const std::string file = qos_file.empty() ? default_qos_file() : qos_file;
+  if (file.empty()) throw DdsError("no QoS profile file: install deploy/qos.xml as /etc/pmu-dds/qos.xml or set qos_file");
+  load_profiles_once(file);
+  DomainParticipantQos pqos = PARTICIPANT_QOS_DEFAULT;
+  pqos.name(participant_name);
+  participant_ = DomainParticipantFactory::get_instance()->create_participant(static_cast<DomainId_t>(domain), pqos);
+  if (!participant_) throw DdsError("cannot create a DDS participant on domain " + std::to_string(domain));
+  publisher_ = participant_->create_publisher(PUBLISHER_QOS_DEFAULT);
+  subscriber_ = participant_->create_subscriber(SUBSCRIBER_QOS_DEFAULT);
+  if (!publisher_ || !subscriber_) {
+    DomainParticipantFactory::get_instance()->delete_participant(participant_);
+    throw DdsError("cannot create a DDS publisher/subscriber on domain " + std::to_string(domain));
+  }
+}
+
+DdsContext::~DdsContext() {
+  if (!participant_) return;
+  participant_->delete_contained_entities();
+  DomainParticipantFactory::get_instance()->delete_participant(participant_);
+}
+
+Topic& DdsContext::topic(const std::string& name, TypeSupport type) {
+  if (auto it = topics_.find(name); it != topics_.end()) return *it->second;
+  const std::string type_name = type.get_type_name();
+  if (type.register_type(participant_) != ReturnCode_t::RETCODE_OK)
+    throw DdsError("cannot register DDS type " + type_name);
+  Topic* t = participant_->create_topic(name, type_name, TOPIC_QOS_DEFAULT);
+  if (!t) throw DdsError("cannot create DDS topic " + name);
+  topics_[name] = t;
+  return *t;
+}
+
+DataWriter& DdsContext::writer(Topic& topic, const std::string& profile, DataWriterListener* listener) {
+  DataWriter* w = publisher_->create_datawriter_with_profile(&topic, profile, listener);
+  if (!w) throw DdsError("cannot create a writer for " + topic.get_name() + " with QoS profile '" + profile + "'");
+  return *w;
+}
+
+DataReader& DdsContext::reader(Topic& topic, const std::string& profile, DataReaderListener* listener) {
+  DataReader* r = subscriber_->create_datareader_with_profile(&topic, profile, listener);
+  if (!r) throw DdsError("cannot create a reader for " + topic.get_name() + " with QoS profile '" + profile + "'");
+  return *r;
+}
+
+}  // namespace pmu::dds

@@ -1,0 +1,131 @@
+// pmu-service configuration: every bad value is refused with FILE:LINE and what is wrong.
+#include <gtest/gtest.h>
+
+#include "pmu/service/config.hpp"
+
+namespace pmu::service {
+namespace {
+
+const char* const kGood = R"(domain: 7
+log_level: debug
+timeouts:
+  reply: 0.3
+  retries: 1
+buses:
+  - name: main
+    interface: can0
+    bitrate: 500000
+    devices:
+      - address: 1
+      - address: 2
+        mode: polling
+        period: 0.2
+        packets: [voltages, status]
+    discover: true
+)";
+
+TEST(Config, GoodFileParses) {
+  const Config c = parse_config(kGood, "good.yaml");
+  EXPECT_EQ(c.domain, 7);
+  EXPECT_EQ(c.log_level, "debug");
+  EXPECT_EQ(c.timeouts.reply, std::chrono::milliseconds(300));
+  EXPECT_EQ(c.timeouts.retries, 1u);
+  ASSERT_EQ(c.buses.size(), 1u);
+  const BusConfig& b = c.buses[0];
+  EXPECT_EQ(b.name, "main");
+  EXPECT_EQ(b.interface, "can0");
+  EXPECT_EQ(b.bitrate, 500000u);
+  EXPECT_TRUE(b.discover);
+  ASSERT_EQ(b.devices.size(), 2u);
+  EXPECT_EQ(b.devices[0].mode, TelemetryMode::Streaming);
+  EXPECT_EQ(b.devices[1].mode, TelemetryMode::Polling);
+  EXPECT_EQ(b.devices[1].period, std::chrono::milliseconds(200));
+  EXPECT_EQ(b.devices[1].groups, 0x11);
+  EXPECT_EQ(b.source_line, "good.yaml:7");
+}
+
+struct BadCase {
+  const char* yaml;
+  const char* message;  // the whole "FILE:LINE: ..." text
+};
+
+const BadCase kBad[] = {
+    {"", "bad.yaml:1: the file is empty"},
+    {"buses: [\n", "bad.yaml:2: YAML syntax error: end of sequence flow not found"},
+    {"domain: 0\n", "bad.yaml:1: no buses: the service needs at least one bus"},
+    {"domian: 0\nbuses: []\n",
+     "bad.yaml:1: unknown key 'domian' in the top level (known: domain, qos_file, log_level, buses, timeouts)"},
+    {"domain: 300\nbuses: []\n", "bad.yaml:1: domain 300 out of range 0..232"},
+    {"domain: x\nbuses: []\n", "bad.yaml:1: domain must be an integer, not 'x'"},
+    {"buses: []\n", "bad.yaml:1: buses must be a non-empty list"},
+    {"buses:\n  - name: a\n", "bad.yaml:2: bus needs an interface (a SocketCAN interface such as can0, or sim)"},
+    {"buses:\n  - interface: can0\n", "bad.yaml:2: bus can0 has no devices and discover is off"},
+    {"buses:\n  - interface: can0\n    devices:\n      - adress: 1\n",
+     "bad.yaml:4: unknown key 'adress' in device (known: address, mode, period, packets, configure_streaming)"},
+    {"buses:\n  - interface: can0\n    devices:\n      - address: 65535\n",
+     "bad.yaml:4: address 65535 out of range 0..65534"},
+    {"buses:\n  - interface: can0\n    devices:\n      - address: 1\n      - address: 1\n",
+     "bad.yaml:5: address 1 appears twice on bus can0"},
+    {"buses:\n  - interface: can0\n    devices:\n      - address: 1\n        mode: push\n",
+     "bad.yaml:5: mode must be streaming or polling, not 'push'"},
+    {"buses:\n  - interface: can0\n    devices:\n      - address: 1\n        period: 30\n",
+     "bad.yaml:5: period 30 out of range 0.1..25.5"},
+    {"buses:\n  - interface: can0\n    devices:\n      - address: 1\n        period: 0.25\n",
+     "bad.yaml:5: period must be a multiple of 0.1 s"},
+    {"buses:\n  - interface: can0\n    devices:\n      - address: 1\n        packets: [volts]\n",
+     "bad.yaml:5: unknown packet 'volts' (known: voltages, currents, battery_energy, temperatures, status)"},
+    {"buses:\n  - interface: can0\n    bitrate: 800000\n    discover: true\n",
+     "bad.yaml:3: bitrate 800000 is not one the PMU supports (125000, 250000, 500000, 1000000)"},
+    {"buses:\n  - interface: averyveryverylongname\n    discover: true\n",
+     "bad.yaml:2: interface 'averyveryverylongname' is not a valid interface name (1..15 characters, no '/')"},
+    {"buses:\n  - interface: can0\n    discover: true\n  - interface: can0\n    name: other\n    discover: true\n",
+     "bad.yaml:4: interface 'can0' is used by two buses (the service owns each bus alone)"},
+    {"buses:\n  - interface: can0\n    discover: true\n  - interface: can1\n    name: can0\n    discover: true\n",
+     "bad.yaml:4: bus name 'can0' appears twice"},
+    {"log_level: loud\nbuses:\n  - interface: can0\n    discover: true\n",
+     "bad.yaml:1: log_level 'loud' is not one of trace, debug, info, warn, error, critical, off"},
+    {"timeouts:\n  stale_periods: 5\n  offline_periods: 4\nbuses:\n  - interface: can0\n    discover: true\n",
+     "bad.yaml:3: offline_periods must be greater than stale_periods"},
+    {"timeouts:\n  reply: 0\nbuses:\n  - interface: can0\n    discover: true\n",
+     "bad.yaml:2: reply 0 out of range 0.01..10"},
+};
+
+TEST(Config, EveryBadValueIsRefusedWithItsLine) {
+  for (const auto& c : kBad) {
+    SCOPED_TRACE(c.yaml);
+    try {
+      (void)parse_config(c.yaml, "bad.yaml");
+      ADD_FAILURE() << "accepted";
+    } catch (const ConfigError& e) {
+      EXPECT_EQ(std::string(e.what()), c.message);
+    }
+  }
+}
+
+TEST(Config, MissingFileSaysSo) {
+  try {
+    (void)load_config("/nonexistent/pmu.yaml");
+    ADD_FAILURE() << "accepted";
+  } catch (const ConfigError& e) {
+    EXPECT_EQ(std::string(e.what()), "/nonexistent/pmu.yaml: cannot open the config file");
+  }
+}
+
+TEST(Config, BusOverride) {
+  Config c = parse_config(kGood, "good.yaml");
+  override_bus(c, "socketcan:vcan0");
+  ASSERT_EQ(c.buses.size(), 1u);
+  EXPECT_EQ(c.buses[0].interface, "vcan0");
+  EXPECT_EQ(c.buses[0].name, "vcan0");
+  EXPECT_EQ(c.buses[0].devices.size(), 2u) << "devices of the first bus are kept";
+  override_bus(c, "sim");
+  EXPECT_EQ(c.buses[0].interface, "sim");
+  EXPECT_THROW(override_bus(c, "can0"), ConfigError);
+  EXPECT_THROW(override_bus(c, "socketcan:"), ConfigError);
+  const Config d = default_sim_config();
+  ASSERT_EQ(d.buses.size(), 1u);
+  EXPECT_EQ(d.buses[0].devices.at(0).address, 1);
+}
+
+}  // namespace
+}  // namespace pmu::service

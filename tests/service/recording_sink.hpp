@@ -1,0 +1,42 @@
+#pragma once
+// A StateSink that keeps everything the service would have published.
+
+#include <chrono>
+#include <vector>
+
+#include "pmu/service/device_state.hpp"
+
+namespace pmu::service::test {
+
+class RecordingSink final : public StateSink {
+ public:
+  struct Telemetry {
+    DeviceKey key;
+    codec::PmuMessage message;
+    std::chrono::system_clock::time_point received;
+  };
+  void on_telemetry(const DeviceKey& k, const codec::PmuMessage& m, std::chrono::system_clock::time_point t) override {
+    telemetry.push_back({k, m, t});
+  }
+  void on_config(const DeviceKey& k, const ConfigState& c) override { configs.push_back({k, c}); }
+  void on_info(const DeviceKey& k, const InfoState& i) override { infos.push_back({k, i}); }
+  void on_health(const DeviceKey& k, const HealthReport& h) override { healths.push_back({k, h}); }
+
+  std::size_t count(codec::PacketId p, std::uint16_t address) const {
+    std::size_t n = 0;
+    for (const auto& t : telemetry) n += (t.message.packet == p && t.key.address == address) ? 1 : 0;
+    return n;
+  }
+  const HealthReport* last_health(std::uint16_t address) const {
+    for (auto it = healths.rbegin(); it != healths.rend(); ++it)
+      if (it->first.address == address) return &it->second;
+    return nullptr;
+  }
+
+  std::vector<Telemetry> telemetry;
+  std::vector<std::pair<DeviceKey, ConfigState>> configs;
+  std::vector<std::pair<DeviceKey, InfoState>> infos;
+  std::vector<std::pair<DeviceKey, HealthReport>> healths;
+};
+
+}  // namespace pmu::service::test

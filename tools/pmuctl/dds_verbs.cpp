@@ -1,0 +1,290 @@
+#include "pmuctl/dds_verbs.hpp"
+
+#include <unistd.h>
+
+#include <atomic>
+#include <chrono>
+#include <csignal>
+#include <cstdio>
+#include <fastdds/dds/core/status/SubscriptionMatchedStatus.hpp>
+#include <fastdds/dds/subscriber/SampleInfo.hpp>
+#include <map>
+#include <thread>
+#include <vector>
+
+#include "pmu/codec/parameters.hpp"
+#include "pmu/idl/commandPubSubTypes.h"
+#include "pmu/idl/statePubSubTypes.h"
+#include "pmu/idl/telemetryPubSubTypes.h"
+#include "pmu/idl/topics.hpp"
+#include "pmu/service/dds_context.hpp"
+#include "pmuctl/dds_json.hpp"
+
+namespace pmu::tools {
+namespace {
+
+using namespace eprosima::fastdds::dds;
+using Clock = std::chrono::steady_clock;
+
+std::atomic<bool> g_interrupted{false};
+extern "C" void on_interrupt(int) { g_interrupted = true; }
+
+double seconds_of(const eprosima::fastrtps::rtps::Time_t& t) { return t.seconds() + t.nanosec() / 1e9; }
+
+template <class T>
+bool selected(const GlobalOptions& o, const T& s) {
+  return (o.bus.empty() || o.bus == s.bus().to_string()) && (!o.address || *o.address == s.address());
+}
+
+std::string device_name(const GlobalOptions& o) {
+  std::string d = o.address ? "device " + std::to_string(*o.address) : std::string("any device");
+  return d + (o.bus.empty() ? std::string() : " on " + o.bus);
+}
+
+// Reads every sample of one state topic (TRANSIENT_LOCAL: the service's current values
+// arrive at once) and keeps the latest per device.
+template <class T, class PubSub>
+class StateCollector {
+ public:
+  StateCollector(pmu::dds::DdsContext& dds, const char* topic)
+      : reader_(dds.reader(dds.topic(topic, TypeSupport(new PubSub())), qos_profiles::kState)) {}
+
+  void poll(const GlobalOptions& o) {
+    T sample;
+    SampleInfo info;
+    while (reader_.take_next_sample(&sample, &info) == ReturnCode_t::RETCODE_OK) {
+      if (!info.valid_data || !selected(o, sample)) continue;
+      latest_[{sample.bus().to_string(), sample.address()}] = sample;
+    }
+  }
+  bool matched() {
+    SubscriptionMatchedStatus st;
+    reader_.get_subscription_matched_status(st);
+    return st.current_count > 0;
+  }
+  const std::map<std::pair<std::string, std::uint16_t>, T>& latest() const { return latest_; }
+
+ private:
+  DataReader& reader_;
+  std::map<std::pair<std::string, std::uint16_t>, T> latest_;
+};
+
+// Waits for the state of the selected devices: returns once samples arrived and a short
+// settle time passed (other devices' samples come in the same burst), or at the timeout.
+template <class Collector>
+int collect(const GlobalOptions& o, Collector& c, double default_timeout) {
+  const auto deadline = Clock::now() + std::chrono::duration<double>(o.timeout.value_or(default_timeout));
+  std::optional<Clock::time_point> settle;
+  while (Clock::now() < deadline && !g_interrupted) {
+    c.poll(o);
+    if (!c.latest().empty() && !settle) settle = Clock::now() + std::chrono::milliseconds(300);
+    if (settle && Clock::now() >= *settle) break;
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+  if (!c.latest().empty()) return 0;
+  if (!c.matched())
+    std::fprintf(stderr, "pmuctl: no pmu-service on domain %d\n", o.domain);
+  else
+    std::fprintf(stderr, "pmuctl: %s not seen%s\n",
+                 o.address ? ("device " + std::to_string(*o.address)).c_str() : "no device",
+                 o.bus.empty() ? "" : (" on " + o.bus).c_str());
+  return 1;
+}
+
+void print_json(const char* topic, const std::string& bus, std::uint16_t address, const Json& values,
+                std::optional<double> time = std::nullopt) {
+  Json j;
+  j["topic"] = topic;
+  j["bus"] = bus;
+  j["address"] = address;
+  if (time) j["time"] = *time;
+  j["values"] = values;
+  std::printf("%s\n", j.dump().c_str());
+}
+
+std::string text(const Json& v) {
+  if (v.is_null()) return "none";
+  if (v.is_boolean()) return v.get<bool>() ? "yes" : "no";
+  if (v.is_string()) return v.get<std::string>();
+  return v.dump();
+}
+
+void print_table(const std::string& bus, std::uint16_t address, const Json& values) {
+  std::printf("%s/%u\n", bus.c_str(), address);
+  for (auto it = values.begin(); it != values.end(); ++it)
+    std::printf("  %-24s %s\n", it.key().c_str(), text(it.value()).c_str());
+}
+
+template <class Collector>
+int print_state(const GlobalOptions& o, Collector& c, const char* topic) {
+  if (int rc = collect(o, c, 3.0)) return rc;
+  for (const auto& [key, s] : c.latest()) {
+    if (o.json)
+      print_json(topic, key.first, key.second, values_of(s));
+    else
+      print_table(key.first, key.second, values_of(s));
+  }
+  return 0;
+}
+
+// ---- watch --------------------------------------------------------------------------------
+
+struct TelemetryLine {
+  std::string topic;
+  std::string bus;
+  std::uint16_t address;
+  double time;
+  Json values;
+};
+
+class TelemetryReader {
+ public:
+  virtual ~TelemetryReader() = default;
+  virtual bool take(const GlobalOptions& o, TelemetryLine& out) = 0;
+};
+
+template <class T, class PubSub>
+class TypedTelemetryReader final : public TelemetryReader {
+ public:
+  TypedTelemetryReader(pmu::dds::DdsContext& dds, const char* topic)
+      : name_(std::string(topic).substr(4)),
+        reader_(dds.reader(dds.topic(topic, TypeSupport(new PubSub())), qos_profiles::kTelemetry)) {}
+  bool take(const GlobalOptions& o, TelemetryLine& out) override {
+    T sample;
+    SampleInfo info;
+    while (reader_.take_next_sample(&sample, &info) == ReturnCode_t::RETCODE_OK) {
+      if (!info.valid_data || !selected(o, sample)) continue;
+      out = {name_, sample.bus().to_string(), sample.address(), seconds_of(info.source_timestamp), values_of(sample)};
+      return true;
+    }
+    return false;
+  }
+
+ private:
+  std::string name_;
+  DataReader& reader_;
+};
+
+}  // namespace
+
+int run_watch(const GlobalOptions& o, long count) {
+  std::signal(SIGINT, on_interrupt);
+  std::signal(SIGTERM, on_interrupt);
+  pmu::dds::DdsContext dds(o.domain, o.qos_file, "pmuctl");
+  std::vector<std::unique_ptr<TelemetryReader>> readers;
+  readers.push_back(std::make_unique<TypedTelemetryReader<pmu::Voltages, pmu::VoltagesPubSubType>>(dds, topics::kVoltages));
+  readers.push_back(std::make_unique<TypedTelemetryReader<pmu::Currents, pmu::CurrentsPubSubType>>(dds, topics::kCurrents));
+  readers.push_back(std::make_unique<TypedTelemetryReader<pmu::BatteryEnergy, pmu::BatteryEnergyPubSubType>>(
+      dds, topics::kBatteryEnergy));
+  readers.push_back(
+      std::make_unique<TypedTelemetryReader<pmu::Temperatures, pmu::TemperaturesPubSubType>>(dds, topics::kTemperatures));
+  readers.push_back(std::make_unique<TypedTelemetryReader<pmu::Status, pmu::StatusPubSubType>>(dds, topics::kStatus));
+
+  const bool refresh = !o.json && isatty(STDOUT_FILENO);
+  const auto deadline = o.timeout ? Clock::now() + std::chrono::duration<double>(*o.timeout) : Clock::time_point::max();
+  std::map<std::tuple<std::string, std::uint16_t, std::string>, TelemetryLine> latest;
+  long seen = 0;
+  auto next_draw = Clock::now();
+  while (!g_interrupted && Clock::now() < deadline && (count <= 0 || seen < count)) {
+    bool any = false;
+    TelemetryLine line;
+    for (auto& r : readers) {
+      while ((count <= 0 || seen < count) && r->take(o, line)) {
+        any = true;
+        ++seen;
+        if (o.json) {
+          print_json(line.topic.c_str(), line.bus, line.address, line.values, line.time);
+        } else if (!refresh) {
+          std::string row;
+          for (auto it = line.values.begin(); it != line.values.end(); ++it)
+            row += " " + it.key() + "=" + text(it.value());
+          std::printf("%.6f %s/%u %s%s\n", line.time, line.bus.c_str(), line.address, line.topic.c_str(), row.c_str());
+        }
+        latest[{line.bus, line.address, line.topic}] = line;
+      }
+    }
+    if (any) std::fflush(stdout);
+    if (refresh && Clock::now() >= next_draw) {
+      next_draw = Clock::now() + std::chrono::milliseconds(500);
+      std::printf("\033[H\033[2J");  // home + clear: a refreshing table
+      std::printf("pmuctl watch — domain %d — %ld samples (Ctrl-C to stop)\n\n", o.domain, seen);
+      for (const auto& [key, l] : latest) {
+        std::printf("%s/%u %-15s", l.bus.c_str(), l.address, l.topic.c_str());
+        for (auto it = l.values.begin(); it != l.values.end(); ++it)
+          std::printf(" %s=%s", it.key().c_str(), text(it.value()).c_str());
+        std::printf("\n");
+      }
+      std::fflush(stdout);
+    }
+    if (!any) std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+  if (seen == 0) {
+    std::fprintf(stderr, "pmuctl: no telemetry received from %s on domain %d\n", device_name(o).c_str(), o.domain);
+    return 1;
+  }
+  return count > 0 && seen < count ? 1 : 0;
+}
+
+int run_list(const GlobalOptions& o) {
+  pmu::dds::DdsContext dds(o.domain, o.qos_file, "pmuctl");
+  StateCollector<pmu::Health, pmu::HealthPubSubType> health(dds, topics::kHealth);
+  StateCollector<pmu::DeviceInfo, pmu::DeviceInfoPubSubType> info(dds, topics::kInfo);
+  if (int rc = collect(o, health, 3.0)) return rc;
+  info.poll(o);
+  if (!o.json) std::printf("%-15s %7s %8s %8s %-9s %-6s %s\n", "BUS", "ADDRESS", "SERIAL", "FIRMWARE", "STATE", "BUS", "LAST FRAME");
+  for (const auto& [key, h] : health.latest()) {
+    const auto it = info.latest().find(key);
+    std::string fw = "-", serial = "-";
+    if (it != info.latest().end()) {
+      fw = std::to_string(it->second.firmware_major()) + "." + std::to_string(it->second.firmware_minor());
+      serial = std::to_string(it->second.serial_number());
+    }
+    if (o.json) {
+      Json j = values_of(h);
+      j["serial_number"] = it != info.latest().end() ? Json(it->second.serial_number()) : Json(nullptr);
+      j["firmware"] = it != info.latest().end() ? Json(fw) : Json(nullptr);
+      print_json("list", key.first, key.second, j);
+    } else {
+      char age[32];
+      std::snprintf(age, sizeof age, h.last_frame_age() < 0 ? "never" : "%.1f s ago",
+                    static_cast<double>(h.last_frame_age()));
+      std::printf("%-15s %7u %8s %8s %-9s %-6s %s\n", key.first.c_str(), key.second, serial.c_str(), fw.c_str(),
+                  to_string(h.state()), to_string(h.bus_state()), age);
+    }
+  }
+  return 0;
+}
+
+int run_info(const GlobalOptions& o) {
+  pmu::dds::DdsContext dds(o.domain, o.qos_file, "pmuctl");
+  StateCollector<pmu::DeviceInfo, pmu::DeviceInfoPubSubType> c(dds, topics::kInfo);
+  return print_state(o, c, "info");
+}
+
+int run_health(const GlobalOptions& o) {
+  pmu::dds::DdsContext dds(o.domain, o.qos_file, "pmuctl");
+  StateCollector<pmu::Health, pmu::HealthPubSubType> c(dds, topics::kHealth);
+  return print_state(o, c, "health");
+}
+
+int run_config_get(const GlobalOptions& o, const std::string& parameter) {
+  if (!parameter.empty() && !codec::parameter_from_name(parameter) && parameter != "outputs" &&
+      parameter != "generation_enabled") {
+    std::fprintf(stderr, "pmuctl: unknown parameter '%s'\n", parameter.c_str());
+    return 2;
+  }
+  pmu::dds::DdsContext dds(o.domain, o.qos_file, "pmuctl");
+  StateCollector<pmu::Config, pmu::ConfigPubSubType> c(dds, topics::kConfig);
+  if (parameter.empty()) return print_state(o, c, "config");
+  if (int rc = collect(o, c, 3.0)) return rc;
+  for (const auto& [key, s] : c.latest()) {
+    const Json v = values_of(s)[parameter];
+    if (o.json)
+      print_json("config", key.first, key.second, Json{{parameter, v}});
+    else
+      std::printf("%s/%u %s = %s\n", key.first.c_str(), key.second, parameter.c_str(), text(v).c_str());
+  }
+  return 0;
+}
+
+}  // namespace pmu::tools

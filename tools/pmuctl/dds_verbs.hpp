@@ -1,0 +1,27 @@
+#pragma once
+// pmuctl's DDS verbs (interface.md section 2): watch, list, info, health, config get.
+// Each returns the process exit status; messages a person can act on go to stderr
+// ("no pmu-service on domain 0", "device 7 not seen on can0").
+
+#include <cstdint>
+#include <optional>
+#include <string>
+
+namespace pmu::tools {
+
+struct GlobalOptions {
+  int domain = 0;
+  std::string bus;                      // empty: every bus
+  std::optional<std::uint16_t> address; // empty: every device
+  bool json = false;
+  std::optional<double> timeout;        // s; verbs have their own default
+  std::string qos_file;                 // empty: the installed qos.xml
+};
+
+int run_watch(const GlobalOptions& o, long count);
+int run_list(const GlobalOptions& o);
+int run_info(const GlobalOptions& o);
+int run_health(const GlobalOptions& o);
+int run_config_get(const GlobalOptions& o, const std::string& parameter);
+
+}  // namespace pmu::tools

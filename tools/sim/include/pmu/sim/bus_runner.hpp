@@ -1,0 +1,57 @@
+#pragma once
+// BusRunner: simulated PMUs living on a CanBus. Each turn drains the bus into every model,
+// ticks them, and lets them send what they emit. Used by pmu-sim (on SocketCAN), by
+// `pmu-service --bus sim` (on the in-process bus) and by integration tests.
+//
+// Thread safety: run() turns in its own thread; with_model() runs harness code (faults,
+// plant changes) under the same lock, so a test can change a running simulator.
+
+#include <atomic>
+#include <chrono>
+#include <functional>
+#include <map>
+#include <memory>
+#include <mutex>
+#include <thread>
+
+#include "pmu/sim/pmu_model.hpp"
+#include "pmu/transport/can_bus.hpp"
+#include "pmu/transport/clock.hpp"
+#include "pmu/transport/unique_fd.hpp"
+
+namespace pmu::sim {
+
+class BusRunner final : private transport::BusHandler {
+ public:
+  // Throws std::system_error when epoll cannot be set up (start-up).
+  BusRunner(std::unique_ptr<transport::CanBus> bus, const transport::Clock& clock);
+  ~BusRunner();  // stops the thread if running
+  BusRunner(const BusRunner&) = delete;
+  BusRunner& operator=(const BusRunner&) = delete;
+
+  // Adds a PMU (before start(), or through with_model's lock). Throws for a broadcast address.
+  void add(const DeviceConfig& config);
+
+  // One turn: wait up to max_wait (or the next model deadline) for frames, then act.
+  void run_once(std::chrono::milliseconds max_wait);
+  void start();  // runs turns in a thread until stop()
+  void stop();
+
+  // Runs `fn` on the model at `address` under the runner's lock; false if there is none.
+  bool with_model(std::uint16_t address, const std::function<void(PmuModel&)>& fn);
+  transport::CanBus& bus() noexcept { return *bus_; }
+
+ private:
+  void on_frame(const transport::ReceivedFrame& frame) override;
+  void on_event(const transport::BusEvent& event) override;
+
+  std::unique_ptr<transport::CanBus> bus_;
+  const transport::Clock& clock_;
+  std::map<std::uint16_t, std::unique_ptr<PmuModel>> models_;
+  std::recursive_mutex mutex_;
+  transport::UniqueFd epoll_;
+  std::atomic<bool> stop_{false};
+  std::thread thread_;
+};
+
+}  // namespace pmu::sim
