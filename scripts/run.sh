@@ -1,12 +1,23 @@
 #!/usr/bin/env bash
-# Quick start: installs what is missing, builds, and shows decoded PMU traffic.
-# Until pmu-service lands this decodes the shipped sample bus log with pmuctl.
+# Quick start: installs what is missing, builds, starts pmu-service on the built-in simulated
+# PMU and shows its live telemetry with `pmuctl watch` (Ctrl-C stops both).
+#   scripts/run.sh [--domain N] [extra pmuctl watch options, e.g. --json --count 20]
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 cd "$root"
+domain=0
+if [ "${1:-}" = "--domain" ]; then domain=$2; shift 2; fi
+
 "$root/scripts/setup.sh"
 cmake -S . -B build/release -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo >/dev/null
-cmake --build build/release -j"$(nproc)" --target pmuctl
-echo
-echo "Decoding deploy/examples/sample-candump.log (every packet of protocol v1.9):"
-exec build/release/tools/pmuctl decode deploy/examples/sample-candump.log
+cmake --build build/release -j"$(nproc)" --target pmu-service pmuctl
+
+log=$(mktemp -t pmu-service.XXXXXX.log)
+build/release/service/pmu-service --bus sim --domain "$domain" >"$log" 2>&1 &
+service=$!
+trap 'kill -TERM $service 2>/dev/null; wait $service 2>/dev/null || true; echo "pmu-service log: $log"' EXIT
+echo "pmu-service (pid $service) runs on the simulated PMU, DDS domain $domain; log: $log"
+sleep 1
+kill -0 $service 2>/dev/null || { cat "$log"; exit 1; }
+build/release/tools/pmuctl --domain "$domain" list
+build/release/tools/pmuctl --domain "$domain" watch "$@"

@@ -1,0 +1,280 @@
+// The telemetry path end to end over real Fast DDS: the service's bus worker and publisher,
+// a simulated PMU, and readers written against interface.md's types and QoS profiles, in one
+// process (fake clock for the bus side) and across processes (pmu-service and pmuctl).
+#include <gtest/gtest.h>
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <fastdds/dds/subscriber/SampleInfo.hpp>
+#include <nlohmann/json.hpp>
+#include <set>
+#include <thread>
+
+#include "../service/harness.hpp"
+#include "pmu/idl/statePubSubTypes.h"
+#include "pmu/idl/telemetryPubSubTypes.h"
+#include "pmu/idl/topics.hpp"
+#include "pmu/service/dds_context.hpp"
+#include "pmu/service/dds_publisher.hpp"
+
+namespace pmu::service::test {
+namespace {
+
+using namespace eprosima::fastdds::dds;
+using namespace std::chrono_literals;
+using Clock = std::chrono::steady_clock;
+
+// Each test process gets its own domain so parallel ctest runs do not see each other.
+int test_domain() { return 100 + static_cast<int>(::getpid() % 100); }
+
+template <class T>
+bool wait_sample(DataReader& r, T& out, SampleInfo& info, std::chrono::milliseconds timeout) {
+  const auto deadline = Clock::now() + timeout;
+  while (Clock::now() < deadline) {
+    while (r.take_next_sample(&out, &info) == ReturnCode_t::RETCODE_OK)
+      if (info.valid_data) return true;
+    std::this_thread::sleep_for(5ms);
+  }
+  return false;
+}
+
+struct Readers {
+  explicit Readers(dds::DdsContext& c)
+      : voltages(c.reader(c.topic(topics::kVoltages, TypeSupport(new pmu::VoltagesPubSubType())), qos_profiles::kTelemetry)),
+        currents(c.reader(c.topic(topics::kCurrents, TypeSupport(new pmu::CurrentsPubSubType())), qos_profiles::kTelemetry)),
+        energy(c.reader(c.topic(topics::kBatteryEnergy, TypeSupport(new pmu::BatteryEnergyPubSubType())),
+                        qos_profiles::kTelemetry)),
+        temperatures(c.reader(c.topic(topics::kTemperatures, TypeSupport(new pmu::TemperaturesPubSubType())),
+                              qos_profiles::kTelemetry)),
+        status(c.reader(c.topic(topics::kStatus, TypeSupport(new pmu::StatusPubSubType())), qos_profiles::kTelemetry)),
+        config(c.reader(c.topic(topics::kConfig, TypeSupport(new pmu::ConfigPubSubType())), qos_profiles::kState)),
+        info(c.reader(c.topic(topics::kInfo, TypeSupport(new pmu::DeviceInfoPubSubType())), qos_profiles::kState)),
+        health(c.reader(c.topic(topics::kHealth, TypeSupport(new pmu::HealthPubSubType())), qos_profiles::kState)) {}
+  DataReader& voltages;
+  DataReader& currents;
+  DataReader& energy;
+  DataReader& temperatures;
+  DataReader& status;
+  DataReader& config;
+  DataReader& info;
+  DataReader& health;
+};
+
+// Runs the bus side (fake clock) in a thread, 10 ms of bus time per 2 ms of real time.
+class BusThread {
+ public:
+  explicit BusThread(Harness& h) : h_(h), t_([this] {
+      while (!stop_) {
+        h_.run_for(10ms);
+        std::this_thread::sleep_for(2ms);
+      }
+    }) {}
+  ~BusThread() {
+    stop_ = true;
+    t_.join();
+  }
+
+ private:
+  Harness& h_;
+  std::atomic<bool> stop_{false};
+  std::thread t_;
+};
+
+TEST(DdsTelemetry, EveryTopicArrivesWithTheSimulatorsValuesAndFrameTimestamps) {
+  dds::DdsContext service_side(test_domain(), "", "pmu-service-test");
+  DdsPublisher publisher(service_side, 3s);
+  dds::DdsContext client(test_domain(), "", "reader-test");
+  Readers r(client);
+
+  auto unit = pmu(1, codec::kCurrentFirmware, 5);
+  Harness h(sim_bus({device(1)}), {unit}, Timeouts{}, &publisher);
+  h.pmus().with_model(1, [&](sim::PmuModel& m) { m.set_engine_running(true, h.clock().steady_now()); });
+  const auto expected = [&] {
+    sim::Telemetry t;
+    h.pmus().with_model(1, [&](sim::PmuModel& m) { t = m.telemetry(); });
+    return t;
+  }();
+  BusThread bus(h);
+
+  SampleInfo si;
+  pmu::Voltages v;
+  ASSERT_TRUE(wait_sample(r.voltages, v, si, 10s));
+  EXPECT_EQ(v.bus().to_string(), "sim0");
+  EXPECT_EQ(v.address(), 1);
+  EXPECT_FLOAT_EQ(v.avionics(), static_cast<float>(expected.voltages.avionics));
+  EXPECT_FLOAT_EQ(v.generator(), static_cast<float>(expected.voltages.generator));
+  // Source timestamp = the frame's receive time on the (fake) bus clock, which started at
+  // 1700000000 s: nothing like the wall clock of this run.
+  EXPECT_GE(si.source_timestamp.seconds(), 1700000000);
+  EXPECT_LT(si.source_timestamp.seconds(), 1700000000 + 3600);
+
+  pmu::Currents c;
+  ASSERT_TRUE(wait_sample(r.currents, c, si, 5s));
+  EXPECT_FLOAT_EQ(c.payload(), static_cast<float>(expected.currents.payload));
+  pmu::BatteryEnergy e;
+  ASSERT_TRUE(wait_sample(r.energy, e, si, 5s));
+  pmu::Temperatures t;
+  ASSERT_TRUE(wait_sample(r.temperatures, t, si, 5s));
+  EXPECT_FLOAT_EQ(t.internal(), static_cast<float>(expected.temperatures.internal));
+  EXPECT_TRUE(std::isnan(t.generator())) << "no generator sensor in the simulator: NaN";
+  pmu::Status s;
+  ASSERT_TRUE(wait_sample(r.status, s, si, 5s));
+  EXPECT_TRUE(s.generation_enabled());
+  EXPECT_TRUE(s.avionics_servo_on());
+  EXPECT_GT(s.generator_rpm(), 0);
+
+  pmu::Config cfg;
+  ASSERT_TRUE(wait_sample(r.config, cfg, si, 5s));
+  EXPECT_FLOAT_EQ(cfg.avionics_voltage(), 12.0f);
+  EXPECT_FLOAT_EQ(cfg.packet_period(), 0.5f);
+  EXPECT_EQ(cfg.can_address(), 1);
+  pmu::DeviceInfo info;
+  ASSERT_TRUE(wait_sample(r.info, info, si, 5s));
+  EXPECT_EQ(info.serial_number(), 4001);
+  EXPECT_EQ(info.firmware_minor(), 17);
+  EXPECT_EQ(info.features().size(), std::size(codec::kAllFeatures)) << "1.17 has every feature";
+  pmu::Health hl;
+  ASSERT_TRUE(wait_sample(r.health, hl, si, 5s));
+  EXPECT_EQ(hl.address(), 1);
+
+  // A late-joining reader gets config, info and health at once (TRANSIENT_LOCAL).
+  dds::DdsContext late(test_domain(), "", "late-reader");
+  Readers lr(late);
+  ASSERT_TRUE(wait_sample(lr.config, cfg, si, 3s));
+  EXPECT_FLOAT_EQ(cfg.avionics_voltage(), 12.0f);
+  ASSERT_TRUE(wait_sample(lr.info, info, si, 3s));
+  EXPECT_EQ(info.serial_number(), 4001);
+  ASSERT_TRUE(wait_sample(lr.health, hl, si, 3s));
+}
+
+TEST(DdsTelemetry, RateFollowsThePacketPeriod) {
+  dds::DdsContext service_side(test_domain(), "", "pmu-service-rate");
+  DdsPublisher publisher(service_side, 3s);
+  dds::DdsContext client(test_domain(), "", "reader-rate");
+  Readers r(client);
+  Harness h(sim_bus({device(1)}), {pmu(1, codec::kCurrentFirmware, 2)}, Timeouts{}, &publisher);  // PP 0.2 s
+  pmu::Voltages v;
+  SampleInfo si;
+  std::set<std::int64_t> stamps;
+  {
+    BusThread bus(h);  // bus time runs ~5x faster than real time: a sample every ~40 ms
+    const auto deadline = Clock::now() + 4s;
+    while (Clock::now() < deadline && stamps.size() < 30) {
+      while (r.voltages.take_next_sample(&v, &si) == ReturnCode_t::RETCODE_OK)
+        if (si.valid_data) stamps.insert(static_cast<std::int64_t>(si.source_timestamp.to_ns() / 1000000));
+      std::this_thread::sleep_for(2ms);
+    }
+  }
+  ASSERT_GE(stamps.size(), 30u);
+  // Consecutive samples are one packet period apart in frame time (a best-effort sample may
+  // be lost, never invented): every gap is a whole multiple of 200 ms, nearly all exactly one.
+  std::vector<std::int64_t> t(stamps.begin(), stamps.end());
+  std::size_t exact = 0;
+  for (std::size_t i = 1; i < t.size(); ++i) {
+    EXPECT_EQ((t[i] - t[i - 1]) % 200, 0) << t[i] - t[i - 1];
+    exact += (t[i] - t[i - 1]) == 200 ? 1u : 0u;
+  }
+  EXPECT_GE(exact, (t.size() - 1) * 9 / 10);
+}
+
+// ---- across processes -----------------------------------------------------------------------
+
+struct Child {
+  pid_t pid = -1;
+  ~Child() {
+    if (pid > 0) {
+      ::kill(pid, SIGKILL);
+      ::waitpid(pid, nullptr, 0);
+    }
+  }
+};
+
+std::string run_capture(const std::string& cmd, int* status) {
+  std::string out;
+  FILE* p = ::popen(cmd.c_str(), "r");
+  if (!p) return out;
+  char buf[4096];
+  std::size_t n = 0;
+  while ((n = std::fread(buf, 1, sizeof buf, p)) > 0) out.append(buf, n);
+  *status = ::pclose(p);
+  return out;
+}
+
+TEST(CrossProcess, ServiceOnSimulatedBusFeedsPmuctl) {
+  const std::string domain = std::to_string(test_domain());
+  Child service;
+  service.pid = ::fork();
+  ASSERT_GE(service.pid, 0);
+  if (service.pid == 0) {
+    ::execl(PMU_SERVICE_PATH, PMU_SERVICE_PATH, "--bus", "sim", "--domain", domain.c_str(), "--log-level", "warn",
+            static_cast<char*>(nullptr));
+    std::_Exit(127);
+  }
+  int status = 0;
+  const std::string out = run_capture(std::string(PMUCTL_PATH) + " --domain " + domain +
+                                          " watch --json --count 15 --timeout 20",
+                                      &status);
+  ASSERT_EQ(status, 0) << out;
+  std::set<std::string> topics;
+  std::size_t lines = 0;
+  std::size_t start = 0;
+  for (std::size_t i = 0; i < out.size(); ++i) {
+    if (out[i] != '\n') continue;
+    const auto j = nlohmann::json::parse(out.substr(start, i - start));
+    start = i + 1;
+    ++lines;
+    topics.insert(j["topic"].get<std::string>());
+    EXPECT_EQ(j["bus"], "sim0");
+    EXPECT_EQ(j["address"], 1);
+    if (j["topic"] == "voltages") {
+      EXPECT_EQ(j["values"]["avionics"], 12.0);
+    }
+  }
+  EXPECT_EQ(lines, 15u);
+  EXPECT_EQ(topics, (std::set<std::string>{"voltages", "currents", "battery_energy", "temperatures", "status"}));
+
+  const std::string list = run_capture(std::string(PMUCTL_PATH) + " --domain " + domain + " list --json", &status);
+  ASSERT_EQ(status, 0) << list;
+  const auto l = nlohmann::json::parse(list.substr(0, list.find('\n')));
+  EXPECT_EQ(l["values"]["state"], "ONLINE");
+  EXPECT_EQ(l["values"]["firmware"], "1.17");
+
+  // SIGTERM stops the service cleanly within a second.
+  const auto t0 = Clock::now();
+  ASSERT_EQ(::kill(service.pid, SIGTERM), 0);
+  int wstatus = 0;
+  while (::waitpid(service.pid, &wstatus, WNOHANG) == 0 && Clock::now() - t0 < 3s) std::this_thread::sleep_for(5ms);
+  const auto took = Clock::now() - t0;
+  service.pid = -1;
+  EXPECT_TRUE(WIFEXITED(wstatus));
+  EXPECT_EQ(WEXITSTATUS(wstatus), 0);
+  EXPECT_LT(took, 1s);
+}
+
+TEST(CrossProcess, PmuctlSaysWhenNoServiceIsThere) {
+  int status = 0;
+  const std::string err = run_capture(std::string(PMUCTL_PATH) + " --domain 231 list --timeout 1 2>&1", &status);
+  EXPECT_NE(status, 0);
+  EXPECT_NE(err.find("no pmu-service on domain 231"), std::string::npos) << err;
+}
+
+TEST(CrossProcess, BadConfigIsRefusedWithItsLineBeforeAnythingStarts) {
+  char path[] = "/tmp/pmu-bad-XXXXXX";
+  const int fd = ::mkstemp(path);
+  ASSERT_GE(fd, 0);
+  const std::string yaml = "buses:\n  - interface: vcan0\n    devices:\n      - address: 70000\n";
+  ASSERT_EQ(::write(fd, yaml.data(), yaml.size()), static_cast<ssize_t>(yaml.size()));
+  ::close(fd);
+  int status = 0;
+  const std::string err = run_capture(std::string(PMU_SERVICE_PATH) + " --config " + path + " 2>&1", &status);
+  ::unlink(path);
+  EXPECT_EQ(WEXITSTATUS(status), 2);
+  EXPECT_NE(err.find(std::string(path) + ":4: address 70000 out of range 0..65534"), std::string::npos) << err;
+}
+
+}  // namespace
+}  // namespace pmu::service::test
