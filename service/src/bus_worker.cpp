@@ -75,6 +75,10 @@ void BusWorker::on_frame(const transport::ReceivedFrame& rx) {
   const std::uint16_t address = id.id->address;
   if (address == codec::kBroadcastAddress) return;  // a broadcast request, not an answer
   DeviceSession* s = session(address);
+  if (!s) {
+    for (auto& [a, candidate] : sessions_)
+      if (candidate->alias() == address) s = candidate.get();
+  }
   if (!s && config_.discover && id.id->packet == codec::PacketId::Firmware && rx.frame.length == 6) {
     DeviceConfig d = config_.discovered_defaults;
     d.address = address;
@@ -134,12 +138,27 @@ std::size_t BusWorker::run_once(milliseconds max_wait) {
     s->tick(now);
   }
   discover(now);
+  rekey_moved_sessions();
   if (now >= next_maintain_) {
     next_maintain_ = now + kMaintainInterval;
     bus_->maintain(now);
   }
   progress_.fetch_add(1, std::memory_order_relaxed);
   return frames;
+}
+
+void BusWorker::rekey_moved_sessions() {
+  // A verified CAN address change moved a session: file it under its new address.
+  for (auto it = sessions_.begin(); it != sessions_.end();) {
+    if (it->second->key().address == it->first) {
+      ++it;
+      continue;
+    }
+    auto moved = std::move(it->second);
+    it = sessions_.erase(it);
+    const auto address = moved->key().address;
+    sessions_[address] = std::move(moved);
+  }
 }
 
 void BusWorker::run() {

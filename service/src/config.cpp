@@ -172,6 +172,37 @@ void parse_timeouts(const Ctx& c, const YAML::Node& n, Timeouts& t) {
     c.fail(n["offline_periods"] ? n["offline_periods"] : n, "offline_periods must be greater than stale_periods");
 }
 
+void parse_policy(const Ctx& c, const YAML::Node& n, PolicyConfig& p) {
+  c.only_keys(n, "policy", {"confirm", "deny", "rate_limit", "burst", "command_lifetime"});
+  if (const auto v = n["confirm"]) {
+    if (!v.IsSequence()) c.fail(v, "confirm must be a list of rule names (may be empty: [])");
+    p.confirm.fill(false);
+    for (const auto& item : v) {
+      const auto name = c.scalar<std::string>(item, "confirm rule", "a name");
+      const auto rule = confirm_rule_from_name(name);
+      if (!rule)
+        c.fail(item, "unknown confirm rule '" + name +
+                         "' (known: disable_avionics, reset, engine_start, set_can_address, thermal_shutdown, "
+                         "power_up_avionics_off)");
+      p.confirm[static_cast<std::size_t>(*rule)] = true;
+    }
+  }
+  if (const auto v = n["deny"]) {
+    if (!v.IsSequence()) c.fail(v, "deny must be a list of command kinds");
+    for (const auto& item : v) {
+      const auto name = c.scalar<std::string>(item, "command", "a name");
+      const auto kind = command_kind_from_name(name);
+      if (!kind) c.fail(item, "unknown command '" + name + "' in deny");
+      if (*kind == CommandKind::EngineStop) c.fail(item, "engine_stop cannot be denied: it is the safety stop");
+      p.deny[static_cast<std::size_t>(*kind)] = true;
+    }
+  }
+  if (const auto v = n["rate_limit"]) p.rate_per_second = c.number(v, "rate_limit", 0, 1000);
+  if (const auto v = n["burst"]) p.burst = c.number(v, "burst", 1, 10000);
+  if (const auto v = n["command_lifetime"])
+    p.default_lifetime = std::chrono::milliseconds(std::lround(c.number(v, "command_lifetime", 0.1, 3600) * 1000));
+}
+
 const char* const kLogLevels[] = {"trace", "debug", "info", "warn", "error", "critical", "off"};
 
 }  // namespace
@@ -191,7 +222,7 @@ Config parse_config(const std::string& text, const std::string& source) {
   Config cfg;
   cfg.source = source;
   if (root.IsNull()) throw ConfigError(source + ":1: the file is empty");
-  c.only_keys(root, "the top level", {"domain", "qos_file", "log_level", "buses", "timeouts"});
+  c.only_keys(root, "the top level", {"domain", "qos_file", "log_level", "buses", "timeouts", "policy"});
   if (const auto v = root["domain"]) cfg.domain = static_cast<int>(c.integer(v, "domain", 0, 232));
   if (const auto v = root["qos_file"]) cfg.qos_file = c.scalar<std::string>(v, "qos_file", "a path");
   if (const auto v = root["log_level"]) {
@@ -200,6 +231,7 @@ Config parse_config(const std::string& text, const std::string& source) {
       c.fail(v, "log_level '" + cfg.log_level + "' is not one of trace, debug, info, warn, error, critical, off");
   }
   if (const auto v = root["timeouts"]) parse_timeouts(c, v, cfg.timeouts);
+  if (const auto v = root["policy"]) parse_policy(c, v, cfg.policy);
   const auto buses = root["buses"];
   if (!buses) c.fail(root, "no buses: the service needs at least one bus");
   if (!buses.IsSequence() || buses.size() == 0) c.fail(buses, "buses must be a non-empty list");

@@ -75,15 +75,20 @@ DdsPublisher::DdsPublisher(dds::DdsContext& dds, std::chrono::milliseconds telem
 
 DdsPublisher::~DdsPublisher() = default;
 
+// DataWriter::write(void*) returns bool in Fast DDS 2.x (write_w_timestamp a ReturnCode_t).
+void DdsPublisher::count(bool ok) noexcept {
+  if (ok)
+    ++written_;
+  else
+    ++failures_;
+}
+
 void DdsPublisher::on_telemetry(const DeviceKey& key, const codec::PmuMessage& m,
                                 std::chrono::system_clock::time_point received) {
   const auto ts = dds_time(received);
   std::lock_guard<std::mutex> lock(w_->mutex);
   auto write = [&](DataWriter* w, void* sample) {
-    if (w->write_w_timestamp(sample, HANDLE_NIL, ts) == ReturnCode_t::RETCODE_OK)
-      ++written_;
-    else
-      ++failures_;
+    count(w->write_w_timestamp(sample, HANDLE_NIL, ts) == ReturnCode_t::RETCODE_OK);
   };
   if (const auto* v = std::get_if<codec::Voltages>(&m.payload)) {
     pmu::Voltages s;
@@ -159,7 +164,7 @@ void DdsPublisher::on_config(const DeviceKey& key, const ConfigState& c) {
   s.outputs(c.outputs.value_or(0));
   s.generation_enabled(c.generation_enabled.value_or(false));
   std::lock_guard<std::mutex> lock(w_->mutex);
-  if (w_->config->write(&s) == ReturnCode_t::RETCODE_OK) ++written_; else ++failures_;
+  count(w_->config->write(&s));
 }
 
 void DdsPublisher::on_info(const DeviceKey& key, const InfoState& i) {
@@ -174,7 +179,7 @@ void DdsPublisher::on_info(const DeviceKey& key, const InfoState& i) {
   for (const auto feature : codec::kAllFeatures)
     if (codec::supports(i.firmware.version(), feature)) s.features().emplace_back(std::string(codec::feature_name(feature)));
   std::lock_guard<std::mutex> lock(w_->mutex);
-  if (w_->info->write(&s) == ReturnCode_t::RETCODE_OK) ++written_; else ++failures_;
+  count(w_->info->write(&s));
 }
 
 void DdsPublisher::on_health(const DeviceKey& key, const HealthReport& h) {
@@ -191,7 +196,7 @@ void DdsPublisher::on_health(const DeviceKey& key, const HealthReport& h) {
   s.timeouts(h.timeouts);
   s.reconnects(h.reconnects);
   std::lock_guard<std::mutex> lock(w_->mutex);
-  if (w_->health->write(&s) == ReturnCode_t::RETCODE_OK) ++written_; else ++failures_;
+  count(w_->health->write(&s));
 }
 
 }  // namespace pmu::service

@@ -123,6 +123,12 @@ void DeviceSession::submit(Request request, SteadyTime now) {
   send_next(now);
 }
 
+void DeviceSession::submit_front(Request request, SteadyTime now) {
+  now_ = now;
+  queue_.push_front(std::move(request));
+  send_next(now);
+}
+
 void DeviceSession::send_next(SteadyTime now) {
   now_ = now;
   if (pumping_) return;  // a done() callback submitted more: the loop below picks it up
@@ -131,6 +137,14 @@ void DeviceSession::send_next(SteadyTime now) {
     in_flight_ = std::move(queue_.front());
     queue_.pop_front();
     attempts_ = 1;
+    if (in_flight_->expires && now > *in_flight_->expires) {
+      RequestOutcome o;
+      o.status = RequestStatus::Expired;
+      Request done = std::move(*in_flight_);
+      in_flight_.reset();
+      if (done.done) done.done(o);
+      continue;
+    }
     const auto sent = send_(in_flight_->frame);
     if (sent.ok()) ++health_.frames_sent;
     if (sent.ok() && in_flight_->reply) {

@@ -22,7 +22,9 @@
 #include <vector>
 
 #include "pmu/service/bus_worker.hpp"
+#include "pmu/service/command_service.hpp"
 #include "pmu/service/config.hpp"
+#include "pmu/service/dds_commands.hpp"
 #include "pmu/service/dds_context.hpp"
 #include "pmu/service/dds_publisher.hpp"
 #include "pmu/service/logging.hpp"
@@ -113,10 +115,16 @@ int run(const service::Config& cfg) {
     auto bus = open_bus(cfg.buses[i], clock, buses[i]);
     buses[i].worker = std::make_unique<service::BusWorker>(cfg.buses[i], std::move(bus), clock, cfg.timeouts, publisher);
   }
+  service::DdsCommandEndpoint command_topics(participant);
+  std::vector<service::BusWorker*> workers;
+  for (auto& b : buses) workers.push_back(b.worker.get());
+  service::CommandService commands(workers, cfg.policy, cfg.timeouts, clock,
+                                   [&](const service::CommandReplyData& r) { command_topics.publish(r); });
   for (auto& b : buses) {
     if (b.simulator) b.simulator->start();
     b.thread = std::thread([w = b.worker.get()] { w->run(); });
   }
+  command_topics.start(commands);
   spdlog::info("pmu-service ready on DDS domain {}: {}", cfg.domain, summary(buses));
   systemd.ready(summary(buses));
 
@@ -149,6 +157,7 @@ int run(const service::Config& cfg) {
   }
 
   systemd.stopping();
+  command_topics.stop();
   for (auto& b : buses) b.worker->stop();
   for (auto& b : buses) {
     if (b.thread.joinable()) b.thread.join();

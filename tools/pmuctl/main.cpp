@@ -13,6 +13,8 @@
 #include <string>
 
 #include "pmu/codec/firmware.hpp"
+#include "pmu/idl/command.h"
+#include "pmuctl/command_verbs.hpp"
 #include "pmuctl/dds_verbs.hpp"
 #include "pmuctl/log_decoder.hpp"
 
@@ -88,6 +90,36 @@ int main(int argc, char** argv) {
   auto* config_get = config->add_subcommand("get", "Show the stored parameters (or one)");
   std::string parameter;
   config_get->add_option("param", parameter, "A parameter name, e.g. avionics_voltage");
+  auto* config_set = config->add_subcommand("set", "Set a stored parameter; verified by reading it back");
+  std::string set_param, set_value;
+  config_set->add_option("param", set_param, "avionics_voltage, payload_voltage, servo_voltage, battery_voltage, "
+                                             "packet_period, packets_streamed, temperature_offset, "
+                                             "upper_temperature_limit, power_up_state, cranking_time, can_address")
+      ->required();
+  config_set->add_option("value", set_value, "Value in the parameter's unit (V, s, degC, or a number/mask)")->required();
+
+  bool confirm = false;
+  app.add_flag("--confirm", confirm, "Confirm a command the safety policy guards (avionics off, reset, engine start...)");
+  auto* outputs = app.add_subcommand("outputs", "Output states (avionics_servo, payload, charger_a, charger_b)");
+  outputs->require_subcommand(1);
+  auto* outputs_get = outputs->add_subcommand("get", "Read the output states from the PMU");
+  std::vector<std::string> output_names;
+  auto* outputs_set = outputs->add_subcommand("set", "Set exactly these outputs on (the others off)");
+  outputs_set->add_option("names", output_names, "Outputs to have on (or none)")->required();
+  auto* outputs_enable = outputs->add_subcommand("enable", "Switch these outputs on");
+  outputs_enable->add_option("names", output_names, "Outputs")->required();
+  auto* outputs_disable = outputs->add_subcommand("disable", "Switch these outputs off");
+  outputs_disable->add_option("names", output_names, "Outputs")->required();
+  auto* generation = app.add_subcommand("generation", "Electrical power generation on|off");
+  std::string on_off;
+  generation->add_option("state", on_off, "on or off")->required()->check(CLI::IsMember({"on", "off"}));
+  auto* engine = app.add_subcommand("engine", "Engine start|stop");
+  std::string start_stop;
+  engine->add_option("action", start_stop, "start or stop")->required()->check(CLI::IsMember({"start", "stop"}));
+  auto* reset = app.add_subcommand("reset", "Restart the PMU (outputs to power-up state, energies to zero)");
+  auto* measure = app.add_subcommand("measure", "Ask for measurements now (0x0F; firmware 1.14+)");
+  std::vector<std::string> groups;
+  measure->add_option("groups", groups, "voltages, currents, battery_energy, temperatures, status (default all)");
 
   auto* decode = app.add_subcommand("decode", "Decode a candump log (-L or screen format) offline");
   std::string path = "-";
@@ -119,6 +151,47 @@ int main(int argc, char** argv) {
     if (app.got_subcommand("info")) return pmu::tools::run_info(g);
     if (app.got_subcommand("health")) return pmu::tools::run_health(g);
     if (*config_get) return pmu::tools::run_config_get(g, parameter);
+    pmu::tools::CommandSpec spec;
+    spec.confirm = confirm;
+    if (*config_set) {
+      char* end = nullptr;
+      spec.value = std::strtod(set_value.c_str(), &end);
+      if (set_value.empty() || *end != '\0') {
+        std::fprintf(stderr, "pmuctl: '%s' is not a number\n", set_value.c_str());
+        return 2;
+      }
+      spec.kind = pmu::SET_PARAMETER;
+      spec.parameter = set_param;
+      return pmu::tools::run_command(g, spec);
+    }
+    if (*outputs_get) {
+      spec.kind = pmu::GET;
+      spec.parameter = "outputs";
+      return pmu::tools::run_command(g, spec);
+    }
+    if (*outputs_set || *outputs_enable || *outputs_disable) {
+      if (!pmu::tools::output_mask(output_names, spec.outputs)) return 2;
+      spec.kind = *outputs_set ? pmu::SET_OUTPUTS : *outputs_enable ? pmu::ENABLE_OUTPUTS : pmu::DISABLE_OUTPUTS;
+      return pmu::tools::run_command(g, spec);
+    }
+    if (*generation) {
+      spec.kind = pmu::SET_GENERATION;
+      spec.enable = on_off == "on";
+      return pmu::tools::run_command(g, spec);
+    }
+    if (*engine) {
+      spec.kind = start_stop == "start" ? pmu::ENGINE_START : pmu::ENGINE_STOP;
+      return pmu::tools::run_command(g, spec);
+    }
+    if (*reset) {
+      spec.kind = pmu::RESET;
+      return pmu::tools::run_command(g, spec);
+    }
+    if (*measure) {
+      if (!pmu::tools::group_mask(groups, spec.groups)) return 2;
+      spec.kind = pmu::REQUEST_MEASUREMENTS;
+      return pmu::tools::run_command(g, spec);
+    }
   } catch (const std::exception& e) {
     std::fprintf(stderr, "pmuctl: %s\n", e.what());
     return 2;

@@ -60,6 +60,7 @@ class BusWorker final : private transport::BusHandler {
   void on_event(const transport::BusEvent& event) override;
   DeviceSession& add_session(const DeviceConfig& device);
   void discover(std::chrono::steady_clock::time_point now);
+  void rekey_moved_sessions();
   void run_posted();
 
   BusConfig config_;

@@ -11,6 +11,8 @@
 #include <string>
 #include <vector>
 
+#include "pmu/service/policy.hpp"
+
 namespace pmu::service {
 
 class ConfigError : public std::runtime_error {
@@ -60,6 +62,7 @@ struct Config {
   std::string log_level = "info";
   std::vector<BusConfig> buses;
   Timeouts timeouts;
+  PolicyConfig policy;
 };
 
 // Parses `path`. Throws ConfigError("path:line: ...") for every problem: unknown keys,

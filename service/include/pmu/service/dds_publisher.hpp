@@ -28,6 +28,7 @@ class DdsPublisher final : public StateSink {
   std::uint64_t write_failures() const noexcept { return failures_; }
 
  private:
+  void count(bool ok) noexcept;
   struct Writers;
   std::unique_ptr<Writers> w_;
   std::uint64_t written_ = 0;

@@ -36,6 +36,7 @@ enum class RequestStatus : std::uint8_t {
   Sent,        // no reply expected (a set or command) and the bus accepted the frame
   Timeout,     // no reply after every try
   SendFailed,  // the bus refused the frame (down, gone, queue full)
+  Expired,     // its expiry passed while it waited in the queue: never sent
 };
 
 struct RequestOutcome {
@@ -51,6 +52,8 @@ struct Request {
   unsigned retries = 0;  // extra tries; only for requests that are safe to repeat
   std::function<void(const RequestOutcome&)> done;
   int tag = 0;  // the session's own requests (reading, polling) are tagged to find them
+  // Not sent after this time (a command that waited too long behind others is dropped).
+  std::optional<std::chrono::steady_clock::time_point> expires;
 };
 
 class DeviceSession {
@@ -73,7 +76,22 @@ class DeviceSession {
 
   // Queues a request behind those already waiting.
   void submit(Request request, SteadyTime now);
+  // Queues a request ahead of everything waiting (ENGINE_STOP must not wait behind a queue).
+  void submit_front(Request request, SteadyTime now);
+  // Reads identity and every stored value again (after a reset).
+  void reread(SteadyTime now) { start_reading(now); }
 
+  // During a CAN address change, frames from `alias` belong to this session too; readdress()
+  // moves the session to its new address once the change is verified.
+  void set_alias(std::optional<std::uint16_t> alias) noexcept { alias_ = alias; }
+  std::optional<std::uint16_t> alias() const noexcept { return alias_; }
+  void readdress(std::uint16_t address) noexcept {
+    key_.address = address;
+    alias_.reset();
+  }
+
+  // The latest time any call brought: callbacks that queue follow-up work use it.
+  SteadyTime now() const noexcept { return now_; }
   const ConfigState& config_state() const noexcept { return config_; }
   const std::optional<InfoState>& info() const noexcept { return info_; }
   std::optional<codec::FirmwareVersion> firmware() const noexcept;
@@ -116,6 +134,7 @@ class DeviceSession {
   SteadyTime deadline_{};
 
   bool pumping_ = false;
+  std::optional<std::uint16_t> alias_;
   SteadyTime now_{};  // the latest time any call brought
   SteadyTime created_{};
   std::optional<SteadyTime> last_rx_;

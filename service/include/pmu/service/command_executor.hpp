@@ -1,0 +1,38 @@
+#pragma once
+// Carries out one command on one device session (on the bus worker's thread): checks it
+// against the spec (range, step, NaN, output bits, what the firmware supports), then sends
+// it and verifies the result, replying exactly once with a final result.
+//
+//   sets        send, read the value back, COMPLETED only if the device reports it
+//   outputs     0x20/0x21/0x22, then read 0x20 back and check the bits
+//   generation  0x23, then read it back
+//   gets        zero-length get, retried (idempotent), TIMEOUT when the device is silent
+//   measure     0x0F (firmware 1.14+), COMPLETED when the first requested packet arrives
+//   engine stop sent ahead of anything queued for the device
+//   reset       sent, then identity and every stored value are read again
+// Nothing reaches the bus for a request that fails the checks (REJECTED / UNSUPPORTED).
+
+#include <functional>
+#include <optional>
+
+#include "pmu/service/command.hpp"
+#include "pmu/service/config.hpp"
+#include "pmu/service/device_session.hpp"
+
+namespace pmu::service {
+
+using ReplyFn = std::function<void(const CommandReplyData&)>;
+
+// The spec checks alone: a final REJECTED/UNSUPPORTED reply for an invalid request, nullopt
+// for a valid one. `fw` is the device's firmware when known.
+std::optional<CommandReplyData> validate_command(const CommandRequest& r, std::optional<codec::FirmwareVersion> fw);
+
+// Validates, then runs the command on `session`. `expires` bounds how long the first frame
+// may wait in the device's queue. `reply` is called exactly once with a final result.
+void execute_command(DeviceSession& session, const CommandRequest& r, SteadyTime now,
+                     std::optional<SteadyTime> expires, const Timeouts& timeouts, ReplyFn reply);
+
+// A final reply to `r` with `result` and `reason`.
+CommandReplyData make_reply(const CommandRequest& r, CommandResult result, std::string reason);
+
+}  // namespace pmu::service

@@ -1,0 +1,32 @@
+#pragma once
+// The command topics on DDS: reads pmu/command (QoS profile `command`) into the
+// CommandService and writes every reply to pmu/command_reply. The only place that converts
+// between pmu::Command / pmu::CommandReply and the service's own command types.
+
+#include <memory>
+
+#include "pmu/service/command.hpp"
+#include "pmu/service/dds_context.hpp"
+
+namespace pmu::service {
+
+class CommandService;
+
+class DdsCommandEndpoint {
+ public:
+  // Creates the reply writer. Throws dds::DdsError at start-up.
+  explicit DdsCommandEndpoint(dds::DdsContext& dds);
+  ~DdsCommandEndpoint();
+  // Starts reading commands into `service` (which must outlive this endpoint's reader).
+  void start(CommandService& service);
+  // Stops reading commands (before the service is torn down). Idempotent.
+  void stop();
+  // Publishes one reply (thread-safe).
+  void publish(const CommandReplyData& reply);
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace pmu::service

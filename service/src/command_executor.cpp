@@ -1,0 +1,310 @@
+#include "pmu/service/command_executor.hpp"
+
+#include <cstdio>
+#include <memory>
+
+#include "pmu/codec/encode.hpp"
+#include "pmu/codec/messages.hpp"
+
+namespace pmu::service {
+namespace {
+
+using codec::PacketId;
+
+// What a GET names: a stored parameter, outputs, generation, or a measurement group.
+std::optional<PacketId> get_target(const std::string& name) {
+  if (auto p = codec::parameter_from_name(name)) return codec::spec_of(*p).packet;
+  if (name == "outputs") return PacketId::Outputs;
+  if (name == "generation" || name == "generation_enabled") return PacketId::Generation;
+  const char* groups[] = {"voltages", "currents", "battery_energy", "temperatures", "status"};
+  for (std::uint8_t i = 0; i < 5; ++i)
+    if (name == groups[i]) return static_cast<PacketId>(i);
+  return std::nullopt;
+}
+
+CommandResult result_of(const codec::EncodeError& e) {
+  return e.kind == codec::EncodeErrorKind::Unsupported ? CommandResult::Unsupported : CommandResult::Rejected;
+}
+
+std::string mask_text(std::uint8_t mask) {
+  static const char* names[] = {"avionics_servo", "payload", "charger_a", "charger_b"};
+  std::string s;
+  for (int b = 0; b < 4; ++b)
+    if (mask & (1u << b)) s += std::string(s.empty() ? "" : ",") + names[b];
+  return s.empty() ? "none" : s;
+}
+
+// One command in progress: the reply is sent once, whatever path ends it.
+struct Run {
+  CommandRequest request;
+  ReplyFn reply;
+  const Timeouts& timeouts;
+  DeviceSession& session;
+  bool replied = false;
+
+  void finish(CommandResult result, std::string reason, std::optional<double> value = std::nullopt,
+              std::string value_text = {}) {
+    if (replied) return;
+    replied = true;
+    CommandReplyData d = make_reply(request, result, std::move(reason));
+    if (value) {
+      d.has_value = true;
+      d.value = *value;
+    }
+    d.value_text = std::move(value_text);
+    reply(d);
+  }
+
+  // Maps a step's failure to the final reply; true when the step succeeded.
+  bool ok(const RequestOutcome& o, const char* what) {
+    switch (o.status) {
+      case RequestStatus::Answered:
+      case RequestStatus::Sent: return true;
+      case RequestStatus::Expired:
+        finish(CommandResult::Rejected, "expired before it could be sent");
+        return false;
+      case RequestStatus::SendFailed:
+        finish(CommandResult::Failed, std::string("bus refused the ") + what + ": " +
+                                          std::string(transport::to_string(o.send.status)));
+        return false;
+      case RequestStatus::Timeout:
+        finish(CommandResult::Timeout, std::string("device ") + std::to_string(request.address) + " did not answer the " +
+                                           what + " after " + std::to_string(timeouts.retries + 1) + " tries");
+        return false;
+    }
+    return false;
+  }
+};
+
+Request step(const codec::CanFrame& frame, std::optional<PacketId> reply, unsigned retries,
+             std::optional<SteadyTime> expires, std::function<void(const RequestOutcome&)> done) {
+  Request r;
+  r.frame = frame;
+  r.reply = reply;
+  r.retries = retries;
+  r.expires = expires;
+  r.done = std::move(done);
+  return r;
+}
+
+}  // namespace
+
+CommandReplyData make_reply(const CommandRequest& r, CommandResult result, std::string reason) {
+  CommandReplyData d;
+  d.request_id = r.request_id;
+  d.bus = r.bus;
+  d.address = r.address;
+  d.kind = r.kind;
+  d.result = result;
+  d.reason = std::move(reason);
+  return d;
+}
+
+std::optional<CommandReplyData> validate_command(const CommandRequest& r, std::optional<codec::FirmwareVersion> fw) {
+  auto reject = [&](CommandResult res, std::string why) { return make_reply(r, res, std::move(why)); };
+  switch (r.kind) {
+    case CommandKind::Get:
+      if (!get_target(r.parameter)) return reject(CommandResult::Rejected, "unknown parameter '" + r.parameter + "'");
+      return std::nullopt;
+    case CommandKind::SetParameter: {
+      const auto p = codec::parameter_from_name(r.parameter);
+      if (!p) return reject(CommandResult::Rejected, "unknown parameter '" + r.parameter + "'");
+      auto raw = codec::to_raw(*p, r.value, fw);
+      if (!raw) return reject(result_of(raw.error()), raw.error().describe());
+      return std::nullopt;
+    }
+    case CommandKind::SetOutputs:
+    case CommandKind::EnableOutputs:
+    case CommandKind::DisableOutputs: {
+      if (r.outputs & ~codec::output_bit::All) {
+        char buf[96];
+        std::snprintf(buf, sizeof buf, "unknown output bits 0x%02X (outputs are bits 0..3)",
+                      r.outputs & ~codec::output_bit::All);
+        return reject(CommandResult::Rejected, buf);
+      }
+      if (r.kind != CommandKind::SetOutputs && r.outputs == 0)
+        return reject(CommandResult::Rejected, "no output named");
+      return std::nullopt;
+    }
+    case CommandKind::RequestMeasurements: {
+      if (r.groups & ~codec::group_bit::All) return reject(CommandResult::Rejected, "unknown measurement group bits");
+      auto f = codec::encode_measurement_request(r.groups ? r.groups : codec::group_bit::All, r.address, fw);
+      if (!f) return reject(result_of(f.error()), f.error().describe());
+      return std::nullopt;
+    }
+    default: return std::nullopt;
+  }
+}
+
+void execute_command(DeviceSession& session, const CommandRequest& request, SteadyTime now,
+                     std::optional<SteadyTime> expires, const Timeouts& timeouts, ReplyFn reply) {
+  const auto fw = session.firmware();
+  if (auto invalid = validate_command(request, fw)) {
+    reply(*invalid);
+    return;
+  }
+  auto run = std::make_shared<Run>(Run{request, std::move(reply), timeouts, session});
+  const std::uint16_t a = request.address;
+  const unsigned retries = timeouts.retries;
+
+  // Sends `first` (which expires), then reads `readback` and hands its answer to `check`.
+  auto set_then_read = [&](const codec::CanFrame& first, PacketId readback, std::uint16_t read_address,
+                           std::function<void(const codec::PmuMessage&)> check) {
+    session.submit(step(first, std::nullopt, 0, expires,
+                        [run, readback, read_address, retries, check](const RequestOutcome& o) {
+                          if (!run->ok(o, "command")) {
+                            run->session.set_alias(std::nullopt);
+                            return;
+                          }
+                          run->session.submit_front(
+                              step(*codec::encode_get(readback, read_address), readback, retries, std::nullopt,
+                                   [run, check](const RequestOutcome& r) {
+                                     if (run->ok(r, "read-back")) check(*r.reply);
+                                   }),
+                              run->session.now());
+                        }),
+                   now);
+  };
+
+  switch (request.kind) {
+    case CommandKind::Get: {
+      const PacketId target = *get_target(request.parameter);
+      session.submit(step(*codec::encode_get(target, a), target, retries, expires,
+                          [run](const RequestOutcome& o) {
+                            if (!run->ok(o, "get")) return;
+                            const auto& m = *o.reply;
+                            if (const auto* p = std::get_if<codec::ParameterValue>(&m.payload))
+                              return run->finish(CommandResult::Completed, "", p->value);
+                            if (const auto* out = std::get_if<codec::OutputStates>(&m.payload))
+                              return run->finish(CommandResult::Completed, "", out->mask, mask_text(out->mask));
+                            if (const auto* g = std::get_if<codec::GenerationState>(&m.payload))
+                              return run->finish(CommandResult::Completed, "", g->enabled ? 1 : 0,
+                                                 g->enabled ? "on" : "off");
+                            run->finish(CommandResult::Completed,
+                                        "published on pmu/" + std::string(codec::packet_name(m.packet)));
+                          }),
+                     now);
+      return;
+    }
+    case CommandKind::SetParameter: {
+      const auto p = *codec::parameter_from_name(request.parameter);
+      const auto raw = *codec::to_raw(p, request.value, fw);
+      const auto& spec = codec::spec_of(p);
+      std::uint16_t read_at = a;
+      if (p == codec::Parameter::CanAddress) {
+        // The unit answers at its new address at once: read back there.
+        read_at = static_cast<std::uint16_t>(raw);
+        session.set_alias(read_at);
+      }
+      set_then_read(*codec::encode_parameter_reply(p, raw, a), spec.packet, read_at,
+                    [run, p, raw](const codec::PmuMessage& m) {
+                      const auto* got = std::get_if<codec::ParameterValue>(&m.payload);
+                      const double want = codec::parameter_value(p, raw);
+                      if (got && got->raw == raw) {
+                        if (p == codec::Parameter::CanAddress) run->session.readdress(static_cast<std::uint16_t>(raw));
+                        return run->finish(CommandResult::Completed, "", want);
+                      }
+                      run->session.set_alias(std::nullopt);
+                      char buf[128];
+                      std::snprintf(buf, sizeof buf, "device reports %g after the set, not %g",
+                                    got ? got->value : -1.0, want);
+                      run->finish(CommandResult::Failed, buf, got ? std::optional<double>(got->value) : std::nullopt);
+                    });
+      return;
+    }
+    case CommandKind::SetOutputs:
+    case CommandKind::EnableOutputs:
+    case CommandKind::DisableOutputs: {
+      const std::uint8_t mask = request.outputs;
+      const CommandKind kind = request.kind;
+      const auto frame = kind == CommandKind::SetOutputs      ? *codec::encode_set_outputs(mask, a)
+                         : kind == CommandKind::EnableOutputs ? *codec::encode_enable_outputs(mask, a)
+                                                              : *codec::encode_disable_outputs(mask, a);
+      set_then_read(frame, PacketId::Outputs, a, [run, mask, kind](const codec::PmuMessage& m) {
+        const auto* got = std::get_if<codec::OutputStates>(&m.payload);
+        const std::uint8_t now_on = got ? got->mask : 0;
+        const bool ok = got && (kind == CommandKind::SetOutputs      ? now_on == mask
+                                : kind == CommandKind::EnableOutputs ? (now_on & mask) == mask
+                                                                     : (now_on & mask) == 0);
+        if (ok) return run->finish(CommandResult::Completed, "", now_on, "on: " + mask_text(now_on));
+        run->finish(CommandResult::Failed, "outputs on after the command: " + mask_text(now_on), now_on,
+                    "on: " + mask_text(now_on));
+      });
+      return;
+    }
+    case CommandKind::SetGeneration: {
+      const bool enable = request.enable;
+      set_then_read(*codec::encode_generation(enable, a), PacketId::Generation, a,
+                    [run, enable](const codec::PmuMessage& m) {
+                      const auto* got = std::get_if<codec::GenerationState>(&m.payload);
+                      if (got && got->enabled == enable)
+                        return run->finish(CommandResult::Completed, "", enable ? 1 : 0, enable ? "on" : "off");
+                      run->finish(CommandResult::Failed,
+                                  std::string("generation still ") + (got && got->enabled ? "on" : "off"));
+                    });
+      return;
+    }
+    case CommandKind::RequestMeasurements: {
+      const std::uint8_t groups = request.groups ? request.groups : codec::group_bit::All;
+      std::uint8_t first = 0;
+      while (!(groups & (1u << first))) ++first;
+      const auto reply_packet = static_cast<PacketId>(first);
+      session.submit(step(*codec::encode_measurement_request(groups, a, fw), reply_packet, 0, expires,
+                          [run](const RequestOutcome& o) {
+                            if (run->ok(o, "measurement request"))
+                              run->finish(CommandResult::Completed, "measurements published on their topics");
+                          }),
+                     now);
+      return;
+    }
+    case CommandKind::EngineStart:
+    case CommandKind::Reset: {
+      const bool reset = request.kind == CommandKind::Reset;
+      const auto frame = reset ? *codec::encode_reset(a) : *codec::encode_engine_start(a);
+      const double ct = session.config_state().value(codec::Parameter::CrankingTime);
+      session.submit(step(frame, std::nullopt, 0, expires,
+                          [run, reset, ct](const RequestOutcome& o) {
+                            if (!run->ok(o, reset ? "reset" : "engine start")) return;
+                            if (reset) {
+                              // Outputs went to S0 and energies to zero: read everything again.
+                              run->session.reread(run->session.now());
+                              return run->finish(CommandResult::Completed, "reset sent; re-reading the device");
+                            }
+                            char buf[96];
+                            std::snprintf(buf, sizeof buf, "start sent; the starter cranks for up to %.1f s", ct);
+                            run->finish(CommandResult::Completed, buf);
+                          }),
+                     now);
+      return;
+    }
+    case CommandKind::EngineStop:
+      // Safety first: ahead of whatever the device has queued, and never expired.
+      session.submit_front(step(*codec::encode_engine_stop(a), std::nullopt, 0, std::nullopt,
+                                [run](const RequestOutcome& o) {
+                                  if (run->ok(o, "engine stop")) run->finish(CommandResult::Completed, "stop sent");
+                                }),
+                           now);
+      return;
+    case CommandKind::GetSerial:
+    case CommandKind::GetFirmware: {
+      const bool serial = request.kind == CommandKind::GetSerial;
+      const PacketId p = serial ? PacketId::Serial : PacketId::Firmware;
+      session.submit(step(*codec::encode_get(p, a), p, retries, expires,
+                          [run](const RequestOutcome& o) {
+                            if (!run->ok(o, "get")) return;
+                            if (const auto* s = std::get_if<codec::SerialNumber>(&o.reply->payload))
+                              return run->finish(CommandResult::Completed, "", s->serial_number,
+                                                 std::to_string(s->serial_number));
+                            const auto& f = std::get<codec::FirmwareInfo>(o.reply->payload);
+                            char buf[64];
+                            std::snprintf(buf, sizeof buf, "%u.%u built %04u-%02u-%02u", f.firmware_major,
+                                          f.firmware_minor, f.build_year, f.build_month, f.build_day);
+                            run->finish(CommandResult::Completed, "", f.firmware_major + f.firmware_minor / 100.0, buf);
+                          }),
+                     now);
+      return;
+    }
+  }
+}
+
+}  // namespace pmu::service

@@ -1,0 +1,78 @@
+#include "pmu/service/policy.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+
+#include "pmu/codec/messages.hpp"
+
+namespace pmu::service {
+namespace {
+
+constexpr std::array<std::string_view, kConfirmRuleCount> kRuleNames{
+    "disable_avionics", "reset", "engine_start", "set_can_address", "thermal_shutdown", "power_up_avionics_off"};
+
+// What each rule protects against, for the DENIED reason.
+constexpr std::array<std::string_view, kConfirmRuleCount> kRuleWhy{
+    "switches the avionics/servo output off",
+    "resets the PMU (outputs to their power-up state)",
+    "cranks the engine",
+    "moves the PMU to another CAN address",
+    "sets the upper temperature limit to 0, which forces thermal shutdown",
+    "leaves the avionics/servo output off at the next power-up or reset",
+};
+
+std::optional<ConfirmRule> rule_for(const CommandRequest& r) {
+  using codec::output_bit::AvionicsServo;
+  switch (r.kind) {
+    case CommandKind::DisableOutputs:
+      if (r.outputs & AvionicsServo) return ConfirmRule::DisableAvionics;
+      return std::nullopt;
+    case CommandKind::SetOutputs:
+      if (!(r.outputs & AvionicsServo)) return ConfirmRule::DisableAvionics;
+      return std::nullopt;
+    case CommandKind::Reset: return ConfirmRule::Reset;
+    case CommandKind::EngineStart: return ConfirmRule::EngineStart;
+    case CommandKind::SetParameter:
+      if (r.parameter == "can_address") return ConfirmRule::SetCanAddress;
+      if (r.parameter == "upper_temperature_limit" && r.value == 0) return ConfirmRule::ThermalShutdown;
+      if (r.parameter == "power_up_state" && std::isfinite(r.value) && r.value >= 0 && r.value <= 255 &&
+          !(static_cast<unsigned>(r.value) & AvionicsServo))
+        return ConfirmRule::PowerUpAvionicsOff;
+      return std::nullopt;
+    default: return std::nullopt;
+  }
+}
+
+}  // namespace
+
+std::string_view to_string(ConfirmRule r) noexcept { return kRuleNames[static_cast<std::size_t>(r)]; }
+
+std::optional<ConfirmRule> confirm_rule_from_name(std::string_view name) noexcept {
+  for (std::size_t i = 0; i < kRuleNames.size(); ++i)
+    if (kRuleNames[i] == name) return static_cast<ConfirmRule>(i);
+  return std::nullopt;
+}
+
+PolicyVerdict check_policy(const CommandRequest& r, const PolicyConfig& p) {
+  if (r.kind == CommandKind::EngineStop) return {};  // never refused by policy
+  if (p.deny[static_cast<std::size_t>(r.kind)])
+    return {CommandResult::Denied, std::string(to_string(r.kind)) + " is denied by the service's policy"};
+  if (const auto rule = rule_for(r); rule && p.confirm[static_cast<std::size_t>(*rule)] && !r.confirm) {
+    return {CommandResult::Denied, std::string(to_string(r.kind)) + " " +
+                                       std::string(kRuleWhy[static_cast<std::size_t>(*rule)]) +
+                                       ": it needs confirm (pmuctl --confirm); rule " + std::string(to_string(*rule))};
+  }
+  return {};
+}
+
+bool RateLimiter::allow(std::chrono::steady_clock::time_point now) {
+  if (rate_ <= 0) return true;
+  if (last_) tokens_ = std::min(burst_, tokens_ + std::chrono::duration<double>(now - *last_).count() * rate_);
+  last_ = now;
+  if (tokens_ < 1) return false;
+  tokens_ -= 1;
+  return true;
+}
+
+}  // namespace pmu::service

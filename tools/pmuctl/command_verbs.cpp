@@ -1,0 +1,227 @@
+#include "pmuctl/command_verbs.hpp"
+
+#include <unistd.h>
+
+#include <chrono>
+#include <cstdio>
+#include <fastdds/dds/core/status/PublicationMatchedStatus.hpp>
+#include <fastdds/dds/core/status/SubscriptionMatchedStatus.hpp>
+#include <fastdds/dds/subscriber/SampleInfo.hpp>
+#include <set>
+#include <thread>
+#include <vector>
+
+#include "pmu/idl/command.h"
+#include "pmu/idl/commandPubSubTypes.h"
+#include "pmu/idl/state.h"
+#include "pmu/idl/statePubSubTypes.h"
+#include "pmu/idl/topics.hpp"
+#include "pmu/service/dds_context.hpp"
+#include "pmuctl/dds_json.hpp"
+
+namespace pmu::tools {
+namespace {
+
+using namespace eprosima::fastdds::dds;
+using Clock = std::chrono::steady_clock;
+
+const char* const kOutputs[] = {"avionics_servo", "payload", "charger_a", "charger_b"};
+const char* const kGroups[] = {"voltages", "currents", "battery_energy", "temperatures", "status"};
+
+const char* result_name(pmu::CommandResult r) {
+  switch (r) {
+    case pmu::COMPLETED: return "COMPLETED";
+    case pmu::REJECTED: return "REJECTED";
+    case pmu::DENIED: return "DENIED";
+    case pmu::UNSUPPORTED: return "UNSUPPORTED";
+    case pmu::TIMEOUT: return "TIMEOUT";
+    case pmu::FAILED: return "FAILED";
+    case pmu::IN_PROGRESS: return "IN_PROGRESS";
+  }
+  return "FAILED";
+}
+
+std::string request_id() {
+  char host[64] = "host";
+  ::gethostname(host, sizeof host - 1);
+  const auto ns = std::chrono::duration_cast<std::chrono::nanoseconds>(
+                      std::chrono::system_clock::now().time_since_epoch())
+                      .count();
+  return "pmuctl-" + std::string(host).substr(0, 24) + "-" + std::to_string(::getpid()) + "-" + std::to_string(ns);
+}
+
+// Finds the device the command is for: --bus/--address when given, else the only PMU the
+// service knows. Returns false with a message a person can act on.
+bool resolve_target(const GlobalOptions& o, pmu::dds::DdsContext& dds, Clock::time_point deadline, std::string& bus,
+                    std::uint16_t& address) {
+  if (!o.bus.empty() && o.address) {
+    bus = o.bus;
+    address = *o.address;
+    return true;
+  }
+  DataReader& r = dds.reader(dds.topic(topics::kHealth, TypeSupport(new pmu::HealthPubSubType())), qos_profiles::kState);
+  std::set<std::pair<std::string, std::uint16_t>> seen;
+  std::optional<Clock::time_point> settle;
+  while (Clock::now() < deadline) {
+    pmu::Health h;
+    SampleInfo info;
+    while (r.take_next_sample(&h, &info) == ReturnCode_t::RETCODE_OK) {
+      if (!info.valid_data) continue;
+      if ((o.bus.empty() || o.bus == h.bus().to_string()) && (!o.address || *o.address == h.address()))
+        seen.insert({h.bus().to_string(), h.address()});
+    }
+    if (!seen.empty() && !settle) settle = Clock::now() + std::chrono::milliseconds(300);
+    if (settle && Clock::now() >= *settle) break;
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+  SubscriptionMatchedStatus st;
+  r.get_subscription_matched_status(st);
+  if (st.current_count == 0) {
+    std::fprintf(stderr, "pmuctl: no pmu-service on domain %d\n", o.domain);
+    return false;
+  }
+  if (seen.empty()) {
+    if (o.address)
+      std::fprintf(stderr, "pmuctl: device %u not seen%s\n", *o.address, o.bus.empty() ? "" : (" on " + o.bus).c_str());
+    else
+      std::fprintf(stderr, "pmuctl: the service knows no PMU%s\n", o.bus.empty() ? "" : (" on " + o.bus).c_str());
+    return false;
+  }
+  if (seen.size() > 1) {
+    std::string list;
+    for (const auto& [b, a] : seen) list += (list.empty() ? "" : ", ") + b + "/" + std::to_string(a);
+    std::fprintf(stderr, "pmuctl: several PMUs (%s): choose one with --bus and --address\n", list.c_str());
+    return false;
+  }
+  bus = seen.begin()->first;
+  address = seen.begin()->second;
+  return true;
+}
+
+}  // namespace
+
+bool output_mask(const std::vector<std::string>& names, std::uint8_t& mask) {
+  mask = 0;
+  for (const auto& n : names) {
+    if (n == "none") continue;
+    if (n == "all") {
+      mask = 0x0F;
+      continue;
+    }
+    bool found = false;
+    for (int b = 0; b < 4; ++b)
+      if (n == kOutputs[b]) {
+        mask = static_cast<std::uint8_t>(mask | (1u << b));
+        found = true;
+      }
+    if (!found) {
+      std::fprintf(stderr, "pmuctl: unknown output '%s' (outputs: avionics_servo, payload, charger_a, charger_b)\n",
+                   n.c_str());
+      return false;
+    }
+  }
+  return true;
+}
+
+bool group_mask(const std::vector<std::string>& names, std::uint8_t& mask) {
+  mask = 0;
+  for (const auto& n : names) {
+    bool found = false;
+    for (int b = 0; b < 5; ++b)
+      if (n == kGroups[b]) {
+        mask = static_cast<std::uint8_t>(mask | (1u << b));
+        found = true;
+      }
+    if (!found) {
+      std::fprintf(stderr,
+                   "pmuctl: unknown measurement group '%s' (voltages, currents, battery_energy, temperatures, status)\n",
+                   n.c_str());
+      return false;
+    }
+  }
+  return true;
+}
+
+int run_command(const GlobalOptions& o, const CommandSpec& spec) {
+  const double timeout = o.timeout.value_or(5.0);
+  const auto deadline = Clock::now() + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(timeout));
+  pmu::dds::DdsContext dds(o.domain, o.qos_file, "pmuctl");
+  DataReader& replies = dds.reader(dds.topic(topics::kCommandReply, TypeSupport(new pmu::CommandReplyPubSubType())),
+                                   qos_profiles::kCommand);
+  DataWriter& writer =
+      dds.writer(dds.topic(topics::kCommand, TypeSupport(new pmu::CommandPubSubType())), qos_profiles::kCommand);
+
+  std::string bus;
+  std::uint16_t address = 0;
+  if (!resolve_target(o, dds, deadline, bus, address)) return 2;
+
+  // Send only once the service's command reader and reply writer are matched: a command
+  // written before that would be lost, and a reply sent before it would never be seen.
+  for (;;) {
+    PublicationMatchedStatus pub;
+    SubscriptionMatchedStatus sub;
+    writer.get_publication_matched_status(pub);
+    replies.get_subscription_matched_status(sub);
+    if (pub.current_count > 0 && sub.current_count > 0) break;
+    if (Clock::now() >= deadline) {
+      std::fprintf(stderr, "pmuctl: no pmu-service on domain %d accepts commands\n", o.domain);
+      return 2;
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+
+  pmu::Command c;
+  const std::string id = request_id();
+  c.request_id(id);
+  c.bus(bus);
+  c.address(address);
+  c.kind(static_cast<pmu::CommandKind>(spec.kind));
+  c.parameter(spec.parameter);
+  c.value(spec.value);
+  c.outputs(spec.outputs);
+  c.enable(spec.enable);
+  c.groups(spec.groups);
+  const auto expires = std::chrono::system_clock::now() + std::chrono::duration_cast<std::chrono::system_clock::duration>(
+                                                              std::chrono::duration<double>(timeout));
+  c.expires_at(static_cast<std::uint64_t>(
+      std::chrono::duration_cast<std::chrono::nanoseconds>(expires.time_since_epoch()).count()));
+  c.confirm(spec.confirm);
+  if (!writer.write(&c)) {  // bool in Fast DDS 2.x
+    std::fprintf(stderr, "pmuctl: the command could not be written to DDS\n");
+    return 2;
+  }
+
+  while (Clock::now() < deadline + std::chrono::milliseconds(500)) {
+    pmu::CommandReply r;
+    SampleInfo info;
+    while (replies.take_next_sample(&r, &info) == ReturnCode_t::RETCODE_OK) {
+      if (!info.valid_data || r.request_id().to_string() != id) continue;
+      if (r.result() == pmu::IN_PROGRESS) {
+        std::fprintf(stderr, "IN_PROGRESS: %s\n", r.reason().c_str());
+        continue;
+      }
+      if (o.json) {
+        Json j{{"request_id", id},
+               {"bus", r.bus().to_string()},
+               {"address", r.address()},
+               {"result", result_name(r.result())},
+               {"reason", r.reason().to_string()}};
+        if (r.has_value()) j["value"] = r.value();
+        if (!(r.value_text().size() == 0)) j["value_text"] = r.value_text().to_string();
+        std::printf("%s\n", j.dump().c_str());
+      } else if (r.has_value() || !(r.value_text().size() == 0)) {
+        if (!(r.value_text().size() == 0))
+          std::printf("%s\n", r.value_text().c_str());
+        else
+          std::printf("%g\n", r.value());
+      }
+      std::fprintf(stderr, "%s%s%s\n", result_name(r.result()), (r.reason().size() == 0) ? "" : ": ", r.reason().c_str());
+      return r.result() == pmu::COMPLETED ? 0 : 1;
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  }
+  std::fprintf(stderr, "pmuctl: no reply from pmu-service within %.1f s (request %s)\n", timeout, id.c_str());
+  return 3;
+}
+
+}  // namespace pmu::tools
