@@ -54,7 +54,7 @@ const BadCase kBad[] = {
     {"buses: [\n", "bad.yaml:2: YAML syntax error: end of sequence flow not found"},
     {"domain: 0\n", "bad.yaml:1: no buses: the service needs at least one bus"},
     {"domian: 0\nbuses: []\n",
-     "bad.yaml:1: unknown key 'domian' in the top level (known: domain, qos_file, log_level, buses, timeouts)"},
+     "bad.yaml:1: unknown key 'domian' in the top level (known: domain, qos_file, log_level, buses, timeouts, policy)"},
     {"domain: 300\nbuses: []\n", "bad.yaml:1: domain 300 out of range 0..232"},
     {"domain: x\nbuses: []\n", "bad.yaml:1: domain must be an integer, not 'x'"},
     {"buses: []\n", "bad.yaml:1: buses must be a non-empty list"},

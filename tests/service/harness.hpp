@@ -70,12 +70,15 @@ inline sim::DeviceConfig pmu(std::uint16_t address, codec::FirmwareVersion fw = 
 
 class Harness {
  public:
-  Harness(BusConfig bus, std::vector<sim::DeviceConfig> pmus, Timeouts timeouts = {}) : network_(clock_) {
+  // `publish_to` replaces the recording sink (e.g. the DDS publisher); `sink` then stays empty.
+  Harness(BusConfig bus, std::vector<sim::DeviceConfig> pmus, Timeouts timeouts = {}, StateSink* publish_to = nullptr)
+      : network_(clock_) {
     runner_ = std::make_unique<sim::BusRunner>(network_.attach("pmu-sim"), clock_);
     for (const auto& p : pmus) runner_->add(p);
     auto recording = std::make_unique<RecordingBus>(network_.attach(bus.name));
     bus_ = recording.get();
-    worker_ = std::make_unique<BusWorker>(bus, std::move(recording), clock_, timeouts, sink);
+    worker_ = std::make_unique<BusWorker>(bus, std::move(recording), clock_, timeouts,
+                                          publish_to ? *publish_to : static_cast<StateSink&>(sink));
     settle();
   }
 
