@@ -26,10 +26,16 @@ class RecordingBus final : public transport::CanBus {
   int fd() const noexcept override { return inner_->fd(); }
   transport::DrainResult drain(transport::BusHandler& h) override { return inner_->drain(h); }
   transport::SendResult send(const codec::CanFrame& f, std::chrono::milliseconds w) override {
+    // A lost set: the bus accepts it but the device never sees it (to test read-back).
+    if (drop_data_of && f.length > 0 && ((f.id >> 16) & 0xFF) == *drop_data_of) {
+      sent.push_back(f);
+      return {};
+    }
     auto r = inner_->send(f, w);
     if (r.ok()) sent.push_back(f);
     return r;
   }
+  std::optional<std::uint8_t> drop_data_of;  // packet id whose data frames are lost
   transport::BusState state() const noexcept override { return inner_->state(); }
   transport::BusCounters counters() const noexcept override { return inner_->counters(); }
   void maintain(std::chrono::steady_clock::time_point now) override { inner_->maintain(now); }
@@ -105,6 +111,8 @@ class Harness {
     return out;
   }
   void clear_sent() { bus_->sent.clear(); }
+  const std::vector<codec::CanFrame>& sent_frames() const { return bus_->sent; }
+  RecordingBus& recording_bus() { return *bus_; }
 
   BusWorker& worker() { return *worker_; }
   sim::BusRunner& pmus() { return *runner_; }

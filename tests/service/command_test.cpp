@@ -1,0 +1,535 @@
+// The command path against simulated PMUs with a fake clock (interface.md, commands):
+// every command kind's frames byte for byte, verification by read-back, every rejection
+// with zero frames sent, the safety policy, duplicates, timeouts, retries, serialisation,
+// and a burst of 1000 mixed commands from two senders.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <map>
+#include <random>
+
+#include "harness.hpp"
+#include "pmu/codec/encode.hpp"
+#include "pmu/service/command_service.hpp"
+
+namespace pmu::service::test {
+namespace {
+
+using codec::CanFrame;
+
+CanFrame frame(std::uint8_t packet, std::uint16_t address, std::initializer_list<std::uint8_t> bytes) {
+  CanFrame f;
+  f.id = (0x1Eu << 24) | (std::uint32_t{packet} << 16) | address;
+  f.extended = true;
+  f.length = static_cast<std::uint8_t>(bytes.size());
+  std::size_t i = 0;
+  for (auto b : bytes) f.data[i++] = b;
+  return f;
+}
+
+std::string hex(const CanFrame& f) {
+  char buf[40];
+  int n = std::snprintf(buf, sizeof buf, "%08X#", f.id);
+  for (std::uint8_t i = 0; i < f.length; ++i) n += std::snprintf(buf + n, sizeof buf - static_cast<std::size_t>(n), "%02X", f.data[i]);
+  return buf;
+}
+
+// A harness plus a CommandService whose replies are collected.
+class Commands {
+ public:
+  explicit Commands(std::vector<sim::DeviceConfig> pmus, PolicyConfig policy = {}, Timeouts timeouts = {},
+                    std::vector<DeviceConfig> devices = {device(1)})
+      : h(sim_bus(devices), std::move(pmus), timeouts),
+        service({&h.worker()}, policy, timeouts, h.clock(), [this](const CommandReplyData& r) { replies.push_back(r); }) {
+    h.run_for(300ms);  // start-up reading done
+    h.clear_sent();
+  }
+
+  CommandRequest req(CommandKind kind, std::uint16_t address = 1) {
+    CommandRequest r;
+    r.request_id = "t-" + std::to_string(++next_id_);
+    r.sender = "test";
+    r.bus = "sim0";
+    r.address = address;
+    r.kind = kind;
+    return r;
+  }
+  // Submits and runs the bus until the reply arrives (or 10 s of bus time pass).
+  CommandReplyData run(const CommandRequest& r) {
+    const auto before = replies.size();
+    service.submit(r);
+    for (int i = 0; i < 1000 && replies.size() == before; ++i) h.run_for(10ms);
+    EXPECT_EQ(replies.size(), before + 1) << "exactly one reply";
+    return replies.empty() ? CommandReplyData{} : replies.back();
+  }
+  std::vector<std::string> sent() const {
+    std::vector<std::string> v;
+    for (const auto& f : h.sent_frames()) v.push_back(hex(f));
+    return v;
+  }
+
+  Harness h;
+  std::vector<CommandReplyData> replies;
+  CommandService service;
+
+ private:
+  int next_id_ = 0;
+};
+
+CommandRequest set_param(Commands& c, const char* name, double value, std::uint16_t address = 1) {
+  auto r = c.req(CommandKind::SetParameter, address);
+  r.parameter = name;
+  r.value = value;
+  return r;
+}
+
+// ---- happy paths: the frames of the spec, and the state that follows --------------------
+
+struct HappyCase {
+  const char* what;
+  std::function<CommandRequest(Commands&)> make;
+  std::vector<CanFrame> frames;  // exactly what goes on the bus, in order
+  std::function<void(Commands&, const CommandReplyData&)> check;
+};
+
+std::uint32_t sim_param(Commands& c, codec::Parameter p) {
+  std::uint32_t v = 0;
+  c.h.pmus().with_model(1, [&](sim::PmuModel& m) { v = m.parameter(p); });
+  return v;
+}
+std::uint8_t sim_outputs(Commands& c) {
+  std::uint8_t v = 0;
+  c.h.pmus().with_model(1, [&](sim::PmuModel& m) { v = m.outputs(); });
+  return v;
+}
+
+TEST(Commands, EveryKindPutsTheSpecsFramesOnTheBusAndTheResultShowsUp) {
+  const HappyCase cases[] = {
+      {"set avionics_voltage 24.0",
+       [](Commands& c) { return set_param(c, "avionics_voltage", 24.0); },
+       {frame(0x10, 1, {240}), frame(0x10, 1, {})},
+       [](Commands& c, const CommandReplyData& r) {
+         EXPECT_DOUBLE_EQ(r.value, 24.0);
+         EXPECT_EQ(sim_param(c, codec::Parameter::AvionicsVoltage), 240u);
+         EXPECT_DOUBLE_EQ(c.h.sink.configs.back().second.value(codec::Parameter::AvionicsVoltage), 24.0);
+       }},
+      {"set cranking_time 2.5",
+       [](Commands& c) { return set_param(c, "cranking_time", 2.5); },
+       {frame(0x19, 1, {25}), frame(0x19, 1, {})},
+       [](Commands& c, const CommandReplyData&) { EXPECT_EQ(sim_param(c, codec::Parameter::CrankingTime), 25u); }},
+      {"set outputs avionics+payload",
+       [](Commands& c) {
+         auto r = c.req(CommandKind::SetOutputs);
+         r.outputs = 0x03;
+         return r;
+       },
+       {frame(0x20, 1, {0x03}), frame(0x20, 1, {})},
+       [](Commands& c, const CommandReplyData& r) {
+         EXPECT_EQ(sim_outputs(c), 0x03);
+         EXPECT_EQ(r.value, 3);
+         EXPECT_EQ(c.h.sink.configs.back().second.outputs, 0x03);
+       }},
+      {"disable payload",
+       [](Commands& c) {
+         auto r = c.req(CommandKind::DisableOutputs);
+         r.outputs = 0x02;
+         return r;
+       },
+       {frame(0x22, 1, {0x02}), frame(0x20, 1, {})},
+       [](Commands& c, const CommandReplyData&) { EXPECT_EQ(sim_outputs(c) & 0x02, 0); }},
+      {"enable payload",
+       [](Commands& c) {
+         auto r = c.req(CommandKind::EnableOutputs);
+         r.outputs = 0x02;
+         return r;
+       },
+       {frame(0x21, 1, {0x02}), frame(0x20, 1, {})},
+       [](Commands& c, const CommandReplyData&) { EXPECT_EQ(sim_outputs(c) & 0x02, 0x02); }},
+      {"generation off",
+       [](Commands& c) {
+         auto r = c.req(CommandKind::SetGeneration);
+         r.enable = false;
+         return r;
+       },
+       {frame(0x23, 1, {0x00}), frame(0x23, 1, {})},
+       [](Commands& c, const CommandReplyData&) {
+         bool on = true;
+         c.h.pmus().with_model(1, [&](sim::PmuModel& m) { on = m.generation_enabled(); });
+         EXPECT_FALSE(on);
+       }},
+      {"measure temperatures",
+       [](Commands& c) {
+         auto r = c.req(CommandKind::RequestMeasurements);
+         r.groups = 0x08;
+         return r;
+       },
+       {frame(0x0F, 1, {0x08})},
+       [](Commands& c, const CommandReplyData&) { EXPECT_GE(c.h.sink.count(codec::PacketId::Temperatures, 1), 1u); }},
+      {"engine start (confirmed)",
+       [](Commands& c) {
+         c.h.pmus().with_model(1, [&](sim::PmuModel& m) { m.set_engine_running(false, c.h.clock().steady_now()); });
+         auto r = c.req(CommandKind::EngineStart);
+         r.confirm = true;
+         return r;
+       },
+       {frame(0x24, 1, {})},
+       [](Commands& c, const CommandReplyData&) {
+         sim::EngineState e{};
+         c.h.pmus().with_model(1, [&](sim::PmuModel& m) { e = m.engine_state(); });
+         EXPECT_NE(e, sim::EngineState::Stopped);
+       }},
+      {"engine stop", [](Commands& c) { return c.req(CommandKind::EngineStop); }, {frame(0x25, 1, {})}, nullptr},
+      {"get avionics_voltage",
+       [](Commands& c) {
+         auto r = c.req(CommandKind::Get);
+         r.parameter = "avionics_voltage";
+         return r;
+       },
+       {frame(0x10, 1, {})},
+       [](Commands&, const CommandReplyData& r) {
+         EXPECT_TRUE(r.has_value);
+         EXPECT_DOUBLE_EQ(r.value, 12.0);
+       }},
+      {"get serial", [](Commands& c) { return c.req(CommandKind::GetSerial); }, {frame(0x30, 1, {})},
+       [](Commands&, const CommandReplyData& r) { EXPECT_EQ(r.value, 4001); }},
+      {"get firmware", [](Commands& c) { return c.req(CommandKind::GetFirmware); }, {frame(0x31, 1, {})},
+       [](Commands&, const CommandReplyData& r) { EXPECT_EQ(r.value_text, "1.17 built 2023-06-15"); }},
+  };
+  for (const auto& hc : cases) {
+    SCOPED_TRACE(hc.what);
+    Commands c({pmu(1)});
+    const auto r = c.run(hc.make(c));
+    EXPECT_EQ(r.result, CommandResult::Completed) << r.reason;
+    std::vector<std::string> want;
+    for (const auto& f : hc.frames) want.push_back(hex(f));
+    EXPECT_EQ(c.sent(), want);
+    if (hc.check) hc.check(c, r);
+  }
+}
+
+TEST(Commands, ResetIsSentThenEverythingIsReadAgain) {
+  Commands c({pmu(1)});
+  auto r = c.req(CommandKind::Reset);
+  r.confirm = true;
+  const auto infos = c.h.sink.infos.size();
+  EXPECT_EQ(c.run(r).result, CommandResult::Completed);
+  c.h.run_for(300ms);
+  ASSERT_GE(c.sent().size(), 16u);
+  EXPECT_EQ(c.sent()[0], hex(frame(0x26, 1, {})));
+  EXPECT_EQ(c.h.sink.infos.size(), infos + 1);
+}
+
+TEST(Commands, CanAddressChangeIsVerifiedAtTheNewAddressAndTheSessionMoves) {
+  Commands c({pmu(1)});
+  auto r = set_param(c, "can_address", 5);
+  r.confirm = true;
+  const auto reply = c.run(r);
+  EXPECT_EQ(reply.result, CommandResult::Completed) << reply.reason;
+  EXPECT_EQ(c.sent(), (std::vector<std::string>{hex(frame(0x1B, 1, {0x00, 0x05})), hex(frame(0x1B, 5, {}))}));
+  c.h.run_for(50ms);
+  EXPECT_EQ(c.h.worker().addresses(), (std::vector<std::uint16_t>{5}));
+  EXPECT_EQ(c.run(c.req(CommandKind::GetSerial, 5)).result, CommandResult::Completed);
+}
+
+// ---- rejected before the bus ----------------------------------------------------------------
+
+struct RefusedCase {
+  const char* what;
+  std::function<CommandRequest(Commands&)> make;
+  CommandResult result;
+  const char* reason;  // a part of the reason
+};
+
+TEST(Commands, InvalidRequestsAreRefusedWithAReasonAndNothingIsSent) {
+  const RefusedCase cases[] = {
+      {"unknown parameter", [](Commands& c) { return set_param(c, "avionics", 12); }, CommandResult::Rejected,
+       "unknown parameter 'avionics'"},
+      {"out of range", [](Commands& c) { return set_param(c, "avionics_voltage", 30.0); }, CommandResult::Rejected,
+       "value 30.0 V out of range 12.0..24.0 V for avionics_voltage"},
+      {"one step past", [](Commands& c) { return set_param(c, "battery_voltage", 25.3); }, CommandResult::Rejected,
+       "out of range 20.0..25.2 V"},
+      {"NaN", [](Commands& c) { return set_param(c, "servo_voltage", std::nan("")); }, CommandResult::Rejected,
+       "is not a number"},
+      {"between steps", [](Commands& c) { return set_param(c, "avionics_voltage", 12.05); }, CommandResult::Rejected,
+       "not a multiple of 0.1 V"},
+      {"unknown output",
+       [](Commands& c) {
+         auto r = c.req(CommandKind::EnableOutputs);
+         r.outputs = 0x10;
+         return r;
+       },
+       CommandResult::Rejected, "unknown output bits 0x10"},
+      {"enable nothing", [](Commands& c) { return c.req(CommandKind::EnableOutputs); }, CommandResult::Rejected,
+       "no output named"},
+      {"unknown get", [](Commands& c) {
+         auto r = c.req(CommandKind::Get);
+         r.parameter = "volts";
+         return r;
+       }, CommandResult::Rejected, "unknown parameter 'volts'"},
+      {"expired",
+       [](Commands& c) {
+         auto r = c.req(CommandKind::GetSerial);
+         r.expires_at = c.h.clock().system_now() - 1s;
+         return r;
+       },
+       CommandResult::Rejected, "expired 1000 ms ago"},
+      {"unknown bus",
+       [](Commands& c) {
+         auto r = c.req(CommandKind::GetSerial);
+         r.bus = "can9";
+         return r;
+       },
+       CommandResult::Rejected, "bus 'can9' is not served here (buses: sim0)"},
+      {"unknown device", [](Commands& c) { return c.req(CommandKind::GetSerial, 7); }, CommandResult::Rejected,
+       "device 7 not seen on sim0"},
+      {"broadcast set", [](Commands& c) { return set_param(c, "avionics_voltage", 12.0, 0xFFFF); },
+       CommandResult::Rejected, "broadcast (65535) is only accepted for engine_stop"},
+      {"disable avionics without confirm",
+       [](Commands& c) {
+         auto r = c.req(CommandKind::DisableOutputs);
+         r.outputs = 0x01;
+         return r;
+       },
+       CommandResult::Denied, "needs confirm"},
+      {"set outputs without avionics, no confirm",
+       [](Commands& c) {
+         auto r = c.req(CommandKind::SetOutputs);
+         r.outputs = 0x02;
+         return r;
+       },
+       CommandResult::Denied, "rule disable_avionics"},
+      {"reset without confirm", [](Commands& c) { return c.req(CommandKind::Reset); }, CommandResult::Denied,
+       "rule reset"},
+      {"engine start without confirm", [](Commands& c) { return c.req(CommandKind::EngineStart); },
+       CommandResult::Denied, "rule engine_start"},
+      {"can address without confirm", [](Commands& c) { return set_param(c, "can_address", 9); },
+       CommandResult::Denied, "rule set_can_address"},
+      {"T_U = 0 without confirm", [](Commands& c) { return set_param(c, "upper_temperature_limit", 0); },
+       CommandResult::Denied, "rule thermal_shutdown"},
+      {"S0 without avionics, no confirm", [](Commands& c) { return set_param(c, "power_up_state", 0x0E); },
+       CommandResult::Denied, "rule power_up_avionics_off"},
+  };
+  for (const auto& rc : cases) {
+    SCOPED_TRACE(rc.what);
+    Commands c({pmu(1)});
+    const auto r = c.run(rc.make(c));
+    EXPECT_EQ(r.result, rc.result) << r.reason;
+    EXPECT_NE(r.reason.find(rc.reason), std::string::npos) << r.reason;
+    c.h.run_for(100ms);
+    EXPECT_TRUE(c.sent().empty()) << "a frame reached the bus";
+  }
+}
+
+TEST(Commands, FeaturesTheFirmwareLacksAreUnsupported) {
+  Commands c({pmu(1, codec::FirmwareVersion{1, 12})});
+  auto m = c.req(CommandKind::RequestMeasurements);
+  m.groups = 0x1F;
+  auto r = c.run(m);
+  EXPECT_EQ(r.result, CommandResult::Unsupported);
+  EXPECT_EQ(r.reason, "measurement_request needs firmware 1.14 (device has 1.12)");
+  r = c.run(set_param(c, "power_up_state", 0x41));
+  EXPECT_EQ(r.result, CommandResult::Unsupported);
+  EXPECT_TRUE(c.sent().empty());
+}
+
+TEST(Commands, DenyListRefusesEvenConfirmedCommandsButNeverEngineStop) {
+  PolicyConfig p;
+  p.deny.fill(true);
+  p.deny[static_cast<std::size_t>(CommandKind::EngineStop)] = false;  // config refuses to deny it anyway
+  Commands c({pmu(1)}, p);
+  auto reset = c.req(CommandKind::Reset);
+  reset.confirm = true;
+  auto r = c.run(reset);
+  EXPECT_EQ(r.result, CommandResult::Denied);
+  EXPECT_EQ(r.reason, "reset is denied by the service's policy");
+  EXPECT_EQ(c.run(c.req(CommandKind::EngineStop)).result, CommandResult::Completed);
+}
+
+TEST(Commands, RateLimitRejectsTheExcessWithAReasonButNeverEngineStop) {
+  PolicyConfig p;
+  p.rate_per_second = 1;
+  p.burst = 3;
+  Commands c({pmu(1)}, p);
+  for (int i = 0; i < 3; ++i) c.service.submit(c.req(CommandKind::GetSerial));
+  c.service.submit(c.req(CommandKind::GetSerial));
+  c.h.run_for(200ms);
+  ASSERT_EQ(c.replies.size(), 4u);
+  std::size_t limited = 0;
+  for (const auto& r : c.replies) limited += r.reason.find("rate limit") != std::string::npos ? 1u : 0u;
+  EXPECT_EQ(limited, 1u);
+  EXPECT_EQ(c.run(c.req(CommandKind::EngineStop)).result, CommandResult::Completed);
+  c.h.run_for(1100ms);  // a token comes back
+  EXPECT_EQ(c.run(c.req(CommandKind::GetSerial)).result, CommandResult::Completed);
+}
+
+TEST(Commands, DuplicateRequestIdIsAnsweredAgainButExecutedOnce) {
+  Commands c({pmu(1)});
+  auto r = set_param(c, "payload_voltage", 20.0);
+  c.service.submit(r);
+  c.service.submit(r);  // while the first is running
+  c.h.run_for(200ms);
+  c.service.submit(r);  // after it ended
+  c.h.run_for(100ms);
+  ASSERT_EQ(c.replies.size(), 3u);
+  for (const auto& reply : c.replies) {
+    EXPECT_EQ(reply.request_id, r.request_id);
+    EXPECT_EQ(reply.result, CommandResult::Completed);
+  }
+  EXPECT_EQ(c.sent(), (std::vector<std::string>{hex(frame(0x11, 1, {200})), hex(frame(0x11, 1, {}))}));
+  EXPECT_EQ(c.service.counters().duplicates, 2u);
+}
+
+TEST(Commands, ReadBackThatDiffersIsFailed) {
+  Commands c({pmu(1)});
+  c.h.recording_bus().drop_data_of = 0x12;  // the set of V_S never reaches the unit
+  const auto r = c.run(set_param(c, "servo_voltage", 9.0));
+  EXPECT_EQ(r.result, CommandResult::Failed);
+  EXPECT_EQ(r.reason, "device reports 6 after the set, not 9");
+}
+
+TEST(Commands, SilentDeviceTimesOutAfterBoundedRetries) {
+  Timeouts t;
+  t.retries = 2;
+  t.reply = 100ms;
+  Commands c({pmu(1)}, {}, t);
+  c.h.pmus().with_model(1, [](sim::PmuModel& m) {
+    auto f = m.faults();
+    f.silent = true;
+    m.set_faults(f);
+  });
+  const auto r = c.run(c.req(CommandKind::GetSerial));
+  EXPECT_EQ(r.result, CommandResult::Timeout);
+  EXPECT_EQ(r.reason, "device 1 did not answer the get after 3 tries");
+  EXPECT_EQ(c.sent().size(), 3u);
+  // A set whose read-back goes unanswered: the set is sent once (sets are not repeated),
+  // the read-back get up to three times.
+  c.h.clear_sent();
+  EXPECT_EQ(c.run(set_param(c, "payload_voltage", 13.0)).result, CommandResult::Timeout);
+  EXPECT_EQ(c.sent().size(), 4u);
+}
+
+TEST(Commands, LossyDeviceIsReachedThroughRetries) {
+  Timeouts t;
+  t.retries = 6;
+  t.reply = 50ms;
+  Commands c({pmu(1)}, {}, t);
+  c.h.pmus().with_model(1, [](sim::PmuModel& m) {
+    auto f = m.faults();
+    f.loss_probability = 0.4;
+    f.loss_seed = 7;
+    m.set_faults(f);
+  });
+  c.h.clear_sent();
+  int completed = 0;
+  for (int i = 0; i < 20; ++i) completed += c.run(c.req(CommandKind::GetSerial)).result == CommandResult::Completed;
+  EXPECT_EQ(completed, 20);
+  EXPECT_GT(c.sent().size(), 20u) << "some answers were lost and the gets retried";
+}
+
+TEST(Commands, OneDeviceIsSerialisedTwoDevicesProceedInParallel) {
+  auto slow = pmu(1);
+  Commands c({slow, pmu(2)}, {}, {}, {device(1), device(2)});
+  c.h.pmus().with_model(1, [](sim::PmuModel& m) {
+    auto f = m.faults();
+    f.delay = std::chrono::milliseconds(150);
+    m.set_faults(f);
+  });
+  c.service.submit(c.req(CommandKind::GetSerial, 1));
+  c.service.submit(c.req(CommandKind::GetFirmware, 1));
+  c.service.submit(c.req(CommandKind::GetSerial, 2));
+  c.h.run_for(20ms);
+  // Device 1 has one get in flight (its second waits); device 2 was asked at the same time.
+  EXPECT_EQ(c.sent(), (std::vector<std::string>{hex(frame(0x30, 1, {})), hex(frame(0x30, 2, {}))}));
+  ASSERT_EQ(c.replies.size(), 1u);
+  EXPECT_EQ(c.replies[0].address, 2);
+  c.h.run_for(400ms);
+  ASSERT_EQ(c.replies.size(), 3u);
+  EXPECT_EQ(c.replies[1].kind, CommandKind::GetSerial);
+  EXPECT_EQ(c.replies[2].kind, CommandKind::GetFirmware);
+  EXPECT_EQ(c.sent().back(), hex(frame(0x31, 1, {})));
+}
+
+TEST(Commands, EngineStopJumpsTheQueue) {
+  auto slow = pmu(1);
+  Commands c({slow});
+  c.h.pmus().with_model(1, [](sim::PmuModel& m) {
+    auto f = m.faults();
+    f.delay = std::chrono::milliseconds(100);
+    m.set_faults(f);
+  });
+  for (int i = 0; i < 5; ++i) c.service.submit(c.req(CommandKind::GetSerial));
+  c.service.submit(c.req(CommandKind::EngineStop));
+  c.h.run_for(150ms);
+  const auto s = c.sent();
+  ASSERT_GE(s.size(), 2u);
+  EXPECT_EQ(s[1], hex(frame(0x25, 1, {}))) << "sent right after the get already in flight";
+}
+
+TEST(Commands, BurstOf1000MixedCommandsFromTwoSendersGetsExactly1000Replies) {
+  PolicyConfig p;
+  p.rate_per_second = 0;  // this test is about delivery, not rate limits
+  Commands c({pmu(1), pmu(2)}, p, {}, {device(1), device(2)});
+  std::mt19937 rng(42);
+  std::vector<CommandRequest> all;
+  const char* params[] = {"avionics_voltage", "payload_voltage", "servo_voltage", "battery_voltage"};
+  for (int i = 0; i < 1000; ++i) {
+    CommandRequest r;
+    r.request_id = std::string(i % 2 ? "ground-a-" : "ground-b-") + std::to_string(i);
+    r.sender = i % 2 ? "ground-a" : "ground-b";
+    r.bus = "sim0";
+    r.address = static_cast<std::uint16_t>(1 + rng() % 2);
+    switch (rng() % 6) {
+      case 0:
+        r.kind = CommandKind::SetParameter;
+        r.parameter = params[rng() % 4];
+        r.value = 4.0 + static_cast<double>(rng() % 250) / 10.0;  // 4.0 .. 28.9 V: many out of range
+        break;
+      case 1:
+        r.kind = CommandKind::EnableOutputs;
+        r.outputs = static_cast<std::uint8_t>(1u << (1 + rng() % 3));
+        break;
+      case 2:
+        r.kind = CommandKind::DisableOutputs;
+        r.outputs = static_cast<std::uint8_t>(1u << (rng() % 4));  // avionics needs confirm
+        break;
+      case 3: r.kind = CommandKind::GetSerial; break;
+      case 4:
+        r.kind = CommandKind::Get;
+        r.parameter = "outputs";
+        break;
+      default:
+        r.kind = CommandKind::RequestMeasurements;
+        r.groups = static_cast<std::uint8_t>(1 + rng() % 31);
+    }
+    all.push_back(r);
+  }
+  for (const auto& r : all) c.service.submit(r);
+  for (int i = 0; i < 3000 && c.replies.size() < 1000; ++i) c.h.run_for(10ms);
+  ASSERT_EQ(c.replies.size(), 1000u);
+  std::map<std::string, int> per_id;
+  std::map<CommandResult, int> per_result;
+  for (const auto& r : c.replies) {
+    ++per_id[r.request_id];
+    ++per_result[r.result];
+  }
+  EXPECT_EQ(per_id.size(), 1000u) << "none lost, none duplicated";
+  EXPECT_GT(per_result[CommandResult::Completed], 300);
+  EXPECT_GT(per_result[CommandResult::Rejected], 50);
+  EXPECT_GT(per_result[CommandResult::Denied], 10);
+  // The devices never saw an out-of-range frame: every set that went out is within the spec.
+  for (const auto& f : c.h.sent_frames()) {
+    const auto m = codec::decode(f);
+    ASSERT_TRUE(m.ok());
+    if (const auto* pv = std::get_if<codec::ParameterValue>(&m->payload)) {
+      const auto& spec = codec::spec_of(pv->parameter);
+      EXPECT_GE(pv->raw, spec.raw_min);
+      EXPECT_LE(pv->raw, spec.raw_max);
+    }
+  }
+  for (std::uint16_t a : {std::uint16_t{1}, std::uint16_t{2}}) {
+    c.h.pmus().with_model(a, [](sim::PmuModel& m) { EXPECT_EQ(m.counters().rejected_sets, 0u); });
+  }
+}
+
+}  // namespace
+}  // namespace pmu::service::test

@@ -1,0 +1,107 @@
+// The safety policy on its own: which requests need confirm, deny lists, the rate limiter,
+// and the config keys that set them.
+#include <gtest/gtest.h>
+
+#include "pmu/service/config.hpp"
+#include "pmu/service/policy.hpp"
+
+namespace pmu::service {
+namespace {
+
+CommandRequest make(CommandKind k, std::uint8_t outputs = 0, const char* param = "", double value = 0) {
+  CommandRequest r;
+  r.kind = k;
+  r.outputs = outputs;
+  r.parameter = param;
+  r.value = value;
+  return r;
+}
+
+struct Case {
+  const char* what;
+  CommandRequest request;
+  bool needs_confirm;
+};
+
+TEST(Policy, ConfirmRulesByDefault) {
+  const Case cases[] = {
+      {"disable avionics", make(CommandKind::DisableOutputs, 0x01), true},
+      {"disable avionics and payload", make(CommandKind::DisableOutputs, 0x03), true},
+      {"disable payload", make(CommandKind::DisableOutputs, 0x02), false},
+      {"set outputs keeping avionics", make(CommandKind::SetOutputs, 0x0F), false},
+      {"set outputs dropping avionics", make(CommandKind::SetOutputs, 0x0E), true},
+      {"enable anything", make(CommandKind::EnableOutputs, 0x0F), false},
+      {"reset", make(CommandKind::Reset), true},
+      {"engine start", make(CommandKind::EngineStart), true},
+      {"engine stop", make(CommandKind::EngineStop), false},
+      {"can address", make(CommandKind::SetParameter, 0, "can_address", 3), true},
+      {"T_U 0", make(CommandKind::SetParameter, 0, "upper_temperature_limit", 0), true},
+      {"T_U 80", make(CommandKind::SetParameter, 0, "upper_temperature_limit", 80), false},
+      {"S0 with avionics", make(CommandKind::SetParameter, 0, "power_up_state", 0x21), false},
+      {"S0 without avionics", make(CommandKind::SetParameter, 0, "power_up_state", 0x20), true},
+      {"a voltage", make(CommandKind::SetParameter, 0, "avionics_voltage", 24), false},
+      {"generation off", make(CommandKind::SetGeneration), false},
+  };
+  const PolicyConfig p;
+  for (const auto& c : cases) {
+    SCOPED_TRACE(c.what);
+    const auto v = check_policy(c.request, p);
+    EXPECT_EQ(v.allowed(), !c.needs_confirm);
+    if (c.needs_confirm) {
+      EXPECT_EQ(v.result, CommandResult::Denied);
+      CommandRequest confirmed = c.request;
+      confirmed.confirm = true;
+      EXPECT_TRUE(check_policy(confirmed, p).allowed());
+    }
+  }
+}
+
+TEST(Policy, RulesCanBeSwitchedOffAndKindsDenied) {
+  const Config c = parse_config(R"(policy:
+  confirm: [reset]
+  deny: [engine_start, set_parameter]
+  rate_limit: 5
+  burst: 2
+  command_lifetime: 2.5
+buses:
+  - interface: can0
+    discover: true
+)",
+                                "p.yaml");
+  EXPECT_TRUE(check_policy(make(CommandKind::DisableOutputs, 0x01), c.policy).allowed());
+  EXPECT_FALSE(check_policy(make(CommandKind::Reset), c.policy).allowed());
+  auto start = make(CommandKind::EngineStart);
+  start.confirm = true;
+  EXPECT_EQ(check_policy(start, c.policy).reason, "engine_start is denied by the service's policy");
+  EXPECT_FALSE(check_policy(make(CommandKind::SetParameter, 0, "avionics_voltage", 24), c.policy).allowed());
+  EXPECT_TRUE(check_policy(make(CommandKind::EngineStop), c.policy).allowed());
+  EXPECT_DOUBLE_EQ(c.policy.rate_per_second, 5);
+  EXPECT_EQ(c.policy.default_lifetime, std::chrono::milliseconds(2500));
+}
+
+TEST(Policy, EngineStopCannotBeDeniedByConfig) {
+  try {
+    (void)parse_config("policy:\n  deny: [engine_stop]\nbuses:\n  - interface: can0\n    discover: true\n", "p.yaml");
+    ADD_FAILURE() << "accepted";
+  } catch (const ConfigError& e) {
+    EXPECT_EQ(std::string(e.what()), "p.yaml:2: engine_stop cannot be denied: it is the safety stop");
+  }
+  EXPECT_THROW((void)parse_config("policy:\n  confirm: [everything]\nbuses:\n  - interface: can0\n    discover: true\n", "p.yaml"),
+               ConfigError);
+}
+
+TEST(Policy, RateLimiterIsATokenBucket) {
+  RateLimiter r(2, 3);  // 2/s, burst 3
+  const auto t0 = std::chrono::steady_clock::time_point{} + std::chrono::seconds(100);
+  EXPECT_TRUE(r.allow(t0));
+  EXPECT_TRUE(r.allow(t0));
+  EXPECT_TRUE(r.allow(t0));
+  EXPECT_FALSE(r.allow(t0));
+  EXPECT_FALSE(r.allow(t0 + std::chrono::milliseconds(400)));
+  EXPECT_TRUE(r.allow(t0 + std::chrono::milliseconds(600)));  // 1.2 tokens refilled, 1 used
+  RateLimiter unlimited(0, 1);
+  for (int i = 0; i < 100; ++i) EXPECT_TRUE(unlimited.allow(t0));
+}
+
+}  // namespace
+}  // namespace pmu::service
