@@ -1,0 +1,226 @@
+// The command path over real Fast DDS: two ground stations burst 1000 commands at an
+// in-process service (real clock, simulated PMUs), and pmuctl / the example client across
+// processes get the contract's results, messages and exit statuses.
+#include <gtest/gtest.h>
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <atomic>
+#include <chrono>
+#include <fastdds/dds/core/status/PublicationMatchedStatus.hpp>
+#include <fastdds/dds/core/status/SubscriptionMatchedStatus.hpp>
+#include <fastdds/dds/subscriber/SampleInfo.hpp>
+#include <map>
+#include <thread>
+
+#include "pmu/idl/command.h"
+#include "pmu/idl/commandPubSubTypes.h"
+#include "pmu/idl/topics.hpp"
+#include "pmu/service/bus_worker.hpp"
+#include "pmu/service/command_service.hpp"
+#include "pmu/service/dds_commands.hpp"
+#include "pmu/service/dds_context.hpp"
+#include "pmu/service/dds_publisher.hpp"
+#include "pmu/sim/bus_runner.hpp"
+#include "pmu/transport/sim_bus.hpp"
+
+namespace pmu::service {
+namespace {
+
+using namespace eprosima::fastdds::dds;
+using namespace std::chrono_literals;
+using Clock = std::chrono::steady_clock;
+
+int test_domain() { return 150 + static_cast<int>(::getpid() % 80); }
+
+struct Sender {
+  Sender(int domain, const std::string& name)
+      : dds(domain, "", name),
+        writer(dds.writer(dds.topic(topics::kCommand, TypeSupport(new pmu::CommandPubSubType())), qos_profiles::kCommand)),
+        replies(dds.reader(dds.topic(topics::kCommandReply, TypeSupport(new pmu::CommandReplyPubSubType())),
+                           qos_profiles::kCommand)) {}
+  bool matched() {
+    PublicationMatchedStatus p;
+    SubscriptionMatchedStatus s;
+    writer.get_publication_matched_status(p);
+    replies.get_subscription_matched_status(s);
+    return p.current_count > 0 && s.current_count > 0;
+  }
+  dds::DdsContext dds;
+  DataWriter& writer;
+  DataReader& replies;
+};
+
+TEST(CommandsOverDds, TwoSendersBurst1000CommandsAndGetExactly1000Replies) {
+  const int domain = test_domain();
+  transport::SystemClock clock;
+  transport::SimulatedNetwork network(clock);
+  sim::BusRunner pmus(network.attach("pmu-sim"), clock);
+  for (std::uint16_t a : {std::uint16_t{1}, std::uint16_t{2}}) {
+    sim::DeviceConfig d;
+    d.address = a;
+    pmus.add(d);
+  }
+  BusConfig bus;
+  bus.name = "sim0";
+  bus.interface = "sim";
+  for (std::uint16_t a : {std::uint16_t{1}, std::uint16_t{2}}) {
+    DeviceConfig d;
+    d.address = a;
+    bus.devices.push_back(d);
+  }
+  dds::DdsContext service_dds(domain, "", "pmu-service-burst");
+  DdsPublisher publisher(service_dds, 3s);
+  BusWorker worker(bus, network.attach("sim0"), clock, Timeouts{}, publisher);
+  DdsCommandEndpoint endpoint(service_dds);
+  PolicyConfig policy;
+  policy.rate_per_second = 0;
+  CommandService service({&worker}, policy, Timeouts{}, clock, [&](const CommandReplyData& r) { endpoint.publish(r); });
+  pmus.start();
+  std::thread worker_thread([&] { worker.run(); });
+  endpoint.start(service);
+
+  Sender a(domain, "ground-a"), b(domain, "ground-b");
+  for (int i = 0; i < 500 && !(a.matched() && b.matched()); ++i) std::this_thread::sleep_for(10ms);
+  ASSERT_TRUE(a.matched() && b.matched());
+  std::this_thread::sleep_for(500ms);  // the devices' start-up reading
+
+  std::map<std::string, int> replies_a, replies_b;
+  std::atomic<bool> done{false};
+  auto collect = [&](Sender& s, std::map<std::string, int>& out, const std::string& prefix) {
+    pmu::CommandReply r;
+    SampleInfo info;
+    while (s.replies.take_next_sample(&r, &info) == ReturnCode_t::RETCODE_OK)
+      if (info.valid_data && r.request_id().to_string().rfind(prefix, 0) == 0) ++out[r.request_id().to_string()];
+  };
+  auto send = [&](Sender& s, const std::string& prefix) {
+    for (int i = 0; i < 500; ++i) {
+      pmu::Command c;
+      c.request_id(prefix + std::to_string(i));
+      c.bus("sim0");
+      c.address(static_cast<unsigned short>(1 + i % 2));
+      switch (i % 4) {
+        case 0:
+          c.kind(pmu::SET_PARAMETER);
+          c.parameter("payload_voltage");
+          c.value(i % 8 == 0 ? 30.0 : 12.0 + (i % 100) / 10.0);  // some out of range
+          break;
+        case 1: c.kind(pmu::GET_SERIAL); break;
+        case 2:
+          c.kind(pmu::ENABLE_OUTPUTS);
+          c.outputs(0x02);
+          break;
+        default:
+          c.kind(pmu::GET);
+          c.parameter("outputs");
+      }
+      s.writer.write(&c);
+      // A well-behaved client sends bursts the command QoS depth (256) holds, and lets
+      // them be acknowledged before the next.
+      if (i % 100 == 99) s.writer.wait_for_acknowledgments(eprosima::fastrtps::Duration_t(5, 0));
+    }
+  };
+  std::thread ta([&] { send(a, "a-"); });
+  std::thread tb([&] { send(b, "b-"); });
+  const auto deadline = Clock::now() + 60s;
+  while (Clock::now() < deadline && (replies_a.size() < 500 || replies_b.size() < 500)) {
+    collect(a, replies_a, "a-");
+    collect(b, replies_b, "b-");
+    std::this_thread::sleep_for(2ms);
+  }
+  ta.join();
+  tb.join();
+  std::this_thread::sleep_for(300ms);  // anything duplicated would arrive now
+  collect(a, replies_a, "a-");
+  collect(b, replies_b, "b-");
+  done = true;
+  endpoint.stop();
+  worker.stop();
+  worker_thread.join();
+  pmus.stop();
+
+  EXPECT_EQ(replies_a.size(), 500u);
+  EXPECT_EQ(replies_b.size(), 500u);
+  for (const auto* m : {&replies_a, &replies_b})
+    for (const auto& [id, n] : *m) EXPECT_EQ(n, 1) << id << " answered " << n << " times";
+  const auto counters = service.counters();
+  EXPECT_EQ(counters.received, 1000u);
+  EXPECT_EQ(counters.duplicates, 0u);
+  for (std::uint16_t addr : {std::uint16_t{1}, std::uint16_t{2}})
+    pmus.with_model(addr, [](sim::PmuModel& m) { EXPECT_EQ(m.counters().rejected_sets, 0u) << "an out-of-range set reached a unit"; });
+}
+
+// ---- pmuctl and the example client against pmu-service ----------------------------------
+
+struct Service {
+  explicit Service(int domain) {
+    pid = ::fork();
+    if (pid == 0) {
+      const std::string d = std::to_string(domain);
+      ::execl(PMU_SERVICE_PATH, PMU_SERVICE_PATH, "--bus", "sim", "--domain", d.c_str(), "--log-level", "warn",
+              static_cast<char*>(nullptr));
+      std::_Exit(127);
+    }
+  }
+  ~Service() {
+    ::kill(pid, SIGTERM);
+    ::waitpid(pid, nullptr, 0);
+  }
+  pid_t pid;
+};
+
+struct Result {
+  int status;
+  std::string out;
+};
+
+Result sh(const std::string& cmd) {
+  Result r{-1, {}};
+  FILE* p = ::popen((cmd + " 2>&1").c_str(), "r");
+  char buf[4096];
+  std::size_t n = 0;
+  while ((n = std::fread(buf, 1, sizeof buf, p)) > 0) r.out.append(buf, n);
+  const int st = ::pclose(p);
+  r.status = WIFEXITED(st) ? WEXITSTATUS(st) : -1;
+  return r;
+}
+
+TEST(PmuctlCommands, ResultsMessagesAndExitStatus) {
+  const int domain = test_domain() + 1;
+  Service service(domain);
+  const std::string p = std::string(PMUCTL_PATH) + " --domain " + std::to_string(domain) + " ";
+  auto r = sh(p + "config set avionics_voltage 24");
+  EXPECT_EQ(r.status, 0) << r.out;
+  EXPECT_NE(r.out.find("COMPLETED"), std::string::npos) << r.out;
+  r = sh(p + "config get avionics_voltage");
+  EXPECT_NE(r.out.find("avionics_voltage = 24.0"), std::string::npos) << r.out;
+  r = sh(p + "config set avionics_voltage 30.0");
+  EXPECT_EQ(r.status, 1);
+  EXPECT_NE(r.out.find("REJECTED: value 30.0 V out of range 12.0..24.0 V"), std::string::npos) << r.out;
+  r = sh(p + "outputs disable avionics_servo");
+  EXPECT_EQ(r.status, 1);
+  EXPECT_NE(r.out.find("DENIED"), std::string::npos) << r.out;
+  r = sh(p + "--confirm outputs disable avionics_servo");
+  EXPECT_EQ(r.status, 0) << r.out;
+  r = sh(p + "outputs get");
+  EXPECT_EQ(r.status, 0) << r.out;
+  EXPECT_EQ(r.out.find("avionics_servo"), std::string::npos) << r.out;
+  r = sh(p + "--address 7 engine stop");
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.out.find("device 7 not seen"), std::string::npos) << r.out;
+  r = sh(p + "--json generation off");
+  EXPECT_EQ(r.status, 0) << r.out;
+  EXPECT_NE(r.out.find("\"result\":\"COMPLETED\""), std::string::npos) << r.out;
+  r = sh("PMU_QOS_FILE=" PMU_QOS_FILE " " GROUND_STATION_PATH " --domain " + std::to_string(domain));
+  EXPECT_EQ(r.status, 0) << r.out;
+}
+
+TEST(PmuctlCommands, NoServiceIsSaid) {
+  const auto r = sh(std::string(PMUCTL_PATH) + " --domain 230 --timeout 1 config set avionics_voltage 24");
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.out.find("no pmu-service on domain 230"), std::string::npos) << r.out;
+}
+
+}  // namespace
+}  // namespace pmu::service
