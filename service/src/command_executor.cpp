@@ -147,21 +147,38 @@ void execute_command(DeviceSession& session, const CommandRequest& request, Stea
   const std::uint16_t a = request.address;
   const unsigned retries = timeouts.retries;
 
-  // Sends `first` (which expires), then reads `readback` and hands its answer to `check`.
-  auto set_then_read = [&](const codec::CanFrame& first, PacketId readback, std::uint16_t read_address,
-                           std::function<void(const codec::PmuMessage&)> check) {
+  // Sends `first` (which expires), then reads `readback` and hands the answer to `check`,
+  // which returns true when the device reports what was asked. A mismatch is read once more
+  // before it counts: the protocol has no sequence numbers, so a late answer to an earlier
+  // get of the same packet can arrive first. `check(m, true)` on the last read must finish.
+  using Check = std::function<bool(const codec::PmuMessage&, bool last)>;
+  auto set_then_read = [&](const codec::CanFrame& first, PacketId readback, std::uint16_t read_address, Check check) {
+    auto read = std::make_shared<std::function<void(bool)>>();
+    *read = [run, readback, read_address, retries, check, read](bool last) {
+      run->session.submit_front(
+          step(*codec::encode_get(readback, read_address), readback, retries, std::nullopt,
+               [run, check, read, last](const RequestOutcome& r) {
+                 if (!run->ok(r, "read-back")) {
+                   run->session.set_alias(std::nullopt);
+                   *read = nullptr;  // break the self-reference
+                   return;
+                 }
+                 if (check(*r.reply, last) || last) {
+                   *read = nullptr;
+                   return;
+                 }
+                 (*read)(true);
+               }),
+          run->session.now());
+    };
     session.submit(step(first, std::nullopt, 0, expires,
-                        [run, readback, read_address, retries, check](const RequestOutcome& o) {
+                        [run, read](const RequestOutcome& o) {
                           if (!run->ok(o, "command")) {
                             run->session.set_alias(std::nullopt);
+                            *read = nullptr;
                             return;
                           }
-                          run->session.submit_front(
-                              step(*codec::encode_get(readback, read_address), readback, retries, std::nullopt,
-                                   [run, check](const RequestOutcome& r) {
-                                     if (run->ok(r, "read-back")) check(*r.reply);
-                                   }),
-                              run->session.now());
+                          (*read)(false);
                         }),
                    now);
   };
@@ -197,18 +214,21 @@ void execute_command(DeviceSession& session, const CommandRequest& request, Stea
         session.set_alias(read_at);
       }
       set_then_read(*codec::encode_parameter_reply(p, raw, a), spec.packet, read_at,
-                    [run, p, raw](const codec::PmuMessage& m) {
+                    [run, p, raw](const codec::PmuMessage& m, bool last) {
                       const auto* got = std::get_if<codec::ParameterValue>(&m.payload);
                       const double want = codec::parameter_value(p, raw);
                       if (got && got->raw == raw) {
                         if (p == codec::Parameter::CanAddress) run->session.readdress(static_cast<std::uint16_t>(raw));
-                        return run->finish(CommandResult::Completed, "", want);
+                        run->finish(CommandResult::Completed, "", want);
+                        return true;
                       }
+                      if (!last) return false;
                       run->session.set_alias(std::nullopt);
                       char buf[128];
                       std::snprintf(buf, sizeof buf, "device reports %g after the set, not %g",
                                     got ? got->value : -1.0, want);
                       run->finish(CommandResult::Failed, buf, got ? std::optional<double>(got->value) : std::nullopt);
+                      return false;
                     });
       return;
     }
@@ -220,27 +240,36 @@ void execute_command(DeviceSession& session, const CommandRequest& request, Stea
       const auto frame = kind == CommandKind::SetOutputs      ? *codec::encode_set_outputs(mask, a)
                          : kind == CommandKind::EnableOutputs ? *codec::encode_enable_outputs(mask, a)
                                                               : *codec::encode_disable_outputs(mask, a);
-      set_then_read(frame, PacketId::Outputs, a, [run, mask, kind](const codec::PmuMessage& m) {
+      set_then_read(frame, PacketId::Outputs, a, [run, mask, kind](const codec::PmuMessage& m, bool last) {
         const auto* got = std::get_if<codec::OutputStates>(&m.payload);
         const std::uint8_t now_on = got ? got->mask : 0;
         const bool ok = got && (kind == CommandKind::SetOutputs      ? now_on == mask
                                 : kind == CommandKind::EnableOutputs ? (now_on & mask) == mask
                                                                      : (now_on & mask) == 0);
-        if (ok) return run->finish(CommandResult::Completed, "", now_on, "on: " + mask_text(now_on));
-        run->finish(CommandResult::Failed, "outputs on after the command: " + mask_text(now_on), now_on,
-                    "on: " + mask_text(now_on));
+        if (ok) {
+          run->finish(CommandResult::Completed, "", now_on, "on: " + mask_text(now_on));
+          return true;
+        }
+        if (last)
+          run->finish(CommandResult::Failed, "outputs on after the command: " + mask_text(now_on), now_on,
+                      "on: " + mask_text(now_on));
+        return false;
       });
       return;
     }
     case CommandKind::SetGeneration: {
       const bool enable = request.enable;
       set_then_read(*codec::encode_generation(enable, a), PacketId::Generation, a,
-                    [run, enable](const codec::PmuMessage& m) {
+                    [run, enable](const codec::PmuMessage& m, bool last) {
                       const auto* got = std::get_if<codec::GenerationState>(&m.payload);
-                      if (got && got->enabled == enable)
-                        return run->finish(CommandResult::Completed, "", enable ? 1 : 0, enable ? "on" : "off");
-                      run->finish(CommandResult::Failed,
-                                  std::string("generation still ") + (got && got->enabled ? "on" : "off"));
+                      if (got && got->enabled == enable) {
+                        run->finish(CommandResult::Completed, "", enable ? 1 : 0, enable ? "on" : "off");
+                        return true;
+                      }
+                      if (last)
+                        run->finish(CommandResult::Failed,
+                                    std::string("generation still ") + (got && got->enabled ? "on" : "off"));
+                      return false;
                     });
       return;
     }

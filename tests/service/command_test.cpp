@@ -533,3 +533,44 @@ TEST(Commands, BurstOf1000MixedCommandsFromTwoSendersGetsExactly1000Replies) {
 
 }  // namespace
 }  // namespace pmu::service::test
+
+namespace pmu::service::test {
+namespace {
+
+TEST(Commands, RequestsThatExpireWhileQueuedAreNeverSent) {
+  Commands c({pmu(1)});
+  c.h.pmus().with_model(1, [](sim::PmuModel& m) {
+    auto f = m.faults();
+    f.delay = std::chrono::milliseconds(300);  // each answer takes 0.3 s
+    m.set_faults(f);
+  });
+  for (int i = 0; i < 4; ++i) {
+    auto r = set_param(c, "payload_voltage", 13.0 + i);
+    r.expires_at = c.h.clock().system_now() + 500ms;
+    c.service.submit(r);
+  }
+  c.h.run_for(3000ms);
+  ASSERT_EQ(c.replies.size(), 4u);
+  std::size_t expired = 0;
+  for (const auto& r : c.replies) expired += r.reason == "expired before it could be sent" ? 1u : 0u;
+  EXPECT_GE(expired, 2u);
+  // Only the sets that were still fresh went out.
+  std::size_t sets = 0;
+  for (const auto& f : c.h.sent_frames()) sets += f.length == 1 ? 1u : 0u;
+  EXPECT_EQ(sets, 4u - expired);
+}
+
+TEST(Commands, ARequestWithoutIdStillGetsExactlyOneReply) {
+  Commands c({pmu(1)});
+  auto r = c.req(CommandKind::GetSerial);
+  r.request_id.clear();
+  c.service.submit(r);
+  c.h.run_for(100ms);
+  ASSERT_EQ(c.replies.size(), 1u);
+  EXPECT_EQ(c.replies[0].result, CommandResult::Rejected);
+  EXPECT_EQ(c.replies[0].reason, "request_id is empty");
+  EXPECT_TRUE(c.sent().empty());
+}
+
+}  // namespace
+}  // namespace pmu::service::test
