@@ -1,6 +1,8 @@
 #!/usr/bin/env bash
 # The one test command (README, .ci/run): installs what is missing, builds, runs every test.
-#   1. release build (-Werror): unit, CLI, transport, simulator tests, benchmark smoke runs
+#   1. release build (-Werror): unit, CLI, transport, simulator, service, DDS integration and
+#      deploy tests, benchmark smoke runs, and the system tests: real SocketCAN on vcan in a
+#      qemu VM booting Debian's kernel (tests/system, about 3 minutes)
 #   2. ASan+UBSan build: unit, CLI, transport, simulator and service tests under the sanitizers
 #      (the DDS integration tests run in the release build: Fast DDS itself is not built with ASan)
 #   3. clang libFuzzer build: each fuzz target for a bounded time over its kept corpus
@@ -29,7 +31,7 @@ cmake --build build/fuzz -j"$jobs"
 
 step "sanitizer tests"
 ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
-  ctest --test-dir build/asan --output-on-failure -j"$jobs" -LE 'fuzz|bench|integration|deploy'
+  ctest --test-dir build/asan --output-on-failure -j"$jobs" -LE 'fuzz|bench|integration|deploy|system'
 
 step "fuzz runs"
 ctest --test-dir build/fuzz --output-on-failure -L fuzz
