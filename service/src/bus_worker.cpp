@@ -4,7 +4,10 @@
 #include <sys/eventfd.h>
 #include <unistd.h>
 
+#include <spdlog/spdlog.h>
+
 #include <cerrno>
+#include <cstring>
 #include <system_error>
 
 #include "pmu/codec/encode.hpp"
@@ -83,6 +86,7 @@ void BusWorker::on_frame(const transport::ReceivedFrame& rx) {
     DeviceConfig d = config_.discovered_defaults;
     d.address = address;
     s = &add_session(d);
+    spdlog::info("{}: discovered a PMU at address {}", config_.name, address);
   }
   if (!s) {
     ++foreign_frames_;
@@ -92,7 +96,21 @@ void BusWorker::on_frame(const transport::ReceivedFrame& rx) {
 }
 
 void BusWorker::on_event(const transport::BusEvent& event) {
-  if (event.kind != transport::BusEventKind::StateChanged && event.kind != transport::BusEventKind::Reopened) return;
+  switch (event.kind) {
+    case transport::BusEventKind::StateChanged:
+      spdlog::log(event.state == transport::BusState::Up ? spdlog::level::info : spdlog::level::warn,
+                  "{}: bus {} (was {})", config_.name, transport::to_string(event.state),
+                  transport::to_string(event.previous));
+      break;
+    case transport::BusEventKind::Reopened: spdlog::info("{}: interface back, socket reopened", config_.name); break;
+    case transport::BusEventKind::SocketError:
+      // Identical lines collapse in the logger's duplicate filter during a flood.
+      spdlog::warn("{}: socket error: {}", config_.name, std::strerror(event.error));
+      return;
+    case transport::BusEventKind::ErrorFrame:
+      spdlog::debug("{}: error frame class 0x{:X}", config_.name, event.error_class);
+      return;
+  }
   const auto now = clock_.steady_now();
   for (auto& [a, s] : sessions_) s->on_bus_state(event.state, now);
 }

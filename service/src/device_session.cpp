@@ -1,5 +1,7 @@
 #include "pmu/service/device_session.hpp"
 
+#include <spdlog/spdlog.h>
+
 #include "pmu/codec/encode.hpp"
 
 namespace pmu::service {
@@ -88,6 +90,9 @@ void DeviceSession::on_reading_done(const RequestOutcome& o, std::uint64_t round
   }
   if (--reading_left_ > 0) return;
   phase_ = Phase::Running;
+  if (info_)
+    spdlog::info("{}/{}: serial {}, firmware {}.{}, configuration read", key_.bus, key_.address, info_->serial_number,
+                 info_->firmware.firmware_major, info_->firmware.firmware_minor);
   next_poll_ = now_;
   if (info_) sink_.on_info(key_, *info_);
   sink_.on_config(key_, config_);
@@ -308,6 +313,9 @@ void DeviceSession::update_health(SteadyTime now, bool force) {
     if (since_start > timeouts_.offline_periods * p) state = HealthState::Offline;
   }
   const bool changed = state != health_.state;
+  if (changed && (state != HealthState::Unknown))
+    spdlog::log(state == HealthState::Online ? spdlog::level::info : spdlog::level::warn, "{}/{}: {} (last frame {:.1f} s ago)",
+                key_.bus, key_.address, to_string(state), health_.last_frame_age);
   health_.state = state;
   if (changed || force || now >= next_health_) {
     next_health_ = now + kHealthInterval;

@@ -574,3 +574,38 @@ TEST(Commands, ARequestWithoutIdStillGetsExactlyOneReply) {
 
 }  // namespace
 }  // namespace pmu::service::test
+
+#include <spdlog/sinks/ostream_sink.h>
+#include <spdlog/spdlog.h>
+
+#include <sstream>
+
+namespace pmu::service::test {
+namespace {
+
+TEST(Commands, EveryCommandAndItsResultIsInTheAuditTrail) {
+  std::ostringstream log;
+  auto previous = spdlog::default_logger();
+  spdlog::set_default_logger(
+      std::make_shared<spdlog::logger>("audit-test", std::make_shared<spdlog::sinks::ostream_sink_mt>(log)));
+  {
+    Commands c({pmu(1)});
+    auto ok = set_param(c, "avionics_voltage", 20.0);
+    ok.sender = "ground-station-7";
+    c.run(ok);
+    auto denied = c.req(CommandKind::Reset);
+    denied.sender = "ground-station-7";
+    c.run(denied);
+  }
+  spdlog::set_default_logger(previous);
+  const std::string text = log.str();
+  EXPECT_NE(text.find("audit: command t-1 from ground-station-7: set_parameter avionics_voltage=20 to sim0/1 -> COMPLETED"),
+            std::string::npos)
+      << text;
+  EXPECT_NE(text.find("audit: command t-2 from ground-station-7: reset to sim0/1 -> DENIED: reset resets the PMU"),
+            std::string::npos)
+      << text;
+}
+
+}  // namespace
+}  // namespace pmu::service::test
