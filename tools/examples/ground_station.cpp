@@ -8,6 +8,10 @@
 //
 // Build: it is the CMake target `ground_station_example` (links the generated pmu::idl and
 // Fast DDS only). Run: pmu-service --bus sim & ground_station_example
+//
+// DDS-Security: with PMU_SECURITY_DIR set (a folder made by deploy/security/make_pki.sh)
+// it joins with the identity PMU_SECURITY_IDENTITY (default ground-station), through the
+// standard DDS-Security participant properties below; nothing else changes.
 
 #include <fastdds/dds/core/status/PublicationMatchedStatus.hpp>
 #include <fastdds/dds/core/status/SubscriptionMatchedStatus.hpp>
@@ -27,6 +31,7 @@
 #include <cstring>
 #include <string>
 #include <thread>
+#include <unistd.h>
 
 #include "pmu/idl/command.h"
 #include "pmu/idl/commandPubSubTypes.h"
@@ -101,6 +106,26 @@ bool latest(DataReader* r, T& out, std::chrono::milliseconds wait) {
   return got;
 }
 
+// DDS-Security's builtin plugins, configured by participant properties (file: URIs).
+void add_security(DomainParticipantQos& qos, std::string dir, const std::string& identity) {
+  if (dir.empty()) return;
+  if (dir.front() != '/') {
+    char cwd[4096];
+    if (getcwd(cwd, sizeof cwd)) dir = std::string(cwd) + "/" + dir;
+  }
+  const std::string uri = "file://" + dir + "/";
+  auto& p = qos.properties().properties();
+  p.emplace_back("dds.sec.auth.plugin", "builtin.PKI-DH");
+  p.emplace_back("dds.sec.auth.builtin.PKI-DH.identity_ca", uri + "identity_ca.pem");
+  p.emplace_back("dds.sec.auth.builtin.PKI-DH.identity_certificate", uri + identity + "/cert.pem");
+  p.emplace_back("dds.sec.auth.builtin.PKI-DH.private_key", uri + identity + "/key.pem");
+  p.emplace_back("dds.sec.access.plugin", "builtin.Access-Permissions");
+  p.emplace_back("dds.sec.access.builtin.Access-Permissions.permissions_ca", uri + "permissions_ca.pem");
+  p.emplace_back("dds.sec.access.builtin.Access-Permissions.governance", uri + "governance.p7s");
+  p.emplace_back("dds.sec.access.builtin.Access-Permissions.permissions", uri + identity + "/permissions.p7s");
+  p.emplace_back("dds.sec.crypto.plugin", "builtin.AES-GCM-GMAC");
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -118,7 +143,16 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "cannot load the QoS profiles (set PMU_QOS_FILE to deploy/qos.xml)\n");
     return 2;
   }
-  l.participant = factory->create_participant(static_cast<DomainId_t>(domain), PARTICIPANT_QOS_DEFAULT);
+  DomainParticipantQos pqos = PARTICIPANT_QOS_DEFAULT;
+  const char* security_dir = std::getenv("PMU_SECURITY_DIR");
+  const char* identity = std::getenv("PMU_SECURITY_IDENTITY");
+  add_security(pqos, security_dir ? security_dir : "", identity && *identity ? identity : "ground-station");
+  l.participant = factory->create_participant(static_cast<DomainId_t>(domain), pqos);
+  if (!l.participant) {
+    std::fprintf(stderr, "cannot create the DDS participant%s\n",
+                 security_dir && *security_dir ? " (check the DDS-Security files in PMU_SECURITY_DIR)" : "");
+    return 2;
+  }
   Publisher* pub = l.participant->create_publisher(PUBLISHER_QOS_DEFAULT);
   Subscriber* sub = l.participant->create_subscriber(SUBSCRIBER_QOS_DEFAULT);
   l.commands = pub->create_datawriter_with_profile(
@@ -129,6 +163,13 @@ int main(int argc, char** argv) {
       topic(l.participant, "pmu/config", TypeSupport(new pmu::ConfigPubSubType())), "state");
   l.status = sub->create_datareader_with_profile(
       topic(l.participant, "pmu/status", TypeSupport(new pmu::StatusPubSubType())), "telemetry");
+  if (!l.commands || !l.replies || !l.config || !l.status) {
+    // With DDS-Security: this identity's permissions do not allow one of them.
+    std::fprintf(stderr, "cannot create the command writer and the readers (DDS-Security permissions?)\n");
+    l.participant->delete_contained_entities();
+    factory->delete_participant(l.participant);
+    return 2;
+  }
 
   // Wait until the service's command reader and reply writer are matched.
   for (int i = 0; i < 500; ++i) {

@@ -5,6 +5,7 @@
 #include <atomic>
 #include <chrono>
 #include <csignal>
+#include <ctime>
 #include <cstdio>
 #include <fastdds/dds/core/status/SubscriptionMatchedStatus.hpp>
 #include <fastdds/dds/subscriber/SampleInfo.hpp>
@@ -102,6 +103,17 @@ void print_json(const char* topic, const std::string& bus, std::uint16_t address
   std::printf("%s\n", j.dump().c_str());
 }
 
+// "23:05:08.507": the sample's source time (the CAN frame's receive time), local time.
+std::string clock_text(double t) {
+  const auto secs = static_cast<std::time_t>(t);
+  std::tm tm{};
+  localtime_r(&secs, &tm);
+  char buf[32];
+  const std::size_t n = std::strftime(buf, sizeof buf, "%H:%M:%S", &tm);
+  std::snprintf(buf + n, sizeof buf - n, ".%03d", static_cast<int>((t - static_cast<double>(secs)) * 1000));
+  return buf;
+}
+
 std::string text(const Json& v) {
   if (v.is_null()) return "none";
   if (v.is_boolean()) return v.get<bool>() ? "yes" : "no";
@@ -170,7 +182,7 @@ class TypedTelemetryReader final : public TelemetryReader {
 int run_watch(const GlobalOptions& o, long count) {
   std::signal(SIGINT, on_interrupt);
   std::signal(SIGTERM, on_interrupt);
-  pmu::dds::DdsContext dds(o.domain, o.qos_file, "pmuctl");
+  pmu::dds::DdsContext dds(o.domain, o.qos_file, "pmuctl", o.security);
   std::vector<std::unique_ptr<TelemetryReader>> readers;
   readers.push_back(std::make_unique<TypedTelemetryReader<pmu::Voltages, pmu::VoltagesPubSubType>>(dds, topics::kVoltages));
   readers.push_back(std::make_unique<TypedTelemetryReader<pmu::Currents, pmu::CurrentsPubSubType>>(dds, topics::kCurrents));
@@ -198,7 +210,8 @@ int run_watch(const GlobalOptions& o, long count) {
           std::string row;
           for (auto it = line.values.begin(); it != line.values.end(); ++it)
             row += " " + it.key() + "=" + text(it.value());
-          std::printf("%.6f %s/%u %s%s\n", line.time, line.bus.c_str(), line.address, line.topic.c_str(), row.c_str());
+          std::printf("%s %s/%u %s%s\n", clock_text(line.time).c_str(), line.bus.c_str(), line.address,
+                      line.topic.c_str(), row.c_str());
         }
         latest[{line.bus, line.address, line.topic}] = line;
       }
@@ -209,7 +222,7 @@ int run_watch(const GlobalOptions& o, long count) {
       std::printf("\033[H\033[2J");  // home + clear: a refreshing table
       std::printf("pmuctl watch — domain %d — %ld samples (Ctrl-C to stop)\n\n", o.domain, seen);
       for (const auto& [key, l] : latest) {
-        std::printf("%s/%u %-15s", l.bus.c_str(), l.address, l.topic.c_str());
+        std::printf("%s %s/%u %-15s", clock_text(l.time).c_str(), l.bus.c_str(), l.address, l.topic.c_str());
         for (auto it = l.values.begin(); it != l.values.end(); ++it)
           std::printf(" %s=%s", it.key().c_str(), text(it.value()).c_str());
         std::printf("\n");
@@ -226,7 +239,7 @@ int run_watch(const GlobalOptions& o, long count) {
 }
 
 int run_list(const GlobalOptions& o) {
-  pmu::dds::DdsContext dds(o.domain, o.qos_file, "pmuctl");
+  pmu::dds::DdsContext dds(o.domain, o.qos_file, "pmuctl", o.security);
   StateCollector<pmu::Health, pmu::HealthPubSubType> health(dds, topics::kHealth);
   StateCollector<pmu::DeviceInfo, pmu::DeviceInfoPubSubType> info(dds, topics::kInfo);
   if (int rc = collect(o, health, 3.0)) return rc;
@@ -256,13 +269,13 @@ int run_list(const GlobalOptions& o) {
 }
 
 int run_info(const GlobalOptions& o) {
-  pmu::dds::DdsContext dds(o.domain, o.qos_file, "pmuctl");
+  pmu::dds::DdsContext dds(o.domain, o.qos_file, "pmuctl", o.security);
   StateCollector<pmu::DeviceInfo, pmu::DeviceInfoPubSubType> c(dds, topics::kInfo);
   return print_state(o, c, "info");
 }
 
 int run_health(const GlobalOptions& o) {
-  pmu::dds::DdsContext dds(o.domain, o.qos_file, "pmuctl");
+  pmu::dds::DdsContext dds(o.domain, o.qos_file, "pmuctl", o.security);
   StateCollector<pmu::Health, pmu::HealthPubSubType> c(dds, topics::kHealth);
   return print_state(o, c, "health");
 }
@@ -273,7 +286,7 @@ int run_config_get(const GlobalOptions& o, const std::string& parameter) {
     std::fprintf(stderr, "pmuctl: unknown parameter '%s'\n", parameter.c_str());
     return 2;
   }
-  pmu::dds::DdsContext dds(o.domain, o.qos_file, "pmuctl");
+  pmu::dds::DdsContext dds(o.domain, o.qos_file, "pmuctl", o.security);
   StateCollector<pmu::Config, pmu::ConfigPubSubType> c(dds, topics::kConfig);
   if (parameter.empty()) return print_state(o, c, "config");
   if (int rc = collect(o, c, 3.0)) return rc;

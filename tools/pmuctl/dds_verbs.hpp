@@ -7,6 +7,8 @@
 #include <optional>
 #include <string>
 
+#include "pmu/service/dds_security.hpp"
+
 namespace pmu::tools {
 
 struct GlobalOptions {
@@ -16,6 +18,7 @@ struct GlobalOptions {
   bool json = false;
   std::optional<double> timeout;        // s; verbs have their own default
   std::string qos_file;                 // empty: the installed qos.xml
+  pmu::dds::SecurityFiles security;     // empty: no DDS-Security (--security-dir/--identity)
 };
 
 int run_watch(const GlobalOptions& o, long count);

@@ -62,6 +62,38 @@ int run_decode(const std::string& path, const pmu::tools::DecodeOptions& options
   return 0;
 }
 
+std::string env_or(const char* name, const std::string& fallback) {
+  const char* v = std::getenv(name);
+  return v && *v ? std::string(v) : fallback;
+}
+
+// --security-dir/--identity (or PMU_SECURITY_DIR/PMU_SECURITY_IDENTITY) into the six files,
+// checked before anything touches DDS. False (after printing why) when they are unusable.
+bool setup_security(pmu::tools::GlobalOptions& g, std::string dir, std::string identity) {
+  dir = dir.empty() ? env_or("PMU_SECURITY_DIR", "") : dir;
+  identity = identity.empty() ? env_or("PMU_SECURITY_IDENTITY", "") : identity;
+  if (dir.empty()) {
+    if (!identity.empty()) {
+      std::fprintf(stderr, "pmuctl: --identity %s needs --security-dir DIR (or PMU_SECURITY_DIR)\n", identity.c_str());
+      return false;
+    }
+    return true;
+  }
+  if (identity.empty()) {
+    std::fprintf(stderr, "pmuctl: --security-dir %s needs --identity NAME (or PMU_SECURITY_IDENTITY), "
+                         "e.g. ground-station to command, mission-computer to watch\n", dir.c_str());
+    return false;
+  }
+  g.security = pmu::dds::security_files_in(dir, identity);
+  pmu::dds::SecurityCheckOptions options;
+  options.domain = g.domain;
+  const auto issues = pmu::dds::check_security_files(g.security, options);
+  for (const auto& i : issues)
+    std::fprintf(stderr, "pmuctl: %s%s\n", i.level == pmu::dds::SecurityIssue::Level::Error ? "" : "warning: ",
+                 i.message.c_str());
+  return !pmu::dds::has_errors(issues);
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -78,6 +110,13 @@ int main(int argc, char** argv) {
   app.add_option("--timeout", timeout, "Seconds to wait (state verbs: default 3; watch: forever)")
       ->check(CLI::PositiveNumber);
   app.add_option("--qos-file", g.qos_file, "QoS profiles (default: $PMU_QOS_FILE or /etc/pmu-dds/qos.xml)");
+  std::string security_dir, identity;
+  app.add_option("--security-dir", security_dir,
+                 "DDS-Security: the folder deploy/security/make_pki.sh made (default: $PMU_SECURITY_DIR; "
+                 "none: no security)");
+  app.add_option("--identity", identity,
+                 "DDS-Security identity in that folder: ground-station (commands) or mission-computer "
+                 "(read-only) (default: $PMU_SECURITY_IDENTITY)");
 
   auto* watch = app.add_subcommand("watch", "Live telemetry: a refreshing table, or one JSON object per sample");
   long count = 0;
@@ -145,6 +184,7 @@ int main(int argc, char** argv) {
     }
     return run_decode(path, options);
   }
+  if (!setup_security(g, security_dir, identity)) return 2;
   try {
     if (*watch) return pmu::tools::run_watch(g, count);
     if (app.got_subcommand("list")) return pmu::tools::run_list(g);
