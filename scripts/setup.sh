@@ -10,6 +10,7 @@ packages=(
   libgtest-dev libgmock-dev libbenchmark-dev
   libfastrtps-dev libfastcdr-dev fastddsgen fastdds-tools
   libspdlog-dev libfmt-dev libsystemd-dev libcli11-dev libyaml-cpp-dev nlohmann-json3-dev
+  libssl-dev libtinyxml2-dev openssl
   can-utils iproute2 python3 python3-can
   qemu-system-x86 busybox-static cpio kmod
 )

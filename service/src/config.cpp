@@ -203,6 +203,32 @@ void parse_policy(const Ctx& c, const YAML::Node& n, PolicyConfig& p) {
     p.default_lifetime = std::chrono::milliseconds(std::lround(c.number(v, "command_lifetime", 0.1, 3600) * 1000));
 }
 
+// security: the six files (all or none) and warn_days. Paths relative to the config file.
+void parse_security(const Ctx& c, const YAML::Node& key, const YAML::Node& n, SecurityConfig& sec) {
+  if (!n.IsMap()) c.fail(key, "security must be a mapping of the six files (see deploy/security/README.md)");
+  c.only_keys(n, "security", {"identity_ca", "identity_certificate", "private_key", "permissions_ca", "governance",
+                              "permissions", "warn_days"});
+  sec.source_line = c.line_of(key);
+  const auto slash = c.source.rfind('/');
+  const std::string base = slash == std::string::npos ? std::string() : c.source.substr(0, slash + 1);
+  std::string missing;
+  for (const auto& ref : dds::kSecurityFileKeys) {
+    const auto v = n[ref.key];
+    if (!v) {
+      missing += std::string(missing.empty() ? "" : ", ") + ref.key;
+      continue;
+    }
+    std::string path = c.scalar<std::string>(v, ref.key, "a path");
+    if (path.empty()) c.fail(v, std::string(ref.key) + " must be a path to a file, not empty");
+    if (path.front() != '/') path = base + path;
+    sec.files.*ref.path = path;
+    sec.key_lines[ref.key] = c.line_of(v);
+  }
+  if (!missing.empty())
+    c.fail(key, "security needs all six files: " + missing + " missing (or remove the section to run without security)");
+  if (const auto v = n["warn_days"]) sec.warn_days = static_cast<int>(c.integer(v, "warn_days", 0, 3650));
+}
+
 const char* const kLogLevels[] = {"trace", "debug", "info", "warn", "error", "critical", "off"};
 
 }  // namespace
@@ -222,7 +248,7 @@ Config parse_config(const std::string& text, const std::string& source) {
   Config cfg;
   cfg.source = source;
   if (root.IsNull()) throw ConfigError(source + ":1: the file is empty");
-  c.only_keys(root, "the top level", {"domain", "qos_file", "log_level", "buses", "timeouts", "policy"});
+  c.only_keys(root, "the top level", {"domain", "qos_file", "log_level", "buses", "timeouts", "policy", "security"});
   if (const auto v = root["domain"]) cfg.domain = static_cast<int>(c.integer(v, "domain", 0, 232));
   if (const auto v = root["qos_file"]) cfg.qos_file = c.scalar<std::string>(v, "qos_file", "a path");
   if (const auto v = root["log_level"]) {
@@ -232,6 +258,8 @@ Config parse_config(const std::string& text, const std::string& source) {
   }
   if (const auto v = root["timeouts"]) parse_timeouts(c, v, cfg.timeouts);
   if (const auto v = root["policy"]) parse_policy(c, v, cfg.policy);
+  for (const auto& kv : root)
+    if (kv.first.as<std::string>() == "security") parse_security(c, kv.first, kv.second, cfg.security);
   const auto buses = root["buses"];
   if (!buses) c.fail(root, "no buses: the service needs at least one bus");
   if (!buses.IsSequence() || buses.size() == 0) c.fail(buses, "buses must be a non-empty list");
@@ -244,6 +272,11 @@ Config parse_config(const std::string& text, const std::string& source) {
     cfg.buses.push_back(std::move(b));
   }
   return cfg;
+}
+
+std::string SecurityConfig::line_of(const std::string& key) const {
+  const auto it = key_lines.find(key);
+  return it != key_lines.end() ? it->second : source_line;
 }
 
 Config load_config(const std::string& path) {

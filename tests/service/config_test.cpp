@@ -54,7 +54,8 @@ const BadCase kBad[] = {
     {"buses: [\n", "bad.yaml:2: YAML syntax error: end of sequence flow not found"},
     {"domain: 0\n", "bad.yaml:1: no buses: the service needs at least one bus"},
     {"domian: 0\nbuses: []\n",
-     "bad.yaml:1: unknown key 'domian' in the top level (known: domain, qos_file, log_level, buses, timeouts, policy)"},
+     "bad.yaml:1: unknown key 'domian' in the top level (known: domain, qos_file, log_level, buses, timeouts, policy, "
+     "security)"},
     {"domain: 300\nbuses: []\n", "bad.yaml:1: domain 300 out of range 0..232"},
     {"domain: x\nbuses: []\n", "bad.yaml:1: domain must be an integer, not 'x'"},
     {"buses: []\n", "bad.yaml:1: buses must be a non-empty list"},
@@ -88,6 +89,23 @@ const BadCase kBad[] = {
      "bad.yaml:3: offline_periods must be greater than stale_periods"},
     {"timeouts:\n  reply: 0\nbuses:\n  - interface: can0\n    discover: true\n",
      "bad.yaml:2: reply 0 out of range 0.01..10"},
+    {"buses:\n  - interface: can0\n    discover: true\nsecurity:\n",
+     "bad.yaml:4: security must be a mapping of the six files (see deploy/security/README.md)"},
+    {"buses:\n  - interface: can0\n    discover: true\nsecurity:\n  identity_ca: a.pem\n  identity_cert: b.pem\n",
+     "bad.yaml:6: unknown key 'identity_cert' in security (known: identity_ca, identity_certificate, private_key, "
+     "permissions_ca, governance, permissions, warn_days)"},
+    {"buses:\n  - interface: can0\n    discover: true\nsecurity:\n  identity_ca: a.pem\n  private_key: k.pem\n",
+     "bad.yaml:4: security needs all six files: identity_certificate, permissions_ca, governance, permissions missing "
+     "(or remove the section to run without security)"},
+    {"buses:\n  - interface: can0\n    discover: true\nsecurity:\n  identity_ca: a\n  identity_certificate: b\n"
+     "  private_key: c\n  permissions_ca: d\n  governance: ''\n  permissions: f\n",
+     "bad.yaml:9: governance must be a path to a file, not empty"},
+    {"buses:\n  - interface: can0\n    discover: true\nsecurity:\n  identity_ca: a\n  identity_certificate: b\n"
+     "  private_key: c\n  permissions_ca: d\n  governance: e\n  permissions: [f]\n",
+     "bad.yaml:10: permissions must be a path"},
+    {"buses:\n  - interface: can0\n    discover: true\nsecurity:\n  identity_ca: a\n  identity_certificate: b\n"
+     "  private_key: c\n  permissions_ca: d\n  governance: e\n  permissions: f\n  warn_days: -1\n",
+     "bad.yaml:11: warn_days -1 out of range 0..3650"},
 };
 
 TEST(Config, EveryBadValueIsRefusedWithItsLine) {
@@ -100,6 +118,36 @@ TEST(Config, EveryBadValueIsRefusedWithItsLine) {
       EXPECT_EQ(std::string(e.what()), c.message);
     }
   }
+}
+
+TEST(Config, SecuritySectionAllSixFilesRelativeToTheConfigFile) {
+  const char* yaml = R"(buses:
+  - interface: can0
+    discover: true
+security:
+  identity_ca: /etc/pmu-dds/security/identity_ca.pem
+  identity_certificate: pmu-service/cert.pem
+  private_key: pmu-service/key.pem
+  permissions_ca: /etc/pmu-dds/security/permissions_ca.pem
+  governance: /etc/pmu-dds/security/governance.p7s
+  permissions: pmu-service/permissions.p7s
+  warn_days: 14
+)";
+  const Config c = parse_config(yaml, "/etc/pmu-dds/pmu-service.yaml");
+  const auto& f = c.security.files;
+  EXPECT_EQ(f.identity_ca, "/etc/pmu-dds/security/identity_ca.pem");
+  EXPECT_EQ(f.identity_certificate, "/etc/pmu-dds/pmu-service/cert.pem");
+  EXPECT_EQ(f.private_key, "/etc/pmu-dds/pmu-service/key.pem");
+  EXPECT_EQ(f.permissions_ca, "/etc/pmu-dds/security/permissions_ca.pem");
+  EXPECT_EQ(f.governance, "/etc/pmu-dds/security/governance.p7s");
+  EXPECT_EQ(f.permissions, "/etc/pmu-dds/pmu-service/permissions.p7s");
+  EXPECT_EQ(c.security.warn_days, 14);
+  EXPECT_EQ(c.security.source_line, "/etc/pmu-dds/pmu-service.yaml:4");
+  EXPECT_EQ(c.security.line_of("private_key"), "/etc/pmu-dds/pmu-service.yaml:7");
+  EXPECT_EQ(c.security.line_of("something else"), "/etc/pmu-dds/pmu-service.yaml:4");
+  // Without the section: no security, as before.
+  EXPECT_TRUE(parse_config(kGood, "good.yaml").security.files.empty());
+  EXPECT_EQ(parse_config(kGood, "good.yaml").security.warn_days, 30);
 }
 
 TEST(Config, MissingFileSaysSo) {

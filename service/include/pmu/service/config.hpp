@@ -6,11 +6,13 @@
 
 #include <chrono>
 #include <cstdint>
+#include <map>
 #include <optional>
 #include <stdexcept>
 #include <string>
 #include <vector>
 
+#include "pmu/service/dds_security.hpp"
 #include "pmu/service/policy.hpp"
 
 namespace pmu::service {
@@ -55,6 +57,19 @@ struct Timeouts {
   std::chrono::milliseconds send{100};      // wait for room in the transmit queue
 };
 
+// DDS-Security (the `security:` section). All six files or none; relative paths are taken
+// relative to the config file's folder. Checked at start-up (dds::check_security_files)
+// before any participant or bus is opened.
+struct SecurityConfig {
+  dds::SecurityFiles files;  // empty: security off
+  int warn_days = 30;        // warn when a certificate or grant ends within this many days
+  std::string source_line;   // "FILE:LINE" of the section
+  // "FILE:LINE" of each file's key (identity_ca, ...), for the start-up check's messages.
+  std::map<std::string, std::string> key_lines;
+  // "FILE:LINE" for a file key (the section's line when the key is unknown).
+  std::string line_of(const std::string& key) const;
+};
+
 struct Config {
   std::string source = "<defaults>";  // the file it came from
   int domain = 0;
@@ -63,6 +78,7 @@ struct Config {
   std::vector<BusConfig> buses;
   Timeouts timeouts;
   PolicyConfig policy;
+  SecurityConfig security;
 };
 
 // Parses `path`. Throws ConfigError("path:line: ...") for every problem: unknown keys,

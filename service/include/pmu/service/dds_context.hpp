@@ -5,6 +5,11 @@
 //
 // Start-up only throws (DdsError: "cannot load QoS profiles from X", "cannot create
 // participant on domain N"); afterwards calls return null or a ReturnCode like Fast DDS.
+//
+// Security: with SecurityFiles (dds_security.hpp) the participant uses DDS-Security's
+// builtin plugins (PKI-DH authentication, Access-Permissions, AES-GCM-GMAC crypto) with
+// those files. Check them first (check_security_files): Fast DDS only says that the
+// participant could not be created.
 
 #include <fastdds/dds/domain/DomainParticipant.hpp>
 #include <fastdds/dds/publisher/DataWriter.hpp>
@@ -17,6 +22,8 @@
 #include <stdexcept>
 #include <string>
 
+#include "pmu/service/dds_security.hpp"
+
 namespace pmu::dds {
 
 class DdsError : public std::runtime_error {
@@ -28,15 +35,23 @@ class DdsError : public std::runtime_error {
 // deploy/qos.xml (for runs from a build directory). Empty when none exists.
 std::string default_qos_file();
 
+// Transports of the participant. Default: Fast DDS's builtin ones (UDPv4, and shared
+// memory between processes on one host). UdpOnly: UDPv4 alone, so that all traffic between
+// participants on one host crosses the loopback interface (tests that look at the wire).
+enum class Transport { Default, UdpOnly };
+
 class DdsContext {
  public:
-  DdsContext(int domain, const std::string& qos_file, const std::string& participant_name);
+  // `security` empty: no DDS-Security (as before). Relative paths are made absolute.
+  DdsContext(int domain, const std::string& qos_file, const std::string& participant_name,
+             const SecurityFiles& security = {}, Transport transport = Transport::Default);
   ~DdsContext();
   DdsContext(const DdsContext&) = delete;
   DdsContext& operator=(const DdsContext&) = delete;
 
   eprosima::fastdds::dds::DomainParticipant& participant() { return *participant_; }
   int domain() const noexcept { return domain_; }
+  bool secure() const noexcept { return secure_; }
 
   // Registers the type (once) and creates the topic (once). `type` is e.g.
   // new pmu::VoltagesPubSubType(). Throws DdsError at start-up when it fails.
@@ -50,6 +65,7 @@ class DdsContext {
 
  private:
   int domain_;
+  bool secure_ = false;
   eprosima::fastdds::dds::DomainParticipant* participant_ = nullptr;
   eprosima::fastdds::dds::Publisher* publisher_ = nullptr;
   eprosima::fastdds::dds::Subscriber* subscriber_ = nullptr;

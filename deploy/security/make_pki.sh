@@ -1,0 +1,285 @@
+#!/usr/bin/env bash
+# make_pki.sh: creates a complete DDS-Security PKI for pmu-dds with openssl.
+#
+#   deploy/security/make_pki.sh OUTDIR [--days N] [--ca-days N] [--domain N|MIN-MAX] [--force]
+#
+#   OUTDIR          where everything goes (created; refused if it already holds a PKI,
+#                   unless --force)
+#   --days N        validity of the identity certificates and of the permission grants,
+#                   in days (default 365)
+#   --ca-days N     validity of the two CA certificates, in days (default 3650)
+#   --domain D      the DDS domain id (N) or range (MIN-MAX) that governance and
+#                   permissions cover (default 0)
+#   --force         replace an existing PKI in OUTDIR (every key and certificate is new)
+#
+# What it makes (deploy/security/README.md explains each file and where it goes):
+#   OUTDIR/identity_ca.pem          Identity CA certificate (issues the identities)
+#   OUTDIR/permissions_ca.pem       Permissions CA certificate (signs governance and
+#                                   permissions only: it issues no certificate at all)
+#   OUTDIR/governance.xml, .p7s     domain rules; .p7s is what DDS reads (S/MIME, signed
+#                                   by the Permissions CA)
+#   OUTDIR/NAME/cert.pem, key.pem   identity of NAME (pmu-service, ground-station,
+#                                   mission-computer), signed by the Identity CA
+#   OUTDIR/NAME/permissions.xml, .p7s   what NAME may publish and subscribe
+#   OUTDIR/ca/                      the two CA private keys and the openssl CA database.
+#                                   Keep it offline; never install or commit it.
+#
+# Keys are ECDSA P-256 and every signature is ecdsa-with-SHA256 (what Fast DDS 2.9's
+# builtin PKI-DH and Access-Permissions plugins accept). The two CAs are separate on
+# purpose: Fast DDS 2.9.1 lacks the fix for CVE-2023-24010, so with one CA for identities
+# and permissions any participant could sign its own permissions.
+#
+# Exit status: 0 on success, 1 on an error, 2 on bad usage.
+
+set -euo pipefail
+
+usage() { sed -n '2,/^$/p' "${BASH_SOURCE[0]}" | sed 's/^# \{0,1\}//'; }
+die() { echo "make_pki.sh: $*" >&2; exit 1; }
+
+out=""
+days=365
+ca_days=3650
+domain="0"
+force=0
+while [ $# -gt 0 ]; do
+  case "$1" in
+    --days) [ $# -ge 2 ] || { usage >&2; exit 2; }; days=$2; shift 2 ;;
+    --ca-days) [ $# -ge 2 ] || { usage >&2; exit 2; }; ca_days=$2; shift 2 ;;
+    --domain) [ $# -ge 2 ] || { usage >&2; exit 2; }; domain=$2; shift 2 ;;
+    --force) force=1; shift ;;
+    -h|--help) usage; exit 0 ;;
+    -*) echo "make_pki.sh: unknown option '$1'" >&2; usage >&2; exit 2 ;;
+    *) [ -z "$out" ] || { echo "make_pki.sh: more than one OUTDIR" >&2; exit 2; }; out=$1; shift ;;
+  esac
+done
+[ -n "$out" ] || { usage >&2; exit 2; }
+[[ "$days" =~ ^[1-9][0-9]*$ ]] || { echo "make_pki.sh: --days must be a positive integer, not '$days'" >&2; exit 2; }
+[[ "$ca_days" =~ ^[1-9][0-9]*$ ]] || { echo "make_pki.sh: --ca-days must be a positive integer, not '$ca_days'" >&2; exit 2; }
+if [[ "$domain" =~ ^([0-9]+)-([0-9]+)$ ]]; then
+  dmin=${BASH_REMATCH[1]}; dmax=${BASH_REMATCH[2]}
+elif [[ "$domain" =~ ^[0-9]+$ ]]; then
+  dmin=$domain; dmax=$domain
+else
+  echo "make_pki.sh: --domain must be N or MIN-MAX, not '$domain'" >&2; exit 2
+fi
+{ [ "$dmin" -le "$dmax" ] && [ "$dmax" -le 232 ]; } || { echo "make_pki.sh: --domain $domain is not within 0..232" >&2; exit 2; }
+[ "$ca_days" -ge "$days" ] || { echo "make_pki.sh: --ca-days ($ca_days) must be at least --days ($days)" >&2; exit 2; }
+command -v openssl >/dev/null || die "openssl is not installed (apt-get install openssl)"
+
+identities=(pmu-service ground-station mission-computer)
+org="pmu-dds"
+
+if [ -e "$out/identity_ca.pem" ] || [ -e "$out/ca" ]; then
+  [ "$force" -eq 1 ] || die "$out already holds a PKI; use --force to replace it (every key is made anew)"
+  rm -rf "${out:?}/ca" "$out/identity_ca.pem" "$out/permissions_ca.pem" "$out/governance.xml" "$out/governance.p7s"
+  for n in "${identities[@]}"; do rm -rf "${out:?}/$n"; done
+fi
+mkdir -p "$out"
+out=$(cd "$out" && pwd)
+umask 077
+mkdir -p "$out/ca/issued"
+: > "$out/ca/index.txt"
+echo 1000 > "$out/ca/serial"
+
+# openssl configuration: the Identity CA database (`openssl ca -name identity_ca`) and the
+# extensions of each kind of certificate. Tests reuse it to issue odd certificates
+# (expired ones) from the same Identity CA.
+cat > "$out/ca/openssl.cnf" <<CNF
+# pmu-dds test/site PKI (made by deploy/security/make_pki.sh)
+dir = $out/ca
+
+[ req ]
+distinguished_name = req_dn
+prompt = no
+[ req_dn ]
+O = $org
+
+[ identity_ca ]
+database = \$dir/index.txt
+serial = \$dir/serial
+new_certs_dir = \$dir/issued
+certificate = $out/identity_ca.pem
+private_key = \$dir/identity_ca.key
+default_md = sha256
+default_days = $days
+policy = identity_policy
+unique_subject = no
+copy_extensions = none
+email_in_dn = no
+x509_extensions = identity_cert
+
+[ identity_policy ]
+organizationName = supplied
+commonName = supplied
+
+# The Identity CA: issues participant certificates, nothing else below it.
+[ identity_ca_cert ]
+basicConstraints = critical, CA:TRUE, pathlen:0
+keyUsage = critical, keyCertSign, cRLSign
+subjectKeyIdentifier = hash
+
+# The Permissions CA: signs the governance and permissions documents (S/MIME), nothing
+# else. Without keyCertSign a certificate it signed would not verify, so no identity can
+# ever chain to it (and sign documents in its name).
+[ permissions_ca_cert ]
+basicConstraints = critical, CA:TRUE, pathlen:0
+keyUsage = critical, digitalSignature
+subjectKeyIdentifier = hash
+
+# A participant identity (PKI-DH signs its handshake with this key).
+[ identity_cert ]
+basicConstraints = critical, CA:FALSE
+keyUsage = critical, digitalSignature, keyAgreement
+subjectKeyIdentifier = hash
+authorityKeyIdentifier = keyid
+CNF
+cnf="$out/ca/openssl.cnf"
+
+newkey() { openssl genpkey -algorithm EC -pkeyopt ec_paramgen_curve:P-256 -out "$1" 2>/dev/null; }
+
+# ---- the two CAs -------------------------------------------------------------------------
+newkey "$out/ca/identity_ca.key"
+openssl req -config "$cnf" -new -x509 -sha256 -days "$ca_days" -key "$out/ca/identity_ca.key" \
+  -subj "/O=$org/CN=$org Identity CA" -extensions identity_ca_cert -out "$out/identity_ca.pem"
+newkey "$out/ca/permissions_ca.key"
+openssl req -config "$cnf" -new -x509 -sha256 -days "$ca_days" -key "$out/ca/permissions_ca.key" \
+  -subj "/O=$org/CN=$org Permissions CA" -extensions permissions_ca_cert -out "$out/permissions_ca.pem"
+
+# ---- identities --------------------------------------------------------------------------
+for n in "${identities[@]}"; do
+  mkdir -p "$out/$n"
+  newkey "$out/$n/key.pem"
+  openssl req -config "$cnf" -new -sha256 -key "$out/$n/key.pem" -subj "/O=$org/CN=$n" -out "$out/ca/$n.csr"
+  openssl ca -config "$cnf" -name identity_ca -batch -notext -days "$days" \
+    -in "$out/ca/$n.csr" -out "$out/$n/cert.pem" 2>/dev/null ||
+    die "openssl ca could not issue the certificate of $n"
+  rm -f "$out/ca/$n.csr"
+done
+
+# ---- governance ----------------------------------------------------------------------------
+# Element order is the OMG XSD's; Fast DDS 2.9's parser insists on it.
+topic_rule() {  # topic_rule EXPRESSION METADATA_PROTECTION DATA_PROTECTION
+  cat <<XML
+        <topic_rule>
+          <topic_expression>$1</topic_expression>
+          <enable_discovery_protection>true</enable_discovery_protection>
+          <enable_liveliness_protection>true</enable_liveliness_protection>
+          <enable_read_access_control>true</enable_read_access_control>
+          <enable_write_access_control>true</enable_write_access_control>
+          <metadata_protection_kind>$2</metadata_protection_kind>
+          <data_protection_kind>$3</data_protection_kind>
+        </topic_rule>
+XML
+}
+if [ "$dmin" -eq "$dmax" ]; then
+  domains_xml="<id>$dmin</id>"
+else
+  domains_xml="<id_range><min>$dmin</min><max>$dmax</max></id_range>"
+fi
+{
+  cat <<XML
+<?xml version="1.0" encoding="UTF-8"?>
+<!-- pmu-dds governance (made by deploy/security/make_pki.sh). Signed by the Permissions CA
+     into governance.p7s, which is the file DDS reads.
+     No unauthenticated participant; join access control on; discovery, liveliness and
+     every RTPS message encrypted; every pmu topic read- and write-access-controlled (what
+     each identity may do is in its permissions) with its data encrypted; the command
+     topics' metadata encrypted as well. Any other topic: access controlled too, so the
+     permissions' default DENY refuses it. -->
+<dds xmlns:xsi="http://www.w3.org/2001/XMLSchema-instance"
+     xsi:noNamespaceSchemaLocation="http://www.omg.org/spec/DDS-Security/20170801/omg_shared_ca_governance.xsd">
+  <domain_access_rules>
+    <domain_rule>
+      <domains>$domains_xml</domains>
+      <allow_unauthenticated_participants>false</allow_unauthenticated_participants>
+      <enable_join_access_control>true</enable_join_access_control>
+      <discovery_protection_kind>ENCRYPT</discovery_protection_kind>
+      <liveliness_protection_kind>ENCRYPT</liveliness_protection_kind>
+      <rtps_protection_kind>ENCRYPT</rtps_protection_kind>
+      <topic_access_rules>
+XML
+  topic_rule "pmu/command" ENCRYPT ENCRYPT
+  topic_rule "pmu/command_reply" ENCRYPT ENCRYPT
+  topic_rule "pmu/*" ENCRYPT ENCRYPT
+  topic_rule "*" ENCRYPT ENCRYPT
+  cat <<XML
+      </topic_access_rules>
+    </domain_rule>
+  </domain_access_rules>
+</dds>
+XML
+} > "$out/governance.xml"
+
+sign() {  # sign IN OUT: S/MIME, signed by the Permissions CA, content inside
+  openssl smime -sign -text -nodetach -in "$1" -out "$2" \
+    -signer "$out/permissions_ca.pem" -inkey "$out/ca/permissions_ca.key" ||
+    die "openssl smime could not sign $1"
+}
+sign "$out/governance.xml" "$out/governance.p7s"
+
+# ---- permissions ---------------------------------------------------------------------------
+telemetry=(pmu/voltages pmu/currents pmu/battery_energy pmu/temperatures pmu/status)
+state=(pmu/config pmu/info pmu/health)
+
+topics_xml() { for t in "$@"; do printf '            <topic>%s</topic>\n' "$t"; done; }
+rule_xml() {  # rule_xml publish|subscribe TOPIC...
+  local kind=$1; shift
+  printf '        <%s>\n          <topics>\n' "$kind"
+  topics_xml "$@"
+  printf '          </topics>\n        </%s>\n' "$kind"
+}
+not_before=$(date -u +%Y-%m-%dT%H:%M:%S)
+not_after=$(date -u -d "+$days days" +%Y-%m-%dT%H:%M:%S)
+
+permissions() {  # permissions NAME -> the permissions XML of NAME on stdout
+  local n=$1
+  cat <<XML
+<?xml version="1.0" encoding="UTF-8"?>
+<!-- pmu-dds permissions of $n (made by deploy/security/make_pki.sh). Signed by the
+     Permissions CA into permissions.p7s. Anything not allowed here is denied. -->
+<dds xmlns:xsi="http://www.w3.org/2001/XMLSchema-instance"
+     xsi:noNamespaceSchemaLocation="http://www.omg.org/spec/DDS-Security/20170801/omg_shared_ca_permissions.xsd">
+  <permissions>
+    <grant name="$n">
+      <subject_name>CN=$n,O=$org</subject_name>
+      <validity>
+        <not_before>$not_before</not_before>
+        <not_after>$not_after</not_after>
+      </validity>
+      <allow_rule>
+        <domains>$domains_xml</domains>
+XML
+  case "$n" in
+    pmu-service)  # publishes telemetry, state and replies; reads commands
+      rule_xml publish "${telemetry[@]}" "${state[@]}" pmu/command_reply
+      rule_xml subscribe pmu/command
+      ;;
+    ground-station)  # the only one that may command; reads everything the service publishes
+      rule_xml publish pmu/command
+      rule_xml subscribe "${telemetry[@]}" "${state[@]}" pmu/command_reply
+      ;;
+    mission-computer)  # listens to telemetry and state, nothing else
+      rule_xml subscribe "${telemetry[@]}" "${state[@]}"
+      ;;
+  esac
+  cat <<XML
+      </allow_rule>
+      <default>DENY</default>
+    </grant>
+  </permissions>
+</dds>
+XML
+}
+for n in "${identities[@]}"; do
+  permissions "$n" > "$out/$n/permissions.xml"
+  sign "$out/$n/permissions.xml" "$out/$n/permissions.p7s"
+done
+
+chmod 755 "$out" "${identities[@]/#/$out/}"
+chmod 644 "$out"/*.pem "$out"/governance.* "$out"/*/cert.pem "$out"/*/permissions.*
+chmod 600 "$out"/*/key.pem
+chmod 700 "$out/ca"
+
+echo "make_pki.sh: PKI in $out (domain $domain; identities valid $days days, CAs $ca_days days)"
+echo "  identities: ${identities[*]}"
+echo "  keep $out/ca offline: it holds the CA keys"

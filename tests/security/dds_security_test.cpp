@@ -1,0 +1,644 @@
+// DDS-Security against the real Fast DDS 2.9.1 library (Debian's, HAVE_SECURITY=1), with a
+// PKI made at test time by deploy/security/make_pki.sh and the bad variants of
+// make_variants.sh. The service side is the real thing in-process (bus worker, command
+// service, DDS publisher and command endpoint on a simulated PMU); clients are separate
+// participants. Every participant here uses UDP only and intraprocess delivery is off, so
+// all traffic crosses the loopback interface like between two hosts.
+//
+// Each test runs in its own process (gtest_discover_tests) on a DDS domain of its own and
+// with a PKI of its own (pki_fixture.hpp). Label `security-integration` (tests/security/
+// CMakeLists.txt says why).
+#include <arpa/inet.h>
+#include <gtest/gtest.h>
+#include <linux/if_ether.h>
+#include <linux/if_packet.h>
+#include <poll.h>
+#include <signal.h>
+#include <sys/socket.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <atomic>
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <fastdds/dds/core/status/PublicationMatchedStatus.hpp>
+#include <fastdds/dds/core/status/SubscriptionMatchedStatus.hpp>
+#include <fastdds/dds/subscriber/SampleInfo.hpp>
+#include <fastdds/dds/log/Log.hpp>
+#include <fastrtps/xmlparser/XMLProfileManager.h>
+#include <fstream>
+#include <functional>
+#include <map>
+#include <memory>
+#include <mutex>
+#include <set>
+#include <sstream>
+#include <thread>
+
+#include "pmu/idl/commandPubSubTypes.h"
+#include "pmu/idl/statePubSubTypes.h"
+#include "pmu/idl/telemetryPubSubTypes.h"
+#include "pmu/idl/topics.hpp"
+#include "pmu/service/bus_worker.hpp"
+#include "pmu/service/command_service.hpp"
+#include "pmu/service/config.hpp"
+#include "pmu/service/dds_commands.hpp"
+#include "pmu/service/dds_context.hpp"
+#include "pmu/service/dds_publisher.hpp"
+#include "pmu/service/dds_security.hpp"
+#include "pmu/sim/bus_runner.hpp"
+#include "pmu/transport/sim_bus.hpp"
+#include "pki_fixture.hpp"
+
+namespace pmu::service {
+namespace {
+
+using namespace eprosima::fastdds::dds;
+using namespace std::chrono_literals;
+using Clock = std::chrono::steady_clock;
+using dds::SecurityFiles;
+using security_test::Pki;
+using security_test::sh;
+using security_test::test_domain;
+using security_test::allowed;
+using security_test::write_config;
+
+// ---- the service, in-process ------------------------------------------------------------
+
+constexpr std::uint8_t kPayload = 0x02;  // output bit 1
+
+struct ServiceUnderTest {
+  // `bus_name` is the DDS key of every sample (also something to look for on the wire).
+  ServiceUnderTest(int domain, const SecurityFiles& files, const std::string& bus_name = "sim0")
+      : network(clock),
+        pmus(network.attach("pmu-sim"), clock),
+        dds(domain, "", "pmu-service", files, dds::Transport::UdpOnly),
+        publisher(dds, 3s),
+        worker(bus_config(bus_name), network.attach(bus_name), clock, Timeouts{}, publisher),
+        endpoint(dds),
+        commands({&worker}, PolicyConfig{}, Timeouts{}, clock, [this](const CommandReplyData& r) { endpoint.publish(r); }) {
+    sim::DeviceConfig d;
+    d.address = 1;
+    d.parameters.set_raw(codec::Parameter::PacketPeriod, 5);  // 0.5 s
+    d.parameters.set_raw(codec::Parameter::PacketsStreamed, 0x1F);
+    pmus.add(d);
+    pmus.start();
+    thread = std::thread([this] { worker.run(); });
+    endpoint.start(commands);
+  }
+  ~ServiceUnderTest() {
+    endpoint.stop();
+    worker.stop();
+    thread.join();
+    pmus.stop();
+  }
+  static BusConfig bus_config(const std::string& name) {
+    BusConfig b;
+    b.name = name;
+    b.interface = "sim";
+    DeviceConfig d;
+    d.address = 1;
+    d.period = 500ms;
+    b.devices.push_back(d);
+    return b;
+  }
+  std::uint8_t outputs() {
+    std::uint8_t o = 0;
+    pmus.with_model(1, [&](sim::PmuModel& m) { o = m.outputs(); });
+    return o;
+  }
+  std::uint64_t handled() {
+    std::uint64_t n = 0;
+    pmus.with_model(1, [&](sim::PmuModel& m) { n = m.counters().handled; });
+    return n;
+  }
+
+  transport::SystemClock clock;
+  transport::SimulatedNetwork network;
+  sim::BusRunner pmus;
+  dds::DdsContext dds;
+  DdsPublisher publisher;
+  BusWorker worker;
+  DdsCommandEndpoint endpoint;
+  CommandService commands;
+  std::thread thread;
+};
+
+// ---- clients -------------------------------------------------------------------------------
+
+struct Client {
+  Client(int domain, const SecurityFiles& files, const std::string& name)
+      : dds(domain, "", name, files, dds::Transport::UdpOnly) {}
+  DataReader& voltages() {
+    if (!voltages_)
+      voltages_ = &dds.reader(dds.topic(topics::kVoltages, TypeSupport(new pmu::VoltagesPubSubType())),
+                              qos_profiles::kTelemetry);
+    return *voltages_;
+  }
+  DataReader& config() {
+    if (!config_)
+      config_ = &dds.reader(dds.topic(topics::kConfig, TypeSupport(new pmu::ConfigPubSubType())), qos_profiles::kState);
+    return *config_;
+  }
+  DataWriter& commands() {
+    if (!commands_)
+      commands_ = &dds.writer(dds.topic(topics::kCommand, TypeSupport(new pmu::CommandPubSubType())),
+                              qos_profiles::kCommand);
+    return *commands_;
+  }
+  DataReader& replies() {
+    if (!replies_)
+      replies_ = &dds.reader(dds.topic(topics::kCommandReply, TypeSupport(new pmu::CommandReplyPubSubType())),
+                             qos_profiles::kCommand);
+    return *replies_;
+  }
+  int commands_matched() {
+    PublicationMatchedStatus s;
+    commands().get_publication_matched_status(s);
+    return s.total_count;
+  }
+  dds::DdsContext dds;
+
+ private:
+  DataReader* voltages_ = nullptr;
+  DataReader* config_ = nullptr;
+  DataWriter* commands_ = nullptr;
+  DataReader* replies_ = nullptr;
+};
+
+template <class T>
+int take_all(DataReader& r) {
+  T sample;
+  SampleInfo info;
+  int n = 0;
+  while (r.take_next_sample(&sample, &info) == ReturnCode_t::RETCODE_OK) n += info.valid_data ? 1 : 0;
+  return n;
+}
+
+template <class T>
+bool wait_sample(DataReader& r, std::chrono::milliseconds timeout) {
+  const auto deadline = Clock::now() + timeout;
+  while (Clock::now() < deadline) {
+    if (take_all<T>(r) > 0) return true;
+    std::this_thread::sleep_for(20ms);
+  }
+  return false;
+}
+
+pmu::Command command(const std::string& id, const std::string& bus = "sim0") {
+  pmu::Command c;
+  c.request_id(id);
+  c.bus(bus);
+  c.address(1);
+  c.kind(pmu::DISABLE_OUTPUTS);  // switch the payload off
+  c.outputs(kPayload);
+  const auto expires = std::chrono::system_clock::now() + 10s;
+  c.expires_at(static_cast<unsigned long long>(
+      std::chrono::duration_cast<std::chrono::nanoseconds>(expires.time_since_epoch()).count()));
+  return c;
+}
+
+std::optional<pmu::CommandReply> wait_reply(DataReader& r, const std::string& id, std::chrono::milliseconds timeout) {
+  const auto deadline = Clock::now() + timeout;
+  while (Clock::now() < deadline) {
+    pmu::CommandReply reply;
+    SampleInfo info;
+    while (r.take_next_sample(&reply, &info) == ReturnCode_t::RETCODE_OK)
+      if (info.valid_data && reply.request_id().to_string() == id && reply.result() != pmu::IN_PROGRESS) return reply;
+    std::this_thread::sleep_for(10ms);
+  }
+  return std::nullopt;
+}
+
+// Like pmuctl: wait until the service's command reader and reply writer are matched.
+bool wait_command_link(Client& gs, std::chrono::milliseconds timeout) {
+  const auto deadline = Clock::now() + timeout;
+  while (Clock::now() < deadline) {
+    PublicationMatchedStatus p;
+    SubscriptionMatchedStatus s;
+    gs.commands().get_publication_matched_status(p);
+    gs.replies().get_subscription_matched_status(s);
+    if (p.current_count > 0 && s.current_count > 0) return true;
+    std::this_thread::sleep_for(10ms);
+  }
+  return false;
+}
+
+// The good ground station commands: the reply comes, and the PMU did it.
+void expect_ground_station_commands(ServiceUnderTest& svc, Client& gs, const std::string& id) {
+  ASSERT_TRUE(wait_command_link(gs, 10s)) << "the ground station's command writer and reply reader never matched";
+  pmu::Command c = command(id);
+  ASSERT_EQ(gs.commands().write(&c), true);
+  const auto reply = wait_reply(gs.replies(), id, 10s);
+  ASSERT_TRUE(reply.has_value()) << "no reply to " << id;
+  EXPECT_EQ(reply->result(), pmu::COMPLETED) << reply->reason();
+  EXPECT_EQ(svc.outputs() & kPayload, 0) << "the payload output is still on";
+}
+
+// What an intruder achieved in 4 s of listening to telemetry and sending commands (switch
+// the payload off), next to a legitimate reader.
+struct Intrusion {
+  int good_samples = 0;     // telemetry the legitimate reader got meanwhile
+  int stolen_samples = 0;   // telemetry the intruder got
+  int writer_matches = 0;   // the intruder's command writer matched the service's reader
+  std::uint64_t received = 0;  // commands the command service received
+  bool outputs_changed = false;
+  bool pmu_handled_something = false;
+};
+
+Intrusion intrude(ServiceUnderTest& svc, Client& intruder, Client& good) {
+  Intrusion r;
+  DataReader& stolen = intruder.voltages();
+  DataWriter& writer = intruder.commands();
+  EXPECT_TRUE(wait_sample<pmu::Voltages>(good.voltages(), 20s)) << "the legitimate reader got no telemetry: "
+                                                                   "the service is not reachable at all";
+  EXPECT_TRUE(wait_sample<pmu::Config>(good.config(), 10s)) << "no pmu/config: the service's start-up is not done";
+  std::this_thread::sleep_for(300ms);
+  const std::uint64_t handled_before = svc.handled();
+  const std::uint8_t outputs_before = svc.outputs();
+  EXPECT_NE(outputs_before & kPayload, 0) << "the payload must be on for the test to mean anything";
+  r.stolen_samples = take_all<pmu::Voltages>(stolen);
+  for (int i = 0; i < 20; ++i) {
+    pmu::Command c = command("intruder-" + std::to_string(i));
+    writer.write(&c);
+    std::this_thread::sleep_for(200ms);
+    r.stolen_samples += take_all<pmu::Voltages>(stolen);
+    r.good_samples += take_all<pmu::Voltages>(good.voltages());
+  }
+  r.writer_matches = intruder.commands_matched();
+  r.received = svc.commands.counters().received;
+  r.outputs_changed = svc.outputs() != outputs_before;
+  r.pmu_handled_something = svc.handled() != handled_before;
+  return r;
+}
+
+// Nothing may reach the intruder and nothing it sends may reach the service or the PMU,
+// while the legitimate reader receives telemetry all along.
+void expect_shut_out(ServiceUnderTest& svc, Client& intruder, Client& good) {
+  const Intrusion r = intrude(svc, intruder, good);
+  EXPECT_GE(r.good_samples, 4) << "the legitimate reader should have received telemetry meanwhile";
+  EXPECT_EQ(r.stolen_samples, 0) << "the intruder received telemetry";
+  EXPECT_EQ(r.writer_matches, 0) << "the intruder's command writer matched the service's reader";
+  EXPECT_EQ(r.received, 0u) << "a command from the intruder reached the command service";
+  EXPECT_FALSE(r.outputs_changed) << "the PMU's outputs changed";
+  EXPECT_FALSE(r.pmu_handled_something) << "the PMU handled a request meanwhile";
+}
+
+// ---- the contract's permissions, entity by entity -------------------------------------------
+
+struct TopicInfo {
+  const char* name;
+  std::function<TypeSupport()> type;
+  const char* profile;
+};
+
+const TopicInfo kTopics[] = {
+    {topics::kVoltages, [] { return TypeSupport(new pmu::VoltagesPubSubType()); }, qos_profiles::kTelemetry},
+    {topics::kCurrents, [] { return TypeSupport(new pmu::CurrentsPubSubType()); }, qos_profiles::kTelemetry},
+    {topics::kBatteryEnergy, [] { return TypeSupport(new pmu::BatteryEnergyPubSubType()); }, qos_profiles::kTelemetry},
+    {topics::kTemperatures, [] { return TypeSupport(new pmu::TemperaturesPubSubType()); }, qos_profiles::kTelemetry},
+    {topics::kStatus, [] { return TypeSupport(new pmu::StatusPubSubType()); }, qos_profiles::kTelemetry},
+    {topics::kConfig, [] { return TypeSupport(new pmu::ConfigPubSubType()); }, qos_profiles::kState},
+    {topics::kInfo, [] { return TypeSupport(new pmu::DeviceInfoPubSubType()); }, qos_profiles::kState},
+    {topics::kHealth, [] { return TypeSupport(new pmu::HealthPubSubType()); }, qos_profiles::kState},
+    {topics::kCommand, [] { return TypeSupport(new pmu::CommandPubSubType()); }, qos_profiles::kCommand},
+    {topics::kCommandReply, [] { return TypeSupport(new pmu::CommandReplyPubSubType()); }, qos_profiles::kCommand},
+};
+
+TEST(Permissions, EveryIdentityMayCreateExactlyTheWritersAndReadersTheContractAllows) {
+  for (const char* identity : {"pmu-service", "ground-station", "mission-computer"}) {
+    dds::DdsContext p(test_domain(), "", std::string("matrix-") + identity, Pki::get().files(identity),
+                      dds::Transport::UdpOnly);
+    for (const auto& t : kTopics) {
+      Topic& topic = p.topic(t.name, t.type());
+      for (const bool publish : {true, false}) {
+        bool created = true;
+        try {
+          if (publish)
+            p.writer(topic, t.profile);
+          else
+            p.reader(topic, t.profile);
+        } catch (const dds::DdsError&) {
+          created = false;
+        }
+        EXPECT_EQ(created, allowed(identity, t.name, publish))
+            << identity << (publish ? " publish " : " subscribe ") << t.name << ": Fast DDS "
+            << (created ? "allowed" : "refused") << " it";
+      }
+    }
+  }
+}
+
+// The governance document says what the issue asks.
+// ---- the right identities work ------------------------------------------------------------
+
+TEST(SecureDds, GroundStationCommandsAndMissionComputerReadsTelemetry) {
+  const int domain = test_domain();
+  ServiceUnderTest svc(domain, Pki::get().files("pmu-service"));
+  Client gs(domain, Pki::get().files("ground-station"), "ground-station");
+  Client mc(domain, Pki::get().files("mission-computer"), "mission-computer");
+  EXPECT_TRUE(wait_sample<pmu::Voltages>(gs.voltages(), 20s)) << "ground station: no telemetry";
+  EXPECT_TRUE(wait_sample<pmu::Voltages>(mc.voltages(), 20s)) << "mission computer: no telemetry";
+  EXPECT_TRUE(wait_sample<pmu::Config>(mc.config(), 10s)) << "mission computer: no pmu/config (state)";
+  expect_ground_station_commands(svc, gs, "gs-1");
+  EXPECT_EQ(svc.commands.counters().received, 1u);
+}
+
+// ---- who is shut out ------------------------------------------------------------------------
+
+TEST(SecureDds, UnauthenticatedParticipantGetsNoTelemetryAndCannotCommand) {
+  const int domain = test_domain();
+  ServiceUnderTest svc(domain, Pki::get().files("pmu-service"));
+  Client good(domain, Pki::get().files("mission-computer"), "mission-computer");
+  Client intruder(domain, SecurityFiles{}, "unauthenticated");
+  expect_shut_out(svc, intruder, good);
+}
+
+TEST(SecureDds, CertificateFromAForeignCaIsRejected) {
+  const int domain = test_domain();
+  // A complete PKI of its own: its own CAs, governance and permissions, and an identity
+  // called ground-station.
+  const std::string foreign = Pki::get().foreign();
+  ServiceUnderTest svc(domain, Pki::get().files("pmu-service"));
+  Client good(domain, Pki::get().files("mission-computer"), "mission-computer");
+  Client intruder(domain, dds::security_files_in(foreign, "ground-station"), "foreign-ground-station");
+  expect_shut_out(svc, intruder, good);
+}
+
+TEST(SecureDds, ExpiredCertificateIsRejected) {
+  const int domain = test_domain();
+  // A ground-station certificate from the real Identity CA, valid for a few seconds: the
+  // intruder's participant is created while it is valid (Fast DDS checks its own identity
+  // only then), the service starts after it has expired.
+  const auto now = std::chrono::system_clock::now();
+  const std::string expiring = Pki::get().window("expiring", now - 60s, now + 5s);
+  Client intruder(domain, dds::security_files_in(expiring, "ground-station"), "expired-ground-station");
+  intruder.voltages();
+  intruder.commands();
+  std::this_thread::sleep_until(now + 7s);
+  ASSERT_GT(std::chrono::system_clock::now(), now + 6s);
+  ServiceUnderTest svc(domain, Pki::get().files("pmu-service"));
+  Client good(domain, Pki::get().files("mission-computer"), "mission-computer");
+  expect_shut_out(svc, intruder, good);
+}
+
+TEST(SecureDds, MissionComputerCannotWriteCommands) {
+  const int domain = test_domain();
+  ServiceUnderTest svc(domain, Pki::get().files("pmu-service"));
+  Client mc(domain, Pki::get().files("mission-computer"), "mission-computer");
+  ASSERT_TRUE(wait_sample<pmu::Voltages>(mc.voltages(), 20s)) << "the mission computer should read telemetry";
+  ASSERT_TRUE(wait_sample<pmu::Config>(mc.config(), 10s)) << "no pmu/config: the service's start-up is not done";
+  const std::uint64_t handled_before = svc.handled();
+  // Its own participant refuses to create the writer (local access control) ...
+  DataWriter* writer = nullptr;
+  try {
+    writer = &mc.commands();
+  } catch (const dds::DdsError&) {
+  }
+  EXPECT_EQ(writer, nullptr) << "Fast DDS let the mission computer create a pmu/command writer";
+  if (writer) {  // only with broken permissions: then show what it can do
+    for (int i = 0; i < 300 && mc.commands_matched() == 0; ++i) std::this_thread::sleep_for(10ms);
+    for (int i = 0; i < 5; ++i) {
+      pmu::Command c = command("mission-computer-" + std::to_string(i));
+      writer->write(&c);
+    }
+  }
+  // ... and the reply topic is not its business either.
+  EXPECT_THROW(mc.replies(), dds::DdsError);
+  std::this_thread::sleep_for(2s);
+  EXPECT_EQ(svc.commands.counters().received, 0u) << "a command from the mission computer reached the service";
+  EXPECT_NE(svc.outputs() & kPayload, 0) << "the payload was switched off";
+  EXPECT_EQ(svc.handled(), handled_before) << "the PMU handled a request meanwhile";
+}
+
+TEST(SecureDds, MissionComputerWithARelaxedGovernanceStillCannotCommand) {
+  const int domain = test_domain();
+  // The mission computer's real identity and permissions, but a local governance (signed by
+  // the real Permissions CA) that does not guard pmu/command, as a tampered or misconfigured
+  // client might have: its own participant then creates the writer. The service must still
+  // not take its commands. (What stops it in Fast DDS 2.9 is the endpoint security
+  // attributes: the writer announces itself as not write-protected, the service's
+  // governance requires it to be, and the match is refused before permissions come into
+  // it. With the mission computer allowed to publish pmu/command this test still passes:
+  // it guards the relaxed-governance case, not the permission itself.)
+  const std::string lax = Pki::get().lax();
+  ServiceUnderTest svc(domain, Pki::get().files("pmu-service"));
+  Client good(domain, Pki::get().files("ground-station"), "ground-station");
+  Client mc(domain, dds::security_files_in(lax, "mission-computer"), "tampered-mission-computer");
+  ASSERT_NO_THROW(mc.commands()) << "the relaxed governance should let its own participant create the writer";
+  ASSERT_TRUE(wait_sample<pmu::Voltages>(mc.voltages(), 20s)) << "it is still a mission computer: telemetry";
+  ASSERT_TRUE(wait_sample<pmu::Config>(good.config(), 10s)) << "no pmu/config: the service's start-up is not done";
+  const std::uint64_t handled_before = svc.handled();
+  for (int i = 0; i < 15; ++i) {
+    pmu::Command c = command("tampered-" + std::to_string(i));
+    mc.commands().write(&c);
+    std::this_thread::sleep_for(200ms);
+  }
+  EXPECT_EQ(mc.commands_matched(), 0) << "the service matched the mission computer's command writer";
+  EXPECT_EQ(svc.commands.counters().received, 0u) << "a command from the mission computer reached the service";
+  EXPECT_NE(svc.outputs() & kPayload, 0) << "the payload was switched off";
+  EXPECT_EQ(svc.handled(), handled_before) << "the PMU handled a request meanwhile";
+  // The ground station still commands.
+  expect_ground_station_commands(svc, good, "gs-after-tampering");
+}
+
+TEST(SecureDds, PermissionsSignedByTheParticipantItselfAreRejected) {
+  const int domain = test_domain();
+  // CVE-2023-24010's shape: mission-computer gives itself the ground station's rights in a
+  // permissions document signed with its own identity (which the Identity CA issued). Its
+  // own participant accepts it (it trusts the Identity CA for documents); the service,
+  // which trusts only the separate Permissions CA, must not.
+  const std::string self = Pki::get().selfsigned();
+  ServiceUnderTest svc(domain, Pki::get().files("pmu-service"));
+  Client good(domain, Pki::get().files("mission-computer"), "mission-computer");
+  Client intruder(domain, dds::security_files_in(self, "mission-computer"), "self-signed-mission-computer");
+  expect_shut_out(svc, intruder, good);
+}
+
+// The control for the test above, and the reason the start-up check refuses one CA for
+// both roles: with a single CA (it issues the identities and signs the documents), Debian's
+// Fast DDS 2.9.1 takes the same self-signed permissions and the mission computer reads
+// telemetry and switches the payload off. Skipped, not failed, if a fixed Fast DDS refuses.
+TEST(SecureDds, Cve202324010WithOneCaTheSelfSignedPermissionsWouldBeAccepted) {
+  const int domain = test_domain();
+  const std::string single = Pki::get().single_ca();
+  ServiceUnderTest svc(domain, dds::security_files_in(single + "/world", "pmu-service"));
+  Client good(domain, dds::security_files_in(single + "/world", "ground-station"), "ground-station");
+  Client intruder(domain, dds::security_files_in(single + "/intruder", "mission-computer"),
+                  "self-signed-mission-computer");
+  const Intrusion r = intrude(svc, intruder, good);
+  EXPECT_GE(r.good_samples, 4) << "the single-CA world itself does not work";
+  if (r.stolen_samples == 0 && r.received == 0)
+    GTEST_SKIP() << "this Fast DDS refuses self-signed permissions even with one CA: CVE-2023-24010 is fixed here";
+  EXPECT_GT(r.stolen_samples, 0);
+  EXPECT_GT(r.received, 0u);
+  EXPECT_TRUE(r.outputs_changed) << "the intruder's command should have switched the payload off";
+  std::printf("CVE-2023-24010 reproduced with one CA: the intruder got %d telemetry samples, the service took %llu "
+              "of its commands\n",
+              r.stolen_samples, static_cast<unsigned long long>(r.received));
+}
+
+// ---- the wire ------------------------------------------------------------------------------
+
+// Every frame on every interface (AF_PACKET) while it runs; needs CAP_NET_RAW.
+class Capture {
+ public:
+  Capture() : fd_(::socket(AF_PACKET, SOCK_RAW, htons(ETH_P_ALL))) {
+    if (fd_ < 0) return;
+    thread_ = std::thread([this] {
+      std::vector<char> buf(1 << 17);
+      while (!stop_) {
+        pollfd p{fd_, POLLIN, 0};
+        if (::poll(&p, 1, 50) <= 0) continue;
+        const ssize_t n = ::recv(fd_, buf.data(), buf.size(), 0);
+        if (n <= 0) continue;
+        std::lock_guard<std::mutex> lock(mutex_);
+        if (bytes_.size() < (256u << 20)) bytes_.append(buf.data(), static_cast<std::size_t>(n));
+        ++frames_;
+      }
+    });
+  }
+  ~Capture() {
+    stop_ = true;
+    if (thread_.joinable()) thread_.join();
+    if (fd_ >= 0) ::close(fd_);
+  }
+  bool ok() const { return fd_ >= 0; }
+  bool contains(const std::string& s) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    return bytes_.find(s) != std::string::npos;
+  }
+  std::size_t bytes() {
+    std::lock_guard<std::mutex> lock(mutex_);
+    return bytes_.size();
+  }
+
+ private:
+  int fd_;
+  std::atomic<bool> stop_{false};
+  std::mutex mutex_;
+  std::string bytes_;
+  std::uint64_t frames_ = 0;
+  std::thread thread_;
+};
+
+struct WireResult {
+  bool command_marker = false;
+  bool telemetry_marker = false;
+  std::size_t bytes = 0;
+};
+
+// A service and a ground station (both with `service_files`/`gs_files`, or both plain): the
+// ground station reads telemetry and sends a command whose request id is the marker.
+WireResult run_on_the_wire(const SecurityFiles& service_files, const SecurityFiles& gs_files, const std::string& marker,
+                           const std::string& bus_marker) {
+  const int domain = test_domain();
+  WireResult w;
+  Capture capture;
+  if (!capture.ok()) return w;
+  {
+    ServiceUnderTest svc(domain, service_files, bus_marker);
+    Client gs(domain, gs_files, "ground-station");
+    EXPECT_TRUE(wait_sample<pmu::Voltages>(gs.voltages(), 20s));
+    EXPECT_TRUE(wait_command_link(gs, 10s));
+    pmu::Command c = command(marker, bus_marker);
+    EXPECT_TRUE(gs.commands().write(&c));
+    const auto reply = wait_reply(gs.replies(), marker, 10s);
+    EXPECT_TRUE(reply.has_value() && reply->result() == pmu::COMPLETED) << "the command did not complete";
+    std::this_thread::sleep_for(1s);  // more telemetry
+  }
+  std::this_thread::sleep_for(200ms);
+  w.command_marker = capture.contains(marker);
+  w.telemetry_marker = capture.contains(bus_marker);
+  w.bytes = capture.bytes();
+  return w;
+}
+
+TEST(SecureDds, TrafficOnTheWireIsEncrypted) {
+  const int probe = ::socket(AF_PACKET, SOCK_RAW, htons(ETH_P_ALL));
+  if (probe < 0) GTEST_SKIP() << "capturing packets needs CAP_NET_RAW (run as root): " << std::strerror(errno);
+  ::close(probe);
+  const std::string pid = std::to_string(::getpid());
+  // Control: without security the command's request id and the telemetry's bus key are
+  // in the capture (so the capture does see this traffic) ...
+  const WireResult plain = run_on_the_wire({}, {}, "PLAINTEXT-MARKER-" + pid + "-A", "wire" + pid + "a");
+  EXPECT_TRUE(plain.command_marker) << "control: the plain command was not seen in " << plain.bytes << " bytes";
+  EXPECT_TRUE(plain.telemetry_marker) << "control: plain telemetry was not seen in " << plain.bytes << " bytes";
+  // ... and with security they are not.
+  const WireResult secure = run_on_the_wire(Pki::get().files("pmu-service"), Pki::get().files("ground-station"),
+                                            "PLAINTEXT-MARKER-" + pid + "-B", "wire" + pid + "b");
+  std::printf("captured %zu bytes without security, %zu bytes with\n", plain.bytes, secure.bytes);
+  EXPECT_GT(secure.bytes, 0u);
+  EXPECT_FALSE(secure.command_marker) << "the command's request id is readable on the wire";
+  EXPECT_FALSE(secure.telemetry_marker) << "telemetry (its bus key) is readable on the wire";
+}
+
+// ---- the programs ---------------------------------------------------------------------------
+
+struct ServiceProcess {
+  explicit ServiceProcess(const std::string& config) {
+    pid = ::fork();
+    if (pid == 0) {
+      ::execl(PMU_SERVICE_PATH, PMU_SERVICE_PATH, "--config", config.c_str(), "--log-level", "warn",
+              static_cast<char*>(nullptr));
+      std::_Exit(127);
+    }
+  }
+  ~ServiceProcess() {
+    ::kill(pid, SIGTERM);
+    ::waitpid(pid, nullptr, 0);
+  }
+  pid_t pid;
+};
+
+TEST(ServiceProgram, SecurePmuServiceWithPmuctlAndTheExampleClient) {
+  const std::string cfg = write_config("good", Pki::get().files("pmu-service"));
+  ServiceProcess service(cfg);
+  const std::string d = " --domain " + std::to_string(test_domain());
+  const std::string sec = " --security-dir " + Pki::get().dir();
+  const std::string pmuctl = PMUCTL_PATH;
+
+  auto r = sh(pmuctl + d + sec + " --identity ground-station --timeout 10 config set avionics_voltage 24");
+  EXPECT_EQ(r.status, 0) << r.out;
+  EXPECT_NE(r.out.find("COMPLETED"), std::string::npos) << r.out;
+  r = sh(pmuctl + d + sec + " --identity mission-computer --timeout 10 list");
+  EXPECT_EQ(r.status, 0) << r.out;
+  EXPECT_NE(r.out.find("sim0"), std::string::npos) << r.out;
+  r = sh(pmuctl + d + sec + " --identity mission-computer --timeout 5 config set avionics_voltage 12");
+  EXPECT_EQ(r.status, 2) << r.out;
+  EXPECT_NE(r.out.find("this identity's permissions may not allow"), std::string::npos) << r.out;
+  r = sh(pmuctl + d + " --timeout 3 list");  // no security at all
+  EXPECT_NE(r.status, 0) << "an unauthenticated pmuctl must not see the service: " << r.out;
+  r = sh(pmuctl + d + sec + " list");
+  EXPECT_EQ(r.status, 2) << r.out;
+  EXPECT_NE(r.out.find("needs --identity NAME"), std::string::npos) << r.out;
+  r = sh("PMU_SECURITY_DIR=" + Pki::get().dir() + " PMU_SECURITY_IDENTITY=mission-computer " + pmuctl + d +
+         " --timeout 10 health");
+  EXPECT_EQ(r.status, 0) << "the environment variables: " << r.out;
+
+  r = sh("PMU_QOS_FILE=" + std::string(PMU_QOS_FILE) + " PMU_SECURITY_DIR=" + Pki::get().dir() + " " +
+         GROUND_STATION_PATH + d);
+  EXPECT_EQ(r.status, 0) << r.out;
+  r = sh("PMU_QOS_FILE=" + std::string(PMU_QOS_FILE) + " PMU_SECURITY_DIR=" + Pki::get().dir() +
+         " PMU_SECURITY_IDENTITY=mission-computer " + GROUND_STATION_PATH + d);
+  EXPECT_EQ(r.status, 2) << "the example as mission-computer may not command: " << r.out;
+}
+
+}  // namespace
+}  // namespace pmu::service
+
+int main(int argc, char** argv) {
+  ::testing::InitGoogleTest(&argc, argv);
+  // Everything between participants goes through the transport (UDP), none of it through
+  // Fast DDS's in-process shortcut: what the wire test looks at is what two hosts exchange.
+  eprosima::fastrtps::LibrarySettingsAttributes library;
+  library.intraprocess_delivery = eprosima::fastrtps::INTRAPROCESS_OFF;
+  eprosima::fastrtps::xmlparser::XMLProfileManager::library_settings(library);
+  ::signal(SIGPIPE, SIG_IGN);
+  // PMU_FASTDDS_WARNINGS=1 shows why Fast DDS rejected a participant (handshake failures
+  // are warnings).
+  if (std::getenv("PMU_FASTDDS_WARNINGS")) eprosima::fastdds::dds::Log::SetVerbosity(eprosima::fastdds::dds::Log::Warning);
+  return RUN_ALL_TESTS();
+}
+

@@ -1,0 +1,137 @@
+#pragma once
+// The PKI of one security test process: deploy/security/make_pki.sh run into a temporary
+// folder once (removed at exit; PMU_KEEP_TEST_PKI=1 keeps it), plus the bad variants of
+// tests/security/make_variants.sh on first use. Each test runs in its own process
+// (gtest_discover_tests), so each test has its own PKI and DDS domain.
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <fstream>
+#include <ctime>
+#include <map>
+#include <set>
+#include <stdexcept>
+#include <string>
+
+#include <gtest/gtest.h>
+
+#include "pmu/service/dds_security.hpp"
+
+namespace pmu::security_test {
+
+using dds::SecurityFiles;
+
+// Domains 10..99: the integration tests use 100 and up.
+inline int test_domain() { return 10 + static_cast<int>(::getpid() % 90); }
+
+struct Result {
+  int status;
+  std::string out;
+};
+
+inline Result sh(const std::string& cmd) {
+  Result r{-1, {}};
+  FILE* p = ::popen((cmd + " 2>&1").c_str(), "r");
+  if (!p) return r;
+  char buf[4096];
+  std::size_t n = 0;
+  while ((n = std::fread(buf, 1, sizeof buf, p)) > 0) r.out.append(buf, n);
+  const int st = ::pclose(p);
+  r.status = WIFEXITED(st) ? WEXITSTATUS(st) : -1;
+  return r;
+}
+
+inline std::string utc(std::chrono::system_clock::time_point t) {
+  const std::time_t tt = std::chrono::system_clock::to_time_t(t);
+  std::tm tm{};
+  gmtime_r(&tt, &tm);
+  char buf[32];
+  std::strftime(buf, sizeof buf, "%Y%m%d%H%M%SZ", &tm);
+  return buf;
+}
+
+// The PKI of this test process: made once, removed at exit.
+class Pki {
+ public:
+  static Pki& get() {
+    static Pki pki;
+    return pki;
+  }
+  const std::string& dir() const { return dir_; }       // make_pki.sh's output
+  const std::string& root() const { return root_; }     // the temporary folder around it
+  SecurityFiles files(const std::string& identity) const { return dds::security_files_in(dir_, identity); }
+
+  // A variant of make_variants.sh (foreign, selfsigned, window START END), made on first use.
+  std::string variant(const std::string& name, const std::string& args) {
+    const std::string out = root_ + "/" + name;
+    if (made_.insert(name).second) {
+      const auto r = sh(std::string("bash ") + PMU_SOURCE_DIR + "/tests/security/make_variants.sh " + args + " " + dir_ +
+                        " " + out + extra_.at(name));
+      if (r.status != 0) ADD_FAILURE() << "make_variants.sh " << args << ": " << r.out;
+    }
+    return out;
+  }
+  std::string window(const std::string& name, std::chrono::system_clock::time_point from,
+                     std::chrono::system_clock::time_point until) {
+    extra_[name] = " " + utc(from) + " " + utc(until);
+    return variant(name, "window");
+  }
+  std::string foreign() { return (extra_["foreign"] = "", variant("foreign", "foreign")); }
+  std::string selfsigned() { return (extra_["selfsigned"] = "", variant("selfsigned", "selfsigned")); }
+  std::string lax() { return (extra_["lax"] = "", variant("lax", "lax")); }
+  std::string single_ca() { return (extra_["single-ca"] = "", variant("single-ca", "single-ca")); }
+
+  ~Pki() {
+    if (!root_.empty() && !std::getenv("PMU_KEEP_TEST_PKI")) sh("rm -rf '" + root_ + "'");
+  }
+
+ private:
+  Pki() {
+    char tmpl[] = "/tmp/pmu-security-test-XXXXXX";
+    if (!::mkdtemp(tmpl)) throw std::runtime_error("mkdtemp failed");
+    root_ = tmpl;
+    dir_ = root_ + "/pki";
+    const auto r = sh(std::string("bash ") + PMU_SOURCE_DIR + "/deploy/security/make_pki.sh " + dir_ + " --domain " +
+                      std::to_string(test_domain()));
+    if (r.status != 0) throw std::runtime_error("make_pki.sh failed: " + r.out);
+  }
+  std::string root_, dir_;
+  std::set<std::string> made_;
+  std::map<std::string, std::string> extra_;
+};
+
+// A pmu-service config: the built-in simulated PMU on this test's domain, with `f`.
+inline std::string write_config(const std::string& name, const SecurityFiles& f, const std::string& extra = "") {
+  const std::string path = Pki::get().root() + "/" + name + ".yaml";
+  std::ofstream out(path);
+  out << "domain: " << test_domain() << "\nbuses:\n  - interface: sim\n    name: sim0\n    devices:\n"
+      << "      - address: 1\n        period: 0.5\nsecurity:\n"
+      << "  identity_ca: " << f.identity_ca << "\n  identity_certificate: " << f.identity_certificate
+      << "\n  private_key: " << f.private_key << "\n  permissions_ca: " << f.permissions_ca
+      << "\n  governance: " << f.governance << "\n  permissions: " << f.permissions << "\n"
+      << extra;
+  return path;
+}
+
+// The contract's topics (interface.md section 1).
+inline const std::set<std::string> kTelemetryAndState = {"pmu/voltages", "pmu/currents", "pmu/battery_energy",
+                                                         "pmu/temperatures", "pmu/status", "pmu/config",
+                                                         "pmu/info", "pmu/health"};
+inline const char* const kContractTopics[] = {"pmu/voltages", "pmu/currents", "pmu/battery_energy",
+                                              "pmu/temperatures", "pmu/status", "pmu/config", "pmu/info",
+                                              "pmu/health", "pmu/command", "pmu/command_reply"};
+
+// What the issue asks: only the ground station commands; the service publishes telemetry,
+// state and replies; the mission computer only reads telemetry and state.
+inline bool allowed(const std::string& identity, const std::string& topic, bool publish) {
+  const bool data = kTelemetryAndState.count(topic) > 0;
+  if (identity == "pmu-service") return publish ? data || topic == "pmu/command_reply" : topic == "pmu/command";
+  if (identity == "ground-station") return publish ? topic == "pmu/command" : data || topic == "pmu/command_reply";
+  if (identity == "mission-computer") return !publish && data;
+  return false;
+}
+
+}  // namespace pmu::security_test
