@@ -116,7 +116,7 @@ TEST(CommandsOverDds, TwoSendersBurst1000CommandsAndGetExactly1000Replies) {
           c.parameter("outputs");
       }
       s.writer.write(&c);
-      // A well-behaved client sends bursts the command QoS depth (256) holds, and lets
+      // A well-behaved client sends bursts the command QoS depth (1024) holds, and lets
       // them be acknowledged before the next.
       if (i % 100 == 99) s.writer.wait_for_acknowledgments(eprosima::fastrtps::Duration_t(5, 0));
     }
