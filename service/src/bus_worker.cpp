@@ -70,10 +70,7 @@ std::vector<std::uint16_t> BusWorker::addresses() const {
 
 void BusWorker::on_frame(const transport::ReceivedFrame& rx) {
   const auto id = codec::parse_id(rx.frame.id, rx.frame.extended);
-  if (!id.id) {
-    ++foreign_frames_;  // CANopen or unknown packets: not a PMU conversation
-    return;
-  }
+  if (!id.id) return;  // CANopen or unknown packets: not a PMU conversation
   const auto now = clock_.steady_now();
   const std::uint16_t address = id.id->address;
   if (address == codec::kBroadcastAddress) return;  // a broadcast request, not an answer
@@ -88,10 +85,7 @@ void BusWorker::on_frame(const transport::ReceivedFrame& rx) {
     s = &add_session(d);
     spdlog::info("{}: discovered a PMU at address {}", config_.name, address);
   }
-  if (!s) {
-    ++foreign_frames_;
-    return;
-  }
+  if (!s) return;  // a PMU the config does not serve
   s->on_frame(rx.frame, now, rx.timestamp);
 }
 

@@ -89,20 +89,22 @@ std::string openssl_error() {
 // No passphrase prompt on the terminal: an encrypted key simply fails to load.
 int no_password(char*, int, int, void*) { return -1; }
 
-std::string format_time(const ASN1_TIME* t) {
-  std::tm tm{};
-  if (!ASN1_TIME_to_tm(t, &tm)) return "an unreadable date";
+std::string format_tm(const std::tm& tm) {
   char buf[40];
   std::strftime(buf, sizeof buf, "%Y-%m-%d %H:%M:%S UTC", &tm);
   return buf;
 }
 
+std::string format_time(const ASN1_TIME* t) {
+  std::tm tm{};
+  if (!ASN1_TIME_to_tm(t, &tm)) return "an unreadable date";
+  return format_tm(tm);
+}
+
 std::string format_time(std::time_t t) {
   std::tm tm{};
   gmtime_r(&t, &tm);
-  char buf[40];
-  std::strftime(buf, sizeof buf, "%Y-%m-%d %H:%M:%S UTC", &tm);
-  return buf;
+  return format_tm(tm);
 }
 
 class Checker {

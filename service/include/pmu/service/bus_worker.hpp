@@ -78,7 +78,6 @@ class BusWorker final : private transport::BusHandler {
   std::atomic<std::uint64_t> progress_{0};
   std::chrono::steady_clock::time_point next_maintain_{};
   std::chrono::steady_clock::time_point next_discovery_{};
-  std::uint64_t foreign_frames_ = 0;
 };
 
 }  // namespace pmu::service
