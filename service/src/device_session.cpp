@@ -44,7 +44,7 @@ DeviceSession::DeviceSession(DeviceKey key, DeviceConfig config, const Timeouts&
 }
 
 std::optional<codec::FirmwareVersion> DeviceSession::firmware() const noexcept {
-  if (!info_) return std::nullopt;
+  if (!info_ || !info_->firmware_known) return std::nullopt;
   return info_->firmware.version();
 }
 
@@ -233,6 +233,7 @@ void DeviceSession::absorb(const codec::PmuMessage& m) {
   } else if (const auto* fw = std::get_if<codec::FirmwareInfo>(&m.payload)) {
     if (!info_) info_ = InfoState{};
     const auto& old = info_->firmware;
+    info_->firmware_known = true;
     if (old.firmware_major != fw->firmware_major || old.firmware_minor != fw->firmware_minor ||
         old.build_year != fw->build_year || old.build_month != fw->build_month || old.build_day != fw->build_day) {
       info_->firmware = *fw;

@@ -4,8 +4,10 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 
 #include "harness.hpp"
+#include "pmu/codec/encode.hpp"
 
 namespace pmu::service::test {
 namespace {
@@ -178,6 +180,31 @@ TEST(Session, TelemetryCarriesTheFrameReceiveTime) {
   const auto now = h.clock().system_now();
   EXPECT_LE(t, now);
   EXPECT_GT(t, now - 600ms);
+}
+
+// A streaming unit's telemetry can arrive between the serial and the firmware replies of
+// the start-up reading. It must be decoded as "firmware unknown", not as firmware 0.0,
+// which would hide the external temperatures (seen in the VM: battery_a read as no sensor).
+TEST(Session, TelemetryBetweenSerialAndFirmwareRepliesDecodesTheExternalSensors) {
+  RecordingSink sink;
+  const auto t0 = std::chrono::steady_clock::time_point{} + 1h;
+  DeviceSession s({"sim0", 1}, device(1), Timeouts{}, sink, [](const codec::CanFrame&) { return transport::SendResult{}; },
+                  t0);
+  s.on_frame(*codec::encode_serial(4001, 1), t0 + 1ms, {});
+  codec::Temperatures temps;
+  temps.internal = 35;
+  temps.battery_a = 25;
+  temps.battery_b = 24;
+  temps.generator = codec::kNoSensor;
+  temps.starter = 20;
+  s.on_frame(*codec::encode_temperatures(temps, 1), t0 + 2ms, {});
+  ASSERT_EQ(sink.telemetry.size(), 1u);
+  const auto* got = std::get_if<codec::Temperatures>(&sink.telemetry[0].message.payload);
+  ASSERT_NE(got, nullptr);
+  EXPECT_DOUBLE_EQ(got->battery_a, 25.0);
+  EXPECT_DOUBLE_EQ(got->battery_b, 24.0);
+  EXPECT_TRUE(std::isnan(got->generator));
+  EXPECT_FALSE(s.firmware().has_value());
 }
 
 }  // namespace

@@ -40,6 +40,9 @@ struct ConfigState {
 struct InfoState {
   std::uint16_t serial_number = 0;
   codec::FirmwareInfo firmware;
+  // The serial reply comes first: until the firmware reply, `firmware` reads 0.0, which is
+  // no real version and would decode telemetry as pre-1.12 (no external temperatures).
+  bool firmware_known = false;
 };
 
 enum class HealthState : std::uint8_t { Unknown, Online, Stale, Offline };
