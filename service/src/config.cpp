@@ -3,6 +3,7 @@
 #include <yaml-cpp/yaml.h>
 
 #include <algorithm>
+#include <charconv>
 #include <cmath>
 #include <fstream>
 #include <initializer_list>
@@ -248,9 +249,16 @@ Config parse_config(const std::string& text, const std::string& source) {
   Config cfg;
   cfg.source = source;
   if (root.IsNull()) throw ConfigError(source + ":1: the file is empty");
-  c.only_keys(root, "the top level", {"domain", "qos_file", "log_level", "buses", "timeouts", "policy", "security"});
+  c.only_keys(root, "the top level", {"domain", "qos_file", "dds_transport", "log_level", "buses", "timeouts", "policy", "security"});
   if (const auto v = root["domain"]) cfg.domain = static_cast<int>(c.integer(v, "domain", 0, 232));
   if (const auto v = root["qos_file"]) cfg.qos_file = c.scalar<std::string>(v, "qos_file", "a path");
+  if (const auto v = root["dds_transport"]) {
+    const auto t = c.scalar<std::string>(v, "dds_transport", "default or udp");
+    if (t == "udp")
+      cfg.dds_transport = dds::Transport::UdpOnly;
+    else if (t != "default")
+      c.fail(v, "dds_transport '" + t + "' is not one of default, udp");
+  }
   if (const auto v = root["log_level"]) {
     cfg.log_level = c.scalar<std::string>(v, "log_level", "a level");
     if (!is_log_level(cfg.log_level))
@@ -311,12 +319,21 @@ void override_bus(Config& config, const std::string& spec) {
     iface = spec.substr(10);
     if (iface.empty() || iface.size() > kMaxBusName || iface == "sim")
       throw ConfigError("--bus " + spec + ": '" + iface + "' is not a valid interface name");
+  } else if (spec.rfind("fd:", 0) == 0) {
+    // An inherited fd carrying struct can_frame records (one end of a socketpair): how the
+    // benchmarks drive the SocketCAN code path on a kernel without CAN.
+    const std::string n = spec.substr(3);
+    int fd = -1;
+    const auto r = std::from_chars(n.data(), n.data() + n.size(), fd);
+    if (n.empty() || r.ec != std::errc{} || r.ptr != n.data() + n.size() || fd < 3)
+      throw ConfigError("--bus " + spec + ": expected fd:N with an inherited file descriptor N >= 3");
+    iface = spec;
   } else {
     throw ConfigError("--bus " + spec + ": expected sim or socketcan:IFACE");
   }
   BusConfig b = config.buses.empty() ? default_sim_config().buses.front() : config.buses.front();
   b.interface = iface;
-  b.name = iface == "sim" ? "sim0" : iface;
+  b.name = iface == "sim" ? "sim0" : iface.rfind("fd:", 0) == 0 ? "fd" + iface.substr(3) : iface;
   b.source_line = "--bus " + spec;
   config.buses.assign(1, b);
 }

@@ -53,7 +53,10 @@ std::unique_ptr<transport::CanBus> open_bus(const service::BusConfig& bus, const
   if (bus.interface != "sim") {
     transport::SocketCanOptions options;
     options.filters = transport::default_filters(false);
-    auto b = transport::SocketCanBus::open(bus.interface, options, clock);
+    auto b = bus.interface.rfind("fd:", 0) == 0
+                 ? transport::SocketCanBus::adopt(transport::UniqueFd(std::stoi(bus.interface.substr(3))), bus.name,
+                                                  options, clock)
+                 : transport::SocketCanBus::open(bus.interface, options, clock);
     const auto& r = b->report();
     spdlog::info("{}: SocketCAN open, receive buffer {} bytes{}, kernel filters {}, timestamps {}", bus.name,
                  r.receive_buffer_bytes, r.receive_buffer_forced ? " (forced)" : "", r.kernel_filters ? "on" : "off",
@@ -107,7 +110,7 @@ int run(const service::Config& cfg) {
     for (const auto& d : b.devices) longest = std::max(longest, d.period);
   if (longest == milliseconds{0}) longest = milliseconds(1000);
 
-  pmu::dds::DdsContext participant(cfg.domain, cfg.qos_file, "pmu-service", cfg.security.files);
+  pmu::dds::DdsContext participant(cfg.domain, cfg.qos_file, "pmu-service", cfg.security.files, cfg.dds_transport);
   if (participant.secure())
     spdlog::info("DDS-Security on: identity {}, permissions {}", cfg.security.files.identity_certificate,
                  cfg.security.files.permissions);
@@ -201,7 +204,8 @@ int main(int argc, char** argv) {
   std::optional<int> domain;
   bool check_only = false;
   app.add_option("--config", config_path, std::string("YAML config file (default ") + kDefaultConfig + ")");
-  app.add_option("--bus", bus_spec, "sim (built-in simulated PMU) or socketcan:IFACE; replaces the config's buses");
+  app.add_option("--bus", bus_spec, "sim (built-in simulated PMU) or socketcan:IFACE; replaces the config's buses "
+                 "(fd:N: an inherited fd carrying struct can_frame records, for benchmarks)");
   app.add_option("--domain", domain, "DDS domain id (0..232)")->check(CLI::Range(0, 232));
   app.add_option("--log-level", log_level, "trace, debug, info, warn, error, critical or off");
   app.add_flag("--check-config", check_only, "Validate the configuration and exit");

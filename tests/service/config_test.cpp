@@ -54,7 +54,7 @@ const BadCase kBad[] = {
     {"buses: [\n", "bad.yaml:2: YAML syntax error: end of sequence flow not found"},
     {"domain: 0\n", "bad.yaml:1: no buses: the service needs at least one bus"},
     {"domian: 0\nbuses: []\n",
-     "bad.yaml:1: unknown key 'domian' in the top level (known: domain, qos_file, log_level, buses, timeouts, policy, "
+     "bad.yaml:1: unknown key 'domian' in the top level (known: domain, qos_file, dds_transport, log_level, buses, timeouts, policy, "
      "security)"},
     {"domain: 300\nbuses: []\n", "bad.yaml:1: domain 300 out of range 0..232"},
     {"domain: x\nbuses: []\n", "bad.yaml:1: domain must be an integer, not 'x'"},
@@ -87,6 +87,8 @@ const BadCase kBad[] = {
      "bad.yaml:1: log_level 'loud' is not one of trace, debug, info, warn, error, critical, off"},
     {"timeouts:\n  stale_periods: 5\n  offline_periods: 4\nbuses:\n  - interface: can0\n    discover: true\n",
      "bad.yaml:3: offline_periods must be greater than stale_periods"},
+    {"dds_transport: shm\nbuses:\n  - interface: can0\n    discover: true\n",
+     "bad.yaml:1: dds_transport 'shm' is not one of default, udp"},
     {"timeouts:\n  reply: 0\nbuses:\n  - interface: can0\n    discover: true\n",
      "bad.yaml:2: reply 0 out of range 0.01..10"},
     {"buses:\n  - interface: can0\n    discover: true\nsecurity:\n",
@@ -170,6 +172,13 @@ TEST(Config, BusOverride) {
   EXPECT_EQ(c.buses[0].interface, "sim");
   EXPECT_THROW(override_bus(c, "can0"), ConfigError);
   EXPECT_THROW(override_bus(c, "socketcan:"), ConfigError);
+  EXPECT_EQ(c.dds_transport, dds::Transport::Default);
+  EXPECT_EQ(parse_config("dds_transport: udp\nbuses:\n  - interface: can0\n    discover: true\n", "u.yaml").dds_transport,
+            dds::Transport::UdpOnly);
+  override_bus(c, "fd:5");
+  EXPECT_EQ(c.buses[0].interface, "fd:5");
+  EXPECT_EQ(c.buses[0].name, "fd5");
+  for (const char* bad : {"fd:", "fd:2", "fd:x", "fd:5x", "fd:-4"}) EXPECT_THROW(override_bus(c, bad), ConfigError) << bad;
   const Config d = default_sim_config();
   ASSERT_EQ(d.buses.size(), 1u);
   EXPECT_EQ(d.buses[0].devices.at(0).address, 1);

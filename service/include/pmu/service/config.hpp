@@ -12,6 +12,7 @@
 #include <string>
 #include <vector>
 
+#include "pmu/service/dds_transport.hpp"
 #include "pmu/service/dds_security.hpp"
 #include "pmu/service/policy.hpp"
 
@@ -74,6 +75,10 @@ struct Config {
   std::string source = "<defaults>";  // the file it came from
   int domain = 0;
   std::string qos_file;  // empty: the installed deploy/qos.xml, found by the service
+  // default: Fast DDS's builtin transports (shared memory between processes on one host,
+  // UDPv4); udp: UDPv4 only, e.g. when readers run as other users (SHM segments are
+  // owner-only in Fast DDS 2.9).
+  dds::Transport dds_transport = dds::Transport::Default;
   std::string log_level = "info";
   std::vector<BusConfig> buses;
   Timeouts timeouts;

@@ -23,6 +23,7 @@
 #include <string>
 
 #include "pmu/service/dds_security.hpp"
+#include "pmu/service/dds_transport.hpp"
 
 namespace pmu::dds {
 
@@ -35,10 +36,6 @@ class DdsError : public std::runtime_error {
 // deploy/qos.xml (for runs from a build directory). Empty when none exists.
 std::string default_qos_file();
 
-// Transports of the participant. Default: Fast DDS's builtin ones (UDPv4, and shared
-// memory between processes on one host). UdpOnly: UDPv4 alone, so that all traffic between
-// participants on one host crosses the loopback interface (tests that look at the wire).
-enum class Transport { Default, UdpOnly };
 
 class DdsContext {
  public:
