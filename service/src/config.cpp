@@ -253,11 +253,13 @@ Config parse_config(const std::string& text, const std::string& source) {
   if (const auto v = root["domain"]) cfg.domain = static_cast<int>(c.integer(v, "domain", 0, 232));
   if (const auto v = root["qos_file"]) cfg.qos_file = c.scalar<std::string>(v, "qos_file", "a path");
   if (const auto v = root["dds_transport"]) {
-    const auto t = c.scalar<std::string>(v, "dds_transport", "default or udp");
+    const auto t = c.scalar<std::string>(v, "dds_transport", "default, udp or shm");
     if (t == "udp")
       cfg.dds_transport = dds::Transport::UdpOnly;
+    else if (t == "shm")
+      cfg.dds_transport = dds::Transport::ShmOnly;
     else if (t != "default")
-      c.fail(v, "dds_transport '" + t + "' is not one of default, udp");
+      c.fail(v, "dds_transport '" + t + "' is not one of default, udp, shm");
   }
   if (const auto v = root["log_level"]) {
     cfg.log_level = c.scalar<std::string>(v, "log_level", "a level");

@@ -2,6 +2,7 @@
 
 #include <fastdds/dds/domain/DomainParticipantFactory.hpp>
 #include <fastdds/rtps/transport/UDPv4TransportDescriptor.h>
+#include <fastdds/rtps/transport/shared_mem/SharedMemTransportDescriptor.h>
 
 #include <cstdlib>
 #include <filesystem>
@@ -69,6 +70,10 @@ DdsContext::DdsContext(int domain, const std::string& qos_file, const std::strin
   if (transport == Transport::UdpOnly) {
     pqos.transport().use_builtin_transports = false;
     pqos.transport().user_transports.push_back(std::make_shared<eprosima::fastdds::rtps::UDPv4TransportDescriptor>());
+  } else if (transport == Transport::ShmOnly) {
+    pqos.transport().use_builtin_transports = false;
+    pqos.transport().user_transports.push_back(
+        std::make_shared<eprosima::fastdds::rtps::SharedMemTransportDescriptor>());
   }
   participant_ = DomainParticipantFactory::get_instance()->create_participant(static_cast<DomainId_t>(domain), pqos);
   if (!participant_)

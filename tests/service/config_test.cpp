@@ -87,8 +87,8 @@ const BadCase kBad[] = {
      "bad.yaml:1: log_level 'loud' is not one of trace, debug, info, warn, error, critical, off"},
     {"timeouts:\n  stale_periods: 5\n  offline_periods: 4\nbuses:\n  - interface: can0\n    discover: true\n",
      "bad.yaml:3: offline_periods must be greater than stale_periods"},
-    {"dds_transport: shm\nbuses:\n  - interface: can0\n    discover: true\n",
-     "bad.yaml:1: dds_transport 'shm' is not one of default, udp"},
+    {"dds_transport: tcp\nbuses:\n  - interface: can0\n    discover: true\n",
+     "bad.yaml:1: dds_transport 'tcp' is not one of default, udp, shm"},
     {"timeouts:\n  reply: 0\nbuses:\n  - interface: can0\n    discover: true\n",
      "bad.yaml:2: reply 0 out of range 0.01..10"},
     {"buses:\n  - interface: can0\n    discover: true\nsecurity:\n",
@@ -175,6 +175,8 @@ TEST(Config, BusOverride) {
   EXPECT_EQ(c.dds_transport, dds::Transport::Default);
   EXPECT_EQ(parse_config("dds_transport: udp\nbuses:\n  - interface: can0\n    discover: true\n", "u.yaml").dds_transport,
             dds::Transport::UdpOnly);
+  EXPECT_EQ(parse_config("dds_transport: shm\nbuses:\n  - interface: can0\n    discover: true\n", "s.yaml").dds_transport,
+            dds::Transport::ShmOnly);
   override_bus(c, "fd:5");
   EXPECT_EQ(c.buses[0].interface, "fd:5");
   EXPECT_EQ(c.buses[0].name, "fd5");

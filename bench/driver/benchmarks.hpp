@@ -1,0 +1,20 @@
+#pragma once
+// The service benchmarks of issue 6, each beside its bare-Fast-DDS reference from the same
+// run. Each prints result rows (JSON lines, bench/report.py's format) on stdout and its
+// progress on stderr.
+
+#include <nlohmann/json.hpp>
+#include <vector>
+
+#include "service_run.hpp"
+
+namespace pmu::bench {
+
+using Rows = std::vector<nlohmann::json>;
+
+// Start-up, idle CPU, memory, latency and CPU at a saturated bus, command round trip and
+// the highest zero-loss rate, over Fast DDS's default transports (shared memory between
+// processes on one host) and the latency again over UDP only.
+Rows run_all(const Settings& s);
+
+}  // namespace pmu::bench

@@ -1,0 +1,65 @@
+// pmu_bench: the service benchmarks (bench/run.sh runs them with the rest), and the bare
+// Fast DDS peers they are compared with.
+//   pmu_bench run --service PATH [--quick] [--domain-base N]   result rows on stdout
+//   pmu_bench peer-writer|peer-echo|peer-pong ...               started by `run`
+// PMU_BENCH_DEBUG=1 lists the numbers of injected frames whose samples never arrived.
+
+#include <unistd.h>
+
+#include <CLI/CLI.hpp>
+#include <cstdio>
+#include <filesystem>
+
+#include "benchmarks.hpp"
+#include "peers.hpp"
+#include "pmu/service/dds_context.hpp"
+
+int main(int argc, char** argv) {
+  using namespace pmu::bench;
+  CLI::App app{"pmu_bench: pmu-service benchmarks against bare Fast DDS"};
+  app.require_subcommand(1);
+  Settings s;
+  s.qos_file = pmu::dds::default_qos_file();
+  s.domain_base = 150 + static_cast<int>(::getpid() % 20) * 4;
+  auto* run = app.add_subcommand("run", "run every service benchmark, print result rows (JSON lines)");
+  run->add_option("--service", s.service_exe, "pmu-service binary")->required()->check(CLI::ExistingFile);
+  run->add_flag("--quick", s.quick, "one short pass (smoke test)");
+  run->add_option("--domain-base", s.domain_base, "first of four DDS domains used")->check(CLI::Range(0, 228));
+  run->add_option("--qos", s.qos_file, "QoS profiles (deploy/qos.xml)");
+  run->add_option("--latency-seconds", s.latency_seconds, "length of each 7,634 frames/s run (default 10, quick 1)");
+
+  PeerOptions p;
+  std::string transport = "default";
+  auto* writer = app.add_subcommand("peer-writer", "bare writer of timed pmu/voltages samples");
+  auto* echo = app.add_subcommand("peer-echo", "bare request/reply on pmu/command");
+  auto* pong = app.add_subcommand("peer-pong", "echo can_frame records on fd 3");
+  for (auto* sub : {writer, echo}) {
+    sub->add_option("--domain", p.domain)->required();
+    sub->add_option("--qos", p.qos_file)->required();
+    sub->add_option("--transport", transport)->check(CLI::IsMember({"default", "udp", "shm"}));
+  }
+  writer->add_option("--rate", p.rate);
+  writer->add_option("--seconds", p.seconds);
+  CLI11_PARSE(app, argc, argv);
+  p.transport = transport == "udp"   ? pmu::dds::Transport::UdpOnly
+                : transport == "shm" ? pmu::dds::Transport::ShmOnly
+                                     : pmu::dds::Transport::Default;
+
+  try {
+    if (*writer) return peer_writer(p);
+    if (*echo) return peer_echo(p);
+    if (*pong) return peer_pong();
+    s.self_exe = std::filesystem::read_symlink("/proc/self/exe").string();
+    s.service_exe = std::filesystem::absolute(s.service_exe).string();
+    char tmpl[] = "/tmp/pmu-bench-XXXXXX";
+    if (!::mkdtemp(tmpl)) throw std::runtime_error("mkdtemp failed");
+    s.workdir = tmpl;
+    const Rows rows = run_all(s);
+    for (const auto& r : rows) std::printf("%s\n", r.dump().c_str());
+    std::filesystem::remove_all(s.workdir);
+    return 0;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "pmu_bench: %s\n", e.what());
+    return 1;
+  }
+}

@@ -1,0 +1,32 @@
+#pragma once
+// The references: the same Fast DDS, types, QoS profiles and transports as pmu-service,
+// with nothing in between. Each runs as its own process (pmu_bench peer-writer|peer-echo).
+
+#include <string>
+
+#include "pmu/service/dds_transport.hpp"
+
+namespace pmu::bench {
+
+struct PeerOptions {
+  int domain = 0;
+  std::string qos_file;
+  dds::Transport transport = dds::Transport::Default;
+  double rate = 5;      // peer-writer: samples per second
+  double seconds = 10;  // peer-writer: how long, once a reader is matched
+};
+
+// A participant with one pmu/voltages writer (telemetry profile) writing samples that carry
+// their write time (dds_probes.hpp) at `rate` for `seconds` once a reader is matched.
+int peer_writer(const PeerOptions& o);
+
+// A participant with a pmu/command reader and a pmu/command_reply writer (command profile)
+// that answers each request at once, from the listener: a bare DDS request/reply.
+// Runs until SIGTERM.
+int peer_echo(const PeerOptions& o);
+
+// Echoes every can_frame record arriving on fd 3 back to it, until the peer closes: the
+// socketpair hop the service's frames take, alone (a blocking read, a wake-up, a write).
+int peer_pong();
+
+}  // namespace pmu::bench
