@@ -30,6 +30,10 @@ for b in service/pmu-service tools/pmuctl bench/pmu_bench bench/codec_bench benc
   [ -x "$build/$b" ] || { echo "bench/run.sh: $build/$b is not built (drop --no-build)" >&2; exit 2; }
 done
 
+# CPU time the hypervisor gave to others ("steal", /proc/stat) during the run: on a shared
+# virtual machine it delays every thread and turns up in every latency.
+steal() { awk '/^cpu / {print $9, $2 + $3 + $4 + $5 + $6 + $7 + $8 + $9}' /proc/stat; }
+read -r steal0 total0 < <(steal)
 rows=$(mktemp)
 trap 'rm -f "$rows"' EXIT
 if [ "$quick" = 1 ]; then frames=20000; min_time=0.01; quick_flag=--quick; else frames=1000000; min_time=0.5; quick_flag=; fi
@@ -46,6 +50,8 @@ cpu=$(sed -n 's/^model name[[:space:]]*: //p' /proc/cpuinfo | head -n1)
 mem=$(awk '/MemTotal/ {printf "%.0f GiB", $2 / 1048576}' /proc/meminfo)
 fastdds=$(dpkg-query -W -f='${Version}' libfastrtps2.9 2>/dev/null || echo unknown)
 echo "Machine: $cpu, $(nproc) cores, $mem; $(uname -sr); Fast DDS $fastdds; $(date -u +%Y-%m-%d)"
+read -r steal1 total1 < <(steal)
+echo "CPU steal during the run: $(awk -v s=$((steal1 - steal0)) -v t=$((total1 - total0)) 'BEGIN {printf "%.1f", t ? 100 * s / t : 0}') % of the machine's CPU time (time the hypervisor gave to other guests)"
 echo "Command: bench/run.sh${quick_flag:+ --quick} (commit $(git -C "$root" rev-parse --short HEAD 2>/dev/null || echo unknown))"
 echo
 python3 "$root/bench/report.py" "$rows"
