@@ -139,10 +139,12 @@ std::size_t BusWorker::run_once(milliseconds max_wait) {
   epoll_event events[2];
   const int n = ::epoll_wait(epoll_.get(), events, 2, static_cast<int>(std::min(max_wait, kTick).count()));
   std::size_t frames = 0;
+  bool woken = false;  // post() ran: only then is there work (and an eventfd to read)
   for (int i = 0; i < n; ++i) {
     if (events[i].data.fd == bus_->fd()) frames += bus_->drain(*this).frames;
+    if (events[i].data.fd == wake_.get()) woken = true;
   }
-  run_posted();
+  if (woken) run_posted();
   const auto now = clock_.steady_now();
   const auto counters = bus_->counters();
   for (auto& [a, s] : sessions_) {

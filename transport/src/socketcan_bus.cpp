@@ -260,7 +260,8 @@ void SocketCanBus::lose_socket(int error, Delivery* out) {
 
 DrainResult SocketCanBus::drain(BusHandler& handler) {
   Delivery out{handler, {}};
-  detail::clear_eventfd(wake_fd_.get());
+  // The eventfd is readable exactly while events are pending: no read() per wakeup else.
+  if (!pending_events_.empty()) detail::clear_eventfd(wake_fd_.get());
   // Swapped out first: a handler that sends can queue new events while we deliver.
   std::vector<BusEvent> queued;
   queued.swap(pending_events_);
