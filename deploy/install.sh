@@ -6,7 +6,7 @@
 #   --build-dir DIR  CMake build tree holding service/pmu-service, tools/pmuctl and
 #                    tools/pmu-sim (default: build/release under the repository root)
 #   --prefix PREFIX  where binaries, the unit and the docs go (default /usr): PREFIX/bin,
-#                    PREFIX/lib/systemd/system, PREFIX/share/doc/pmu-dds. Configuration
+#                    PREFIX/lib/systemd/system, PREFIX/share/{doc/,}pmu-dds. Configuration
 #                    always goes to /etc (the service looks for /etc/pmu-dds).
 #   --destdir DIR    stage everything under DIR (packaging, tests); same as DESTDIR=DIR.
 #                    With a DESTDIR, systemctl is not called.
@@ -21,6 +21,9 @@
 #   PREFIX/lib/systemd/system/pmu-service.service    the unit (ExecStart= follows PREFIX)
 #   /etc/systemd/network/80-can0.network             CAN link setup, only if absent
 #   PREFIX/share/doc/pmu-dds/README.md               deploy/README.md
+#   PREFIX/share/doc/pmu-dds/security.md             deploy/security/README.md
+#   PREFIX/share/pmu-dds/make_pki.sh                 the DDS-Security PKI maker (run it on
+#                                                    the machine that keeps the CA keys)
 # then `systemctl daemon-reload` when systemd is running (skipped, with a message,
 # otherwise). The service is not enabled or started: see the message at the end.
 #
@@ -77,7 +80,8 @@ service_bin=$(find_binary pmu-service service) ||
 pmuctl_bin=$(find_binary pmuctl tools) || pmuctl_bin=
 sim_bin=$(find_binary pmu-sim tools) || sim_bin=
 
-for f in qos.xml pmu-service.yaml systemd/pmu-service.service systemd/80-can0.network README.md; do
+for f in qos.xml pmu-service.yaml systemd/pmu-service.service systemd/80-can0.network README.md \
+         security/make_pki.sh security/README.md; do
   [ -f "$script_dir/$f" ] || die "missing deploy/$f in $script_dir"
 done
 
@@ -144,6 +148,7 @@ bindir="$root$prefix/bin"
 [ "$prefix" = / ] && bindir="$root/bin"
 unitdir="$root${prefix%/}/lib/systemd/system"
 docdir="$root${prefix%/}/share/doc/pmu-dds"
+datadir="$root${prefix%/}/share/pmu-dds"
 confdir="$root/etc/pmu-dds"
 networkdir="$root/etc/systemd/network"
 
@@ -170,6 +175,11 @@ put 0644 "$unit_src" "$unitdir/pmu-service.service" "$script_dir/systemd/pmu-ser
 unit_changed=$last_changed
 put_keep 0644 "$script_dir/systemd/80-can0.network" "$networkdir/80-can0.network"
 put 0644 "$script_dir/README.md" "$docdir/README.md"
+
+# ---- security tooling ----------------------------------------------------------------------
+# Only the script and its guide: no key or certificate is ever installed by this script.
+put 0755 "$script_dir/security/make_pki.sh" "$datadir/make_pki.sh"
+put 0644 "$script_dir/security/README.md" "$docdir/security.md"
 
 # ---- reload --------------------------------------------------------------------------------
 if [ -n "$destdir" ]; then

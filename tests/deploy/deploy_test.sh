@@ -101,6 +101,9 @@ expect 644 /etc/pmu-dds/pmu-service.yaml.example
 expect 644 /usr/lib/systemd/system/pmu-service.service
 expect 644 /etc/systemd/network/80-can0.network
 expect 644 /usr/share/doc/pmu-dds/README.md
+expect 644 /usr/share/doc/pmu-dds/security.md
+expect 755 /usr/share/pmu-dds/make_pki.sh
+cmp -s "$deploy/security/make_pki.sh" "$dest/usr/share/pmu-dds/make_pki.sh" || fail "installed make_pki.sh differs from deploy/security/make_pki.sh"
 [ -f "$build_dir/tools/pmuctl" ] && expect 755 /usr/bin/pmuctl
 [ -f "$build_dir/tools/pmu-sim" ] && expect 755 /usr/bin/pmu-sim
 cmp -s "$deploy/qos.xml" "$dest/etc/pmu-dds/qos.xml" || fail "installed qos.xml differs from deploy/qos.xml"
