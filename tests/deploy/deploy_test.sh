@@ -43,6 +43,10 @@ out=$("$service_bin" --config "$deploy/pmu-service.yaml" --check-config 2>&1) ||
   fail "pmu-service rejected deploy/pmu-service.yaml: $out"
 echo "$out"
 grep -q "configuration OK (1 bus(es))" <<<"$out" || fail "unexpected check-config output: $out"
+# The unit's transient user can share shared memory with no one: the shipped config must
+# keep DDS on UDP (deploy/README.md, "Fast DDS shared memory is off").
+grep -q "^dds_transport: udp$" "$deploy/pmu-service.yaml" ||
+  fail "deploy/pmu-service.yaml must set dds_transport: udp for the DynamicUser unit"
 
 step "check-config with the commented examples switched on"
 full="$work/full.yaml"
