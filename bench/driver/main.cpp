@@ -27,6 +27,9 @@ int main(int argc, char** argv) {
   run->add_option("--domain-base", s.domain_base, "first of four DDS domains used")->check(CLI::Range(0, 228));
   run->add_option("--qos", s.qos_file, "QoS profiles (deploy/qos.xml)");
   run->add_option("--latency-seconds", s.latency_seconds, "length of each 7,634 frames/s run (default 10, quick 1)");
+  run->add_option("--startups", s.startups, "starts of pmu-service for the start-up rows (default 5, quick 1)")
+      ->check(CLI::Range(1, 1000));
+  run->add_flag("--startup-only", s.startup_only, "measure start-up alone (each start is printed on stderr)");
 
   PeerOptions p;
   std::string transport = "default";

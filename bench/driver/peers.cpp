@@ -1,9 +1,11 @@
 #include "peers.hpp"
 
 #include <linux/can.h>
+#include <pthread.h>
 #include <signal.h>
 #include <sys/socket.h>
 
+#include <atomic>
 #include <cstdio>
 #include <fastdds/dds/core/status/PublicationMatchedStatus.hpp>
 #include <fastdds/dds/subscriber/DataReaderListener.hpp>
@@ -24,10 +26,33 @@ namespace pmu::bench {
 using namespace eprosima::fastdds::dds;
 
 int peer_writer(const PeerOptions& o) {
+  // SIGTERM ends the run cleanly: a process killed with its participant alive leaves its
+  // listener in Fast DDS's shared-memory ports, and every later participant opening those
+  // ports then waits out a health check (333 ms each), which would skew the start-ups.
+  sigset_t set;
+  sigemptyset(&set);
+  sigaddset(&set, SIGTERM);
+  sigaddset(&set, SIGINT);
+  pthread_sigmask(SIG_BLOCK, &set, nullptr);  // before Fast DDS starts its threads
+  std::atomic<bool> stop{false};
+  std::thread waiter([&] {
+    int sig = 0;
+    sigwait(&set, &sig);
+    stop = true;
+  });
+  struct Joiner {
+    std::thread& t;
+    const std::atomic<bool>& stopped;
+    ~Joiner() {
+      if (!stopped) pthread_kill(t.native_handle(), SIGTERM);  // the run ended by itself: wake the waiter
+      t.join();
+    }
+  } joiner{waiter, stop};
   pmu::dds::DdsContext dds(o.domain, o.qos_file, "bench-peer-writer", {}, o.transport);
   DataWriter& w = dds.writer(dds.topic(topics::kVoltages, TypeSupport(new pmu::VoltagesPubSubType())),
                              qos_profiles::kTelemetry);
   for (int i = 0;; ++i) {
+    if (stop) return 0;
     PublicationMatchedStatus s;
     w.get_publication_matched_status(s);
     if (s.current_count > 0) break;
@@ -44,7 +69,7 @@ int peer_writer(const PeerOptions& o) {
   v.battery_b(22.2f);
   v.generator(48.0f);
   const auto count = static_cast<std::uint64_t>(o.rate * o.seconds);
-  paced(o.rate, count, nullptr, [&](std::uint64_t) {
+  paced(o.rate, count, &stop, [&](std::uint64_t) {
     const auto t = static_cast<std::uint64_t>(steady_ns());
     v.avionics(static_cast<float>(t >> 48 & 0xFFFF));
     v.output_28v(static_cast<float>(t >> 32 & 0xFFFF));
@@ -52,7 +77,7 @@ int peer_writer(const PeerOptions& o) {
     v.servo(static_cast<float>(t & 0xFFFF));
     w.write(&v);
   });
-  std::this_thread::sleep_for(std::chrono::milliseconds(300));  // let the last samples arrive
+  if (!stop) std::this_thread::sleep_for(std::chrono::milliseconds(300));  // let the last samples arrive
   return 0;
 }
 

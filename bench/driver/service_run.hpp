@@ -21,6 +21,8 @@ struct Settings {
   bool quick = false;   // one short pass of everything (the test command's smoke run)
   int domain_base = 0;
   double latency_seconds = 0;  // > 0: length of each 7,634 frames/s run (e.g. for profiling)
+  int startups = 0;             // > 0: how many starts the start-up rows take the median of
+  bool startup_only = false;    // the start-up rows alone (to study start-up)
 };
 
 // The config file's name of a transport: default, udp, shm.
