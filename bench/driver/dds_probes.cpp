@@ -61,6 +61,10 @@ VoltagesProbe::~VoltagesProbe() {
   dds_.participant().delete_subscriber(subscriber_);
 }
 
+void VoltagesProbe::on_sample_lost(DataReader*, const SampleLostStatus& status) {
+  if (status.total_count_change > 0) lost_ += static_cast<std::uint64_t>(status.total_count_change);
+}
+
 void VoltagesProbe::on_data_available(DataReader* reader) {
   pmu::Voltages v;
   SampleInfo info;

@@ -29,10 +29,16 @@ class VoltagesProbe : public eprosima::fastdds::dds::DataReaderListener {
   ~VoltagesProbe() override;
 
   void on_data_available(eprosima::fastdds::dds::DataReader* reader) override;
+  // Fast DDS reports a gap in a writer's sequence numbers: samples the writer wrote that
+  // never reached this reader (lost in delivery, not before the write).
+  void on_sample_lost(eprosima::fastdds::dds::DataReader* reader,
+                      const eprosima::fastdds::dds::SampleLostStatus& status) override;
 
   // Latencies (ns) of the samples received since the last call; counting restarts.
   std::vector<std::int64_t> take_latencies();
   std::uint64_t received() const noexcept { return received_.load(); }
+  // Samples of any writer on the topic that Fast DDS reported lost, since creation.
+  std::uint64_t lost_in_delivery() const noexcept { return lost_.load(); }
   // steady_clock ns of the first timed sample since reset_first(); 0 while none.
   std::int64_t first_sample_ns() const noexcept { return first_.load(); }
   void reset_first() noexcept { first_ = 0; }
@@ -49,6 +55,7 @@ class VoltagesProbe : public eprosima::fastdds::dds::DataReaderListener {
   std::mutex mutex_;
   std::vector<std::int64_t> latencies_;
   std::atomic<std::uint64_t> received_{0};
+  std::atomic<std::uint64_t> lost_{0};
   std::atomic<std::int64_t> first_{0};
   std::atomic<std::int64_t> last_{0};
 };
