@@ -25,15 +25,26 @@ namespace pmu::bench {
 
 using namespace eprosima::fastdds::dds;
 
-int peer_writer(const PeerOptions& o) {
-  // SIGTERM ends the run cleanly: a process killed with its participant alive leaves its
-  // listener in Fast DDS's shared-memory ports, and every later participant opening those
-  // ports then waits out a health check (333 ms each), which would skew the start-ups.
+namespace {
+
+// SIGTERM and SIGINT, blocked in this thread and so in every thread started after it (call
+// it before Fast DDS starts its threads), for sigwait().
+sigset_t block_stop_signals() {
   sigset_t set;
   sigemptyset(&set);
   sigaddset(&set, SIGTERM);
   sigaddset(&set, SIGINT);
-  pthread_sigmask(SIG_BLOCK, &set, nullptr);  // before Fast DDS starts its threads
+  pthread_sigmask(SIG_BLOCK, &set, nullptr);
+  return set;
+}
+
+}  // namespace
+
+int peer_writer(const PeerOptions& o) {
+  // SIGTERM ends the run cleanly: a process killed with its participant alive leaves its
+  // listener in Fast DDS's shared-memory ports, and every later participant opening those
+  // ports then waits out a health check (333 ms each), which would skew the start-ups.
+  sigset_t set = block_stop_signals();
   std::atomic<bool> stop{false};
   std::thread waiter([&] {
     int sig = 0;
@@ -110,11 +121,7 @@ class Echo : public DataReaderListener {
 }  // namespace
 
 int peer_echo(const PeerOptions& o) {
-  sigset_t set;
-  sigemptyset(&set);
-  sigaddset(&set, SIGTERM);
-  sigaddset(&set, SIGINT);
-  pthread_sigmask(SIG_BLOCK, &set, nullptr);  // before Fast DDS starts its threads
+  sigset_t set = block_stop_signals();
   pmu::dds::DdsContext dds(o.domain, o.qos_file, "bench-peer-echo", {}, o.transport);
   DataWriter& replies = dds.writer(dds.topic(topics::kCommandReply, TypeSupport(new pmu::CommandReplyPubSubType())),
                                    qos_profiles::kCommand);
