@@ -11,17 +11,6 @@ namespace {
 
 using codec::PacketId;
 
-// What a GET names: a stored parameter, outputs, generation, or a measurement group.
-std::optional<PacketId> get_target(const std::string& name) {
-  if (auto p = codec::parameter_from_name(name)) return codec::spec_of(*p).packet;
-  if (name == "outputs") return PacketId::Outputs;
-  if (name == "generation" || name == "generation_enabled") return PacketId::Generation;
-  const char* groups[] = {"voltages", "currents", "battery_energy", "temperatures", "status"};
-  for (std::uint8_t i = 0; i < 5; ++i)
-    if (name == groups[i]) return static_cast<PacketId>(i);
-  return std::nullopt;
-}
-
 CommandResult result_of(const codec::EncodeError& e) {
   return e.kind == codec::EncodeErrorKind::Unsupported ? CommandResult::Unsupported : CommandResult::Rejected;
 }
@@ -94,52 +83,40 @@ CommandReplyData make_reply(const CommandRequest& r, CommandResult result, std::
   d.request_id = r.request_id;
   d.bus = r.bus;
   d.address = r.address;
-  d.kind = r.kind;
+  d.kind = r.kind();
   d.result = result;
   d.reason = std::move(reason);
   return d;
 }
 
-std::optional<CommandReplyData> validate_command(const CommandRequest& r, std::optional<codec::FirmwareVersion> fw) {
-  auto reject = [&](CommandResult res, std::string why) { return make_reply(r, res, std::move(why)); };
-  switch (r.kind) {
-    case CommandKind::Get:
-      if (!get_target(r.parameter)) return reject(CommandResult::Rejected, "unknown parameter '" + r.parameter + "'");
-      return std::nullopt;
-    case CommandKind::SetParameter: {
-      const auto p = codec::parameter_from_name(r.parameter);
-      if (!p) return reject(CommandResult::Rejected, "unknown parameter '" + r.parameter + "'");
-      auto raw = codec::to_raw(*p, r.value, fw);
-      if (!raw) return reject(result_of(raw.error()), raw.error().describe());
-      return std::nullopt;
-    }
-    case CommandKind::SetOutputs:
-    case CommandKind::EnableOutputs:
-    case CommandKind::DisableOutputs: {
-      if (r.outputs & ~codec::output_bit::All) {
-        char buf[96];
-        std::snprintf(buf, sizeof buf, "unknown output bits 0x%02X (outputs are bits 0..3)",
-                      r.outputs & ~codec::output_bit::All);
-        return reject(CommandResult::Rejected, buf);
-      }
-      if (r.kind != CommandKind::SetOutputs && r.outputs == 0)
-        return reject(CommandResult::Rejected, "no output named");
-      return std::nullopt;
-    }
-    case CommandKind::RequestMeasurements: {
-      if (r.groups & ~codec::group_bit::All) return reject(CommandResult::Rejected, "unknown measurement group bits");
-      auto f = codec::encode_measurement_request(r.groups ? r.groups : codec::group_bit::All, r.address, fw);
-      if (!f) return reject(result_of(f.error()), f.error().describe());
-      return std::nullopt;
-    }
-    default: return std::nullopt;
-  }
+CommandReplyData make_reply(const CommandSample& s, CommandResult result, std::string reason) {
+  CommandReplyData d;
+  d.request_id = s.request_id;
+  d.bus = s.bus;
+  d.address = s.address;
+  d.kind = s.kind < kCommandKindCount ? static_cast<CommandKind>(s.kind) : CommandKind::Get;
+  d.result = result;
+  d.reason = std::move(reason);
+  return d;
 }
 
-void execute_command(DeviceSession& session, const CommandRequest& request, SteadyTime now,
-                     std::optional<SteadyTime> expires, const Timeouts& timeouts, ReplyFn reply) {
+std::optional<CommandReplyData> check_firmware(const CommandRequest& r, std::optional<codec::FirmwareVersion> fw) {
+  if (const auto* set = std::get_if<action::SetParameter>(&r.action)) {
+    // S0's bits depend on the firmware; the value itself was checked at the boundary.
+    const auto raw = codec::to_raw(set->parameter, codec::parameter_value(set->parameter, set->raw), fw);
+    if (!raw) return make_reply(r, result_of(raw.error()), raw.error().describe());
+  } else if (const auto* m = std::get_if<action::RequestMeasurements>(&r.action)) {
+    const auto f = codec::encode_measurement_request(m->groups, r.address, fw);
+    if (!f) return make_reply(r, result_of(f.error()), f.error().describe());
+  }
+  return std::nullopt;
+}
+
+void execute_command(DeviceSession& session, const CommandRequest& request, SteadyTime now, const Timeouts& timeouts,
+                     ReplyFn reply) {
   const auto fw = session.firmware();
-  if (auto invalid = validate_command(request, fw)) {
+  const std::optional<SteadyTime> expires = request.expires;
+  if (auto invalid = check_firmware(request, fw)) {
     reply(*invalid);
     return;
   }
@@ -183,9 +160,9 @@ void execute_command(DeviceSession& session, const CommandRequest& request, Stea
                    now);
   };
 
-  switch (request.kind) {
+  switch (request.kind()) {
     case CommandKind::Get: {
-      const PacketId target = *get_target(request.parameter);
+      const PacketId target = std::get<action::Get>(request.action).packet;
       session.submit(step(*codec::encode_get(target, a), target, retries, expires,
                           [run](const RequestOutcome& o) {
                             if (!run->ok(o, "get")) return;
@@ -204,8 +181,9 @@ void execute_command(DeviceSession& session, const CommandRequest& request, Stea
       return;
     }
     case CommandKind::SetParameter: {
-      const auto p = *codec::parameter_from_name(request.parameter);
-      const auto raw = *codec::to_raw(p, request.value, fw);
+      const auto& set = std::get<action::SetParameter>(request.action);
+      const codec::Parameter p = set.parameter;
+      const std::uint32_t raw = set.raw;
       const auto& spec = codec::spec_of(p);
       std::uint16_t read_at = a;
       if (p == codec::Parameter::CanAddress) {
@@ -235,8 +213,10 @@ void execute_command(DeviceSession& session, const CommandRequest& request, Stea
     case CommandKind::SetOutputs:
     case CommandKind::EnableOutputs:
     case CommandKind::DisableOutputs: {
-      const std::uint8_t mask = request.outputs;
-      const CommandKind kind = request.kind;
+      const CommandKind kind = request.kind();
+      const std::uint8_t mask = kind == CommandKind::SetOutputs      ? std::get<action::SetOutputs>(request.action).mask
+                                : kind == CommandKind::EnableOutputs ? std::get<action::EnableOutputs>(request.action).mask
+                                                                     : std::get<action::DisableOutputs>(request.action).mask;
       const auto frame = kind == CommandKind::SetOutputs      ? *codec::encode_set_outputs(mask, a)
                          : kind == CommandKind::EnableOutputs ? *codec::encode_enable_outputs(mask, a)
                                                               : *codec::encode_disable_outputs(mask, a);
@@ -258,7 +238,7 @@ void execute_command(DeviceSession& session, const CommandRequest& request, Stea
       return;
     }
     case CommandKind::SetGeneration: {
-      const bool enable = request.enable;
+      const bool enable = std::get<action::SetGeneration>(request.action).enable;
       set_then_read(*codec::encode_generation(enable, a), PacketId::Generation, a,
                     [run, enable](const codec::PmuMessage& m, bool last) {
                       const auto* got = std::get_if<codec::GenerationState>(&m.payload);
@@ -274,7 +254,7 @@ void execute_command(DeviceSession& session, const CommandRequest& request, Stea
       return;
     }
     case CommandKind::RequestMeasurements: {
-      const std::uint8_t groups = request.groups ? request.groups : codec::group_bit::All;
+      const std::uint8_t groups = std::get<action::RequestMeasurements>(request.action).groups;
       std::uint8_t first = 0;
       while (!(groups & (1u << first))) ++first;
       const auto reply_packet = static_cast<PacketId>(first);
@@ -288,7 +268,7 @@ void execute_command(DeviceSession& session, const CommandRequest& request, Stea
     }
     case CommandKind::EngineStart:
     case CommandKind::Reset: {
-      const bool reset = request.kind == CommandKind::Reset;
+      const bool reset = request.kind() == CommandKind::Reset;
       const auto frame = reset ? *codec::encode_reset(a) : *codec::encode_engine_start(a);
       const double ct = session.config_state().value(codec::Parameter::CrankingTime);
       session.submit(step(frame, std::nullopt, 0, expires,
@@ -316,7 +296,7 @@ void execute_command(DeviceSession& session, const CommandRequest& request, Stea
       return;
     case CommandKind::GetSerial:
     case CommandKind::GetFirmware: {
-      const bool serial = request.kind == CommandKind::GetSerial;
+      const bool serial = request.kind() == CommandKind::GetSerial;
       const PacketId p = serial ? PacketId::Serial : PacketId::Firmware;
       session.submit(step(*codec::encode_get(p, a), p, retries, expires,
                           [run](const RequestOutcome& o) {

@@ -2,7 +2,6 @@
 
 #include <spdlog/spdlog.h>
 
-#include <cmath>
 #include <cstdio>
 
 #include "pmu/codec/encode.hpp"
@@ -11,8 +10,13 @@
 namespace pmu::service {
 namespace {
 
-// Request ids remembered for duplicate detection: far more than any burst in flight.
-constexpr std::size_t kRemembered = 16384;
+// Request ids are unique per sender: the key is both. Senders are DDS GUIDs (no NUL).
+std::string sender_key(const std::string& sender, const std::string& request_id) {
+  std::string key = sender;
+  key += '\0';
+  key += request_id;
+  return key;
+}
 
 }  // namespace
 
@@ -31,23 +35,47 @@ CommandService::Counters CommandService::counters() const {
   return counters_;
 }
 
-void CommandService::answer_now(const CommandRequest& r, CommandResult result, std::string reason) {
-  finish(make_reply(r, result, std::move(reason)));
+std::size_t CommandService::remembered() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return seen_.size();
 }
 
-void CommandService::finish(const CommandReplyData& reply) {
+CommandService::Seen CommandService::remember(const std::string& key, const CommandSample& s,
+                                              std::optional<CommandReplyData>& again) {
+  const std::uint64_t fingerprint = content_fingerprint(s);
+  std::lock_guard<std::mutex> lock(mutex_);
+  ++counters_.received;
+  if (auto it = seen_.find(key); it != seen_.end()) {
+    if (it->second.fingerprint != fingerprint) {
+      ++counters_.reused_ids;
+      return Seen::Reused;
+    }
+    ++counters_.duplicates;
+    if (it->second.final)
+      again = it->second.final;
+    else
+      ++it->second.owed;
+    return Seen::Resend;
+  }
+  seen_.emplace(key, Entry{fingerprint, std::nullopt, 0});
+  order_.push_back(key);
+  while (order_.size() > kRememberedRequests) {
+    seen_.erase(order_.front());
+    order_.pop_front();
+  }
+  return Seen::New;
+}
+
+void CommandService::finish(const std::string& key, const std::string& sender, const std::string& what,
+                            const CommandReplyData& reply) {
   unsigned copies = 1;
-  std::string what, sender;
   {
     std::lock_guard<std::mutex> lock(mutex_);
-    auto it = seen_.find(reply.request_id);
-    if (it != seen_.end()) {
+    if (auto it = seen_.find(key); it != seen_.end()) {
       if (it->second.final) return;  // already answered: never a second final reply
       it->second.final = reply;
       copies += it->second.owed;
       it->second.owed = 0;
-      what = it->second.what;
-      sender = it->second.sender;
     }
     if (reply.result == CommandResult::Completed)
       ++counters_.completed;
@@ -56,97 +84,98 @@ void CommandService::finish(const CommandReplyData& reply) {
     else
       ++counters_.refused;
   }
-  spdlog::info("audit: command {} from {}: {} -> {}{}{}", reply.request_id, sender, what, to_string(reply.result),
-               reply.reason.empty() ? "" : ": ", reply.reason);
+  // Reasons quote network text only through printable(); ids and senders are escaped here.
+  spdlog::info("audit: command {} from {}: {} -> {}{}{}", printable(reply.request_id), printable(sender), what,
+               to_string(reply.result), reply.reason.empty() ? "" : ": ", reply.reason);
   for (unsigned i = 0; i < copies; ++i) reply_(reply);
 }
 
-void CommandService::submit(CommandRequest r) {
-  const auto now_wall = clock_.system_now();
-  const auto now = clock_.steady_now();
-  if (r.request_id.empty()) {
-    spdlog::warn("audit: command without request_id from {}: {} -> REJECTED", r.sender, describe(r));
-    CommandReplyData d = make_reply(r, CommandResult::Rejected, "request_id is empty");
-    reply_(d);
+void CommandService::answer(const CommandRequest& r, CommandResult result, std::string reason) {
+  finish(sender_key(r.sender, r.request_id), r.sender, describe(r), make_reply(r, result, std::move(reason)));
+}
+
+void CommandService::submit(const CommandSample& s) {
+  const Now now{clock_.system_now(), clock_.steady_now()};
+  if (s.request_id.empty()) {
+    // Nothing to correlate a resend with: answered, not remembered.
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      ++counters_.received;
+      ++counters_.refused;
+    }
+    spdlog::warn("audit: command without request_id from {}: {} -> REJECTED", printable(s.sender), describe(s));
+    reply_(make_reply(s, CommandResult::Rejected, "request_id is empty"));
     return;
   }
-  {
-    std::lock_guard<std::mutex> lock(mutex_);
-    ++counters_.received;
-    auto it = seen_.find(r.request_id);
-    if (it != seen_.end()) {
-      ++counters_.duplicates;
-      spdlog::info("audit: duplicate command {} from {}: answered again, not executed", r.request_id, r.sender);
-      if (!it->second.final) {
-        ++it->second.owed;
-        return;
-      }
-      const CommandReplyData again = *it->second.final;
-      reply_(again);
+  const std::string key = sender_key(s.sender, s.request_id);
+  std::optional<CommandReplyData> again;
+  switch (remember(key, s, again)) {
+    case Seen::Resend:
+      spdlog::info("audit: duplicate command {} from {}: answered again, not executed", printable(s.request_id),
+                   printable(s.sender));
+      if (again) reply_(*again);
       return;
-    }
-    seen_[r.request_id] = Entry{std::nullopt, 0, describe(r), r.sender};
-    order_.push_back(r.request_id);
-    while (order_.size() > kRemembered) {
-      seen_.erase(order_.front());
-      order_.pop_front();
-    }
+    case Seen::Reused:
+      spdlog::warn("audit: command {} from {} reuses that id for another command: {} -> REJECTED",
+                   printable(s.request_id), printable(s.sender), describe(s));
+      reply_(make_reply(s, CommandResult::Rejected,
+                        "request id '" + printable(s.request_id) +
+                            "' was already used by this sender for another command; not executed (use a new id)"));
+      return;
+    case Seen::New: break;
   }
+  auto parsed = parse_command(s, now, policy_.lifetimes);
+  if (!parsed) return finish(key, s.sender, describe(s), make_reply(s, CommandResult::Rejected, parsed.error()));
+  execute(*parsed);
+}
 
-  const auto expires_wall = r.expires_at.value_or(now_wall + policy_.default_lifetime);
-  if (now_wall > expires_wall) {
-    const auto late = std::chrono::duration_cast<std::chrono::milliseconds>(now_wall - expires_wall).count();
-    return answer_now(r, CommandResult::Rejected, "expired " + std::to_string(late) + " ms ago");
-  }
-  const auto expires = now + std::chrono::duration_cast<std::chrono::steady_clock::duration>(expires_wall - now_wall);
-
+void CommandService::execute(const CommandRequest& r) {
   BusWorker* worker = worker_for(r.bus);
   if (!worker) {
     std::string served;
     for (auto* w : workers_) served += (served.empty() ? "" : ", ") + w->config().name;
-    return answer_now(r, CommandResult::Rejected, "bus '" + r.bus + "' is not served here (buses: " + served + ")");
+    return answer(r, CommandResult::Rejected,
+                  "bus '" + printable(r.bus) + "' is not served here (buses: " + served + ")");
   }
-  if (r.address == codec::kBroadcastAddress && r.kind != CommandKind::EngineStop)
-    return answer_now(r, CommandResult::Rejected, "broadcast (65535) is only accepted for engine_stop");
-
   const PolicyVerdict verdict = check_policy(r, policy_);
-  if (!verdict.allowed()) return answer_now(r, verdict.result, verdict.reason);
+  if (!verdict.allowed()) return answer(r, verdict.result, verdict.reason);
 
   bool limited = false;
-  if (r.kind != CommandKind::EngineStop) {
+  if (r.kind() != CommandKind::EngineStop) {
     std::lock_guard<std::mutex> lock(mutex_);
     auto it = limiters_.try_emplace({r.bus, r.address}, policy_.rate_per_second, policy_.burst).first;
-    limited = !it->second.allow(now);
+    limited = !it->second.allow(clock_.steady_now());
   }
   if (limited) {
     char buf[96];
     std::snprintf(buf, sizeof buf, "rate limit: more than %g commands/s (burst %g) to this device",
                   policy_.rate_per_second, policy_.burst);
-    return answer_now(r, CommandResult::Rejected, buf);
+    return answer(r, CommandResult::Rejected, buf);
   }
 
-  worker->post([this, worker, r, expires] {
-    const auto now_w = clock_.steady_now();
-    if (r.address == codec::kBroadcastAddress) {
+  worker->post([this, worker, r] {
+    const auto now = clock_.steady_now();
+    if (r.address == codec::kBroadcastAddress) {  // parse_command lets only engine_stop through
       const auto sent = worker->bus().send(*codec::encode_engine_stop(r.address), timeouts_.send);
-      return sent.ok() ? answer_now(r, CommandResult::Completed, "stop sent to every PMU (broadcast)")
-                       : answer_now(r, CommandResult::Failed,
-                                    "bus refused the engine stop: " + std::string(transport::to_string(sent.status)));
+      return sent.ok() ? answer(r, CommandResult::Completed, "stop sent to every PMU (broadcast)")
+                       : answer(r, CommandResult::Failed,
+                                "bus refused the engine stop: " + std::string(transport::to_string(sent.status)));
     }
     DeviceSession* session = worker->session(r.address);
     if (!session)
-      return answer_now(r, CommandResult::Rejected,
-                        "device " + std::to_string(r.address) + " not seen on " + r.bus);
-    if (!session->info() && r.kind != CommandKind::EngineStop)
-      return answer_now(r, CommandResult::Rejected,
-                        "device " + std::to_string(r.address) + " on " + r.bus +
-                            " is not ready: its firmware and configuration have not been read yet");
-    if (r.kind == CommandKind::SetParameter && r.parameter == "can_address" && std::isfinite(r.value) &&
-        r.value >= 0 && r.value <= 65534 && worker->session(static_cast<std::uint16_t>(r.value)) &&
-        static_cast<std::uint16_t>(r.value) != r.address)
-      return answer_now(r, CommandResult::Rejected,
-                        "address " + std::to_string(static_cast<int>(r.value)) + " is already in use on " + r.bus);
-    execute_command(*session, r, now_w, expires, timeouts_, [this](const CommandReplyData& d) { finish(d); });
+      return answer(r, CommandResult::Rejected, "device " + std::to_string(r.address) + " not seen on " + r.bus);
+    if (!session->info() && r.kind() != CommandKind::EngineStop)
+      return answer(r, CommandResult::Rejected,
+                    "device " + std::to_string(r.address) + " on " + r.bus +
+                        " is not ready: its firmware and configuration have not been read yet");
+    if (const auto* set = std::get_if<action::SetParameter>(&r.action);
+        set && set->parameter == codec::Parameter::CanAddress && set->raw != r.address &&
+        worker->session(static_cast<std::uint16_t>(set->raw)))
+      return answer(r, CommandResult::Rejected,
+                    "address " + std::to_string(set->raw) + " is already in use on " + r.bus);
+    execute_command(*session, r, now, timeouts_,
+                    [this, key = sender_key(r.sender, r.request_id), sender = r.sender,
+                     what = describe(r)](const CommandReplyData& d) { finish(key, sender, what, d); });
   });
 }
 

@@ -174,7 +174,8 @@ void parse_timeouts(const Ctx& c, const YAML::Node& n, Timeouts& t) {
 }
 
 void parse_policy(const Ctx& c, const YAML::Node& n, PolicyConfig& p) {
-  c.only_keys(n, "policy", {"confirm", "deny", "rate_limit", "burst", "command_lifetime"});
+  c.only_keys(n, "policy", {"confirm", "deny", "rate_limit", "burst", "command_lifetime",
+                                "max_command_lifetime"});
   if (const auto v = n["confirm"]) {
     if (!v.IsSequence()) c.fail(v, "confirm must be a list of rule names (may be empty: [])");
     p.confirm.fill(false);
@@ -200,8 +201,16 @@ void parse_policy(const Ctx& c, const YAML::Node& n, PolicyConfig& p) {
   }
   if (const auto v = n["rate_limit"]) p.rate_per_second = c.number(v, "rate_limit", 0, 1000);
   if (const auto v = n["burst"]) p.burst = c.number(v, "burst", 1, 10000);
+  auto& lt = p.lifetimes;
   if (const auto v = n["command_lifetime"])
-    p.default_lifetime = std::chrono::milliseconds(std::lround(c.number(v, "command_lifetime", 0.1, 3600) * 1000));
+    lt.default_lifetime = std::chrono::milliseconds(std::lround(c.number(v, "command_lifetime", 0.1, 3600) * 1000));
+  if (const auto v = n["max_command_lifetime"])
+    lt.max_lifetime = std::chrono::milliseconds(std::lround(c.number(v, "max_command_lifetime", 0.1, 3600) * 1000));
+  if (lt.max_lifetime < lt.default_lifetime) {
+    if (n["max_command_lifetime"])
+      c.fail(n["max_command_lifetime"], "max_command_lifetime must be at least command_lifetime");
+    lt.max_lifetime = lt.default_lifetime;  // only the default was raised: the cap follows it
+  }
 }
 
 // security: the six files (all or none) and warn_days. Paths relative to the config file.

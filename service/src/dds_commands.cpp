@@ -2,12 +2,16 @@
 
 #include <fastdds/dds/subscriber/DataReaderListener.hpp>
 #include <fastdds/dds/subscriber/SampleInfo.hpp>
+#include <spdlog/spdlog.h>
+
+#include <chrono>
 #include <mutex>
 #include <sstream>
 
 #include "pmu/idl/command.h"
 #include "pmu/idl/commandPubSubTypes.h"
 #include "pmu/idl/topics.hpp"
+#include "pmu/service/command_cdr.hpp"
 #include "pmu/service/command_service.hpp"
 
 namespace pmu::service {
@@ -18,25 +22,12 @@ using namespace eprosima::fastdds::dds;
 static_assert(static_cast<int>(pmu::GET_FIRMWARE) == static_cast<int>(CommandKind::GetFirmware));
 static_assert(static_cast<int>(pmu::IN_PROGRESS) == static_cast<int>(CommandResult::InProgress));
 
-CommandRequest from_dds(const pmu::Command& c, const SampleInfo& info) {
-  CommandRequest r;
-  r.request_id = c.request_id().to_string();
+constexpr std::chrono::seconds kMalformedLogInterval{10};
+
+std::string guid_of(const SampleInfo& info) {
   std::ostringstream who;
   who << info.sample_identity.writer_guid();
-  r.sender = who.str();
-  r.bus = c.bus().to_string();
-  r.address = c.address();
-  r.kind = static_cast<CommandKind>(static_cast<int>(c.kind()));
-  r.parameter = c.parameter().to_string();
-  r.value = c.value();
-  r.outputs = c.outputs();
-  r.enable = c.enable();
-  r.groups = c.groups();
-  if (c.expires_at() != 0)
-    r.expires_at = std::chrono::system_clock::time_point(
-        std::chrono::duration_cast<std::chrono::system_clock::duration>(std::chrono::nanoseconds(c.expires_at())));
-  r.confirm = c.confirm();
-  return r;
+  return who.str();
 }
 
 }  // namespace
@@ -45,33 +36,51 @@ struct DdsCommandEndpoint::Impl final : public DataReaderListener {
   dds::DdsContext& dds;
   DataWriter* writer = nullptr;
   DataReader* reader = nullptr;
+  CommandSampleType* type = nullptr;  // owned by the TypeSupport registered with the participant
+  // Held while a callback runs and while stop() detaches the service: once stop() returns,
+  // no callback is inside, or will enter, the service.
+  std::mutex service_mutex;
   CommandService* service = nullptr;
   std::mutex write_mutex;
   std::uint64_t write_failures = 0;
+  std::uint64_t malformed_logged = 0;
+  std::chrono::steady_clock::time_point next_malformed_log{};
 
   explicit Impl(dds::DdsContext& d) : dds(d) {}
 
   void on_data_available(DataReader* r) override {
-    pmu::Command c;
+    std::lock_guard<std::mutex> lock(service_mutex);
+    if (!service) return;
+    CommandSampleType::Received received;
     SampleInfo info;
-    while (r->take_next_sample(&c, &info) == ReturnCode_t::RETCODE_OK) {
+    while (r->take_next_sample(&received, &info) == ReturnCode_t::RETCODE_OK) {
       if (!info.valid_data) continue;
-      if (c.kind() > pmu::GET_FIRMWARE) {
-        // An enum value from a newer client: still exactly one reply.
-        CommandRequest bad = from_dds(c, info);
-        bad.kind = CommandKind::Get;
-        CommandReplyData d = make_reply(bad, CommandResult::Rejected, "unknown command kind");
-        publish(d);
+      if (!received.sample) {
+        report_malformed(info);
         continue;
       }
-      service->submit(from_dds(c, info));
+      received.sample->sender = guid_of(info);
+      service->submit(*received.sample);
     }
+  }
+
+  // A payload that is not a pmu::Command cannot be answered (it has no readable request id):
+  // counted by the type, logged at most every few seconds so a flood cannot fill the journal.
+  void report_malformed(const SampleInfo& info) {
+    const auto now = std::chrono::steady_clock::now();
+    if (now < next_malformed_log) return;
+    next_malformed_log = now + kMalformedLogInterval;
+    const auto total = type->malformed();
+    spdlog::warn("pmu/command: dropped {} sample(s) that are not a pmu::Command as idl/command.idl defines it "
+                 "(latest from {}); no reply is possible without a readable request_id",
+                 total - malformed_logged, guid_of(info));
+    malformed_logged = total;
   }
 
   void publish(const CommandReplyData& d) {
     pmu::CommandReply s;
-    s.request_id(d.request_id);
-    s.bus(d.bus);
+    s.request_id(d.request_id.substr(0, kMaxRequestIdLength));
+    s.bus(d.bus.substr(0, kMaxBusNameLength));
     s.address(d.address);
     s.kind(static_cast<pmu::CommandKind>(static_cast<int>(d.kind)));
     s.result(static_cast<pmu::CommandResult>(static_cast<int>(d.result)));
@@ -92,16 +101,27 @@ DdsCommandEndpoint::DdsCommandEndpoint(dds::DdsContext& dds) : impl_(std::make_u
 DdsCommandEndpoint::~DdsCommandEndpoint() { stop(); }
 
 void DdsCommandEndpoint::stop() {
-  // No more callbacks into the service it feeds.
+  {
+    std::lock_guard<std::mutex> lock(impl_->service_mutex);  // waits for a callback inside
+    impl_->service = nullptr;
+  }
+  // Outside the lock: Fast DDS may wait here for a callback that waits for the lock.
   if (impl_->reader) impl_->reader->set_listener(nullptr);
 }
 
 void DdsCommandEndpoint::start(CommandService& service) {
-  impl_->service = &service;
-  impl_->reader = &impl_->dds.reader(impl_->dds.topic(topics::kCommand, TypeSupport(new pmu::CommandPubSubType())),
-                                     qos_profiles::kCommand, impl_.get());
+  {
+    std::lock_guard<std::mutex> lock(impl_->service_mutex);
+    impl_->service = &service;
+  }
+  auto* type = new CommandSampleType();
+  impl_->type = type;
+  impl_->reader = &impl_->dds.reader(impl_->dds.topic(topics::kCommand, TypeSupport(type)), qos_profiles::kCommand,
+                                     impl_.get());
 }
 
 void DdsCommandEndpoint::publish(const CommandReplyData& reply) { impl_->publish(reply); }
+
+std::uint64_t DdsCommandEndpoint::malformed() const noexcept { return impl_->type ? impl_->type->malformed() : 0; }
 
 }  // namespace pmu::service

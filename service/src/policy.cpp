@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <array>
-#include <cmath>
 
 #include "pmu/codec/messages.hpp"
 
@@ -22,26 +21,27 @@ constexpr std::array<std::string_view, kConfirmRuleCount> kRuleWhy{
     "leaves the avionics/servo output off at the next power-up or reset",
 };
 
+// Judged on the typed request, whose values are already what the wire will carry: a
+// requested 0.0004 that rounds to 0 is 0 here.
 std::optional<ConfirmRule> rule_for(const CommandRequest& r) {
   using codec::output_bit::AvionicsServo;
-  switch (r.kind) {
-    case CommandKind::DisableOutputs:
-      if (r.outputs & AvionicsServo) return ConfirmRule::DisableAvionics;
-      return std::nullopt;
-    case CommandKind::SetOutputs:
-      if (!(r.outputs & AvionicsServo)) return ConfirmRule::DisableAvionics;
-      return std::nullopt;
-    case CommandKind::Reset: return ConfirmRule::Reset;
-    case CommandKind::EngineStart: return ConfirmRule::EngineStart;
-    case CommandKind::SetParameter:
-      if (r.parameter == "can_address") return ConfirmRule::SetCanAddress;
-      if (r.parameter == "upper_temperature_limit" && r.value == 0) return ConfirmRule::ThermalShutdown;
-      if (r.parameter == "power_up_state" && std::isfinite(r.value) && r.value >= 0 && r.value <= 255 &&
-          !(static_cast<unsigned>(r.value) & AvionicsServo))
-        return ConfirmRule::PowerUpAvionicsOff;
-      return std::nullopt;
-    default: return std::nullopt;
+  if (const auto* off = std::get_if<action::DisableOutputs>(&r.action))
+    return off->mask & AvionicsServo ? std::optional(ConfirmRule::DisableAvionics) : std::nullopt;
+  if (const auto* set = std::get_if<action::SetOutputs>(&r.action))
+    return set->mask & AvionicsServo ? std::nullopt : std::optional(ConfirmRule::DisableAvionics);
+  if (std::holds_alternative<action::Reset>(r.action)) return ConfirmRule::Reset;
+  if (std::holds_alternative<action::EngineStart>(r.action)) return ConfirmRule::EngineStart;
+  if (const auto* p = std::get_if<action::SetParameter>(&r.action)) {
+    switch (p->parameter) {
+      case codec::Parameter::CanAddress: return ConfirmRule::SetCanAddress;
+      case codec::Parameter::UpperTemperatureLimit:
+        return p->raw == 0 ? std::optional(ConfirmRule::ThermalShutdown) : std::nullopt;
+      case codec::Parameter::PowerUpState:
+        return p->raw & AvionicsServo ? std::nullopt : std::optional(ConfirmRule::PowerUpAvionicsOff);
+      default: return std::nullopt;
+    }
   }
+  return std::nullopt;
 }
 
 }  // namespace
@@ -55,11 +55,11 @@ std::optional<ConfirmRule> confirm_rule_from_name(std::string_view name) noexcep
 }
 
 PolicyVerdict check_policy(const CommandRequest& r, const PolicyConfig& p) {
-  if (r.kind == CommandKind::EngineStop) return {};  // never refused by policy
-  if (p.deny[static_cast<std::size_t>(r.kind)])
-    return {CommandResult::Denied, std::string(to_string(r.kind)) + " is denied by the service's policy"};
+  if (r.kind() == CommandKind::EngineStop) return {};  // never refused by policy
+  if (p.deny[static_cast<std::size_t>(r.kind())])
+    return {CommandResult::Denied, std::string(to_string(r.kind())) + " is denied by the service's policy"};
   if (const auto rule = rule_for(r); rule && p.confirm[static_cast<std::size_t>(*rule)] && !r.confirm) {
-    return {CommandResult::Denied, std::string(to_string(r.kind)) + " " +
+    return {CommandResult::Denied, std::string(to_string(r.kind())) + " " +
                                        std::string(kRuleWhy[static_cast<std::size_t>(*rule)]) +
                                        ": it needs confirm (pmuctl --confirm); rule " + std::string(to_string(*rule))};
   }

@@ -27,6 +27,12 @@ CanFrame frame(std::uint8_t packet, std::uint16_t address, std::initializer_list
   return f;
 }
 
+std::uint32_t wire(CommandKind k) { return static_cast<std::uint32_t>(k); }
+
+std::uint64_t epoch_ns(std::chrono::system_clock::time_point t) {
+  return static_cast<std::uint64_t>(std::chrono::duration_cast<std::chrono::nanoseconds>(t.time_since_epoch()).count());
+}
+
 std::string hex(const CanFrame& f) {
   char buf[40];
   int n = std::snprintf(buf, sizeof buf, "%08X#", f.id);
@@ -45,17 +51,17 @@ class Commands {
     h.clear_sent();
   }
 
-  CommandRequest req(CommandKind kind, std::uint16_t address = 1) {
-    CommandRequest r;
+  CommandSample req(CommandKind kind, std::uint16_t address = 1) {
+    CommandSample r;
     r.request_id = "t-" + std::to_string(++next_id_);
     r.sender = "test";
     r.bus = "sim0";
     r.address = address;
-    r.kind = kind;
+    r.kind = wire(kind);
     return r;
   }
   // Submits and runs the bus until the reply arrives (or 10 s of bus time pass).
-  CommandReplyData run(const CommandRequest& r) {
+  CommandReplyData run(const CommandSample& r) {
     const auto before = replies.size();
     service.submit(r);
     for (int i = 0; i < 1000 && replies.size() == before; ++i) h.run_for(10ms);
@@ -76,7 +82,7 @@ class Commands {
   int next_id_ = 0;
 };
 
-CommandRequest set_param(Commands& c, const char* name, double value, std::uint16_t address = 1) {
+CommandSample set_param(Commands& c, const char* name, double value, std::uint16_t address = 1) {
   auto r = c.req(CommandKind::SetParameter, address);
   r.parameter = name;
   r.value = value;
@@ -87,7 +93,7 @@ CommandRequest set_param(Commands& c, const char* name, double value, std::uint1
 
 struct HappyCase {
   const char* what;
-  std::function<CommandRequest(Commands&)> make;
+  std::function<CommandSample(Commands&)> make;
   std::vector<CanFrame> frames;  // exactly what goes on the bus, in order
   std::function<void(Commands&, const CommandReplyData&)> check;
 };
@@ -235,7 +241,7 @@ TEST(Commands, CanAddressChangeIsVerifiedAtTheNewAddressAndTheSessionMoves) {
 
 struct RefusedCase {
   const char* what;
-  std::function<CommandRequest(Commands&)> make;
+  std::function<CommandSample(Commands&)> make;
   CommandResult result;
   const char* reason;  // a part of the reason
 };
@@ -269,7 +275,7 @@ TEST(Commands, InvalidRequestsAreRefusedWithAReasonAndNothingIsSent) {
       {"expired",
        [](Commands& c) {
          auto r = c.req(CommandKind::GetSerial);
-         r.expires_at = c.h.clock().system_now() - 1s;
+         r.expires_at = epoch_ns(c.h.clock().system_now() - 1s);
          return r;
        },
        CommandResult::Rejected, "expired 1000 ms ago"},
@@ -308,6 +314,23 @@ TEST(Commands, InvalidRequestsAreRefusedWithAReasonAndNothingIsSent) {
        CommandResult::Denied, "rule thermal_shutdown"},
       {"S0 without avionics, no confirm", [](Commands& c) { return set_param(c, "power_up_state", 0x0E); },
        CommandResult::Denied, "rule power_up_avionics_off"},
+      // Policy judges the value the wire would carry: each of these rounds to 0.
+      {"T_U 0.0005 without confirm", [](Commands& c) { return set_param(c, "upper_temperature_limit", 0.0005); },
+       CommandResult::Denied, "rule thermal_shutdown"},
+      {"T_U -0.0009 without confirm", [](Commands& c) { return set_param(c, "upper_temperature_limit", -0.0009); },
+       CommandResult::Denied, "rule thermal_shutdown"},
+      {"S0 -0.0004 without confirm", [](Commands& c) { return set_param(c, "power_up_state", -0.0004); },
+       CommandResult::Denied, "rule power_up_avionics_off"},
+      {"kind from a newer client", [](Commands& c) {
+         auto r = c.req(CommandKind::Get);
+         r.kind = 99;
+         return r;
+       }, CommandResult::Rejected, "unknown command kind 99"},
+      {"a boolean byte of 2", [](Commands& c) {
+         auto r = c.req(CommandKind::EngineStart);
+         r.confirm = 2;
+         return r;
+       }, CommandResult::Rejected, "confirm is not a boolean"},
   };
   for (const auto& rc : cases) {
     SCOPED_TRACE(rc.what);
@@ -470,35 +493,35 @@ TEST(Commands, BurstOf1000MixedCommandsFromTwoSendersGetsExactly1000Replies) {
   p.rate_per_second = 0;  // this test is about delivery, not rate limits
   Commands c({pmu(1), pmu(2)}, p, {}, {device(1), device(2)});
   std::mt19937 rng(42);
-  std::vector<CommandRequest> all;
+  std::vector<CommandSample> all;
   const char* params[] = {"avionics_voltage", "payload_voltage", "servo_voltage", "battery_voltage"};
   for (int i = 0; i < 1000; ++i) {
-    CommandRequest r;
+    CommandSample r;
     r.request_id = std::string(i % 2 ? "ground-a-" : "ground-b-") + std::to_string(i);
     r.sender = i % 2 ? "ground-a" : "ground-b";
     r.bus = "sim0";
     r.address = static_cast<std::uint16_t>(1 + rng() % 2);
     switch (rng() % 6) {
       case 0:
-        r.kind = CommandKind::SetParameter;
+        r.kind = wire(CommandKind::SetParameter);
         r.parameter = params[rng() % 4];
         r.value = 4.0 + static_cast<double>(rng() % 250) / 10.0;  // 4.0 .. 28.9 V: many out of range
         break;
       case 1:
-        r.kind = CommandKind::EnableOutputs;
+        r.kind = wire(CommandKind::EnableOutputs);
         r.outputs = static_cast<std::uint8_t>(1u << (1 + rng() % 3));
         break;
       case 2:
-        r.kind = CommandKind::DisableOutputs;
+        r.kind = wire(CommandKind::DisableOutputs);
         r.outputs = static_cast<std::uint8_t>(1u << (rng() % 4));  // avionics needs confirm
         break;
-      case 3: r.kind = CommandKind::GetSerial; break;
+      case 3: r.kind = wire(CommandKind::GetSerial); break;
       case 4:
-        r.kind = CommandKind::Get;
+        r.kind = wire(CommandKind::Get);
         r.parameter = "outputs";
         break;
       default:
-        r.kind = CommandKind::RequestMeasurements;
+        r.kind = wire(CommandKind::RequestMeasurements);
         r.groups = static_cast<std::uint8_t>(1 + rng() % 31);
     }
     all.push_back(r);
@@ -546,7 +569,7 @@ TEST(Commands, RequestsThatExpireWhileQueuedAreNeverSent) {
   });
   for (int i = 0; i < 4; ++i) {
     auto r = set_param(c, "payload_voltage", 13.0 + i);
-    r.expires_at = c.h.clock().system_now() + 500ms;
+    r.expires_at = epoch_ns(c.h.clock().system_now() + 500ms);
     c.service.submit(r);
   }
   c.h.run_for(3000ms);
@@ -605,6 +628,101 @@ TEST(Commands, EveryCommandAndItsResultIsInTheAuditTrail) {
   EXPECT_NE(text.find("audit: command t-2 from ground-station-7: reset to sim0/1 -> DENIED: reset resets the PMU"),
             std::string::npos)
       << text;
+}
+
+TEST(Commands, NetworkTextCannotForgeAuditLines) {
+  std::ostringstream log;
+  auto previous = spdlog::default_logger();
+  spdlog::set_default_logger(
+      std::make_shared<spdlog::logger>("audit-test", std::make_shared<spdlog::sinks::ostream_sink_mt>(log)));
+  {
+    Commands c({pmu(1)});
+    auto r = c.req(CommandKind::SetParameter);
+    r.request_id = "x\n\x1b[2Jaudit: FORGED id";
+    r.parameter = "volts\naudit: FORGED parameter";
+    c.run(r);
+    auto bus = c.req(CommandKind::GetSerial);
+    bus.bus = "can\naudit: FORGED";
+    c.run(bus);
+  }
+  spdlog::set_default_logger(previous);
+  std::istringstream lines(log.str());
+  std::string line;
+  int audit_lines = 0;
+  while (std::getline(lines, line)) {
+    // Every line is one the logger began (its pattern starts "[time]"): none was started by
+    // a newline in a peer's text, and no terminal escape reaches the journal.
+    EXPECT_EQ(line.rfind('[', 0), 0u) << line;
+    EXPECT_EQ(line.find('\x1b'), std::string::npos) << line;
+    audit_lines += line.find("audit: command") != std::string::npos;
+  }
+  EXPECT_EQ(audit_lines, 2) << log.str();
+  EXPECT_NE(log.str().find("x\\x0A\\x1B[2Jaudit: FORGED id"), std::string::npos) << log.str();
+}
+
+}  // namespace
+}  // namespace pmu::service::test
+
+namespace pmu::service::test {
+namespace {
+
+// Request ids are unique per sender, not across senders (interface.md).
+TEST(Commands, TheSameIdFromTwoSendersIsTwoCommands) {
+  Commands c({pmu(1)});
+  auto a = set_param(c, "avionics_voltage", 20.0);
+  a.sender = "ground-a";
+  auto b = set_param(c, "avionics_voltage", 16.5);
+  b.sender = "ground-b";
+  b.request_id = a.request_id;
+  EXPECT_EQ(c.run(a).result, CommandResult::Completed);
+  const auto r = c.run(b);
+  EXPECT_EQ(r.result, CommandResult::Completed) << r.reason;
+  EXPECT_DOUBLE_EQ(r.value, 16.5);
+  EXPECT_EQ(sim_param(c, codec::Parameter::AvionicsVoltage), 165u);
+}
+
+TEST(Commands, AReusedIdWithOtherContentIsRejectedNotAnsweredWithTheOldReply) {
+  Commands c({pmu(1)});
+  auto first = set_param(c, "avionics_voltage", 20.0);
+  EXPECT_EQ(c.run(first).result, CommandResult::Completed);
+  c.h.clear_sent();
+  auto reused = set_param(c, "avionics_voltage", 16.5);
+  reused.request_id = first.request_id;
+  const auto r = c.run(reused);
+  EXPECT_EQ(r.result, CommandResult::Rejected);
+  EXPECT_EQ(r.reason, "request id '" + first.request_id +
+                          "' was already used by this sender for another command; not executed (use a new id)");
+  c.h.run_for(100ms);
+  EXPECT_TRUE(c.sent().empty());
+  EXPECT_EQ(sim_param(c, codec::Parameter::AvionicsVoltage), 200u);
+  EXPECT_EQ(c.service.counters().reused_ids, 1u);
+  // The first command's answer is unchanged for a true resend.
+  EXPECT_EQ(c.run(first).result, CommandResult::Completed);
+}
+
+TEST(Commands, AnExpiryFarInTheFutureIsHeldToTheCapAndExecuted) {
+  Commands c({pmu(1)});
+  for (std::uint64_t expires : {1ull << 63, ~0ull - 1, ~0ull}) {
+    auto r = c.req(CommandKind::GetSerial);
+    r.expires_at = expires;
+    const auto reply = c.run(r);
+    EXPECT_EQ(reply.result, CommandResult::Completed) << expires << ": " << reply.reason;
+  }
+}
+
+TEST(Commands, FiftyThousandDistinctIdsKeepTheMemoryBounded) {
+  PolicyConfig unlimited;
+  unlimited.rate_per_second = 0;
+  Commands c({pmu(1)}, unlimited);
+  constexpr int kIds = 50000;
+  for (int i = 0; i < kIds; ++i) {
+    auto r = c.req(CommandKind::GetSerial);
+    r.bus = "can9";  // answered at once: the test is about what is remembered
+    c.service.submit(r);
+    ASSERT_LE(c.service.remembered(), kRememberedRequests);
+  }
+  EXPECT_EQ(c.replies.size(), static_cast<std::size_t>(kIds));
+  EXPECT_EQ(c.service.remembered(), kRememberedRequests);
 }
 
 }  // namespace

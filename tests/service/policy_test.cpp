@@ -8,13 +8,19 @@
 namespace pmu::service {
 namespace {
 
+// A request as the boundary makes it from a sample with these fields.
 CommandRequest make(CommandKind k, std::uint8_t outputs = 0, const char* param = "", double value = 0) {
-  CommandRequest r;
-  r.kind = k;
-  r.outputs = outputs;
-  r.parameter = param;
-  r.value = value;
-  return r;
+  CommandSample s;
+  s.request_id = "p";
+  s.bus = "can0";
+  s.address = 1;
+  s.kind = static_cast<std::uint32_t>(k);
+  s.outputs = outputs;
+  s.parameter = param;
+  s.value = value;
+  const auto r = parse_command(s, Now{}, Lifetimes{});
+  EXPECT_TRUE(r.ok()) << r.error();
+  return r.ok() ? *r : CommandRequest{};
 }
 
 struct Case {
@@ -37,6 +43,11 @@ TEST(Policy, ConfirmRulesByDefault) {
       {"can address", make(CommandKind::SetParameter, 0, "can_address", 3), true},
       {"T_U 0", make(CommandKind::SetParameter, 0, "upper_temperature_limit", 0), true},
       {"T_U 80", make(CommandKind::SetParameter, 0, "upper_temperature_limit", 80), false},
+      // Judged on what the wire will carry: these round to 0.
+      {"T_U 0.0005", make(CommandKind::SetParameter, 0, "upper_temperature_limit", 0.0005), true},
+      {"T_U -0.0009", make(CommandKind::SetParameter, 0, "upper_temperature_limit", -0.0009), true},
+      {"S0 -0.0004", make(CommandKind::SetParameter, 0, "power_up_state", -0.0004), true},
+      {"S0 0.0004 + avionics", make(CommandKind::SetParameter, 0, "power_up_state", 1.0004), false},
       {"S0 with avionics", make(CommandKind::SetParameter, 0, "power_up_state", 0x21), false},
       {"S0 without avionics", make(CommandKind::SetParameter, 0, "power_up_state", 0x20), true},
       {"a voltage", make(CommandKind::SetParameter, 0, "avionics_voltage", 24), false},
@@ -76,7 +87,7 @@ buses:
   EXPECT_FALSE(check_policy(make(CommandKind::SetParameter, 0, "avionics_voltage", 24), c.policy).allowed());
   EXPECT_TRUE(check_policy(make(CommandKind::EngineStop), c.policy).allowed());
   EXPECT_DOUBLE_EQ(c.policy.rate_per_second, 5);
-  EXPECT_EQ(c.policy.default_lifetime, std::chrono::milliseconds(2500));
+  EXPECT_EQ(c.policy.lifetimes.default_lifetime, std::chrono::milliseconds(2500));
 }
 
 TEST(Policy, EngineStopCannotBeDeniedByConfig) {

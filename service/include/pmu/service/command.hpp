@@ -1,12 +1,28 @@
 #pragma once
-// Commands in the service's own terms (mirroring pmu::Command / pmu::CommandReply of
-// interface.md); dds_commands.cpp converts at the DDS boundary, everything else uses these.
+// Commands in the service's own terms (interface.md, Commands).
+//
+// Two stages, with one total function between them:
+//   CommandSample   a pmu::Command exactly as it arrived: any kind number, any double, any
+//                   byte in a boolean, any expiry, strings of any length. Not trusted.
+//   CommandRequest  what the rest of the service works on: one typed action per kind,
+//                   values already in wire units (so policy judges what will be sent), the
+//                   expiry as a steady-clock deadline.
+// parse_command() turns every possible sample into a request or a rejection reason; it never
+// throws, and nothing after it looks at the sample's strings again.
+//
+// Text from the network reaches logs only through printable(): a peer cannot start a line,
+// move the cursor or forge an audit entry.
 
 #include <chrono>
 #include <cstdint>
 #include <optional>
 #include <string>
 #include <string_view>
+#include <variant>
+
+#include "pmu/codec/ids.hpp"
+#include "pmu/codec/parameters.hpp"
+#include "pmu/codec/result.hpp"
 
 namespace pmu::service {
 
@@ -34,20 +50,70 @@ enum class CommandResult : std::uint8_t { Completed, Rejected, Denied, Unsupport
 std::string_view to_string(CommandResult r) noexcept;  // "COMPLETED", ...
 inline bool is_final(CommandResult r) noexcept { return r != CommandResult::InProgress; }
 
-struct CommandRequest {
+// The IDL's string bounds (idl/command.idl): longer strings are rejected, not truncated.
+inline constexpr std::size_t kMaxRequestIdLength = 63;
+inline constexpr std::size_t kMaxBusNameLength = 15;
+inline constexpr std::size_t kMaxParameterLength = 31;
+
+// A pmu::Command as received (field for field), before anything is trusted.
+struct CommandSample {
   std::string request_id;
-  std::string sender;  // who sent it, for the audit trail (the DDS writer's GUID)
   std::string bus;
   std::uint16_t address = 0;
-  CommandKind kind = CommandKind::Get;
+  std::uint32_t kind = 0;  // a CommandKind if < kCommandKindCount
   std::string parameter;
   double value = 0;
   std::uint8_t outputs = 0;
-  bool enable = false;
+  std::uint8_t enable = 0;  // a CDR boolean: only 0 and 1 are valid
   std::uint8_t groups = 0;
-  // Absolute expiry (wall clock); nullopt: the service's default lifetime from receipt.
-  std::optional<std::chrono::system_clock::time_point> expires_at;
+  std::uint64_t expires_at = 0;  // ns since the Unix epoch (UTC); 0 = the default lifetime
+  std::uint8_t confirm = 0;      // a CDR boolean
+  // Not part of the sample: who wrote it (the DDS writer's GUID), set by the endpoint.
+  // Request ids are unique per sender, so duplicates are recognised per sender.
+  std::string sender;
+};
+
+// Identical content: everything but the expiry (a resend with a fresh deadline is the same
+// command), the id and the sender. Used to tell a resend from a reused id.
+std::uint64_t content_fingerprint(const CommandSample& s) noexcept;
+
+// One typed alternative per kind, in CommandKind's order.
+namespace action {
+struct Get {  // a stored parameter (0x10..0x1B), outputs (0x20), generation (0x23) or a group (0x00..0x04)
+  codec::PacketId packet;
+};
+struct SetParameter {
+  codec::Parameter parameter;
+  std::uint32_t raw;  // exactly what goes on the wire
+};
+struct SetOutputs { std::uint8_t mask; };
+struct EnableOutputs { std::uint8_t mask; };   // non-empty
+struct DisableOutputs { std::uint8_t mask; };  // non-empty
+struct SetGeneration { bool enable; };
+struct RequestMeasurements { std::uint8_t groups; };  // non-empty (0 on the wire means all)
+struct EngineStart {};
+struct EngineStop {};
+struct Reset {};
+struct GetSerial {};
+struct GetFirmware {};
+}  // namespace action
+
+using CommandAction =
+    std::variant<action::Get, action::SetParameter, action::SetOutputs, action::EnableOutputs, action::DisableOutputs,
+                 action::SetGeneration, action::RequestMeasurements, action::EngineStart, action::EngineStop,
+                 action::Reset, action::GetSerial, action::GetFirmware>;
+static_assert(std::variant_size_v<CommandAction> == kCommandKindCount);
+
+struct CommandRequest {
+  std::string request_id;
+  std::string sender;
+  std::string bus;
+  std::uint16_t address = 0;
+  CommandAction action;
+  std::chrono::steady_clock::time_point expires;  // the first frame is not sent after this
   bool confirm = false;
+
+  CommandKind kind() const noexcept { return static_cast<CommandKind>(action.index()); }
 };
 
 struct CommandReplyData {
@@ -62,7 +128,32 @@ struct CommandReplyData {
   std::string value_text;
 };
 
-// "set_parameter avionics_voltage=24.0 to can0/1 (confirm)": for logs and the audit trail.
+// How long a request may wait (config `policy`).
+struct Lifetimes {
+  std::chrono::milliseconds default_lifetime{10000};  // expires_at = 0
+  // An expires_at further ahead than this is held to it: the service never keeps a request
+  // (nor its duplicate-detection entry) for longer, whatever a peer's clock or intent.
+  std::chrono::milliseconds max_lifetime{60000};
+};
+
+struct Now {
+  std::chrono::system_clock::time_point wall;
+  std::chrono::steady_clock::time_point steady;
+};
+
+// The boundary. A valid sample gives a request; anything else the reason to reject it, which
+// quotes the sample's text through printable(). Firmware-dependent checks come later
+// (check_firmware in command_executor.hpp), when the device is known.
+codec::Result<CommandRequest, std::string> parse_command(const CommandSample& s, const Now& now,
+                                                         const Lifetimes& lifetimes);
+
+// "set_parameter avionics_voltage=24 to can0/1 (confirmed)": for logs and the audit trail.
 std::string describe(const CommandRequest& r);
+// The same for a sample that did not parse, with its text made printable.
+std::string describe(const CommandSample& s);
+
+// `text` with every byte outside printable ASCII, and the backslash, written as \xNN (\\),
+// cut to `max` bytes of input (marked with "..."). Safe in a log line.
+std::string printable(std::string_view text, std::size_t max = 64);
 
 }  // namespace pmu::service

@@ -1,7 +1,8 @@
 #pragma once
 // Carries out one command on one device session (on the bus worker's thread): checks it
-// against the spec (range, step, NaN, output bits, what the firmware supports), then sends
-// it and verifies the result, replying exactly once with a final result.
+// against what the device's firmware supports, then sends
+// it and verifies the result, replying exactly once with a final result. It works on parsed
+// requests only (command.hpp): every value is already in range and in wire units.
 //
 //   sets        send, read the value back, COMPLETED only if the device reports it
 //   outputs     0x20/0x21/0x22, then read 0x20 back and check the bits
@@ -23,16 +24,18 @@ namespace pmu::service {
 
 using ReplyFn = std::function<void(const CommandReplyData&)>;
 
-// The spec checks alone: a final REJECTED/UNSUPPORTED reply for an invalid request, nullopt
-// for a valid one. `fw` is the device's firmware when known.
-std::optional<CommandReplyData> validate_command(const CommandRequest& r, std::optional<codec::FirmwareVersion> fw);
+// What the device's firmware decides (parse_command checked everything else): a final
+// UNSUPPORTED reply when `fw` lacks what `r` asks for, nullopt otherwise.
+std::optional<CommandReplyData> check_firmware(const CommandRequest& r, std::optional<codec::FirmwareVersion> fw);
 
-// Validates, then runs the command on `session`. `expires` bounds how long the first frame
-// may wait in the device's queue. `reply` is called exactly once with a final result.
-void execute_command(DeviceSession& session, const CommandRequest& r, SteadyTime now,
-                     std::optional<SteadyTime> expires, const Timeouts& timeouts, ReplyFn reply);
+// Checks the firmware, then runs the command on `session`. `r.expires` bounds how long the
+// first frame may wait in the device's queue. `reply` is called exactly once, final.
+void execute_command(DeviceSession& session, const CommandRequest& r, SteadyTime now, const Timeouts& timeouts,
+                     ReplyFn reply);
 
 // A final reply to `r` with `result` and `reason`.
 CommandReplyData make_reply(const CommandRequest& r, CommandResult result, std::string reason);
+// The same for a sample that did not parse (an unknown kind is answered as GET).
+CommandReplyData make_reply(const CommandSample& s, CommandResult result, std::string reason);
 
 }  // namespace pmu::service

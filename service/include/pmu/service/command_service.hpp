@@ -1,13 +1,22 @@
 #pragma once
 // CommandService: the front door for commands, callable from any thread (the DDS listener).
-// It guarantees exactly one final reply per request id:
-//   * a repeated request id is answered again with the first one's result, never executed
-//     twice (while the first is still running, the answer is owed and sent when it ends);
-//   * expired, malformed, unroutable, denied or rate-limited requests are answered at once,
-//     with nothing sent to a bus;
+// It guarantees exactly one final reply per received sample:
+//   * every sample is parsed once (parse_command, command.hpp); one that does not parse is
+//     REJECTED with the reason, with nothing sent to a bus;
+//   * a request id is remembered per sender (ids are unique per sender, not globally): a
+//     resend with the same content is answered again with the first one's result, never
+//     executed twice (while the first still runs, the answer is owed and sent when it ends);
+//     the same id with other content is REJECTED, never answered with the other's reply;
+//   * expired, unroutable, denied or rate-limited requests are answered at once, with
+//     nothing sent to a bus;
 //   * valid ones run on their bus worker's thread (command_executor.hpp), serialised per
 //     device by the device session, in parallel across devices and buses.
-// Every command and its result is logged as an audit trail (who, what, result, reason).
+// Replies are handed to `reply` outside the service's lock. Every command and its result is
+// logged as an audit trail (who, what, result, reason), with network text made printable.
+//
+// Memory: at most kRememberedRequests ids are kept (oldest forgotten first); no request
+// lives longer than policy.lifetimes.max_lifetime, so at any rate below
+// kRememberedRequests per max_lifetime no live request's id is ever forgotten.
 
 #include <chrono>
 #include <deque>
@@ -24,29 +33,37 @@
 
 namespace pmu::service {
 
+inline constexpr std::size_t kRememberedRequests = 16384;
+
 class CommandService {
  public:
   // `reply` publishes a reply; it is called from bus worker threads and the caller's thread.
   CommandService(std::vector<BusWorker*> workers, PolicyConfig policy, Timeouts timeouts,
                  const transport::Clock& clock, ReplyFn reply);
 
-  void submit(CommandRequest request);
+  void submit(const CommandSample& sample);
 
   struct Counters {
-    std::uint64_t received = 0, duplicates = 0, completed = 0, refused = 0, failed = 0;
+    std::uint64_t received = 0, duplicates = 0, reused_ids = 0, completed = 0, refused = 0, failed = 0;
   };
   Counters counters() const;
+  // Request ids currently remembered for duplicate detection (at most kRememberedRequests).
+  std::size_t remembered() const;
 
  private:
   struct Entry {
+    std::uint64_t fingerprint = 0;
     std::optional<CommandReplyData> final;
-    unsigned owed = 0;  // duplicates that arrived while it ran
-    std::string what;   // describe(request), for the audit trail
-    std::string sender;
+    unsigned owed = 0;  // resends that arrived while it ran
   };
+  enum class Seen { New, Resend, Reused };
 
-  void finish(const CommandReplyData& reply);
-  void answer_now(const CommandRequest& r, CommandResult result, std::string reason);
+  Seen remember(const std::string& key, const CommandSample& s, std::optional<CommandReplyData>& again);
+  void execute(const CommandRequest& r);
+  // Records the final reply under `key`, logs it and publishes it (and the owed copies).
+  void finish(const std::string& key, const std::string& sender, const std::string& what,
+              const CommandReplyData& reply);
+  void answer(const CommandRequest& r, CommandResult result, std::string reason);
   BusWorker* worker_for(const std::string& bus) const;
 
   std::vector<BusWorker*> workers_;
@@ -56,8 +73,8 @@ class CommandService {
   ReplyFn reply_;
 
   mutable std::mutex mutex_;
-  std::unordered_map<std::string, Entry> seen_;
-  std::deque<std::string> order_;  // oldest first, to bound seen_
+  std::unordered_map<std::string, Entry> seen_;  // by sender_key(sender, request_id)
+  std::deque<std::string> order_;                // oldest first, to bound seen_
   std::map<std::pair<std::string, std::uint16_t>, RateLimiter> limiters_;
   Counters counters_;
 };

@@ -1,7 +1,9 @@
 #pragma once
 // The command topics on DDS: reads pmu/command (QoS profile `command`) into the
 // CommandService and writes every reply to pmu/command_reply. The only place that converts
-// between pmu::Command / pmu::CommandReply and the service's own command types.
+// between pmu::Command / pmu::CommandReply and the service's own command types: samples are
+// read field for field as they arrived (command_cdr.hpp) and parsed by CommandService, so
+// no payload a peer can send reaches Fast DDS's threads as an exception.
 
 #include <memory>
 
@@ -19,10 +21,13 @@ class DdsCommandEndpoint {
   ~DdsCommandEndpoint();
   // Starts reading commands into `service` (which must outlive this endpoint's reader).
   void start(CommandService& service);
-  // Stops reading commands (before the service is torn down). Idempotent.
+  // Stops reading commands (before the service is torn down): when it returns no callback
+  // is running in, or will enter, the service. Idempotent.
   void stop();
   // Publishes one reply (thread-safe).
   void publish(const CommandReplyData& reply);
+  // Received payloads that were not a pmu::Command (counted and dropped, logged rate-limited).
+  std::uint64_t malformed() const noexcept;
 
  private:
   struct Impl;

@@ -40,7 +40,7 @@ struct PolicyConfig {
   std::array<bool, kCommandKindCount> deny{};  // by CommandKind
   double rate_per_second = 20;                 // per device; 0 = no limit
   double burst = 40;                           // commands allowed at once
-  std::chrono::milliseconds default_lifetime{10000};  // for requests with no expiry
+  Lifetimes lifetimes;                         // command_lifetime, max_command_lifetime
 };
 
 struct PolicyVerdict {
