@@ -54,26 +54,25 @@ struct DdsCommandEndpoint::Impl final : public DataReaderListener {
     CommandSampleType::Received received;
     SampleInfo info;
     while (r->take_next_sample(&received, &info) == ReturnCode_t::RETCODE_OK) {
-      if (!info.valid_data) continue;
-      if (!received.sample) {
-        report_malformed(info);
-        continue;
-      }
+      // Fast DDS 2.9 drops a sample whose deserialize failed before take sees it; a library
+      // that hands it over anyway gives an empty Received. Either way it was counted.
+      if (!info.valid_data || !received.sample) continue;
       received.sample->sender = guid_of(info);
       service->submit(*received.sample);
     }
+    report_malformed();
   }
 
   // A payload that is not a pmu::Command cannot be answered (it has no readable request id):
   // counted by the type, logged at most every few seconds so a flood cannot fill the journal.
-  void report_malformed(const SampleInfo& info) {
-    const auto now = std::chrono::steady_clock::now();
-    if (now < next_malformed_log) return;
-    next_malformed_log = now + kMalformedLogInterval;
+  void report_malformed() {
     const auto total = type->malformed();
+    const auto now = std::chrono::steady_clock::now();
+    if (total == malformed_logged || now < next_malformed_log) return;
+    next_malformed_log = now + kMalformedLogInterval;
     spdlog::warn("pmu/command: dropped {} sample(s) that are not a pmu::Command as idl/command.idl defines it "
-                 "(latest from {}); no reply is possible without a readable request_id",
-                 total - malformed_logged, guid_of(info));
+                 "({} since start); no reply is possible without a readable request_id",
+                 total - malformed_logged, total);
     malformed_logged = total;
   }
 

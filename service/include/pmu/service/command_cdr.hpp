@@ -36,6 +36,10 @@ class CommandSampleType final : public pmu::CommandPubSubType {
     std::optional<CommandSample> sample;  // nullopt: malformed, count and drop
   };
 
+  // Room for strings past the IDL's bounds, so they reach parse_command and get a reason.
+  static constexpr std::uint32_t kMaxPayload = 4096;
+  CommandSampleType() { m_typeSize = kMaxPayload; }
+
   bool serialize(void* data, eprosima::fastrtps::rtps::SerializedPayload_t* payload) override;
   bool deserialize(eprosima::fastrtps::rtps::SerializedPayload_t* payload, void* data) override;
   std::function<uint32_t()> getSerializedSizeProvider(void* data) override;

@@ -1,0 +1,462 @@
+// The command boundary against the real pmu-service process, as a hostile or careless DDS
+// peer would meet it: every kind of malformed or adversarial pmu::Command gets exactly one
+// reply with a reason (or, when it is not a pmu::Command at all, is counted and dropped),
+// nothing kills or stalls the service, nothing forges its log, duplicates are told apart per
+// sender, bursts are answered in full and the memory for remembered ids stays bounded.
+#include <gtest/gtest.h>
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <cmath>
+#include <cstring>
+#include <fastdds/dds/core/status/PublicationMatchedStatus.hpp>
+#include <fastdds/dds/core/status/SubscriptionMatchedStatus.hpp>
+#include <fastdds/dds/subscriber/SampleInfo.hpp>
+#include <fastrtps/rtps/common/SerializedPayload.h>
+#include <fstream>
+#include <limits>
+#include <map>
+#include <regex>
+#include <sstream>
+#include <thread>
+
+#include "../support/dds_domain.hpp"
+#include "pmu/idl/command.h"
+#include "pmu/idl/commandPubSubTypes.h"
+#include "pmu/idl/topics.hpp"
+#include "pmu/service/command_cdr.hpp"
+#include "pmu/service/dds_context.hpp"
+
+namespace pmu::service {
+namespace {
+
+using namespace eprosima::fastdds::dds;
+using namespace std::chrono_literals;
+using Clock = std::chrono::steady_clock;
+
+std::uint32_t wire(CommandKind k) { return static_cast<std::uint32_t>(k); }
+
+std::uint64_t now_ns() {
+  return static_cast<std::uint64_t>(
+      std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::system_clock::now().time_since_epoch())
+          .count());
+}
+
+// pmu-service on two simulated PMUs, its log in a file. No rate limit: the bursts below are
+// about delivery, not policy.
+class Service {
+ public:
+  explicit Service(int domain) : log_path_("/tmp/pmu-boundary-" + std::to_string(::getpid()) + ".log") {
+    config_path_ = "/tmp/pmu-boundary-" + std::to_string(::getpid()) + ".yaml";
+    std::ofstream(config_path_) << "domain: " << domain
+                                << "\nbuses:\n  - interface: sim\n    name: sim0\n    devices:\n"
+                                   "      - address: 1\n      - address: 2\npolicy:\n  rate_limit: 0\n";
+    pid_ = ::fork();
+    if (pid_ == 0) {
+      const int fd = ::open(log_path_.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+      ::dup2(fd, 2);
+      ::execl(PMU_SERVICE_PATH, PMU_SERVICE_PATH, "--config", config_path_.c_str(), static_cast<char*>(nullptr));
+      std::_Exit(127);
+    }
+  }
+  ~Service() {
+    if (pid_ > 0) {
+      ::kill(pid_, SIGKILL);
+      ::waitpid(pid_, nullptr, 0);
+    }
+    ::unlink(config_path_.c_str());
+    ::unlink(log_path_.c_str());
+  }
+  bool alive() const { return pid_ > 0 && ::waitpid(pid_, nullptr, WNOHANG) == 0; }
+  std::string log() const {
+    std::ifstream in(log_path_);
+    std::stringstream ss;
+    ss << in.rdbuf();
+    return ss.str();
+  }
+  long rss_kib() const {
+    std::ifstream in("/proc/" + std::to_string(pid_) + "/status");
+    std::string line;
+    while (std::getline(in, line))
+      if (line.rfind("VmRSS:", 0) == 0) return std::stol(line.substr(6));
+    return -1;
+  }
+
+ private:
+  pid_t pid_ = -1;
+  std::string config_path_, log_path_;
+};
+
+// A peer that writes CommandSamples as they are, booleans and all, and reads every reply.
+class Peer {
+ public:
+  Peer(int domain, const std::string& name)
+      : dds_(domain, "", name),
+        writer_(dds_.writer(dds_.topic(topics::kCommand, TypeSupport(new CommandSampleType())), qos_profiles::kCommand)),
+        replies_(dds_.reader(dds_.topic(topics::kCommandReply, TypeSupport(new pmu::CommandReplyPubSubType())),
+                             qos_profiles::kCommand)) {}
+
+  bool wait_matched(std::chrono::seconds within = 20s) {
+    for (const auto end = Clock::now() + within; Clock::now() < end; std::this_thread::sleep_for(10ms)) {
+      PublicationMatchedStatus p;
+      SubscriptionMatchedStatus s;
+      writer_.get_publication_matched_status(p);
+      replies_.get_subscription_matched_status(s);
+      if (p.current_count > 0 && s.current_count > 0) return true;
+    }
+    return false;
+  }
+  void send(const CommandSample& s) {
+    CommandSampleType::Received r{s};
+    ASSERT_TRUE(writer_.write(&r));
+  }
+  void settle() { writer_.wait_for_acknowledgments(eprosima::fastrtps::Duration_t(10, 0)); }
+  // Replies received so far (a mark for replies()).
+  std::size_t received() {
+    (void)replies("", 0, 0s);
+    return all_.size();
+  }
+  // Every reply (from the `since`-th received on) whose id starts with `prefix`, until `count`
+  // of them arrived or `within` passed.
+  std::vector<pmu::CommandReply> replies(const std::string& prefix, std::size_t count,
+                                         std::chrono::seconds within = 20s, std::size_t since = 0) {
+    const auto end = Clock::now() + within;
+    do {
+      pmu::CommandReply r;
+      SampleInfo info;
+      bool any = false;
+      while (replies_.take_next_sample(&r, &info) == ReturnCode_t::RETCODE_OK) {
+        any = true;
+        if (info.valid_data) all_.push_back(r);
+      }
+      mine_.clear();
+      for (std::size_t i = since; i < all_.size(); ++i)
+        if (all_[i].request_id().to_string().rfind(prefix, 0) == 0) mine_.push_back(all_[i]);
+      if (mine_.size() >= count) break;
+      if (!any) std::this_thread::sleep_for(2ms);
+    } while (Clock::now() < end);
+    return mine_;
+  }
+  dds::DdsContext& dds() { return dds_; }
+
+ private:
+  dds::DdsContext dds_;
+  DataWriter& writer_;
+  DataReader& replies_;
+  std::vector<pmu::CommandReply> all_, mine_;
+};
+
+CommandSample command(const std::string& id, CommandKind kind, std::uint16_t address = 1) {
+  CommandSample s;
+  s.request_id = id;
+  s.bus = "sim0";
+  s.address = address;
+  s.kind = wire(kind);
+  return s;
+}
+
+CommandSample set(const std::string& id, const char* parameter, double value) {
+  auto s = command(id, CommandKind::SetParameter);
+  s.parameter = parameter;
+  s.value = value;
+  return s;
+}
+
+class Boundary : public ::testing::Test {
+ protected:
+  Boundary() : domain_(test::exclusive_dds_domain()), service_(domain_), peer_(domain_, "hostile-peer") {}
+  void SetUp() override {
+    ASSERT_TRUE(peer_.wait_matched()) << service_.log();
+    // The devices' start-up reading: wait until a GET is answered.
+    for (int i = 0; i < 100; ++i) {
+      const std::string id = "ready-" + std::to_string(i);
+      peer_.send(command(id, CommandKind::GetSerial));
+      const auto r = peer_.replies(id, 1, 2s);
+      if (!r.empty() && r[0].result() == pmu::COMPLETED) return;
+      std::this_thread::sleep_for(100ms);
+    }
+    FAIL() << "the service never became ready\n" << service_.log();
+  }
+  // Sends `s` and returns its one reply (fails the test unless exactly one arrives).
+  pmu::CommandReply one_reply(const CommandSample& s) {
+    const auto since = peer_.received();
+    peer_.send(s);
+    auto r = peer_.replies(s.request_id, 1, 20s, since);
+    std::this_thread::sleep_for(100ms);
+    r = peer_.replies(s.request_id, 2, 0s, since);
+    EXPECT_EQ(r.size(), 1u) << "replies to " << s.request_id;
+    return r.empty() ? pmu::CommandReply{} : r.front();
+  }
+
+  int domain_;
+  Service service_;
+  Peer peer_;
+};
+
+struct Hostile {
+  const char* what;
+  CommandSample sample;
+  pmu::CommandResult result;
+  const char* reason;  // a part of the reason
+};
+
+TEST_F(Boundary, EveryHostileSampleGetsOneReplyWithAReasonAndTheServiceLivesOn) {
+  const double inf = std::numeric_limits<double>::infinity();
+  auto with = [](CommandSample s, auto&& change) {
+    change(s);
+    return s;
+  };
+  const std::uint64_t far = 1ull << 63;
+  const Hostile cases[] = {
+      {"kind 12", with(command("h-kind12", CommandKind::Get), [](auto& s) { s.kind = 12; }), pmu::REJECTED,
+       "unknown command kind 12"},
+      {"kind 2^32-1", with(command("h-kindmax", CommandKind::Get), [](auto& s) { s.kind = 0xFFFFFFFF; }),
+       pmu::REJECTED, "unknown command kind 4294967295"},
+      {"NaN", set("h-nan", "avionics_voltage", std::nan("")), pmu::REJECTED, "is not a number"},
+      {"Inf", set("h-inf", "avionics_voltage", inf), pmu::REJECTED, "is not a number"},
+      {"-Inf", set("h-ninf", "servo_voltage", -inf), pmu::REJECTED, "is not a number"},
+      {"huge", set("h-huge", "battery_voltage", 1e300), pmu::REJECTED, "out of range"},
+      {"denormal voltage", set("h-denorm", "payload_voltage", 4e-320), pmu::REJECTED, "out of range"},
+      {"undefined output bits", with(command("h-outbits", CommandKind::EnableOutputs), [](auto& s) { s.outputs = 0xF2; }),
+       pmu::REJECTED, "unknown output bits 0xF0"},
+      {"undefined group bits",
+       with(command("h-groups", CommandKind::RequestMeasurements), [](auto& s) { s.groups = 0xE1; }), pmu::REJECTED,
+       "unknown measurement group bits 0xE0"},
+      {"broadcast set", with(set("h-bcast", "avionics_voltage", 20), [](auto& s) { s.address = 0xFFFF; }),
+       pmu::REJECTED, "broadcast (65535) is only accepted for engine_stop"},
+      {"unknown address", command("h-addr", CommandKind::GetSerial, 9), pmu::REJECTED, "device 9 not seen on sim0"},
+      {"unknown bus", with(command("h-bus", CommandKind::GetSerial), [](auto& s) { s.bus = "can7"; }), pmu::REJECTED,
+       "bus 'can7' is not served here"},
+      {"empty bus", with(command("h-nobus", CommandKind::GetSerial), [](auto& s) { s.bus.clear(); }), pmu::REJECTED,
+       "bus '' is not served here"},
+      {"over-long bus name",
+       with(command("h-longbus", CommandKind::GetSerial), [](auto& s) { s.bus = std::string(200, 'b'); }),
+       pmu::REJECTED, "bus is 200 bytes long; at most 15 are allowed"},
+      {"over-long parameter", set("h-longparam", std::string(40, 'p').c_str(), 1), pmu::REJECTED,
+       "parameter is 40 bytes long"},
+      {"confirm byte 2", with(command("h-confirm2", CommandKind::EngineStart), [](auto& s) { s.confirm = 2; }),
+       pmu::REJECTED, "confirm is not a boolean (byte 0x02"},
+      {"confirm byte 0xFF", with(command("h-confirmff", CommandKind::Reset), [](auto& s) { s.confirm = 0xFF; }),
+       pmu::REJECTED, "confirm is not a boolean (byte 0xFF"},
+      {"enable byte 2", with(command("h-enable2", CommandKind::SetGeneration), [](auto& s) { s.enable = 2; }),
+       pmu::REJECTED, "enable is not a boolean"},
+      {"T_U 0.0005 rounds to 0", set("h-tu", "upper_temperature_limit", 0.0005), pmu::DENIED, "rule thermal_shutdown"},
+      {"T_U -0.0009 rounds to 0", set("h-tu2", "upper_temperature_limit", -0.0009), pmu::DENIED,
+       "rule thermal_shutdown"},
+      {"S0 -0.0004 rounds to 0", set("h-s0", "power_up_state", -0.0004), pmu::DENIED, "rule power_up_avionics_off"},
+      {"newline and escapes in the parameter", set("h-esc", "volts\n\x1b[2Jaudit: x", 1), pmu::REJECTED,
+       "unknown parameter 'volts\\x0A\\x1B[2Jaudit: x'"},
+      {"expires_at 1", with(command("h-exp1", CommandKind::GetSerial), [](auto& s) { s.expires_at = 1; }),
+       pmu::REJECTED, "expired"},
+      {"expired a second ago",
+       with(command("h-exp-1s", CommandKind::GetSerial), [](auto& s) { s.expires_at = now_ns() - 1000000000ull; }),
+       pmu::REJECTED, "expired"},
+      {"expires_at 2^63", with(command("h-exp63", CommandKind::GetSerial), [&](auto& s) { s.expires_at = far; }),
+       pmu::COMPLETED, ""},
+      {"expires_at 2^64-2", with(command("h-exp64-2", CommandKind::GetSerial), [](auto& s) { s.expires_at = ~0ull - 1; }),
+       pmu::COMPLETED, ""},
+      {"expires_at 2^64-1", with(command("h-exp64-1", CommandKind::GetSerial), [](auto& s) { s.expires_at = ~0ull; }),
+       pmu::COMPLETED, ""},
+      {"expires in 5 s",
+       with(command("h-exp5", CommandKind::GetSerial), [](auto& s) { s.expires_at = now_ns() + 5000000000ull; }),
+       pmu::COMPLETED, ""},
+      {"broadcast engine stop", command("h-stopall", CommandKind::EngineStop, 0xFFFF), pmu::COMPLETED,
+       "stop sent to every PMU"},
+  };
+  for (const auto& c : cases) {
+    SCOPED_TRACE(c.what);
+    const auto r = one_reply(c.sample);
+    EXPECT_EQ(r.result(), c.result) << r.request_id().to_string() << " " << r.reason().to_string() << " "
+                                    << r.value_text().to_string();
+    EXPECT_NE(r.reason().to_string().find(c.reason), std::string::npos) << r.reason().to_string();
+    ASSERT_TRUE(service_.alive()) << service_.log();
+  }
+  // An over-long request id: answered (cut to the reply's 63 bytes), not executed.
+  auto long_id = command("h-longid-" + std::string(60, 'i'), CommandKind::GetSerial);
+  peer_.send(long_id);
+  const auto r = peer_.replies("h-longid-", 1);
+  ASSERT_EQ(r.size(), 1u);
+  EXPECT_EQ(r[0].result(), pmu::REJECTED);
+  EXPECT_NE(r[0].reason().to_string().find("request_id is 69 bytes long"), std::string::npos);
+  // An empty id: one reply, REJECTED.
+  peer_.send(command("", CommandKind::GetSerial));
+  std::this_thread::sleep_for(300ms);
+  const auto empty = peer_.replies("", 1000, 0s);
+  std::size_t empties = 0;
+  for (const auto& x : empty) empties += x.request_id().to_string().empty() ? 1u : 0u;
+  EXPECT_EQ(empties, 1u);
+  // Still serving.
+  EXPECT_EQ(one_reply(set("h-after", "avionics_voltage", 20.0)).result(), pmu::COMPLETED);
+}
+
+TEST_F(Boundary, NetworkTextCannotForgeTheServiceLog) {
+  auto s = command("x\n\x1b[2Jaudit: FORGED command from nobody", CommandKind::GetSerial);
+  s.bus = "s\naudit: FORGED";
+  peer_.send(s);
+  peer_.replies("x\n", 1);
+  EXPECT_EQ(one_reply(command("log-after", CommandKind::GetSerial)).result(), pmu::COMPLETED);
+  const std::string log = service_.log();
+  EXPECT_NE(log.find("x\\x0A\\x1B[2Jaudit: FORGED command from nobody"), std::string::npos) << log;
+  std::istringstream lines(log);
+  std::string line;
+  const std::regex logger_began(R"(^\d{4}-\d\d-\d\d \d\d:\d\d:\d\d)");  // the console pattern's time
+  while (std::getline(lines, line)) {
+    EXPECT_TRUE(std::regex_search(line, logger_began)) << "a line the logger did not begin: " << line;
+    EXPECT_EQ(line.find('\x1b'), std::string::npos) << line;
+  }
+}
+
+TEST_F(Boundary, DuplicatesAreKnownPerSenderAndAReusedIdIsRejected) {
+  // The same command twice: answered twice, executed once (the audit trail says so).
+  const auto first = set("dup-1", "avionics_voltage", 20.0);
+  peer_.send(first);
+  peer_.send(first);
+  const auto both = peer_.replies("dup-1", 2);
+  ASSERT_EQ(both.size(), 2u);
+  EXPECT_EQ(both[0].result(), pmu::COMPLETED);
+  EXPECT_EQ(both[1].result(), pmu::COMPLETED);
+  // The same id with other content from the same sender: rejected, not the old reply.
+  const auto reused = one_reply(set("dup-1", "avionics_voltage", 16.5));
+  EXPECT_EQ(reused.result(), pmu::REJECTED);
+  EXPECT_NE(reused.reason().to_string().find("was already used by this sender for another command"), std::string::npos)
+      << reused.reason().to_string();
+  // The same id from another sender: its own command, executed.
+  Peer other(domain_, "other-ground-station");
+  ASSERT_TRUE(other.wait_matched());
+  other.send(set("dup-1", "avionics_voltage", 16.5));
+  const auto theirs = other.replies("dup-1", 1);
+  ASSERT_EQ(theirs.size(), 1u);
+  EXPECT_EQ(theirs[0].result(), pmu::COMPLETED) << theirs[0].reason().to_string();
+  EXPECT_DOUBLE_EQ(theirs[0].value(), 16.5);
+
+  std::this_thread::sleep_for(200ms);
+  const std::string log = service_.log();
+  std::size_t executed = 0, pos = 0;
+  while ((pos = log.find("audit: command dup-1 from", pos)) != std::string::npos) {
+    executed += log.find("-> COMPLETED", pos) < log.find('\n', pos) ? 1u : 0u;
+    ++pos;
+  }
+  EXPECT_EQ(executed, 2u) << log;  // once for each sender
+  EXPECT_NE(log.find("audit: duplicate command dup-1"), std::string::npos) << log;
+}
+
+// A payload that is not a pmu::Command (a look-alike type of the same name with another
+// layout, a truncated one, another encapsulation) cannot be answered: dropped and counted.
+class RawCommandType final : public TopicDataType {
+ public:
+  RawCommandType() {
+    setName("pmu::Command");
+    m_typeSize = 4096;
+    m_isGetKeyDefined = false;
+  }
+  bool serialize(void* data, eprosima::fastrtps::rtps::SerializedPayload_t* payload) override {
+    const auto& bytes = *static_cast<std::vector<std::uint8_t>*>(data);
+    std::memcpy(payload->data, bytes.data(), bytes.size());
+    payload->length = static_cast<std::uint32_t>(bytes.size());
+    return true;
+  }
+  bool deserialize(eprosima::fastrtps::rtps::SerializedPayload_t*, void*) override { return false; }
+  std::function<uint32_t()> getSerializedSizeProvider(void* data) override {
+    return [data] { return static_cast<uint32_t>(static_cast<std::vector<std::uint8_t>*>(data)->size()); };
+  }
+  void* createData() override { return new std::vector<std::uint8_t>(); }
+  void deleteData(void* data) override { delete static_cast<std::vector<std::uint8_t>*>(data); }
+  bool getKey(void*, eprosima::fastrtps::rtps::InstanceHandle_t*, bool) override { return false; }
+};
+
+TEST_F(Boundary, ALookAlikeTypeOrGarbageIsDroppedNeverFatal) {
+  dds::DdsContext raw(domain_, "", "look-alike");
+  DataWriter& w = raw.writer(raw.topic(topics::kCommand, TypeSupport(new RawCommandType())), qos_profiles::kCommand);
+  for (int i = 0; i < 500; ++i) {
+    PublicationMatchedStatus p;
+    w.get_publication_matched_status(p);
+    if (p.current_count > 0) break;
+    std::this_thread::sleep_for(10ms);
+  }
+  // The fields of pmu::Command in another order: kind and address first, then the strings.
+  std::vector<std::uint8_t> reordered = {0, 1, 0, 0, /*kind*/ 7, 0, 0, 0, /*address*/ 1, 0, 0, 0,
+                                         /*string length 1000*/ 0xE8, 0x03, 0, 0, 'x', 0};
+  const auto valid = write_command_cdr(command("raw-valid", CommandKind::GetSerial));
+  std::vector<std::uint8_t> truncated(valid.begin(), valid.begin() + 20);
+  std::vector<std::uint8_t> xcdr2 = valid;
+  xcdr2[1] = 0x07;  // CDR2 little-endian: not what pmu::Command's readers speak
+  std::vector<std::uint8_t> bool_two = write_command_cdr(command("raw-bool", CommandKind::EngineStart));
+  bool_two.back() = 2;  // confirm = 2, which aborted the service before
+  for (auto* bytes : {&reordered, &truncated, &xcdr2, &bool_two}) ASSERT_TRUE(w.write(bytes));
+  w.wait_for_acknowledgments(eprosima::fastrtps::Duration_t(5, 0));
+
+  const auto r = peer_.replies("raw-bool", 1);
+  ASSERT_EQ(r.size(), 1u);
+  EXPECT_EQ(r[0].result(), pmu::REJECTED);
+  EXPECT_EQ(one_reply(command("raw-after", CommandKind::GetSerial)).result(), pmu::COMPLETED);
+  ASSERT_TRUE(service_.alive());
+  const std::string log = service_.log();
+  EXPECT_NE(log.find("pmu/command: dropped"), std::string::npos) << log;
+}
+
+// Every peer sends `per_peer` commands as fast as it can, reading replies as it goes (as a
+// client does: a reader's history holds the command profile's depth, not the whole burst).
+// Half-way through, peer 0 sends ENGINE_STOP: it goes ahead of the device's queue, so its
+// reply comes before the burst's last one.
+void burst(Service& service, std::vector<Peer*> peers, int per_peer) {
+  for (int i = 0; i < per_peer; ++i) {
+    for (std::size_t p = 0; p < peers.size(); ++p)
+      peers[p]->send(command("b" + std::to_string(p) + "-" + std::to_string(i),
+                             i % 3 ? CommandKind::GetSerial : CommandKind::GetFirmware,
+                             static_cast<std::uint16_t>(1 + i % 2)));
+    if (i == per_peer / 2) peers[0]->send(command("stop-in-burst", CommandKind::EngineStop));
+    if (i % 50 == 49)
+      for (auto* p : peers) (void)p->received();
+  }
+  for (std::size_t p = 0; p < peers.size(); ++p) {
+    const std::string prefix = "b" + std::to_string(p) + "-";
+    const auto got = peers[p]->replies(prefix, static_cast<std::size_t>(per_peer), 120s);
+    std::map<std::string, int> per_id;
+    for (const auto& r : got) ++per_id[r.request_id().to_string()];
+    EXPECT_EQ(per_id.size(), static_cast<std::size_t>(per_peer)) << "peer " << p;
+    for (const auto& [id, n] : per_id) EXPECT_EQ(n, 1) << id;
+  }
+  const auto stop = peers[0]->replies("stop-in-burst", 1, 10s);
+  ASSERT_EQ(stop.size(), 1u);
+  EXPECT_EQ(stop[0].result(), pmu::COMPLETED);
+  // Arrival order at peer 0: the stop's reply before the last reply of its own burst.
+  const auto order = peers[0]->replies("", 1u << 30, 0s);
+  std::size_t stop_at = 0, last_burst_at = 0;
+  for (std::size_t i = 0; i < order.size(); ++i) {
+    const auto id = order[i].request_id().to_string();
+    if (id == "stop-in-burst") stop_at = i;
+    if (id.rfind("b0-", 0) == 0) last_burst_at = i;
+  }
+  EXPECT_LT(stop_at, last_burst_at) << "ENGINE_STOP was answered only after the burst";
+  EXPECT_TRUE(service.alive());
+}
+
+TEST_F(Boundary, ABurstOf2000FromOneWriterIsAnsweredInFull) { burst(service_, {&peer_}, 2000); }
+
+TEST_F(Boundary, BurstsOf2000FromFourWritersAtOnceAreAnsweredInFull) {
+  Peer b(domain_, "ground-b"), c(domain_, "ground-c"), d(domain_, "ground-d");
+  for (auto* p : {&b, &c, &d}) ASSERT_TRUE(p->wait_matched());
+  burst(service_, {&peer_, &b, &c, &d}, 2000);
+}
+
+TEST_F(Boundary, FiftyThousandDistinctIdsAreAllAnsweredWithBoundedMemory) {
+  const long before = service_.rss_kib();
+  constexpr int kIds = 50000;
+  for (int i = 0; i < kIds; ++i) {
+    auto s = command("m-" + std::to_string(i), CommandKind::GetSerial);
+    s.bus = "nowhere";  // answered at once: what is measured is what the service remembers
+    peer_.send(s);
+    if (i % 1000 == 999) peer_.settle();
+  }
+  const auto got = peer_.replies("m-", kIds, 120s);
+  EXPECT_EQ(got.size(), static_cast<std::size_t>(kIds));
+  const long after = service_.rss_kib();
+  // At most 16,384 ids are remembered (CommandService); each costs well under 1 KiB.
+  std::printf("service RSS before %ld KiB, after 50,000 ids %ld KiB\n", before, after);
+  EXPECT_LT(after - before, 32 * 1024) << "remembered ids are not bounded";
+}
+
+}  // namespace
+}  // namespace pmu::service
