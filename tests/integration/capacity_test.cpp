@@ -9,6 +9,8 @@
 #include <unistd.h>
 
 #include <chrono>
+#include <fastdds/dds/subscriber/SampleInfo.hpp>
+#include <map>
 #include <cstdio>
 #include <fstream>
 #include <nlohmann/json.hpp>
@@ -17,9 +19,16 @@
 #include <string>
 #include <thread>
 
+#include "pmu/idl/statePubSubTypes.h"
+#include "pmu/idl/topics.hpp"
+#include "pmu/service/capacity.hpp"
+#include "pmu/service/dds_context.hpp"
+#include "pmu/service/dds_publisher.hpp"
+
 namespace pmu::service {
 namespace {
 
+using namespace eprosima::fastdds::dds;
 using namespace std::chrono_literals;
 using Clock = std::chrono::steady_clock;
 
@@ -174,6 +183,38 @@ TEST(QosCapacity, AMiseditedProfileIsAStartUpError) {
                        "(PMUs per service, pmu::service::kMaxDevicesPerService)"),
             std::string::npos)
       << r.out;
+}
+
+// A PMU beyond the capacity (discovery can find one) is not published, and that is counted
+// and carried in pmu/health's publish_failures rather than lost without a trace.
+TEST(QosCapacity, PmusBeyondTheCapacityAreCountedInHealthNotDroppedSilently) {
+  ASSERT_GE(exclusive_domain(), 0);
+  dds::DdsContext service_side(exclusive_domain(), PMU_QOS_FILE, "capacity-publisher");
+  DdsPublisher publisher(service_side, 3s);
+  dds::DdsContext client(exclusive_domain(), PMU_QOS_FILE, "capacity-reader");
+  DataReader& health = client.reader(
+      client.topic(topics::kHealth, TypeSupport(new pmu::HealthPubSubType())), qos_profiles::kState);
+  HealthReport report;
+  report.state = HealthState::Online;
+  for (std::size_t a = 1; a <= kMaxDevicesPerService + 1; ++a)
+    publisher.on_health(DeviceKey{"sim0", static_cast<std::uint16_t>(a)}, report);
+  EXPECT_EQ(publisher.samples_written(), kMaxDevicesPerService);
+  EXPECT_EQ(publisher.samples_over_capacity(), 1u);
+  EXPECT_EQ(publisher.write_failures(), 1u);
+
+  publisher.on_health(DeviceKey{"sim0", 1}, report);  // an admitted PMU still publishes
+  std::map<int, std::uint64_t> failures_by_address;
+  pmu::Health h;
+  SampleInfo info;
+  const auto deadline = Clock::now() + 20s;
+  while (Clock::now() < deadline && failures_by_address.size() < kMaxDevicesPerService) {
+    while (health.take_next_sample(&h, &info) == ReturnCode_t::RETCODE_OK)
+      if (info.valid_data) failures_by_address[h.address()] = h.publish_failures();
+    std::this_thread::sleep_for(10ms);
+  }
+  EXPECT_EQ(failures_by_address.size(), kMaxDevicesPerService);
+  EXPECT_EQ(failures_by_address.count(static_cast<int>(kMaxDevicesPerService) + 1), 0u);
+  EXPECT_EQ(failures_by_address[1], 1u) << "the refused PMU's sample is counted in the next health sample";
 }
 
 }  // namespace
