@@ -11,6 +11,7 @@ packages=(
   libfastrtps-dev libfastcdr-dev fastddsgen fastdds-tools
   libspdlog-dev libfmt-dev libsystemd-dev libcli11-dev libyaml-cpp-dev nlohmann-json3-dev
   libssl-dev libtinyxml2-dev openssl
+  cyclonedds-dev cyclonedds-tools
   can-utils iproute2 python3 python3-can
   qemu-system-x86 busybox-static cpio kmod
 )

@@ -283,8 +283,17 @@ Config parse_config(const std::string& text, const std::string& source) {
   if (!buses) c.fail(root, "no buses: the service needs at least one bus");
   if (!buses.IsSequence() || buses.size() == 0) c.fail(buses, "buses must be a non-empty list");
   std::set<std::string> names, interfaces;
+  std::size_t devices = 0;
   for (const auto& bn : buses) {
     BusConfig b = parse_bus(c, bn);
+    // The QoS profiles hold kMaxDevicesPerService instances per writer; past that Fast DDS
+    // would refuse the extra PMUs' samples at run time.
+    if (devices + b.devices.size() > kMaxDevicesPerService)
+      c.fail(bn["devices"][kMaxDevicesPerService - devices],
+             "more than " + std::to_string(kMaxDevicesPerService) +
+                 " devices in one service (the capacity its DDS writers are sized for, "
+                 "pmu::service::kMaxDevicesPerService); split them across services");
+    devices += b.devices.size();
     if (!names.insert(b.name).second) c.fail(bn, "bus name '" + b.name + "' appears twice");
     if (b.interface != "sim" && !interfaces.insert(b.interface).second)
       c.fail(bn, "interface '" + b.interface + "' is used by two buses (the service owns each bus alone)");

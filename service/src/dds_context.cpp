@@ -10,6 +10,8 @@
 #include <memory>
 #include <mutex>
 
+#include "pmu/service/dds_capacity.hpp"
+
 namespace pmu::dds {
 namespace {
 
@@ -62,6 +64,7 @@ DdsContext::DdsContext(int domain, const std::string& qos_file, const std::strin
                        const SecurityFiles& security, Transport transport)
     : domain_(domain), secure_(!security.empty()) {
   const std::string file = qos_file.empty() ? default_qos_file() : qos_file;
+  qos_file_ = file;
   if (file.empty()) throw DdsError("no QoS profile file: install deploy/qos.xml as /etc/pmu-dds/qos.xml or set qos_file");
   load_profiles_once(file);
   DomainParticipantQos pqos = PARTICIPANT_QOS_DEFAULT;
@@ -109,6 +112,12 @@ DataWriter& DdsContext::writer(Topic& topic, const std::string& profile, DataWri
   if (!w)
     throw DdsError("cannot create a writer for " + topic.get_name() + " with QoS profile '" + profile + "'" +
                    (secure_ ? " (DDS-Security: this identity's permissions may not allow publishing it)" : ""));
+  const DataWriterQos q = w->get_qos();
+  if (const auto s = capacity_shortfall(profile, EndpointKind::Writer, q.resource_limits(), q.history()); !s.empty()) {
+    publisher_->delete_datawriter(w);
+    throw DdsError(qos_file_ + ": <data_writer profile_name=\"" + profile + "\"> (" + topic.get_name() + "): " + s +
+                   ": raise its <resourceLimitsQos> (deploy/qos.xml says how each number is derived)");
+  }
   return *w;
 }
 
@@ -117,6 +126,12 @@ DataReader& DdsContext::reader(Topic& topic, const std::string& profile, DataRea
   if (!r)
     throw DdsError("cannot create a reader for " + topic.get_name() + " with QoS profile '" + profile + "'" +
                    (secure_ ? " (DDS-Security: this identity's permissions may not allow subscribing to it)" : ""));
+  const DataReaderQos q = r->get_qos();
+  if (const auto s = capacity_shortfall(profile, EndpointKind::Reader, q.resource_limits(), q.history()); !s.empty()) {
+    subscriber_->delete_datareader(r);
+    throw DdsError(qos_file_ + ": <data_reader profile_name=\"" + profile + "\"> (" + topic.get_name() + "): " + s +
+                   ": raise its <resourceLimitsQos> (deploy/qos.xml says how each number is derived)");
+  }
   return *r;
 }
 

@@ -1,7 +1,11 @@
 #include "pmu/service/dds_publisher.hpp"
 
+#include <spdlog/spdlog.h>
+
 #include <cmath>
 #include <mutex>
+#include <set>
+#include <utility>
 
 #include "pmu/idl/command.h"
 #include "pmu/idl/commandPubSubTypes.h"
@@ -10,6 +14,8 @@
 #include "pmu/idl/telemetry.h"
 #include "pmu/idl/telemetryPubSubTypes.h"
 #include "pmu/idl/topics.hpp"
+#include "pmu/service/capacity.hpp"
+#include "pmu/service/rate_limit.hpp"
 
 namespace pmu::service {
 namespace {
@@ -25,6 +31,17 @@ eprosima::fastrtps::Time_t dds_time(std::chrono::system_clock::time_point t) {
   out.seconds = static_cast<std::int32_t>(ns / 1000000000);
   out.nanosec = static_cast<std::uint32_t>(ns % 1000000000);
   return out;
+}
+
+constexpr auto kReportInterval = std::chrono::seconds(5);
+
+const char* why(ReturnCode_t rc) {
+  if (rc == ReturnCode_t::RETCODE_OUT_OF_RESOURCES) return "out of resources";
+  if (rc == ReturnCode_t::RETCODE_TIMEOUT) return "timeout";
+  if (rc == ReturnCode_t::RETCODE_NOT_ENABLED) return "writer not enabled";
+  if (rc == ReturnCode_t::RETCODE_BAD_PARAMETER) return "bad parameter";
+  if (rc == ReturnCode_t::RETCODE_PRECONDITION_NOT_MET) return "precondition not met";
+  return "error";
 }
 
 template <class T>
@@ -44,8 +61,11 @@ struct DdsPublisher::Writers {
   DataWriter* config;
   DataWriter* info;
   DataWriter* health;
-  // Bus workers run in threads of their own and share these writers.
+  // Bus workers run in threads of their own and share these writers and the rest below.
   std::mutex mutex;
+  std::set<std::pair<std::string, std::uint16_t>> admitted;
+  RateLimit failure_reports{kReportInterval};
+  RateLimit refusal_reports{kReportInterval};
 };
 
 DdsPublisher::DdsPublisher(dds::DdsContext& dds, std::chrono::milliseconds telemetry_deadline)
@@ -75,20 +95,43 @@ DdsPublisher::DdsPublisher(dds::DdsContext& dds, std::chrono::milliseconds telem
 
 DdsPublisher::~DdsPublisher() = default;
 
-// DataWriter::write(void*) returns bool in Fast DDS 2.x (write_w_timestamp a ReturnCode_t).
-void DdsPublisher::count(bool ok) noexcept {
-  if (ok)
-    ++written_;
-  else
-    ++failures_;
+bool DdsPublisher::admit(const DeviceKey& key) {
+  if (w_->admitted.count({key.bus, key.address})) return true;
+  if (w_->admitted.size() < service::kMaxDevicesPerService) {
+    w_->admitted.insert({key.bus, key.address});
+    return true;
+  }
+  const auto refused = refused_.fetch_add(1, std::memory_order_relaxed) + 1;
+  failures_.fetch_add(1, std::memory_order_relaxed);
+  if (const auto held = w_->refusal_reports.allow(RateLimit::Clock::now()))
+    spdlog::error("{}/{}: not published on DDS: this service already publishes {} PMUs, the capacity its DDS "
+                  "writers are sized for (kMaxDevicesPerService); {} sample(s) of PMUs over capacity not "
+                  "published so far{}",
+                  key.bus, key.address, service::kMaxDevicesPerService, refused,
+                  *held ? " (" + std::to_string(*held) + " such messages held back)" : std::string());
+  return false;
+}
+
+void DdsPublisher::count(bool ok, const char* topic, const DeviceKey& key, const char* reason) {
+  if (ok) {
+    written_.fetch_add(1, std::memory_order_relaxed);
+    return;
+  }
+  const auto total = failures_.fetch_add(1, std::memory_order_relaxed) + 1;
+  if (const auto held = w_->failure_reports.allow(RateLimit::Clock::now()))
+    spdlog::warn("{}/{}: DDS write to {} failed ({}); {} sample(s) not published so far{}", key.bus, key.address,
+                 topic, reason, total,
+                 *held ? " (" + std::to_string(*held) + " failures not logged since the last message)" : std::string());
 }
 
 void DdsPublisher::on_telemetry(const DeviceKey& key, const codec::PmuMessage& m,
                                 std::chrono::system_clock::time_point received) {
   const auto ts = dds_time(received);
   std::lock_guard<std::mutex> lock(w_->mutex);
+  if (!admit(key)) return;
   auto write = [&](DataWriter* w, void* sample) {
-    count(w->write_w_timestamp(sample, HANDLE_NIL, ts) == ReturnCode_t::RETCODE_OK);
+    const ReturnCode_t rc = w->write_w_timestamp(sample, HANDLE_NIL, ts);
+    count(rc == ReturnCode_t::RETCODE_OK, w->get_topic()->get_name().c_str(), key, why(rc));
   };
   if (const auto* v = std::get_if<codec::Voltages>(&m.payload)) {
     pmu::Voltages s;
@@ -164,7 +207,9 @@ void DdsPublisher::on_config(const DeviceKey& key, const ConfigState& c) {
   s.outputs(c.outputs.value_or(0));
   s.generation_enabled(c.generation_enabled.value_or(false));
   std::lock_guard<std::mutex> lock(w_->mutex);
-  count(w_->config->write(&s));
+  if (!admit(key)) return;
+  // DataWriter::write(void*) returns bool in Fast DDS 2.x, without a reason.
+  count(w_->config->write(&s), topics::kConfig, key, "write returned false");
 }
 
 void DdsPublisher::on_info(const DeviceKey& key, const InfoState& i) {
@@ -179,7 +224,8 @@ void DdsPublisher::on_info(const DeviceKey& key, const InfoState& i) {
   for (const auto feature : codec::kAllFeatures)
     if (codec::supports(i.firmware.version(), feature)) s.features().emplace_back(std::string(codec::feature_name(feature)));
   std::lock_guard<std::mutex> lock(w_->mutex);
-  count(w_->info->write(&s));
+  if (!admit(key)) return;
+  count(w_->info->write(&s), topics::kInfo, key, "write returned false");
 }
 
 void DdsPublisher::on_health(const DeviceKey& key, const HealthReport& h) {
@@ -196,7 +242,9 @@ void DdsPublisher::on_health(const DeviceKey& key, const HealthReport& h) {
   s.timeouts(h.timeouts);
   s.reconnects(h.reconnects);
   std::lock_guard<std::mutex> lock(w_->mutex);
-  count(w_->health->write(&s));
+  if (!admit(key)) return;
+  s.publish_failures(failures_.load(std::memory_order_relaxed));
+  count(w_->health->write(&s), topics::kHealth, key, "write returned false");
 }
 
 }  // namespace pmu::service

@@ -122,6 +122,36 @@ TEST(Config, EveryBadValueIsRefusedWithItsLine) {
   }
 }
 
+// Devices 1..n on two buses (can0 holds the first half), one `- address:` line each.
+std::string many_devices(int n) {
+  std::string y = "buses:\n";
+  for (int bus = 0; bus < 2; ++bus) {
+    y += "  - interface: can" + std::to_string(bus) + "\n    devices:\n";
+    const int first = bus == 0 ? 1 : n / 2 + 1, last = bus == 0 ? n / 2 : n;
+    for (int a = first; a <= last; ++a) y += "      - address: " + std::to_string(a) + "\n";
+  }
+  return y;
+}
+
+TEST(Config, AsManyDevicesAsTheDdsWritersHoldAreAccepted) {
+  const Config c = parse_config(many_devices(static_cast<int>(kMaxDevicesPerService)), "fleet.yaml");
+  ASSERT_EQ(c.buses.size(), 2u);
+  EXPECT_EQ(c.buses[0].devices.size() + c.buses[1].devices.size(), kMaxDevicesPerService);
+}
+
+TEST(Config, MoreDevicesThanTheDdsWritersHoldAreRefusedAtTheFirstOneTooMany) {
+  // 257 devices: can0 has 1..128 (lines 4..131), can1 header lines 132-133, then 129..257;
+  // the 257th is on line 133 + 129 = 262.
+  try {
+    (void)parse_config(many_devices(static_cast<int>(kMaxDevicesPerService) + 1), "fleet.yaml");
+    ADD_FAILURE() << "accepted";
+  } catch (const ConfigError& e) {
+    EXPECT_EQ(std::string(e.what()),
+              "fleet.yaml:262: more than 256 devices in one service (the capacity its DDS writers are sized for, "
+              "pmu::service::kMaxDevicesPerService); split them across services");
+  }
+}
+
 TEST(Config, SecuritySectionAllSixFilesRelativeToTheConfigFile) {
   const char* yaml = R"(buses:
   - interface: can0

@@ -109,7 +109,8 @@ Json values_of(const pmu::Health& s) {
               {"bus_errors", s.bus_errors()},
               {"rx_dropped", s.rx_dropped()},
               {"timeouts", s.timeouts()},
-              {"reconnects", s.reconnects()}};
+              {"reconnects", s.reconnects()},
+              {"publish_failures", s.publish_failures()}};
 }
 
 }  // namespace pmu::tools

@@ -12,6 +12,7 @@
 #include <string>
 #include <vector>
 
+#include "pmu/service/capacity.hpp"
 #include "pmu/service/dds_transport.hpp"
 #include "pmu/service/dds_security.hpp"
 #include "pmu/service/policy.hpp"

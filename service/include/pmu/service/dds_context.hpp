@@ -54,7 +54,8 @@ class DdsContext {
   // new pmu::VoltagesPubSubType(). Throws DdsError at start-up when it fails.
   eprosima::fastdds::dds::Topic& topic(const std::string& name, eprosima::fastdds::dds::TypeSupport type);
 
-  // A writer/reader with the named profile of qos.xml. Throws DdsError when it fails.
+  // A writer/reader with the named profile of qos.xml. Throws DdsError when it fails, and
+  // when the profile holds less than the declared capacity (capacity.hpp, dds_capacity.hpp).
   eprosima::fastdds::dds::DataWriter& writer(eprosima::fastdds::dds::Topic& topic, const std::string& profile,
                                              eprosima::fastdds::dds::DataWriterListener* listener = nullptr);
   eprosima::fastdds::dds::DataReader& reader(eprosima::fastdds::dds::Topic& topic, const std::string& profile,
@@ -62,6 +63,7 @@ class DdsContext {
 
  private:
   int domain_;
+  std::string qos_file_;
   bool secure_ = false;
   eprosima::fastdds::dds::DomainParticipant* participant_ = nullptr;
   eprosima::fastdds::dds::Publisher* publisher_ = nullptr;

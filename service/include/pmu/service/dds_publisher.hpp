@@ -1,8 +1,15 @@
 #pragma once
 // DdsPublisher: the StateSink that puts the service's view of each PMU on the contract's
 // topics. The only place that converts codec values to the generated DDS types.
+//
+// Nothing is dropped silently: a write Fast DDS refuses is counted (pmu/health's
+// publish_failures) and logged at most once every few seconds with the running count, and a
+// PMU beyond the capacity the writers are sized for (kMaxDevicesPerService, e.g. found by
+// discovery) is not published, said in the log the same way, and counted too.
 
+#include <atomic>
 #include <chrono>
+#include <cstdint>
 #include <memory>
 
 #include "pmu/service/dds_context.hpp"
@@ -23,16 +30,23 @@ class DdsPublisher final : public StateSink {
   void on_info(const DeviceKey& key, const InfoState& info) override;
   void on_health(const DeviceKey& key, const HealthReport& health) override;
 
-  // Samples written, and writes Fast DDS refused (counted, logged by the caller's loop).
-  std::uint64_t samples_written() const noexcept { return written_; }
-  std::uint64_t write_failures() const noexcept { return failures_; }
+  // Samples written, and samples not published: writes Fast DDS refused plus samples of PMUs
+  // beyond the capacity. Read from any thread while the bus workers write.
+  std::uint64_t samples_written() const noexcept { return written_.load(std::memory_order_relaxed); }
+  std::uint64_t write_failures() const noexcept { return failures_.load(std::memory_order_relaxed); }
+  // Samples (counted in write_failures too) of PMUs not published because
+  // kMaxDevicesPerService others are.
+  std::uint64_t samples_over_capacity() const noexcept { return refused_.load(std::memory_order_relaxed); }
 
  private:
-  void count(bool ok) noexcept;
   struct Writers;
+  // Both called with Writers::mutex held.
+  bool admit(const DeviceKey& key);
+  void count(bool ok, const char* topic, const DeviceKey& key, const char* why);
   std::unique_ptr<Writers> w_;
-  std::uint64_t written_ = 0;
-  std::uint64_t failures_ = 0;
+  std::atomic<std::uint64_t> written_{0};
+  std::atomic<std::uint64_t> failures_{0};
+  std::atomic<std::uint64_t> refused_{0};
 };
 
 }  // namespace pmu::service

@@ -1,0 +1,221 @@
+// No silent caps: a service with many PMUs serves every one of them to pmuctl. Fast DDS's
+// default resource limits (10 instances per writer and reader) once cut a 50-PMU service
+// down to 9 or 10 devices in `pmuctl list` and `watch`, with nothing logged.
+#include <gtest/gtest.h>
+#include <fcntl.h>
+#include <signal.h>
+#include <sys/file.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <fastdds/dds/subscriber/SampleInfo.hpp>
+#include <map>
+#include <cstdio>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <set>
+#include <sstream>
+#include <string>
+#include <thread>
+
+#include "pmu/idl/statePubSubTypes.h"
+#include "pmu/idl/topics.hpp"
+#include "pmu/service/capacity.hpp"
+#include "pmu/service/dds_context.hpp"
+#include "pmu/service/dds_publisher.hpp"
+
+namespace pmu::service {
+namespace {
+
+using namespace eprosima::fastdds::dds;
+using namespace std::chrono_literals;
+using Clock = std::chrono::steady_clock;
+
+constexpr int kDevices = 50;
+
+// A DDS domain no other test process is using: one of 220..229, held by an flock on
+// /tmp/pmu-dds-test-domain-D.lock for the life of this process. Every lower domain is taken
+// by a pid-derived scheme of another test (security 10..99, dds_test 100..199, benchmarks and
+// command_dds_test 150..229, 230 and 231 for "no service" checks); a pid alone cannot keep
+// two parallel runs apart, the lock can (tests/cyclone/crossvendor.sh takes the same locks).
+int exclusive_domain() {
+  static const int domain = [] {
+    const int first = static_cast<int>(::getpid() % 10);
+    for (int i = 0; i < 10; ++i) {
+      const int d = 220 + (first + i) % 10;
+      const std::string path = "/tmp/pmu-dds-test-domain-" + std::to_string(d) + ".lock";
+      const int fd = ::open(path.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0666);
+      if (fd < 0) continue;
+      if (::flock(fd, LOCK_EX | LOCK_NB) == 0) return d;  // fd stays open: the lock stays held
+      ::close(fd);
+    }
+    return -1;
+  }();
+  return domain;
+}
+
+struct Result {
+  int status;
+  std::string out;
+};
+
+// stdout only: pmuctl's diagnostics go to stderr and would not parse as JSON.
+Result run(const std::string& cmd) {
+  Result r{-1, {}};
+  FILE* p = ::popen(cmd.c_str(), "r");
+  if (!p) return r;
+  char buf[4096];
+  std::size_t n = 0;
+  while ((n = std::fread(buf, 1, sizeof buf, p)) > 0) r.out.append(buf, n);
+  const int st = ::pclose(p);
+  r.status = WIFEXITED(st) ? WEXITSTATUS(st) : -1;
+  return r;
+}
+
+std::vector<nlohmann::json> json_lines(const std::string& out) {
+  std::vector<nlohmann::json> v;
+  std::istringstream in(out);
+  for (std::string line; std::getline(in, line);)
+    if (!line.empty()) v.push_back(nlohmann::json::parse(line, nullptr, false));
+  return v;
+}
+
+class ManyPmus : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    char path[] = "/tmp/pmu-capacity-XXXXXX.yaml";
+    const int fd = ::mkstemps(path, 5);
+    ASSERT_GE(fd, 0);
+    ::close(fd);
+    config_ = path;
+    std::ofstream yaml(config_);
+    yaml << "buses:\n  - interface: sim\n    name: sim0\n    devices:\n";
+    for (int a = 1; a <= kDevices; ++a) yaml << "      - address: " << a << "\n        period: 0.5\n";
+    yaml.close();
+    ASSERT_GE(exclusive_domain(), 0) << "domains 220..229 are all held by other test processes";
+    domain_ = std::to_string(exclusive_domain());
+    pid_ = ::fork();
+    ASSERT_GE(pid_, 0);
+    if (pid_ == 0) {
+      ::execl(PMU_SERVICE_PATH, PMU_SERVICE_PATH, "--config", config_.c_str(), "--domain", domain_.c_str(),
+              "--log-level", "warn", static_cast<char*>(nullptr));
+      std::_Exit(127);
+    }
+  }
+  void TearDown() override {
+    if (pid_ > 0) {
+      ::kill(pid_, SIGTERM);
+      ::waitpid(pid_, nullptr, 0);
+    }
+    if (!config_.empty()) std::remove(config_.c_str());
+  }
+  std::string pmuctl(const std::string& args) const {
+    return std::string("PMU_QOS_FILE=" PMU_QOS_FILE " " PMUCTL_PATH " --domain ") + domain_ + " " + args;
+  }
+
+  std::string config_;
+  std::string domain_;
+  pid_t pid_ = -1;
+};
+
+TEST_F(ManyPmus, PmuctlListsWatchesAndCommandsEveryOneOf50) {
+  // The service reads each PMU's identity and parameters before it lists it: poll until all
+  // are there or the deadline passes (a cap shows as a count stuck below 50).
+  std::set<int> listed;
+  const auto deadline = Clock::now() + 60s;
+  while (Clock::now() < deadline && listed.size() < kDevices) {
+    const auto r = run(pmuctl("--json --timeout 5 list"));
+    listed.clear();
+    for (const auto& j : json_lines(r.out))
+      if (j.is_object() && j.contains("address") && j.value("/values/state"_json_pointer, "") == "ONLINE")
+        listed.insert(j["address"].get<int>());
+    if (listed.size() < kDevices) std::this_thread::sleep_for(500ms);
+  }
+  ASSERT_EQ(listed.size(), static_cast<std::size_t>(kDevices)) << "pmuctl list shows " << listed.size() << " PMUs";
+  EXPECT_EQ(*listed.begin(), 1);
+  EXPECT_EQ(*listed.rbegin(), kDevices);
+
+  // 50 PMUs x 5 packets every 0.5 s: 1,500 samples take about 3 s and hold every address.
+  const auto w = run(pmuctl("--json --timeout 30 watch --count 1500"));
+  ASSERT_EQ(w.status, 0) << w.out.substr(0, 2000);
+  std::map<std::string, std::set<int>> watched;
+  for (const auto& j : json_lines(w.out)) {
+    ASSERT_TRUE(j.is_object()) << "pmuctl watch printed a line that is not JSON";
+    watched[j["topic"].get<std::string>()].insert(j["address"].get<int>());
+  }
+  for (const char* topic : {"voltages", "currents", "battery_energy", "temperatures", "status"})
+    EXPECT_EQ(watched[topic].size(), static_cast<std::size_t>(kDevices)) << topic << ": addresses seen";
+
+  const auto c = run(pmuctl("--address 30 --timeout 10 config get avionics_voltage 2>&1"));
+  EXPECT_EQ(c.status, 0) << c.out;
+  EXPECT_NE(c.out.find("sim0/30"), std::string::npos) << c.out;
+  EXPECT_NE(c.out.find("avionics_voltage"), std::string::npos) << c.out;
+  const auto s = run(pmuctl("--address 50 --timeout 10 config set payload_voltage 18.0 2>&1"));
+  EXPECT_EQ(s.status, 0) << s.out;
+  EXPECT_NE(s.out.find("COMPLETED"), std::string::npos) << s.out;
+}
+
+// A qos.xml whose state writer was left at Fast DDS's default limits (the bug this guards
+// against) stops pmu-service at start-up, naming the file, the profile and the shortfall.
+TEST(QosCapacity, AMiseditedProfileIsAStartUpError) {
+  std::ifstream shipped(PMU_QOS_FILE);
+  std::stringstream text;
+  text << shipped.rdbuf();
+  std::string xml = text.str();
+  const std::string state = "<data_writer profile_name=\"state\">";
+  const auto at = xml.find(state);
+  ASSERT_NE(at, std::string::npos);
+  const auto from = xml.find("<resourceLimitsQos>", at), to = xml.find("</resourceLimitsQos>", at);
+  ASSERT_NE(from, std::string::npos);
+  xml.erase(from, to + std::string("</resourceLimitsQos>").size() - from);
+  char path[] = "/tmp/pmu-qos-XXXXXX.xml";
+  const int fd = ::mkstemps(path, 4);
+  ASSERT_GE(fd, 0);
+  ASSERT_EQ(::write(fd, xml.data(), xml.size()), static_cast<ssize_t>(xml.size()));
+  ::close(fd);
+  ASSERT_GE(exclusive_domain(), 0);
+  const auto r = run(std::string("PMU_QOS_FILE=") + path + " " PMU_SERVICE_PATH " --bus sim --domain " +
+                     std::to_string(exclusive_domain()) + " 2>&1");
+  std::remove(path);
+  EXPECT_EQ(r.status, 1) << r.out;
+  EXPECT_NE(r.out.find(std::string(path) + ": <data_writer profile_name=\"state\"> (pmu/config): max_instances 10 < 256 "
+                       "(PMUs per service, pmu::service::kMaxDevicesPerService)"),
+            std::string::npos)
+      << r.out;
+}
+
+// A PMU beyond the capacity (discovery can find one) is not published, and that is counted
+// and carried in pmu/health's publish_failures rather than lost without a trace.
+TEST(QosCapacity, PmusBeyondTheCapacityAreCountedInHealthNotDroppedSilently) {
+  ASSERT_GE(exclusive_domain(), 0);
+  dds::DdsContext service_side(exclusive_domain(), PMU_QOS_FILE, "capacity-publisher");
+  DdsPublisher publisher(service_side, 3s);
+  dds::DdsContext client(exclusive_domain(), PMU_QOS_FILE, "capacity-reader");
+  DataReader& health = client.reader(
+      client.topic(topics::kHealth, TypeSupport(new pmu::HealthPubSubType())), qos_profiles::kState);
+  HealthReport report;
+  report.state = HealthState::Online;
+  for (std::size_t a = 1; a <= kMaxDevicesPerService + 1; ++a)
+    publisher.on_health(DeviceKey{"sim0", static_cast<std::uint16_t>(a)}, report);
+  EXPECT_EQ(publisher.samples_written(), kMaxDevicesPerService);
+  EXPECT_EQ(publisher.samples_over_capacity(), 1u);
+  EXPECT_EQ(publisher.write_failures(), 1u);
+
+  publisher.on_health(DeviceKey{"sim0", 1}, report);  // an admitted PMU still publishes
+  std::map<int, std::uint64_t> failures_by_address;
+  pmu::Health h;
+  SampleInfo info;
+  const auto deadline = Clock::now() + 20s;
+  while (Clock::now() < deadline && failures_by_address.size() < kMaxDevicesPerService) {
+    while (health.take_next_sample(&h, &info) == ReturnCode_t::RETCODE_OK)
+      if (info.valid_data) failures_by_address[h.address()] = h.publish_failures();
+    std::this_thread::sleep_for(10ms);
+  }
+  EXPECT_EQ(failures_by_address.size(), kMaxDevicesPerService);
+  EXPECT_EQ(failures_by_address.count(static_cast<int>(kMaxDevicesPerService) + 1), 0u);
+  EXPECT_EQ(failures_by_address[1], 1u) << "the refused PMU's sample is counted in the next health sample";
+}
+
+}  // namespace
+}  // namespace pmu::service
