@@ -13,6 +13,7 @@
 #include "pmu/idl/topics.hpp"
 #include "pmu/service/command_cdr.hpp"
 #include "pmu/service/command_service.hpp"
+#include "pmu/service/dds_publisher.hpp"
 
 namespace pmu::service {
 namespace {
@@ -42,11 +43,11 @@ struct DdsCommandEndpoint::Impl final : public DataReaderListener {
   std::mutex service_mutex;
   CommandService* service = nullptr;
   std::mutex write_mutex;
-  std::uint64_t write_failures = 0;
+  DdsPublisher* failures = nullptr;
   std::uint64_t malformed_logged = 0;
   std::chrono::steady_clock::time_point next_malformed_log{};
 
-  explicit Impl(dds::DdsContext& d) : dds(d) {}
+  Impl(dds::DdsContext& d, DdsPublisher* f) : dds(d), failures(f) {}
 
   void on_data_available(DataReader* r) override {
     std::lock_guard<std::mutex> lock(service_mutex);
@@ -87,12 +88,18 @@ struct DdsCommandEndpoint::Impl final : public DataReaderListener {
     s.has_value(d.has_value);
     s.value(d.value);
     s.value_text(d.value_text.substr(0, 63));
-    std::lock_guard<std::mutex> lock(write_mutex);
-    if (!writer->write(&s)) ++write_failures;
+    bool ok = false;
+    {
+      std::lock_guard<std::mutex> lock(write_mutex);
+      ok = writer->write(&s);
+    }
+    if (!ok && failures)
+      failures->count_failed_write(topics::kCommandReply, DeviceKey{d.bus, d.address}, "reply not sent");
   }
 };
 
-DdsCommandEndpoint::DdsCommandEndpoint(dds::DdsContext& dds) : impl_(std::make_unique<Impl>(dds)) {
+DdsCommandEndpoint::DdsCommandEndpoint(dds::DdsContext& dds, DdsPublisher* failures)
+    : impl_(std::make_unique<Impl>(dds, failures)) {
   impl_->writer = &dds.writer(dds.topic(topics::kCommandReply, TypeSupport(new pmu::CommandReplyPubSubType())),
                               qos_profiles::kCommand);
 }

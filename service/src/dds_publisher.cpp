@@ -124,6 +124,11 @@ void DdsPublisher::count(bool ok, const char* topic, const DeviceKey& key, const
                  *held ? " (" + std::to_string(*held) + " failures not logged since the last message)" : std::string());
 }
 
+void DdsPublisher::count_failed_write(const char* topic, const DeviceKey& key, const char* why) {
+  std::lock_guard<std::mutex> lock(w_->mutex);
+  count(false, topic, key, why);
+}
+
 void DdsPublisher::on_telemetry(const DeviceKey& key, const codec::PmuMessage& m,
                                 std::chrono::system_clock::time_point received) {
   const auto ts = dds_time(received);

@@ -33,7 +33,7 @@ using std::chrono::milliseconds;
 // interface.md: sized like pmuctl for a fleet of 64 services x 256 PMUs (deploy/qos.xml).
 constexpr int32_t kFleetInstances = 64 * 256;
 // The command profile's depth: a burst of several hundred commands does not overflow it.
-constexpr int32_t kCommandDepth = 1024;
+constexpr int32_t kCommandDepth = 4096;
 
 struct Options {
   uint32_t domain = 0;

@@ -401,20 +401,25 @@ TEST_F(Boundary, ALookAlikeTypeOrGarbageIsDroppedNeverFatal) {
 // Half-way through, peer 0 sends ENGINE_STOP: it goes ahead of the device's queue, so its
 // reply comes before the burst's last one.
 void burst(Service& service, std::vector<Peer*> peers, int per_peer) {
-  for (int i = 0; i < per_peer; ++i) {
-    for (std::size_t p = 0; p < peers.size(); ++p)
-      peers[p]->send(command("b" + std::to_string(p) + "-" + std::to_string(i),
-                             i % 3 ? CommandKind::GetSerial : CommandKind::GetFirmware,
-                             static_cast<std::uint16_t>(1 + i % 2)));
-    if (i == per_peer / 2) peers[0]->send(command("stop-in-burst", CommandKind::EngineStop));
-    if (i % 50 == 49)
-      for (auto* p : peers) (void)p->received();
-  }
+  // One thread per client, each touching only its own Peer.
+  std::vector<std::vector<pmu::CommandReply>> got(peers.size());
+  std::vector<std::thread> clients;
+  for (std::size_t p = 0; p < peers.size(); ++p)
+    clients.emplace_back([&, p] {
+      Peer& peer = *peers[p];
+      const std::string prefix = "b" + std::to_string(p) + "-";
+      for (int i = 0; i < per_peer; ++i) {
+        peer.send(command(prefix + std::to_string(i), i % 3 ? CommandKind::GetSerial : CommandKind::GetFirmware,
+                          static_cast<std::uint16_t>(1 + i % 2)));
+        if (p == 0 && i == per_peer / 2) peer.send(command("stop-in-burst", CommandKind::EngineStop));
+        if (i % 50 == 49) (void)peer.received();
+      }
+      got[p] = peer.replies(prefix, static_cast<std::size_t>(per_peer), 120s);
+    });
+  for (auto& t : clients) t.join();
   for (std::size_t p = 0; p < peers.size(); ++p) {
-    const std::string prefix = "b" + std::to_string(p) + "-";
-    const auto got = peers[p]->replies(prefix, static_cast<std::size_t>(per_peer), 120s);
     std::map<std::string, int> per_id;
-    for (const auto& r : got) ++per_id[r.request_id().to_string()];
+    for (const auto& r : got[p]) ++per_id[r.request_id().to_string()];
     EXPECT_EQ(per_id.size(), static_cast<std::size_t>(per_peer)) << "peer " << p;
     for (const auto& [id, n] : per_id) EXPECT_EQ(n, 1) << id;
   }
@@ -448,7 +453,10 @@ TEST_F(Boundary, FiftyThousandDistinctIdsAreAllAnsweredWithBoundedMemory) {
     auto s = command("m-" + std::to_string(i), CommandKind::GetSerial);
     s.bus = "nowhere";  // answered at once: what is measured is what the service remembers
     peer_.send(s);
-    if (i % 1000 == 999) peer_.settle();
+    if (i % 1000 == 999) {
+      peer_.settle();
+      (void)peer_.received();  // read as a client does: the reader holds 4096 replies
+    }
   }
   const auto got = peer_.replies("m-", kIds, 120s);
   EXPECT_EQ(got.size(), static_cast<std::size_t>(kIds));

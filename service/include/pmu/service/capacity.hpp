@@ -17,7 +17,7 @@ inline constexpr std::size_t kFleetServices = 64;
 // Instances of each telemetry and state reader of a client: every PMU of the fleet.
 inline constexpr std::size_t kFleetDevices = kMaxDevicesPerService * kFleetServices;
 // Commands (and replies) queued per writer and reader: profile `command`'s KEEP_LAST depth,
-// which a burst of several hundred commands from several clients does not overflow.
-inline constexpr std::size_t kCommandQueueDepth = 1024;
+// which a burst of 2,000 commands written at once does not overflow.
+inline constexpr std::size_t kCommandQueueDepth = 4096;
 
 }  // namespace pmu::service

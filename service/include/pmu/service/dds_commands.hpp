@@ -13,11 +13,13 @@
 namespace pmu::service {
 
 class CommandService;
+class DdsPublisher;
 
 class DdsCommandEndpoint {
  public:
-  // Creates the reply writer. Throws dds::DdsError at start-up.
-  explicit DdsCommandEndpoint(dds::DdsContext& dds);
+  // Creates the reply writer. Throws dds::DdsError at start-up. A reply Fast DDS refuses is
+  // counted and logged through `failures` (pmu/health's publish_failures) when given.
+  explicit DdsCommandEndpoint(dds::DdsContext& dds, DdsPublisher* failures = nullptr);
   ~DdsCommandEndpoint();
   // Starts reading commands into `service` (which must outlive this endpoint's reader).
   void start(CommandService& service);

@@ -30,6 +30,10 @@ class DdsPublisher final : public StateSink {
   void on_info(const DeviceKey& key, const InfoState& info) override;
   void on_health(const DeviceKey& key, const HealthReport& health) override;
 
+  // A write to another of the service's topics (pmu/command_reply) failed: counted in
+  // publish_failures and logged like the publisher's own. Thread-safe.
+  void count_failed_write(const char* topic, const DeviceKey& key, const char* why);
+
   // Samples written, and samples not published: writes Fast DDS refused plus samples of PMUs
   // beyond the capacity. Read from any thread while the bus workers write.
   std::uint64_t samples_written() const noexcept { return written_.load(std::memory_order_relaxed); }
