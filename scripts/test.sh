@@ -46,8 +46,9 @@ ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1:ha
 step "ThreadSanitizer tests"
 # setarch -R: TSan's fixed memory layout fails under the high mmap randomisation of some
 # newer kernels (vm.mmap_rnd_bits > 28); without address randomisation it always fits.
-# Scale: the 100-PMU tests measure nothing about threads that the others do not, and take
-# minutes under TSan; they run in the release build.
+# Scale.*: the 100-PMU tests run in the release build only: under TSan they add about a
+# minute, and in 1 of 4 runs one reported a race inside libfastrtps itself (no symbols, so
+# no narrow suppression yet) that would make this step flaky.
 TSAN_OPTIONS="suppressions=$root/tests/tsan.supp halt_on_error=1 second_deadlock_stack=1" \
   setarch "$(uname -m)" -R ctest --test-dir build/tsan --output-on-failure -j"$jobs" \
   -L '^(transport|sim|service|integration)$' -E '^Scale\.'
