@@ -13,6 +13,7 @@
 #include "dds_probes.hpp"
 #include "pacer.hpp"
 #include "proc_stats.hpp"
+#include "scale_bench.hpp"
 #include "stats.hpp"
 
 namespace pmu::bench {
@@ -282,6 +283,10 @@ void startup_rows(const Settings& s, const Durations& d, Rows& rows, dds::Transp
 Rows run_all(const Settings& s) {
   const Durations d = durations(s);
   Rows rows;
+  if (s.scale_only) {
+    scale_rows(s, rows, s.domain_base, s.domain_base + 2);
+    return rows;
+  }
   const int d_shm = s.domain_base, d_ref_shm = s.domain_base + 2;
   WriteTimes times;
 
@@ -413,6 +418,7 @@ Rows run_all(const Settings& s) {
 
   latency_phase(s, rows, times, dds::Transport::UdpOnly, "UDP", s.domain_base + 1, s.domain_base + 3);
   latency_phase(s, rows, times, dds::Transport::Default, "default transports", s.domain_base + 1, s.domain_base + 3);
+  scale_rows(s, rows, s.domain_base, s.domain_base + 2);  // their earlier users are gone by now
   return rows;
 }
 

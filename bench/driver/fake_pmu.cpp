@@ -3,7 +3,9 @@
 #include <poll.h>
 #include <sys/socket.h>
 
+#include <algorithm>
 #include <cerrno>
+#include <memory>
 #include <stdexcept>
 
 #include "pacer.hpp"
@@ -13,7 +15,9 @@
 
 namespace pmu::bench {
 
-FakePmu::FakePmu(transport::UniqueFd fd) : fd_(std::move(fd)) { thread_ = std::thread([this] { run(); }); }
+FakePmu::FakePmu(transport::UniqueFd fd, FakePmuLoad load) : fd_(std::move(fd)), load_(load) {
+  thread_ = std::thread([this] { run(); });
+}
 
 FakePmu::~FakePmu() {
   stop_ = true;
@@ -28,30 +32,35 @@ void FakePmu::write_raw(const void* frame) {
 }
 
 void FakePmu::run() {
-  sim::DeviceConfig config;
-  config.address = 1;
-  config.serial_number = 1001;
-  config.parameters.set_raw(codec::Parameter::PacketPeriod, 10);     // 1.0 s
-  config.parameters.set_raw(codec::Parameter::PacketsStreamed, 0x1F);  // every packet
-  sim::PmuModel model(
-      config,
-      [this](const codec::CanFrame& f) {
-        const struct can_frame raw = transport::to_linux(f);
-        write_raw(&raw);
-      },
-      sim::Clock::now());
-  model.set_engine_running(true, sim::Clock::now());
+  const auto send = [this](const codec::CanFrame& f) {
+    const struct can_frame raw = transport::to_linux(f);
+    write_raw(&raw);
+  };
+  std::vector<std::unique_ptr<sim::PmuModel>> models;
+  for (std::uint16_t a = 1; a <= load_.units; ++a) {
+    sim::DeviceConfig config;
+    config.address = a;
+    config.serial_number = static_cast<std::uint16_t>(1000 + a);
+    config.parameters.set_raw(codec::Parameter::PacketPeriod, load_.period_tenths);
+    config.parameters.set_raw(codec::Parameter::PacketsStreamed, 0x1F);  // every packet
+    models.push_back(std::make_unique<sim::PmuModel>(config, send, sim::Clock::now()));
+    models.back()->set_engine_running(true, sim::Clock::now());
+  }
   while (!stop_) {
-    const auto now = sim::Clock::now();
-    const auto wait = std::chrono::duration_cast<std::chrono::milliseconds>(model.next_deadline() - now);
+    auto next = models.front()->next_deadline();
+    for (const auto& m : models) next = std::min(next, m->next_deadline());
+    const auto wait = std::chrono::duration_cast<std::chrono::milliseconds>(next - sim::Clock::now());
     pollfd p{fd_.get(), POLLIN, 0};
     ::poll(&p, 1, static_cast<int>(std::clamp<std::int64_t>(wait.count(), 0, 20)));
     struct can_frame raw{};
     while (::recv(fd_.get(), &raw, sizeof raw, MSG_DONTWAIT) == static_cast<ssize_t>(sizeof raw)) {
       ++from_service_;
-      if (const auto f = transport::from_linux(raw)) model.on_frame(*f, sim::Clock::now());
+      // Every unit sees every frame, as on a bus; each acts on its own address only.
+      if (const auto f = transport::from_linux(raw))
+        for (const auto& m : models) m->on_frame(*f, sim::Clock::now());
     }
-    model.tick(sim::Clock::now());
+    const auto now = sim::Clock::now();
+    for (const auto& m : models) m->tick(now);
   }
 }
 

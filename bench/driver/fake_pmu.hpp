@@ -3,6 +3,8 @@
 // records, the way the service reads a CAN_RAW socket). A thread runs the simulator model,
 // which answers the service's gets and streams every packet once a second; the benchmark
 // thread adds numbered voltages frames at a chosen rate and notes when each was written.
+// For the scale rows the same thread runs several models (addresses 1..units) streaming
+// every packet at a chosen period.
 
 #include <array>
 #include <atomic>
@@ -50,9 +52,16 @@ struct Injection {
   double rate() const noexcept { return seconds > 0 ? static_cast<double>(frames - 1) / seconds : 0; }
 };
 
+// How many PMUs the far end simulates (addresses 1..units) and their packet period (PP,
+// tenths of a second); each streams all five packets.
+struct FakePmuLoad {
+  std::uint16_t units = 1;
+  std::uint32_t period_tenths = 10;
+};
+
 class FakePmu {
  public:
-  explicit FakePmu(transport::UniqueFd fd);
+  explicit FakePmu(transport::UniqueFd fd, FakePmuLoad load = {});
   ~FakePmu();
   FakePmu(const FakePmu&) = delete;
   FakePmu& operator=(const FakePmu&) = delete;
@@ -68,6 +77,7 @@ class FakePmu {
   void write_raw(const void* frame);
 
   transport::UniqueFd fd_;
+  FakePmuLoad load_;
   std::atomic<bool> stop_{false};
   std::atomic<std::uint64_t> from_service_{0};
   std::uint16_t seq_ = 0;

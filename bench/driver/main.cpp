@@ -1,7 +1,7 @@
 // pmu_bench: the service benchmarks (bench/run.sh runs them with the rest), and the bare
 // Fast DDS peers they are compared with.
 //   pmu_bench run --service PATH [--quick] [--domain-base N]   result rows on stdout
-//   pmu_bench peer-writer|peer-echo|peer-pong ...               started by `run`
+//   pmu_bench peer-writer|peer-echo|peer-pong|peer-telemetry|peer-reader ...   started by `run`
 // PMU_BENCH_DEBUG=1 lists the numbers of injected frames whose samples never arrived.
 
 #include <unistd.h>
@@ -12,6 +12,7 @@
 
 #include "benchmarks.hpp"
 #include "peers.hpp"
+#include "scale_peers.hpp"
 #include "pmu/service/dds_context.hpp"
 
 int main(int argc, char** argv) {
@@ -30,13 +31,18 @@ int main(int argc, char** argv) {
   run->add_option("--startups", s.startups, "starts of pmu-service for the start-up rows (default 5, quick 1)")
       ->check(CLI::Range(1, 1000));
   run->add_flag("--startup-only", s.startup_only, "measure start-up alone (each start is printed on stderr)");
+  run->add_flag("--scale-only", s.scale_only, "only the rows of how CPU and memory grow with PMUs and subscribers");
 
   PeerOptions p;
   std::string transport = "default";
   auto* writer = app.add_subcommand("peer-writer", "bare writer of timed pmu/voltages samples");
   auto* echo = app.add_subcommand("peer-echo", "bare request/reply on pmu/command");
   auto* pong = app.add_subcommand("peer-pong", "echo can_frame records on fd 3");
-  for (auto* sub : {writer, echo}) {
+  auto* telemetry = app.add_subcommand("peer-telemetry", "bare writer of every telemetry topic for N units");
+  auto* reader = app.add_subcommand("peer-reader", "subscriber to every telemetry topic, counting samples");
+  telemetry->add_option("--units", p.units)->check(CLI::Range(1, 1000));
+  telemetry->add_option("--period", p.period)->check(CLI::Range(0.01, 100.0));
+  for (auto* sub : {writer, echo, telemetry, reader}) {
     sub->add_option("--domain", p.domain)->required();
     sub->add_option("--qos", p.qos_file)->required();
     sub->add_option("--transport", transport)->check(CLI::IsMember({"default", "udp", "shm"}));
@@ -52,6 +58,8 @@ int main(int argc, char** argv) {
     if (*writer) return peer_writer(p);
     if (*echo) return peer_echo(p);
     if (*pong) return peer_pong();
+    if (*telemetry) return peer_telemetry(p);
+    if (*reader) return peer_reader(p);
     s.self_exe = std::filesystem::read_symlink("/proc/self/exe").string();
     s.service_exe = std::filesystem::absolute(s.service_exe).string();
     char tmpl[] = "/tmp/pmu-bench-XXXXXX";

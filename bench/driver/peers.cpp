@@ -25,10 +25,6 @@ namespace pmu::bench {
 
 using namespace eprosima::fastdds::dds;
 
-namespace {
-
-// SIGTERM and SIGINT, blocked in this thread and so in every thread started after it (call
-// it before Fast DDS starts its threads), for sigwait().
 sigset_t block_stop_signals() {
   sigset_t set;
   sigemptyset(&set);
@@ -37,8 +33,6 @@ sigset_t block_stop_signals() {
   pthread_sigmask(SIG_BLOCK, &set, nullptr);
   return set;
 }
-
-}  // namespace
 
 int peer_writer(const PeerOptions& o) {
   // SIGTERM ends the run cleanly: a process killed with its participant alive leaves its

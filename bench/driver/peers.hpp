@@ -2,6 +2,8 @@
 // The references: the same Fast DDS, types, QoS profiles and transports as pmu-service,
 // with nothing in between. Each runs as its own process (pmu_bench peer-writer|peer-echo).
 
+#include <signal.h>
+
 #include <string>
 
 #include "pmu/service/dds_transport.hpp"
@@ -14,7 +16,13 @@ struct PeerOptions {
   dds::Transport transport = dds::Transport::Default;
   double rate = 5;      // peer-writer: samples per second
   double seconds = 10;  // peer-writer: how long, once a reader is matched
+  int units = 1;        // peer-telemetry: PMUs (instances per topic)
+  double period = 0.1;  // peer-telemetry: seconds between one unit's rounds of five packets
 };
+
+// SIGTERM and SIGINT, blocked in this thread and so in every thread started after it (call
+// it before Fast DDS starts its threads), for sigwait().
+sigset_t block_stop_signals();
 
 // A participant with one pmu/voltages writer (telemetry profile) writing samples that carry
 // their write time (dds_probes.hpp) at `rate` for `seconds` once a reader is matched.

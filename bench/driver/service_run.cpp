@@ -22,20 +22,24 @@ const char* transport_name(dds::Transport t) noexcept {
   return "default";
 }
 
-ServiceRun::ServiceRun(const Settings& s, int domain, dds::Transport transport, const std::string& tag) {
+ServiceRun::ServiceRun(const Settings& s, int domain, dds::Transport transport, const std::string& tag,
+                       FakePmuLoad load) {
   const std::string config = s.workdir + "/" + tag + ".yaml";
   log_ = s.workdir + "/" + tag + ".log";
   notify_path_ = s.workdir + "/" + tag + ".notify";
   {
     std::ofstream c(config);
-    // One PMU streaming every packet once a second, as in service; commands unthrottled
-    // enough for sequential round trips.
+    // The fake PMUs streaming every packet at their period; commands unthrottled enough
+    // for sequential round trips.
     c << "domain: " << domain << "\n"
       << "qos_file: " << s.qos_file << "\n"
       << "dds_transport: " << transport_name(transport) << "\n"
       << "log_level: warn\n"
       << "policy:\n  rate_limit: 1000\n  burst: 10000\n"
-      << "buses:\n  - interface: can0\n    devices:\n      - address: 1\n        period: 1.0\n";
+      << "buses:\n  - interface: can0\n    devices:\n";
+    for (unsigned a = 1; a <= load.units; ++a)
+      c << "      - address: " << a << "\n        period: " << load.period_tenths / 10 << "." << load.period_tenths % 10
+        << "\n";
     if (!c) throw std::runtime_error("cannot write " + config);
   }
   notify_ = transport::UniqueFd(::socket(AF_UNIX, SOCK_DGRAM | SOCK_CLOEXEC, 0));
@@ -51,7 +55,7 @@ ServiceRun::ServiceRun(const Settings& s, int domain, dds::Transport transport, 
   if (::socketpair(AF_UNIX, SOCK_SEQPACKET | SOCK_CLOEXEC, 0, ends) != 0)
     throw std::runtime_error(std::string("socketpair: ") + std::strerror(errno));
   transport::UniqueFd ours(ends[0]), theirs(ends[1]);
-  pmu_ = std::make_unique<FakePmu>(std::move(ours));
+  pmu_ = std::make_unique<FakePmu>(std::move(ours), load);
   process_ = std::make_unique<ChildProcess>(
       std::vector<std::string>{s.service_exe, "--config", config, "--bus", "fd:3"},
       std::vector<std::string>{"NOTIFY_SOCKET=" + notify_path_}, std::move(theirs), log_);

@@ -23,6 +23,7 @@ struct Settings {
   double latency_seconds = 0;  // > 0: length of each 7,634 frames/s run (e.g. for profiling)
   int startups = 0;             // > 0: how many starts the start-up rows take the median of
   bool startup_only = false;    // the start-up rows alone (to study start-up)
+  bool scale_only = false;      // the scale rows alone (scale_bench.hpp)
 };
 
 // The config file's name of a transport: default, udp, shm.
@@ -30,9 +31,11 @@ const char* transport_name(dds::Transport t) noexcept;
 
 class ServiceRun {
  public:
-  // Writes the config, starts pmu-service with `--bus fd:3` and the fake PMU. Throws
-  // std::runtime_error when it cannot.
-  ServiceRun(const Settings& s, int domain, dds::Transport transport, const std::string& tag);
+  // Writes the config, starts pmu-service with `--bus fd:3` and the fake PMU(s): one PMU
+  // streaming once a second unless `load` says otherwise. Throws std::runtime_error when
+  // it cannot.
+  ServiceRun(const Settings& s, int domain, dds::Transport transport, const std::string& tag,
+             FakePmuLoad load = {});
   ~ServiceRun();
 
   pid_t pid() const noexcept { return process_->pid(); }

@@ -53,6 +53,7 @@ DeviceSession& BusWorker::add_session(const DeviceConfig& device) {
       [this](const codec::CanFrame& f) { return bus_->send(f, timeouts_.send); }, clock_.steady_now());
   auto& ref = *s;
   sessions_[device.address] = std::move(s);
+  device_count_.store(sessions_.size(), std::memory_order_relaxed);
   ref.on_bus_state(bus_->state(), clock_.steady_now());
   return ref;
 }
@@ -172,6 +173,8 @@ void BusWorker::rekey_moved_sessions() {
     it = sessions_.erase(it);
     const auto address = moved->key().address;
     sessions_[address] = std::move(moved);
+    // A move onto an address that had a session of its own leaves one session fewer.
+    device_count_.store(sessions_.size(), std::memory_order_relaxed);
   }
 }
 

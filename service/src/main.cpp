@@ -86,9 +86,10 @@ std::unique_ptr<transport::CanBus> open_bus(const service::BusConfig& bus, const
   return rt.network->attach(bus.name);
 }
 
+// Called on the main thread while the workers run: only their thread-safe counters.
 std::string summary(const std::vector<BusRuntime>& buses) {
   std::size_t devices = 0;
-  for (const auto& b : buses) devices += b.worker->addresses().size();
+  for (const auto& b : buses) devices += b.worker->device_count();
   return "serving " + std::to_string(devices) + " PMU(s) on " + std::to_string(buses.size()) + " bus(es)";
 }
 
@@ -126,6 +127,24 @@ int run(const service::Config& cfg) {
   for (auto& b : buses) workers.push_back(b.worker.get());
   service::CommandService commands(workers, cfg.policy, cfg.timeouts, clock,
                                    [&](const service::CommandReplyData& r) { command_topics.publish(r); });
+  // Declared after everything the running threads use, so it is destroyed first, on every
+  // way out of this function: commands stop first (no new request reaches `commands`, and
+  // the bus workers are still there to finish the ones in flight), then the worker threads
+  // end (nothing runs posted command work or writes a reply any more), and only then are
+  // `commands`, the endpoint, the workers and the publisher destroyed.
+  struct Shutdown {
+    service::DdsCommandEndpoint& command_topics;
+    std::vector<BusRuntime>& buses;
+    ~Shutdown() {
+      command_topics.stop();
+      for (auto& b : buses) b.worker->stop();
+      for (auto& b : buses) {
+        if (b.thread.joinable()) b.thread.join();
+        if (b.simulator) b.simulator->stop();
+      }
+      spdlog::info("pmu-service stopped");
+    }
+  } shutdown{command_topics, buses};
   for (auto& b : buses) {
     if (b.simulator) b.simulator->start();
     b.thread = std::thread([w = b.worker.get()] { w->run(); });
@@ -163,13 +182,6 @@ int run(const service::Config& cfg) {
   }
 
   systemd.stopping();
-  command_topics.stop();
-  for (auto& b : buses) b.worker->stop();
-  for (auto& b : buses) {
-    if (b.thread.joinable()) b.thread.join();
-    if (b.simulator) b.simulator->stop();
-  }
-  spdlog::info("pmu-service stopped");
   return 0;
 }
 

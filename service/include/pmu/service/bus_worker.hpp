@@ -49,6 +49,11 @@ class BusWorker final : private transport::BusHandler {
   // Worker thread only (or before run()):
   DeviceSession* session(std::uint16_t address);
   std::vector<std::uint16_t> addresses() const;
+
+  // Devices served now (configured and discovered). Thread-safe: sessions_ belongs to the
+  // worker thread, so the worker publishes its size here after every change, for the
+  // main thread's status line.
+  std::size_t device_count() const noexcept { return device_count_.load(std::memory_order_relaxed); }
   const BusConfig& config() const noexcept { return config_; }
   transport::CanBus& bus() noexcept { return *bus_; }
 
@@ -76,6 +81,7 @@ class BusWorker final : private transport::BusHandler {
   std::vector<std::function<void()>> posted_;
   std::atomic<bool> stop_{false};
   std::atomic<std::uint64_t> progress_{0};
+  std::atomic<std::size_t> device_count_{0};
   std::chrono::steady_clock::time_point next_maintain_{};
   std::chrono::steady_clock::time_point next_discovery_{};
 };
