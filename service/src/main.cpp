@@ -122,7 +122,7 @@ int run(const service::Config& cfg) {
     auto bus = open_bus(cfg.buses[i], clock, buses[i]);
     buses[i].worker = std::make_unique<service::BusWorker>(cfg.buses[i], std::move(bus), clock, cfg.timeouts, publisher);
   }
-  service::DdsCommandEndpoint command_topics(participant);
+  service::DdsCommandEndpoint command_topics(participant, &publisher);
   std::vector<service::BusWorker*> workers;
   for (auto& b : buses) workers.push_back(b.worker.get());
   service::CommandService commands(workers, cfg.policy, cfg.timeouts, clock,
