@@ -101,6 +101,25 @@ TEST(Policy, EngineStopCannotBeDeniedByConfig) {
                ConfigError);
 }
 
+TEST(Policy, LifetimesAndTheirCap) {
+  const auto parse = [](const std::string& policy) {
+    return parse_config("policy:\n" + policy + "buses:\n  - interface: can0\n    discover: true\n", "p.yaml");
+  };
+  const auto defaults = parse("  rate_limit: 20\n").policy.lifetimes;
+  EXPECT_EQ(defaults.default_lifetime, std::chrono::seconds(10));
+  EXPECT_EQ(defaults.max_lifetime, std::chrono::seconds(60));
+  EXPECT_EQ(parse("  max_command_lifetime: 5\n  command_lifetime: 2\n").policy.lifetimes.max_lifetime,
+            std::chrono::seconds(5));
+  // Raising only the default lifetime raises the cap with it.
+  EXPECT_EQ(parse("  command_lifetime: 120\n").policy.lifetimes.max_lifetime, std::chrono::seconds(120));
+  try {
+    (void)parse("  command_lifetime: 20\n  max_command_lifetime: 5\n");
+    ADD_FAILURE() << "accepted";
+  } catch (const ConfigError& e) {
+    EXPECT_EQ(std::string(e.what()), "p.yaml:3: max_command_lifetime must be at least command_lifetime");
+  }
+}
+
 TEST(Policy, RateLimiterIsATokenBucket) {
   RateLimiter r(2, 3);  // 2/s, burst 3
   const auto t0 = std::chrono::steady_clock::time_point{} + std::chrono::seconds(100);

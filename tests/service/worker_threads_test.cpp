@@ -64,12 +64,12 @@ TEST(WorkerThreads, DeviceCountFollowsAnAddressChange) {
   h.run_for(300ms);
   ASSERT_EQ(h.worker().device_count(), 2u);
 
-  CommandRequest r;
+  CommandSample r;
   r.request_id = "move-1";
   r.sender = "test";
   r.bus = "sim0";
   r.address = 1;
-  r.kind = CommandKind::SetParameter;
+  r.kind = static_cast<std::uint32_t>(CommandKind::SetParameter);
   r.parameter = "can_address";
   r.value = 7;
   r.confirm = true;
