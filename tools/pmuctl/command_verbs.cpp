@@ -11,6 +11,7 @@
 #include <thread>
 #include <vector>
 
+#include "pmu/idl/guarded_type.hpp"
 #include "pmu/idl/command.h"
 #include "pmu/idl/commandPubSubTypes.h"
 #include "pmu/idl/state.h"
@@ -59,7 +60,7 @@ bool resolve_target(const GlobalOptions& o, pmu::dds::DdsContext& dds, Clock::ti
     address = *o.address;
     return true;
   }
-  DataReader& r = dds.reader(dds.topic(topics::kHealth, TypeSupport(new pmu::HealthPubSubType())), qos_profiles::kState);
+  DataReader& r = dds.reader(dds.topic(topics::kHealth, TypeSupport(new idl::Guarded<pmu::HealthPubSubType>())), qos_profiles::kState);
   std::set<std::pair<std::string, std::uint16_t>> seen;
   std::optional<Clock::time_point> settle;
   while (Clock::now() < deadline) {
@@ -146,7 +147,7 @@ int run_command(const GlobalOptions& o, const CommandSpec& spec) {
   const double timeout = o.timeout.value_or(5.0);
   const auto deadline = Clock::now() + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(timeout));
   pmu::dds::DdsContext dds(o.domain, o.qos_file, "pmuctl", o.security);
-  DataReader& replies = dds.reader(dds.topic(topics::kCommandReply, TypeSupport(new pmu::CommandReplyPubSubType())),
+  DataReader& replies = dds.reader(dds.topic(topics::kCommandReply, TypeSupport(new idl::Guarded<pmu::CommandReplyPubSubType>())),
                                    qos_profiles::kCommand);
   DataWriter& writer =
       dds.writer(dds.topic(topics::kCommand, TypeSupport(new pmu::CommandPubSubType())), qos_profiles::kCommand);

@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "pmu/codec/parameters.hpp"
+#include "pmu/idl/guarded_type.hpp"
 #include "pmu/idl/commandPubSubTypes.h"
 #include "pmu/idl/statePubSubTypes.h"
 #include "pmu/idl/telemetryPubSubTypes.h"
@@ -48,7 +49,7 @@ template <class T, class PubSub>
 class StateCollector {
  public:
   StateCollector(pmu::dds::DdsContext& dds, const char* topic)
-      : reader_(dds.reader(dds.topic(topic, TypeSupport(new PubSub())), qos_profiles::kState)) {}
+      : reader_(dds.reader(dds.topic(topic, TypeSupport(new idl::Guarded<PubSub>())), qos_profiles::kState)) {}
 
   void poll(const GlobalOptions& o) {
     T sample;
@@ -160,7 +161,7 @@ class TypedTelemetryReader final : public TelemetryReader {
  public:
   TypedTelemetryReader(pmu::dds::DdsContext& dds, const char* topic)
       : name_(std::string(topic).substr(4)),
-        reader_(dds.reader(dds.topic(topic, TypeSupport(new PubSub())), qos_profiles::kTelemetry)) {}
+        reader_(dds.reader(dds.topic(topic, TypeSupport(new idl::Guarded<PubSub>())), qos_profiles::kTelemetry)) {}
   bool take(const GlobalOptions& o, TelemetryLine& out) override {
     T sample;
     SampleInfo info;
