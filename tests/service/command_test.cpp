@@ -606,11 +606,25 @@ TEST(Commands, ARequestWithoutIdStillGetsExactlyOneReply) {
 namespace pmu::service::test {
 namespace {
 
+// Everything logged while it lives goes to `text()` instead of the console.
+class CapturedLog {
+ public:
+  CapturedLog() : previous_(spdlog::default_logger()) {
+    spdlog::set_default_logger(
+        std::make_shared<spdlog::logger>("audit-test", std::make_shared<spdlog::sinks::ostream_sink_mt>(out_)));
+  }
+  ~CapturedLog() { spdlog::set_default_logger(previous_); }
+  CapturedLog(const CapturedLog&) = delete;
+  CapturedLog& operator=(const CapturedLog&) = delete;
+  std::string text() const { return out_.str(); }
+
+ private:
+  std::ostringstream out_;
+  std::shared_ptr<spdlog::logger> previous_;
+};
+
 TEST(Commands, EveryCommandAndItsResultIsInTheAuditTrail) {
-  std::ostringstream log;
-  auto previous = spdlog::default_logger();
-  spdlog::set_default_logger(
-      std::make_shared<spdlog::logger>("audit-test", std::make_shared<spdlog::sinks::ostream_sink_mt>(log)));
+  CapturedLog log;
   {
     Commands c({pmu(1)});
     auto ok = set_param(c, "avionics_voltage", 20.0);
@@ -620,8 +634,7 @@ TEST(Commands, EveryCommandAndItsResultIsInTheAuditTrail) {
     denied.sender = "ground-station-7";
     c.run(denied);
   }
-  spdlog::set_default_logger(previous);
-  const std::string text = log.str();
+  const std::string text = log.text();
   EXPECT_NE(text.find("audit: command t-1 from ground-station-7: set_parameter avionics_voltage=20 to sim0/1 -> COMPLETED"),
             std::string::npos)
       << text;
@@ -631,10 +644,7 @@ TEST(Commands, EveryCommandAndItsResultIsInTheAuditTrail) {
 }
 
 TEST(Commands, NetworkTextCannotForgeAuditLines) {
-  std::ostringstream log;
-  auto previous = spdlog::default_logger();
-  spdlog::set_default_logger(
-      std::make_shared<spdlog::logger>("audit-test", std::make_shared<spdlog::sinks::ostream_sink_mt>(log)));
+  CapturedLog log;
   {
     Commands c({pmu(1)});
     auto r = c.req(CommandKind::SetParameter);
@@ -645,8 +655,7 @@ TEST(Commands, NetworkTextCannotForgeAuditLines) {
     bus.bus = "can\naudit: FORGED";
     c.run(bus);
   }
-  spdlog::set_default_logger(previous);
-  std::istringstream lines(log.str());
+  std::istringstream lines(log.text());
   std::string line;
   int audit_lines = 0;
   while (std::getline(lines, line)) {
@@ -656,8 +665,8 @@ TEST(Commands, NetworkTextCannotForgeAuditLines) {
     EXPECT_EQ(line.find('\x1b'), std::string::npos) << line;
     audit_lines += line.find("audit: command") != std::string::npos;
   }
-  EXPECT_EQ(audit_lines, 2) << log.str();
-  EXPECT_NE(log.str().find("x\\x0A\\x1B[2Jaudit: FORGED id"), std::string::npos) << log.str();
+  EXPECT_EQ(audit_lines, 2) << log.text();
+  EXPECT_NE(log.text().find("x\\x0A\\x1B[2Jaudit: FORGED id"), std::string::npos) << log.text();
 }
 
 }  // namespace
