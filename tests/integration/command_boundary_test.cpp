@@ -118,18 +118,24 @@ class Peer {
   // of them arrived or `within` passed.
   std::vector<pmu::CommandReply> replies(const std::string& prefix, std::size_t count,
                                          std::chrono::seconds within = 20s, std::size_t since = 0) {
-    pmu::test::wait_until(
-        [&] {
-          pmu::CommandReply r;
-          SampleInfo info;
-          while (replies_.take_next_sample(&r, &info) == ReturnCode_t::RETCODE_OK)
-            if (info.valid_data) all_.push_back(r);
-          mine_.clear();
-          for (std::size_t i = since; i < all_.size(); ++i)
-            if (all_[i].request_id().to_string().rfind(prefix, 0) == 0) mine_.push_back(all_[i]);
-          return mine_.size() >= count;
-        },
-        within, 2ms);
+    // Not wait_until: under a burst the reader must be drained again at once whenever the last
+    // take found samples (its history is the command profile's depth), and sleep only when
+    // it found none.
+    const auto end = Clock::now() + within;
+    do {
+      pmu::CommandReply r;
+      SampleInfo info;
+      bool any = false;
+      while (replies_.take_next_sample(&r, &info) == ReturnCode_t::RETCODE_OK) {
+        any = true;
+        if (info.valid_data) all_.push_back(r);
+      }
+      mine_.clear();
+      for (std::size_t i = since; i < all_.size(); ++i)
+        if (all_[i].request_id().to_string().rfind(prefix, 0) == 0) mine_.push_back(all_[i]);
+      if (mine_.size() >= count) break;
+      if (!any) std::this_thread::sleep_for(2ms);
+    } while (Clock::now() < end);
     return mine_;
   }
   dds::DdsContext& dds() { return dds_; }

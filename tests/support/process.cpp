@@ -2,6 +2,7 @@
 
 #include <fcntl.h>
 #include <signal.h>
+#include <sys/prctl.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -51,8 +52,14 @@ Child::Child(const std::vector<std::string>& argv, const ChildOptions& options) 
   if (!options.stderr_path.empty())
     err_fd = options.stderr_path == options.stdout_path ? out_fd : open_output(options.stderr_path);
 
+  const pid_t parent = ::getpid();
   pid_ = ::fork();
   if (pid_ == 0) {
+    // Dies with the test (SIGTERM when the forking thread ends: tests start children from
+    // their main thread): a killed test must not leave a pmu-service on its domain, which
+    // the kernel hands to the next test once the test's lock is gone.
+    ::prctl(PR_SET_PDEATHSIG, SIGTERM);
+    if (::getppid() != parent) ::_exit(127);
     if (out_fd >= 0) ::dup2(out_fd, 1);  // dup2 clears O_CLOEXEC on the copy
     if (err_fd >= 0) ::dup2(err_fd, 2);
     ::execve(args[0], args.data(), envp.data());

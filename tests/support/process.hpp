@@ -3,8 +3,10 @@
 //
 // Child: one program started with fork/execve, stopped and reaped when the Child goes out of
 // scope (SIGTERM, then SIGKILL if it has not exited within `stop_grace`), so a failing
-// assertion never leaves a pmu-service running. SIGTERM first: a Fast DDS participant killed
-// outright leaves its shared-memory ports behind for later tests to wait on.
+// assertion never leaves a pmu-service running; the child also gets SIGTERM if the test
+// process dies first (PR_SET_PDEATHSIG; start children from the test's main thread).
+// SIGTERM first: a Fast DDS participant killed outright leaves its shared-memory ports
+// behind for later tests to wait on.
 //
 //   pmu::test::ChildOptions o;
 //   o.stderr_path = "/tmp/x.log";
