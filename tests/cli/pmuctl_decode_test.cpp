@@ -9,6 +9,8 @@
 #include <string>
 #include <vector>
 
+#include "support/process.hpp"
+
 namespace {
 
 using nlohmann::json;
@@ -21,13 +23,9 @@ struct CliRun {
 CliRun run(const std::string& args) {
   const std::string cmd = std::string(PMUCTL_PATH) + " " + args + " 2>/dev/null";
   CliRun r;
-  FILE* p = popen(cmd.c_str(), "r");
-  if (!p) return r;
-  std::string cur;
-  std::array<char, 4096> buf{};
-  std::size_t n = 0;
-  while ((n = fread(buf.data(), 1, buf.size(), p)) > 0) cur.append(buf.data(), n);
-  r.status = pclose(p);
+  const auto run = pmu::test::run_capture(cmd);
+  const std::string& cur = run.out;
+  r.status = run.status;
   std::size_t start = 0;
   for (std::size_t i = 0; i < cur.size(); ++i)
     if (cur[i] == '\n') {

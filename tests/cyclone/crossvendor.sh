@@ -7,17 +7,11 @@ set -euo pipefail
 service=$1 pmuctl=$2 client=$3 qos=$4 runs=$5
 shift 5
 
-# A domain no other test process uses: one of 220..229, held by an flock on
-# /tmp/pmu-dds-test-domain-D.lock while this script runs (as tests/integration/capacity_test.cpp
-# does); every lower domain is taken by the pid-derived scheme of another test.
-domain=
-for i in $(seq 0 9); do
-  d=$((220 + ($$ + i) % 10))
-  exec {lock}>>"/tmp/pmu-dds-test-domain-$d.lock"
-  if flock -n "$lock"; then domain=$d; break; fi
-  exec {lock}>&-
-done
-if [ -z "$domain" ]; then echo "crossvendor: domains 220..229 are all held by other test processes" >&2; exit 1; fi
+# A domain no other test process uses, held (flock) while this script and its children run:
+# the same lock files as pmu::test::exclusive_dds_domain() in the C++ tests.
+. "$(dirname "${BASH_SOURCE[0]}")/../support/dds_domain.sh"
+pmu_test_dds_domain
+domain=$PMU_TEST_DDS_DOMAIN
 work=$(mktemp -d /tmp/pmu-crossvendor-XXXXXX)
 service_pid=
 cleanup() {

@@ -2,10 +2,6 @@
 // default resource limits (10 instances per writer and reader) once cut a 50-PMU service
 // down to 9 or 10 devices in `pmuctl list` and `watch`, with nothing logged.
 #include <gtest/gtest.h>
-#include <fcntl.h>
-#include <signal.h>
-#include <sys/file.h>
-#include <sys/wait.h>
 #include <unistd.h>
 
 #include <chrono>
@@ -24,54 +20,23 @@
 #include "pmu/service/capacity.hpp"
 #include "pmu/service/dds_context.hpp"
 #include "pmu/service/dds_publisher.hpp"
+#include "support/domain.hpp"
+#include "support/process.hpp"
+#include "support/wait.hpp"
 
 namespace pmu::service {
 namespace {
 
 using namespace eprosima::fastdds::dds;
 using namespace std::chrono_literals;
-using Clock = std::chrono::steady_clock;
 
 constexpr int kDevices = 50;
 
-// A DDS domain no other test process is using: one of 220..229, held by an flock on
-// /tmp/pmu-dds-test-domain-D.lock for the life of this process. Every lower domain is taken
-// by a pid-derived scheme of another test (security 10..99, dds_test 100..199, benchmarks and
-// command_dds_test 150..229, 230 and 231 for "no service" checks); a pid alone cannot keep
-// two parallel runs apart, the lock can (tests/cyclone/crossvendor.sh takes the same locks).
-int exclusive_domain() {
-  static const int domain = [] {
-    const int first = static_cast<int>(::getpid() % 10);
-    for (int i = 0; i < 10; ++i) {
-      const int d = 220 + (first + i) % 10;
-      const std::string path = "/tmp/pmu-dds-test-domain-" + std::to_string(d) + ".lock";
-      const int fd = ::open(path.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0666);
-      if (fd < 0) continue;
-      if (::flock(fd, LOCK_EX | LOCK_NB) == 0) return d;  // fd stays open: the lock stays held
-      ::close(fd);
-    }
-    return -1;
-  }();
-  return domain;
-}
-
-struct Result {
-  int status;
-  std::string out;
-};
+// Each test process holds a domain of its own (a lock file), so parallel runs never meet.
+int exclusive_domain() { return pmu::test::exclusive_dds_domain(); }
 
 // stdout only: pmuctl's diagnostics go to stderr and would not parse as JSON.
-Result run(const std::string& cmd) {
-  Result r{-1, {}};
-  FILE* p = ::popen(cmd.c_str(), "r");
-  if (!p) return r;
-  char buf[4096];
-  std::size_t n = 0;
-  while ((n = std::fread(buf, 1, sizeof buf, p)) > 0) r.out.append(buf, n);
-  const int st = ::pclose(p);
-  r.status = WIFEXITED(st) ? WEXITSTATUS(st) : -1;
-  return r;
-}
+pmu::test::RunResult run(const std::string& cmd) { return pmu::test::run_capture(cmd); }
 
 std::vector<nlohmann::json> json_lines(const std::string& out) {
   std::vector<nlohmann::json> v;
@@ -93,21 +58,12 @@ class ManyPmus : public ::testing::Test {
     yaml << "buses:\n  - interface: sim\n    name: sim0\n    devices:\n";
     for (int a = 1; a <= kDevices; ++a) yaml << "      - address: " << a << "\n        period: 0.5\n";
     yaml.close();
-    ASSERT_GE(exclusive_domain(), 0) << "domains 220..229 are all held by other test processes";
+    ASSERT_GE(exclusive_domain(), 0);
     domain_ = std::to_string(exclusive_domain());
-    pid_ = ::fork();
-    ASSERT_GE(pid_, 0);
-    if (pid_ == 0) {
-      ::execl(PMU_SERVICE_PATH, PMU_SERVICE_PATH, "--config", config_.c_str(), "--domain", domain_.c_str(),
-              "--log-level", "warn", static_cast<char*>(nullptr));
-      std::_Exit(127);
-    }
+    service_ = pmu::test::Child({PMU_SERVICE_PATH, "--config", config_, "--domain", domain_, "--log-level", "warn"});
   }
   void TearDown() override {
-    if (pid_ > 0) {
-      ::kill(pid_, SIGTERM);
-      ::waitpid(pid_, nullptr, 0);
-    }
+    (void)service_.stop(10s);
     if (!config_.empty()) std::remove(config_.c_str());
   }
   std::string pmuctl(const std::string& args) const {
@@ -116,22 +72,23 @@ class ManyPmus : public ::testing::Test {
 
   std::string config_;
   std::string domain_;
-  pid_t pid_ = -1;
+  pmu::test::Child service_;
 };
 
 TEST_F(ManyPmus, PmuctlListsWatchesAndCommandsEveryOneOf50) {
   // The service reads each PMU's identity and parameters before it lists it: poll until all
   // are there or the deadline passes (a cap shows as a count stuck below 50).
   std::set<int> listed;
-  const auto deadline = Clock::now() + 60s;
-  while (Clock::now() < deadline && listed.size() < kDevices) {
-    const auto r = run(pmuctl("--json --timeout 5 list"));
-    listed.clear();
-    for (const auto& j : json_lines(r.out))
-      if (j.is_object() && j.contains("address") && j.value("/values/state"_json_pointer, "") == "ONLINE")
-        listed.insert(j["address"].get<int>());
-    if (listed.size() < kDevices) std::this_thread::sleep_for(500ms);
-  }
+  pmu::test::wait_until(
+      [&] {
+        const auto r = run(pmuctl("--json --timeout 5 list"));
+        listed.clear();
+        for (const auto& j : json_lines(r.out))
+          if (j.is_object() && j.contains("address") && j.value("/values/state"_json_pointer, "") == "ONLINE")
+            listed.insert(j["address"].get<int>());
+        return listed.size() >= kDevices;
+      },
+      60s, 500ms);
   ASSERT_EQ(listed.size(), static_cast<std::size_t>(kDevices)) << "pmuctl list shows " << listed.size() << " PMUs";
   EXPECT_EQ(*listed.begin(), 1);
   EXPECT_EQ(*listed.rbegin(), kDevices);
@@ -206,12 +163,13 @@ TEST(QosCapacity, PmusBeyondTheCapacityAreCountedInHealthNotDroppedSilently) {
   std::map<int, std::uint64_t> failures_by_address;
   pmu::Health h;
   SampleInfo info;
-  const auto deadline = Clock::now() + 20s;
-  while (Clock::now() < deadline && failures_by_address.size() < kMaxDevicesPerService) {
-    while (health.take_next_sample(&h, &info) == ReturnCode_t::RETCODE_OK)
-      if (info.valid_data) failures_by_address[h.address()] = h.publish_failures();
-    std::this_thread::sleep_for(10ms);
-  }
+  pmu::test::wait_until(
+      [&] {
+        while (health.take_next_sample(&h, &info) == ReturnCode_t::RETCODE_OK)
+          if (info.valid_data) failures_by_address[h.address()] = h.publish_failures();
+        return failures_by_address.size() >= kMaxDevicesPerService;
+      },
+      20s);
   EXPECT_EQ(failures_by_address.size(), kMaxDevicesPerService);
   EXPECT_EQ(failures_by_address.count(static_cast<int>(kMaxDevicesPerService) + 1), 0u);
   EXPECT_EQ(failures_by_address[1], 1u) << "the refused PMU's sample is counted in the next health sample";

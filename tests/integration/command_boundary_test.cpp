@@ -4,8 +4,6 @@
 // nothing kills or stalls the service, nothing forges its log, duplicates are told apart per
 // sender, bursts are answered in full and the memory for remembered ids stays bounded.
 #include <gtest/gtest.h>
-#include <signal.h>
-#include <sys/wait.h>
 #include <unistd.h>
 
 #include <chrono>
@@ -23,13 +21,15 @@
 #include <sstream>
 #include <thread>
 
-#include "../support/dds_domain.hpp"
 #include "pmu/idl/command.h"
 #include "pmu/idl/commandPubSubTypes.h"
 #include "pmu/idl/guarded_type.hpp"
 #include "pmu/idl/topics.hpp"
 #include "pmu/service/command_cdr.hpp"
 #include "pmu/service/dds_context.hpp"
+#include "support/domain.hpp"
+#include "support/process.hpp"
+#include "support/wait.hpp"
 
 namespace pmu::service {
 namespace {
@@ -55,23 +55,16 @@ class Service {
     std::ofstream(config_path_) << "domain: " << domain
                                 << "\nbuses:\n  - interface: sim\n    name: sim0\n    devices:\n"
                                    "      - address: 1\n      - address: 2\npolicy:\n  rate_limit: 0\n";
-    pid_ = ::fork();
-    if (pid_ == 0) {
-      const int fd = ::open(log_path_.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-      ::dup2(fd, 2);
-      ::execl(PMU_SERVICE_PATH, PMU_SERVICE_PATH, "--config", config_path_.c_str(), static_cast<char*>(nullptr));
-      std::_Exit(127);
-    }
+    pmu::test::ChildOptions o;
+    o.stderr_path = log_path_;
+    process_ = pmu::test::Child({PMU_SERVICE_PATH, "--config", config_path_}, o);
   }
   ~Service() {
-    if (pid_ > 0) {
-      ::kill(pid_, SIGKILL);
-      ::waitpid(pid_, nullptr, 0);
-    }
+    (void)process_.stop(10s);
     ::unlink(config_path_.c_str());
     ::unlink(log_path_.c_str());
   }
-  bool alive() const { return pid_ > 0 && ::waitpid(pid_, nullptr, WNOHANG) == 0; }
+  bool alive() const { return process_.running(); }
   std::string log() const {
     std::ifstream in(log_path_);
     std::stringstream ss;
@@ -79,7 +72,7 @@ class Service {
     return ss.str();
   }
   long rss_kib() const {
-    std::ifstream in("/proc/" + std::to_string(pid_) + "/status");
+    std::ifstream in("/proc/" + std::to_string(process_.pid()) + "/status");
     std::string line;
     while (std::getline(in, line))
       if (line.rfind("VmRSS:", 0) == 0) return std::stol(line.substr(6));
@@ -87,7 +80,7 @@ class Service {
   }
 
  private:
-  pid_t pid_ = -1;
+  mutable pmu::test::Child process_;  // running() reaps it once it has exited
   std::string config_path_, log_path_;
 };
 
@@ -101,14 +94,15 @@ class Peer {
                              qos_profiles::kCommand)) {}
 
   bool wait_matched(std::chrono::seconds within = 20s) {
-    for (const auto end = Clock::now() + within; Clock::now() < end; std::this_thread::sleep_for(10ms)) {
-      PublicationMatchedStatus p;
-      SubscriptionMatchedStatus s;
-      writer_.get_publication_matched_status(p);
-      replies_.get_subscription_matched_status(s);
-      if (p.current_count > 0 && s.current_count > 0) return true;
-    }
-    return false;
+    return pmu::test::wait_until(
+        [&] {
+          PublicationMatchedStatus p;
+          SubscriptionMatchedStatus s;
+          writer_.get_publication_matched_status(p);
+          replies_.get_subscription_matched_status(s);
+          return p.current_count > 0 && s.current_count > 0;
+        },
+        within);
   }
   void send(const CommandSample& s) {
     CommandSampleType::Received r{s};
@@ -124,6 +118,9 @@ class Peer {
   // of them arrived or `within` passed.
   std::vector<pmu::CommandReply> replies(const std::string& prefix, std::size_t count,
                                          std::chrono::seconds within = 20s, std::size_t since = 0) {
+    // Not wait_until: under a burst the reader must be drained again at once whenever the last
+    // take found samples (its history is the command profile's depth), and sleep only when
+    // it found none.
     const auto end = Clock::now() + within;
     do {
       pmu::CommandReply r;
@@ -171,21 +168,26 @@ class Boundary : public ::testing::Test {
   Boundary() : domain_(test::exclusive_dds_domain()), service_(domain_), peer_(domain_, "hostile-peer") {}
   void SetUp() override {
     ASSERT_TRUE(peer_.wait_matched()) << service_.log();
-    // The devices' start-up reading: wait until a GET is answered.
-    for (int i = 0; i < 100; ++i) {
-      const std::string id = "ready-" + std::to_string(i);
-      peer_.send(command(id, CommandKind::GetSerial));
-      const auto r = peer_.replies(id, 1, 2s);
-      if (!r.empty() && r[0].result() == pmu::COMPLETED) return;
-      std::this_thread::sleep_for(100ms);
-    }
-    FAIL() << "the service never became ready\n" << service_.log();
+    // The devices' start-up reading: wait until a GET is answered (each try waits up to 2 s
+    // for its reply, then the next is sent).
+    int tries = 0;
+    const bool ready = pmu::test::wait_until(
+        [&] {
+          const std::string id = "ready-" + std::to_string(tries++);
+          peer_.send(command(id, CommandKind::GetSerial));
+          const auto r = peer_.replies(id, 1, 2s);
+          return !r.empty() && r[0].result() == pmu::COMPLETED;
+        },
+        200s, 100ms);
+    if (!ready) FAIL() << "the service never became ready\n" << service_.log();
   }
   // Sends `s` and returns its one reply (fails the test unless exactly one arrives).
   pmu::CommandReply one_reply(const CommandSample& s) {
     const auto since = peer_.received();
     peer_.send(s);
     auto r = peer_.replies(s.request_id, 1, 20s, since);
+    // Meant to let time pass: a second reply must NOT come, so there is no condition to wait
+    // for; 100 ms gives one already sent the time to arrive.
     std::this_thread::sleep_for(100ms);
     r = peer_.replies(s.request_id, 2, 0s, since);
     EXPECT_EQ(r.size(), 1u) << "replies to " << s.request_id;
@@ -284,10 +286,16 @@ TEST_F(Boundary, EveryHostileSampleGetsOneReplyWithAReasonAndTheServiceLivesOn) 
   EXPECT_NE(r[0].reason().to_string().find("request_id is 69 bytes long"), std::string::npos);
   // An empty id: one reply, REJECTED.
   peer_.send(command("", CommandKind::GetSerial));
-  std::this_thread::sleep_for(300ms);
-  const auto empty = peer_.replies("", 1000, 0s);
   std::size_t empties = 0;
-  for (const auto& x : empty) empties += x.request_id().to_string().empty() ? 1u : 0u;
+  const auto count_empties = [&] {
+    empties = 0;
+    for (const auto& x : peer_.replies("", 1000, 0s)) empties += x.request_id().to_string().empty() ? 1u : 0u;
+    return empties;
+  };
+  pmu::test::wait_until([&] { return count_empties() >= 1; }, 20s);
+  // Meant to let time pass: a second reply to it must NOT come; give one the time to arrive.
+  std::this_thread::sleep_for(100ms);
+  count_empties();
   EXPECT_EQ(empties, 1u);
   // Still serving.
   EXPECT_EQ(one_reply(set("h-after", "avionics_voltage", 20.0)).result(), pmu::COMPLETED);
@@ -333,13 +341,19 @@ TEST_F(Boundary, DuplicatesAreKnownPerSenderAndAReusedIdIsRejected) {
   EXPECT_EQ(theirs[0].result(), pmu::COMPLETED) << theirs[0].reason().to_string();
   EXPECT_DOUBLE_EQ(theirs[0].value(), 16.5);
 
-  std::this_thread::sleep_for(200ms);
-  const std::string log = service_.log();
-  std::size_t executed = 0, pos = 0;
-  while ((pos = log.find("audit: command dup-1 from", pos)) != std::string::npos) {
-    executed += log.find("-> COMPLETED", pos) < log.find('\n', pos) ? 1u : 0u;
-    ++pos;
-  }
+  // The audit lines reach the log file after the replies: wait until both executions and the
+  // duplicate are there (or 10 s pass, and the assertions below say what is missing).
+  std::string log;
+  std::size_t executed = 0;
+  pmu::test::wait_until(
+      [&] {
+        log = service_.log();
+        executed = 0;
+        for (std::size_t pos = 0; (pos = log.find("audit: command dup-1 from", pos)) != std::string::npos; ++pos)
+          executed += log.find("-> COMPLETED", pos) < log.find('\n', pos) ? 1u : 0u;
+        return executed >= 2 && log.find("audit: duplicate command dup-1") != std::string::npos;
+      },
+      10s, 20ms);
   EXPECT_EQ(executed, 2u) << log;  // once for each sender
   EXPECT_NE(log.find("audit: duplicate command dup-1"), std::string::npos) << log;
 }
@@ -371,12 +385,13 @@ class RawCommandType final : public TopicDataType {
 TEST_F(Boundary, ALookAlikeTypeOrGarbageIsDroppedNeverFatal) {
   dds::DdsContext raw(domain_, "", "look-alike");
   DataWriter& w = raw.writer(raw.topic(topics::kCommand, TypeSupport(new RawCommandType())), qos_profiles::kCommand);
-  for (int i = 0; i < 500; ++i) {
-    PublicationMatchedStatus p;
-    w.get_publication_matched_status(p);
-    if (p.current_count > 0) break;
-    std::this_thread::sleep_for(10ms);
-  }
+  pmu::test::wait_until(
+      [&] {
+        PublicationMatchedStatus p;
+        w.get_publication_matched_status(p);
+        return p.current_count > 0;
+      },
+      5s);
   // The fields of pmu::Command in another order: kind and address first, then the strings.
   std::vector<std::uint8_t> reordered = {0, 1, 0, 0, /*kind*/ 7, 0, 0, 0, /*address*/ 1, 0, 0, 0,
                                          /*string length 1000*/ 0xE8, 0x03, 0, 0, 'x', 0};

@@ -2,9 +2,6 @@
 // in-process service (real clock, simulated PMUs), and pmuctl / the example client across
 // processes get the contract's results, messages and exit statuses.
 #include <gtest/gtest.h>
-#include <signal.h>
-#include <sys/wait.h>
-#include <unistd.h>
 
 #include <atomic>
 #include <chrono>
@@ -12,10 +9,12 @@
 #include <fastdds/dds/core/status/SubscriptionMatchedStatus.hpp>
 #include <fastdds/dds/subscriber/SampleInfo.hpp>
 #include <map>
+#include <set>
 #include <thread>
 
 #include "pmu/idl/command.h"
 #include "pmu/idl/commandPubSubTypes.h"
+#include "pmu/idl/statePubSubTypes.h"
 #include "pmu/idl/topics.hpp"
 #include "pmu/service/bus_worker.hpp"
 #include "pmu/service/command_service.hpp"
@@ -24,15 +23,18 @@
 #include "pmu/service/dds_publisher.hpp"
 #include "pmu/sim/bus_runner.hpp"
 #include "pmu/transport/sim_bus.hpp"
+#include "support/domain.hpp"
+#include "support/process.hpp"
+#include "support/wait.hpp"
 
 namespace pmu::service {
 namespace {
 
 using namespace eprosima::fastdds::dds;
 using namespace std::chrono_literals;
-using Clock = std::chrono::steady_clock;
 
-int test_domain() { return 150 + static_cast<int>(::getpid() % 80); }
+// Each test process holds a domain of its own (a lock file), so parallel runs never meet.
+int test_domain() { return pmu::test::exclusive_dds_domain(); }
 
 struct Sender {
   Sender(int domain, const std::string& name)
@@ -82,9 +84,23 @@ TEST(CommandsOverDds, TwoSendersBurst1000CommandsAndGetExactly1000Replies) {
   endpoint.start(service);
 
   Sender a(domain, "ground-a"), b(domain, "ground-b");
-  for (int i = 0; i < 500 && !(a.matched() && b.matched()); ++i) std::this_thread::sleep_for(10ms);
+  pmu::test::wait_until([&] { return a.matched() && b.matched(); }, 5s);
   ASSERT_TRUE(a.matched() && b.matched());
-  std::this_thread::sleep_for(500ms);  // the devices' start-up reading
+  // The devices' start-up reading: over when each has published its configuration (a
+  // session publishes pmu/config as it enters its running phase).
+  DataReader& configs =
+      a.dds.reader(a.dds.topic(topics::kConfig, TypeSupport(new pmu::ConfigPubSubType())), qos_profiles::kState);
+  std::set<unsigned> configured;
+  ASSERT_TRUE(pmu::test::wait_until(
+      [&] {
+        pmu::Config c;
+        SampleInfo i;
+        while (configs.take_next_sample(&c, &i) == ReturnCode_t::RETCODE_OK)
+          if (i.valid_data) configured.insert(c.address());
+        return configured.size() == 2;
+      },
+      30s))
+      << "the devices' start-up reading did not finish";
 
   std::map<std::string, int> replies_a, replies_b;
   std::atomic<bool> done{false};
@@ -123,15 +139,18 @@ TEST(CommandsOverDds, TwoSendersBurst1000CommandsAndGetExactly1000Replies) {
   };
   std::thread ta([&] { send(a, "a-"); });
   std::thread tb([&] { send(b, "b-"); });
-  const auto deadline = Clock::now() + 60s;
-  while (Clock::now() < deadline && (replies_a.size() < 500 || replies_b.size() < 500)) {
-    collect(a, replies_a, "a-");
-    collect(b, replies_b, "b-");
-    std::this_thread::sleep_for(2ms);
-  }
+  pmu::test::wait_until(
+      [&] {
+        collect(a, replies_a, "a-");
+        collect(b, replies_b, "b-");
+        return replies_a.size() >= 500 && replies_b.size() >= 500;
+      },
+      60s, 2ms);
   ta.join();
   tb.join();
-  std::this_thread::sleep_for(300ms);  // anything duplicated would arrive now
+  // Meant to let time pass: a duplicate reply is an event that must NOT happen, so there is
+  // no condition to wait for; 300 ms is ample for one already sent to arrive.
+  std::this_thread::sleep_for(300ms);
   collect(a, replies_a, "a-");
   collect(b, replies_b, "b-");
   done = true;
@@ -153,42 +172,12 @@ TEST(CommandsOverDds, TwoSendersBurst1000CommandsAndGetExactly1000Replies) {
 
 // ---- pmuctl and the example client against pmu-service ----------------------------------
 
-struct Service {
-  explicit Service(int domain) {
-    pid = ::fork();
-    if (pid == 0) {
-      const std::string d = std::to_string(domain);
-      ::execl(PMU_SERVICE_PATH, PMU_SERVICE_PATH, "--bus", "sim", "--domain", d.c_str(), "--log-level", "warn",
-              static_cast<char*>(nullptr));
-      std::_Exit(127);
-    }
-  }
-  ~Service() {
-    ::kill(pid, SIGTERM);
-    ::waitpid(pid, nullptr, 0);
-  }
-  pid_t pid;
-};
-
-struct Result {
-  int status;
-  std::string out;
-};
-
-Result sh(const std::string& cmd) {
-  Result r{-1, {}};
-  FILE* p = ::popen((cmd + " 2>&1").c_str(), "r");
-  char buf[4096];
-  std::size_t n = 0;
-  while ((n = std::fread(buf, 1, sizeof buf, p)) > 0) r.out.append(buf, n);
-  const int st = ::pclose(p);
-  r.status = WIFEXITED(st) ? WEXITSTATUS(st) : -1;
-  return r;
-}
+pmu::test::RunResult sh(const std::string& cmd) { return pmu::test::run_capture(cmd, true); }
 
 TEST(PmuctlCommands, ResultsMessagesAndExitStatus) {
-  const int domain = test_domain() + 1;
-  Service service(domain);
+  const int domain = test_domain();
+  pmu::test::Child service(
+      {PMU_SERVICE_PATH, "--bus", "sim", "--domain", std::to_string(domain), "--log-level", "warn"});
   const std::string p = std::string(PMUCTL_PATH) + " --domain " + std::to_string(domain) + " ";
   auto r = sh(p + "config set avionics_voltage 24");
   EXPECT_EQ(r.status, 0) << r.out;
@@ -217,9 +206,11 @@ TEST(PmuctlCommands, ResultsMessagesAndExitStatus) {
 }
 
 TEST(PmuctlCommands, NoServiceIsSaid) {
-  const auto r = sh(std::string(PMUCTL_PATH) + " --domain 230 --timeout 1 config set avionics_voltage 24");
+  // This process's own domain: no service runs on it (this test starts none).
+  const std::string domain = std::to_string(test_domain());
+  const auto r = sh(std::string(PMUCTL_PATH) + " --domain " + domain + " --timeout 1 config set avionics_voltage 24");
   EXPECT_EQ(r.status, 2);
-  EXPECT_NE(r.out.find("no pmu-service on domain 230"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("no pmu-service on domain " + domain), std::string::npos) << r.out;
 }
 
 }  // namespace

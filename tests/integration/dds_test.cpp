@@ -11,6 +11,7 @@
 #include <cstdio>
 #include <fastdds/dds/subscriber/SampleInfo.hpp>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <set>
 #include <thread>
 
@@ -20,6 +21,9 @@
 #include "pmu/idl/topics.hpp"
 #include "pmu/service/dds_context.hpp"
 #include "pmu/service/dds_publisher.hpp"
+#include "support/domain.hpp"
+#include "support/process.hpp"
+#include "support/wait.hpp"
 
 namespace pmu::service::test {
 namespace {
@@ -28,18 +32,18 @@ using namespace eprosima::fastdds::dds;
 using namespace std::chrono_literals;
 using Clock = std::chrono::steady_clock;
 
-// Each test process gets its own domain so parallel ctest runs do not see each other.
-int test_domain() { return 100 + static_cast<int>(::getpid() % 100); }
+// Each test process holds a domain of its own (a lock file), so parallel runs never meet.
+int test_domain() { return pmu::test::exclusive_dds_domain(); }
 
 template <class T>
 bool wait_sample(DataReader& r, T& out, SampleInfo& info, std::chrono::milliseconds timeout) {
-  const auto deadline = Clock::now() + timeout;
-  while (Clock::now() < deadline) {
-    while (r.take_next_sample(&out, &info) == ReturnCode_t::RETCODE_OK)
-      if (info.valid_data) return true;
-    std::this_thread::sleep_for(5ms);
-  }
-  return false;
+  return pmu::test::wait_until(
+      [&] {
+        while (r.take_next_sample(&out, &info) == ReturnCode_t::RETCODE_OK)
+          if (info.valid_data) return true;
+        return false;
+      },
+      timeout, 5ms);
 }
 
 struct Readers {
@@ -70,6 +74,7 @@ class BusThread {
   explicit BusThread(Harness& h) : h_(h), t_([this] {
       while (!stop_) {
         h_.run_for(10ms);
+        // Meant: real time passes between steps of bus time (the DDS side runs in real time).
         std::this_thread::sleep_for(2ms);
       }
     }) {}
@@ -162,12 +167,13 @@ TEST(DdsTelemetry, RateFollowsThePacketPeriod) {
   std::set<std::int64_t> stamps;
   {
     BusThread bus(h);  // bus time runs ~5x faster than real time: a sample every ~40 ms
-    const auto deadline = Clock::now() + 4s;
-    while (Clock::now() < deadline && stamps.size() < 30) {
-      while (r.voltages.take_next_sample(&v, &si) == ReturnCode_t::RETCODE_OK)
-        if (si.valid_data) stamps.insert(static_cast<std::int64_t>(si.source_timestamp.to_ns() / 1000000));
-      std::this_thread::sleep_for(2ms);
-    }
+    pmu::test::wait_until(
+        [&] {
+          while (r.voltages.take_next_sample(&v, &si) == ReturnCode_t::RETCODE_OK)
+            if (si.valid_data) stamps.insert(static_cast<std::int64_t>(si.source_timestamp.to_ns() / 1000000));
+          return stamps.size() >= 30;
+        },
+        4s, 2ms);
   }
   ASSERT_GE(stamps.size(), 30u);
   // Consecutive samples are one packet period apart in frame time (a best-effort sample may
@@ -183,42 +189,14 @@ TEST(DdsTelemetry, RateFollowsThePacketPeriod) {
 
 // ---- across processes -----------------------------------------------------------------------
 
-struct Child {
-  pid_t pid = -1;
-  ~Child() {
-    if (pid > 0) {
-      ::kill(pid, SIGKILL);
-      ::waitpid(pid, nullptr, 0);
-    }
-  }
-};
-
-std::string run_capture(const std::string& cmd, int* status) {
-  std::string out;
-  FILE* p = ::popen(cmd.c_str(), "r");
-  if (!p) return out;
-  char buf[4096];
-  std::size_t n = 0;
-  while ((n = std::fread(buf, 1, sizeof buf, p)) > 0) out.append(buf, n);
-  *status = ::pclose(p);
-  return out;
-}
+using pmu::test::run_capture;
 
 TEST(CrossProcess, ServiceOnSimulatedBusFeedsPmuctl) {
   const std::string domain = std::to_string(test_domain());
-  Child service;
-  service.pid = ::fork();
-  ASSERT_GE(service.pid, 0);
-  if (service.pid == 0) {
-    ::execl(PMU_SERVICE_PATH, PMU_SERVICE_PATH, "--bus", "sim", "--domain", domain.c_str(), "--log-level", "warn",
-            static_cast<char*>(nullptr));
-    std::_Exit(127);
-  }
-  int status = 0;
-  const std::string out = run_capture(std::string(PMUCTL_PATH) + " --domain " + domain +
-                                          " watch --json --count 15 --timeout 20",
-                                      &status);
-  ASSERT_EQ(status, 0) << out;
+  pmu::test::Child service({PMU_SERVICE_PATH, "--bus", "sim", "--domain", domain, "--log-level", "warn"});
+  const auto watched = run_capture(std::string(PMUCTL_PATH) + " --domain " + domain + " watch --json --count 15 --timeout 20");
+  const std::string& out = watched.out;
+  ASSERT_EQ(watched.status, 0) << out;
   std::set<std::string> topics;
   std::size_t lines = 0;
   std::size_t start = 0;
@@ -237,29 +215,34 @@ TEST(CrossProcess, ServiceOnSimulatedBusFeedsPmuctl) {
   EXPECT_EQ(lines, 15u);
   EXPECT_EQ(topics, (std::set<std::string>{"voltages", "currents", "battery_energy", "temperatures", "status"}));
 
-  const std::string list = run_capture(std::string(PMUCTL_PATH) + " --domain " + domain + " list --json", &status);
-  ASSERT_EQ(status, 0) << list;
+  const auto listed = run_capture(std::string(PMUCTL_PATH) + " --domain " + domain + " list --json");
+  const std::string& list = listed.out;
+  ASSERT_EQ(listed.status, 0) << list;
   const auto l = nlohmann::json::parse(list.substr(0, list.find('\n')));
   EXPECT_EQ(l["values"]["state"], "ONLINE");
   EXPECT_EQ(l["values"]["firmware"], "1.17");
 
-  // SIGTERM stops the service cleanly within a second.
+  // SIGTERM stops the service cleanly within a second. Not a speed measurement (those live in
+  // bench/): the README and interface.md promise systemd a stop within a second of SIGTERM,
+  // a behavioural bound, so it stays an assertion. Stopping takes tens of ms; a second is
+  // the contract's own margin.
   const auto t0 = Clock::now();
-  ASSERT_EQ(::kill(service.pid, SIGTERM), 0);
-  int wstatus = 0;
-  while (::waitpid(service.pid, &wstatus, WNOHANG) == 0 && Clock::now() - t0 < 3s) std::this_thread::sleep_for(5ms);
+  ASSERT_TRUE(service.signal(SIGTERM));
+  const std::optional<int> stopped = service.wait_for(3s);
   const auto took = Clock::now() - t0;
-  service.pid = -1;
-  EXPECT_TRUE(WIFEXITED(wstatus));
+  const int wstatus = stopped.value_or(-1);
+  EXPECT_TRUE(stopped && WIFEXITED(wstatus));
   EXPECT_EQ(WEXITSTATUS(wstatus), 0);
   EXPECT_LT(took, 1s);
 }
 
 TEST(CrossProcess, PmuctlSaysWhenNoServiceIsThere) {
-  int status = 0;
-  const std::string err = run_capture(std::string(PMUCTL_PATH) + " --domain 231 list --timeout 1 2>&1", &status);
-  EXPECT_NE(status, 0);
-  EXPECT_NE(err.find("no pmu-service on domain 231"), std::string::npos) << err;
+  // This process's own domain: no service runs on it (this test starts none).
+  const std::string domain = std::to_string(test_domain());
+  const auto r = run_capture(std::string(PMUCTL_PATH) + " --domain " + domain + " list --timeout 1", true);
+  const std::string& err = r.out;
+  EXPECT_NE(r.status, 0);
+  EXPECT_NE(err.find("no pmu-service on domain " + domain), std::string::npos) << err;
 }
 
 TEST(CrossProcess, BadConfigIsRefusedWithItsLineBeforeAnythingStarts) {
@@ -269,10 +252,10 @@ TEST(CrossProcess, BadConfigIsRefusedWithItsLineBeforeAnythingStarts) {
   const std::string yaml = "buses:\n  - interface: vcan0\n    devices:\n      - address: 70000\n";
   ASSERT_EQ(::write(fd, yaml.data(), yaml.size()), static_cast<ssize_t>(yaml.size()));
   ::close(fd);
-  int status = 0;
-  const std::string err = run_capture(std::string(PMU_SERVICE_PATH) + " --config " + path + " 2>&1", &status);
+  const auto r = run_capture(std::string(PMU_SERVICE_PATH) + " --config " + path, true);
+  const std::string& err = r.out;
   ::unlink(path);
-  EXPECT_EQ(WEXITSTATUS(status), 2);
+  EXPECT_EQ(r.status, 2);
   EXPECT_NE(err.find(std::string(path) + ":4: address 70000 out of range 0..65534"), std::string::npos) << err;
 }
 

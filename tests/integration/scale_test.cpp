@@ -5,7 +5,6 @@
 // shows up here as units that are missing.
 // Cost at scale (CPU, memory) is measured by bench/run.sh, not here.
 #include <gtest/gtest.h>
-#include <signal.h>
 #include <stdlib.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -23,10 +22,13 @@
 #include <thread>
 #include <vector>
 
+#include "support/domain.hpp"
+#include "support/process.hpp"
+#include "support/wait.hpp"
+
 namespace {
 
 using namespace std::chrono_literals;
-using Clock = std::chrono::steady_clock;
 using Key = std::pair<std::string, int>;  // (bus, address)
 
 constexpr int kBuses = 4;
@@ -34,29 +36,10 @@ constexpr int kPerBus = 25;
 constexpr std::size_t kUnits = kBuses * kPerBus;
 const std::set<std::string> kTelemetryTopics{"voltages", "currents", "battery_energy", "temperatures", "status"};
 
-// Domains 1..9: no other test uses them (dds_test 100..199, command_dds_test 150..230,
-// security 10..99, pmu_bench 150..229). Each test of this file has three of its own
-// (ctest runs them in parallel), and the pid spreads runs from other build trees.
-int scale_domain(int test) { return 1 + 3 * test + static_cast<int>(::getpid() % 3); }
-
 std::string bus_name(int b) { return "sim" + std::to_string(b); }
 
-struct Result {
-  int status = -1;  // exit status, -1 when killed
-  std::string out;  // stdout only: pmuctl's JSON lines
-};
-
-Result run(const std::string& cmd) {
-  Result r;
-  FILE* p = ::popen(cmd.c_str(), "r");
-  if (!p) return r;
-  char buf[4096];
-  std::size_t n = 0;
-  while ((n = std::fread(buf, 1, sizeof buf, p)) > 0) r.out.append(buf, n);
-  const int st = ::pclose(p);
-  r.status = WIFEXITED(st) ? WEXITSTATUS(st) : -1;
-  return r;
-}
+// stdout only: pmuctl's JSON lines.
+pmu::test::RunResult run(const std::string& cmd) { return pmu::test::run_capture(cmd); }
 
 std::vector<nlohmann::json> json_lines(const std::string& out) {
   std::vector<nlohmann::json> v;
@@ -81,46 +64,30 @@ class Service {
       for (int a = 1; a <= kPerBus; ++a) c << "      - address: " << a << "\n        period: 1.0\n";
     }
     c.close();
-    pid_ = ::fork();
-    if (pid_ == 0) {
-      ::execl(PMU_SERVICE_PATH, PMU_SERVICE_PATH, "--config", config_.c_str(), static_cast<char*>(nullptr));
-      std::_Exit(127);
-    }
+    process_ = pmu::test::Child({PMU_SERVICE_PATH, "--config", config_});
   }
   ~Service() {
-    if (pid_ > 0) (void)stop();
+    (void)stop();
     if (!config_.empty()) ::unlink(config_.c_str());
     if (!dir_.empty()) ::rmdir(dir_.c_str());
   }
-  bool started() const { return pid_ > 0 && !dir_.empty(); }
+  bool started() const { return process_.pid() > 0 && !dir_.empty(); }
   // SIGTERM; the exit status (non-zero also when a sanitizer reported something at exit).
   int stop() {
-    ::kill(pid_, SIGTERM);
-    int st = 0;
-    const auto give_up = Clock::now() + 10s;
-    while (::waitpid(pid_, &st, WNOHANG) == 0) {
-      if (Clock::now() > give_up) {
-        ::kill(pid_, SIGKILL);
-        ::waitpid(pid_, &st, 0);
-        break;
-      }
-      std::this_thread::sleep_for(10ms);
-    }
-    pid_ = -1;
-    return WIFEXITED(st) ? WEXITSTATUS(st) : -1;
+    const auto st = process_.stop(10s);  // std::nullopt: it had to be killed
+    return st && WIFEXITED(*st) ? WEXITSTATUS(*st) : -1;
   }
 
  private:
   std::string dir_, config_;
-  pid_t pid_ = -1;
+  pmu::test::Child process_;
 };
 
 class Scale : public ::testing::Test {
  protected:
-  // `test`: 0, 1 or 2, a different one in each test.
-  void start(int test) {
+  void start() {
     ::setenv("PMU_QOS_FILE", PMU_QOS_FILE, 1);  // pmuctl reads the same profiles as the service
-    domain_ = scale_domain(test);
+    domain_ = pmu::test::exclusive_dds_domain();  // this test process's own
     service_ = std::make_unique<Service>(domain_);
     ASSERT_TRUE(service_->started());
   }
@@ -133,13 +100,13 @@ class Scale : public ::testing::Test {
   template <class Done>
   std::vector<nlohmann::json> until(const std::string& args, Done&& done) const {
     std::vector<nlohmann::json> last;
-    const auto give_up = Clock::now() + 60s;
-    while (Clock::now() < give_up) {
-      const auto r = run(pmuctl(args));
-      last = json_lines(r.out);
-      if (r.status == 0 && done(last)) break;
-      std::this_thread::sleep_for(500ms);
-    }
+    pmu::test::wait_until(
+        [&] {
+          const auto r = run(pmuctl(args));
+          last = json_lines(r.out);
+          return r.status == 0 && done(last);
+        },
+        60s, 500ms);
     return last;
   }
 
@@ -168,7 +135,7 @@ const nlohmann::json& values(const nlohmann::json& j) {
 Key key_of(const nlohmann::json& j) { return {text(j, "bus"), static_cast<int>(number(j, "address"))}; }
 
 TEST_F(Scale, EveryOneOf100UnitsOnFourBusesIsListedOnline) {
-  ASSERT_NO_FATAL_FAILURE(start(0));
+  ASSERT_NO_FATAL_FAILURE(start());
   const auto rows = until("--json --timeout 5 list", [](const std::vector<nlohmann::json>& v) {
     std::size_t online = 0;
     for (const auto& j : v) online += text(values(j), "state") == "ONLINE" ? 1u : 0u;
@@ -188,7 +155,7 @@ TEST_F(Scale, EveryOneOf100UnitsOnFourBusesIsListedOnline) {
 }
 
 TEST_F(Scale, WatchShowsEveryPacketOfEveryUnit) {
-  ASSERT_NO_FATAL_FAILURE(start(1));
+  ASSERT_NO_FATAL_FAILURE(start());
   // 100 units x 5 packets once a second: 10 s of watching gives each (unit, packet) about
   // ten chances; telemetry is best effort, but a unit missing from all of them is a bug.
   (void)until("--json --timeout 5 list", [](const std::vector<nlohmann::json>& v) { return v.size() == kUnits; });
@@ -206,7 +173,7 @@ TEST_F(Scale, WatchShowsEveryPacketOfEveryUnit) {
 }
 
 TEST_F(Scale, UnitsOnEveryBusTakeCommandsAndOnlyTheirOwn) {
-  ASSERT_NO_FATAL_FAILURE(start(2));
+  ASSERT_NO_FATAL_FAILURE(start());
   // Wait for the whole config state: sets are checked against it afterwards.
   const auto is_all = [](const std::vector<nlohmann::json>& v) { return v.size() == kUnits; };
   ASSERT_EQ(until("--json --timeout 5 config get avionics_voltage", is_all).size(), kUnits);

@@ -50,6 +50,8 @@
 #include "pmu/sim/bus_runner.hpp"
 #include "pmu/transport/sim_bus.hpp"
 #include "pki_fixture.hpp"
+#include "support/process.hpp"
+#include "support/wait.hpp"
 
 namespace pmu::service {
 namespace {
@@ -178,12 +180,7 @@ int take_all(DataReader& r) {
 
 template <class T>
 bool wait_sample(DataReader& r, std::chrono::milliseconds timeout) {
-  const auto deadline = Clock::now() + timeout;
-  while (Clock::now() < deadline) {
-    if (take_all<T>(r) > 0) return true;
-    std::this_thread::sleep_for(20ms);
-  }
-  return false;
+  return pmu::test::wait_until([&] { return take_all<T>(r) > 0; }, timeout, 20ms);
 }
 
 pmu::Command command(const std::string& id, const std::string& bus = "sim0") {
@@ -200,29 +197,33 @@ pmu::Command command(const std::string& id, const std::string& bus = "sim0") {
 }
 
 std::optional<pmu::CommandReply> wait_reply(DataReader& r, const std::string& id, std::chrono::milliseconds timeout) {
-  const auto deadline = Clock::now() + timeout;
-  while (Clock::now() < deadline) {
-    pmu::CommandReply reply;
-    SampleInfo info;
-    while (r.take_next_sample(&reply, &info) == ReturnCode_t::RETCODE_OK)
-      if (info.valid_data && reply.request_id().to_string() == id && reply.result() != pmu::IN_PROGRESS) return reply;
-    std::this_thread::sleep_for(10ms);
-  }
-  return std::nullopt;
+  std::optional<pmu::CommandReply> found;
+  pmu::test::wait_until(
+      [&] {
+        pmu::CommandReply reply;
+        SampleInfo info;
+        while (r.take_next_sample(&reply, &info) == ReturnCode_t::RETCODE_OK)
+          if (info.valid_data && reply.request_id().to_string() == id && reply.result() != pmu::IN_PROGRESS) {
+            found = reply;
+            return true;
+          }
+        return false;
+      },
+      timeout);
+  return found;
 }
 
 // Like pmuctl: wait until the service's command reader and reply writer are matched.
 bool wait_command_link(Client& gs, std::chrono::milliseconds timeout) {
-  const auto deadline = Clock::now() + timeout;
-  while (Clock::now() < deadline) {
-    PublicationMatchedStatus p;
-    SubscriptionMatchedStatus s;
-    gs.commands().get_publication_matched_status(p);
-    gs.replies().get_subscription_matched_status(s);
-    if (p.current_count > 0 && s.current_count > 0) return true;
-    std::this_thread::sleep_for(10ms);
-  }
-  return false;
+  return pmu::test::wait_until(
+      [&] {
+        PublicationMatchedStatus p;
+        SubscriptionMatchedStatus s;
+        gs.commands().get_publication_matched_status(p);
+        gs.replies().get_subscription_matched_status(s);
+        return p.current_count > 0 && s.current_count > 0;
+      },
+      timeout);
 }
 
 // The good ground station commands: the reply comes, and the PMU did it.
@@ -254,6 +255,9 @@ Intrusion intrude(ServiceUnderTest& svc, Client& intruder, Client& good) {
   EXPECT_TRUE(wait_sample<pmu::Voltages>(good.voltages(), 20s)) << "the legitimate reader got no telemetry: "
                                                                    "the service is not reachable at all";
   EXPECT_TRUE(wait_sample<pmu::Config>(good.config(), 10s)) << "no pmu/config: the service's start-up is not done";
+  // Meant to let time pass (kept as it was): the intruder's discovery and handshake attempts
+  // run before the "before" figures are taken; there is nothing to wait for, since it must
+  // NOT match.
   std::this_thread::sleep_for(300ms);
   const std::uint64_t handled_before = svc.handled();
   const std::uint8_t outputs_before = svc.outputs();
@@ -262,6 +266,7 @@ Intrusion intrude(ServiceUnderTest& svc, Client& intruder, Client& good) {
   for (int i = 0; i < 20; ++i) {
     pmu::Command c = command("intruder-" + std::to_string(i));
     writer.write(&c);
+    // Meant to let time pass: 20 x 200 ms = the 4 s of intrusion; nothing must happen in them.
     std::this_thread::sleep_for(200ms);
     r.stolen_samples += take_all<pmu::Voltages>(stolen);
     r.good_samples += take_all<pmu::Voltages>(good.voltages());
@@ -398,7 +403,7 @@ TEST(SecureDds, MissionComputerCannotWriteCommands) {
   }
   EXPECT_EQ(writer, nullptr) << "Fast DDS let the mission computer create a pmu/command writer";
   if (writer) {  // only with broken permissions: then show what it can do
-    for (int i = 0; i < 300 && mc.commands_matched() == 0; ++i) std::this_thread::sleep_for(10ms);
+    pmu::test::wait_until([&] { return mc.commands_matched() != 0; }, 3s);
     for (int i = 0; i < 5; ++i) {
       pmu::Command c = command("mission-computer-" + std::to_string(i));
       writer->write(&c);
@@ -406,6 +411,7 @@ TEST(SecureDds, MissionComputerCannotWriteCommands) {
   }
   // ... and the reply topic is not its business either.
   EXPECT_THROW(mc.replies(), dds::DdsError);
+  // Meant to let time pass: no command may arrive, so there is no condition to wait for.
   std::this_thread::sleep_for(2s);
   EXPECT_EQ(svc.commands.counters().received, 0u) << "a command from the mission computer reached the service";
   EXPECT_NE(svc.outputs() & kPayload, 0) << "the payload was switched off";
@@ -433,6 +439,7 @@ TEST(SecureDds, MissionComputerWithARelaxedGovernanceStillCannotCommand) {
   for (int i = 0; i < 15; ++i) {
     pmu::Command c = command("tampered-" + std::to_string(i));
     mc.commands().write(&c);
+    // Meant to let time pass: 15 x 200 ms in which nothing may reach the service.
     std::this_thread::sleep_for(200ms);
   }
   EXPECT_EQ(mc.commands_matched(), 0) << "the service matched the mission computer's command writer";
@@ -546,8 +553,11 @@ WireResult run_on_the_wire(const SecurityFiles& service_files, const SecurityFil
     EXPECT_TRUE(gs.commands().write(&c));
     const auto reply = wait_reply(gs.replies(), marker, 10s);
     EXPECT_TRUE(reply.has_value() && reply->result() == pmu::COMPLETED) << "the command did not complete";
-    std::this_thread::sleep_for(1s);  // more telemetry
+    // Meant to let time pass: a second more of telemetry on the wire. With security the
+    // marker must NOT show up, so there is no condition to wait for.
+    std::this_thread::sleep_for(1s);
   }
+  // Meant to let time pass: the capture thread reads the last packets.
   std::this_thread::sleep_for(200ms);
   w.command_marker = capture.contains(marker);
   w.telemetry_marker = capture.contains(bus_marker);
@@ -576,25 +586,14 @@ TEST(SecureDds, TrafficOnTheWireIsEncrypted) {
 
 // ---- the programs ---------------------------------------------------------------------------
 
-struct ServiceProcess {
-  explicit ServiceProcess(const std::string& config) {
-    pid = ::fork();
-    if (pid == 0) {
-      ::execl(PMU_SERVICE_PATH, PMU_SERVICE_PATH, "--config", config.c_str(), "--log-level", "warn",
-              static_cast<char*>(nullptr));
-      std::_Exit(127);
-    }
-  }
-  ~ServiceProcess() {
-    ::kill(pid, SIGTERM);
-    ::waitpid(pid, nullptr, 0);
-  }
-  pid_t pid;
-};
+// pmu-service on `config`, stopped (SIGTERM) and reaped at the end of the test.
+pmu::test::Child service_process(const std::string& config) {
+  return pmu::test::Child({PMU_SERVICE_PATH, "--config", config, "--log-level", "warn"});
+}
 
 TEST(ServiceProgram, SecurePmuServiceWithPmuctlAndTheExampleClient) {
   const std::string cfg = write_config("good", Pki::get().files("pmu-service"));
-  ServiceProcess service(cfg);
+  const auto service = service_process(cfg);
   const std::string d = " --domain " + std::to_string(test_domain());
   const std::string sec = " --security-dir " + Pki::get().dir();
   const std::string pmuctl = PMUCTL_PATH;

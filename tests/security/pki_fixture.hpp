@@ -19,30 +19,18 @@
 #include <gtest/gtest.h>
 
 #include "pmu/service/dds_security.hpp"
+#include "support/domain.hpp"
+#include "support/process.hpp"
 
 namespace pmu::security_test {
 
 using dds::SecurityFiles;
 
-// Domains 10..99: the integration tests use 100 and up.
-inline int test_domain() { return 10 + static_cast<int>(::getpid() % 90); }
+// This test process's own DDS domain (a lock file held while it runs).
+inline int test_domain() { return pmu::test::exclusive_dds_domain(); }
 
-struct Result {
-  int status;
-  std::string out;
-};
-
-inline Result sh(const std::string& cmd) {
-  Result r{-1, {}};
-  FILE* p = ::popen((cmd + " 2>&1").c_str(), "r");
-  if (!p) return r;
-  char buf[4096];
-  std::size_t n = 0;
-  while ((n = std::fread(buf, 1, sizeof buf, p)) > 0) r.out.append(buf, n);
-  const int st = ::pclose(p);
-  r.status = WIFEXITED(st) ? WEXITSTATUS(st) : -1;
-  return r;
-}
+// stdout and stderr of a shell command, and its exit status.
+inline pmu::test::RunResult sh(const std::string& cmd) { return pmu::test::run_capture(cmd, true); }
 
 inline std::string utc(std::chrono::system_clock::time_point t) {
   const std::time_t tt = std::chrono::system_clock::to_time_t(t);
