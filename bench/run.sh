@@ -10,6 +10,9 @@
 # rows, 1-100 PMUs and 1-16 subscriber processes, about 3.5 minutes).
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
+# pmu_bench, pmu-service and pmuctl from a build tree look for qos.xml only where it is
+# installed; the benchmarks use the source tree's.
+export PMU_QOS_FILE=${PMU_QOS_FILE:-$root/deploy/qos.xml}
 build="$root/build/bench"
 quick=0
 build_it=1

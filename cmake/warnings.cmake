@@ -4,7 +4,7 @@ add_library(pmu_warnings INTERFACE)
 target_compile_options(pmu_warnings INTERFACE
   -Wall -Wextra -Wpedantic -Wconversion -Wsign-conversion -Wshadow
   -Wnon-virtual-dtor -Wold-style-cast -Wcast-align -Woverloaded-virtual
-  -Wdouble-promotion -Wformat=2 -Wimplicit-fallthrough)
+  -Wdouble-promotion -Wformat=2 -Wimplicit-fallthrough -Wswitch-enum)
 if(PMU_WERROR)
   target_compile_options(pmu_warnings INTERFACE -Werror)
 endif()

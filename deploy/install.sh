@@ -7,7 +7,8 @@
 #                    tools/pmu-sim (default: build/release under the repository root)
 #   --prefix PREFIX  where binaries, the unit and the docs go (default /usr): PREFIX/bin,
 #                    PREFIX/lib/systemd/system, PREFIX/share/{doc/,}pmu-dds. Configuration
-#                    always goes to /etc (the service looks for /etc/pmu-dds).
+#                    always goes to /etc (the service looks for /etc/pmu-dds: PMU_SYSCONFDIR,
+#                    the CMake default).
 #   --destdir DIR    stage everything under DIR (packaging, tests); same as DESTDIR=DIR.
 #                    With a DESTDIR, systemctl is not called.
 #   --dry-run        print what would be done, change nothing

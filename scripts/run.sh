@@ -5,6 +5,8 @@
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 cd "$root"
+# A binary from the build tree looks for qos.xml only where it is installed.
+export PMU_QOS_FILE=${PMU_QOS_FILE:-$root/deploy/qos.xml}
 domain=0
 if [ "${1:-}" = "--domain" ]; then domain=$2; shift 2; fi
 

@@ -76,7 +76,17 @@ Payload decode_payload(PacketId p, const std::uint8_t* d, std::optional<Firmware
     case PacketId::EngineStart:
     case PacketId::EngineStop:
     case PacketId::Reset: return NoPayload{};
-    default: break;
+    case PacketId::AvionicsVoltage:
+    case PacketId::PayloadVoltage:
+    case PacketId::ServoVoltage:
+    case PacketId::BatteryVoltage:
+    case PacketId::PacketPeriod:
+    case PacketId::PacketsStreamed:
+    case PacketId::TemperatureOffset:
+    case PacketId::UpperTemperatureLimit:
+    case PacketId::PowerUpState:
+    case PacketId::CrankingTime:
+    case PacketId::CanAddress: break;  // a stored parameter: its width comes from the spec table below
   }
   if (auto param = parameter_from_packet(p)) {
     const auto& spec = spec_of(*param);
@@ -101,8 +111,23 @@ std::uint8_t data_length(PacketId packet) noexcept {
     case PacketId::Reset: return 0;
     case PacketId::Serial: return 2;
     case PacketId::Firmware: return 6;
-    default: return 1;  // 0x0F, 0x10..0x19, 0x20..0x23
+    case PacketId::MeasurementRequest:
+    case PacketId::AvionicsVoltage:
+    case PacketId::PayloadVoltage:
+    case PacketId::ServoVoltage:
+    case PacketId::BatteryVoltage:
+    case PacketId::PacketPeriod:
+    case PacketId::PacketsStreamed:
+    case PacketId::TemperatureOffset:
+    case PacketId::UpperTemperatureLimit:
+    case PacketId::PowerUpState:
+    case PacketId::CrankingTime:
+    case PacketId::Outputs:
+    case PacketId::EnableOutputs:
+    case PacketId::DisableOutputs:
+    case PacketId::Generation: return 1;
   }
+  return 1;  // an id outside table 1 (a PacketId made from a raw byte)
 }
 
 bool has_zero_length_get(PacketId packet) noexcept {

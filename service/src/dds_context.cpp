@@ -11,6 +11,7 @@
 #include <mutex>
 
 #include "pmu/service/dds_capacity.hpp"
+#include "pmu/sysconf_dir.hpp"
 
 namespace pmu::dds {
 namespace {
@@ -55,8 +56,9 @@ void add_security(DomainParticipantQos& pqos, const SecurityFiles& f) {
 
 std::string default_qos_file() {
   if (const char* env = std::getenv("PMU_QOS_FILE"); env && *env) return env;
-  for (const char* p : {"/etc/pmu-dds/qos.xml", PMU_SOURCE_QOS_FILE})
-    if (readable(p)) return p;
+  // Only installed places: a binary that also looked in its build tree would carry that
+  // path into the package. Runs from a build directory set PMU_QOS_FILE.
+  if (const char* installed = PMU_SYSCONFDIR "/qos.xml"; readable(installed)) return installed;
   return {};
 }
 
@@ -65,7 +67,7 @@ DdsContext::DdsContext(int domain, const std::string& qos_file, const std::strin
     : domain_(domain), secure_(!security.empty()) {
   const std::string file = qos_file.empty() ? default_qos_file() : qos_file;
   qos_file_ = file;
-  if (file.empty()) throw DdsError("no QoS profile file: install deploy/qos.xml as /etc/pmu-dds/qos.xml or set qos_file");
+  if (file.empty()) throw DdsError("no QoS profile file: install deploy/qos.xml as " PMU_SYSCONFDIR "/qos.xml, set PMU_QOS_FILE or set qos_file");
   load_profiles_once(file);
   DomainParticipantQos pqos = PARTICIPANT_QOS_DEFAULT;
   pqos.name(participant_name);

@@ -30,6 +30,7 @@
 #include "pmu/service/logging.hpp"
 #include "pmu/service/systemd.hpp"
 #include "pmu/sim/bus_runner.hpp"
+#include "pmu/sysconf_dir.hpp"
 #include "pmu/transport/sim_bus.hpp"
 #include "pmu/transport/socketcan_bus.hpp"
 
@@ -38,7 +39,7 @@ namespace {
 using namespace pmu;
 using std::chrono::milliseconds;
 
-constexpr const char* kDefaultConfig = "/etc/pmu-dds/pmu-service.yaml";
+constexpr const char* kDefaultConfig = PMU_SYSCONFDIR "/pmu-service.yaml";
 
 // Everything one bus needs, torn down in reverse order.
 struct BusRuntime {

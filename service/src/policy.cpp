@@ -38,7 +38,14 @@ std::optional<ConfirmRule> rule_for(const CommandRequest& r) {
         return p->raw == 0 ? std::optional(ConfirmRule::ThermalShutdown) : std::nullopt;
       case codec::Parameter::PowerUpState:
         return p->raw & AvionicsServo ? std::nullopt : std::optional(ConfirmRule::PowerUpAvionicsOff);
-      default: return std::nullopt;
+      case codec::Parameter::AvionicsVoltage:
+      case codec::Parameter::PayloadVoltage:
+      case codec::Parameter::ServoVoltage:
+      case codec::Parameter::BatteryVoltage:
+      case codec::Parameter::PacketPeriod:
+      case codec::Parameter::PacketsStreamed:
+      case codec::Parameter::TemperatureOffset:
+      case codec::Parameter::CrankingTime: return std::nullopt;
     }
   }
   return std::nullopt;

@@ -120,7 +120,7 @@ wait_telemetry() {  # the service and the simulator are up and samples reach pmu
 # ---- scenarios -------------------------------------------------------------------------
 
 # Every telemetry topic arrives through pmu-service from pmu-sim over vcan0, with the
-# simulator's values (tools/sim/include/pmu/sim/config.hpp: V_A 12.0, V_P 12.0, V_S 6.0,
+# simulator's values (sim/include/pmu/sim/config.hpp: V_A 12.0, V_P 12.0, V_S 6.0,
 # PP 1.0 s, plant 22.2 V batteries, 35 degC inside, engine running at 6000 rpm).
 scenario_telemetry() {
   start_sim

@@ -7,7 +7,8 @@
 // reply, correlated by request_id. Exit status 0 when every step COMPLETED.
 //
 // Build: it is the CMake target `ground_station_example` (links the generated pmu::idl and
-// Fast DDS only). Run: pmu-service --bus sim & ground_station_example
+// Fast DDS only; pmu/sysconf_dir.hpp only names where qos.xml is installed).
+// Run: pmu-service --bus sim & ground_station_example
 //
 // DDS-Security: with PMU_SECURITY_DIR set (a folder made by deploy/security/make_pki.sh)
 // it joins with the identity PMU_SECURITY_IDENTITY (default ground-station), through the
@@ -38,6 +39,7 @@
 #include "pmu/idl/state.h"
 #include "pmu/idl/statePubSubTypes.h"
 #include "pmu/idl/telemetry.h"
+#include "pmu/sysconf_dir.hpp"
 #include "pmu/idl/telemetryPubSubTypes.h"
 
 using namespace eprosima::fastdds::dds;
@@ -139,7 +141,7 @@ int main(int argc, char** argv) {
   // The contract's QoS profiles, loaded by name.
   const char* qos = std::getenv("PMU_QOS_FILE");
   auto* factory = DomainParticipantFactory::get_instance();
-  if (factory->load_XML_profiles_file(qos ? qos : "/etc/pmu-dds/qos.xml") != ReturnCode_t::RETCODE_OK) {
+  if (factory->load_XML_profiles_file(qos ? qos : PMU_SYSCONFDIR "/qos.xml") != ReturnCode_t::RETCODE_OK) {
     std::fprintf(stderr, "cannot load the QoS profiles (set PMU_QOS_FILE to deploy/qos.xml)\n");
     return 2;
   }

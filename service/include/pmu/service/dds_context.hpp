@@ -32,8 +32,9 @@ class DdsError : public std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
-// The installed qos.xml: $PMU_QOS_FILE, else /etc/pmu-dds/qos.xml, else the source tree's
-// deploy/qos.xml (for runs from a build directory). Empty when none exists.
+// The installed qos.xml: $PMU_QOS_FILE, else qos.xml in the configuration directory
+// (PMU_SYSCONFDIR, /etc/pmu-dds). Empty when none exists. Never the source tree: runs from a
+// build directory set PMU_QOS_FILE (scripts/run.sh and the tests do).
 std::string default_qos_file();
 
 

@@ -66,6 +66,12 @@ void ModelState::on_frame(const codec::CanFrame& frame, TimePoint now) noexcept 
 }
 
 void ModelState::handle(const codec::PmuMessage& msg, TimePoint now) noexcept {
+  // Unreachable while decode only yields table 1 packets; checked here so that the switch
+  // below can name every packet and the compiler points at it when the table grows.
+  if (!codec::is_known_packet(static_cast<std::uint8_t>(msg.packet))) {
+    ++counters.unknown_packet;
+    return;
+  }
   switch (msg.packet) {
     case PacketId::Voltages:
     case PacketId::Currents:
@@ -139,7 +145,17 @@ void ModelState::handle(const codec::PmuMessage& msg, TimePoint now) noexcept {
         send(codec::encode_firmware(info, address), now);
       }
       break;
-    default:
+    case PacketId::AvionicsVoltage:
+    case PacketId::PayloadVoltage:
+    case PacketId::ServoVoltage:
+    case PacketId::BatteryVoltage:
+    case PacketId::PacketPeriod:
+    case PacketId::PacketsStreamed:
+    case PacketId::TemperatureOffset:
+    case PacketId::UpperTemperatureLimit:
+    case PacketId::PowerUpState:
+    case PacketId::CrankingTime:
+    case PacketId::CanAddress:
       handle_parameter(msg, now);
       return;  // counts for itself
   }
@@ -185,8 +201,17 @@ void ModelState::handle_parameter(const codec::PmuMessage& msg, TimePoint now) n
       // restart); the unit answers on it from the next frame.
       address = static_cast<std::uint16_t>(set->raw);
       break;
-    default:
-      break;  // V_A/V_P/V_S show in the next measurement; S0 applies at the next reset
+    case codec::Parameter::AvionicsVoltage:
+    case codec::Parameter::PayloadVoltage:
+    case codec::Parameter::ServoVoltage:
+      break;  // they show in the next measurement
+    case codec::Parameter::PowerUpState:
+      break;  // applies at the next reset
+    case codec::Parameter::BatteryVoltage:
+    case codec::Parameter::PacketsStreamed:
+    case codec::Parameter::TemperatureOffset:
+    case codec::Parameter::CrankingTime:
+      break;  // read where they are used (streaming, readings, cranking), nothing to redo
   }
 }
 

@@ -1,0 +1,18 @@
+# Install directories (GNUInstallDirs) and the one place the configuration directory is named.
+#
+# The configuration lives in /etc/pmu-dds whatever the prefix: the systemd unit, install.sh
+# and the documentation name it, and a service built for /usr/local must still find the
+# config the site installed. So sysconfdir defaults to /etc (GNUInstallDirs alone would make
+# it PREFIX/etc); a packager may still pass -DCMAKE_INSTALL_SYSCONFDIR or -DPMU_SYSCONFDIR.
+set(CMAKE_INSTALL_SYSCONFDIR /etc CACHE PATH "read-only single-machine data (/etc)")
+include(GNUInstallDirs)
+set(PMU_SYSCONFDIR "${CMAKE_INSTALL_FULL_SYSCONFDIR}/pmu-dds" CACHE PATH
+    "Where pmu-service and pmuctl look for pmu-service.yaml and qos.xml")
+
+# The binaries learn the directory from this one generated header, so nothing else in the
+# sources names it and no build-tree path reaches an installed binary.
+configure_file(${CMAKE_CURRENT_LIST_DIR}/sysconf_dir.hpp.in
+               ${PROJECT_BINARY_DIR}/generated/include/pmu/sysconf_dir.hpp @ONLY)
+add_library(pmu_sysconf_dir INTERFACE)
+target_include_directories(pmu_sysconf_dir INTERFACE ${PROJECT_BINARY_DIR}/generated/include)
+add_library(pmu::sysconf_dir ALIAS pmu_sysconf_dir)
