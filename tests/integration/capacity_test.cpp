@@ -21,6 +21,7 @@
 #include "pmu/service/dds_context.hpp"
 #include "pmu/service/dds_publisher.hpp"
 #include "support/domain.hpp"
+#include "support/json_lines.hpp"
 #include "support/process.hpp"
 #include "support/wait.hpp"
 
@@ -38,13 +39,7 @@ int exclusive_domain() { return pmu::test::exclusive_dds_domain(); }
 // stdout only: pmuctl's diagnostics go to stderr and would not parse as JSON.
 pmu::test::RunResult run(const std::string& cmd) { return pmu::test::run_capture(cmd); }
 
-std::vector<nlohmann::json> json_lines(const std::string& out) {
-  std::vector<nlohmann::json> v;
-  std::istringstream in(out);
-  for (std::string line; std::getline(in, line);)
-    if (!line.empty()) v.push_back(nlohmann::json::parse(line, nullptr, false));
-  return v;
-}
+using pmu::test::json_lines;
 
 class ManyPmus : public ::testing::Test {
  protected:

@@ -22,6 +22,7 @@
 #include "pmu/service/dds_context.hpp"
 #include "pmu/service/dds_publisher.hpp"
 #include "support/domain.hpp"
+#include "support/json_lines.hpp"
 #include "support/process.hpp"
 #include "support/wait.hpp"
 
@@ -199,11 +200,8 @@ TEST(CrossProcess, ServiceOnSimulatedBusFeedsPmuctl) {
   ASSERT_EQ(watched.status, 0) << out;
   std::set<std::string> topics;
   std::size_t lines = 0;
-  std::size_t start = 0;
-  for (std::size_t i = 0; i < out.size(); ++i) {
-    if (out[i] != '\n') continue;
-    const auto j = nlohmann::json::parse(out.substr(start, i - start));
-    start = i + 1;
+  for (const auto& j : pmu::test::json_lines(out)) {
+    ASSERT_FALSE(j.is_discarded()) << out;
     ++lines;
     topics.insert(j["topic"].get<std::string>());
     EXPECT_EQ(j["bus"], "sim0");

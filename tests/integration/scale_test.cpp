@@ -23,6 +23,7 @@
 #include <vector>
 
 #include "support/domain.hpp"
+#include "support/json_lines.hpp"
 #include "support/process.hpp"
 #include "support/wait.hpp"
 
@@ -41,13 +42,7 @@ std::string bus_name(int b) { return "sim" + std::to_string(b); }
 // stdout only: pmuctl's JSON lines.
 pmu::test::RunResult run(const std::string& cmd) { return pmu::test::run_capture(cmd); }
 
-std::vector<nlohmann::json> json_lines(const std::string& out) {
-  std::vector<nlohmann::json> v;
-  std::istringstream in(out);
-  for (std::string line; std::getline(in, line);)
-    if (!line.empty()) v.push_back(nlohmann::json::parse(line, nullptr, false));
-  return v;
-}
+using pmu::test::json_lines;
 
 // pmu-service on a generated config, stopped with SIGTERM (a killed participant would leave
 // its shared-memory ports behind for later tests to wait on).
