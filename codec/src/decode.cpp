@@ -3,6 +3,7 @@
 #include <cstdio>
 
 #include "bytes.hpp"
+#include "pmu/codec/packets.hpp"
 
 namespace pmu::codec {
 namespace {
@@ -99,41 +100,13 @@ Payload decode_payload(PacketId p, const std::uint8_t* d, std::optional<Firmware
 }  // namespace
 
 std::uint8_t data_length(PacketId packet) noexcept {
-  switch (packet) {
-    case PacketId::Voltages: return 7;
-    case PacketId::Currents: return 6;
-    case PacketId::BatteryEnergy: return 4;
-    case PacketId::Temperatures: return 5;
-    case PacketId::Status: return 5;
-    case PacketId::CanAddress: return 2;
-    case PacketId::EngineStart:
-    case PacketId::EngineStop:
-    case PacketId::Reset: return 0;
-    case PacketId::Serial: return 2;
-    case PacketId::Firmware: return 6;
-    case PacketId::MeasurementRequest:
-    case PacketId::AvionicsVoltage:
-    case PacketId::PayloadVoltage:
-    case PacketId::ServoVoltage:
-    case PacketId::BatteryVoltage:
-    case PacketId::PacketPeriod:
-    case PacketId::PacketsStreamed:
-    case PacketId::TemperatureOffset:
-    case PacketId::UpperTemperatureLimit:
-    case PacketId::PowerUpState:
-    case PacketId::CrankingTime:
-    case PacketId::Outputs:
-    case PacketId::EnableOutputs:
-    case PacketId::DisableOutputs:
-    case PacketId::Generation: return 1;
-  }
-  return 1;  // an id outside table 1 (a PacketId made from a raw byte)
+  const PacketSpec* p = find_packet(packet);
+  return p ? p->length : 0;
 }
 
 bool has_zero_length_get(PacketId packet) noexcept {
-  const auto id = static_cast<std::uint8_t>(packet);
-  return id <= 0x20 || packet == PacketId::Generation || packet == PacketId::Serial ||
-         packet == PacketId::Firmware;
+  const PacketSpec* p = find_packet(packet);
+  return p && p->zero_length_get;
 }
 
 Result<PmuMessage, DecodeError> decode(const CanFrame& frame, std::optional<FirmwareVersion> fw) noexcept {

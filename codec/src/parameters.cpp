@@ -1,5 +1,7 @@
 #include "pmu/codec/parameters.hpp"
 
+#include "pmu/codec/packets.hpp"
+
 namespace pmu::codec {
 namespace {
 
@@ -24,6 +26,16 @@ constexpr ParameterSpec kTable[kParameterCount] = {
     // CA: 0..65534; 65535 is the broadcast address (table 18).
     {Parameter::CanAddress, PacketId::CanAddress, "can_address", "", K::Integer, 1, 0, 65534, 2},
 };
+
+// The width is the packet's length in table 1; packets.hpp states it too, and they must agree.
+constexpr bool widths_match_packet_table() noexcept {
+  for (const auto& s : kTable) {
+    const PacketSpec* p = find_packet(s.packet);
+    if (!p || p->length != s.width) return false;
+  }
+  return true;
+}
+static_assert(widths_match_packet_table());
 
 }  // namespace
 
