@@ -1,43 +1,33 @@
 #include "pmu/codec/decode.hpp"
 
 #include <cstdio>
+#include <type_traits>
 
 #include "bytes.hpp"
+#include "fields.hpp"
 #include "pmu/codec/packets.hpp"
 
 namespace pmu::codec {
 namespace {
 
-constexpr std::int8_t kNoSensorRaw = -128;
-
-double temperature(std::uint8_t byte, bool sensor_optional) noexcept {
-  const auto t = as_signed(byte);
-  if (sensor_optional && t == kNoSensorRaw) return kNoSensor;
-  return t;
-}
-
-Voltages decode_voltages(const std::uint8_t* d) noexcept {
-  // Table 2: x10 except 28 V (x5) and generator (x2.5).
-  return {d[0] / 10.0, d[1] / 5.0, d[2] / 10.0, d[3] / 10.0, d[4] / 10.0, d[5] / 10.0, d[6] / 2.5};
-}
-
-Currents decode_currents(const std::uint8_t* d) noexcept {
-  // Table 3: 28 V and battery currents are signed, the outputs unsigned; all x10.
-  return {d[0] / 10.0, as_signed(d[1]) / 10.0, d[2] / 10.0, d[3] / 10.0, as_signed(d[4]) / 10.0,
-          as_signed(d[5]) / 10.0};
-}
-
-Temperatures decode_temperatures(const std::uint8_t* d, std::optional<FirmwareVersion> fw) noexcept {
-  Temperatures t;
-  t.internal = temperature(d[0], false);
-  t.starter = temperature(d[4], false);
-  // External sensing exists from firmware 1.12; earlier firmware has nothing to report.
-  if (supports(fw, Feature::ExternalTemperatures)) {
-    t.battery_a = temperature(d[1], true);
-    t.battery_b = temperature(d[2], true);
-    t.generator = temperature(d[3], true);
+// One telemetry packet from its table. A 1.12+ external sensor is left at "no sensor" (the
+// struct's NaN) on older firmware: the feature did not exist, so the byte means nothing.
+template <class Packet>
+Packet decode_fields(const std::uint8_t* d, std::optional<FirmwareVersion> fw) noexcept {
+  Packet p;
+  const bool external = supports(fw, Feature::ExternalTemperatures);
+  for (const auto& f : Telemetry<Packet>::fields) {
+    if (f.external_sensor && !external) continue;
+    const std::int32_t raw = read_field(f.wire, d + f.offset);
+    using Value = std::remove_reference_t<decltype(p.*f.member)>;
+    if constexpr (std::is_floating_point_v<Value>) {
+      // Division (not multiplication by 0.1) so 123 -> 12.3 exactly as printed.
+      p.*f.member = f.external_sensor && raw == kNoSensorRaw ? kNoSensor : static_cast<double>(raw) / f.divisor;
+    } else {
+      p.*f.member = static_cast<Value>(raw);
+    }
   }
-  return t;
+  return p;
 }
 
 Status decode_status(const std::uint8_t* d, std::optional<FirmwareVersion> fw) noexcept {
@@ -59,11 +49,10 @@ Status decode_status(const std::uint8_t* d, std::optional<FirmwareVersion> fw) n
 
 Payload decode_payload(PacketId p, const std::uint8_t* d, std::optional<FirmwareVersion> fw) noexcept {
   switch (p) {
-    case PacketId::Voltages: return decode_voltages(d);
-    case PacketId::Currents: return decode_currents(d);
-    case PacketId::BatteryEnergy:
-      return BatteryEnergy{as_signed16(be16(d)), as_signed16(be16(d + 2))};
-    case PacketId::Temperatures: return decode_temperatures(d, fw);
+    case PacketId::Voltages: return decode_fields<Voltages>(d, fw);
+    case PacketId::Currents: return decode_fields<Currents>(d, fw);
+    case PacketId::BatteryEnergy: return decode_fields<BatteryEnergy>(d, fw);
+    case PacketId::Temperatures: return decode_fields<Temperatures>(d, fw);
     case PacketId::Status: return decode_status(d, fw);
     case PacketId::MeasurementRequest:
       // Bits 5..7 are "don't care" (table 7).
