@@ -4,7 +4,9 @@
 // the rows of a packet tile its frame, and names and ids map both ways.
 #include <gtest/gtest.h>
 
+#include <chrono>
 #include <cmath>
+#include <utility>
 #include <set>
 #include <string>
 #include <type_traits>
@@ -171,6 +173,76 @@ TEST(TelemetryTables, ClampToFieldStopsAtTheRangeAndPassesNaN) {
   const Voltages c = clamped_to_fields(v);
   EXPECT_EQ(c.generator, 100.0);
   EXPECT_EQ(c.servo, 0.0);
+}
+
+// ---- output and group names (interface.md; tables 7, 13, 19..21) ---------------------------
+TEST(Names, OutputsByNameAndBack) {
+  const std::pair<const char*, std::uint8_t> typed[] = {
+      {"avionics_servo", 0x01}, {"payload", 0x02}, {"charger_a", 0x04}, {"charger_b", 0x08}};
+  for (const auto& [name, bit] : typed) {
+    EXPECT_EQ(bit_named(kOutputNames, name), bit) << name;
+    EXPECT_EQ(names_of(kOutputNames, bit), name);
+  }
+  EXPECT_EQ(bit_named(kOutputNames, "charger_c"), std::nullopt);
+  EXPECT_EQ(bit_named(kOutputNames, "voltages"), std::nullopt);
+  EXPECT_EQ(names_of(kOutputNames, 0x05), "avionics_servo,charger_a");
+  EXPECT_EQ(names_of(kOutputNames, 0x00), "");
+  EXPECT_EQ(names_of(kOutputNames, 0xF0), "");  // undefined bits have no name
+  EXPECT_EQ(names_of(kOutputNames, output_bit::All, ", "), "avionics_servo, payload, charger_a, charger_b");
+}
+
+TEST(Names, GroupsByNameAndBack) {
+  const std::pair<const char*, std::uint8_t> typed[] = {{"voltages", 0x01},
+                                                        {"currents", 0x02},
+                                                        {"battery_energy", 0x04},
+                                                        {"temperatures", 0x08},
+                                                        {"status", 0x10}};
+  for (const auto& [name, bit] : typed) {
+    EXPECT_EQ(bit_named(kGroupNames, name), bit) << name;
+    EXPECT_EQ(names_of(kGroupNames, bit), name);
+  }
+  EXPECT_EQ(bit_named(kGroupNames, "payload"), std::nullopt);
+  EXPECT_EQ(names_of(kGroupNames, group_bit::All, ", "), "voltages, currents, battery_energy, temperatures, status");
+}
+
+template <std::size_t N>
+void expect_bits_tile(const std::array<NamedBit, N>& table, std::uint8_t all) {
+  std::uint8_t seen = 0;
+  for (const auto& b : table) {
+    EXPECT_EQ(b.bit & (b.bit - 1), 0) << b.name << " is one bit";
+    EXPECT_EQ(seen & b.bit, 0) << b.name;
+    seen = static_cast<std::uint8_t>(seen | b.bit);
+  }
+  EXPECT_EQ(seen, all);
+}
+
+TEST(Names, EachDefinedBitHasExactlyOneName) {
+  expect_bits_tile(kOutputNames, output_bit::All);
+  expect_bits_tile(kGroupNames, group_bit::All);
+}
+
+// ---- durations (tables 12 and 17: 0.1 s steps) --------------------------------------------
+TEST(Durations, PacketPeriodAndCrankingTimeInMilliseconds) {
+  using std::chrono::milliseconds;
+  EXPECT_EQ(duration_value(Parameter::PacketPeriod, milliseconds(1500)), 1.5);
+  EXPECT_EQ(duration_value(Parameter::CrankingTime, milliseconds(100)), 0.1);
+  EXPECT_EQ(duration_of(Parameter::PacketPeriod, 15), milliseconds(1500));
+  EXPECT_EQ(duration_of(Parameter::CrankingTime, 0), milliseconds(0));
+  for (std::uint32_t raw = 1; raw <= 255; ++raw) {
+    SCOPED_TRACE(raw);
+    EXPECT_EQ(duration_of(Parameter::PacketPeriod, raw), milliseconds(raw * 100));
+    const auto back = to_raw(Parameter::PacketPeriod, duration_value(Parameter::PacketPeriod, milliseconds(raw * 100)));
+    ASSERT_TRUE(back.ok());
+    EXPECT_EQ(*back, raw);
+  }
+  // 0.15 s is between two steps: refused, not rounded.
+  EXPECT_FALSE(to_raw(Parameter::PacketPeriod, duration_value(Parameter::PacketPeriod, milliseconds(150))).ok());
+}
+
+TEST(Durations, OtherParametersAreNotDurations) {
+  EXPECT_TRUE(std::isnan(duration_value(Parameter::AvionicsVoltage, std::chrono::milliseconds(1000))));
+  EXPECT_EQ(duration_of(Parameter::UpperTemperatureLimit, 80), std::chrono::milliseconds(0));
+  EXPECT_FALSE(to_raw(Parameter::AvionicsVoltage, duration_value(Parameter::AvionicsVoltage, std::chrono::seconds(12))).ok());
 }
 
 }  // namespace
