@@ -2,6 +2,7 @@
 
 #include <cstdio>
 #include <type_traits>
+#include <utility>
 
 #include "bytes.hpp"
 #include "fields.hpp"
@@ -10,24 +11,46 @@
 namespace pmu::codec {
 namespace {
 
-// One telemetry packet from its table. A 1.12+ external sensor is left at "no sensor" (the
-// struct's NaN) on older firmware: the feature did not exist, so the byte means nothing.
+// One field of a telemetry packet, its row a compile-time constant so the wire type and
+// the member fold into straight-line code (no per-field dispatch on the frame path).
+template <class Packet, std::size_t I>
+void decode_field(Packet& p, const std::uint8_t* d, bool external) noexcept {
+  constexpr const auto& f = Telemetry<Packet>::fields[I];
+  using Value = std::remove_reference_t<decltype(p.*f.member)>;
+  if constexpr (f.external_sensor) {
+    // Left at "no sensor" (the struct's NaN) before 1.12: the feature did not exist, so the
+    // byte means nothing.
+    if (!external) return;
+  }
+  const std::int32_t raw = read_field(f.wire, d + f.offset);
+  if constexpr (std::is_floating_point_v<Value>) {
+    if constexpr (f.external_sensor) {
+      if (raw == kNoSensorRaw) {
+        p.*f.member = kNoSensor;
+        return;
+      }
+    }
+    // Division (not multiplication by 0.1) so 123 -> 12.3 exactly as printed.
+    p.*f.member = static_cast<double>(raw) / f.divisor;
+  } else {
+    p.*f.member = static_cast<Value>(raw);
+  }
+}
+
+template <class Packet, std::size_t... I>
+Packet decode_fields(const std::uint8_t* d, std::optional<FirmwareVersion> fw, std::index_sequence<I...>) noexcept {
+  Packet p;
+  bool external = true;
+  if constexpr ((Telemetry<Packet>::fields[I].external_sensor || ...))
+    external = supports(fw, Feature::ExternalTemperatures);
+  (decode_field<Packet, I>(p, d, external), ...);
+  return p;
+}
+
+// One telemetry packet from its table (telemetry.hpp).
 template <class Packet>
 Packet decode_fields(const std::uint8_t* d, std::optional<FirmwareVersion> fw) noexcept {
-  Packet p;
-  const bool external = supports(fw, Feature::ExternalTemperatures);
-  for (const auto& f : Telemetry<Packet>::fields) {
-    if (f.external_sensor && !external) continue;
-    const std::int32_t raw = read_field(f.wire, d + f.offset);
-    using Value = std::remove_reference_t<decltype(p.*f.member)>;
-    if constexpr (std::is_floating_point_v<Value>) {
-      // Division (not multiplication by 0.1) so 123 -> 12.3 exactly as printed.
-      p.*f.member = f.external_sensor && raw == kNoSensorRaw ? kNoSensor : static_cast<double>(raw) / f.divisor;
-    } else {
-      p.*f.member = static_cast<Value>(raw);
-    }
-  }
-  return p;
+  return decode_fields<Packet>(d, fw, std::make_index_sequence<Telemetry<Packet>::fields.size()>{});
 }
 
 Status decode_status(const std::uint8_t* d, std::optional<FirmwareVersion> fw) noexcept {

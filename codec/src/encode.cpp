@@ -4,6 +4,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <type_traits>
+#include <utility>
 
 #include "bytes.hpp"
 #include "fields.hpp"
@@ -56,28 +57,45 @@ Result<long, EncodeError> measured(double value, double divisor, long raw_min, l
   return raw;
 }
 
-// One telemetry packet from its table; the first field that does not fit is the error.
-template <class Packet>
-Encoded encode_fields(const Packet& p, std::uint16_t address) noexcept {
+// One field of a telemetry packet into `out`, its row a compile-time constant (as in
+// decode.cpp); false with `error` set when the value does not fit the field.
+template <class Packet, std::size_t I>
+bool encode_field(const Packet& p, CanFrame& out, EncodeError& error) noexcept {
+  constexpr const auto& f = Telemetry<Packet>::fields[I];
+  const auto value = p.*f.member;
+  long raw = 0;
+  if constexpr (std::is_floating_point_v<decltype(value)>) {
+    if (f.external_sensor && std::isnan(value)) {
+      raw = kNoSensorRaw;
+    } else {
+      auto r = measured(value, f.divisor, f.raw_min, f.raw_max, f.name, f.unit);
+      if (!r) {
+        error = r.error();
+        return false;
+      }
+      raw = *r;
+    }
+  } else {
+    raw = value;  // an integer field holds nothing its wire type cannot carry
+  }
+  write_field(f.wire, out.data.data() + f.offset, raw);
+  return true;
+}
+
+// One telemetry packet from its table (telemetry.hpp); the first field that does not fit
+// is the error.
+template <class Packet, std::size_t... I>
+Encoded encode_fields(const Packet& p, std::uint16_t address, std::index_sequence<I...>) noexcept {
   constexpr PacketId id = Telemetry<Packet>::packet;
   CanFrame f = frame(id, address, data_length(id));
-  for (const auto& field : Telemetry<Packet>::fields) {
-    const auto value = p.*field.member;
-    long raw = 0;
-    if constexpr (std::is_floating_point_v<decltype(value)>) {
-      if (field.external_sensor && std::isnan(value)) {
-        raw = kNoSensorRaw;
-      } else {
-        auto r = measured(value, field.divisor, field.raw_min, field.raw_max, field.name, field.unit);
-        if (!r) return Unexpected{r.error()};
-        raw = *r;
-      }
-    } else {
-      raw = value;  // an integer field holds nothing its wire type cannot carry
-    }
-    write_field(field.wire, f.data.data() + field.offset, raw);
-  }
+  EncodeError error;
+  if (!(encode_field<Packet, I>(p, f, error) && ...)) return Unexpected{error};
   return f;
+}
+
+template <class Packet>
+Encoded encode_fields(const Packet& p, std::uint16_t address) noexcept {
+  return encode_fields(p, address, std::make_index_sequence<Telemetry<Packet>::fields.size()>{});
 }
 
 Encoded mask_command(PacketId p, std::uint8_t mask, std::uint16_t address, bool allow_empty) noexcept {

@@ -50,11 +50,23 @@ inline constexpr std::array<PacketSpec, 26> kPacketTable{{
     {PacketId::Firmware, "firmware", 6, true},
 }};
 
+namespace detail {
+inline constexpr std::uint8_t kNoRow = 0xFF;
+// Packet byte -> row, so a lookup on the frame path is one load rather than a search.
+constexpr std::array<std::uint8_t, 256> make_packet_index() noexcept {
+  std::array<std::uint8_t, 256> index{};
+  for (auto& i : index) i = kNoRow;
+  for (std::size_t row = 0; row < kPacketTable.size(); ++row)
+    index[static_cast<std::uint8_t>(kPacketTable[row].id)] = static_cast<std::uint8_t>(row);
+  return index;
+}
+inline constexpr std::array<std::uint8_t, 256> kPacketIndex = make_packet_index();
+}  // namespace detail
+
 // The row of `packet`; nullptr for an id outside table 1 (a PacketId made from a raw byte).
 constexpr const PacketSpec* find_packet(PacketId packet) noexcept {
-  for (const auto& p : kPacketTable)
-    if (p.id == packet) return &p;
-  return nullptr;
+  const std::uint8_t row = detail::kPacketIndex[static_cast<std::uint8_t>(packet)];
+  return row == detail::kNoRow ? nullptr : &kPacketTable[row];
 }
 
 }  // namespace pmu::codec
