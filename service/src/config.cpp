@@ -118,8 +118,9 @@ DeviceConfig parse_device(const Ctx& c, const YAML::Node& n) {
   c.only_keys(n, "device", {"address", "mode", "period", "packets", "configure_streaming"});
   DeviceConfig d;
   const auto a = n["address"];
-  if (!a) c.fail(n, "device needs an address (0..65534)");
-  d.address = static_cast<std::uint16_t>(c.integer(a, "address", 0, 65534));
+  // 65535 is the broadcast address, never a device's (v1.9 section 4).
+  if (!a) c.fail(n, "device needs an address (0.." + std::to_string(codec::kMaxDeviceAddress) + ")");
+  d.address = static_cast<std::uint16_t>(c.integer(a, "address", 0, codec::kMaxDeviceAddress));
   parse_device_settings(c, n, d);
   return d;
 }
