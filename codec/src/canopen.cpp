@@ -35,10 +35,6 @@ struct Entry {
   std::string_view unit;
 };
 
-constexpr std::uint16_t kMpptBase = 0x4E6;
-constexpr std::uint16_t kMpptStride = 8;
-constexpr std::uint8_t kMpptDevices = 8;
-
 // Battery (MG) table.
 constexpr Entry kBattery[] = {
     {0x302, 0x2005, 0x01, "voltage", Type::U16, 1000, "V"},
@@ -83,13 +79,17 @@ constexpr Entry kMppt[] = {
 
 constexpr std::uint8_t kHeader = 4;  // Data[0] command byte, Data[1..2] index, Data[3] subindex
 
-bool is_battery_id(std::uint32_t id) noexcept { return id == 0x202 || id == 0x302 || id == 0x402 || id == 0x482; }
+bool is_battery_id(std::uint32_t id) noexcept {
+  for (const auto cob : kBatteryCobIds)
+    if (id == cob) return true;
+  return false;
+}
 
 bool mppt_slot(std::uint32_t id, std::uint8_t& device, std::uint16_t& offset) noexcept {
   if (id < kMpptBase || id >= kMpptBase + kMpptStride * kMpptDevices) return false;
   device = static_cast<std::uint8_t>((id - kMpptBase) / kMpptStride);
   offset = static_cast<std::uint16_t>((id - kMpptBase) % kMpptStride);
-  return offset <= 1;  // the rest of each block is unassigned
+  return offset < kMpptIdsUsed;  // the rest of each block is unassigned
 }
 
 double scalar(Type t, const std::uint8_t* p) noexcept {

@@ -1,42 +1,56 @@
 #include "pmu/codec/decode.hpp"
 
 #include <cstdio>
+#include <type_traits>
+#include <utility>
 
 #include "bytes.hpp"
+#include "fields.hpp"
+#include "pmu/codec/packets.hpp"
 
 namespace pmu::codec {
 namespace {
 
-constexpr std::int8_t kNoSensorRaw = -128;
-
-double temperature(std::uint8_t byte, bool sensor_optional) noexcept {
-  const auto t = as_signed(byte);
-  if (sensor_optional && t == kNoSensorRaw) return kNoSensor;
-  return t;
-}
-
-Voltages decode_voltages(const std::uint8_t* d) noexcept {
-  // Table 2: x10 except 28 V (x5) and generator (x2.5).
-  return {d[0] / 10.0, d[1] / 5.0, d[2] / 10.0, d[3] / 10.0, d[4] / 10.0, d[5] / 10.0, d[6] / 2.5};
-}
-
-Currents decode_currents(const std::uint8_t* d) noexcept {
-  // Table 3: 28 V and battery currents are signed, the outputs unsigned; all x10.
-  return {d[0] / 10.0, as_signed(d[1]) / 10.0, d[2] / 10.0, d[3] / 10.0, as_signed(d[4]) / 10.0,
-          as_signed(d[5]) / 10.0};
-}
-
-Temperatures decode_temperatures(const std::uint8_t* d, std::optional<FirmwareVersion> fw) noexcept {
-  Temperatures t;
-  t.internal = temperature(d[0], false);
-  t.starter = temperature(d[4], false);
-  // External sensing exists from firmware 1.12; earlier firmware has nothing to report.
-  if (supports(fw, Feature::ExternalTemperatures)) {
-    t.battery_a = temperature(d[1], true);
-    t.battery_b = temperature(d[2], true);
-    t.generator = temperature(d[3], true);
+// One field of a telemetry packet, its row a compile-time constant so the wire type and
+// the member fold into straight-line code (no per-field dispatch on the frame path).
+template <class Packet, std::size_t I>
+void decode_field(Packet& p, const std::uint8_t* d, bool external) noexcept {
+  constexpr const auto& f = Telemetry<Packet>::fields[I];
+  using Value = std::remove_reference_t<decltype(p.*f.member)>;
+  if constexpr (f.external_sensor) {
+    // Left at "no sensor" (the struct's NaN) before 1.12: the feature did not exist, so the
+    // byte means nothing.
+    if (!external) return;
   }
-  return t;
+  const std::int32_t raw = read_field(f.wire, d + f.offset);
+  if constexpr (std::is_floating_point_v<Value>) {
+    if constexpr (f.external_sensor) {
+      if (raw == kNoSensorRaw) {
+        p.*f.member = kNoSensor;
+        return;
+      }
+    }
+    // Division (not multiplication by 0.1) so 123 -> 12.3 exactly as printed.
+    p.*f.member = static_cast<double>(raw) / f.divisor;
+  } else {
+    p.*f.member = static_cast<Value>(raw);
+  }
+}
+
+template <class Packet, std::size_t... I>
+Packet decode_fields(const std::uint8_t* d, std::optional<FirmwareVersion> fw, std::index_sequence<I...>) noexcept {
+  Packet p;
+  bool external = true;
+  if constexpr ((Telemetry<Packet>::fields[I].external_sensor || ...))
+    external = supports(fw, Feature::ExternalTemperatures);
+  (decode_field<Packet, I>(p, d, external), ...);
+  return p;
+}
+
+// One telemetry packet from its table (telemetry.hpp).
+template <class Packet>
+Packet decode_fields(const std::uint8_t* d, std::optional<FirmwareVersion> fw) noexcept {
+  return decode_fields<Packet>(d, fw, std::make_index_sequence<Telemetry<Packet>::fields.size()>{});
 }
 
 Status decode_status(const std::uint8_t* d, std::optional<FirmwareVersion> fw) noexcept {
@@ -58,11 +72,10 @@ Status decode_status(const std::uint8_t* d, std::optional<FirmwareVersion> fw) n
 
 Payload decode_payload(PacketId p, const std::uint8_t* d, std::optional<FirmwareVersion> fw) noexcept {
   switch (p) {
-    case PacketId::Voltages: return decode_voltages(d);
-    case PacketId::Currents: return decode_currents(d);
-    case PacketId::BatteryEnergy:
-      return BatteryEnergy{as_signed16(be16(d)), as_signed16(be16(d + 2))};
-    case PacketId::Temperatures: return decode_temperatures(d, fw);
+    case PacketId::Voltages: return decode_fields<Voltages>(d, fw);
+    case PacketId::Currents: return decode_fields<Currents>(d, fw);
+    case PacketId::BatteryEnergy: return decode_fields<BatteryEnergy>(d, fw);
+    case PacketId::Temperatures: return decode_fields<Temperatures>(d, fw);
     case PacketId::Status: return decode_status(d, fw);
     case PacketId::MeasurementRequest:
       // Bits 5..7 are "don't care" (table 7).
@@ -99,41 +112,13 @@ Payload decode_payload(PacketId p, const std::uint8_t* d, std::optional<Firmware
 }  // namespace
 
 std::uint8_t data_length(PacketId packet) noexcept {
-  switch (packet) {
-    case PacketId::Voltages: return 7;
-    case PacketId::Currents: return 6;
-    case PacketId::BatteryEnergy: return 4;
-    case PacketId::Temperatures: return 5;
-    case PacketId::Status: return 5;
-    case PacketId::CanAddress: return 2;
-    case PacketId::EngineStart:
-    case PacketId::EngineStop:
-    case PacketId::Reset: return 0;
-    case PacketId::Serial: return 2;
-    case PacketId::Firmware: return 6;
-    case PacketId::MeasurementRequest:
-    case PacketId::AvionicsVoltage:
-    case PacketId::PayloadVoltage:
-    case PacketId::ServoVoltage:
-    case PacketId::BatteryVoltage:
-    case PacketId::PacketPeriod:
-    case PacketId::PacketsStreamed:
-    case PacketId::TemperatureOffset:
-    case PacketId::UpperTemperatureLimit:
-    case PacketId::PowerUpState:
-    case PacketId::CrankingTime:
-    case PacketId::Outputs:
-    case PacketId::EnableOutputs:
-    case PacketId::DisableOutputs:
-    case PacketId::Generation: return 1;
-  }
-  return 1;  // an id outside table 1 (a PacketId made from a raw byte)
+  const PacketSpec* p = find_packet(packet);
+  return p ? p->length : 0;
 }
 
 bool has_zero_length_get(PacketId packet) noexcept {
-  const auto id = static_cast<std::uint8_t>(packet);
-  return id <= 0x20 || packet == PacketId::Generation || packet == PacketId::Serial ||
-         packet == PacketId::Firmware;
+  const PacketSpec* p = find_packet(packet);
+  return p && p->zero_length_get;
 }
 
 Result<PmuMessage, DecodeError> decode(const CanFrame& frame, std::optional<FirmwareVersion> fw) noexcept {

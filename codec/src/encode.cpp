@@ -3,8 +3,11 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <type_traits>
+#include <utility>
 
 #include "bytes.hpp"
+#include "fields.hpp"
 #include "pmu/codec/decode.hpp"
 
 namespace pmu::codec {
@@ -54,7 +57,46 @@ Result<long, EncodeError> measured(double value, double divisor, long raw_min, l
   return raw;
 }
 
-std::uint8_t u8(long v) noexcept { return static_cast<std::uint8_t>(v & 0xFF); }
+// One field of a telemetry packet into `out`, its row a compile-time constant (as in
+// decode.cpp); false with `error` set when the value does not fit the field.
+template <class Packet, std::size_t I>
+bool encode_field(const Packet& p, CanFrame& out, EncodeError& error) noexcept {
+  constexpr const auto& f = Telemetry<Packet>::fields[I];
+  const auto value = p.*f.member;
+  long raw = 0;
+  if constexpr (std::is_floating_point_v<decltype(value)>) {
+    if (f.external_sensor && std::isnan(value)) {
+      raw = kNoSensorRaw;
+    } else {
+      auto r = measured(value, f.divisor, f.raw_min, f.raw_max, f.name, f.unit);
+      if (!r) {
+        error = r.error();
+        return false;
+      }
+      raw = *r;
+    }
+  } else {
+    raw = value;  // an integer field holds nothing its wire type cannot carry
+  }
+  write_field(f.wire, out.data.data() + f.offset, raw);
+  return true;
+}
+
+// One telemetry packet from its table (telemetry.hpp); the first field that does not fit
+// is the error.
+template <class Packet, std::size_t... I>
+Encoded encode_fields(const Packet& p, std::uint16_t address, std::index_sequence<I...>) noexcept {
+  constexpr PacketId id = Telemetry<Packet>::packet;
+  CanFrame f = frame(id, address, data_length(id));
+  EncodeError error;
+  if (!(encode_field<Packet, I>(p, f, error) && ...)) return Unexpected{error};
+  return f;
+}
+
+template <class Packet>
+Encoded encode_fields(const Packet& p, std::uint16_t address) noexcept {
+  return encode_fields(p, address, std::make_index_sequence<Telemetry<Packet>::fields.size()>{});
+}
 
 Encoded mask_command(PacketId p, std::uint8_t mask, std::uint16_t address, bool allow_empty) noexcept {
   const auto name = packet_name(p);
@@ -175,61 +217,13 @@ Encoded encode_reset(std::uint16_t address) noexcept { return frame(PacketId::Re
 
 // ---- device side -------------------------------------------------------------------------
 
-Encoded encode_voltages(const Voltages& v, std::uint16_t address) noexcept {
-  struct F { double value, divisor; long max; std::string_view name; };
-  const F fields[7] = {{v.avionics, 10, 250, "avionics"}, {v.output_28v, 5, 250, "output_28v"},
-                       {v.payload, 10, 250, "payload"},   {v.servo, 10, 125, "servo"},
-                       {v.battery_a, 10, 250, "battery_a"}, {v.battery_b, 10, 250, "battery_b"},
-                       {v.generator, 2.5, 250, "generator"}};
-  CanFrame f = frame(PacketId::Voltages, address, 7);
-  for (std::size_t i = 0; i < 7; ++i) {
-    auto raw = measured(fields[i].value, fields[i].divisor, 0, fields[i].max, fields[i].name, "V");
-    if (!raw) return Unexpected{raw.error()};
-    f.data[i] = u8(*raw);
-  }
-  return f;
-}
-
-Encoded encode_currents(const Currents& c, std::uint16_t address) noexcept {
-  struct F { double value; long min, max; std::string_view name; };
-  const F fields[6] = {{c.avionics, 0, 100, "avionics"},      {c.output_28v, -125, 125, "output_28v"},
-                       {c.payload, 0, 100, "payload"},        {c.servo, 0, 100, "servo"},
-                       {c.battery_a, -125, 125, "battery_a"}, {c.battery_b, -125, 125, "battery_b"}};
-  CanFrame f = frame(PacketId::Currents, address, 6);
-  for (std::size_t i = 0; i < 6; ++i) {
-    auto raw = measured(fields[i].value, 10, fields[i].min, fields[i].max, fields[i].name, "A");
-    if (!raw) return Unexpected{raw.error()};
-    f.data[i] = u8(*raw);
-  }
-  return f;
-}
-
+Encoded encode_voltages(const Voltages& v, std::uint16_t address) noexcept { return encode_fields(v, address); }
+Encoded encode_currents(const Currents& c, std::uint16_t address) noexcept { return encode_fields(c, address); }
 Encoded encode_battery_energy(const BatteryEnergy& e, std::uint16_t address) noexcept {
-  CanFrame f = frame(PacketId::BatteryEnergy, address, 4);
-  put_be16(f.data.data(), static_cast<std::uint16_t>(e.battery_a_mah));
-  put_be16(f.data.data() + 2, static_cast<std::uint16_t>(e.battery_b_mah));
-  return f;
+  return encode_fields(e, address);
 }
-
 Encoded encode_temperatures(const Temperatures& t, std::uint16_t address) noexcept {
-  struct F { double value; long min; bool optional; std::string_view name; };
-  // Table 5: -128 means "no sensor" for the external sensors; the starter reads -49..127.
-  const F fields[5] = {{t.internal, -128, false, "internal"},
-                       {t.battery_a, -127, true, "battery_a"},
-                       {t.battery_b, -127, true, "battery_b"},
-                       {t.generator, -127, true, "generator"},
-                       {t.starter, -49, false, "starter"}};
-  CanFrame f = frame(PacketId::Temperatures, address, 5);
-  for (std::size_t i = 0; i < 5; ++i) {
-    if (fields[i].optional && std::isnan(fields[i].value)) {
-      f.data[i] = 0x80;
-      continue;
-    }
-    auto raw = measured(fields[i].value, 1, fields[i].min, 127, fields[i].name, "degC");
-    if (!raw) return Unexpected{raw.error()};
-    f.data[i] = u8(*raw);
-  }
-  return f;
+  return encode_fields(t, address);
 }
 
 Encoded encode_status(const Status& s, std::uint16_t address, std::optional<FirmwareVersion> fw) noexcept {

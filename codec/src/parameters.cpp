@@ -1,5 +1,10 @@
 #include "pmu/codec/parameters.hpp"
 
+#include <cmath>
+#include <limits>
+
+#include "pmu/codec/packets.hpp"
+
 namespace pmu::codec {
 namespace {
 
@@ -25,6 +30,16 @@ constexpr ParameterSpec kTable[kParameterCount] = {
     {Parameter::CanAddress, PacketId::CanAddress, "can_address", "", K::Integer, 1, 0, 65534, 2},
 };
 
+// The width is the packet's length in table 1; packets.hpp states it too, and they must agree.
+constexpr bool widths_match_packet_table() noexcept {
+  for (const auto& s : kTable) {
+    const PacketSpec* p = find_packet(s.packet);
+    if (!p || p->length != s.width) return false;
+  }
+  return true;
+}
+static_assert(widths_match_packet_table());
+
 }  // namespace
 
 const ParameterSpec (&parameter_table() noexcept)[kParameterCount] { return kTable; }
@@ -46,6 +61,20 @@ std::optional<Parameter> parameter_from_name(std::string_view name) noexcept {
 double parameter_value(Parameter p, std::uint32_t raw) noexcept {
   // Division (not multiplication by 0.1) so 123 -> 12.3 exactly as printed.
   return static_cast<double>(raw) / spec_of(p).divisor;
+}
+
+namespace {
+bool is_duration(Parameter p) noexcept { return spec_of(p).unit == "s"; }
+}  // namespace
+
+double duration_value(Parameter p, std::chrono::milliseconds d) noexcept {
+  if (!is_duration(p)) return std::numeric_limits<double>::quiet_NaN();
+  return static_cast<double>(d.count()) / 1000.0;
+}
+
+std::chrono::milliseconds duration_of(Parameter p, std::uint32_t raw) noexcept {
+  if (!is_duration(p)) return std::chrono::milliseconds::zero();
+  return std::chrono::milliseconds(std::llround(parameter_value(p, raw) * 1000.0));
 }
 
 }  // namespace pmu::codec

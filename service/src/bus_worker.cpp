@@ -80,7 +80,7 @@ void BusWorker::on_frame(const transport::ReceivedFrame& rx) {
     for (auto& [a, candidate] : sessions_)
       if (candidate->alias() == address) s = candidate.get();
   }
-  if (!s && config_.discover && id.id->packet == codec::PacketId::Firmware && rx.frame.length == 6) {
+  if (!s && config_.discover && id.id->packet == codec::PacketId::Firmware && rx.frame.length == codec::data_length(codec::PacketId::Firmware)) {
     DeviceConfig d = config_.discovered_defaults;
     d.address = address;
     s = &add_session(d);

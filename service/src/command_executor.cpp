@@ -16,10 +16,7 @@ CommandResult result_of(const codec::EncodeError& e) {
 }
 
 std::string mask_text(std::uint8_t mask) {
-  static const char* names[] = {"avionics_servo", "payload", "charger_a", "charger_b"};
-  std::string s;
-  for (int b = 0; b < 4; ++b)
-    if (mask & (1u << b)) s += std::string(s.empty() ? "" : ",") + names[b];
+  const std::string s = codec::names_of(codec::kOutputNames, mask);
   return s.empty() ? "none" : s;
 }
 

@@ -11,6 +11,7 @@
 #include <sstream>
 
 #include "pmu/codec/firmware.hpp"
+#include "pmu/codec/messages.hpp"
 
 namespace pmu::service {
 namespace {
@@ -69,29 +70,33 @@ struct Ctx {
   std::string line_of(const YAML::Node& n) const { return source + ":" + std::to_string(n.Mark().line + 1); }
 };
 
-const char* const kGroupNames[] = {"voltages", "currents", "battery_energy", "temperatures", "status"};
-
 std::uint8_t parse_groups(const Ctx& c, const YAML::Node& n) {
   if (!n.IsSequence()) c.fail(n, "packets must be a list, e.g. [voltages, status]");
   std::uint8_t mask = 0;
   for (const auto& item : n) {
     const auto name = c.scalar<std::string>(item, "packet", "a name");
-    const auto* it = std::find(std::begin(kGroupNames), std::end(kGroupNames), name);
-    if (it == std::end(kGroupNames))
-      c.fail(item, "unknown packet '" + name +
-                       "' (known: voltages, currents, battery_energy, temperatures, status)");
-    mask = static_cast<std::uint8_t>(mask | (1u << (it - std::begin(kGroupNames))));
+    const auto bit = codec::bit_named(codec::kGroupNames, name);
+    if (!bit)
+      c.fail(item, "unknown packet '" + name + "' (known: " + codec::names_of(codec::kGroupNames, 0xFF, ", ") + ")");
+    mask = static_cast<std::uint8_t>(mask | *bit);
   }
   if (mask == 0) c.fail(n, "packets must name at least one packet");
   return mask;
 }
 
 std::chrono::milliseconds period_of(const Ctx& c, const YAML::Node& n, const char* name) {
-  // PP is 0.1..25.5 s in 0.1 s steps (protocol table 12); a poll period follows the same rule.
-  const double s = c.number(n, name, 0.1, 25.5);
-  const double tenths = s * 10;
-  if (std::fabs(tenths - std::round(tenths)) > 1e-6) c.fail(n, std::string(name) + " must be a multiple of 0.1 s");
-  return std::chrono::milliseconds(std::lround(tenths) * 100);
+  // A period is what PP can hold (0.1..25.5 s in 0.1 s steps); a poll period follows the
+  // same rule.
+  constexpr auto pp = codec::Parameter::PacketPeriod;
+  const auto& spec = codec::spec_of(pp);
+  const double s = c.number(n, name, codec::parameter_value(pp, spec.raw_min), codec::parameter_value(pp, spec.raw_max));
+  const double raw = s * spec.divisor;
+  if (std::fabs(raw - std::round(raw)) > 1e-6) {
+    std::ostringstream m;
+    m << name << " must be a multiple of " << codec::parameter_value(pp, 1) << " " << spec.unit;
+    c.fail(n, m.str());
+  }
+  return codec::duration_of(pp, static_cast<std::uint32_t>(std::lround(raw)));
 }
 
 void parse_device_settings(const Ctx& c, const YAML::Node& n, DeviceConfig& d) {
@@ -113,8 +118,9 @@ DeviceConfig parse_device(const Ctx& c, const YAML::Node& n) {
   c.only_keys(n, "device", {"address", "mode", "period", "packets", "configure_streaming"});
   DeviceConfig d;
   const auto a = n["address"];
-  if (!a) c.fail(n, "device needs an address (0..65534)");
-  d.address = static_cast<std::uint16_t>(c.integer(a, "address", 0, 65534));
+  // 65535 is the broadcast address, never a device's (v1.9 section 4).
+  if (!a) c.fail(n, "device needs an address (0.." + std::to_string(codec::kMaxDeviceAddress) + ")");
+  d.address = static_cast<std::uint16_t>(c.integer(a, "address", 0, codec::kMaxDeviceAddress));
   parse_device_settings(c, n, d);
   return d;
 }

@@ -105,7 +105,7 @@ void DeviceSession::configure_streaming() {
     double value;
   };
   const Want wants[] = {
-      {codec::Parameter::PacketPeriod, static_cast<double>(config_cfg_.period.count()) / 1000.0},
+      {codec::Parameter::PacketPeriod, codec::duration_value(codec::Parameter::PacketPeriod, config_cfg_.period)},
       {codec::Parameter::PacketsStreamed, static_cast<double>(config_cfg_.groups)},
   };
   for (const auto& w : wants) {

@@ -21,6 +21,7 @@
 #include <thread>
 #include <vector>
 
+#include "pmu/codec/encode.hpp"
 #include "pmu/service/bus_worker.hpp"
 #include "pmu/service/command_service.hpp"
 #include "pmu/service/config.hpp"
@@ -76,7 +77,9 @@ std::unique_ptr<transport::CanBus> open_bus(const service::BusConfig& bus, const
     d.address = dev.address;
     d.serial_number = static_cast<std::uint16_t>(1000 + dev.address);
     // Stream what the service expects, so the demo shows every topic at the configured rate.
-    d.parameters.set_raw(codec::Parameter::PacketPeriod, static_cast<std::uint32_t>(dev.period.count() / 100));
+    const auto pp = codec::to_raw(codec::Parameter::PacketPeriod,
+                                  codec::duration_value(codec::Parameter::PacketPeriod, dev.period));
+    if (pp) d.parameters.set_raw(codec::Parameter::PacketPeriod, *pp);  // the config checked it is a PP
     d.parameters.set_raw(codec::Parameter::PacketsStreamed, dev.groups);
     rt.simulator->add(d);
     // An engine that is already running makes the generator figures come alive.

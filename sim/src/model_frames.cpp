@@ -31,7 +31,7 @@ void ModelState::on_frame(const codec::CanFrame& frame, TimePoint now) noexcept 
       ++counters.not_pmu;
       return;
     }
-    const auto to = static_cast<std::uint16_t>(frame.id & 0xFFFFu);
+    const auto to = codec::address_of_id(frame.id);
     if (!addressed_to_us(to))
       ++counters.other_address;
     else if (outbox.faults().silent)

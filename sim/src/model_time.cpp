@@ -10,7 +10,6 @@ namespace pmu::sim::detail {
 namespace {
 
 using codec::Parameter;
-constexpr Duration kTenthSecond = std::chrono::milliseconds(100);
 
 }  // namespace
 
@@ -100,12 +99,12 @@ Duration ModelState::packet_period() const noexcept {
   // Table 12: PP in 0.1 s. A preloaded 0 (no set can write it) would stream on every tick;
   // treat it as the shortest period instead.
   const auto pp = std::max<std::uint32_t>(params.raw(Parameter::PacketPeriod), 1);
-  return kTenthSecond * pp;
+  return codec::duration_of(Parameter::PacketPeriod, pp);
 }
 
 Duration ModelState::cranking_time() const noexcept {
   // Table 17: CT in 0.1 s; 0 disables the timeout (Duration::zero() means none).
-  return kTenthSecond * params.raw(Parameter::CrankingTime);
+  return codec::duration_of(Parameter::CrankingTime, params.raw(Parameter::CrankingTime));
 }
 
 Operating ModelState::operating() const noexcept {

@@ -2,7 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
-#include <limits>
+
+#include "pmu/codec/telemetry.hpp"
 
 namespace pmu::sim::detail {
 namespace {
@@ -16,11 +17,6 @@ constexpr double kBatteryPresentVolts = 1.0;
 
 double highest_battery(const Plant& p) noexcept {
   return std::max({0.0, p.battery_a_voltage, p.battery_b_voltage});
-}
-
-double field(double v, double lo, double hi) noexcept {
-  if (std::isnan(v)) return v;  // left for the encoder: "no sensor" or an encode error
-  return std::clamp(v, lo, hi);
 }
 
 }  // namespace
@@ -78,35 +74,18 @@ std::uint16_t generator_rpm(const Plant& p, const Operating& op) noexcept {
   return op.engine == EngineState::Running && op.generation_on ? p.engine_rpm : 0;
 }
 
-codec::Voltages clamped(const codec::Voltages& v) noexcept {
-  // Table 2 ranges.
-  return {field(v.avionics, 0, 25.0),  field(v.output_28v, 0, 50.0), field(v.payload, 0, 25.0),
-          field(v.servo, 0, 12.5),     field(v.battery_a, 0, 25.0),  field(v.battery_b, 0, 25.0),
-          field(v.generator, 0, 100.0)};
-}
-
-codec::Currents clamped(const codec::Currents& c) noexcept {
-  // Table 3 ranges; the 28 V output and the batteries are signed.
-  return {field(c.avionics, 0, 10.0),        field(c.output_28v, -12.5, 12.5),
-          field(c.payload, 0, 10.0),         field(c.servo, 0, 10.0),
-          field(c.battery_a, -12.5, 12.5),   field(c.battery_b, -12.5, 12.5)};
-}
-
-codec::Temperatures clamped(const codec::Temperatures& t) noexcept {
-  // Table 5. -128 on an external sensor means "no sensor", so a real reading stops at -127.
-  return {field(t.internal, -128, 127), field(t.battery_a, -127, 127), field(t.battery_b, -127, 127),
-          field(t.generator, -127, 127), field(t.starter, -49, 127)};
-}
+codec::Voltages clamped(const codec::Voltages& v) noexcept { return codec::clamped_to_fields(v); }
+codec::Currents clamped(const codec::Currents& c) noexcept { return codec::clamped_to_fields(c); }
+codec::Temperatures clamped(const codec::Temperatures& t) noexcept { return codec::clamped_to_fields(t); }
 
 codec::BatteryEnergy energy_field(double battery_a_mah, double battery_b_mah) noexcept {
-  // Table 4: a signed 16-bit mAh count; the integral saturates rather than wrapping.
-  const auto to_field = [](double mah) {
-    const double lo = std::numeric_limits<std::int16_t>::min();
-    const double hi = std::numeric_limits<std::int16_t>::max();
+  // The integral saturates at the field's limits rather than wrapping.
+  const auto to_field = [](const auto& field, double mah) {
     if (std::isnan(mah)) return std::int16_t{0};
-    return static_cast<std::int16_t>(std::lround(std::clamp(mah, lo, hi)));
+    return static_cast<std::int16_t>(std::lround(codec::clamp_to_field(field, mah)));
   };
-  return {to_field(battery_a_mah), to_field(battery_b_mah)};
+  const auto& f = codec::Telemetry<codec::BatteryEnergy>::fields;
+  return {to_field(f[0], battery_a_mah), to_field(f[1], battery_b_mah)};
 }
 
 bool next_thermal_shutdown(bool in_shutdown, double temperature, std::uint32_t limit) noexcept {

@@ -32,8 +32,9 @@ codec::Voltages voltages(const Plant& plant, const Operating& op) noexcept;
 codec::Currents currents(const Plant& plant, const Operating& op) noexcept;
 std::uint16_t generator_rpm(const Plant& plant, const Operating& op) noexcept;
 
-// Into each field's range (tables 2, 3, 5): a real reading beyond what the field can carry
-// is reported at the field's limit. NaN passes through (a temperature's "no sensor").
+// Into each field's range (tables 2..5, as codec/telemetry.hpp holds them): a real reading
+// beyond what the field can carry is reported at the field's limit. NaN passes through (a
+// temperature's "no sensor").
 codec::Voltages clamped(const codec::Voltages& v) noexcept;
 codec::Currents clamped(const codec::Currents& c) noexcept;
 codec::Temperatures clamped(const codec::Temperatures& t) noexcept;

@@ -5,6 +5,7 @@
 
 #include <cmath>
 
+#include "pmu/codec/telemetry.hpp"
 #include "sim_harness.hpp"
 
 namespace pmu::sim::test {
@@ -339,6 +340,53 @@ TEST(SimMeasurements, ClampedIntoFieldRange) {
   EXPECT_DOUBLE_EQ(t->starter, -49.0);
   EXPECT_EQ(s->generator_rpm, 65535);
   EXPECT_EQ(h.pmu.counters().encode_errors, 0u);
+}
+
+// The limits are the codec's telemetry tables, the ranges its encoder refuses beyond: a
+// simulated reading can never be an encode error, whichever way the table changes.
+template <class Packet>
+double table_limit(std::string_view field, bool upper) {
+  for (const auto& f : codec::Telemetry<Packet>::fields)
+    if (f.name == field) return upper ? f.max() : f.min();
+  ADD_FAILURE() << "no field " << field;
+  return 0;
+}
+
+TEST(SimMeasurements, ClampLimitsAreTheCodecTablesRanges) {
+  for (const double far : {1e6, -1e6}) {
+    SCOPED_TRACE(far);
+    const bool up = far > 0;
+    {
+      Harness h;
+      Plant p;
+      p.battery_a_voltage = p.battery_b_voltage = p.output_28v_voltage = p.generator_voltage = far;
+      p.avionics_load = p.payload_load = p.servo_load = p.output_28v_load = p.charge_current = far;
+      h.pmu.set_plant(p, h.now);
+      h.pmu.set_engine_running(true, h.now);
+      const auto v = h.get<codec::Voltages>(PacketId::Voltages);
+      const auto a = h.get<codec::Currents>(PacketId::Currents);
+      ASSERT_TRUE(v && a);
+      EXPECT_DOUBLE_EQ(v->battery_a, table_limit<codec::Voltages>("battery_a", up));
+      EXPECT_DOUBLE_EQ(v->battery_b, table_limit<codec::Voltages>("battery_b", up));
+      EXPECT_DOUBLE_EQ(v->output_28v, table_limit<codec::Voltages>("output_28v", up));
+      EXPECT_DOUBLE_EQ(v->generator, table_limit<codec::Voltages>("generator", up));
+      for (const auto& f : codec::Telemetry<codec::Currents>::fields)
+        EXPECT_DOUBLE_EQ((*a).*f.member, table_limit<codec::Currents>(f.name, up)) << f.name;
+      EXPECT_EQ(h.pmu.counters().encode_errors, 0u);
+    }
+    {
+      Harness h;
+      Plant p;
+      p.internal_temperature = p.starter_temperature = far;
+      p.battery_a_temperature = p.battery_b_temperature = p.generator_temperature = far;
+      h.pmu.set_plant(p, h.now);
+      const auto t = h.get<codec::Temperatures>(PacketId::Temperatures);
+      ASSERT_TRUE(t);
+      for (const auto& f : codec::Telemetry<codec::Temperatures>::fields)
+        EXPECT_DOUBLE_EQ((*t).*f.member, table_limit<codec::Temperatures>(f.name, up)) << f.name;
+      EXPECT_EQ(h.pmu.counters().encode_errors, 0u);
+    }
+  }
 }
 
 TEST(SimMeasurements, NanWithoutNoSensorValueIsNotSent) {

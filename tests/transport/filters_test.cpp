@@ -68,6 +68,22 @@ TEST(Filters, EveryCanopenIdTheCodecDecodesPassesAndNoOtherElevenBitIdOutsideThe
   }
 }
 
+TEST(Filters, CanopenFiltersAreTheFewestAlignedBlocks) {
+  // What a kernel filter list for the document's ids should be: the four battery ids, and
+  // 0x4E6..0x51F as 2 + 8 + 16 + 32 ids.
+  const std::vector<std::pair<std::uint32_t, std::uint32_t>> want = {
+      {0x202, 0x7FF}, {0x302, 0x7FF}, {0x402, 0x7FF}, {0x482, 0x7FF},
+      {0x4E6, 0x7FE}, {0x4E8, 0x7F8}, {0x4F0, 0x7F0}, {0x500, 0x7E0},
+  };
+  const auto filters = canopen_filters();
+  ASSERT_EQ(filters.size(), want.size());
+  for (std::size_t i = 0; i < want.size(); ++i) {
+    EXPECT_EQ(filters[i].id, want[i].first) << i;
+    EXPECT_EQ(filters[i].mask, want[i].second) << i;
+    EXPECT_FALSE(filters[i].extended) << i;
+  }
+}
+
 TEST(Filters, ThePmuFilterPassesExactlyTheIdsOfTheGroup) {
   const IdFilter pmu = pmu_filter();
   // Every group value, a few packet/address patterns each.

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "pmu/codec/firmware.hpp"
+#include "pmu/codec/ids.hpp"
 #include "pmu/sim/bus_runner.hpp"
 #include "pmu/transport/socketcan_bus.hpp"
 
@@ -22,7 +23,7 @@ int main(int argc, char** argv) {
   bool engine_running = true;
   app.add_option("iface", iface, "SocketCAN interface, e.g. vcan0")->required();
   app.add_option("--address", addresses, "CAN address (repeat for several units; default 1)")
-      ->check(CLI::Range(0, 65534));
+      ->check(CLI::Range(0, int{pmu::codec::kMaxDeviceAddress}));
   app.add_option("--firmware", firmware, "Firmware version to behave as: 1.12, 1.14, 1.16 or 1.17");
   app.add_option("--serial", serial, "Serial number of the first unit (the next get +1)")->check(CLI::Range(0, 65535));
   app.add_flag("!--engine-stopped", engine_running, "Start with the engine stopped (default: running)");

@@ -11,6 +11,7 @@
 #include <thread>
 #include <vector>
 
+#include "pmu/codec/messages.hpp"
 #include "pmu/idl/guarded_type.hpp"
 #include "pmu/idl/command.h"
 #include "pmu/idl/commandPubSubTypes.h"
@@ -25,9 +26,6 @@ namespace {
 
 using namespace eprosima::fastdds::dds;
 using Clock = std::chrono::steady_clock;
-
-const char* const kOutputs[] = {"avionics_servo", "payload", "charger_a", "charger_b"};
-const char* const kGroups[] = {"voltages", "currents", "battery_energy", "temperatures", "status"};
 
 const char* result_name(pmu::CommandResult r) {
   switch (r) {
@@ -106,20 +104,16 @@ bool output_mask(const std::vector<std::string>& names, std::uint8_t& mask) {
   for (const auto& n : names) {
     if (n == "none") continue;
     if (n == "all") {
-      mask = 0x0F;
+      mask = codec::output_bit::All;
       continue;
     }
-    bool found = false;
-    for (int b = 0; b < 4; ++b)
-      if (n == kOutputs[b]) {
-        mask = static_cast<std::uint8_t>(mask | (1u << b));
-        found = true;
-      }
-    if (!found) {
-      std::fprintf(stderr, "pmuctl: unknown output '%s' (outputs: avionics_servo, payload, charger_a, charger_b)\n",
-                   n.c_str());
+    const auto bit = codec::bit_named(codec::kOutputNames, n);
+    if (!bit) {
+      std::fprintf(stderr, "pmuctl: unknown output '%s' (outputs: %s)\n", n.c_str(),
+                   codec::names_of(codec::kOutputNames, codec::output_bit::All, ", ").c_str());
       return false;
     }
+    mask = static_cast<std::uint8_t>(mask | *bit);
   }
   return true;
 }
@@ -127,18 +121,13 @@ bool output_mask(const std::vector<std::string>& names, std::uint8_t& mask) {
 bool group_mask(const std::vector<std::string>& names, std::uint8_t& mask) {
   mask = 0;
   for (const auto& n : names) {
-    bool found = false;
-    for (int b = 0; b < 5; ++b)
-      if (n == kGroups[b]) {
-        mask = static_cast<std::uint8_t>(mask | (1u << b));
-        found = true;
-      }
-    if (!found) {
-      std::fprintf(stderr,
-                   "pmuctl: unknown measurement group '%s' (voltages, currents, battery_energy, temperatures, status)\n",
-                   n.c_str());
+    const auto bit = codec::bit_named(codec::kGroupNames, n);
+    if (!bit) {
+      std::fprintf(stderr, "pmuctl: unknown measurement group '%s' (%s)\n", n.c_str(),
+                   codec::names_of(codec::kGroupNames, codec::group_bit::All, ", ").c_str());
       return false;
     }
+    mask = static_cast<std::uint8_t>(mask | *bit);
   }
   return true;
 }

@@ -1,14 +1,12 @@
 #include "pmuctl/frame_fields.hpp"
 
+#include <string>
 #include <type_traits>
+
+#include "pmu/codec/telemetry.hpp"
 
 namespace pmu::tools {
 namespace {
-
-using codec::output_bit::AvionicsServo;
-using codec::output_bit::ChargerA;
-using codec::output_bit::ChargerB;
-using codec::output_bit::Payload;
 
 struct Visitor {
   FieldSink& s;
@@ -20,34 +18,20 @@ struct Visitor {
   void flag(std::string_view n, bool v) { s.field(n, FieldValue::of_bool(v), {}); }
 
   void operator()(const codec::NoPayload&) {}
-  void operator()(const codec::Voltages& v) {
-    num("avionics", v.avionics, "V");
-    num("output_28v", v.output_28v, "V");
-    num("payload", v.payload, "V");
-    num("servo", v.servo, "V");
-    num("battery_a", v.battery_a, "V");
-    num("battery_b", v.battery_b, "V");
-    num("generator", v.generator, "V");
+  // The telemetry tables give each field's name and unit in frame order.
+  template <class Packet>
+  void measured(const Packet& p) {
+    for (const auto& f : codec::Telemetry<Packet>::fields) {
+      if constexpr (std::is_floating_point_v<std::remove_reference_t<decltype(p.*f.member)>>)
+        num(f.name, p.*f.member, f.unit);
+      else
+        integer(f.name, p.*f.member, f.unit);
+    }
   }
-  void operator()(const codec::Currents& c) {
-    num("avionics", c.avionics, "A");
-    num("output_28v", c.output_28v, "A");
-    num("payload", c.payload, "A");
-    num("servo", c.servo, "A");
-    num("battery_a", c.battery_a, "A");
-    num("battery_b", c.battery_b, "A");
-  }
-  void operator()(const codec::BatteryEnergy& e) {
-    integer("battery_a_mah", e.battery_a_mah, "mAh");
-    integer("battery_b_mah", e.battery_b_mah, "mAh");
-  }
-  void operator()(const codec::Temperatures& t) {
-    num("internal", t.internal, "degC");
-    num("battery_a", t.battery_a, "degC");
-    num("battery_b", t.battery_b, "degC");
-    num("generator", t.generator, "degC");
-    num("starter", t.starter, "degC");
-  }
+  void operator()(const codec::Voltages& v) { measured(v); }
+  void operator()(const codec::Currents& c) { measured(c); }
+  void operator()(const codec::BatteryEnergy& e) { measured(e); }
+  void operator()(const codec::Temperatures& t) { measured(t); }
   void operator()(const codec::Status& st) {
     integer("generator_rpm", st.generator_rpm, "rpm");
     flag("generation_enabled", st.generation_enabled);
@@ -56,10 +40,7 @@ struct Visitor {
     flag("start_button", st.start_button);
     flag("payload_shed", st.payload_shed);
     flag("starter_ready", st.starter_ready);
-    flag("avionics_servo_on", st.outputs & AvionicsServo);
-    flag("payload_on", st.outputs & Payload);
-    flag("charger_a_on", st.outputs & ChargerA);
-    flag("charger_b_on", st.outputs & ChargerB);
+    for (const auto& o : codec::kOutputNames) flag(std::string(o.name) + "_on", (st.outputs & o.bit) != 0);
   }
   void operator()(const codec::MeasurementRequest& r) { integer("measurements", r.groups); }
   void operator()(const codec::ParameterValue& p) {

@@ -160,7 +160,7 @@ void LogDecoder::decode_line(std::string_view line, std::string& out) {
     return;
   }
 
-  const std::uint16_t address = static_cast<std::uint16_t>(l.frame.id & 0xFFFFu);
+  const std::uint16_t address = codec::address_of_id(l.frame.id);
   const auto fw = firmware_of(address);
   const auto m = codec::decode(l.frame, fw);
   if (!m) return report_error(m.error().describe());

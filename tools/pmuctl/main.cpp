@@ -13,6 +13,7 @@
 #include <string>
 
 #include "pmu/codec/firmware.hpp"
+#include "pmu/codec/messages.hpp"
 #include "pmu/idl/command.h"
 #include "pmuctl/command_verbs.hpp"
 #include "pmuctl/dds_verbs.hpp"
@@ -106,7 +107,7 @@ int main(int argc, char** argv) {
   double timeout = -1;
   app.add_option("--domain", g.domain, "DDS domain id")->check(CLI::Range(0, 232));
   app.add_option("--bus", g.bus, "Only this bus (the service's name for it, e.g. can0)");
-  app.add_option("--address", address, "Only the PMU at this CAN address")->check(CLI::Range(0, 65534));
+  app.add_option("--address", address, "Only the PMU at this CAN address")->check(CLI::Range(0, int{pmu::codec::kMaxDeviceAddress}));
   app.add_flag("--json", g.json, "Machine-readable output: one JSON object per line");
   app.add_option("--timeout", timeout, "Seconds to wait (state verbs: default 3; watch: forever)")
       ->check(CLI::PositiveNumber);
@@ -132,15 +133,16 @@ int main(int argc, char** argv) {
   config_get->add_option("param", parameter, "A parameter name, e.g. avionics_voltage");
   auto* config_set = config->add_subcommand("set", "Set a stored parameter; verified by reading it back");
   std::string set_param, set_value;
-  config_set->add_option("param", set_param, "avionics_voltage, payload_voltage, servo_voltage, battery_voltage, "
-                                             "packet_period, packets_streamed, temperature_offset, "
-                                             "upper_temperature_limit, power_up_state, cranking_time, can_address")
-      ->required();
+  std::string parameter_names;
+  for (const auto& spec : pmu::codec::parameter_table())
+    parameter_names += (parameter_names.empty() ? "" : ", ") + std::string(spec.name);
+  config_set->add_option("param", set_param, parameter_names)->required();
   config_set->add_option("value", set_value, "Value in the parameter's unit (V, s, degC, or a number/mask)")->required();
 
   bool confirm = false;
   app.add_flag("--confirm", confirm, "Confirm a command the safety policy guards (avionics off, reset, engine start...)");
-  auto* outputs = app.add_subcommand("outputs", "Output states (avionics_servo, payload, charger_a, charger_b)");
+  auto* outputs = app.add_subcommand(
+      "outputs", "Output states (" + pmu::codec::names_of(pmu::codec::kOutputNames, pmu::codec::output_bit::All, ", ") + ")");
   outputs->require_subcommand(1);
   auto* outputs_get = outputs->add_subcommand("get", "Read the output states from the PMU");
   std::vector<std::string> output_names;
@@ -159,7 +161,8 @@ int main(int argc, char** argv) {
   auto* reset = app.add_subcommand("reset", "Restart the PMU (outputs to power-up state, energies to zero)");
   auto* measure = app.add_subcommand("measure", "Ask for measurements now (0x0F; firmware 1.14+)");
   std::vector<std::string> groups;
-  measure->add_option("groups", groups, "voltages, currents, battery_energy, temperatures, status (default all)");
+  measure->add_option("groups", groups,
+                      pmu::codec::names_of(pmu::codec::kGroupNames, pmu::codec::group_bit::All, ", ") + " (default all)");
 
   auto* decode = app.add_subcommand("decode", "Decode a candump log (-L or screen format) offline");
   std::string path = "-";

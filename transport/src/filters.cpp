@@ -1,5 +1,6 @@
 #include "pmu/transport/filters.hpp"
 
+#include "pmu/codec/canopen.hpp"
 #include "pmu/codec/ids.hpp"
 
 namespace pmu::transport {
@@ -15,16 +16,19 @@ IdFilter pmu_filter() noexcept {
 }
 
 std::vector<IdFilter> canopen_filters() {
-  // spec/solar-boat-canopen-battery-mppt.txt: battery COB-IDs, then MPPT 0x4E6..0x51F
-  // (eight devices at 0x4E6 + 8 * n, two ids each) covered by aligned power-of-two blocks.
-  return {
-      {0x202, kExact11, false}, {0x302, kExact11, false}, {0x402, kExact11, false},
-      {0x482, kExact11, false},
-      {0x4E6, 0x7FE, false},  // 0x4E6..0x4E7
-      {0x4E8, 0x7F8, false},  // 0x4E8..0x4EF
-      {0x4F0, 0x7F0, false},  // 0x4F0..0x4FF
-      {0x500, 0x7E0, false},  // 0x500..0x51F
-  };
+  // The codec's COB-IDs (canopen.hpp): each battery id exactly, then the MPPT range as the
+  // aligned power-of-two blocks that cover it (0x4E6..0x51F: four filters, not sixteen).
+  std::vector<IdFilter> filters;
+  for (const auto id : codec::canopen::kBatteryCobIds) filters.push_back({id, kExact11, false});
+  std::uint32_t lo = codec::canopen::kMpptBase;
+  const std::uint32_t hi = codec::canopen::kMpptLastId;
+  while (lo <= hi) {
+    std::uint32_t size = 1;
+    while (size < 0x800 && lo % (size * 2) == 0 && lo + size * 2 - 1 <= hi) size *= 2;
+    filters.push_back({lo, kExact11 & ~(size - 1), false});
+    lo += size;
+  }
+  return filters;
 }
 
 std::vector<IdFilter> default_filters(bool with_canopen) {

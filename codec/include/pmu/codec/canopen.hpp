@@ -61,6 +61,16 @@ struct Error {
   std::string describe() const;
 };
 
+// The COB-IDs of the document: the battery's four, and per MPPT device (0..7) a block of
+// kMpptStride ids from 0x4E6 + 8 * device of which the first two are used (see above).
+// Bus filters are built from these.
+inline constexpr std::array<std::uint16_t, 4> kBatteryCobIds{{0x202, 0x302, 0x402, 0x482}};
+inline constexpr std::uint16_t kMpptBase = 0x4E6;
+inline constexpr std::uint16_t kMpptStride = 8;
+inline constexpr std::uint8_t kMpptDevices = 8;
+inline constexpr std::uint8_t kMpptIdsUsed = 2;
+inline constexpr std::uint16_t kMpptLastId = kMpptBase + kMpptStride * (kMpptDevices - 1) + kMpptIdsUsed - 1;
+
 // True for 11-bit ids this module decodes (0x202, 0x302, 0x402, 0x482, MPPT blocks).
 bool is_canopen_id(std::uint32_t id, bool extended) noexcept;
 

@@ -53,12 +53,12 @@ struct PmuMessage {
 Result<PmuMessage, DecodeError> decode(const CanFrame& frame,
                                        std::optional<FirmwareVersion> fw = std::nullopt) noexcept;
 
-// Data length of a frame carrying values for `packet` (the "Length" column of table 1);
-// 0 for data-less commands and for unknown packets.
+// Data length of a frame carrying values for `packet` (the "Length" column of table 1, as
+// kPacketTable in packets.hpp); 0 for data-less commands and for unknown packets.
 std::uint8_t data_length(PacketId packet) noexcept;
 
 // True where a zero-length frame is a get that the PMU answers with the current value:
-// every id up to 0x20, plus 0x23 (section 5.21), 0x30 and 0x31.
+// every id up to 0x20, plus 0x23 (section 5.21), 0x30 and 0x31; false for unknown packets.
 bool has_zero_length_get(PacketId packet) noexcept;
 
 }  // namespace pmu::codec

@@ -71,6 +71,13 @@ constexpr std::uint32_t make_id(PacketId packet, std::uint16_t address) noexcept
          address;
 }
 
+// Bits 15..0 of an identifier, the address field. Readable without parse_id: a frame whose
+// packet byte is unknown still says which device it is for, and a log line needs the
+// address (to pick that device's firmware) before it can be decoded.
+constexpr std::uint16_t address_of_id(std::uint32_t id) noexcept {
+  return static_cast<std::uint16_t>(id & 0xFFFFu);
+}
+
 enum class IdError : std::uint8_t {
   NotExtended,    // an 11-bit identifier: never a PMU frame
   ForeignGroup,   // 29-bit, but the group is not 0x1E

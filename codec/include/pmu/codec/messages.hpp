@@ -2,11 +2,16 @@
 // Typed contents of every PMU packet, in SI units (volts, amperes, degrees Celsius, rpm,
 // mAh). Field names follow interface.md so the service and pmuctl map them one to one.
 
+#include <array>
 #include <cstdint>
 #include <limits>
+#include <optional>
+#include <string>
+#include <string_view>
 #include <variant>
 
 #include "pmu/codec/firmware.hpp"
+#include "pmu/codec/packets.hpp"
 #include "pmu/codec/parameters.hpp"
 
 namespace pmu::codec {
@@ -29,6 +34,52 @@ inline constexpr std::uint8_t Temperatures = 1u << 3;
 inline constexpr std::uint8_t Status = 1u << 4;
 inline constexpr std::uint8_t All = 0x1F;
 }  // namespace group_bit
+
+// The contract's names of those bits (interface.md: pmuctl's verbs and `packets:` in the
+// config, CommandReply reasons, the `*_on` fields), so every user of a name reads it here.
+struct NamedBit {
+  std::uint8_t bit;
+  std::string_view name;
+};
+
+// Tables 19..21 (and flag register 2 of table 6), bit order.
+inline constexpr std::array<NamedBit, 4> kOutputNames{{
+    {output_bit::AvionicsServo, "avionics_servo"},
+    {output_bit::Payload, "payload"},
+    {output_bit::ChargerA, "charger_a"},
+    {output_bit::ChargerB, "charger_b"},
+}};
+
+// Tables 7 and 13, bit order: a group is named after the packet it selects.
+inline constexpr std::array<NamedBit, 5> kGroupNames{{
+    {group_bit::Voltages, find_packet(PacketId::Voltages)->name},
+    {group_bit::Currents, find_packet(PacketId::Currents)->name},
+    {group_bit::BatteryEnergy, find_packet(PacketId::BatteryEnergy)->name},
+    {group_bit::Temperatures, find_packet(PacketId::Temperatures)->name},
+    {group_bit::Status, find_packet(PacketId::Status)->name},
+}};
+
+// "payload" -> output_bit::Payload; nullopt for a name the table lacks.
+template <std::size_t N>
+constexpr std::optional<std::uint8_t> bit_named(const std::array<NamedBit, N>& table,
+                                                std::string_view name) noexcept {
+  for (const auto& b : table)
+    if (b.name == name) return b.bit;
+  return std::nullopt;
+}
+
+// The names of the bits set in `mask`, in bit order, between `separator`s; "" for none.
+// names_of(kOutputNames, 0x05) -> "avionics_servo,charger_a".
+template <std::size_t N>
+std::string names_of(const std::array<NamedBit, N>& table, std::uint8_t mask, std::string_view separator = ",") {
+  std::string s;
+  for (const auto& b : table) {
+    if (!(mask & b.bit)) continue;
+    if (!s.empty()) s += separator;
+    s += b.name;
+  }
+  return s;
+}
 
 // S0 bits (table 16). Bits 4 and 6 exist only on newer firmware, see firmware.hpp.
 namespace power_up_bit {

@@ -3,6 +3,7 @@
 // ranges the spec allows a set to take. The table is the single source for encoding,
 // decoding, validation in the service, and `pmuctl config set` names.
 
+#include <chrono>
 #include <cstdint>
 #include <optional>
 #include <string_view>
@@ -52,5 +53,12 @@ std::optional<Parameter> parameter_from_name(std::string_view name) noexcept;
 
 // Engineering value of a raw parameter value as read from the device.
 double parameter_value(Parameter p, std::uint32_t raw) noexcept;
+
+// PP and CT are durations (unit "s"; tables 12 and 17). A duration as such a parameter's
+// engineering value, ready for to_raw/encode_set: 1500 ms -> 1.5. NaN, which encoding
+// refuses, for a parameter that is not a duration.
+double duration_value(Parameter p, std::chrono::milliseconds d) noexcept;
+// The duration a raw PP or CT value stands for: 15 -> 1500 ms; zero for other parameters.
+std::chrono::milliseconds duration_of(Parameter p, std::uint32_t raw) noexcept;
 
 }  // namespace pmu::codec

@@ -12,6 +12,7 @@
 #include <string>
 #include <vector>
 
+#include "pmu/codec/messages.hpp"
 #include "pmu/service/capacity.hpp"
 #include "pmu/service/dds_transport.hpp"
 #include "pmu/service/dds_security.hpp"
@@ -35,7 +36,7 @@ struct DeviceConfig {
   // Polling: the poll period. Streaming: the packet period expected (PP); with
   // `configure_streaming` it is written to the PMU when the PMU's own PP differs.
   std::chrono::milliseconds period{1000};
-  std::uint8_t groups = 0x1F;  // measurement groups: voltages(0) .. status(4)
+  std::uint8_t groups = codec::group_bit::All;  // measurement groups, codec::kGroupNames
   // Streaming only: write PP and PS to the PMU when they differ from period/groups. Off by
   // default: they live in the PMU's non-volatile memory and belong to whoever set it up.
   bool configure_streaming = false;
