@@ -10,6 +10,7 @@
 #include "pmu/codec/decode.hpp"
 #include "pmu/codec/encode.hpp"
 #include "pmu/service/command_executor.hpp"
+#include "recording_sink.hpp"
 
 namespace pmu::service {
 namespace {
@@ -192,6 +193,37 @@ TEST(CommandPlan, ACanAddressChangeReadsBackAtTheNewAddressUnderAnAlias) {
   EXPECT_EQ(p.read_back->address, 7);
   EXPECT_EQ(p.alias, std::optional<std::uint16_t>(7));
   EXPECT_TRUE(p.on_completed) << "the session moves to the new address once verified";
+}
+
+// Named defect (fixed): the alias under which a queued CAN address change expects its answer
+// was dropped by any other read-back command that failed before it ran.
+TEST(CommandRun, AnotherCommandsFailureLeavesAQueuedAddressChangesAliasAlone) {
+  using namespace std::chrono_literals;
+  test::RecordingSink sink;
+  const auto t0 = SteadyTime{} + 1h;
+  DeviceConfig dc;
+  dc.address = 1;
+  Timeouts timeouts;
+  DeviceSession s({"can0", 1}, dc, timeouts, sink, [](const codec::CanFrame&) { return transport::SendResult{}; },
+                  t0);
+  auto t = t0;
+  for (int i = 0; i < 100 && s.queued() > 0; ++i) s.tick(t += 100ms);  // a silent device: the reading round fails
+  ASSERT_EQ(s.queued(), 0u);
+
+  std::vector<CommandReplyData> replies;
+  const ReplyFn collect = [&replies](const CommandReplyData& d) { replies.push_back(d); };
+  CommandRequest outputs = request(action::SetOutputs{0x01});
+  outputs.expires = t + 10s;
+  execute_command(s, outputs, t, timeouts, collect);  // sent; its read-back now waits for 0x20
+  CommandRequest move = request(action::SetParameter{codec::Parameter::CanAddress, 7});
+  move.expires = t + 10s;
+  execute_command(s, move, t, timeouts, collect);
+  EXPECT_EQ(s.alias(), std::optional<std::uint16_t>(7));
+  for (int i = 0; i < 100 && replies.empty(); ++i) s.tick(t += 100ms);
+  ASSERT_EQ(replies.size(), 1u);
+  EXPECT_EQ(replies[0].kind, CommandKind::SetOutputs);
+  EXPECT_EQ(replies[0].result, CommandResult::Timeout);
+  EXPECT_EQ(s.alias(), std::optional<std::uint16_t>(7)) << "the address change still waits for its answer there";
 }
 
 }  // namespace

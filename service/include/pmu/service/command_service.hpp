@@ -69,9 +69,12 @@ class CommandService {
   // Duplicate detection: false when `s` is a resend (answered again) or reuses an id.
   bool first_time(const std::string& key, const CommandSample& s);
   Seen remember(const std::string& key, const CommandSample& s, std::optional<CommandReplyData>& again);
-  Refusal not_served(const CommandRequest& r) const;                   // routing
-  std::optional<Refusal> judge(const CommandRequest& r) const;         // policy
-  std::optional<Refusal> limit_rate(const CommandRequest& r);          // per device
+  // Routing: the bus is not one of this service's (when worker_for found none).
+  Refusal not_served(const CommandRequest& r) const;
+  // The deny list and confirm rules (policy.hpp).
+  std::optional<Refusal> judge(const CommandRequest& r) const;
+  // The per-device token bucket; never for engine stop.
+  std::optional<Refusal> limit_rate(const CommandRequest& r);
   // ...and on the bus worker's thread:
   void run_on_worker(BusWorker& worker, const CommandRequest& r);
   void broadcast(BusWorker& worker, const CommandRequest& r);
