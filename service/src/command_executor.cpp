@@ -31,7 +31,8 @@ struct Table {
   CommandPlan operator()(const action::Get& g) const {
     CommandPlan p = get(g.packet);
     p.check = [](const codec::PmuMessage* m) -> Verdict {
-      if (const auto* v = std::get_if<codec::ParameterValue>(&m->payload)) return {CommandResult::Completed, "", v->value, ""};
+      if (const auto* v = std::get_if<codec::ParameterValue>(&m->payload))
+        return {CommandResult::Completed, "", v->value, ""};
       if (const auto* out = std::get_if<codec::OutputStates>(&m->payload))
         return {CommandResult::Completed, "", out->mask, mask_text(out->mask)};
       if (const auto* gen = std::get_if<codec::GenerationState>(&m->payload))

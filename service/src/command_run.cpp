@@ -61,7 +61,9 @@ class Run : public std::enable_shared_from_this<Run> {
     switch (o.status) {
       case RequestStatus::Answered:
       case RequestStatus::Sent: return true;
-      case RequestStatus::Expired: conclude({CommandResult::Rejected, "expired before it could be sent", {}, {}}); break;
+      case RequestStatus::Expired:
+        conclude({CommandResult::Rejected, "expired before it could be sent", {}, {}});
+        break;
       case RequestStatus::SendFailed:
         conclude({CommandResult::Failed,
                   "bus refused the " + what + ": " + std::string(transport::to_string(o.send.status)),
