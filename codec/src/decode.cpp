@@ -132,7 +132,15 @@ Result<PmuMessage, DecodeError> decode(const CanFrame& frame, std::optional<Firm
     err.packet = id.raw_packet;
     return Unexpected{err};
   }
-  const PacketId packet = id.id->packet;
+  return decode(frame, *id.id, fw);
+}
+
+Result<PmuMessage, DecodeError> decode(const CanFrame& frame, const PmuId& id,
+                                       std::optional<FirmwareVersion> fw) noexcept {
+  DecodeError err;
+  err.id = frame.id;
+  err.length = frame.length;
+  const PacketId packet = id.packet;
   err.packet = static_cast<std::uint8_t>(packet);
   if (frame.remote) {
     err.kind = DecodeErrorKind::RemoteFrame;
@@ -145,7 +153,7 @@ Result<PmuMessage, DecodeError> decode(const CanFrame& frame, std::optional<Firm
 
   PmuMessage msg;
   msg.packet = packet;
-  msg.address = id.id->address;
+  msg.address = id.address;
   msg.unsupported_by_firmware =
       packet == PacketId::MeasurementRequest && !supports(fw, Feature::MeasurementRequest);
 

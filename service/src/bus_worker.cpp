@@ -87,7 +87,7 @@ void BusWorker::on_frame(const transport::ReceivedFrame& rx) {
     spdlog::info("{}: discovered a PMU at address {}", config_.name, address);
   }
   if (!s) return;  // a PMU the config does not serve
-  s->on_frame(rx.frame, now, rx.timestamp);
+  s->on_frame(*id.id, rx.frame, now, rx.timestamp);  // the id is parsed here only
 }
 
 void BusWorker::on_event(const transport::BusEvent& event) {

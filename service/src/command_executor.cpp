@@ -20,71 +20,170 @@ std::string mask_text(std::uint8_t mask) {
   return s.empty() ? "none" : s;
 }
 
-// One command in progress: the reply is sent once, whatever path ends it.
-struct Run {
-  CommandRequest request;
-  ReplyFn reply;
-  const Timeouts& timeouts;
-  DeviceSession& session;
-  bool replied = false;
+// The table: one description per kind (command_plan.hpp says how a run reads them).
+struct Table {
+  std::uint16_t a;  // the device's address
+  const DeviceFacts& device;
 
-  void finish(CommandResult result, std::string reason, std::optional<double> value = std::nullopt,
-              std::string value_text = {}) {
-    if (replied) return;
-    replied = true;
-    CommandReplyData d = make_reply(request, result, std::move(reason));
-    if (value) {
-      d.has_value = true;
-      d.value = *value;
-    }
-    d.value_text = std::move(value_text);
-    reply(d);
+  CommandPlan operator()(const action::Get& g) const {
+    CommandPlan p = get(g.packet);
+    p.check = [](const codec::PmuMessage* m) -> Verdict {
+      if (const auto* v = std::get_if<codec::ParameterValue>(&m->payload))
+        return {CommandResult::Completed, "", v->value, ""};
+      if (const auto* out = std::get_if<codec::OutputStates>(&m->payload))
+        return {CommandResult::Completed, "", out->mask, mask_text(out->mask)};
+      if (const auto* gen = std::get_if<codec::GenerationState>(&m->payload))
+        return {CommandResult::Completed, "", gen->enabled ? 1 : 0, gen->enabled ? "on" : "off"};
+      return {CommandResult::Completed, "published on pmu/" + std::string(codec::packet_name(m->packet)), {}, ""};
+    };
+    return p;
   }
 
-  // Maps a step's failure to the final reply; true when the step succeeded.
-  bool ok(const RequestOutcome& o, const char* what) {
-    switch (o.status) {
-      case RequestStatus::Answered:
-      case RequestStatus::Sent: return true;
-      case RequestStatus::Expired:
-        finish(CommandResult::Rejected, "expired before it could be sent");
-        return false;
-      case RequestStatus::SendFailed:
-        finish(CommandResult::Failed, std::string("bus refused the ") + what + ": " +
-                                          std::string(transport::to_string(o.send.status)));
-        return false;
-      case RequestStatus::Timeout:
-        finish(CommandResult::Timeout, std::string("device ") + std::to_string(request.address) + " did not answer the " +
-                                           what + " after " + std::to_string(timeouts.retries + 1) + " tries");
-        return false;
+  CommandPlan operator()(const action::SetParameter& set) const {
+    const codec::Parameter param = set.parameter;
+    const std::uint32_t raw = set.raw;
+    CommandPlan p;
+    p.frame = *codec::encode_parameter_reply(param, raw, a);
+    p.read_back = CommandPlan::ReadBack{codec::spec_of(param).packet, a};
+    if (param == codec::Parameter::CanAddress) {
+      // The unit answers at its new address at once: read back there.
+      const auto moved_to = static_cast<std::uint16_t>(raw);
+      p.read_back->address = moved_to;
+      p.alias = moved_to;
+      p.on_completed = [moved_to](DeviceSession& s) { s.readdress(moved_to); };
     }
-    return false;
+    p.check = [param, raw](const codec::PmuMessage* m) -> Verdict {
+      const auto* got = std::get_if<codec::ParameterValue>(&m->payload);
+      const double want = codec::parameter_value(param, raw);
+      if (got && got->raw == raw) return {CommandResult::Completed, "", want, ""};
+      char buf[128];
+      std::snprintf(buf, sizeof buf, "device reports %g after the set, not %g", got ? got->value : -1.0, want);
+      return {CommandResult::Failed, buf, got ? std::optional<double>(got->value) : std::nullopt, ""};
+    };
+    return p;
+  }
+
+  CommandPlan operator()(const action::SetOutputs& o) const {
+    return outputs(*codec::encode_set_outputs(o.mask, a), [want = o.mask](std::uint8_t on) { return on == want; });
+  }
+  CommandPlan operator()(const action::EnableOutputs& o) const {
+    return outputs(*codec::encode_enable_outputs(o.mask, a),
+                   [want = o.mask](std::uint8_t on) { return (on & want) == want; });
+  }
+  CommandPlan operator()(const action::DisableOutputs& o) const {
+    return outputs(*codec::encode_disable_outputs(o.mask, a),
+                   [off = o.mask](std::uint8_t on) { return (on & off) == 0; });
+  }
+
+  CommandPlan operator()(const action::SetGeneration& g) const {
+    CommandPlan p;
+    p.frame = *codec::encode_generation(g.enable, a);
+    p.read_back = CommandPlan::ReadBack{PacketId::Generation, a};
+    p.check = [enable = g.enable](const codec::PmuMessage* m) -> Verdict {
+      const auto* got = std::get_if<codec::GenerationState>(&m->payload);
+      if (got && got->enabled == enable) return {CommandResult::Completed, "", enable ? 1 : 0, enable ? "on" : "off"};
+      return {CommandResult::Failed, std::string("generation still ") + (got && got->enabled ? "on" : "off"), {}, ""};
+    };
+    return p;
+  }
+
+  CommandPlan operator()(const action::RequestMeasurements& m) const {
+    std::uint8_t first = 0;
+    while (!(m.groups & (1u << first))) ++first;
+    CommandPlan p;
+    p.frame = *codec::encode_measurement_request(m.groups, a, device.firmware);
+    p.what = "measurement request";
+    p.answer = static_cast<PacketId>(first);  // the device sends the groups in id order
+    p.check = done("measurements published on their topics");
+    return p;
+  }
+
+  CommandPlan operator()(const action::EngineStart&) const {
+    char buf[96];
+    std::snprintf(buf, sizeof buf, "start sent; the starter cranks for up to %.1f s", device.cranking_time);
+    CommandPlan p;
+    p.frame = *codec::encode_engine_start(a);
+    p.what = "engine start";
+    p.check = done(buf);
+    return p;
+  }
+
+  CommandPlan operator()(const action::EngineStop&) const {
+    CommandPlan p;
+    p.frame = *codec::encode_engine_stop(a);
+    p.what = "engine stop";
+    p.urgent = true;  // safety first: ahead of whatever the device has queued, and never expired
+    p.check = done("stop sent");
+    return p;
+  }
+
+  CommandPlan operator()(const action::Reset&) const {
+    CommandPlan p;
+    p.frame = *codec::encode_reset(a);
+    p.what = "reset";
+    p.check = done("reset sent; re-reading the device");
+    // Outputs went to S0 and energies to zero: read everything again.
+    p.on_completed = [](DeviceSession& s) { s.reread(s.now()); };
+    return p;
+  }
+
+  CommandPlan operator()(const action::GetSerial&) const {
+    CommandPlan p = get(PacketId::Serial);
+    p.check = [](const codec::PmuMessage* m) -> Verdict {
+      const auto* s = std::get_if<codec::SerialNumber>(&m->payload);
+      if (!s) return {CommandResult::Failed, "the answer carries no serial number", {}, ""};
+      return {CommandResult::Completed, "", s->serial_number, std::to_string(s->serial_number)};
+    };
+    return p;
+  }
+
+  CommandPlan operator()(const action::GetFirmware&) const {
+    CommandPlan p = get(PacketId::Firmware);
+    p.check = [](const codec::PmuMessage* m) -> Verdict {
+      const auto* f = std::get_if<codec::FirmwareInfo>(&m->payload);
+      if (!f) return {CommandResult::Failed, "the answer carries no firmware version", {}, ""};
+      char buf[64];
+      std::snprintf(buf, sizeof buf, "%u.%u built %04u-%02u-%02u", f->firmware_major, f->firmware_minor,
+                    f->build_year, f->build_month, f->build_day);
+      return {CommandResult::Completed, "", f->firmware_major + f->firmware_minor / 100.0, buf};
+    };
+    return p;
+  }
+
+ private:
+  // A zero-length get, answered by the same packet and safe to repeat.
+  CommandPlan get(PacketId packet) const {
+    CommandPlan p;
+    p.frame = *codec::encode_get(packet, a);
+    p.what = "get";
+    p.answer = packet;
+    p.idempotent = true;
+    return p;
+  }
+
+  // 0x20/0x21/0x22, verified by reading 0x20 back: `ok` judges the outputs now on.
+  CommandPlan outputs(const codec::CanFrame& frame, std::function<bool(std::uint8_t)> ok) const {
+    CommandPlan p;
+    p.frame = frame;
+    p.read_back = CommandPlan::ReadBack{PacketId::Outputs, a};
+    p.check = [ok = std::move(ok)](const codec::PmuMessage* m) -> Verdict {
+      const auto* got = std::get_if<codec::OutputStates>(&m->payload);
+      const std::uint8_t on = got ? got->mask : 0;
+      if (got && ok(on)) return {CommandResult::Completed, "", on, "on: " + mask_text(on)};
+      return {CommandResult::Failed, "outputs on after the command: " + mask_text(on), on, "on: " + mask_text(on)};
+    };
+    return p;
+  }
+
+  // A frame the device does not answer: sending it is the whole command.
+  static std::function<Verdict(const codec::PmuMessage*)> done(std::string reason) {
+    return [reason = std::move(reason)](const codec::PmuMessage*) {
+      return Verdict{CommandResult::Completed, reason, {}, ""};
+    };
   }
 };
 
-Request step(const codec::CanFrame& frame, std::optional<PacketId> reply, unsigned retries,
-             std::optional<SteadyTime> expires, std::function<void(const RequestOutcome&)> done) {
-  Request r;
-  r.frame = frame;
-  r.reply = reply;
-  r.retries = retries;
-  r.expires = expires;
-  r.done = std::move(done);
-  return r;
-}
-
 }  // namespace
-
-CommandReplyData make_reply(const CommandRequest& r, CommandResult result, std::string reason) {
-  CommandReplyData d;
-  d.request_id = r.request_id;
-  d.bus = r.bus;
-  d.address = r.address;
-  d.kind = r.kind();
-  d.result = result;
-  d.reason = std::move(reason);
-  return d;
-}
 
 CommandReplyData make_reply(const CommandSample& s, CommandResult result, std::string reason) {
   CommandReplyData d;
@@ -109,208 +208,20 @@ std::optional<CommandReplyData> check_firmware(const CommandRequest& r, std::opt
   return std::nullopt;
 }
 
+CommandPlan plan_command(const CommandRequest& r, const DeviceFacts& device) {
+  return std::visit(Table{r.address, device}, r.action);
+}
+
 void execute_command(DeviceSession& session, const CommandRequest& request, SteadyTime now, const Timeouts& timeouts,
                      ReplyFn reply) {
-  const auto fw = session.firmware();
-  const std::optional<SteadyTime> expires = request.expires;
-  if (auto invalid = check_firmware(request, fw)) {
+  DeviceFacts device;
+  device.firmware = session.firmware();
+  device.cranking_time = session.config_state().value(codec::Parameter::CrankingTime);
+  if (auto invalid = check_firmware(request, device.firmware)) {
     reply(*invalid);
     return;
   }
-  auto run = std::make_shared<Run>(Run{request, std::move(reply), timeouts, session});
-  const std::uint16_t a = request.address;
-  const unsigned retries = timeouts.retries;
-
-  // Sends `first` (which expires), then reads `readback` and hands the answer to `check`,
-  // which returns true when the device reports what was asked. A mismatch is read once more
-  // before it counts: the protocol has no sequence numbers, so a late answer to an earlier
-  // get of the same packet can arrive first. `check(m, true)` on the last read must finish.
-  using Check = std::function<bool(const codec::PmuMessage&, bool last)>;
-  auto set_then_read = [&](const codec::CanFrame& first, PacketId readback, std::uint16_t read_address, Check check) {
-    auto read = std::make_shared<std::function<void(bool)>>();
-    *read = [run, readback, read_address, retries, check, read](bool last) {
-      run->session.submit_front(
-          step(*codec::encode_get(readback, read_address), readback, retries, std::nullopt,
-               [run, check, read, last](const RequestOutcome& r) {
-                 if (!run->ok(r, "read-back")) {
-                   run->session.set_alias(std::nullopt);
-                   *read = nullptr;  // break the self-reference
-                   return;
-                 }
-                 if (check(*r.reply, last) || last) {
-                   *read = nullptr;
-                   return;
-                 }
-                 (*read)(true);
-               }),
-          run->session.now());
-    };
-    session.submit(step(first, std::nullopt, 0, expires,
-                        [run, read](const RequestOutcome& o) {
-                          if (!run->ok(o, "command")) {
-                            run->session.set_alias(std::nullopt);
-                            *read = nullptr;
-                            return;
-                          }
-                          (*read)(false);
-                        }),
-                   now);
-  };
-
-  switch (request.kind()) {
-    case CommandKind::Get: {
-      const PacketId target = std::get<action::Get>(request.action).packet;
-      session.submit(step(*codec::encode_get(target, a), target, retries, expires,
-                          [run](const RequestOutcome& o) {
-                            if (!run->ok(o, "get")) return;
-                            const auto& m = *o.reply;
-                            if (const auto* p = std::get_if<codec::ParameterValue>(&m.payload))
-                              return run->finish(CommandResult::Completed, "", p->value);
-                            if (const auto* out = std::get_if<codec::OutputStates>(&m.payload))
-                              return run->finish(CommandResult::Completed, "", out->mask, mask_text(out->mask));
-                            if (const auto* g = std::get_if<codec::GenerationState>(&m.payload))
-                              return run->finish(CommandResult::Completed, "", g->enabled ? 1 : 0,
-                                                 g->enabled ? "on" : "off");
-                            run->finish(CommandResult::Completed,
-                                        "published on pmu/" + std::string(codec::packet_name(m.packet)));
-                          }),
-                     now);
-      return;
-    }
-    case CommandKind::SetParameter: {
-      const auto& set = std::get<action::SetParameter>(request.action);
-      const codec::Parameter p = set.parameter;
-      const std::uint32_t raw = set.raw;
-      const auto& spec = codec::spec_of(p);
-      std::uint16_t read_at = a;
-      if (p == codec::Parameter::CanAddress) {
-        // The unit answers at its new address at once: read back there.
-        read_at = static_cast<std::uint16_t>(raw);
-        session.set_alias(read_at);
-      }
-      set_then_read(*codec::encode_parameter_reply(p, raw, a), spec.packet, read_at,
-                    [run, p, raw](const codec::PmuMessage& m, bool last) {
-                      const auto* got = std::get_if<codec::ParameterValue>(&m.payload);
-                      const double want = codec::parameter_value(p, raw);
-                      if (got && got->raw == raw) {
-                        if (p == codec::Parameter::CanAddress) run->session.readdress(static_cast<std::uint16_t>(raw));
-                        run->finish(CommandResult::Completed, "", want);
-                        return true;
-                      }
-                      if (!last) return false;
-                      run->session.set_alias(std::nullopt);
-                      char buf[128];
-                      std::snprintf(buf, sizeof buf, "device reports %g after the set, not %g",
-                                    got ? got->value : -1.0, want);
-                      run->finish(CommandResult::Failed, buf, got ? std::optional<double>(got->value) : std::nullopt);
-                      return false;
-                    });
-      return;
-    }
-    case CommandKind::SetOutputs:
-    case CommandKind::EnableOutputs:
-    case CommandKind::DisableOutputs: {
-      const CommandKind kind = request.kind();
-      const std::uint8_t mask = kind == CommandKind::SetOutputs      ? std::get<action::SetOutputs>(request.action).mask
-                                : kind == CommandKind::EnableOutputs ? std::get<action::EnableOutputs>(request.action).mask
-                                                                     : std::get<action::DisableOutputs>(request.action).mask;
-      const auto frame = kind == CommandKind::SetOutputs      ? *codec::encode_set_outputs(mask, a)
-                         : kind == CommandKind::EnableOutputs ? *codec::encode_enable_outputs(mask, a)
-                                                              : *codec::encode_disable_outputs(mask, a);
-      set_then_read(frame, PacketId::Outputs, a, [run, mask, kind](const codec::PmuMessage& m, bool last) {
-        const auto* got = std::get_if<codec::OutputStates>(&m.payload);
-        const std::uint8_t now_on = got ? got->mask : 0;
-        const bool ok = got && (kind == CommandKind::SetOutputs      ? now_on == mask
-                                : kind == CommandKind::EnableOutputs ? (now_on & mask) == mask
-                                                                     : (now_on & mask) == 0);
-        if (ok) {
-          run->finish(CommandResult::Completed, "", now_on, "on: " + mask_text(now_on));
-          return true;
-        }
-        if (last)
-          run->finish(CommandResult::Failed, "outputs on after the command: " + mask_text(now_on), now_on,
-                      "on: " + mask_text(now_on));
-        return false;
-      });
-      return;
-    }
-    case CommandKind::SetGeneration: {
-      const bool enable = std::get<action::SetGeneration>(request.action).enable;
-      set_then_read(*codec::encode_generation(enable, a), PacketId::Generation, a,
-                    [run, enable](const codec::PmuMessage& m, bool last) {
-                      const auto* got = std::get_if<codec::GenerationState>(&m.payload);
-                      if (got && got->enabled == enable) {
-                        run->finish(CommandResult::Completed, "", enable ? 1 : 0, enable ? "on" : "off");
-                        return true;
-                      }
-                      if (last)
-                        run->finish(CommandResult::Failed,
-                                    std::string("generation still ") + (got && got->enabled ? "on" : "off"));
-                      return false;
-                    });
-      return;
-    }
-    case CommandKind::RequestMeasurements: {
-      const std::uint8_t groups = std::get<action::RequestMeasurements>(request.action).groups;
-      std::uint8_t first = 0;
-      while (!(groups & (1u << first))) ++first;
-      const auto reply_packet = static_cast<PacketId>(first);
-      session.submit(step(*codec::encode_measurement_request(groups, a, fw), reply_packet, 0, expires,
-                          [run](const RequestOutcome& o) {
-                            if (run->ok(o, "measurement request"))
-                              run->finish(CommandResult::Completed, "measurements published on their topics");
-                          }),
-                     now);
-      return;
-    }
-    case CommandKind::EngineStart:
-    case CommandKind::Reset: {
-      const bool reset = request.kind() == CommandKind::Reset;
-      const auto frame = reset ? *codec::encode_reset(a) : *codec::encode_engine_start(a);
-      const double ct = session.config_state().value(codec::Parameter::CrankingTime);
-      session.submit(step(frame, std::nullopt, 0, expires,
-                          [run, reset, ct](const RequestOutcome& o) {
-                            if (!run->ok(o, reset ? "reset" : "engine start")) return;
-                            if (reset) {
-                              // Outputs went to S0 and energies to zero: read everything again.
-                              run->session.reread(run->session.now());
-                              return run->finish(CommandResult::Completed, "reset sent; re-reading the device");
-                            }
-                            char buf[96];
-                            std::snprintf(buf, sizeof buf, "start sent; the starter cranks for up to %.1f s", ct);
-                            run->finish(CommandResult::Completed, buf);
-                          }),
-                     now);
-      return;
-    }
-    case CommandKind::EngineStop:
-      // Safety first: ahead of whatever the device has queued, and never expired.
-      session.submit_front(step(*codec::encode_engine_stop(a), std::nullopt, 0, std::nullopt,
-                                [run](const RequestOutcome& o) {
-                                  if (run->ok(o, "engine stop")) run->finish(CommandResult::Completed, "stop sent");
-                                }),
-                           now);
-      return;
-    case CommandKind::GetSerial:
-    case CommandKind::GetFirmware: {
-      const bool serial = request.kind() == CommandKind::GetSerial;
-      const PacketId p = serial ? PacketId::Serial : PacketId::Firmware;
-      session.submit(step(*codec::encode_get(p, a), p, retries, expires,
-                          [run](const RequestOutcome& o) {
-                            if (!run->ok(o, "get")) return;
-                            if (const auto* s = std::get_if<codec::SerialNumber>(&o.reply->payload))
-                              return run->finish(CommandResult::Completed, "", s->serial_number,
-                                                 std::to_string(s->serial_number));
-                            const auto& f = std::get<codec::FirmwareInfo>(o.reply->payload);
-                            char buf[64];
-                            std::snprintf(buf, sizeof buf, "%u.%u built %04u-%02u-%02u", f.firmware_major,
-                                          f.firmware_minor, f.build_year, f.build_month, f.build_day);
-                            run->finish(CommandResult::Completed, "", f.firmware_major + f.firmware_minor / 100.0, buf);
-                          }),
-                     now);
-      return;
-    }
-  }
+  run_plan(session, request, plan_command(request, device), now, timeouts, std::move(reply));
 }
 
 }  // namespace pmu::service

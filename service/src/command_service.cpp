@@ -94,89 +94,113 @@ void CommandService::answer(const CommandRequest& r, CommandResult result, std::
   finish(sender_key(r.sender, r.request_id), r.sender, describe(r), make_reply(r, result, std::move(reason)));
 }
 
+void CommandService::refuse(const CommandRequest& r, const Refusal& refusal) {
+  answer(r, refusal.result, refusal.reason);
+}
+
+// The stages, in order. Each either lets the command on or says why not; every refusal is
+// one final reply, published outside the lock, with nothing sent to a bus.
+
 void CommandService::submit(const CommandSample& s) {
-  const Now now{clock_.system_now(), clock_.steady_now()};
-  if (s.request_id.empty()) {
-    // Nothing to correlate a resend with: answered, not remembered.
-    {
-      std::lock_guard<std::mutex> lock(mutex_);
-      ++counters_.received;
-      ++counters_.refused;
-    }
-    spdlog::warn("audit: command without request_id from {}: {} -> REJECTED", printable(s.sender), describe(s));
-    reply_(make_reply(s, CommandResult::Rejected, "request_id is empty"));
-    return;
-  }
+  if (s.request_id.empty()) return reject_without_id(s);
   const std::string key = sender_key(s.sender, s.request_id);
+  if (!first_time(key, s)) return;
+  // Values, ranges and the expiry: parse_command checks them all.
+  auto parsed = parse_command(s, Now{clock_.system_now(), clock_.steady_now()}, policy_.lifetimes);
+  if (!parsed) return finish(key, s.sender, describe(s), make_reply(s, CommandResult::Rejected, parsed.error()));
+  const CommandRequest& r = *parsed;
+  BusWorker* worker = worker_for(r.bus);
+  if (!worker) return refuse(r, not_served(r));
+  if (auto no = judge(r)) return refuse(r, *no);
+  if (auto no = limit_rate(r)) return refuse(r, *no);
+  worker->post([this, worker, r] { run_on_worker(*worker, r); });
+}
+
+void CommandService::reject_without_id(const CommandSample& s) {
+  // Nothing to correlate a resend with: answered, not remembered.
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    ++counters_.received;
+    ++counters_.refused;
+  }
+  spdlog::warn("audit: command without request_id from {}: {} -> REJECTED", printable(s.sender), describe(s));
+  reply_(make_reply(s, CommandResult::Rejected, "request_id is empty"));
+}
+
+bool CommandService::first_time(const std::string& key, const CommandSample& s) {
   std::optional<CommandReplyData> again;
   switch (remember(key, s, again)) {
+    case Seen::New: return true;
     case Seen::Resend:
       spdlog::info("audit: duplicate command {} from {}: answered again, not executed", printable(s.request_id),
                    printable(s.sender));
-      if (again) reply_(*again);
-      return;
+      if (again) reply_(*again);  // else owed: sent with the first one's final reply
+      return false;
     case Seen::Reused:
       spdlog::warn("audit: command {} from {} reuses that id for another command: {} -> REJECTED",
                    printable(s.request_id), printable(s.sender), describe(s));
       reply_(make_reply(s, CommandResult::Rejected,
                         "request id '" + printable(s.request_id) +
                             "' was already used by this sender for another command; not executed (use a new id)"));
-      return;
-    case Seen::New: break;
+      return false;
   }
-  auto parsed = parse_command(s, now, policy_.lifetimes);
-  if (!parsed) return finish(key, s.sender, describe(s), make_reply(s, CommandResult::Rejected, parsed.error()));
-  execute(*parsed);
+  return false;
 }
 
-void CommandService::execute(const CommandRequest& r) {
-  BusWorker* worker = worker_for(r.bus);
-  if (!worker) {
-    std::string served;
-    for (auto* w : workers_) served += (served.empty() ? "" : ", ") + w->config().name;
-    return answer(r, CommandResult::Rejected,
-                  "bus '" + printable(r.bus) + "' is not served here (buses: " + served + ")");
-  }
-  const PolicyVerdict verdict = check_policy(r, policy_);
-  if (!verdict.allowed()) return answer(r, verdict.result, verdict.reason);
+CommandService::Refusal CommandService::not_served(const CommandRequest& r) const {
+  std::string served;
+  for (auto* w : workers_) served += (served.empty() ? "" : ", ") + w->config().name;
+  return {CommandResult::Rejected, "bus '" + printable(r.bus) + "' is not served here (buses: " + served + ")"};
+}
 
-  bool limited = false;
-  if (r.kind() != CommandKind::EngineStop) {
+std::optional<CommandService::Refusal> CommandService::judge(const CommandRequest& r) const {
+  PolicyVerdict verdict = check_policy(r, policy_);
+  if (verdict.allowed()) return std::nullopt;
+  return Refusal{verdict.result, std::move(verdict.reason)};
+}
+
+std::optional<CommandService::Refusal> CommandService::limit_rate(const CommandRequest& r) {
+  if (r.kind() == CommandKind::EngineStop) return std::nullopt;  // a stop is never held back
+  {
     std::lock_guard<std::mutex> lock(mutex_);
     auto it = limiters_.try_emplace({r.bus, r.address}, policy_.rate_per_second, policy_.burst).first;
-    limited = !it->second.allow(clock_.steady_now());
+    if (it->second.allow(clock_.steady_now())) return std::nullopt;
   }
-  if (limited) {
-    char buf[96];
-    std::snprintf(buf, sizeof buf, "rate limit: more than %g commands/s (burst %g) to this device",
-                  policy_.rate_per_second, policy_.burst);
-    return answer(r, CommandResult::Rejected, buf);
-  }
+  char buf[96];
+  std::snprintf(buf, sizeof buf, "rate limit: more than %g commands/s (burst %g) to this device",
+                policy_.rate_per_second, policy_.burst);
+  return Refusal{CommandResult::Rejected, buf};
+}
 
-  worker->post([this, worker, r] {
-    const auto now = clock_.steady_now();
-    if (r.address == codec::kBroadcastAddress) {  // parse_command lets only engine_stop through
-      const auto sent = worker->bus().send(*codec::encode_engine_stop(r.address), timeouts_.send);
-      return sent.ok() ? answer(r, CommandResult::Completed, "stop sent to every PMU (broadcast)")
-                       : answer(r, CommandResult::Failed,
-                                "bus refused the engine stop: " + std::string(transport::to_string(sent.status)));
-    }
-    DeviceSession* session = worker->session(r.address);
-    if (!session)
-      return answer(r, CommandResult::Rejected, "device " + std::to_string(r.address) + " not seen on " + r.bus);
-    if (!session->info() && r.kind() != CommandKind::EngineStop)
-      return answer(r, CommandResult::Rejected,
-                    "device " + std::to_string(r.address) + " on " + r.bus +
-                        " is not ready: its firmware and configuration have not been read yet");
-    if (const auto* set = std::get_if<action::SetParameter>(&r.action);
-        set && set->parameter == codec::Parameter::CanAddress && set->raw != r.address &&
-        worker->session(static_cast<std::uint16_t>(set->raw)))
-      return answer(r, CommandResult::Rejected,
-                    "address " + std::to_string(set->raw) + " is already in use on " + r.bus);
-    execute_command(*session, r, now, timeouts_,
-                    [this, key = sender_key(r.sender, r.request_id), sender = r.sender,
-                     what = describe(r)](const CommandReplyData& d) { finish(key, sender, what, d); });
-  });
+void CommandService::run_on_worker(BusWorker& worker, const CommandRequest& r) {
+  if (r.address == codec::kBroadcastAddress) return broadcast(worker, r);
+  DeviceSession* session = worker.session(r.address);
+  if (auto no = check_device(worker, session, r)) return refuse(r, *no);
+  execute_command(*session, r, clock_.steady_now(), timeouts_,
+                  [this, key = sender_key(r.sender, r.request_id), sender = r.sender,
+                   what = describe(r)](const CommandReplyData& d) { finish(key, sender, what, d); });
+}
+
+void CommandService::broadcast(BusWorker& worker, const CommandRequest& r) {
+  // parse_command lets only engine_stop through to the broadcast address; no device answers.
+  const auto sent = worker.bus().send(*codec::encode_engine_stop(r.address), timeouts_.send);
+  if (sent.ok()) return answer(r, CommandResult::Completed, "stop sent to every PMU (broadcast)");
+  answer(r, CommandResult::Failed, "bus refused the engine stop: " + std::string(transport::to_string(sent.status)));
+}
+
+std::optional<CommandService::Refusal> CommandService::check_device(BusWorker& worker, const DeviceSession* session,
+                                                                  const CommandRequest& r) {
+  const std::string device = "device " + std::to_string(r.address);
+  if (!session) return Refusal{CommandResult::Rejected, device + " not seen on " + r.bus};
+  // Firmware decides what a command may do; a stop needs nothing read.
+  if (!session->info() && r.kind() != CommandKind::EngineStop)
+    return Refusal{CommandResult::Rejected,
+                   device + " on " + r.bus + " is not ready: its firmware and configuration have not been read yet"};
+  if (const auto* set = std::get_if<action::SetParameter>(&r.action);
+      set && set->parameter == codec::Parameter::CanAddress && set->raw != r.address &&
+      worker.session(static_cast<std::uint16_t>(set->raw)))
+    return Refusal{CommandResult::Rejected, "address " + std::to_string(set->raw) + " is already in use on " + r.bus};
+  return std::nullopt;
 }
 
 }  // namespace pmu::service

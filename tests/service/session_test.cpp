@@ -190,14 +190,17 @@ TEST(Session, TelemetryBetweenSerialAndFirmwareRepliesDecodesTheExternalSensors)
   const auto t0 = std::chrono::steady_clock::time_point{} + 1h;
   DeviceSession s({"sim0", 1}, device(1), Timeouts{}, sink, [](const codec::CanFrame&) { return transport::SendResult{}; },
                   t0);
-  s.on_frame(*codec::encode_serial(4001, 1), t0 + 1ms, {});
+  const auto deliver = [&s](const codec::CanFrame& f, SteadyTime t) {
+    s.on_frame(*codec::parse_id(f.id, f.extended).id, f, t, {});
+  };
+  deliver(*codec::encode_serial(4001, 1), t0 + 1ms);
   codec::Temperatures temps;
   temps.internal = 35;
   temps.battery_a = 25;
   temps.battery_b = 24;
   temps.generator = codec::kNoSensor;
   temps.starter = 20;
-  s.on_frame(*codec::encode_temperatures(temps, 1), t0 + 2ms, {});
+  deliver(*codec::encode_temperatures(temps, 1), t0 + 2ms);
   ASSERT_EQ(sink.telemetry.size(), 1u);
   const auto* got = std::get_if<codec::Temperatures>(&sink.telemetry[0].message.payload);
   ASSERT_NE(got, nullptr);

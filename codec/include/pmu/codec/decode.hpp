@@ -53,6 +53,12 @@ struct PmuMessage {
 Result<PmuMessage, DecodeError> decode(const CanFrame& frame,
                                        std::optional<FirmwareVersion> fw = std::nullopt) noexcept;
 
+// The same for a frame whose id the caller has already parsed into `id` (parse_id(frame.id,
+// frame.extended)): code that routes frames by address parses the id once, then decodes
+// with the firmware of the device it routed to.
+Result<PmuMessage, DecodeError> decode(const CanFrame& frame, const PmuId& id,
+                                       std::optional<FirmwareVersion> fw) noexcept;
+
 // Data length of a frame carrying values for `packet` (the "Length" column of table 1, as
 // kPacketTable in packets.hpp); 0 for data-less commands and for unknown packets.
 std::uint8_t data_length(PacketId packet) noexcept;

@@ -12,17 +12,17 @@
 //   engine stop sent ahead of anything queued for the device
 //   reset       sent, then identity and every stored value are read again
 // Nothing reaches the bus for a request that fails the checks (REJECTED / UNSUPPORTED).
+// Each kind is a description in one table (command_plan.hpp), run by one generic runner.
 
 #include <functional>
 #include <optional>
 
 #include "pmu/service/command.hpp"
+#include "pmu/service/command_plan.hpp"
 #include "pmu/service/config.hpp"
 #include "pmu/service/device_session.hpp"
 
 namespace pmu::service {
-
-using ReplyFn = std::function<void(const CommandReplyData&)>;
 
 // What the device's firmware decides (parse_command checked everything else): a final
 // UNSUPPORTED reply when `fw` lacks what `r` asks for, nullopt otherwise.
@@ -33,9 +33,8 @@ std::optional<CommandReplyData> check_firmware(const CommandRequest& r, std::opt
 void execute_command(DeviceSession& session, const CommandRequest& r, SteadyTime now, const Timeouts& timeouts,
                      ReplyFn reply);
 
-// A final reply to `r` with `result` and `reason`.
-CommandReplyData make_reply(const CommandRequest& r, CommandResult result, std::string reason);
-// The same for a sample that did not parse (an unknown kind is answered as GET).
+// A final reply to a sample that did not parse (an unknown kind is answered as GET);
+// make_reply for a parsed request is in command_plan.hpp.
 CommandReplyData make_reply(const CommandSample& s, CommandResult result, std::string reason);
 
 }  // namespace pmu::service

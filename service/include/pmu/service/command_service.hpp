@@ -58,12 +58,34 @@ class CommandService {
   };
   enum class Seen { New, Resend, Reused };
 
+  // Why a stage stopped a command: its final reply.
+  struct Refusal {
+    CommandResult result = CommandResult::Rejected;
+    std::string reason;
+  };
+
+  // The stages of submit(), in order (each answers or lets the command on):
+  void reject_without_id(const CommandSample& s);
+  // Duplicate detection: false when `s` is a resend (answered again) or reuses an id.
+  bool first_time(const std::string& key, const CommandSample& s);
   Seen remember(const std::string& key, const CommandSample& s, std::optional<CommandReplyData>& again);
-  void execute(const CommandRequest& r);
+  // Routing: the bus is not one of this service's (when worker_for found none).
+  Refusal not_served(const CommandRequest& r) const;
+  // The deny list and confirm rules (policy.hpp).
+  std::optional<Refusal> judge(const CommandRequest& r) const;
+  // The per-device token bucket; never for engine stop.
+  std::optional<Refusal> limit_rate(const CommandRequest& r);
+  // ...and on the bus worker's thread:
+  void run_on_worker(BusWorker& worker, const CommandRequest& r);
+  void broadcast(BusWorker& worker, const CommandRequest& r);
+  // Known, read (firmware known) and, for an address change, the new address free.
+  std::optional<Refusal> check_device(BusWorker& worker, const DeviceSession* session, const CommandRequest& r);
+
   // Records the final reply under `key`, logs it and publishes it (and the owed copies).
   void finish(const std::string& key, const std::string& sender, const std::string& what,
               const CommandReplyData& reply);
   void answer(const CommandRequest& r, CommandResult result, std::string reason);
+  void refuse(const CommandRequest& r, const Refusal& refusal);
   BusWorker* worker_for(const std::string& bus) const;
 
   std::vector<BusWorker*> workers_;

@@ -1,10 +1,14 @@
 #pragma once
-// DeviceSession: the service's conversation with one PMU.
-//
-// The PMU's answers carry no sequence number, only the packet id they answer, so requests
-// to one device are strictly serialised: one in flight, the rest queued in order. A request
-// that expects an answer is matched by (address, packet id, data-carrying frame); it is
-// retried (idempotent gets only) and ends in Timeout when the device stays silent.
+// DeviceSession: the service's conversation with one PMU, composed of three parts:
+//   RequestQueue     request/response correlation: one request in flight, the rest queued
+//                    in order, answers matched by packet id, retries, timeouts, expiry
+//                    (request_queue.hpp);
+//   ReadingMachine   the device's identity and stored values and the rounds of gets that
+//                    read them (reading_machine.hpp);
+//   HealthTracker    ONLINE / STALE / OFFLINE from frame age, and the counters
+//                    (health_tracker.hpp).
+// The session wires them together and owns what spans them: publishing, polling, and the
+// streaming set-up.
 //
 // Life of a session: READING (serial, firmware, every stored parameter, outputs, generation)
 // -> publishes info and config -> RUNNING (streaming: listen; polling: ask every period,
@@ -13,64 +17,41 @@
 // period, then OFFLINE; a frame after OFFLINE re-reads info and config (the unit may have
 // been swapped or reset).
 //
+// Frames arrive with their id already parsed (the bus worker parses it once to route the
+// frame); the session decodes the payload with the firmware it knows, so firmware-
+// dependent packets are read right from the first frame after the firmware is known.
+//
 // No I/O and no clock of its own: frames go out through a send callback, time comes in
 // through every call, so tests drive it with a fake clock.
 
 #include <chrono>
 #include <cstdint>
-#include <deque>
 #include <functional>
 #include <optional>
 
 #include "pmu/codec/decode.hpp"
 #include "pmu/service/config.hpp"
 #include "pmu/service/device_state.hpp"
+#include "pmu/service/health_tracker.hpp"
+#include "pmu/service/reading_machine.hpp"
+#include "pmu/service/request_queue.hpp"
 
 namespace pmu::service {
-
-using SteadyTime = std::chrono::steady_clock::time_point;
-using WallTime = std::chrono::system_clock::time_point;
-
-enum class RequestStatus : std::uint8_t {
-  Answered,    // the device replied; `reply` holds it
-  Sent,        // no reply expected (a set or command) and the bus accepted the frame
-  Timeout,     // no reply after every try
-  SendFailed,  // the bus refused the frame (down, gone, queue full)
-  Expired,     // its expiry passed while it waited in the queue: never sent
-};
-
-struct RequestOutcome {
-  RequestStatus status = RequestStatus::Sent;
-  std::optional<codec::PmuMessage> reply;
-  transport::SendResult send;  // the last send attempt
-};
-
-struct Request {
-  codec::CanFrame frame;
-  // Packet id of the expected answer; nullopt when the device sends none (sets, commands).
-  std::optional<codec::PacketId> reply;
-  unsigned retries = 0;  // extra tries; only for requests that are safe to repeat
-  std::function<void(const RequestOutcome&)> done;
-  int tag = 0;  // the session's own requests (reading, polling) are tagged to find them
-  // Not sent after this time (a command that waited too long behind others is dropped).
-  std::optional<std::chrono::steady_clock::time_point> expires;
-};
 
 class DeviceSession {
  public:
   using SendFn = std::function<transport::SendResult(const codec::CanFrame&)>;
 
-  DeviceSession(DeviceKey key, DeviceConfig config, const Timeouts& timeouts, StateSink& sink, SendFn send,
+  DeviceSession(DeviceKey key, DeviceConfig device, const Timeouts& timeouts, StateSink& sink, SendFn send,
                 SteadyTime now);
 
   const DeviceKey& key() const noexcept { return key_; }
-  // A frame from this device's address, already decoded without firmware knowledge; the
-  // session re-decodes firmware-dependent packets once it knows the firmware.
-  void on_frame(const codec::CanFrame& frame, SteadyTime now, WallTime received);
+  // A frame from this device's address (or alias) whose id the caller parsed into `id`.
+  void on_frame(const codec::PmuId& id, const codec::CanFrame& frame, SteadyTime now, WallTime received);
   // A frame from this address that did not decode.
-  void on_decode_error() noexcept { ++health_.decode_errors; }
+  void on_decode_error() noexcept { health_.on_decode_error(); }
   void on_bus_state(transport::BusState state, SteadyTime now);
-  void on_bus_counters(const transport::BusCounters& counters) noexcept;
+  void on_bus_counters(const transport::BusCounters& counters) noexcept { health_.on_bus_counters(counters); }
   // Timeouts, polling, health. Call at least every few tens of ms.
   void tick(SteadyTime now);
 
@@ -92,15 +73,14 @@ class DeviceSession {
 
   // The latest time any call brought: callbacks that queue follow-up work use it.
   SteadyTime now() const noexcept { return now_; }
-  const ConfigState& config_state() const noexcept { return config_; }
-  const std::optional<InfoState>& info() const noexcept { return info_; }
-  std::optional<codec::FirmwareVersion> firmware() const noexcept;
-  const HealthReport& health() const noexcept { return health_; }
-  bool ready() const noexcept { return phase_ == Phase::Running; }
-  std::size_t queued() const noexcept { return queue_.size() + (in_flight_ ? 1 : 0); }
+  const ConfigState& config_state() const noexcept { return reading_.config(); }
+  const std::optional<InfoState>& info() const noexcept { return reading_.info(); }
+  std::optional<codec::FirmwareVersion> firmware() const noexcept { return reading_.firmware(); }
+  const HealthReport& health() const noexcept { return health_.report(); }
+  bool ready() const noexcept { return reading_.running(); }
+  std::size_t queued() const noexcept { return queue_.size(); }
 
  private:
-  enum class Phase : std::uint8_t { Reading, Running };
   static constexpr int kReadingTag = 1;
   static constexpr int kPollTag = 2;
 
@@ -108,39 +88,23 @@ class DeviceSession {
   void on_reading_done(const RequestOutcome& outcome, std::uint64_t round);
   void configure_streaming();
   void poll(SteadyTime now);
-  void send_next(SteadyTime now);
-  void finish(RequestOutcome outcome, SteadyTime now);
   void absorb(const codec::PmuMessage& m);
   void update_health(SteadyTime now, bool force);
   std::chrono::milliseconds period() const noexcept;
 
   DeviceKey key_;
-  DeviceConfig config_cfg_;
+  DeviceConfig config_cfg_;  // the config file's settings for it; what the device stores: reading_.config()
   Timeouts timeouts_;
   StateSink& sink_;
   SendFn send_;
 
-  Phase phase_ = Phase::Reading;
-  std::uint64_t reading_round_ = 0;
-  unsigned reading_left_ = 0;  // gets of the current reading round still to be answered
-  bool reading_failed_ = false;
-  ConfigState config_;
-  std::optional<InfoState> info_;
-  HealthReport health_;
+  HealthTracker health_;
+  ReadingMachine reading_;
+  RequestQueue queue_;
 
-  std::deque<Request> queue_;
-  std::optional<Request> in_flight_;
-  unsigned attempts_ = 0;
-  SteadyTime deadline_{};
-
-  bool pumping_ = false;
   std::optional<std::uint16_t> alias_;
   SteadyTime now_{};  // the latest time any call brought
-  SteadyTime created_{};
-  std::optional<SteadyTime> last_rx_;
   SteadyTime next_poll_{};
-  SteadyTime next_health_{};
-  SteadyTime retry_reading_at_{};
 };
 
 }  // namespace pmu::service
