@@ -15,7 +15,7 @@ bool is_telemetry(codec::PacketId p) noexcept { return static_cast<std::uint8_t>
 
 DeviceSession::DeviceSession(DeviceKey key, DeviceConfig device, const Timeouts& timeouts, StateSink& sink,
                              SendFn send, SteadyTime now)
-    : key_(std::move(key)), config_cfg_(device), timeouts_(timeouts), sink_(sink), send_(std::move(send)),
+    : key_(std::move(key)), settings_(device), timeouts_(timeouts), sink_(sink), send_(std::move(send)),
       health_(now, timeouts),
       queue_(
           [this](const codec::CanFrame& f) {
@@ -28,11 +28,11 @@ DeviceSession::DeviceSession(DeviceKey key, DeviceConfig device, const Timeouts&
 }
 
 std::chrono::milliseconds DeviceSession::period() const noexcept {
-  if (config_cfg_.mode == TelemetryMode::Streaming) {
+  if (settings_.mode == TelemetryMode::Streaming) {
     const auto& pp = reading_.config().raw[static_cast<std::size_t>(codec::Parameter::PacketPeriod)];
-    if (pp && *pp > 0) return milliseconds(*pp * 100);
+    if (pp && *pp > 0) return codec::duration_of(codec::Parameter::PacketPeriod, *pp);
   }
-  return config_cfg_.period;
+  return settings_.period;
 }
 
 void DeviceSession::start_reading(SteadyTime now) {
@@ -67,7 +67,7 @@ void DeviceSession::on_reading_done(const RequestOutcome& o, std::uint64_t round
   next_poll_ = now_;
   if (info) sink_.on_info(key_, *info);
   sink_.on_config(key_, reading_.config());
-  if (config_cfg_.mode == TelemetryMode::Streaming && config_cfg_.configure_streaming) configure_streaming();
+  if (settings_.mode == TelemetryMode::Streaming && settings_.configure_streaming) configure_streaming();
 }
 
 void DeviceSession::configure_streaming() {
@@ -76,8 +76,8 @@ void DeviceSession::configure_streaming() {
     double value;
   };
   const Want wants[] = {
-      {codec::Parameter::PacketPeriod, codec::duration_value(codec::Parameter::PacketPeriod, config_cfg_.period)},
-      {codec::Parameter::PacketsStreamed, static_cast<double>(config_cfg_.groups)},
+      {codec::Parameter::PacketPeriod, codec::duration_value(codec::Parameter::PacketPeriod, settings_.period)},
+      {codec::Parameter::PacketsStreamed, static_cast<double>(settings_.groups)},
   };
   for (const auto& w : wants) {
     auto raw = codec::to_raw(w.p, w.value, firmware());
@@ -145,24 +145,24 @@ void DeviceSession::tick(SteadyTime now) {
   now_ = now;
   if (queue_.tick(now)) health_.on_timeout();
   if (reading_.retry_due(now)) start_reading(now);
-  if (reading_.running() && config_cfg_.mode == TelemetryMode::Polling && now >= next_poll_) poll(now);
+  if (reading_.running() && settings_.mode == TelemetryMode::Polling && now >= next_poll_) poll(now);
   update_health(now, false);
 }
 
 void DeviceSession::poll(SteadyTime now) {
-  next_poll_ = std::max(next_poll_ + config_cfg_.period, now);
+  next_poll_ = std::max(next_poll_ + settings_.period, now);
   // A device slower than the poll period must not make polls pile up behind each other.
   if (queue_.waiting(kPollTag)) return;
   if (codec::supports(firmware(), codec::Feature::MeasurementRequest)) {
     Request r;
-    r.frame = *codec::encode_measurement_request(config_cfg_.groups, key_.address, firmware());
+    r.frame = *codec::encode_measurement_request(settings_.groups, key_.address, firmware());
     r.tag = kPollTag;
     submit(std::move(r), now);
     return;
   }
   // Before 1.14 there is no 0x0F: one zero-length get per packet.
   for (std::uint8_t bit = 0; bit < 5; ++bit) {
-    if (!(config_cfg_.groups & (1u << bit))) continue;
+    if (!(settings_.groups & (1u << bit))) continue;
     const auto packet = static_cast<codec::PacketId>(bit);
     Request r;
     r.frame = *codec::encode_get(packet, key_.address);

@@ -93,7 +93,7 @@ class DeviceSession {
   std::chrono::milliseconds period() const noexcept;
 
   DeviceKey key_;
-  DeviceConfig config_cfg_;  // the config file's settings for it; what the device stores: reading_.config()
+  DeviceConfig settings_;  // the config file's settings for it; what the device stores: reading_.config()
   Timeouts timeouts_;
   StateSink& sink_;
   SendFn send_;
