@@ -1,12 +1,8 @@
 #include "pmu/service/bus_worker.hpp"
 
-#include <sys/epoll.h>
-#include <sys/eventfd.h>
-#include <unistd.h>
-
 #include <spdlog/spdlog.h>
 
-#include <cerrno>
+#include <algorithm>
 #include <cstring>
 #include <system_error>
 
@@ -22,27 +18,26 @@ constexpr milliseconds kTick{20};  // session timers need no finer grain than th
 constexpr milliseconds kMaintainInterval{250};
 constexpr milliseconds kDiscoveryInterval{10000};
 
-[[noreturn]] void fail(const char* what) { throw std::system_error(errno, std::generic_category(), what); }
-
 }  // namespace
 
 BusWorker::BusWorker(BusConfig config, std::unique_ptr<transport::CanBus> bus, const transport::Clock& clock,
                      const Timeouts& timeouts, StateSink& sink)
-    : config_(std::move(config)), bus_(std::move(bus)), clock_(clock), timeouts_(timeouts), sink_(sink) {
-  epoll_.reset(::epoll_create1(EPOLL_CLOEXEC));
-  if (!epoll_) fail("epoll_create1");
-  wake_.reset(::eventfd(0, EFD_CLOEXEC | EFD_NONBLOCK));
-  if (!wake_) fail("eventfd");
-  for (int fd : {bus_->fd(), wake_.get()}) {
-    epoll_event ev{};
-    ev.events = EPOLLIN;
-    ev.data.fd = fd;
-    if (::epoll_ctl(epoll_.get(), EPOLL_CTL_ADD, fd, &ev) != 0) fail("epoll_ctl");
-  }
+    : config_(std::move(config)),
+      bus_(std::move(bus)),
+      clock_(clock),
+      timeouts_(timeouts),
+      sink_(sink),
+      loop_(clock, config_.name) {
+  const int error = loop_.watch(bus_->fd(), transport::EventLoop::kReadable,
+                                [this](std::uint32_t) { turn_frames_ += bus_->drain(*this).frames; });
+  if (error != 0) throw std::system_error(error, std::generic_category(), "epoll_ctl");
   const auto now = clock_.steady_now();
   for (const auto& d : config_.devices) add_session(d);
-  next_maintain_ = now;
-  next_discovery_ = now;
+  // Both due at the first turn. Of two timers due together the one added first fires first:
+  // discovery before maintenance, their order when they were checks at the end of a turn.
+  if (config_.discover)
+    loop_.add_timer(now, kDiscoveryInterval, [this](std::chrono::steady_clock::time_point) { discover(); });
+  loop_.add_timer(now, kMaintainInterval, [this](std::chrono::steady_clock::time_point t) { bus_->maintain(t); });
 }
 
 BusWorker::~BusWorker() = default;
@@ -110,56 +105,28 @@ void BusWorker::on_event(const transport::BusEvent& event) {
   for (auto& [a, s] : sessions_) s->on_bus_state(event.state, now);
 }
 
-void BusWorker::discover(std::chrono::steady_clock::time_point now) {
-  if (!config_.discover || now < next_discovery_) return;
-  next_discovery_ = now + kDiscoveryInterval;
+void BusWorker::discover() {
   (void)bus_->send(*codec::encode_get(codec::PacketId::Firmware, codec::kBroadcastAddress), timeouts_.send);
 }
 
-void BusWorker::post(std::function<void()> fn) {
-  {
-    std::lock_guard<std::mutex> lock(posted_mutex_);
-    posted_.push_back(std::move(fn));
-  }
-  const std::uint64_t one = 1;
-  (void)!::write(wake_.get(), &one, sizeof one);
-}
-
-void BusWorker::run_posted() {
-  std::uint64_t count = 0;
-  (void)!::read(wake_.get(), &count, sizeof count);
-  std::vector<std::function<void()>> work;
-  {
-    std::lock_guard<std::mutex> lock(posted_mutex_);
-    work.swap(posted_);
-  }
-  for (auto& fn : work) fn();
-}
+void BusWorker::post(std::function<void()> fn) { loop_.post(std::move(fn)); }
 
 std::size_t BusWorker::run_once(milliseconds max_wait) {
-  epoll_event events[2];
-  const int n = ::epoll_wait(epoll_.get(), events, 2, static_cast<int>(std::min(max_wait, kTick).count()));
-  std::size_t frames = 0;
-  bool woken = false;  // post() ran: only then is there work (and an eventfd to read)
-  for (int i = 0; i < n; ++i) {
-    if (events[i].data.fd == bus_->fd()) frames += bus_->drain(*this).frames;
-    if (events[i].data.fd == wake_.get()) woken = true;
-  }
-  if (woken) run_posted();
+  turn_frames_ = 0;
+  loop_.run_once(std::min(max_wait, kTick));
+  end_turn();
+  return turn_frames_;
+}
+
+void BusWorker::end_turn() {
   const auto now = clock_.steady_now();
   const auto counters = bus_->counters();
   for (auto& [a, s] : sessions_) {
     s->on_bus_counters(counters);
     s->tick(now);
   }
-  discover(now);
   rekey_moved_sessions();
-  if (now >= next_maintain_) {
-    next_maintain_ = now + kMaintainInterval;
-    bus_->maintain(now);
-  }
   progress_.fetch_add(1, std::memory_order_relaxed);
-  return frames;
 }
 
 void BusWorker::rekey_moved_sessions() {
@@ -178,13 +145,8 @@ void BusWorker::rekey_moved_sessions() {
   }
 }
 
-void BusWorker::run() {
-  while (!stop_.load(std::memory_order_relaxed)) run_once(kTick);
-}
+void BusWorker::run() { loop_.run(kTick, [this] { end_turn(); }); }
 
-void BusWorker::stop() {
-  stop_.store(true);
-  post([] {});
-}
+void BusWorker::stop() { loop_.stop(); }
 
 }  // namespace pmu::service

@@ -1,24 +1,29 @@
 #include "pmu/sim/bus_runner.hpp"
 
-#include <sys/epoll.h>
-
 #include <algorithm>
-#include <cerrno>
+#include <cstdint>
 #include <system_error>
 
 namespace pmu::sim {
 
 using std::chrono::milliseconds;
 
+namespace {
+// The longest wait of start()'s turns: how late a change made through with_model() may be
+// noticed while the loop waits.
+constexpr milliseconds kTurn{50};
+}  // namespace
+
 BusRunner::BusRunner(std::unique_ptr<transport::CanBus> bus, const transport::Clock& clock)
-    : bus_(std::move(bus)), clock_(clock) {
-  epoll_.reset(::epoll_create1(EPOLL_CLOEXEC));
-  if (!epoll_) throw std::system_error(errno, std::generic_category(), "epoll_create1");
-  epoll_event ev{};
-  ev.events = EPOLLIN;
-  ev.data.fd = bus_->fd();
-  if (::epoll_ctl(epoll_.get(), EPOLL_CTL_ADD, bus_->fd(), &ev) != 0)
-    throw std::system_error(errno, std::generic_category(), "epoll_ctl");
+    : bus_(std::move(bus)), clock_(clock), loop_(clock, bus_->name()) {
+  const int error = loop_.watch(bus_->fd(), transport::EventLoop::kReadable, [this](std::uint32_t) {
+    std::lock_guard<std::recursive_mutex> lock(mutex_);
+    bus_->drain(*this);
+  });
+  if (error != 0) throw std::system_error(error, std::generic_category(), "epoll_ctl");
+  // Only ends waits: every turn ticks every model whether or not a deadline passed.
+  deadline_timer_ = loop_.add_timer(clock_.steady_now(), milliseconds{0}, {});
+  loop_.disarm(deadline_timer_);
 }
 
 BusRunner::~BusRunner() { stop(); }
@@ -38,35 +43,44 @@ void BusRunner::on_frame(const transport::ReceivedFrame& frame) {
 
 void BusRunner::on_event(const transport::BusEvent&) {}
 
-void BusRunner::run_once(milliseconds max_wait) {
-  milliseconds wait = max_wait;
-  {
-    std::lock_guard<std::recursive_mutex> lock(mutex_);
-    const auto now = clock_.steady_now();
-    for (const auto& [address, model] : models_) {
-      const auto until = std::chrono::duration_cast<milliseconds>(model->next_deadline() - now);
-      wait = std::clamp(until, milliseconds(0), wait);
-    }
-  }
-  epoll_event ev{};
-  const int n = ::epoll_wait(epoll_.get(), &ev, 1, static_cast<int>(wait.count()));
+void BusRunner::wake_at_next_deadline() {
   std::lock_guard<std::recursive_mutex> lock(mutex_);
-  if (n > 0) bus_->drain(*this);
+  if (models_.empty()) {
+    loop_.disarm(deadline_timer_);
+    return;
+  }
+  auto earliest = transport::EventLoop::TimePoint::max();
+  for (const auto& [address, model] : models_) earliest = std::min(earliest, model->next_deadline());
+  loop_.schedule(deadline_timer_, earliest);
+}
+
+void BusRunner::end_turn() {
+  std::lock_guard<std::recursive_mutex> lock(mutex_);
   const auto now = clock_.steady_now();
   for (auto& [address, model] : models_) model->tick(now);
   bus_->maintain(now);
 }
 
+void BusRunner::run_once(milliseconds max_wait) {
+  wake_at_next_deadline();
+  loop_.run_once(max_wait);
+  end_turn();
+}
+
 void BusRunner::start() {
-  stop_ = false;
   thread_ = std::thread([this] {
-    while (!stop_.load()) run_once(milliseconds(50));
+    wake_at_next_deadline();
+    loop_.run(kTurn, [this] {
+      end_turn();
+      wake_at_next_deadline();
+    });
   });
 }
 
 void BusRunner::stop() {
-  stop_ = true;
-  if (thread_.joinable()) thread_.join();
+  if (!thread_.joinable()) return;
+  loop_.stop();
+  thread_.join();
 }
 
 bool BusRunner::with_model(std::uint16_t address, const std::function<void(PmuModel&)>& fn) {

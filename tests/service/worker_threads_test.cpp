@@ -10,6 +10,7 @@
 #include <thread>
 
 #include "harness.hpp"
+#include "support/wait.hpp"
 #include "pmu/service/command_service.hpp"
 
 namespace pmu::service::test {
@@ -80,6 +81,38 @@ TEST(WorkerThreads, DeviceCountFollowsAnAddressChange) {
   h.run_for(50ms);
   EXPECT_EQ(h.worker().addresses(), (std::vector<std::uint16_t>{2, 7}));
   EXPECT_EQ(h.worker().device_count(), 2u);
+}
+
+// The threading model of pmu-service (main.cpp): the simulator's runner and the worker each
+// turn in a thread of their own; work posted from another thread runs on the worker's; stop()
+// from the main thread ends both, and the runner can be started again.
+TEST(WorkerThreads, PostedWorkRunsOnTheWorkerThreadAndStopEndsBothLoops) {
+  Harness h(sim_bus({device(1)}), {pmu(1)});
+  h.pmus().start();
+  std::atomic<bool> returned{false};
+  std::thread::id worker_id;
+  std::thread worker([&] {
+    worker_id = std::this_thread::get_id();
+    h.worker().run();
+    returned = true;
+  });
+  std::atomic<bool> ran{false};
+  std::thread::id ran_on;
+  h.worker().post([&] {
+    ran_on = std::this_thread::get_id();
+    ran = true;
+  });
+  ASSERT_TRUE(pmu::test::wait_until([&] { return ran.load(); }, 10s));
+  const auto progress = h.worker().progress();
+  ASSERT_TRUE(pmu::test::wait_until([&] { return h.worker().progress() > progress; }, 10s))
+      << "turns keep coming with nothing to do (the watchdog depends on it)";
+  h.worker().stop();
+  ASSERT_TRUE(pmu::test::wait_until([&] { return returned.load(); }, 10s)) << "stop() did not end run()";
+  worker.join();
+  EXPECT_EQ(ran_on, worker_id);
+  h.pmus().stop();
+  h.pmus().start();  // a runner stopped once runs again
+  h.pmus().stop();
 }
 
 }  // namespace

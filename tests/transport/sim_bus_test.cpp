@@ -1,13 +1,12 @@
 // SimulatedNetwork / SimBus: delivery to every other endpoint, injected-clock timestamps,
-// the fault knobs, and use from an epoll loop on another thread.
+// the fault knobs, and use from an event loop on another thread.
 
 #include <gtest/gtest.h>
-#include <sys/epoll.h>
 
-#include <atomic>
 #include <chrono>
 #include <thread>
 
+#include "pmu/transport/event_loop.hpp"
 #include "pmu/transport/sim_bus.hpp"
 #include "test_support.hpp"
 
@@ -178,8 +177,8 @@ TEST_F(Sim, InvalidFramesAreRefused) {
 }
 
 // A device on one thread answering from inside its drain() handler, the service on another
-// waiting in epoll: the shape pmu-sim and the integration tests use.
-TEST(SimThreads, EchoAcrossThreadsThroughEpollLoops) {
+// waiting in its event loop: the shape pmu-sim and the integration tests use.
+TEST(SimThreads, EchoAcrossThreadsThroughEventLoops) {
   SystemClock clock;
   SimulatedNetwork network{clock};
   auto service = network.attach("service");
@@ -191,34 +190,26 @@ TEST(SimThreads, EchoAcrossThreadsThroughEpollLoops) {
     void on_frame(const ReceivedFrame& f) override { bus->send(f.frame, milliseconds{0}); }
     void on_event(const BusEvent&) override {}
   };
-  std::atomic<bool> stop{false};
-  std::thread device_thread([&] {
-    Echo echo;
-    echo.bus = device.get();
-    UniqueFd loop{::epoll_create1(EPOLL_CLOEXEC)};
-    struct epoll_event registration {};
-    registration.events = EPOLLIN;
-    ::epoll_ctl(loop.get(), EPOLL_CTL_ADD, device->fd(), &registration);
-    while (!stop) {
-      struct epoll_event ready {};
-      if (::epoll_wait(loop.get(), &ready, 1, 20) == 1) device->drain(echo);
-    }
-  });
+  Echo echo;
+  echo.bus = device.get();
+  EventLoop device_loop{clock, "device"};
+  ASSERT_EQ(device_loop.watch(device->fd(), EventLoop::kReadable,
+                              [&](std::uint32_t) { device->drain(echo); }),
+            0);
+  RecordingHandler replies;
+  EventLoop service_loop{clock, "service"};
+  ASSERT_EQ(service_loop.watch(service->fd(), EventLoop::kReadable,
+                               [&](std::uint32_t) { service->drain(replies); }),
+            0);
+  std::thread device_thread([&] { device_loop.run(); });
 
   for (int i = 0; i < kFrames; ++i)
     service->send(pmu_frame(PacketId::Voltages, static_cast<std::uint16_t>(i)), milliseconds{0});
 
-  RecordingHandler replies;
-  UniqueFd loop{::epoll_create1(EPOLL_CLOEXEC)};
-  struct epoll_event registration {};
-  registration.events = EPOLLIN;
-  ASSERT_EQ(::epoll_ctl(loop.get(), EPOLL_CTL_ADD, service->fd(), &registration), 0);
   const auto give_up = std::chrono::steady_clock::now() + std::chrono::seconds{10};
-  while (replies.frames.size() < kFrames && std::chrono::steady_clock::now() < give_up) {
-    struct epoll_event ready {};
-    if (::epoll_wait(loop.get(), &ready, 1, 100) == 1) service->drain(replies);
-  }
-  stop = true;
+  while (replies.frames.size() < kFrames && std::chrono::steady_clock::now() < give_up)
+    service_loop.run_once(milliseconds{100});
+  device_loop.stop();
   device_thread.join();
 
   ASSERT_EQ(replies.frames.size(), static_cast<std::size_t>(kFrames));

@@ -3,7 +3,6 @@
 #include <linux/can/error.h>
 #include <linux/can/raw.h>
 #include <net/if.h>
-#include <sys/epoll.h>
 
 #include <algorithm>
 #include <cerrno>
@@ -12,7 +11,6 @@
 #include <system_error>
 #include <utility>
 
-#include "eventfd.hpp"
 #include "pmu/transport/linux_frame.hpp"
 
 namespace pmu::transport {
@@ -130,15 +128,7 @@ SocketCanBus::SocketCanBus(Private, std::string name, std::string interface,
       options_(options),
       clock_(clock),
       ops_(ops),
-      poll_fd_(::epoll_create1(EPOLL_CLOEXEC)) {
-  if (!poll_fd_) throw_setup(errno, name_, "epoll_create1");
-  wake_fd_ = detail::make_eventfd();
-  struct epoll_event registration {};
-  registration.events = EPOLLIN;
-  registration.data.fd = wake_fd_.get();
-  if (::epoll_ctl(poll_fd_.get(), EPOLL_CTL_ADD, wake_fd_.get(), &registration) != 0)
-    throw_setup(errno, name_, "epoll_ctl(eventfd)");
-}
+      loop_(clock, name_) {}
 
 SocketCanBus::~SocketCanBus() = default;
 
@@ -204,10 +194,10 @@ SocketCanBus::Opened SocketCanBus::open_bound_socket() {
 }
 
 int SocketCanBus::attach_socket(UniqueFd socket) {
-  struct epoll_event registration {};
-  registration.events = EPOLLIN;
-  registration.data.fd = socket.get();
-  if (::epoll_ctl(poll_fd_.get(), EPOLL_CTL_ADD, socket.get(), &registration) != 0) return errno;
+  // No callback: drain() reads the socket itself on every call, so the loop only has to
+  // make fd() readable while frames wait.
+  if (const int error = loop_.watch(socket.get(), EventLoop::kReadable, {}); error != 0)
+    return error;
   socket_ = std::move(socket);
   last_kernel_drops_ = 0;  // the running total starts again with each socket
   return 0;
@@ -215,8 +205,8 @@ int SocketCanBus::attach_socket(UniqueFd socket) {
 
 void SocketCanBus::close_socket() noexcept {
   if (!socket_) return;
-  // Removed explicitly: epoll forgets an fd on close only when no duplicate of it remains.
-  ::epoll_ctl(poll_fd_.get(), EPOLL_CTL_DEL, socket_.get(), nullptr);
+  // Before the close: epoll forgets an fd on close only when no duplicate of it remains.
+  loop_.unwatch(socket_.get());
   socket_.reset();
 }
 
@@ -235,7 +225,7 @@ void SocketCanBus::emit(const BusEvent& event, Delivery* out) {
     return;
   }
   pending_events_.push_back(event);
-  detail::signal_eventfd(wake_fd_.get());
+  loop_.wake();
 }
 
 void SocketCanBus::set_state(BusState next, Delivery* out) {
@@ -260,8 +250,9 @@ void SocketCanBus::lose_socket(int error, Delivery* out) {
 
 DrainResult SocketCanBus::drain(BusHandler& handler) {
   Delivery out{handler, {}};
-  // The eventfd is readable exactly while events are pending: no read() per wakeup else.
-  if (!pending_events_.empty()) detail::clear_eventfd(wake_fd_.get());
+  // The loop's wake-up is pending exactly while events are: only then is a turn (which
+  // consumes it) worth its epoll_wait. The socket is read below either way.
+  if (!pending_events_.empty()) loop_.run_once(std::chrono::milliseconds{0});
   // Swapped out first: a handler that sends can queue new events while we deliver.
   std::vector<BusEvent> queued;
   queued.swap(pending_events_);

@@ -1,10 +1,12 @@
 #pragma once
 // BusWorker: one CAN bus and the PMUs on it, driven by one thread.
 //
-// Each wakeup drains every pending frame from the bus (transport contract), hands each to
-// the session of its address, then ticks every session (timeouts, polling, health). Work
-// from other threads (commands, shutdown) arrives through post(), which wakes the loop via
-// an eventfd, so sessions are only ever touched on the worker's thread.
+// The loop is a transport::EventLoop (event_loop.hpp). Each turn drains every pending frame
+// from the bus (transport contract) and hands each to the session of its address, runs
+// posted work, fires the loop's timers (bus maintenance every 250 ms, the discovery
+// broadcast), then ticks every session (timeouts, polling, health); a turn waits at most
+// 20 ms. Work from other threads (commands, shutdown) arrives through post(), which wakes
+// the loop, so sessions are only ever touched on the worker's thread.
 //
 // Discovery: when the bus config asks for it, a broadcast firmware request (0x31 to 0xFFFF)
 // is sent at start and every 10 s; every address that answers
@@ -16,28 +18,28 @@
 #include <functional>
 #include <map>
 #include <memory>
-#include <mutex>
 #include <vector>
 
 #include "pmu/service/config.hpp"
 #include "pmu/service/device_session.hpp"
 #include "pmu/transport/can_bus.hpp"
 #include "pmu/transport/clock.hpp"
-#include "pmu/transport/unique_fd.hpp"
+#include "pmu/transport/event_loop.hpp"
 
 namespace pmu::service {
 
 class BusWorker final : private transport::BusHandler {
  public:
-  // Throws std::system_error when the wake fd or epoll cannot be created (start-up).
+  // Throws std::system_error when the event loop cannot be set up (start-up).
   BusWorker(BusConfig config, std::unique_ptr<transport::CanBus> bus, const transport::Clock& clock,
             const Timeouts& timeouts, StateSink& sink);
   ~BusWorker();
   BusWorker(const BusWorker&) = delete;
   BusWorker& operator=(const BusWorker&) = delete;
 
-  // One turn of the loop: waits up to `max_wait` for the bus or posted work, then drains,
-  // runs posted work, ticks sessions and maintains the bus. Returns the number of frames.
+  // One turn of the loop: waits up to `max_wait` (at most 20 ms) for the bus, posted work
+  // or a timer, then drains, runs posted work and due timers, and ticks sessions. Returns
+  // the number of frames.
   std::size_t run_once(std::chrono::milliseconds max_wait);
   // Runs turns until stop() is called (from any thread).
   void run();
@@ -64,9 +66,9 @@ class BusWorker final : private transport::BusHandler {
   void on_frame(const transport::ReceivedFrame& frame) override;
   void on_event(const transport::BusEvent& event) override;
   DeviceSession& add_session(const DeviceConfig& device);
-  void discover(std::chrono::steady_clock::time_point now);
+  void discover();  // the broadcast firmware request (a loop timer, when config_.discover)
   void rekey_moved_sessions();
-  void run_posted();
+  void end_turn();  // ticks every session; the watchdog's progress
 
   BusConfig config_;
   std::unique_ptr<transport::CanBus> bus_;
@@ -75,15 +77,10 @@ class BusWorker final : private transport::BusHandler {
   StateSink& sink_;
   std::map<std::uint16_t, std::unique_ptr<DeviceSession>> sessions_;
 
-  transport::UniqueFd epoll_;
-  transport::UniqueFd wake_;
-  std::mutex posted_mutex_;
-  std::vector<std::function<void()>> posted_;
-  std::atomic<bool> stop_{false};
+  transport::EventLoop loop_;
+  std::size_t turn_frames_ = 0;  // frames drained in the run_once() turn in progress
   std::atomic<std::uint64_t> progress_{0};
   std::atomic<std::size_t> device_count_{0};
-  std::chrono::steady_clock::time_point next_maintain_{};
-  std::chrono::steady_clock::time_point next_discovery_{};
 };
 
 }  // namespace pmu::service

@@ -3,10 +3,14 @@
 // ticks them, and lets them send what they emit. Used by pmu-sim (on SocketCAN), by
 // `pmu-service --bus sim` (on the in-process bus) and by integration tests.
 //
-// Thread safety: run() turns in its own thread; with_model() runs harness code (faults,
-// plant changes) under the same lock, so a test can change a running simulator.
+// The turns are those of a transport::EventLoop (event_loop.hpp) watching the bus; a
+// one-shot timer on it, re-armed before every wait, ends the wait at the models' earliest
+// next_deadline(), and no wait is longer than 50 ms (start()) or run_once's max_wait.
+//
+// Thread safety: start() turns in its own thread; with_model() runs harness code (faults,
+// plant changes) under the same lock, so a test can change a running simulator. A change
+// of a model's deadline made while the loop waits is seen within one turn (<= 50 ms).
 
-#include <atomic>
 #include <chrono>
 #include <functional>
 #include <map>
@@ -17,13 +21,13 @@
 #include "pmu/sim/pmu_model.hpp"
 #include "pmu/transport/can_bus.hpp"
 #include "pmu/transport/clock.hpp"
-#include "pmu/transport/unique_fd.hpp"
+#include "pmu/transport/event_loop.hpp"
 
 namespace pmu::sim {
 
 class BusRunner final : private transport::BusHandler {
  public:
-  // Throws std::system_error when epoll cannot be set up (start-up).
+  // Throws std::system_error when the event loop cannot be set up (start-up).
   BusRunner(std::unique_ptr<transport::CanBus> bus, const transport::Clock& clock);
   ~BusRunner();  // stops the thread if running
   BusRunner(const BusRunner&) = delete;
@@ -35,7 +39,7 @@ class BusRunner final : private transport::BusHandler {
   // One turn: wait up to max_wait (or the next model deadline) for frames, then act.
   void run_once(std::chrono::milliseconds max_wait);
   void start();  // runs turns in a thread until stop()
-  void stop();
+  void stop();   // ends the thread's turns and joins it; nothing when not started
 
   // Runs `fn` on the model at `address` under the runner's lock; false if there is none.
   bool with_model(std::uint16_t address, const std::function<void(PmuModel&)>& fn);
@@ -44,13 +48,16 @@ class BusRunner final : private transport::BusHandler {
  private:
   void on_frame(const transport::ReceivedFrame& frame) override;
   void on_event(const transport::BusEvent& event) override;
+  // Arms the wake-up timer for the earliest model deadline (disarms it with no models).
+  void wake_at_next_deadline();
+  void end_turn();  // ticks every model and maintains the bus
 
   std::unique_ptr<transport::CanBus> bus_;
   const transport::Clock& clock_;
   std::map<std::uint16_t, std::unique_ptr<PmuModel>> models_;
   std::recursive_mutex mutex_;
-  transport::UniqueFd epoll_;
-  std::atomic<bool> stop_{false};
+  transport::EventLoop loop_;
+  transport::EventLoop::TimerId deadline_timer_ = 0;
   std::thread thread_;
 };
 

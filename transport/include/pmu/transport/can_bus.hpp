@@ -7,9 +7,10 @@
 //   carry codec::CanFrame and know nothing of the protocol above the identifier filter.
 //
 // Assumptions
-//   * The service runs one epoll loop per bus. It registers fd() for EPOLLIN once; fd()
-//     stays the same number for the life of the bus, even when the socket underneath is
-//     closed and reopened, so the loop never re-registers anything.
+//   * The service runs one event loop per bus (EventLoop, event_loop.hpp; any epoll loop
+//     will do). It registers fd() for EPOLLIN once; fd() stays the same number for the
+//     life of the bus, even when the socket underneath is closed and reopened, so the loop
+//     never re-registers anything.
 //   * fd() is level-triggered readable while frames or events are pending. Each wakeup the
 //     loop calls drain(), which delivers EVERY pending frame and event (a kernel wakeup costs
 //     far more than a frame: design.md measures ~28 us here), then returns.

@@ -8,8 +8,10 @@
 //
 // Assumptions
 //   * Classic CAN only (no CAN FD): records are exactly sizeof(struct can_frame).
-//   * The socket is non-blocking; the event loop polls fd(), which is an internal epoll
-//     instance holding the socket and an eventfd, so its number survives a reopen.
+//   * The socket is non-blocking; the caller's event loop polls fd(), which is the fd of
+//     an EventLoop inside the bus (event_loop.hpp) watching the socket, so its number
+//     survives a reopen. Events raised outside drain() wake that loop; drain() runs a turn
+//     of it only then, and reads the socket on every call without asking epoll first.
 //   * The Clock and SocketOps passed in outlive the bus.
 //
 // Error handling (run time; construction throws std::system_error, see can_bus.hpp)
@@ -42,6 +44,7 @@
 
 #include "pmu/transport/can_bus.hpp"
 #include "pmu/transport/clock.hpp"
+#include "pmu/transport/event_loop.hpp"
 #include "pmu/transport/filters.hpp"
 #include "pmu/transport/socket_ops.hpp"
 #include "pmu/transport/unique_fd.hpp"
@@ -82,7 +85,7 @@ class SocketCanBus final : public CanBus {
   // Wraps an fd that already carries struct can_frame records. Socket options are applied
   // where the fd accepts them (report() says which); there is no interface to reopen, so
   // after ENODEV or end-of-stream the bus stays DOWN. Throws std::system_error only when
-  // the epoll/eventfd set-up fails or `fd` is not open.
+  // the EventLoop set-up (epoll, eventfd) fails or `fd` is not open.
   static std::unique_ptr<SocketCanBus> adopt(UniqueFd fd, const std::string& name,
                                              const SocketCanOptions& options, const Clock& clock,
                                              SocketOps& ops = system_socket_ops());
@@ -93,7 +96,7 @@ class SocketCanBus final : public CanBus {
   ~SocketCanBus() override;
 
   const std::string& name() const noexcept override { return name_; }
-  int fd() const noexcept override { return poll_fd_.get(); }
+  int fd() const noexcept override { return loop_.fd(); }
   DrainResult drain(BusHandler& handler) override;
   SendResult send(const codec::CanFrame& frame, std::chrono::milliseconds max_wait) override;
   BusState state() const noexcept override { return state_; }
@@ -138,8 +141,8 @@ class SocketCanBus final : public CanBus {
   const Clock& clock_;
   SocketOps& ops_;
 
-  UniqueFd poll_fd_;  // epoll instance handed to the loop
-  UniqueFd wake_fd_;  // eventfd: readable while pending_events_ is not empty
+  // Watches the socket; its fd is fd(). Woken while pending_events_ is not empty.
+  EventLoop loop_;
   UniqueFd socket_;
 
   BusState state_ = BusState::Up;
