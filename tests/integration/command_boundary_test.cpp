@@ -434,12 +434,19 @@ void burst(Service& service, std::vector<Peer*> peers, int per_peer) {
                          static_cast<std::uint16_t>(1 + i % 2));
         peer.send(c);
         sent.emplace(c.request_id, c);
-        if (p == 0 && i == per_peer / 2) peer.send(command("stop-in-burst", CommandKind::EngineStop));
+        if (p == 0 && i == per_peer / 2) {
+          const auto stop = command("stop-in-burst", CommandKind::EngineStop);
+          peer.send(stop);
+          sent.emplace(stop.request_id, stop);
+        }
         if (i % 50 == 49) (void)peer.received();
       }
       for (const auto end = Clock::now() + 120s; Clock::now() < end;) {
-        for (const auto& r : peer.replies(prefix, static_cast<std::size_t>(per_peer), 2s))
-          results[p][r.request_id().to_string()].insert(static_cast<int>(r.result()));
+        (void)peer.replies(prefix, static_cast<std::size_t>(per_peer), 2s);  // waits for the burst's
+        for (const auto& r : peer.replies("", 0, 0s)) {                        // then takes them all
+          const auto id = r.request_id().to_string();
+          if (sent.count(id)) results[p][id].insert(static_cast<int>(r.result()));
+        }
         if (results[p].size() == sent.size()) break;
         for (const auto& [id, c] : sent)
           if (!results[p].count(id)) peer.send(c);
@@ -447,26 +454,24 @@ void burst(Service& service, std::vector<Peer*> peers, int per_peer) {
     });
   for (auto& t : clients) t.join();
   const std::string log = service.log();
+  // Every peer resends what it has not seen answered, as a client must: its reader sees every
+  // client's replies, and on a loaded machine a peer that reads late can lose some from its
+  // history (KEEP_LAST 4096); the service answers a resend again and never executes it twice.
   for (std::size_t p = 0; p < peers.size(); ++p) {
-    EXPECT_EQ(results[p].size(), static_cast<std::size_t>(per_peer)) << "peer " << p << ": ids answered";
+    const std::size_t ids = static_cast<std::size_t>(per_peer) + (p == 0 ? 1 : 0);  // + the stop
+    EXPECT_EQ(results[p].size(), ids) << "peer " << p << ": ids answered";
     for (const auto& [id, seen] : results[p]) EXPECT_EQ(seen, std::set<int>{pmu::COMPLETED}) << id;
     std::size_t executed = 0;
     const std::string audit = "audit: command b" + std::to_string(p) + "-";
     for (auto at = log.find(audit); at != std::string::npos; at = log.find(audit, at + 1)) ++executed;
     EXPECT_EQ(executed, static_cast<std::size_t>(per_peer)) << "peer " << p << ": commands executed";
   }
-  const auto stop = peers[0]->replies("stop-in-burst", 1, 10s);
-  ASSERT_EQ(stop.size(), 1u);
-  EXPECT_EQ(stop[0].result(), pmu::COMPLETED);
-  // Arrival order at peer 0: the stop's reply before the last reply of its own burst.
-  const auto order = peers[0]->replies("", 1u << 30, 0s);
-  std::size_t stop_at = 0, last_burst_at = 0;
-  for (std::size_t i = 0; i < order.size(); ++i) {
-    const auto id = order[i].request_id().to_string();
-    if (id == "stop-in-burst") stop_at = i;
-    if (id.rfind("b0-", 0) == 0) last_burst_at = i;
-  }
-  EXPECT_LT(stop_at, last_burst_at) << "ENGINE_STOP was answered only after the burst";
+  // ENGINE_STOP jumps the queue: the service executed it, once, before the last command of
+  // the burst it was sent in the middle of (the audit trail is in execution order).
+  const auto stop_at = log.find("audit: command stop-in-burst");
+  ASSERT_NE(stop_at, std::string::npos) << "ENGINE_STOP was never executed";
+  EXPECT_EQ(log.find("audit: command stop-in-burst", stop_at + 1), std::string::npos) << "ENGINE_STOP ran twice";
+  EXPECT_LT(stop_at, log.rfind("audit: command b0-")) << "ENGINE_STOP was executed only after the burst";
   EXPECT_TRUE(service.alive());
 }
 

@@ -179,7 +179,9 @@ TEST(PmuctlCommands, ResultsMessagesAndExitStatus) {
   pmu::test::Child service(
       {PMU_SERVICE_PATH, "--bus", "sim", "--domain", std::to_string(domain), "--log-level", "warn"});
   const std::string p = std::string(PMUCTL_PATH) + " --domain " + std::to_string(domain) + " ";
-  auto r = sh(p + "config set avionics_voltage 24");
+  // The first call waits for the service as long as a loaded (or ThreadSanitizer) run needs:
+  // it returns as soon as the device is seen.
+  auto r = sh(p + "--timeout 30 config set avionics_voltage 24");
   EXPECT_EQ(r.status, 0) << r.out;
   EXPECT_NE(r.out.find("COMPLETED"), std::string::npos) << r.out;
   r = sh(p + "config get avionics_voltage");

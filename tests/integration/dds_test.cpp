@@ -213,7 +213,7 @@ TEST(CrossProcess, ServiceOnSimulatedBusFeedsPmuctl) {
   EXPECT_EQ(lines, 15u);
   EXPECT_EQ(topics, (std::set<std::string>{"voltages", "currents", "battery_energy", "temperatures", "status"}));
 
-  const auto listed = run_capture(std::string(PMUCTL_PATH) + " --domain " + domain + " list --json");
+  const auto listed = run_capture(std::string(PMUCTL_PATH) + " --domain " + domain + " --timeout 20 list --json");  // returns once seen
   const std::string& list = listed.out;
   ASSERT_EQ(listed.status, 0) << list;
   const auto l = nlohmann::json::parse(list.substr(0, list.find('\n')));
