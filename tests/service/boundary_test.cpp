@@ -7,6 +7,7 @@
 #include <cmath>
 #include <limits>
 
+#include "command_sample.hpp"
 #include "pmu/service/command.hpp"
 
 namespace pmu::service {
@@ -20,14 +21,7 @@ const Now kNow{std::chrono::system_clock::time_point(std::chrono::seconds(170000
 constexpr std::uint64_t kNowNs = 1700000000ull * 1000000000ull;
 
 CommandSample sample(CommandKind kind, const char* parameter = "", double value = 0) {
-  CommandSample s;
-  s.request_id = "id-1";
-  s.bus = "can0";
-  s.address = 1;
-  s.kind = static_cast<std::uint32_t>(kind);
-  s.parameter = parameter;
-  s.value = value;
-  return s;
+  return command_sample(kind, 0, parameter, value);
 }
 
 struct Rejected {

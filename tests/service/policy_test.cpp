@@ -2,6 +2,7 @@
 // and the config keys that set them.
 #include <gtest/gtest.h>
 
+#include "command_sample.hpp"
 #include "pmu/service/config.hpp"
 #include "pmu/service/policy.hpp"
 
@@ -10,15 +11,7 @@ namespace {
 
 // A request as the boundary makes it from a sample with these fields.
 CommandRequest make(CommandKind k, std::uint8_t outputs = 0, const char* param = "", double value = 0) {
-  CommandSample s;
-  s.request_id = "p";
-  s.bus = "can0";
-  s.address = 1;
-  s.kind = static_cast<std::uint32_t>(k);
-  s.outputs = outputs;
-  s.parameter = param;
-  s.value = value;
-  const auto r = parse_command(s, Now{}, Lifetimes{});
+  const auto r = parse_command(command_sample(k, outputs, param, value), Now{}, Lifetimes{});
   EXPECT_TRUE(r.ok()) << r.error();
   return r.ok() ? *r : CommandRequest{};
 }
