@@ -33,8 +33,10 @@ constexpr ParameterSpec kTable[kParameterCount] = {
 // The width is the packet's length in table 1; packets.hpp states it too, and they must agree.
 constexpr bool widths_match_packet_table() noexcept {
   for (const auto& s : kTable) {
-    const PacketSpec* p = find_packet(s.packet);
-    if (!p || p->length != s.width) return false;
+    // By row index, not find_packet's pointer: GCC's UBSan build does not take a pointer
+    // compared with null as a constant expression.
+    const std::uint8_t row = detail::kPacketIndex[static_cast<std::uint8_t>(s.packet)];
+    if (row == detail::kNoRow || kPacketTable[row].length != s.width) return false;
   }
   return true;
 }
