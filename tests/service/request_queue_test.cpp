@@ -30,11 +30,11 @@ struct Wire {
 };
 
 // A get of `p` that records how it ended into `log` as "<name>:<status>".
-Request get(PacketId p, std::vector<std::string>& log, unsigned retries = 0, const char* name = "get") {
+// A request for `frame` that records how it ended into `log` as "<name>:<status>".
+Request logged(const codec::Encoded& frame, std::vector<std::string>& log, const char* name) {
+  EXPECT_TRUE(frame.ok()) << frame.error().describe();
   Request r;
-  r.frame = *codec::encode_get(p, 1);
-  r.reply = p;
-  r.retries = retries;
+  if (frame) r.frame = *frame;
   r.done = [&log, name](const RequestOutcome& o) {
     static const char* names[] = {"answered", "sent", "timeout", "send_failed", "expired"};
     log.push_back(std::string(name) + ":" + names[static_cast<int>(o.status)]);
@@ -42,11 +42,17 @@ Request get(PacketId p, std::vector<std::string>& log, unsigned retries = 0, con
   return r;
 }
 
-Request command(const char* name, std::vector<std::string>& log) {
-  Request r = get(PacketId::EngineStart, log, 0, name);
-  r.frame = *codec::encode_engine_start(1);
-  r.reply.reset();
+// A get of `p`, answered by a frame of `p`.
+Request get(PacketId p, std::vector<std::string>& log, unsigned retries = 0, const char* name = "get") {
+  Request r = logged(codec::encode_get(p, 1), log, name);
+  r.reply = p;
+  r.retries = retries;
   return r;
+}
+
+// A command the device does not answer (ENGINE_START).
+Request command(const char* name, std::vector<std::string>& log) {
+  return logged(codec::encode_engine_start(1), log, name);
 }
 
 codec::PmuMessage data_of(PacketId p) {
