@@ -1,5 +1,6 @@
 #include "pmu/codec/encode.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -68,12 +69,16 @@ bool encode_field(const Packet& p, CanFrame& out, EncodeError& error) noexcept {
     if (f.external_sensor && std::isnan(value)) {
       raw = kNoSensorRaw;
     } else {
-      auto r = measured(value, f.divisor, f.raw_min, f.raw_max, f.name, f.unit);
-      if (!r) {
-        error = r.error();
+      // The in-range test inline, measured() only to word a refusal: returning its Result
+      // for every field made the table-driven encoder a third slower than the code it
+      // replaced. The test is measured()'s own, so both agree on every value.
+      const double x = value * f.divisor;
+      if (std::isfinite(x) && x >= f.raw_min - 0.5 && x <= f.raw_max + 0.5) {
+        raw = std::clamp(std::lround(x), static_cast<long>(f.raw_min), static_cast<long>(f.raw_max));
+      } else {
+        error = measured(value, f.divisor, f.raw_min, f.raw_max, f.name, f.unit).error();
         return false;
       }
-      raw = *r;
     }
   } else {
     raw = value;  // an integer field holds nothing its wire type cannot carry
