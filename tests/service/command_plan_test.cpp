@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <string>
 
+#include "frame_text.hpp"
 #include "pmu/codec/decode.hpp"
 #include "pmu/codec/encode.hpp"
 #include "pmu/service/command_executor.hpp"
@@ -16,14 +17,6 @@ namespace pmu::service {
 namespace {
 
 using codec::PacketId;
-
-std::string hex(const codec::CanFrame& f) {
-  char buf[40];
-  int n = std::snprintf(buf, sizeof buf, "%08X#", f.id);
-  for (std::uint8_t i = 0; i < f.length; ++i)
-    n += std::snprintf(buf + n, sizeof buf - static_cast<std::size_t>(n), "%02X", f.data[i]);
-  return buf;
-}
 
 CommandRequest request(CommandAction action, std::uint16_t address = 1) {
   CommandRequest r;

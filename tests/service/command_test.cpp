@@ -8,6 +8,7 @@
 #include <map>
 #include <random>
 
+#include "frame_text.hpp"
 #include "harness.hpp"
 #include "pmu/codec/encode.hpp"
 #include "pmu/service/command_service.hpp"
@@ -31,13 +32,6 @@ std::uint32_t wire(CommandKind k) { return static_cast<std::uint32_t>(k); }
 
 std::uint64_t epoch_ns(std::chrono::system_clock::time_point t) {
   return static_cast<std::uint64_t>(std::chrono::duration_cast<std::chrono::nanoseconds>(t.time_since_epoch()).count());
-}
-
-std::string hex(const CanFrame& f) {
-  char buf[40];
-  int n = std::snprintf(buf, sizeof buf, "%08X#", f.id);
-  for (std::uint8_t i = 0; i < f.length; ++i) n += std::snprintf(buf + n, sizeof buf - static_cast<std::size_t>(n), "%02X", f.data[i]);
-  return buf;
 }
 
 // A harness plus a CommandService whose replies are collected.
