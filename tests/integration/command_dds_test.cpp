@@ -184,7 +184,7 @@ TEST(PmuctlCommands, ResultsMessagesAndExitStatus) {
   auto r = sh(p + "--timeout 30 config set avionics_voltage 24");
   EXPECT_EQ(r.status, 0) << r.out;
   EXPECT_NE(r.out.find("COMPLETED"), std::string::npos) << r.out;
-  r = sh(p + "config get avionics_voltage");
+  r = sh(p + "--timeout 20 config get avionics_voltage");  // a state verb: 3 s by default, returns once seen
   EXPECT_NE(r.out.find("avionics_voltage = 24.0"), std::string::npos) << r.out;
   r = sh(p + "config set avionics_voltage 30.0");
   EXPECT_EQ(r.status, 1);
