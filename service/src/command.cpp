@@ -147,6 +147,7 @@ std::uint64_t content_fingerprint(const CommandSample& s) noexcept {
     mix(&n, sizeof n);
     mix(t.data(), n);
   };
+  mix_text(s.vehicle);
   mix_text(s.bus);
   mix(&s.address, sizeof s.address);
   mix(&s.kind, sizeof s.kind);

@@ -16,7 +16,7 @@ using eprosima::fastrtps::rtps::SerializedPayload_t;
 // Field order and types of idl/command.idl; a boolean is one byte on the wire.
 template <class Stream, class Sample>
 void fields(Stream& cdr, Sample& s) {
-  cdr & s.request_id & s.bus & s.address & s.kind & s.parameter & s.value & s.outputs & s.enable & s.groups &
+  cdr & s.request_id & s.vehicle & s.bus & s.address & s.kind & s.parameter & s.value & s.outputs & s.enable & s.groups &
       s.expires_at & s.confirm;
 }
 
@@ -58,7 +58,7 @@ std::optional<CommandSample> read_command_cdr(const std::uint8_t* data, std::siz
 }
 
 std::vector<std::uint8_t> write_command_cdr(const CommandSample& s) {
-  std::vector<char> buf(64 + s.request_id.size() + s.bus.size() + s.parameter.size() + 64);
+  std::vector<char> buf(64 + s.request_id.size() + s.vehicle.size() + s.bus.size() + s.parameter.size() + 64);
   FastBuffer buffer(buf.data(), buf.size());
   Cdr cdr(buffer, Cdr::LITTLE_ENDIANNESS, Cdr::DDS_CDR);
   cdr.serialize_encapsulation();

@@ -12,6 +12,7 @@
 
 #include "pmu/codec/firmware.hpp"
 #include "pmu/codec/messages.hpp"
+#include "pmu/service/vehicle.hpp"
 
 namespace pmu::service {
 namespace {
@@ -264,8 +265,14 @@ Config parse_config(const std::string& text, const std::string& source) {
   Config cfg;
   cfg.source = source;
   if (root.IsNull()) throw ConfigError(source + ":1: the file is empty");
-  c.only_keys(root, "the top level", {"domain", "qos_file", "dds_transport", "log_level", "buses", "timeouts", "policy", "security"});
+  c.only_keys(root, "the top level", {"domain", "vehicle", "qos_file", "dds_transport", "log_level", "buses", "timeouts", "policy", "security"});
   if (const auto v = root["domain"]) cfg.domain = static_cast<int>(c.integer(v, "domain", 0, 232));
+  if (const auto v = root["vehicle"]) {
+    // `vehicle:` with nothing after it is YAML null: the unnamed vehicle, like no key.
+    if (!v.IsNull()) cfg.vehicle = c.scalar<std::string>(v, "vehicle", "a name");
+    if (const auto why = vehicle_name_problem(cfg.vehicle); !why.empty())
+      c.fail(v, "vehicle '" + cfg.vehicle + "' " + why);
+  }
   if (const auto v = root["qos_file"]) cfg.qos_file = c.scalar<std::string>(v, "qos_file", "a path");
   if (const auto v = root["dds_transport"]) {
     const auto t = c.scalar<std::string>(v, "dds_transport", "default, udp or shm");

@@ -1,12 +1,17 @@
 #include "pmu/service/dds_commands.hpp"
 
+#include <fastdds/dds/domain/DomainParticipantListener.hpp>
 #include <fastdds/dds/subscriber/DataReaderListener.hpp>
 #include <fastdds/dds/subscriber/SampleInfo.hpp>
 #include <spdlog/spdlog.h>
 
+#include <atomic>
 #include <chrono>
+#include <optional>
+#include <map>
 #include <mutex>
 #include <sstream>
+#include <vector>
 
 #include "pmu/idl/command.h"
 #include "pmu/idl/commandPubSubTypes.h"
@@ -14,6 +19,8 @@
 #include "pmu/service/command_cdr.hpp"
 #include "pmu/service/command_service.hpp"
 #include "pmu/service/dds_publisher.hpp"
+#include "pmu/service/rate_limit.hpp"
+#include "pmu/service/vehicle.hpp"
 
 namespace pmu::service {
 namespace {
@@ -25,16 +32,59 @@ static_assert(static_cast<int>(pmu::IN_PROGRESS) == static_cast<int>(CommandResu
 
 constexpr std::chrono::seconds kMalformedLogInterval{10};
 
-std::string guid_of(const SampleInfo& info) {
+template <class Guid>
+std::string text_of(const Guid& guid) {
   std::ostringstream who;
-  who << info.sample_identity.writer_guid();
+  who << guid;
   return who.str();
 }
+
+std::string guid_of(const SampleInfo& info) { return text_of(info.sample_identity.writer_guid()); }
+
+std::string partition_list(const std::vector<std::string>& names) {
+  if (names.empty()) return "the default partition";
+  std::string out;
+  for (const auto& n : names) out += (out.empty() ? "'" : ", '") + printable(n) + "'";
+  return "partition(s) " + out;
+}
+
+// The partitions every remote pmu/command writer announced in discovery, by writer GUID (the
+// text CommandSample::sender holds).
+class CommandWriters final : public DomainParticipantListener {
+ public:
+  void on_publisher_discovery(DomainParticipant*, eprosima::fastrtps::rtps::WriterDiscoveryInfo&& info) override {
+    if (info.info.topicName().to_string() != topics::kCommand) return;
+    const auto guid = text_of(info.info.guid());
+    std::lock_guard<std::mutex> lock(mutex_);
+    using Status = eprosima::fastrtps::rtps::WriterDiscoveryInfo::DISCOVERY_STATUS;
+    if (info.status == Status::REMOVED_WRITER)
+      partitions_.erase(guid);
+    else
+      partitions_[guid] = info.info.m_qos.m_partition.names();
+  }
+
+  // nullopt: the writer was not (yet) seen in discovery.
+  std::optional<std::vector<std::string>> partitions_of(const std::string& guid) const {
+    std::lock_guard<std::mutex> lock(mutex_);
+    const auto it = partitions_.find(guid);
+    if (it == partitions_.end()) return std::nullopt;
+    return it->second;
+  }
+
+ private:
+  mutable std::mutex mutex_;
+  std::map<std::string, std::vector<std::string>> partitions_;
+};
 
 }  // namespace
 
 struct DdsCommandEndpoint::Impl final : public DataReaderListener {
   dds::DdsContext& dds;
+  std::string vehicle;
+  CommandWriters writers;
+  std::atomic<std::uint64_t> not_ours{0};  // commands for another vehicle or from another partition
+  // (the rate limit below is used under service_mutex)
+  RateLimit not_ours_reports{kMalformedLogInterval};
   DataWriter* writer = nullptr;
   DataReader* reader = nullptr;
   CommandSampleType* type = nullptr;  // owned by the TypeSupport registered with the participant
@@ -47,7 +97,33 @@ struct DdsCommandEndpoint::Impl final : public DataReaderListener {
   std::uint64_t malformed_logged = 0;
   std::chrono::steady_clock::time_point next_malformed_log{};
 
-  Impl(dds::DdsContext& d, DdsPublisher* f) : dds(d), failures(f) {}
+  Impl(dds::DdsContext& d, DdsPublisher* f, std::string v) : dds(d), vehicle(std::move(v)), failures(f) {}
+
+  // Only this vehicle's commands are answered: a command for another vehicle is that
+  // vehicle's service's to answer, and one from a writer outside this vehicle's partition
+  // (a pattern such as "*" reaches every vehicle) is not addressed to this vehicle alone.
+  bool ours(const CommandSample& s) {
+    std::string why;
+    if (s.vehicle != vehicle) {
+      why = "is for vehicle '" + printable(s.vehicle) + "'";
+    } else if (const auto p = writers.partitions_of(s.sender); !p) {
+      // Fast DDS reports a writer in discovery before its data arrives; one it has not
+      // reported cannot be judged, so it is not trusted (its client's resend is).
+      why = "came from a writer discovery has not reported (yet)";
+    } else if (!partitions_address_only(*p, vehicle)) {
+      why = "was written in " + partition_list(*p) + ", not in " + partition_list(vehicle_partitions(vehicle)) +
+            " alone";
+    } else {
+      return true;
+    }
+    const auto total = not_ours.fetch_add(1, std::memory_order_relaxed) + 1;
+    if (const auto held = not_ours_reports.allow(RateLimit::Clock::now()))
+      spdlog::warn("audit: command {} from {} {}; this service is vehicle '{}': not executed, not answered "
+                   "({} such command(s) since start{})",
+                   printable(s.request_id), printable(s.sender), why, printable(vehicle), total,
+                   *held ? ", " + std::to_string(*held) + " not logged since the last message" : std::string());
+    return false;
+  }
 
   void on_data_available(DataReader* r) override {
     std::lock_guard<std::mutex> lock(service_mutex);
@@ -59,7 +135,7 @@ struct DdsCommandEndpoint::Impl final : public DataReaderListener {
       // that hands it over anyway gives an empty Received. Either way it was counted.
       if (!info.valid_data || !received.sample) continue;
       received.sample->sender = guid_of(info);
-      service->submit(*received.sample);
+      if (ours(*received.sample)) service->submit(*received.sample);
     }
     report_malformed();
   }
@@ -80,6 +156,7 @@ struct DdsCommandEndpoint::Impl final : public DataReaderListener {
   void publish(const CommandReplyData& d) {
     pmu::CommandReply s;
     s.request_id(d.request_id.substr(0, kMaxRequestIdLength));
+    s.vehicle(vehicle);
     s.bus(d.bus.substr(0, kMaxBusNameLength));
     s.address(d.address);
     s.kind(static_cast<pmu::CommandKind>(static_cast<int>(d.kind)));
@@ -98,13 +175,13 @@ struct DdsCommandEndpoint::Impl final : public DataReaderListener {
   }
 };
 
-DdsCommandEndpoint::DdsCommandEndpoint(dds::DdsContext& dds, DdsPublisher* failures)
-    : impl_(std::make_unique<Impl>(dds, failures)) {
+DdsCommandEndpoint::DdsCommandEndpoint(dds::DdsContext& dds, DdsPublisher* failures, std::string vehicle)
+    : impl_(std::make_unique<Impl>(dds, failures, std::move(vehicle))) {
+  // Discovery callbacks only: the entities' statuses stay with their own listeners.
+  dds.participant().set_listener(&impl_->writers, StatusMask::none());
   impl_->writer = &dds.writer(dds.topic(topics::kCommandReply, TypeSupport(new pmu::CommandReplyPubSubType())),
                               qos_profiles::kCommand);
 }
-
-DdsCommandEndpoint::~DdsCommandEndpoint() { stop(); }
 
 void DdsCommandEndpoint::stop() {
   {
@@ -113,6 +190,11 @@ void DdsCommandEndpoint::stop() {
   }
   // Outside the lock: Fast DDS may wait here for a callback that waits for the lock.
   if (impl_->reader) impl_->reader->set_listener(nullptr);
+}
+
+DdsCommandEndpoint::~DdsCommandEndpoint() {
+  stop();
+  impl_->dds.participant().set_listener(nullptr);
 }
 
 void DdsCommandEndpoint::start(CommandService& service) {
@@ -127,6 +209,10 @@ void DdsCommandEndpoint::start(CommandService& service) {
 }
 
 void DdsCommandEndpoint::publish(const CommandReplyData& reply) { impl_->publish(reply); }
+
+std::uint64_t DdsCommandEndpoint::not_ours() const noexcept {
+  return impl_->not_ours.load(std::memory_order_relaxed);
+}
 
 std::uint64_t DdsCommandEndpoint::malformed() const noexcept { return impl_->type ? impl_->type->malformed() : 0; }
 

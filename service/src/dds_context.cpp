@@ -63,7 +63,7 @@ std::string default_qos_file() {
 }
 
 DdsContext::DdsContext(int domain, const std::string& qos_file, const std::string& participant_name,
-                       const SecurityFiles& security, Transport transport)
+                       const SecurityFiles& security, Transport transport, const Partitions& partitions)
     : domain_(domain), secure_(!security.empty()) {
   const std::string file = qos_file.empty() ? default_qos_file() : qos_file;
   qos_file_ = file;
@@ -84,11 +84,16 @@ DdsContext::DdsContext(int domain, const std::string& qos_file, const std::strin
   if (!participant_)
     throw DdsError("cannot create a DDS participant on domain " + std::to_string(domain) +
                    (secure_ ? " with DDS-Security (see the Fast DDS SECURITY error above)" : ""));
-  publisher_ = participant_->create_publisher(PUBLISHER_QOS_DEFAULT);
-  subscriber_ = participant_->create_subscriber(SUBSCRIBER_QOS_DEFAULT);
+  PublisherQos pub_qos = PUBLISHER_QOS_DEFAULT;
+  for (const auto& p : partitions.publisher) pub_qos.partition().push_back(p.c_str());
+  SubscriberQos sub_qos = SUBSCRIBER_QOS_DEFAULT;
+  for (const auto& p : partitions.subscriber) sub_qos.partition().push_back(p.c_str());
+  publisher_ = participant_->create_publisher(pub_qos);
+  subscriber_ = participant_->create_subscriber(sub_qos);
   if (!publisher_ || !subscriber_) {
     DomainParticipantFactory::get_instance()->delete_participant(participant_);
-    throw DdsError("cannot create a DDS publisher/subscriber on domain " + std::to_string(domain));
+    throw DdsError("cannot create a DDS publisher/subscriber on domain " + std::to_string(domain) +
+                   (secure_ ? " (DDS-Security: this identity's permissions may not allow its vehicle's partition)" : ""));
   }
 }
 

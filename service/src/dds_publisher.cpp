@@ -45,7 +45,8 @@ const char* why(ReturnCode_t rc) {
 }
 
 template <class T>
-void set_key(T& s, const DeviceKey& k) {
+void set_key(T& s, const std::string& vehicle, const DeviceKey& k) {
+  s.vehicle(vehicle);
   s.bus(k.bus);
   s.address(k.address);
 }
@@ -53,6 +54,7 @@ void set_key(T& s, const DeviceKey& k) {
 }  // namespace
 
 struct DdsPublisher::Writers {
+  std::string vehicle;
   DataWriter* voltages;
   DataWriter* currents;
   DataWriter* energy;
@@ -68,8 +70,9 @@ struct DdsPublisher::Writers {
   RateLimit refusal_reports{kReportInterval};
 };
 
-DdsPublisher::DdsPublisher(dds::DdsContext& dds, std::chrono::milliseconds telemetry_deadline)
+DdsPublisher::DdsPublisher(dds::DdsContext& dds, std::chrono::milliseconds telemetry_deadline, std::string vehicle)
     : w_(std::make_unique<Writers>()) {
+  w_->vehicle = std::move(vehicle);
   auto telemetry = [&](const char* name, TypeSupport type) {
     DataWriter& w = dds.writer(dds.topic(name, type), qos_profiles::kTelemetry);
     DataWriterQos q = w.get_qos();
@@ -140,7 +143,7 @@ void DdsPublisher::on_telemetry(const DeviceKey& key, const codec::PmuMessage& m
   };
   if (const auto* v = std::get_if<codec::Voltages>(&m.payload)) {
     pmu::Voltages s;
-    set_key(s, key);
+    set_key(s, w_->vehicle, key);
     s.avionics(f(v->avionics));
     s.output_28v(f(v->output_28v));
     s.payload(f(v->payload));
@@ -151,7 +154,7 @@ void DdsPublisher::on_telemetry(const DeviceKey& key, const codec::PmuMessage& m
     write(w_->voltages, &s);
   } else if (const auto* c = std::get_if<codec::Currents>(&m.payload)) {
     pmu::Currents s;
-    set_key(s, key);
+    set_key(s, w_->vehicle, key);
     s.avionics(f(c->avionics));
     s.output_28v(f(c->output_28v));
     s.payload(f(c->payload));
@@ -161,13 +164,13 @@ void DdsPublisher::on_telemetry(const DeviceKey& key, const codec::PmuMessage& m
     write(w_->currents, &s);
   } else if (const auto* e = std::get_if<codec::BatteryEnergy>(&m.payload)) {
     pmu::BatteryEnergy s;
-    set_key(s, key);
+    set_key(s, w_->vehicle, key);
     s.battery_a_mah(e->battery_a_mah);
     s.battery_b_mah(e->battery_b_mah);
     write(w_->energy, &s);
   } else if (const auto* t = std::get_if<codec::Temperatures>(&m.payload)) {
     pmu::Temperatures s;
-    set_key(s, key);
+    set_key(s, w_->vehicle, key);
     s.internal(f(t->internal));
     s.battery_a(f(t->battery_a));  // NaN stays NaN: "no sensor"
     s.battery_b(f(t->battery_b));
@@ -176,7 +179,7 @@ void DdsPublisher::on_telemetry(const DeviceKey& key, const codec::PmuMessage& m
     write(w_->temperatures, &s);
   } else if (const auto* st = std::get_if<codec::Status>(&m.payload)) {
     pmu::Status s;
-    set_key(s, key);
+    set_key(s, w_->vehicle, key);
     s.generator_rpm(st->generator_rpm);
     s.generation_enabled(st->generation_enabled);
     s.thermal_shutdown(st->thermal_shutdown);
@@ -194,7 +197,7 @@ void DdsPublisher::on_telemetry(const DeviceKey& key, const codec::PmuMessage& m
 
 void DdsPublisher::on_config(const DeviceKey& key, const ConfigState& c) {
   pmu::Config s;
-  set_key(s, key);
+  set_key(s, w_->vehicle, key);
   auto raw8 = [&](Parameter p) {
     return static_cast<std::uint8_t>(c.raw[static_cast<std::size_t>(p)].value_or(0) & 0xFF);
   };
@@ -219,7 +222,7 @@ void DdsPublisher::on_config(const DeviceKey& key, const ConfigState& c) {
 
 void DdsPublisher::on_info(const DeviceKey& key, const InfoState& i) {
   pmu::DeviceInfo s;
-  set_key(s, key);
+  set_key(s, w_->vehicle, key);
   s.serial_number(i.serial_number);
   s.firmware_major(i.firmware.firmware_major);
   s.firmware_minor(i.firmware.firmware_minor);
@@ -235,7 +238,7 @@ void DdsPublisher::on_info(const DeviceKey& key, const InfoState& i) {
 
 void DdsPublisher::on_health(const DeviceKey& key, const HealthReport& h) {
   pmu::Health s;
-  set_key(s, key);
+  set_key(s, w_->vehicle, key);
   s.state(static_cast<pmu::HealthState>(static_cast<int>(h.state)));
   s.bus_state(static_cast<pmu::BusState>(static_cast<int>(h.bus_state)));
   s.last_frame_age(f(h.last_frame_age));

@@ -30,6 +30,7 @@
 #include "pmu/service/dds_publisher.hpp"
 #include "pmu/service/logging.hpp"
 #include "pmu/service/systemd.hpp"
+#include "pmu/service/vehicle.hpp"
 #include "pmu/sim/bus_runner.hpp"
 #include "pmu/sysconf_dir.hpp"
 #include "pmu/transport/sim_bus.hpp"
@@ -115,18 +116,20 @@ int run(const service::Config& cfg) {
     for (const auto& d : b.devices) longest = std::max(longest, d.period);
   if (longest == milliseconds{0}) longest = milliseconds(1000);
 
-  pmu::dds::DdsContext participant(cfg.domain, cfg.qos_file, "pmu-service", cfg.security.files, cfg.dds_transport);
+  const auto partitions = service::vehicle_partitions(cfg.vehicle);
+  pmu::dds::DdsContext participant(cfg.domain, cfg.qos_file, "pmu-service", cfg.security.files, cfg.dds_transport,
+                                   {partitions, partitions});
   if (participant.secure())
     spdlog::info("DDS-Security on: identity {}, permissions {}", cfg.security.files.identity_certificate,
                  cfg.security.files.permissions);
-  service::DdsPublisher publisher(participant, 3 * longest);
+  service::DdsPublisher publisher(participant, 3 * longest, cfg.vehicle);
 
   std::vector<BusRuntime> buses(cfg.buses.size());
   for (std::size_t i = 0; i < cfg.buses.size(); ++i) {
     auto bus = open_bus(cfg.buses[i], clock, buses[i]);
     buses[i].worker = std::make_unique<service::BusWorker>(cfg.buses[i], std::move(bus), clock, cfg.timeouts, publisher);
   }
-  service::DdsCommandEndpoint command_topics(participant, &publisher);
+  service::DdsCommandEndpoint command_topics(participant, &publisher, cfg.vehicle);
   std::vector<service::BusWorker*> workers;
   for (auto& b : buses) workers.push_back(b.worker.get());
   service::CommandService commands(workers, cfg.policy, cfg.timeouts, clock,

@@ -513,10 +513,10 @@ TEST(GuardedType, AMalformedBooleanIsCountedNotThrown) {
   pmu::CommandReplyPubSubType plain;
   eprosima::fastrtps::rtps::SerializedPayload_t payload(1024);
   ASSERT_TRUE(plain.serialize(&reply, &payload));
-  // Body offsets (after the 4-byte encapsulation): "r" 0..5, "b" 8..13, address 14, kind 16,
-  // result 20, reason "" 24..28, has_value 29.
-  ASSERT_EQ(payload.data[4 + 29], 1);
-  payload.data[4 + 29] = 2;
+  // Body offsets (after the 4-byte encapsulation): "r" 0..5, vehicle "" 8..12, "b" 16..21,
+  // address 22, kind 24, result 28, reason "" 32..36, has_value 37.
+  ASSERT_EQ(payload.data[4 + 37], 1);
+  payload.data[4 + 37] = 2;
   pmu::CommandReply out;
   EXPECT_ANY_THROW(plain.deserialize(&payload, &out));  // what the service and pmuctl met
 
@@ -527,7 +527,7 @@ TEST(GuardedType, AMalformedBooleanIsCountedNotThrown) {
   EXPECT_EQ(guarded.malformed(), 1u);
   EXPECT_TRUE(out.request_id().to_string().empty());  // reset, not half-filled
 
-  payload.data[4 + 29] = 1;
+  payload.data[4 + 37] = 1;
   EXPECT_TRUE(guarded.deserialize(&payload, &out));
   EXPECT_EQ(out.request_id().to_string(), "r");
   EXPECT_EQ(guarded.malformed(), 1u);

@@ -54,8 +54,14 @@ const BadCase kBad[] = {
     {"buses: [\n", "bad.yaml:2: YAML syntax error: end of sequence flow not found"},
     {"domain: 0\n", "bad.yaml:1: no buses: the service needs at least one bus"},
     {"domian: 0\nbuses: []\n",
-     "bad.yaml:1: unknown key 'domian' in the top level (known: domain, qos_file, dds_transport, log_level, buses, timeouts, policy, "
-     "security)"},
+     "bad.yaml:1: unknown key 'domian' in the top level (known: domain, vehicle, qos_file, dds_transport, log_level, buses, "
+     "timeouts, policy, security)"},
+    {"domain: 0\nvehicle: uav*\nbuses: []\n",
+     "bad.yaml:2: vehicle 'uav*' contains '*'; a vehicle name is letters, digits, '_', '-' and '.' (it is also a DDS "
+     "partition name, where other characters are patterns)"},
+    {"vehicle: a-vehicle-name-16\nbuses: []\n",
+     "bad.yaml:1: vehicle 'a-vehicle-name-16' is 17 characters; a vehicle name has at most 15 (it is a DDS key)"},
+    {"vehicle: [uav1]\nbuses: []\n", "bad.yaml:1: vehicle must be a name"},
     {"domain: 300\nbuses: []\n", "bad.yaml:1: domain 300 out of range 0..232"},
     {"domain: x\nbuses: []\n", "bad.yaml:1: domain must be an integer, not 'x'"},
     {"buses: []\n", "bad.yaml:1: buses must be a non-empty list"},
@@ -180,6 +186,13 @@ security:
   // Without the section: no security, as before.
   EXPECT_TRUE(parse_config(kGood, "good.yaml").security.files.empty());
   EXPECT_EQ(parse_config(kGood, "good.yaml").security.warn_days, 30);
+}
+
+TEST(Config, VehicleIsTheUnnamedOneUnlessNamed) {
+  EXPECT_EQ(parse_config("buses:\n  - interface: sim\n    discover: true\n", "a.yaml").vehicle, "");
+  EXPECT_EQ(parse_config("vehicle:\nbuses:\n  - interface: sim\n    discover: true\n", "a.yaml").vehicle, "");
+  EXPECT_EQ(parse_config("vehicle: UAV-7.b_2\nbuses:\n  - interface: sim\n    discover: true\n", "a.yaml").vehicle,
+            "UAV-7.b_2");
 }
 
 TEST(Config, MissingFileSaysSo) {

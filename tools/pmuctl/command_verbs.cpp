@@ -49,10 +49,24 @@ std::string request_id() {
   return "pmuctl-" + std::string(host).substr(0, 24) + "-" + std::to_string(::getpid()) + "-" + std::to_string(ns);
 }
 
+std::string vehicle_text(const std::string& vehicle) {
+  return vehicle.empty() ? "the unnamed vehicle" : "vehicle " + vehicle;
+}
+
+// ": vehicles seen: uav1, uav2 (choose one with --vehicle)", or "" when none was seen.
+std::string other_vehicles(const std::set<std::string>& seen) {
+  if (seen.empty()) return {};
+  std::string list;
+  for (const auto& v : seen) list += (list.empty() ? "" : ", ") + (v.empty() ? std::string("(unnamed)") : v);
+  return "; vehicles seen: " + list + " (choose one with --vehicle)";
+}
+
 // Finds the device the command is for: --bus/--address when given, else the only PMU the
 // service knows. Returns false with a message a person can act on.
-bool resolve_target(const GlobalOptions& o, pmu::dds::DdsContext& dds, Clock::time_point deadline, std::string& bus,
-                    std::uint16_t& address) {
+// The vehicle is never guessed: a command names --vehicle, or goes to the unnamed vehicle.
+bool resolve_target(const GlobalOptions& o, const std::string& vehicle, pmu::dds::DdsContext& dds,
+                    Clock::time_point deadline, std::string& bus, std::uint16_t& address,
+                    std::set<std::string>& vehicles_seen) {
   if (!o.bus.empty() && o.address) {
     bus = o.bus;
     address = *o.address;
@@ -66,7 +80,9 @@ bool resolve_target(const GlobalOptions& o, pmu::dds::DdsContext& dds, Clock::ti
     SampleInfo info;
     while (r.take_next_sample(&h, &info) == ReturnCode_t::RETCODE_OK) {
       if (!info.valid_data) continue;
-      if ((o.bus.empty() || o.bus == h.bus().to_string()) && (!o.address || *o.address == h.address()))
+      vehicles_seen.insert(h.vehicle().to_string());
+      if (h.vehicle().to_string() == vehicle && (o.bus.empty() || o.bus == h.bus().to_string()) &&
+          (!o.address || *o.address == h.address()))
         seen.insert({h.bus().to_string(), h.address()});
     }
     if (!seen.empty() && !settle) settle = Clock::now() + std::chrono::milliseconds(300);
@@ -77,6 +93,11 @@ bool resolve_target(const GlobalOptions& o, pmu::dds::DdsContext& dds, Clock::ti
   r.get_subscription_matched_status(st);
   if (st.current_count == 0) {
     std::fprintf(stderr, "pmuctl: no pmu-service on domain %d\n", o.domain);
+    return false;
+  }
+  if (seen.empty() && !vehicles_seen.count(vehicle)) {
+    std::fprintf(stderr, "pmuctl: no pmu-service of %s on domain %d%s\n", vehicle_text(vehicle).c_str(), o.domain,
+                 other_vehicles(vehicles_seen).c_str());
     return false;
   }
   if (seen.empty()) {
@@ -135,7 +156,9 @@ bool group_mask(const std::vector<std::string>& names, std::uint8_t& mask) {
 int run_command(const GlobalOptions& o, const CommandSpec& spec) {
   const double timeout = o.timeout.value_or(5.0);
   const auto deadline = Clock::now() + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(timeout));
-  pmu::dds::DdsContext dds(o.domain, o.qos_file, "pmuctl", o.security);
+  const std::string vehicle = o.vehicle.value_or(std::string());
+  // Reading every vehicle's health (without --vehicle) lets a failure name the vehicles there are.
+  pmu::dds::DdsContext dds(o.domain, o.qos_file, "pmuctl", o.security, pmu::dds::Transport::Default, partitions_for(o));
   DataReader& replies = dds.reader(dds.topic(topics::kCommandReply, TypeSupport(new idl::Guarded<pmu::CommandReplyPubSubType>())),
                                    qos_profiles::kCommand);
   DataWriter& writer =
@@ -143,7 +166,8 @@ int run_command(const GlobalOptions& o, const CommandSpec& spec) {
 
   std::string bus;
   std::uint16_t address = 0;
-  if (!resolve_target(o, dds, deadline, bus, address)) return 2;
+  std::set<std::string> vehicles_seen;
+  if (!resolve_target(o, vehicle, dds, deadline, bus, address, vehicles_seen)) return 2;
 
   // Send only once the service's command reader and reply writer are matched: a command
   // written before that would be lost, and a reply sent before it would never be seen.
@@ -154,7 +178,8 @@ int run_command(const GlobalOptions& o, const CommandSpec& spec) {
     replies.get_subscription_matched_status(sub);
     if (pub.current_count > 0 && sub.current_count > 0) break;
     if (Clock::now() >= deadline) {
-      std::fprintf(stderr, "pmuctl: no pmu-service on domain %d accepts commands\n", o.domain);
+      std::fprintf(stderr, "pmuctl: no pmu-service of %s on domain %d accepts commands%s\n",
+                   vehicle_text(vehicle).c_str(), o.domain, other_vehicles(vehicles_seen).c_str());
       return 2;
     }
     std::this_thread::sleep_for(std::chrono::milliseconds(10));
@@ -163,6 +188,7 @@ int run_command(const GlobalOptions& o, const CommandSpec& spec) {
   pmu::Command c;
   const std::string id = request_id();
   c.request_id(id);
+  c.vehicle(vehicle);
   c.bus(bus);
   c.address(address);
   c.kind(static_cast<pmu::CommandKind>(spec.kind));
@@ -181,17 +207,29 @@ int run_command(const GlobalOptions& o, const CommandSpec& spec) {
     return 2;
   }
 
+  // A request that met no reply is sent again with the same id (interface.md 4.2: answered
+  // again, never executed twice): a reader that matched a moment too late, or a service that
+  // had not yet seen this writer in discovery (section 5), answers the resend.
+  constexpr auto kResendAfter = std::chrono::seconds(1);
+  auto next_resend = Clock::now() + kResendAfter;
+  bool heard = false;
   while (Clock::now() < deadline + std::chrono::milliseconds(500)) {
+    if (!heard && Clock::now() >= next_resend && Clock::now() < deadline) {
+      (void)writer.write(&c);
+      next_resend = Clock::now() + kResendAfter;
+    }
     pmu::CommandReply r;
     SampleInfo info;
     while (replies.take_next_sample(&r, &info) == ReturnCode_t::RETCODE_OK) {
-      if (!info.valid_data || r.request_id().to_string() != id) continue;
+      if (!info.valid_data || r.request_id().to_string() != id || r.vehicle().to_string() != vehicle) continue;
+      heard = true;
       if (r.result() == pmu::IN_PROGRESS) {
         std::fprintf(stderr, "IN_PROGRESS: %s\n", r.reason().c_str());
         continue;
       }
       if (o.json) {
         Json j{{"request_id", id},
+               {"vehicle", r.vehicle().to_string()},
                {"bus", r.bus().to_string()},
                {"address", r.address()},
                {"result", result_name(r.result())},

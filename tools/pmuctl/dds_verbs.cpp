@@ -11,6 +11,7 @@
 #include <fastdds/dds/subscriber/SampleInfo.hpp>
 #include <map>
 #include <thread>
+#include <tuple>
 #include <vector>
 
 #include "pmu/codec/parameters.hpp"
@@ -20,6 +21,7 @@
 #include "pmu/idl/telemetryPubSubTypes.h"
 #include "pmu/idl/topics.hpp"
 #include "pmu/service/dds_context.hpp"
+#include "pmu/service/vehicle.hpp"
 #include "pmuctl/dds_json.hpp"
 
 namespace pmu::tools {
@@ -35,12 +37,31 @@ double seconds_of(const eprosima::fastrtps::rtps::Time_t& t) { return t.seconds(
 
 template <class T>
 bool selected(const GlobalOptions& o, const T& s) {
-  return (o.bus.empty() || o.bus == s.bus().to_string()) && (!o.address || *o.address == s.address());
+  return (!o.vehicle || *o.vehicle == s.vehicle().to_string()) && (o.bus.empty() || o.bus == s.bus().to_string()) &&
+         (!o.address || *o.address == s.address());
 }
 
-std::string device_name(const GlobalOptions& o) {
-  std::string d = o.address ? "device " + std::to_string(*o.address) : std::string("any device");
-  return d + (o.bus.empty() ? std::string() : " on " + o.bus);
+// `no_address`: the words for "every device" ("any device", "no device").
+std::string device_name(const GlobalOptions& o, const char* no_address = "any device") {
+  std::string d = o.address ? "device " + std::to_string(*o.address) : std::string(no_address);
+  d += o.bus.empty() ? std::string() : " on " + o.bus;
+  if (o.vehicle) d += o.vehicle->empty() ? " of the unnamed vehicle" : " of vehicle " + *o.vehicle;
+  return d;
+}
+
+// A device on DDS: the samples' keys.
+struct DeviceId {
+  std::string vehicle;
+  std::string bus;
+  std::uint16_t address;
+  bool operator<(const DeviceId& o) const {
+    return std::tie(vehicle, bus, address) < std::tie(o.vehicle, o.bus, o.address);
+  }
+};
+
+template <class T>
+DeviceId id_of(const T& s) {
+  return {s.vehicle().to_string(), s.bus().to_string(), s.address()};
 }
 
 // Reads every sample of one state topic (TRANSIENT_LOCAL: the service's current values
@@ -56,7 +77,7 @@ class StateCollector {
     SampleInfo info;
     while (reader_.take_next_sample(&sample, &info) == ReturnCode_t::RETCODE_OK) {
       if (!info.valid_data || !selected(o, sample)) continue;
-      latest_[{sample.bus().to_string(), sample.address()}] = sample;
+      latest_[id_of(sample)] = sample;
     }
   }
   bool matched() {
@@ -64,11 +85,11 @@ class StateCollector {
     reader_.get_subscription_matched_status(st);
     return st.current_count > 0;
   }
-  const std::map<std::pair<std::string, std::uint16_t>, T>& latest() const { return latest_; }
+  const std::map<DeviceId, T>& latest() const { return latest_; }
 
  private:
   DataReader& reader_;
-  std::map<std::pair<std::string, std::uint16_t>, T> latest_;
+  std::map<DeviceId, T> latest_;
 };
 
 // Waits for the state of the selected devices: returns once samples arrived and a short
@@ -85,20 +106,20 @@ int collect(const GlobalOptions& o, Collector& c, double default_timeout) {
   }
   if (!c.latest().empty()) return 0;
   if (!c.matched())
-    std::fprintf(stderr, "pmuctl: no pmu-service on domain %d\n", o.domain);
+    std::fprintf(stderr, "pmuctl: no pmu-service%s on domain %d\n",
+                 !o.vehicle ? "" : o.vehicle->empty() ? " of the unnamed vehicle" : (" of vehicle " + *o.vehicle).c_str(),
+                 o.domain);
   else
-    std::fprintf(stderr, "pmuctl: %s not seen%s\n",
-                 o.address ? ("device " + std::to_string(*o.address)).c_str() : "no device",
-                 o.bus.empty() ? "" : (" on " + o.bus).c_str());
+    std::fprintf(stderr, "pmuctl: %s not seen\n", device_name(o, "no device").c_str());
   return 1;
 }
 
-void print_json(const char* topic, const std::string& bus, std::uint16_t address, const Json& values,
-                std::optional<double> time = std::nullopt) {
+void print_json(const char* topic, const DeviceId& d, const Json& values, std::optional<double> time = std::nullopt) {
   Json j;
   j["topic"] = topic;
-  j["bus"] = bus;
-  j["address"] = address;
+  j["vehicle"] = d.vehicle;
+  j["bus"] = d.bus;
+  j["address"] = d.address;
   if (time) j["time"] = *time;
   j["values"] = values;
   std::printf("%s\n", j.dump().c_str());
@@ -122,8 +143,8 @@ std::string text(const Json& v) {
   return v.dump();
 }
 
-void print_table(const std::string& bus, std::uint16_t address, const Json& values) {
-  std::printf("%s/%u\n", bus.c_str(), address);
+void print_table(const DeviceId& d, const Json& values) {
+  std::printf("%s\n", device_label(d.vehicle, d.bus, d.address).c_str());
   for (auto it = values.begin(); it != values.end(); ++it)
     std::printf("  %-24s %s\n", it.key().c_str(), text(it.value()).c_str());
 }
@@ -133,9 +154,9 @@ int print_state(const GlobalOptions& o, Collector& c, const char* topic) {
   if (int rc = collect(o, c, 3.0)) return rc;
   for (const auto& [key, s] : c.latest()) {
     if (o.json)
-      print_json(topic, key.first, key.second, values_of(s));
+      print_json(topic, key, values_of(s));
     else
-      print_table(key.first, key.second, values_of(s));
+      print_table(key, values_of(s));
   }
   return 0;
 }
@@ -144,8 +165,7 @@ int print_state(const GlobalOptions& o, Collector& c, const char* topic) {
 
 struct TelemetryLine {
   std::string topic;
-  std::string bus;
-  std::uint16_t address;
+  DeviceId device;
   double time;
   Json values;
 };
@@ -167,7 +187,7 @@ class TypedTelemetryReader final : public TelemetryReader {
     SampleInfo info;
     while (reader_.take_next_sample(&sample, &info) == ReturnCode_t::RETCODE_OK) {
       if (!info.valid_data || !selected(o, sample)) continue;
-      out = {name_, sample.bus().to_string(), sample.address(), seconds_of(info.source_timestamp), values_of(sample)};
+      out = {name_, id_of(sample), seconds_of(info.source_timestamp), values_of(sample)};
       return true;
     }
     return false;
@@ -180,10 +200,19 @@ class TypedTelemetryReader final : public TelemetryReader {
 
 }  // namespace
 
+pmu::dds::Partitions partitions_for(const GlobalOptions& o) {
+  return {service::vehicle_partitions(o.vehicle.value_or(std::string())),
+          o.vehicle ? service::vehicle_partitions(*o.vehicle) : service::every_vehicle_partitions()};
+}
+
+std::string device_label(const std::string& vehicle, const std::string& bus, std::uint16_t address) {
+  return (vehicle.empty() ? std::string() : vehicle + "/") + bus + "/" + std::to_string(address);
+}
+
 int run_watch(const GlobalOptions& o, long count) {
   std::signal(SIGINT, on_interrupt);
   std::signal(SIGTERM, on_interrupt);
-  pmu::dds::DdsContext dds(o.domain, o.qos_file, "pmuctl", o.security);
+  pmu::dds::DdsContext dds(o.domain, o.qos_file, "pmuctl", o.security, pmu::dds::Transport::Default, partitions_for(o));
   std::vector<std::unique_ptr<TelemetryReader>> readers;
   readers.push_back(std::make_unique<TypedTelemetryReader<pmu::Voltages, pmu::VoltagesPubSubType>>(dds, topics::kVoltages));
   readers.push_back(std::make_unique<TypedTelemetryReader<pmu::Currents, pmu::CurrentsPubSubType>>(dds, topics::kCurrents));
@@ -195,7 +224,7 @@ int run_watch(const GlobalOptions& o, long count) {
 
   const bool refresh = !o.json && isatty(STDOUT_FILENO);
   const auto deadline = o.timeout ? Clock::now() + std::chrono::duration<double>(*o.timeout) : Clock::time_point::max();
-  std::map<std::tuple<std::string, std::uint16_t, std::string>, TelemetryLine> latest;
+  std::map<std::pair<DeviceId, std::string>, TelemetryLine> latest;
   long seen = 0;
   auto next_draw = Clock::now();
   while (!g_interrupted && Clock::now() < deadline && (count <= 0 || seen < count)) {
@@ -206,15 +235,16 @@ int run_watch(const GlobalOptions& o, long count) {
         any = true;
         ++seen;
         if (o.json) {
-          print_json(line.topic.c_str(), line.bus, line.address, line.values, line.time);
+          print_json(line.topic.c_str(), line.device, line.values, line.time);
         } else if (!refresh) {
           std::string row;
           for (auto it = line.values.begin(); it != line.values.end(); ++it)
             row += " " + it.key() + "=" + text(it.value());
-          std::printf("%s %s/%u %s%s\n", clock_text(line.time).c_str(), line.bus.c_str(), line.address,
+          std::printf("%s %s %s%s\n", clock_text(line.time).c_str(),
+                      device_label(line.device.vehicle, line.device.bus, line.device.address).c_str(),
                       line.topic.c_str(), row.c_str());
         }
-        latest[{line.bus, line.address, line.topic}] = line;
+        latest[{line.device, line.topic}] = line;
       }
     }
     if (any) std::fflush(stdout);
@@ -223,7 +253,8 @@ int run_watch(const GlobalOptions& o, long count) {
       std::printf("\033[H\033[2J");  // home + clear: a refreshing table
       std::printf("pmuctl watch — domain %d — %ld samples (Ctrl-C to stop)\n\n", o.domain, seen);
       for (const auto& [key, l] : latest) {
-        std::printf("%s %s/%u %-15s", clock_text(l.time).c_str(), l.bus.c_str(), l.address, l.topic.c_str());
+        std::printf("%s %s %-15s", clock_text(l.time).c_str(),
+                    device_label(l.device.vehicle, l.device.bus, l.device.address).c_str(), l.topic.c_str());
         for (auto it = l.values.begin(); it != l.values.end(); ++it)
           std::printf(" %s=%s", it.key().c_str(), text(it.value()).c_str());
         std::printf("\n");
@@ -240,12 +271,14 @@ int run_watch(const GlobalOptions& o, long count) {
 }
 
 int run_list(const GlobalOptions& o) {
-  pmu::dds::DdsContext dds(o.domain, o.qos_file, "pmuctl", o.security);
+  pmu::dds::DdsContext dds(o.domain, o.qos_file, "pmuctl", o.security, pmu::dds::Transport::Default, partitions_for(o));
   StateCollector<pmu::Health, pmu::HealthPubSubType> health(dds, topics::kHealth);
   StateCollector<pmu::DeviceInfo, pmu::DeviceInfoPubSubType> info(dds, topics::kInfo);
   if (int rc = collect(o, health, 3.0)) return rc;
   info.poll(o);
-  if (!o.json) std::printf("%-15s %7s %8s %8s %-9s %-6s %s\n", "BUS", "ADDRESS", "SERIAL", "FIRMWARE", "STATE", "BUS", "LAST FRAME");
+  if (!o.json)
+    std::printf("%-15s %-15s %7s %8s %8s %-9s %-6s %s\n", "VEHICLE", "BUS", "ADDRESS", "SERIAL", "FIRMWARE", "STATE", "BUS",
+                "LAST FRAME");
   for (const auto& [key, h] : health.latest()) {
     const auto it = info.latest().find(key);
     std::string fw = "-", serial = "-";
@@ -257,26 +290,27 @@ int run_list(const GlobalOptions& o) {
       Json j = values_of(h);
       j["serial_number"] = it != info.latest().end() ? Json(it->second.serial_number()) : Json(nullptr);
       j["firmware"] = it != info.latest().end() ? Json(fw) : Json(nullptr);
-      print_json("list", key.first, key.second, j);
+      print_json("list", key, j);
     } else {
       char age[32];
       std::snprintf(age, sizeof age, h.last_frame_age() < 0 ? "never" : "%.1f s ago",
                     static_cast<double>(h.last_frame_age()));
-      std::printf("%-15s %7u %8s %8s %-9s %-6s %s\n", key.first.c_str(), key.second, serial.c_str(), fw.c_str(),
-                  to_string(h.state()), to_string(h.bus_state()), age);
+      std::printf("%-15s %-15s %7u %8s %8s %-9s %-6s %s\n", key.vehicle.empty() ? "-" : key.vehicle.c_str(),
+                  key.bus.c_str(), key.address, serial.c_str(), fw.c_str(), to_string(h.state()),
+                  to_string(h.bus_state()), age);
     }
   }
   return 0;
 }
 
 int run_info(const GlobalOptions& o) {
-  pmu::dds::DdsContext dds(o.domain, o.qos_file, "pmuctl", o.security);
+  pmu::dds::DdsContext dds(o.domain, o.qos_file, "pmuctl", o.security, pmu::dds::Transport::Default, partitions_for(o));
   StateCollector<pmu::DeviceInfo, pmu::DeviceInfoPubSubType> c(dds, topics::kInfo);
   return print_state(o, c, "info");
 }
 
 int run_health(const GlobalOptions& o) {
-  pmu::dds::DdsContext dds(o.domain, o.qos_file, "pmuctl", o.security);
+  pmu::dds::DdsContext dds(o.domain, o.qos_file, "pmuctl", o.security, pmu::dds::Transport::Default, partitions_for(o));
   StateCollector<pmu::Health, pmu::HealthPubSubType> c(dds, topics::kHealth);
   return print_state(o, c, "health");
 }
@@ -287,16 +321,17 @@ int run_config_get(const GlobalOptions& o, const std::string& parameter) {
     std::fprintf(stderr, "pmuctl: unknown parameter '%s'\n", parameter.c_str());
     return 2;
   }
-  pmu::dds::DdsContext dds(o.domain, o.qos_file, "pmuctl", o.security);
+  pmu::dds::DdsContext dds(o.domain, o.qos_file, "pmuctl", o.security, pmu::dds::Transport::Default, partitions_for(o));
   StateCollector<pmu::Config, pmu::ConfigPubSubType> c(dds, topics::kConfig);
   if (parameter.empty()) return print_state(o, c, "config");
   if (int rc = collect(o, c, 3.0)) return rc;
   for (const auto& [key, s] : c.latest()) {
     const Json v = values_of(s)[parameter];
     if (o.json)
-      print_json("config", key.first, key.second, Json{{parameter, v}});
+      print_json("config", key, Json{{parameter, v}});
     else
-      std::printf("%s/%u %s = %s\n", key.first.c_str(), key.second, parameter.c_str(), text(v).c_str());
+      std::printf("%s %s = %s\n", device_label(key.vehicle, key.bus, key.address).c_str(), parameter.c_str(),
+                  text(v).c_str());
   }
   return 0;
 }

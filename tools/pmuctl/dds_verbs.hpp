@@ -7,12 +7,16 @@
 #include <optional>
 #include <string>
 
+#include "pmu/service/dds_context.hpp"
 #include "pmu/service/dds_security.hpp"
 
 namespace pmu::tools {
 
 struct GlobalOptions {
   int domain = 0;
+  // --vehicle / $PMU_VEHICLE. Readers: only that vehicle, or every vehicle when absent.
+  // Commands: that vehicle, or the unnamed vehicle ("") when absent.
+  std::optional<std::string> vehicle;
   std::string bus;                      // empty: every bus
   std::optional<std::uint16_t> address; // empty: every device
   bool json = false;
@@ -20,6 +24,11 @@ struct GlobalOptions {
   std::string qos_file;                 // empty: the installed qos.xml
   pmu::dds::SecurityFiles security;     // empty: no DDS-Security (--security-dir/--identity)
 };
+
+// The partitions of pmuctl's participant for these options (service/vehicle.hpp).
+pmu::dds::Partitions partitions_for(const GlobalOptions& o);
+// "uav1/can0/1", or "can0/1" for the unnamed vehicle.
+std::string device_label(const std::string& vehicle, const std::string& bus, std::uint16_t address);
 
 int run_watch(const GlobalOptions& o, long count);
 int run_list(const GlobalOptions& o);

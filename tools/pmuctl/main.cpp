@@ -18,6 +18,8 @@
 #include "pmuctl/command_verbs.hpp"
 #include "pmuctl/dds_verbs.hpp"
 #include "pmuctl/log_decoder.hpp"
+#include "pmu/service/command.hpp"
+#include "pmu/service/vehicle.hpp"
 #include "pmu/sysconf_dir.hpp"
 
 namespace {
@@ -96,6 +98,24 @@ bool setup_security(pmu::tools::GlobalOptions& g, std::string dir, std::string i
   return !pmu::dds::has_errors(issues);
 }
 
+// --vehicle (or PMU_VEHICLE) checked like the service's config key. An option given as ""
+// names the unnamed vehicle; absent, readers see every vehicle.
+bool setup_vehicle(pmu::tools::GlobalOptions& g, const CLI::Option* option, const std::string& value) {
+  const char* from = "--vehicle";
+  if (option->count() > 0) {
+    g.vehicle = value;
+  } else if (const char* env = std::getenv("PMU_VEHICLE")) {
+    g.vehicle = std::string(env);
+    from = "PMU_VEHICLE";
+  }
+  if (!g.vehicle) return true;
+  if (const auto why = pmu::service::vehicle_name_problem(*g.vehicle); !why.empty()) {
+    std::fprintf(stderr, "pmuctl: %s '%s' %s\n", from, pmu::service::printable(*g.vehicle).c_str(), why.c_str());
+    return false;
+  }
+  return true;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -106,6 +126,11 @@ int main(int argc, char** argv) {
   int address = -1;
   double timeout = -1;
   app.add_option("--domain", g.domain, "DDS domain id")->check(CLI::Range(0, 232));
+  std::string vehicle;
+  auto* vehicle_option = app.add_option(
+      "--vehicle", vehicle,
+      "Only this vehicle (config `vehicle` of its service); commands go to it (default: $PMU_VEHICLE; none: "
+      "read every vehicle, command the unnamed one)");
   app.add_option("--bus", g.bus, "Only this bus (the service's name for it, e.g. can0)");
   app.add_option("--address", address, "Only the PMU at this CAN address")->check(CLI::Range(0, int{pmu::codec::kMaxDeviceAddress}));
   app.add_flag("--json", g.json, "Machine-readable output: one JSON object per line");
@@ -189,6 +214,7 @@ int main(int argc, char** argv) {
     return run_decode(path, options);
   }
   if (!setup_security(g, security_dir, identity)) return 2;
+  if (!setup_vehicle(g, vehicle_option, vehicle)) return 2;
   try {
     if (*watch) return pmu::tools::run_watch(g, count);
     if (app.got_subcommand("list")) return pmu::tools::run_list(g);

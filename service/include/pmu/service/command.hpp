@@ -58,6 +58,7 @@ inline constexpr std::size_t kMaxParameterLength = 31;
 // A pmu::Command as received (field for field), before anything is trusted.
 struct CommandSample {
   std::string request_id;
+  std::string vehicle;  // the endpoint passes on only its own vehicle's commands
   std::string bus;
   std::uint16_t address = 0;
   std::uint32_t kind = 0;  // a CommandKind if < kCommandKindCount

@@ -76,6 +76,9 @@ struct SecurityConfig {
 struct Config {
   std::string source = "<defaults>";  // the file it came from
   int domain = 0;
+  // The vehicle this service belongs to (vehicle.hpp): the first key of every sample and its
+  // DDS partition. "" (the default): the unnamed vehicle, in the default partition.
+  std::string vehicle;
   std::string qos_file;  // empty: the installed deploy/qos.xml, found by the service
   // default: Fast DDS's builtin transports (shared memory between processes on one host,
   // UDPv4); udp: UDPv4 only, e.g. when readers run as other users (SHM segments are

@@ -6,6 +6,7 @@
 // no payload a peer can send reaches Fast DDS's threads as an exception.
 
 #include <memory>
+#include <string>
 
 #include "pmu/service/command.hpp"
 #include "pmu/service/dds_context.hpp"
@@ -19,7 +20,9 @@ class DdsCommandEndpoint {
  public:
   // Creates the reply writer. Throws dds::DdsError at start-up. A reply Fast DDS refuses is
   // counted and logged through `failures` (pmu/health's publish_failures) when given.
-  explicit DdsCommandEndpoint(dds::DdsContext& dds, DdsPublisher* failures = nullptr);
+  // Only commands for `vehicle` (vehicle.hpp), written in its partition alone, are executed
+  // and answered; others are logged (rate-limited) and counted in not_ours().
+  explicit DdsCommandEndpoint(dds::DdsContext& dds, DdsPublisher* failures = nullptr, std::string vehicle = {});
   ~DdsCommandEndpoint();
   // Starts reading commands into `service` (which must outlive this endpoint's reader).
   void start(CommandService& service);
@@ -30,6 +33,8 @@ class DdsCommandEndpoint {
   void publish(const CommandReplyData& reply);
   // Received payloads that were not a pmu::Command (counted and dropped, logged rate-limited).
   std::uint64_t malformed() const noexcept;
+  // Commands for another vehicle, or written outside this vehicle's partition, since start.
+  std::uint64_t not_ours() const noexcept;
 
  private:
   struct Impl;

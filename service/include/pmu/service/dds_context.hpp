@@ -21,6 +21,7 @@
 #include <map>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 #include "pmu/service/dds_security.hpp"
 #include "pmu/service/dds_transport.hpp"
@@ -38,11 +39,19 @@ class DdsError : public std::runtime_error {
 std::string default_qos_file();
 
 
+// The DDS partitions of the participant's one publisher and one subscriber (empty: the
+// default partition). vehicle.hpp says which a service and a client use.
+struct Partitions {
+  std::vector<std::string> publisher;
+  std::vector<std::string> subscriber;
+};
+
 class DdsContext {
  public:
   // `security` empty: no DDS-Security (as before). Relative paths are made absolute.
   DdsContext(int domain, const std::string& qos_file, const std::string& participant_name,
-             const SecurityFiles& security = {}, Transport transport = Transport::Default);
+             const SecurityFiles& security = {}, Transport transport = Transport::Default,
+             const Partitions& partitions = {});
   ~DdsContext();
   DdsContext(const DdsContext&) = delete;
   DdsContext& operator=(const DdsContext&) = delete;

@@ -21,7 +21,8 @@ class DdsPublisher final : public StateSink {
  public:
   // Creates the topics and writers. `telemetry_deadline` is the writers' DEADLINE
   // (3 x the longest packet period served). Throws dds::DdsError at start-up.
-  DdsPublisher(dds::DdsContext& dds, std::chrono::milliseconds telemetry_deadline);
+  // `vehicle`: the first key of every sample (vehicle.hpp).
+  DdsPublisher(dds::DdsContext& dds, std::chrono::milliseconds telemetry_deadline, std::string vehicle = {});
   ~DdsPublisher() override;
 
   void on_telemetry(const DeviceKey& key, const codec::PmuMessage& message,

@@ -1,0 +1,36 @@
+#include "pmu/service/vehicle.hpp"
+
+namespace pmu::service {
+
+std::string vehicle_name_problem(std::string_view name) {
+  if (name.size() > kMaxVehicleNameLength)
+    return "is " + std::to_string(name.size()) + " characters; a vehicle name has at most " +
+           std::to_string(kMaxVehicleNameLength) + " (it is a DDS key)";
+  for (const char ch : name) {
+    const bool ok = (ch >= 'a' && ch <= 'z') || (ch >= 'A' && ch <= 'Z') || (ch >= '0' && ch <= '9') || ch == '_' ||
+                    ch == '-' || ch == '.';
+    if (!ok)
+      return "contains '" + std::string(1, ch) +
+             "'; a vehicle name is letters, digits, '_', '-' and '.' (it is also a DDS partition name, where "
+             "other characters are patterns)";
+  }
+  return {};
+}
+
+std::vector<std::string> vehicle_partitions(const std::string& vehicle) {
+  if (vehicle.empty()) return {};
+  return {vehicle};
+}
+
+std::vector<std::string> every_vehicle_partitions() { return {"", "*"}; }
+
+bool partitions_address_only(const std::vector<std::string>& writer_partitions, const std::string& vehicle) {
+  if (vehicle.empty()) {
+    for (const auto& p : writer_partitions)
+      if (!p.empty()) return false;
+    return true;
+  }
+  return writer_partitions.size() == 1 && writer_partitions.front() == vehicle;
+}
+
+}  // namespace pmu::service

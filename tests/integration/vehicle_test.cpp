@@ -1,0 +1,270 @@
+// Several vehicles on one DDS domain (docs/interface.md section 5): three in-process services
+// (the unnamed vehicle, uav1, uav2), each with a simulated PMU under the same keys sim0/1, and
+// ground stations that read every vehicle or address one.
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <fastdds/dds/core/status/PublicationMatchedStatus.hpp>
+#include <fastdds/dds/core/status/SubscriptionMatchedStatus.hpp>
+#include <fastdds/dds/subscriber/SampleInfo.hpp>
+#include <map>
+#include <memory>
+#include <set>
+#include <thread>
+#include <vector>
+
+#include "pmu/idl/command.h"
+#include "pmu/idl/commandPubSubTypes.h"
+#include "pmu/idl/state.h"
+#include "pmu/idl/statePubSubTypes.h"
+#include "pmu/idl/telemetry.h"
+#include "pmu/idl/telemetryPubSubTypes.h"
+#include "pmu/idl/topics.hpp"
+#include "pmu/service/bus_worker.hpp"
+#include "pmu/service/command_service.hpp"
+#include "pmu/service/dds_commands.hpp"
+#include "pmu/service/dds_context.hpp"
+#include "pmu/service/dds_publisher.hpp"
+#include "pmu/service/vehicle.hpp"
+#include "pmu/sim/bus_runner.hpp"
+#include "pmu/transport/sim_bus.hpp"
+#include "support/domain.hpp"
+#include "support/wait.hpp"
+
+namespace pmu::service {
+namespace {
+
+using namespace eprosima::fastdds::dds;
+using namespace std::chrono_literals;
+
+// One vehicle's pmu-service, assembled as main.cpp does, on its own simulated bus.
+struct VehicleService {
+  VehicleService(int domain, const std::string& vehicle)
+      : network(clock),
+        pmus(network.attach("pmu-sim"), clock),
+        dds(domain, "", "pmu-service-" + vehicle, {}, dds::Transport::Default,
+            {vehicle_partitions(vehicle), vehicle_partitions(vehicle)}),
+        publisher(dds, 3s, vehicle),
+        worker(bus_config(), network.attach("sim0"), clock, Timeouts{}, publisher),
+        endpoint(dds, &publisher, vehicle),
+        service({&worker}, PolicyConfig{}, Timeouts{}, clock, [this](const CommandReplyData& r) { endpoint.publish(r); }) {
+    sim::DeviceConfig d;
+    d.address = 1;
+    pmus.add(d);
+    pmus.start();
+    thread = std::thread([this] { worker.run(); });
+    endpoint.start(service);
+  }
+  ~VehicleService() {
+    endpoint.stop();
+    worker.stop();
+    thread.join();
+    pmus.stop();
+  }
+  static BusConfig bus_config() {
+    BusConfig bus;
+    bus.name = "sim0";
+    bus.interface = "sim";
+    DeviceConfig d;
+    d.address = 1;
+    bus.devices.push_back(d);
+    return bus;
+  }
+  // The stored raw value: what a set changes on the unit itself.
+  std::uint32_t payload_voltage() {
+    std::uint32_t v = 0;
+    pmus.with_model(1, [&](sim::PmuModel& m) { v = m.parameter(codec::Parameter::PayloadVoltage); });
+    return v;
+  }
+
+  transport::SystemClock clock;
+  transport::SimulatedNetwork network;
+  sim::BusRunner pmus;
+  dds::DdsContext dds;
+  DdsPublisher publisher;
+  BusWorker worker;
+  DdsCommandEndpoint endpoint;
+  CommandService service;
+  std::thread thread;
+};
+
+// A ground station: reads in `read` partitions, writes commands in `write` partitions.
+struct Ground {
+  Ground(int domain, const std::string& name, dds::Partitions partitions)
+      : dds(domain, "", name, {}, dds::Transport::Default, std::move(partitions)),
+        writer(dds.writer(dds.topic(topics::kCommand, TypeSupport(new pmu::CommandPubSubType())), qos_profiles::kCommand)),
+        replies(dds.reader(dds.topic(topics::kCommandReply, TypeSupport(new pmu::CommandReplyPubSubType())),
+                           qos_profiles::kCommand)),
+        configs(dds.reader(dds.topic(topics::kConfig, TypeSupport(new pmu::ConfigPubSubType())), qos_profiles::kState)),
+        voltages(dds.reader(dds.topic(topics::kVoltages, TypeSupport(new pmu::VoltagesPubSubType())),
+                            qos_profiles::kTelemetry)) {}
+
+  std::size_t command_readers() {
+    PublicationMatchedStatus p;
+    writer.get_publication_matched_status(p);
+    return static_cast<std::size_t>(p.current_count);
+  }
+  std::string send(const std::string& id, const std::string& vehicle, double payload_voltage) {
+    pmu::Command c;
+    c.request_id(id);
+    c.vehicle(vehicle);
+    c.bus("sim0");
+    c.address(1);
+    c.kind(pmu::SET_PARAMETER);
+    c.parameter("payload_voltage");
+    c.value(payload_voltage);
+    EXPECT_TRUE(writer.write(&c));
+    return id;
+  }
+  // Replies so far, by request id.
+  std::vector<pmu::CommandReply> take_replies() {
+    std::vector<pmu::CommandReply> out;
+    pmu::CommandReply r;
+    SampleInfo info;
+    while (replies.take_next_sample(&r, &info) == ReturnCode_t::RETCODE_OK)
+      if (info.valid_data) out.push_back(r);
+    return out;
+  }
+
+  dds::DdsContext dds;
+  DataWriter& writer;
+  DataReader& replies;
+  DataReader& configs;
+  DataReader& voltages;
+};
+
+// Not the simulator's default (12.0 V), so a set that executes changes the stored value.
+constexpr double kNewPayloadVoltage = 23.0;
+
+dds::Partitions every_vehicle() { return {vehicle_partitions(""), every_vehicle_partitions()}; }
+dds::Partitions only(const std::string& v) { return {vehicle_partitions(v), vehicle_partitions(v)}; }
+
+class Vehicles : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    domain_ = pmu::test::exclusive_dds_domain();
+    for (const char* v : {"", "uav1", "uav2"}) services_[v] = std::make_unique<VehicleService>(domain_, v);
+  }
+  // Waits until `g` has the command readers it should match, and every service has told its
+  // state (the start-up reading is over: a set is answered against a known configuration).
+  void ready(Ground& g, std::size_t command_readers) {
+    ASSERT_TRUE(pmu::test::wait_until([&] { return g.command_readers() == command_readers; }, 20s))
+        << "matched " << g.command_readers() << " command readers, expected " << command_readers;
+    Ground watcher(domain_, "watcher", every_vehicle());
+    std::set<std::string> configured;
+    ASSERT_TRUE(pmu::test::wait_until(
+        [&] {
+          pmu::Config c;
+          SampleInfo i;
+          while (watcher.configs.take_next_sample(&c, &i) == ReturnCode_t::RETCODE_OK)
+            if (i.valid_data) configured.insert(c.vehicle().to_string());
+          return configured.size() == services_.size();
+        },
+        30s));
+  }
+  int domain_ = 0;
+  std::map<std::string, std::unique_ptr<VehicleService>> services_;
+};
+
+TEST_F(Vehicles, AGroundStationWithDefaultSettingsSeesEveryVehicleAndWhichSampleIsWhose) {
+  Ground g(domain_, "ground-all", every_vehicle());
+  std::set<std::string> config_vehicles, voltage_vehicles;
+  ASSERT_TRUE(pmu::test::wait_until(
+      [&] {
+        pmu::Config c;
+        SampleInfo i;
+        while (g.configs.take_next_sample(&c, &i) == ReturnCode_t::RETCODE_OK)
+          if (i.valid_data && c.bus().to_string() == "sim0" && c.address() == 1) config_vehicles.insert(c.vehicle().to_string());
+        pmu::Voltages v;
+        while (g.voltages.take_next_sample(&v, &i) == ReturnCode_t::RETCODE_OK)
+          if (i.valid_data) voltage_vehicles.insert(v.vehicle().to_string());
+        return config_vehicles.size() == 3 && voltage_vehicles.size() == 3;
+      },
+      30s));
+  EXPECT_EQ(config_vehicles, (std::set<std::string>{"", "uav1", "uav2"}));
+  EXPECT_EQ(voltage_vehicles, (std::set<std::string>{"", "uav1", "uav2"}));
+  // Same bus and address, three instances: the state a late joiner gets holds all three.
+  Ground late(domain_, "ground-late", every_vehicle());
+  std::set<std::string> late_vehicles;
+  EXPECT_TRUE(pmu::test::wait_until(
+      [&] {
+        pmu::Config c;
+        SampleInfo i;
+        while (late.configs.take_next_sample(&c, &i) == ReturnCode_t::RETCODE_OK)
+          if (i.valid_data) late_vehicles.insert(c.vehicle().to_string());
+        return late_vehicles.size() == 3;
+      },
+      10s));
+}
+
+TEST_F(Vehicles, ACommandReachesOnlyItsVehicleWhichGivesTheOneReply) {
+  Ground g(domain_, "ground-uav1", only("uav1"));
+  ready(g, 1);  // its partition holds uav1's command reader alone
+  const auto before_unnamed = services_[""]->payload_voltage();
+  const auto before_uav1 = services_["uav1"]->payload_voltage();
+  const auto before_uav2 = services_["uav2"]->payload_voltage();
+  g.send("to-uav1", "uav1", kNewPayloadVoltage);
+  std::vector<pmu::CommandReply> replies;
+  ASSERT_TRUE(pmu::test::wait_until(
+      [&] {
+        for (auto& r : g.take_replies()) replies.push_back(r);
+        return !replies.empty();
+      },
+      20s));
+  std::this_thread::sleep_for(500ms);  // a second reply, which must not come, would be here by now
+  for (auto& r : g.take_replies()) replies.push_back(r);
+  ASSERT_EQ(replies.size(), 1u);
+  EXPECT_EQ(replies[0].vehicle().to_string(), "uav1");
+  EXPECT_EQ(replies[0].result(), pmu::COMPLETED) << replies[0].reason();
+  EXPECT_NE(services_["uav1"]->payload_voltage(), before_uav1);
+  EXPECT_EQ(services_[""]->payload_voltage(), before_unnamed);
+  EXPECT_EQ(services_["uav2"]->payload_voltage(), before_uav2);
+  EXPECT_EQ(services_["uav2"]->service.counters().received, 0u) << "uav2's service received uav1's command";
+  EXPECT_EQ(services_[""]->service.counters().received, 0u);
+}
+
+TEST_F(Vehicles, TheUnnamedVehicleIsCommandedAsBeforeVehiclesExisted) {
+  Ground g(domain_, "ground-unnamed", only(""));
+  ready(g, 1);
+  const auto before = services_[""]->payload_voltage();
+  g.send("to-unnamed", "", kNewPayloadVoltage);
+  std::vector<pmu::CommandReply> replies;
+  ASSERT_TRUE(pmu::test::wait_until(
+      [&] {
+        for (auto& r : g.take_replies()) replies.push_back(r);
+        return !replies.empty();
+      },
+      20s));
+  EXPECT_EQ(replies[0].vehicle().to_string(), "");
+  EXPECT_EQ(replies[0].result(), pmu::COMPLETED) << replies[0].reason();
+  EXPECT_NE(services_[""]->payload_voltage(), before);
+}
+
+// A command in uav2's partition that names uav1, and one written in partition "*" (which
+// matches every vehicle's command reader) that names uav2: neither is executed or answered.
+TEST_F(Vehicles, ACommandNotAddressedToThisVehicleAloneIsNeitherExecutedNorAnswered) {
+  Ground wrong_name(domain_, "ground-wrong-name", only("uav2"));
+  Ground wildcard(domain_, "ground-wildcard", {{"*"}, every_vehicle_partitions()});
+  ready(wrong_name, 1);
+  ready(wildcard, 2);  // uav1's and uav2's: "*" matches every named partition
+  const auto before = services_["uav2"]->payload_voltage();
+  wrong_name.send("named-uav1-sent-to-uav2", "uav1", kNewPayloadVoltage);
+  wildcard.send("wildcard-for-uav2", "uav2", kNewPayloadVoltage);
+  auto& uav1 = services_["uav1"]->endpoint;
+  auto& uav2 = services_["uav2"]->endpoint;
+  // uav2 gets both (one names another vehicle, one comes from "*"); uav1 gets the "*" one,
+  // which names uav2.
+  ASSERT_TRUE(pmu::test::wait_until([&] { return uav2.not_ours() == 2 && uav1.not_ours() == 1; }, 20s))
+      << "uav1 ignored " << uav1.not_ours() << ", uav2 ignored " << uav2.not_ours() << "; received: unnamed "
+      << services_[""]->service.counters().received << ", uav1 " << services_["uav1"]->service.counters().received
+      << ", uav2 " << services_["uav2"]->service.counters().received;
+  std::this_thread::sleep_for(500ms);  // a reply, which must not come, would be here by now
+  EXPECT_TRUE(wrong_name.take_replies().empty());
+  EXPECT_TRUE(wildcard.take_replies().empty());
+  EXPECT_EQ(services_["uav2"]->payload_voltage(), before);
+  EXPECT_EQ(services_["uav2"]->service.counters().received, 0u);
+  EXPECT_EQ(services_["uav1"]->service.counters().received, 0u);
+}
+
+}  // namespace
+}  // namespace pmu::service
