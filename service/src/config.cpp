@@ -265,13 +265,19 @@ Config parse_config(const std::string& text, const std::string& source) {
   Config cfg;
   cfg.source = source;
   if (root.IsNull()) throw ConfigError(source + ":1: the file is empty");
-  c.only_keys(root, "the top level", {"domain", "vehicle", "qos_file", "dds_transport", "log_level", "buses", "timeouts", "policy", "security"});
+  c.only_keys(root, "the top level", {"domain", "vehicle", "low_rate_period", "qos_file", "dds_transport", "log_level", "buses", "timeouts", "policy", "security"});
   if (const auto v = root["domain"]) cfg.domain = static_cast<int>(c.integer(v, "domain", 0, 232));
   if (const auto v = root["vehicle"]) {
     // `vehicle:` with nothing after it is YAML null: the unnamed vehicle, like no key.
     if (!v.IsNull()) cfg.vehicle = c.scalar<std::string>(v, "vehicle", "a name");
     if (const auto why = vehicle_name_problem(cfg.vehicle); !why.empty())
       c.fail(v, "vehicle '" + cfg.vehicle + "' " + why);
+  }
+  if (const auto v = root["low_rate_period"]) {
+    // 0 turns the low-rate topics off; below 0.1 s they would be no slower than a PMU streams.
+    const double p = c.number(v, "low_rate_period", 0, 3600);
+    if (p != 0 && p < 0.1) c.fail(v, "low_rate_period " + v.Scalar() + " is below 0.1 s (0 turns the low-rate topics off)");
+    cfg.low_rate_period = std::chrono::milliseconds(std::lround(p * 1000));
   }
   if (const auto v = root["qos_file"]) cfg.qos_file = c.scalar<std::string>(v, "qos_file", "a path");
   if (const auto v = root["dds_transport"]) {

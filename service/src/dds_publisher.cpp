@@ -2,6 +2,8 @@
 
 #include <spdlog/spdlog.h>
 
+#include <algorithm>
+#include <array>
 #include <cmath>
 #include <mutex>
 #include <set>
@@ -15,6 +17,7 @@
 #include "pmu/idl/telemetryPubSubTypes.h"
 #include "pmu/idl/topics.hpp"
 #include "pmu/service/capacity.hpp"
+#include "pmu/service/low_rate.hpp"
 #include "pmu/service/rate_limit.hpp"
 
 namespace pmu::service {
@@ -54,7 +57,11 @@ void set_key(T& s, const std::string& vehicle, const DeviceKey& k) {
 }  // namespace
 
 struct DdsPublisher::Writers {
+  explicit Writers(std::chrono::milliseconds low_rate_period) : low_rate(low_rate_period) {}
   std::string vehicle;
+  // pmu/low_rate/*, in packet order 0x00..0x04; null when the low-rate topics are off.
+  std::array<DataWriter*, LowRateGate::kPackets> low{};
+  LowRateGate low_rate;
   DataWriter* voltages;
   DataWriter* currents;
   DataWriter* energy;
@@ -70,13 +77,14 @@ struct DdsPublisher::Writers {
   RateLimit refusal_reports{kReportInterval};
 };
 
-DdsPublisher::DdsPublisher(dds::DdsContext& dds, std::chrono::milliseconds telemetry_deadline, std::string vehicle)
-    : w_(std::make_unique<Writers>()) {
+DdsPublisher::DdsPublisher(dds::DdsContext& dds, std::chrono::milliseconds telemetry_deadline, std::string vehicle,
+                           std::chrono::milliseconds low_rate_period)
+    : w_(std::make_unique<Writers>(low_rate_period)) {
   w_->vehicle = std::move(vehicle);
-  auto telemetry = [&](const char* name, TypeSupport type) {
+  auto telemetry = [&](const char* name, TypeSupport type, std::chrono::milliseconds deadline) {
     DataWriter& w = dds.writer(dds.topic(name, type), qos_profiles::kTelemetry);
     DataWriterQos q = w.get_qos();
-    const auto ns = std::chrono::duration_cast<std::chrono::nanoseconds>(telemetry_deadline).count();
+    const auto ns = std::chrono::duration_cast<std::chrono::nanoseconds>(deadline).count();
     q.deadline().period = eprosima::fastrtps::Duration_t(static_cast<std::int32_t>(ns / 1000000000),
                                                          static_cast<std::uint32_t>(ns % 1000000000));
     if (w.set_qos(q) != ReturnCode_t::RETCODE_OK)
@@ -86,11 +94,21 @@ DdsPublisher::DdsPublisher(dds::DdsContext& dds, std::chrono::milliseconds telem
   auto state = [&](const char* name, TypeSupport type) {
     return &dds.writer(dds.topic(name, type), qos_profiles::kState);
   };
-  w_->voltages = telemetry(topics::kVoltages, TypeSupport(new pmu::VoltagesPubSubType()));
-  w_->currents = telemetry(topics::kCurrents, TypeSupport(new pmu::CurrentsPubSubType()));
-  w_->energy = telemetry(topics::kBatteryEnergy, TypeSupport(new pmu::BatteryEnergyPubSubType()));
-  w_->temperatures = telemetry(topics::kTemperatures, TypeSupport(new pmu::TemperaturesPubSubType()));
-  w_->status = telemetry(topics::kStatus, TypeSupport(new pmu::StatusPubSubType()));
+  const auto d = telemetry_deadline;
+  w_->voltages = telemetry(topics::kVoltages, TypeSupport(new pmu::VoltagesPubSubType()), d);
+  w_->currents = telemetry(topics::kCurrents, TypeSupport(new pmu::CurrentsPubSubType()), d);
+  w_->energy = telemetry(topics::kBatteryEnergy, TypeSupport(new pmu::BatteryEnergyPubSubType()), d);
+  w_->temperatures = telemetry(topics::kTemperatures, TypeSupport(new pmu::TemperaturesPubSubType()), d);
+  w_->status = telemetry(topics::kStatus, TypeSupport(new pmu::StatusPubSubType()), d);
+  if (w_->low_rate.enabled()) {
+    // The same types on topics of their own: a reader of one never matches the other's writer.
+    const auto low = std::max(telemetry_deadline, 3 * low_rate_period);
+    w_->low[0] = telemetry(topics::kLowRateVoltages, TypeSupport(new pmu::VoltagesPubSubType()), low);
+    w_->low[1] = telemetry(topics::kLowRateCurrents, TypeSupport(new pmu::CurrentsPubSubType()), low);
+    w_->low[2] = telemetry(topics::kLowRateBatteryEnergy, TypeSupport(new pmu::BatteryEnergyPubSubType()), low);
+    w_->low[3] = telemetry(topics::kLowRateTemperatures, TypeSupport(new pmu::TemperaturesPubSubType()), low);
+    w_->low[4] = telemetry(topics::kLowRateStatus, TypeSupport(new pmu::StatusPubSubType()), low);
+  }
   w_->config = state(topics::kConfig, TypeSupport(new pmu::ConfigPubSubType()));
   w_->info = state(topics::kInfo, TypeSupport(new pmu::DeviceInfoPubSubType()));
   w_->health = state(topics::kHealth, TypeSupport(new pmu::HealthPubSubType()));
@@ -137,9 +155,14 @@ void DdsPublisher::on_telemetry(const DeviceKey& key, const codec::PmuMessage& m
   const auto ts = dds_time(received);
   std::lock_guard<std::mutex> lock(w_->mutex);
   if (!admit(key)) return;
-  auto write = [&](DataWriter* w, void* sample) {
+  auto write_one = [&](DataWriter* w, void* sample) {
     const ReturnCode_t rc = w->write_w_timestamp(sample, HANDLE_NIL, ts);
     count(rc == ReturnCode_t::RETCODE_OK, w->get_topic()->get_name().c_str(), key, why(rc));
+  };
+  // `packet`: 0x00..0x04, the index of the low-rate writer.
+  auto write = [&](DataWriter* w, void* sample, std::size_t packet) {
+    write_one(w, sample);
+    if (w_->low_rate.due(key.bus, key.address, packet, received)) write_one(w_->low[packet], sample);
   };
   if (const auto* v = std::get_if<codec::Voltages>(&m.payload)) {
     pmu::Voltages s;
@@ -151,7 +174,7 @@ void DdsPublisher::on_telemetry(const DeviceKey& key, const codec::PmuMessage& m
     s.battery_a(f(v->battery_a));
     s.battery_b(f(v->battery_b));
     s.generator(f(v->generator));
-    write(w_->voltages, &s);
+    write(w_->voltages, &s, 0);
   } else if (const auto* c = std::get_if<codec::Currents>(&m.payload)) {
     pmu::Currents s;
     set_key(s, w_->vehicle, key);
@@ -161,13 +184,13 @@ void DdsPublisher::on_telemetry(const DeviceKey& key, const codec::PmuMessage& m
     s.servo(f(c->servo));
     s.battery_a(f(c->battery_a));
     s.battery_b(f(c->battery_b));
-    write(w_->currents, &s);
+    write(w_->currents, &s, 1);
   } else if (const auto* e = std::get_if<codec::BatteryEnergy>(&m.payload)) {
     pmu::BatteryEnergy s;
     set_key(s, w_->vehicle, key);
     s.battery_a_mah(e->battery_a_mah);
     s.battery_b_mah(e->battery_b_mah);
-    write(w_->energy, &s);
+    write(w_->energy, &s, 2);
   } else if (const auto* t = std::get_if<codec::Temperatures>(&m.payload)) {
     pmu::Temperatures s;
     set_key(s, w_->vehicle, key);
@@ -176,7 +199,7 @@ void DdsPublisher::on_telemetry(const DeviceKey& key, const codec::PmuMessage& m
     s.battery_b(f(t->battery_b));
     s.generator(f(t->generator));
     s.starter(f(t->starter));
-    write(w_->temperatures, &s);
+    write(w_->temperatures, &s, 3);
   } else if (const auto* st = std::get_if<codec::Status>(&m.payload)) {
     pmu::Status s;
     set_key(s, w_->vehicle, key);
@@ -191,7 +214,7 @@ void DdsPublisher::on_telemetry(const DeviceKey& key, const codec::PmuMessage& m
     s.payload_on(st->payload_on());
     s.charger_a_on(st->charger_a_on());
     s.charger_b_on(st->charger_b_on());
-    write(w_->status, &s);
+    write(w_->status, &s, 4);
   }
 }
 

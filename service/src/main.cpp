@@ -122,7 +122,7 @@ int run(const service::Config& cfg) {
   if (participant.secure())
     spdlog::info("DDS-Security on: identity {}, permissions {}", cfg.security.files.identity_certificate,
                  cfg.security.files.permissions);
-  service::DdsPublisher publisher(participant, 3 * longest, cfg.vehicle);
+  service::DdsPublisher publisher(participant, 3 * longest, cfg.vehicle, cfg.low_rate_period);
 
   std::vector<BusRuntime> buses(cfg.buses.size());
   for (std::size_t i = 0; i < cfg.buses.size(); ++i) {

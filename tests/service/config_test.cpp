@@ -54,7 +54,7 @@ const BadCase kBad[] = {
     {"buses: [\n", "bad.yaml:2: YAML syntax error: end of sequence flow not found"},
     {"domain: 0\n", "bad.yaml:1: no buses: the service needs at least one bus"},
     {"domian: 0\nbuses: []\n",
-     "bad.yaml:1: unknown key 'domian' in the top level (known: domain, vehicle, qos_file, dds_transport, log_level, buses, "
+     "bad.yaml:1: unknown key 'domian' in the top level (known: domain, vehicle, low_rate_period, qos_file, dds_transport, log_level, buses, "
      "timeouts, policy, security)"},
     {"domain: 0\nvehicle: uav*\nbuses: []\n",
      "bad.yaml:2: vehicle 'uav*' contains '*'; a vehicle name is letters, digits, '_', '-' and '.' (it is also a DDS "
@@ -62,6 +62,9 @@ const BadCase kBad[] = {
     {"vehicle: a-vehicle-name-16\nbuses: []\n",
      "bad.yaml:1: vehicle 'a-vehicle-name-16' is 17 characters; a vehicle name has at most 15 (it is a DDS key)"},
     {"vehicle: [uav1]\nbuses: []\n", "bad.yaml:1: vehicle must be a name"},
+    {"low_rate_period: 0.05\nbuses: []\n",
+     "bad.yaml:1: low_rate_period 0.05 is below 0.1 s (0 turns the low-rate topics off)"},
+    {"low_rate_period: -1\nbuses: []\n", "bad.yaml:1: low_rate_period -1 out of range 0..3600"},
     {"domain: 300\nbuses: []\n", "bad.yaml:1: domain 300 out of range 0..232"},
     {"domain: x\nbuses: []\n", "bad.yaml:1: domain must be an integer, not 'x'"},
     {"buses: []\n", "bad.yaml:1: buses must be a non-empty list"},

@@ -214,13 +214,18 @@ int run_watch(const GlobalOptions& o, long count) {
   std::signal(SIGTERM, on_interrupt);
   pmu::dds::DdsContext dds(o.domain, o.qos_file, "pmuctl", o.security, pmu::dds::Transport::Default, partitions_for(o));
   std::vector<std::unique_ptr<TelemetryReader>> readers;
-  readers.push_back(std::make_unique<TypedTelemetryReader<pmu::Voltages, pmu::VoltagesPubSubType>>(dds, topics::kVoltages));
-  readers.push_back(std::make_unique<TypedTelemetryReader<pmu::Currents, pmu::CurrentsPubSubType>>(dds, topics::kCurrents));
+  // --low-rate: only the low-rate topics' writers match, so only their samples cross the link.
+  const bool low = o.low_rate;
+  readers.push_back(std::make_unique<TypedTelemetryReader<pmu::Voltages, pmu::VoltagesPubSubType>>(
+      dds, low ? topics::kLowRateVoltages : topics::kVoltages));
+  readers.push_back(std::make_unique<TypedTelemetryReader<pmu::Currents, pmu::CurrentsPubSubType>>(
+      dds, low ? topics::kLowRateCurrents : topics::kCurrents));
   readers.push_back(std::make_unique<TypedTelemetryReader<pmu::BatteryEnergy, pmu::BatteryEnergyPubSubType>>(
-      dds, topics::kBatteryEnergy));
-  readers.push_back(
-      std::make_unique<TypedTelemetryReader<pmu::Temperatures, pmu::TemperaturesPubSubType>>(dds, topics::kTemperatures));
-  readers.push_back(std::make_unique<TypedTelemetryReader<pmu::Status, pmu::StatusPubSubType>>(dds, topics::kStatus));
+      dds, low ? topics::kLowRateBatteryEnergy : topics::kBatteryEnergy));
+  readers.push_back(std::make_unique<TypedTelemetryReader<pmu::Temperatures, pmu::TemperaturesPubSubType>>(
+      dds, low ? topics::kLowRateTemperatures : topics::kTemperatures));
+  readers.push_back(std::make_unique<TypedTelemetryReader<pmu::Status, pmu::StatusPubSubType>>(
+      dds, low ? topics::kLowRateStatus : topics::kStatus));
 
   const bool refresh = !o.json && isatty(STDOUT_FILENO);
   const auto deadline = o.timeout ? Clock::now() + std::chrono::duration<double>(*o.timeout) : Clock::time_point::max();

@@ -20,6 +20,7 @@ struct GlobalOptions {
   std::string bus;                      // empty: every bus
   std::optional<std::uint16_t> address; // empty: every device
   bool json = false;
+  bool low_rate = false;                // watch: the pmu/low_rate/* topics
   std::optional<double> timeout;        // s; verbs have their own default
   std::string qos_file;                 // empty: the installed qos.xml
   pmu::dds::SecurityFiles security;     // empty: no DDS-Security (--security-dir/--identity)

@@ -148,6 +148,9 @@ int main(int argc, char** argv) {
   auto* watch = app.add_subcommand("watch", "Live telemetry: a refreshing table, or one JSON object per sample");
   long count = 0;
   watch->add_option("--count", count, "Stop after N samples")->check(CLI::PositiveNumber);
+  watch->add_flag("--low-rate", g.low_rate,
+                  "The low-rate topics pmu/low_rate/*: at most one sample per device and packet per the service's "
+                  "low_rate_period (1 s by default), for slow links");
   app.add_subcommand("list", "PMUs the service knows, with health");
   app.add_subcommand("info", "Serial number, firmware and features");
   app.add_subcommand("health", "Link, bus and device health");

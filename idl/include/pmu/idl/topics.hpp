@@ -12,6 +12,13 @@ inline constexpr const char* kStatus = "pmu/status";
 inline constexpr const char* kConfig = "pmu/config";
 inline constexpr const char* kInfo = "pmu/info";
 inline constexpr const char* kHealth = "pmu/health";
+// The same telemetry at most once per configured period (config low_rate_period), for
+// subscribers on slow links: docs/interface.md 5.2.
+inline constexpr const char* kLowRateVoltages = "pmu/low_rate/voltages";
+inline constexpr const char* kLowRateCurrents = "pmu/low_rate/currents";
+inline constexpr const char* kLowRateBatteryEnergy = "pmu/low_rate/battery_energy";
+inline constexpr const char* kLowRateTemperatures = "pmu/low_rate/temperatures";
+inline constexpr const char* kLowRateStatus = "pmu/low_rate/status";
 inline constexpr const char* kCommand = "pmu/command";
 inline constexpr const char* kCommandReply = "pmu/command_reply";
 

@@ -79,6 +79,8 @@ struct Config {
   // The vehicle this service belongs to (vehicle.hpp): the first key of every sample and its
   // DDS partition. "" (the default): the unnamed vehicle, in the default partition.
   std::string vehicle;
+  // pmu/low_rate/* get each device's telemetry at most once per this period (0: off).
+  std::chrono::milliseconds low_rate_period{1000};
   std::string qos_file;  // empty: the installed deploy/qos.xml, found by the service
   // default: Fast DDS's builtin transports (shared memory between processes on one host,
   // UDPv4); udp: UDPv4 only, e.g. when readers run as other users (SHM segments are

@@ -11,6 +11,7 @@
 #include <chrono>
 #include <cstdint>
 #include <memory>
+#include <string>
 
 #include "pmu/service/dds_context.hpp"
 #include "pmu/service/device_state.hpp"
@@ -21,8 +22,10 @@ class DdsPublisher final : public StateSink {
  public:
   // Creates the topics and writers. `telemetry_deadline` is the writers' DEADLINE
   // (3 x the longest packet period served). Throws dds::DdsError at start-up.
-  // `vehicle`: the first key of every sample (vehicle.hpp).
-  DdsPublisher(dds::DdsContext& dds, std::chrono::milliseconds telemetry_deadline, std::string vehicle = {});
+  // `vehicle`: the first key of every sample (vehicle.hpp). `low_rate_period` > 0: also the
+  // low-rate telemetry topics, one sample per device and packet per period (low_rate.hpp).
+  DdsPublisher(dds::DdsContext& dds, std::chrono::milliseconds telemetry_deadline, std::string vehicle = {},
+               std::chrono::milliseconds low_rate_period = {});
   ~DdsPublisher() override;
 
   void on_telemetry(const DeviceKey& key, const codec::PmuMessage& message,
