@@ -52,6 +52,29 @@ void add_security(DomainParticipantQos& pqos, const SecurityFiles& f) {
   p.emplace_back("dds.sec.crypto.plugin", "builtin.AES-GCM-GMAC");
 }
 
+// Fast DDS 2.9.1 (Debian bookworm's) can hang forever deleting a reliable writer whose readers
+// have not acknowledged everything. Its destructor (RTPSWriter::deinit) returns the history's
+// samples to their pool one at a time, dropping the writer's lock between them, while the history
+// still lists them with their sequence numbers reset to 0, and the periodic heartbeat stays armed
+// until after that. A heartbeat that fires in between walks the history for holes
+// (StatefulWriter::add_gaps_for_holes_in_history_): from the first freed sample's 0 + 1 it counts
+// up to the next one's number, 0 again, i.e. through the whole 64-bit sequence space, holding
+// the lock the destructor waits for. The four-writer burst of command_boundary_test.cpp hung so
+// in a client's teardown. Fixed upstream in 2.13.0 (eProsima/Fast-DDS#4076; backported to 2.6.10,
+// 2.10.3, 2.11.3 and 2.12.2, never to 2.9).
+// The heartbeat needs a matched reader: with none it sends nothing and its timer is cancelled.
+// Moving the publisher to a partition nobody subscribes to unmatches every reader of its writers
+// at once (Fast DDS re-pairs a writer synchronously when its publisher's QoS changes), so the
+// deletion that follows has nobody to send a heartbeat to. Readers lose nothing they would have
+// kept: a deleted writer repairs nothing either. Only a reader of a wildcard partition ("*")
+// would stay matched; no pmu-dds program subscribes so, and interface.md names no partition.
+void unmatch_writers_before_deleting_them(Publisher& publisher) {
+  PublisherQos qos = publisher.get_qos();
+  qos.partition().clear();
+  qos.partition().push_back("pmu-dds.closing");
+  (void)publisher.set_qos(qos);  // if refused, the deletion runs as before: nothing else to do
+}
+
 }  // namespace
 
 std::string default_qos_file() {
@@ -99,6 +122,7 @@ DdsContext::DdsContext(int domain, const std::string& qos_file, const std::strin
 
 DdsContext::~DdsContext() {
   if (!participant_) return;
+  unmatch_writers_before_deleting_them(*publisher_);
   participant_->delete_contained_entities();
   DomainParticipantFactory::get_instance()->delete_participant(participant_);
 }

@@ -423,6 +423,7 @@ TEST_F(Boundary, ALookAlikeTypeOrGarbageIsDroppedNeverFatal) {
 // be answered, and the audit trail must show each executed exactly once.
 void burst(Service& service, std::vector<Peer*> peers, int per_peer) {
   std::vector<std::map<std::string, std::set<int>>> results(peers.size());  // id -> results seen
+  std::vector<std::map<std::string, std::string>> refusals(peers.size());   // id -> reason of one not COMPLETED
   std::vector<std::thread> clients;
   for (std::size_t p = 0; p < peers.size(); ++p)
     clients.emplace_back([&, p] {
@@ -445,7 +446,9 @@ void burst(Service& service, std::vector<Peer*> peers, int per_peer) {
         (void)peer.replies(prefix, static_cast<std::size_t>(per_peer), 2s);  // waits for the burst's
         for (const auto& r : peer.replies("", 0, 0s)) {                        // then takes them all
           const auto id = r.request_id().to_string();
-          if (sent.count(id)) results[p][id].insert(static_cast<int>(r.result()));
+          if (!sent.count(id)) continue;
+          results[p][id].insert(static_cast<int>(r.result()));
+          if (r.result() != pmu::COMPLETED) refusals[p][id] = r.reason().to_string();
         }
         if (results[p].size() == sent.size()) break;
         for (const auto& [id, c] : sent)
@@ -460,7 +463,8 @@ void burst(Service& service, std::vector<Peer*> peers, int per_peer) {
   for (std::size_t p = 0; p < peers.size(); ++p) {
     const std::size_t ids = static_cast<std::size_t>(per_peer) + (p == 0 ? 1 : 0);  // + the stop
     EXPECT_EQ(results[p].size(), ids) << "peer " << p << ": ids answered";
-    for (const auto& [id, seen] : results[p]) EXPECT_EQ(seen, std::set<int>{pmu::COMPLETED}) << id;
+    for (const auto& [id, seen] : results[p])
+      EXPECT_EQ(seen, std::set<int>{pmu::COMPLETED}) << id << ": " << refusals[p][id];
     std::size_t executed = 0;
     const std::string audit = "audit: command b" + std::to_string(p) + "-";
     for (auto at = log.find(audit); at != std::string::npos; at = log.find(audit, at + 1)) ++executed;
