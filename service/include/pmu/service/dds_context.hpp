@@ -22,6 +22,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "pmu/service/dds_network.hpp"
 #include "pmu/service/dds_security.hpp"
 #include "pmu/service/dds_transport.hpp"
 
@@ -41,8 +42,10 @@ std::string default_qos_file();
 class DdsContext {
  public:
   // `security` empty: no DDS-Security (as before). Relative paths are made absolute.
+  // `network`: discovery and interface allowlist (dds_network.hpp); default multicast, all.
   DdsContext(int domain, const std::string& qos_file, const std::string& participant_name,
-             const SecurityFiles& security = {}, Transport transport = Transport::Default);
+             const SecurityFiles& security = {}, Transport transport = Transport::Default,
+             const ResolvedNetwork& network = {});
   ~DdsContext();
   DdsContext(const DdsContext&) = delete;
   DdsContext& operator=(const DdsContext&) = delete;
