@@ -255,7 +255,17 @@ ResolvedNetwork resolve_network(const NetworkConfig& config, const NetworkLookup
     for (const auto& ip : found) add(ip);
     interfaces.push_back(join(found) + " (" + (is_ipv4(i.host) ? name : i.host) + ")");
   }
-  if (!interfaces.empty()) summary += "; DDS over UDP only on " + join(interfaces);
+  if (!interfaces.empty()) {
+    // Loopback always: Fast DDS 2.9 sends to a participant on this host through 127.0.0.1
+    // whenever its own allowlist admits loopback (UDPTransportInterface::transform_remote_locator),
+    // and drops a same-host address its allowlist lacks; without 127.0.0.1 here, pmuctl beside
+    // pmu-service could not reach it. Loopback never leaves the host, and Fast DDS announces
+    // no loopback address to others while another address is allowed.
+    const bool had_loopback = std::find(r.interface_addresses.begin(), r.interface_addresses.end(), "127.0.0.1") !=
+                              r.interface_addresses.end();
+    if (!had_loopback) r.interface_addresses.push_back("127.0.0.1");
+    summary += "; DDS over UDP only on " + join(interfaces) + (had_loopback ? "" : " and loopback (127.0.0.1)");
+  }
   r.summary = summary;
   return r;
 }

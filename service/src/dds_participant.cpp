@@ -68,6 +68,8 @@ DomainParticipantQos participant_qos(const std::string& name, Transport transpor
     throw NetworkError(std::string("shared memory only (dds_transport shm) cannot carry ") +
                        (allowlist ? "an interface allowlist" : std::string(to_string(network.mode)) + " discovery") +
                        ": both are about UDP");
+  if (network.mode == DiscoveryMode::Server && !security.empty())
+    throw NetworkError(std::string("Discovery Server mode ") + kServerWithSecurity);
   if (network.servers.size() > kMaxServers)
     throw NetworkError("more than " + std::to_string(kMaxServers) + " Discovery Servers (server ids are 0..255)");
   auto udp = std::make_shared<UDPv4TransportDescriptor>();

@@ -127,6 +127,15 @@ TEST(NetworkResolve, InterfaceNamesBecomeTheirAddresses) {
                        "127.0.0.1 (lo)");
 }
 
+TEST(NetworkResolve, LoopbackIsAlwaysAllowedSoSameHostParticipantsMeet) {
+  NetworkConfig c;
+  c.interfaces = {interface("eth1")};
+  const ResolvedNetwork r = resolve_network(c, fake_lookup());
+  EXPECT_EQ(r.interface_addresses, (std::vector<std::string>{"192.168.10.1", "192.168.11.1", "127.0.0.1"}));
+  EXPECT_EQ(r.summary, "multicast discovery; DDS over UDP only on 192.168.10.1, 192.168.11.1 (eth1) and loopback "
+                       "(127.0.0.1)");
+}
+
 TEST(NetworkResolve, WhatCannotBeFoundIsAStartupErrorAtItsLine) {
   const auto message = [](const NetworkConfig& c) {
     try {

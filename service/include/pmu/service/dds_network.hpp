@@ -11,8 +11,10 @@
 // (UDPv4TransportDescriptor::interfaceWhiteList) compares the local IPv4 addresses with the
 // strings it is given, so an interface name there matches nothing (the transport then logs
 // "All whitelist interfaces were filtered out" and binds to 192.0.2.0, TEST-NET-1): names
-// are turned into their addresses here, once, at start. A peer or server given as a host
-// name is resolved at start too; a later change of its address needs a restart.
+// are turned into their addresses here, once, at start, and 127.0.0.1 is added to every
+// allowlist (same-host participants reach each other through it; resolve_network says why).
+// A peer or server given as a host name is resolved at start too; a later change of its
+// address needs a restart.
 //
 // Error handling: parsing returns the reason as text (parse_address: empty when the text
 // is good); resolve_network, a start-up step, throws NetworkError "WHERE: what" where
@@ -64,6 +66,17 @@ struct NetworkConfig {
 inline constexpr std::uint16_t kDefaultServerPort = 11811;  // `fastdds discovery`'s default
 inline constexpr std::size_t kMaxServers = 256;             // server ids 0..255 (a GUID prefix byte)
 
+// Why DDS-Security and Discovery Server mode are refused together (config and pmuctl): with
+// Fast DDS 2.9.1, secure clients ignore a server that does not authenticate, and a server
+// with DDS-Security no longer has the GUID prefix `fastdds discovery -i N` gives it (the
+// PKI-DH plugin derives the prefix from the certificate), so clients find nothing either
+// way; they also abort in SecurityManager::encode_rtps_message (an assertion Debian's build
+// keeps) when they stop. Unicast peers work with DDS-Security.
+inline constexpr const char* kServerWithSecurity =
+    "cannot be combined with DDS-Security in Fast DDS 2.9.1: secure participants find nothing through a "
+    "Discovery Server (an unauthenticated server is ignored, and a secure one loses the GUID prefix its id "
+    "gives it); use unicast peers";
+
 // "HOST[:PORT]" into `out` (host and port; text and where are left alone). Empty result:
 // good; otherwise what is wrong, e.g. "port 70000 out of range 1..65535".
 std::string parse_address(std::string_view text, Address& out);
@@ -104,7 +117,9 @@ struct ResolvedNetwork {
   DiscoveryMode mode = DiscoveryMode::Multicast;
   std::vector<Ipv4Endpoint> peers;            // Unicast
   std::vector<ResolvedServer> servers;        // Server; index = server id
-  std::vector<std::string> interface_addresses;  // empty: every interface
+  // Empty: every interface. Otherwise the allowed addresses, 127.0.0.1 always among them
+  // (same-host traffic; resolve_network says why).
+  std::vector<std::string> interface_addresses;
   // One line for the start-up log, e.g. "unicast discovery to 127.0.0.1; interfaces 10.0.0.1 (eth1)".
   std::string summary;
 };

@@ -16,15 +16,18 @@
 //   server:    discovery protocol CLIENT; m_DiscoveryServers = the servers, server i with
 //              the GUID prefix of `fastdds discovery -i i` (44.53.<i>.5f.45.50.52.4f.53.49.4d.41)
 //              and its locators; metatraffic as in unicast (no multicast).
-// Interfaces (allowlist): the UDPv4 transport's interfaceWhiteList = the addresses, and the
-// builtin transports are replaced by explicit ones (use_builtin_transports = false): left
-// on, Fast DDS would add its own UDPv4 transport without the allowlist and use every
-// interface anyway. Transport Default keeps shared memory beside the restricted UDPv4
-// (same-host traffic, which never reaches a network interface); UdpOnly has UDPv4 alone.
-// Security: the DDS-Security plugin properties when `security` is not empty, in every mode.
+// Interfaces (allowlist): the UDPv4 transport's interfaceWhiteList = the addresses
+// (127.0.0.1 always among them, see resolve_network), and the builtin transports are
+// replaced by explicit ones (use_builtin_transports = false): left on, Fast DDS would add
+// its own UDPv4 transport without the allowlist and use every interface anyway. Transport
+// Default keeps shared memory beside the restricted UDPv4 (same-host traffic, which never
+// reaches a network interface); UdpOnly has UDPv4 alone.
+// Security: the DDS-Security plugin properties when `security` is not empty, with multicast
+// and unicast discovery and with an allowlist.
 //
 // Throws NetworkError for a combination that cannot work (ShmOnly with unicast or server
-// discovery, or with an allowlist; the config refuses these with their line first).
+// discovery, or with an allowlist; server discovery with DDS-Security, kServerWithSecurity
+// says why); the config and pmuctl refuse these first, naming the line or the option.
 
 #include <fastdds/dds/domain/qos/DomainParticipantQos.hpp>
 #include <string>
