@@ -135,7 +135,7 @@ bool group_mask(const std::vector<std::string>& names, std::uint8_t& mask) {
 int run_command(const GlobalOptions& o, const CommandSpec& spec) {
   const double timeout = o.timeout.value_or(5.0);
   const auto deadline = Clock::now() + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(timeout));
-  pmu::dds::DdsContext dds(o.domain, o.qos_file, "pmuctl", o.security);
+  pmu::dds::DdsContext dds(o.domain, o.qos_file, "pmuctl", o.security, pmu::dds::Transport::Default, o.network);
   DataReader& replies = dds.reader(dds.topic(topics::kCommandReply, TypeSupport(new idl::Guarded<pmu::CommandReplyPubSubType>())),
                                    qos_profiles::kCommand);
   DataWriter& writer =

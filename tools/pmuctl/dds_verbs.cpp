@@ -183,7 +183,7 @@ class TypedTelemetryReader final : public TelemetryReader {
 int run_watch(const GlobalOptions& o, long count) {
   std::signal(SIGINT, on_interrupt);
   std::signal(SIGTERM, on_interrupt);
-  pmu::dds::DdsContext dds(o.domain, o.qos_file, "pmuctl", o.security);
+  pmu::dds::DdsContext dds(o.domain, o.qos_file, "pmuctl", o.security, pmu::dds::Transport::Default, o.network);
   std::vector<std::unique_ptr<TelemetryReader>> readers;
   readers.push_back(std::make_unique<TypedTelemetryReader<pmu::Voltages, pmu::VoltagesPubSubType>>(dds, topics::kVoltages));
   readers.push_back(std::make_unique<TypedTelemetryReader<pmu::Currents, pmu::CurrentsPubSubType>>(dds, topics::kCurrents));
@@ -240,7 +240,7 @@ int run_watch(const GlobalOptions& o, long count) {
 }
 
 int run_list(const GlobalOptions& o) {
-  pmu::dds::DdsContext dds(o.domain, o.qos_file, "pmuctl", o.security);
+  pmu::dds::DdsContext dds(o.domain, o.qos_file, "pmuctl", o.security, pmu::dds::Transport::Default, o.network);
   StateCollector<pmu::Health, pmu::HealthPubSubType> health(dds, topics::kHealth);
   StateCollector<pmu::DeviceInfo, pmu::DeviceInfoPubSubType> info(dds, topics::kInfo);
   if (int rc = collect(o, health, 3.0)) return rc;
@@ -270,13 +270,13 @@ int run_list(const GlobalOptions& o) {
 }
 
 int run_info(const GlobalOptions& o) {
-  pmu::dds::DdsContext dds(o.domain, o.qos_file, "pmuctl", o.security);
+  pmu::dds::DdsContext dds(o.domain, o.qos_file, "pmuctl", o.security, pmu::dds::Transport::Default, o.network);
   StateCollector<pmu::DeviceInfo, pmu::DeviceInfoPubSubType> c(dds, topics::kInfo);
   return print_state(o, c, "info");
 }
 
 int run_health(const GlobalOptions& o) {
-  pmu::dds::DdsContext dds(o.domain, o.qos_file, "pmuctl", o.security);
+  pmu::dds::DdsContext dds(o.domain, o.qos_file, "pmuctl", o.security, pmu::dds::Transport::Default, o.network);
   StateCollector<pmu::Health, pmu::HealthPubSubType> c(dds, topics::kHealth);
   return print_state(o, c, "health");
 }
@@ -287,7 +287,7 @@ int run_config_get(const GlobalOptions& o, const std::string& parameter) {
     std::fprintf(stderr, "pmuctl: unknown parameter '%s'\n", parameter.c_str());
     return 2;
   }
-  pmu::dds::DdsContext dds(o.domain, o.qos_file, "pmuctl", o.security);
+  pmu::dds::DdsContext dds(o.domain, o.qos_file, "pmuctl", o.security, pmu::dds::Transport::Default, o.network);
   StateCollector<pmu::Config, pmu::ConfigPubSubType> c(dds, topics::kConfig);
   if (parameter.empty()) return print_state(o, c, "config");
   if (int rc = collect(o, c, 3.0)) return rc;

@@ -7,6 +7,7 @@
 #include <optional>
 #include <string>
 
+#include "pmu/service/dds_network.hpp"
 #include "pmu/service/dds_security.hpp"
 
 namespace pmu::tools {
@@ -19,6 +20,7 @@ struct GlobalOptions {
   std::optional<double> timeout;        // s; verbs have their own default
   std::string qos_file;                 // empty: the installed qos.xml
   pmu::dds::SecurityFiles security;     // empty: no DDS-Security (--security-dir/--identity)
+  pmu::dds::ResolvedNetwork network;    // discovery and interfaces (--peer, --discovery-server, --interface)
 };
 
 int run_watch(const GlobalOptions& o, long count);
