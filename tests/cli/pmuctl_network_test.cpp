@@ -1,11 +1,12 @@
 // pmuctl's discovery and interface options and their environment variables (interface.md
 // section 2.1): every bad value is refused before any DDS participant exists, with exit
-// status 2 and a message naming the option or the variable.
+// status 2 and a message naming the option or the variable. (That options win over the
+// variables needs a participant: tests/integration/discovery_test.cpp, since Fast DDS 2.9.1
+// trips AddressSanitizer, under which this label runs too.)
 #include <gtest/gtest.h>
 
 #include <string>
 
-#include "support/domain.hpp"
 #include "support/process.hpp"
 
 namespace {
@@ -17,8 +18,9 @@ struct BadCase {
 
 // `env -u` first: a variable exported where the tests run must not change them.
 std::string pmuctl(const std::string& command) {
-  return "env -u PMU_DDS_PEERS -u PMU_DISCOVERY_SERVER -u PMU_DDS_INTERFACES " + command.substr(0, command.find("pmuctl")) +
-         PMUCTL_PATH + command.substr(command.find("pmuctl") + 6) + " 2>&1 >/dev/null";
+  const auto at = command.find("pmuctl");
+  return "env -u PMU_DDS_PEERS -u PMU_DISCOVERY_SERVER -u PMU_DDS_INTERFACES " + command.substr(0, at) + PMUCTL_PATH +
+         command.substr(at + 6) + " 2>&1 >/dev/null";
 }
 
 const BadCase kBad[] = {
@@ -45,7 +47,8 @@ const BadCase kBad[] = {
     {"PMU_DISCOVERY_SERVER='[::1]:11811' pmuctl list",
      "pmuctl: PMU_DISCOVERY_SERVER '[::1]:11811': IPv6 is not supported (Fast DDS's UDPv4 transport carries DDS "
      "here): give an IPv4 address or a host name\n"},
-    {"PMU_DISCOVERY_SERVER=10.0.0.1:x pmuctl list", "pmuctl: PMU_DISCOVERY_SERVER '10.0.0.1:x': port 'x' is not a number\n"},
+    {"PMU_DISCOVERY_SERVER=10.0.0.1:x pmuctl list",
+     "pmuctl: PMU_DISCOVERY_SERVER '10.0.0.1:x': port 'x' is not a number\n"},
     {"pmuctl --interface eth1/x list",
      "pmuctl: --interface 'eth1/x': 'eth1/x' is not an interface name (1..15 characters, no '/', ':' or space) or an "
      "IPv4 address\n"},
@@ -80,16 +83,6 @@ TEST(PmuctlNetworkOptions, AnInterfaceThisMachineLacksIsRefused) {
                         0),
             0u)
       << a.out;
-}
-
-TEST(PmuctlNetworkOptions, OptionsWinOverTheEnvironment) {
-  // A bad PMU_DDS_PEERS is not even read when --discovery-server is given, nor a bad
-  // PMU_DDS_INTERFACES with --interface: pmuctl gets as far as looking for the service.
-  const std::string domain = std::to_string(pmu::test::exclusive_dds_domain());
-  const auto r = pmu::test::run_capture(pmuctl("PMU_DDS_PEERS=bad_host PMU_DDS_INTERFACES=bad/if pmuctl --domain " +
-                                                domain + " --discovery-server 127.0.0.1:1 --interface lo --timeout 0.5 list"));
-  EXPECT_NE(r.status, 0);
-  EXPECT_EQ(r.out, "pmuctl: no pmu-service on domain " + domain + "\n");
 }
 
 TEST(PmuctlNetworkOptions, HelpNamesTheOptionsAndVariables) {

@@ -229,7 +229,8 @@ std::set<std::string> udp_addresses_of_this_process() {
     f >> slot >> local >> remote >> state >> queues >> timer >> retransmits >> uid >> timeout >> inode;
     if (!inodes.count(inode)) continue;
     in_addr a{};
-    a.s_addr = static_cast<in_addr_t>(std::stoul(local.substr(0, 8), nullptr, 16));  // host order as the kernel prints it
+    // The kernel prints the address as the number in memory: read back, it is network order.
+    a.s_addr = static_cast<in_addr_t>(std::stoul(local.substr(0, 8), nullptr, 16));
     addresses.insert(::inet_ntoa(a));
   }
   return addresses;
@@ -290,7 +291,8 @@ struct ConfigFile {
     char name[] = "/tmp/pmu-discovery-XXXXXX.yaml";
     const int fd = ::mkstemps(name, 5);
     path = name;
-    const std::string yaml = lines + "buses:\n  - interface: sim\n    devices:\n      - address: 1\n        period: 0.5\n";
+    const std::string yaml =
+        lines + "buses:\n  - interface: sim\n    devices:\n      - address: 1\n        period: 0.5\n";
     if (fd < 0 || ::write(fd, yaml.data(), yaml.size()) != static_cast<ssize_t>(yaml.size())) ADD_FAILURE() << path;
     ::close(fd);
   }
@@ -341,6 +343,18 @@ TEST(DiscoveryEndToEnd, ServiceAndPmuctlAsClientsOfADiscoveryServer) {
   // The variable, as an operator's shell profile would set it.
   expect_watch("PMU_DISCOVERY_SERVER=127.0.0.1:" + port, "", domain);
   EXPECT_TRUE(service.running());
+}
+
+TEST(DiscoveryEndToEnd, PmuctlOptionsWinOverTheEnvironment) {
+  // A bad PMU_DDS_PEERS is not even read when --discovery-server is given, nor a bad
+  // PMU_DDS_INTERFACES with --interface: pmuctl gets as far as looking for the service.
+  const std::string domain = std::to_string(test_domain());
+  const auto r = pmu::test::run_capture("env PMU_DDS_PEERS=bad_host PMU_DDS_INTERFACES=bad/if " +
+                                        std::string(PMUCTL_PATH) + " --domain " + domain +
+                                        " --discovery-server 127.0.0.1:1 --interface lo --timeout 0.5 list "
+                                        "2>&1 >/dev/null");
+  EXPECT_NE(r.status, 0);
+  EXPECT_EQ(r.out, "pmuctl: no pmu-service on domain " + domain + "\n");
 }
 
 }  // namespace

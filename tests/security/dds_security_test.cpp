@@ -666,7 +666,8 @@ TEST(ServiceProgram, UnicastDiscoveryKeepsSecurityAndServerModeIsRefusedWithIt) 
   const std::string server_cfg = write_config("server", files, "discovery: {mode: server, servers: [127.0.0.1]}\n");
   r = sh(std::string(PMU_SERVICE_PATH) + " --config " + server_cfg + " --check-config");
   EXPECT_EQ(r.status, 2) << r.out;
-  EXPECT_NE(r.out.find(server_cfg + ":15: discovery mode server cannot be combined with DDS-Security"), std::string::npos)
+  EXPECT_NE(r.out.find(server_cfg + ":15: discovery mode server cannot be combined with DDS-Security"),
+            std::string::npos)
       << r.out;
 }
 
