@@ -20,6 +20,11 @@
 #   /etc/pmu-dds/pmu-service.yaml                    example config, only if absent; the
 #   /etc/pmu-dds/pmu-service.yaml.example              example itself is always refreshed
 #   PREFIX/lib/systemd/system/pmu-service.service    the unit (ExecStart= follows PREFIX)
+#   PREFIX/lib/systemd/system/pmu-discovery-server.service
+#                                                    the Fast DDS Discovery Server unit
+#                                                    (runs Debian's fast-discovery-server)
+#   /etc/pmu-dds/discovery-server.env                its id and address, only if absent; the
+#   /etc/pmu-dds/discovery-server.env.example          example itself is always refreshed
 #   /etc/systemd/network/80-can0.network             CAN link setup, only if absent
 #   PREFIX/share/doc/pmu-dds/README.md               deploy/README.md
 #   PREFIX/share/doc/pmu-dds/security.md             deploy/security/README.md
@@ -82,7 +87,7 @@ pmuctl_bin=$(find_binary pmuctl tools) || pmuctl_bin=
 sim_bin=$(find_binary pmu-sim tools) || sim_bin=
 
 for f in qos.xml pmu-service.yaml systemd/pmu-service.service systemd/80-can0.network README.md \
-         security/make_pki.sh security/README.md; do
+         security/make_pki.sh security/README.md systemd/pmu-discovery-server.service discovery-server.env; do
   [ -f "$script_dir/$f" ] || die "missing deploy/$f in $script_dir"
 done
 
@@ -174,6 +179,15 @@ sed -e "s#/usr/bin/pmu-service#$bin_path/pmu-service#g" \
     "$script_dir/systemd/pmu-service.service" > "$unit_src"
 put 0644 "$unit_src" "$unitdir/pmu-service.service" "$script_dir/systemd/pmu-service.service (ExecStart= under $bin_path)"
 unit_changed=$last_changed
+# The Discovery Server unit runs Debian's /usr/bin/fast-discovery-server (fastdds-tools),
+# not a binary of this build, so only its documentation path follows PREFIX.
+ds_unit_src="$tmp/pmu-discovery-server.service"
+sed -e "s#/usr/share/doc/pmu-dds#${prefix%/}/share/doc/pmu-dds#g" \
+    "$script_dir/systemd/pmu-discovery-server.service" > "$ds_unit_src"
+put 0644 "$ds_unit_src" "$unitdir/pmu-discovery-server.service" "$script_dir/systemd/pmu-discovery-server.service"
+if [ "$last_changed" -eq 1 ]; then unit_changed=1; fi
+put_keep 0644 "$script_dir/discovery-server.env" "$confdir/discovery-server.env"
+put 0644 "$script_dir/discovery-server.env" "$confdir/discovery-server.env.example"
 put_keep 0644 "$script_dir/systemd/80-can0.network" "$networkdir/80-can0.network"
 put 0644 "$script_dir/README.md" "$docdir/README.md"
 
@@ -188,7 +202,7 @@ if [ -n "$destdir" ]; then
 elif [ ! -d /run/systemd/system ]; then
   say "skipped    systemctl daemon-reload (systemd is not running on this machine)"
 elif [ "$unit_changed" -eq 0 ]; then
-  say "skipped    systemctl daemon-reload (the unit is unchanged)"
+  say "skipped    systemctl daemon-reload (the units are unchanged)"
 else
   run systemctl daemon-reload
 fi
@@ -207,5 +221,8 @@ Next steps (see $prefix/share/doc/pmu-dds/README.md):
   CAN link via systemd-networkd:  systemctl enable --now systemd-networkd && networkctl reload
   start the service:              systemctl enable --now pmu-service
   check it:                       systemctl status pmu-service; journalctl -u pmu-service; pmuctl list
+  Discovery Server (only for discovery mode server; needs Debian's fastdds-tools):
+                                  edit /etc/pmu-dds/discovery-server.env, then
+                                  systemctl enable --now pmu-discovery-server
 EOF
 fi

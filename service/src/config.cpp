@@ -4,11 +4,13 @@
 
 #include <algorithm>
 #include <charconv>
+#include <cctype>
 #include <cmath>
 #include <fstream>
 #include <initializer_list>
 #include <set>
 #include <sstream>
+#include <utility>
 
 #include "pmu/codec/firmware.hpp"
 #include "pmu/codec/messages.hpp"
@@ -246,6 +248,89 @@ void parse_security(const Ctx& c, const YAML::Node& key, const YAML::Node& n, Se
   if (const auto v = n["warn_days"]) sec.warn_days = static_cast<int>(c.integer(v, "warn_days", 0, 3650));
 }
 
+// discovery: and interfaces: (interface.md 2.1). Each entry is read by dds::parse_address or
+// dds::parse_interface, which pmuctl uses too, so both say the same about the same text.
+// Names are only checked for form here; they are looked up at start (dds::resolve_network).
+std::vector<dds::Address> parse_address_list(const Ctx& c, const YAML::Node& n, const std::string& key,
+                                             const std::string& what, const std::string& example) {
+  if (!n.IsSequence()) c.fail(n, key + " must be a list, e.g. " + example);
+  if (n.size() == 0) c.fail(n, key + " must name at least one " + what + ", e.g. " + example);
+  std::vector<dds::Address> out;
+  std::set<std::pair<std::string, std::uint16_t>> seen;
+  for (const auto& item : n) {
+    if (!item.IsScalar()) c.fail(item, what + " must be a single address, e.g. " + example);
+    dds::Address a;
+    a.text = item.Scalar();
+    a.where = c.line_of(item);
+    const std::string why = what == "interface" ? dds::parse_interface(a.text, a) : dds::parse_address(a.text, a);
+    if (!why.empty()) c.fail(item, what + " '" + a.text + "': " + why);
+    std::string host = a.host;  // host names are case-insensitive
+    std::transform(host.begin(), host.end(), host.begin(), [](unsigned char ch) { return std::tolower(ch); });
+    if (!seen.insert({host, a.port}).second) c.fail(item, what + " '" + a.text + "' appears twice in " + key);
+    out.push_back(std::move(a));
+  }
+  return out;
+}
+
+// The value of `key` in `map`, or the key itself when the value is empty (`peers:` alone):
+// an empty value has no position of its own, so messages point at its key's line.
+std::optional<YAML::Node> value_or_key(const YAML::Node& map, const char* key) {
+  for (const auto& kv : map)
+    if (kv.first.as<std::string>() == key) return kv.second.IsNull() ? kv.first : kv.second;
+  return std::nullopt;
+}
+
+void parse_discovery(const Ctx& c, const YAML::Node& key, const YAML::Node& n, dds::Transport transport,
+                     dds::NetworkConfig& net) {
+  if (!n.IsMap()) c.fail(key, "discovery must be a mapping: mode (multicast, unicast or server), peers, servers");
+  c.only_keys(n, "discovery", {"mode", "peers", "servers"});
+  const YAML::Node mode = n["mode"];
+  if (mode && mode.IsNull()) c.fail(*value_or_key(n, "mode"), "discovery mode must be multicast, unicast or server");
+  if (mode) {
+    const auto m = c.scalar<std::string>(mode, "discovery mode", "multicast, unicast or server");
+    if (m == "unicast")
+      net.mode = dds::DiscoveryMode::Unicast;
+    else if (m == "server")
+      net.mode = dds::DiscoveryMode::Server;
+    else if (m != "multicast")
+      c.fail(mode, "discovery mode '" + m + "' is not one of multicast, unicast, server");
+  }
+  const std::string mode_name = dds::to_string(net.mode);
+  const YAML::Node at = mode ? mode : key;
+  if (const auto v = value_or_key(n, "peers")) {
+    const YAML::Node& p = *v;
+    if (net.mode != dds::DiscoveryMode::Unicast)
+      c.fail(p, "peers are for discovery mode unicast, not " + mode_name + " (set mode: unicast, or remove peers)");
+    net.peers = parse_address_list(c, p, "peers", "peer", "[192.168.10.2, \"10.0.0.7:7412\", gcs.local]");
+  }
+  if (const auto v = value_or_key(n, "servers")) {
+    const YAML::Node& s = *v;
+    if (net.mode != dds::DiscoveryMode::Server)
+      c.fail(s, "servers are for discovery mode server, not " + mode_name + " (set mode: server, or remove servers)");
+    net.servers = parse_address_list(c, s, "servers", "server", "[\"10.0.0.1:11811\"]");
+    if (net.servers.size() > dds::kMaxServers)
+      c.fail(s[dds::kMaxServers], "more than " + std::to_string(dds::kMaxServers) + " servers (server ids are 0..255)");
+  }
+  if (net.mode == dds::DiscoveryMode::Unicast && net.peers.empty())
+    c.fail(at, "discovery mode unicast needs peers: a list of IPv4 addresses or host names, each with an optional "
+               ":PORT");
+  if (net.mode == dds::DiscoveryMode::Server && net.servers.empty())
+    c.fail(at, "discovery mode server needs servers: the Discovery Servers' ADDRESS[:PORT] (port 11811 if none), "
+               "in server id order");
+  if (net.mode != dds::DiscoveryMode::Multicast && transport == dds::Transport::ShmOnly)
+    c.fail(at, "discovery mode " + mode_name + " reaches other hosts over UDP, but dds_transport is shm "
+               "(shared memory only): set dds_transport to udp or default");
+}
+
+void parse_interfaces(const Ctx& c, const YAML::Node& key, const YAML::Node& n, dds::Transport transport,
+                      dds::NetworkConfig& net) {
+  if (transport == dds::Transport::ShmOnly)
+    c.fail(key, "interfaces restrict DDS over UDP, but dds_transport is shm (shared memory only, no network): "
+              "set dds_transport to udp or default, or remove interfaces");
+  // A bare `interfaces:` has no position of its own: report the key's line.
+  net.interfaces = parse_address_list(c, n.IsNull() ? key : n, "interfaces", "interface", "[eth1, 192.168.10.1]");
+}
+
 const char* const kLogLevels[] = {"trace", "debug", "info", "warn", "error", "critical", "off"};
 
 }  // namespace
@@ -265,7 +350,8 @@ Config parse_config(const std::string& text, const std::string& source) {
   Config cfg;
   cfg.source = source;
   if (root.IsNull()) throw ConfigError(source + ":1: the file is empty");
-  c.only_keys(root, "the top level", {"domain", "vehicle", "low_rate_period", "qos_file", "dds_transport", "log_level", "buses", "timeouts", "policy", "security"});
+  c.only_keys(root, "the top level", {"domain", "vehicle", "low_rate_period", "qos_file", "dds_transport", "log_level",
+                                      "buses", "timeouts", "policy", "security", "discovery", "interfaces"});
   if (const auto v = root["domain"]) cfg.domain = static_cast<int>(c.integer(v, "domain", 0, 232));
   if (const auto v = root["vehicle"]) {
     // `vehicle:` with nothing after it is YAML null: the unnamed vehicle, like no key.
@@ -294,10 +380,20 @@ Config parse_config(const std::string& text, const std::string& source) {
     if (!is_log_level(cfg.log_level))
       c.fail(v, "log_level '" + cfg.log_level + "' is not one of trace, debug, info, warn, error, critical, off");
   }
+  for (const auto& kv : root) {
+    const auto key = kv.first.as<std::string>();
+    if (key == "discovery") parse_discovery(c, kv.first, kv.second, cfg.dds_transport, cfg.network);
+    if (key == "interfaces") parse_interfaces(c, kv.first, kv.second, cfg.dds_transport, cfg.network);
+  }
   if (const auto v = root["timeouts"]) parse_timeouts(c, v, cfg.timeouts);
   if (const auto v = root["policy"]) parse_policy(c, v, cfg.policy);
   for (const auto& kv : root)
     if (kv.first.as<std::string>() == "security") parse_security(c, kv.first, kv.second, cfg.security);
+  // Both sections are read by now; what one says about the other is checked here.
+  if (cfg.network.mode == dds::DiscoveryMode::Server && !cfg.security.files.empty()) {
+    const auto d = root["discovery"];
+    c.fail(d["mode"] ? d["mode"] : d, std::string("discovery mode server ") + dds::kServerWithSecurity);
+  }
   const auto buses = root["buses"];
   if (!buses) c.fail(root, "no buses: the service needs at least one bus");
   if (!buses.IsSequence() || buses.size() == 0) c.fail(buses, "buses must be a non-empty list");

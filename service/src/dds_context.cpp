@@ -1,16 +1,14 @@
 #include "pmu/service/dds_context.hpp"
 
 #include <fastdds/dds/domain/DomainParticipantFactory.hpp>
-#include <fastdds/rtps/transport/UDPv4TransportDescriptor.h>
-#include <fastdds/rtps/transport/shared_mem/SharedMemTransportDescriptor.h>
 
 #include <cstdlib>
-#include <filesystem>
 #include <fstream>
 #include <memory>
 #include <mutex>
 
 #include "pmu/service/dds_capacity.hpp"
+#include "pmu/service/dds_participant.hpp"
 #include "pmu/sysconf_dir.hpp"
 
 namespace pmu::dds {
@@ -32,26 +30,6 @@ void load_profiles_once(const std::string& file) {
   loaded[file] = true;
 }
 
-// file: URIs as Fast DDS's builtin security plugins take them ("file://" + absolute path).
-std::string file_uri(const std::string& path) {
-  std::error_code ec;
-  const auto abs = std::filesystem::absolute(path, ec);
-  return "file://" + (ec ? path : abs.lexically_normal().string());
-}
-
-void add_security(DomainParticipantQos& pqos, const SecurityFiles& f) {
-  auto& p = pqos.properties().properties();
-  p.emplace_back("dds.sec.auth.plugin", "builtin.PKI-DH");
-  p.emplace_back("dds.sec.auth.builtin.PKI-DH.identity_ca", file_uri(f.identity_ca));
-  p.emplace_back("dds.sec.auth.builtin.PKI-DH.identity_certificate", file_uri(f.identity_certificate));
-  p.emplace_back("dds.sec.auth.builtin.PKI-DH.private_key", file_uri(f.private_key));
-  p.emplace_back("dds.sec.access.plugin", "builtin.Access-Permissions");
-  p.emplace_back("dds.sec.access.builtin.Access-Permissions.permissions_ca", file_uri(f.permissions_ca));
-  p.emplace_back("dds.sec.access.builtin.Access-Permissions.governance", file_uri(f.governance));
-  p.emplace_back("dds.sec.access.builtin.Access-Permissions.permissions", file_uri(f.permissions));
-  p.emplace_back("dds.sec.crypto.plugin", "builtin.AES-GCM-GMAC");
-}
-
 // Fast DDS 2.9.1 (Debian bookworm's) can hang forever deleting a reliable writer whose readers
 // have not acknowledged everything. Its destructor (RTPSWriter::deinit) returns the history's
 // samples to their pool one at a time, dropping the writer's lock between them, while the history
@@ -66,12 +44,14 @@ void add_security(DomainParticipantQos& pqos, const SecurityFiles& f) {
 // Moving the publisher to a partition nobody subscribes to unmatches every reader of its writers
 // at once (Fast DDS re-pairs a writer synchronously when its publisher's QoS changes), so the
 // deletion that follows has nobody to send a heartbeat to. Readers lose nothing they would have
-// kept: a deleted writer repairs nothing either. Only a reader of a wildcard partition ("*")
-// would stay matched; no pmu-dds program subscribes so, and interface.md names no partition.
+// kept: a deleted writer repairs nothing either. The partition starts with '#', which no vehicle
+// name can (vehicle.hpp), so even the every-vehicle readers' pattern does not match it.
+constexpr const char* kClosingPartition = "#pmu-dds-closing";
+
 void unmatch_writers_before_deleting_them(Publisher& publisher) {
   PublisherQos qos = publisher.get_qos();
   qos.partition().clear();
-  qos.partition().push_back("pmu-dds.closing");
+  qos.partition().push_back(kClosingPartition);
   (void)publisher.set_qos(qos);  // if refused, the deletion runs as before: nothing else to do
 }
 
@@ -86,27 +66,27 @@ std::string default_qos_file() {
 }
 
 DdsContext::DdsContext(int domain, const std::string& qos_file, const std::string& participant_name,
-                       const SecurityFiles& security, Transport transport, const Partitions& partitions)
+                       const SecurityFiles& security, Transport transport, const ResolvedNetwork& network,
+                       const Partitions& partitions)
     : domain_(domain), secure_(!security.empty()) {
   const std::string file = qos_file.empty() ? default_qos_file() : qos_file;
   qos_file_ = file;
   if (file.empty()) throw DdsError("no QoS profile file: install deploy/qos.xml as " PMU_SYSCONFDIR "/qos.xml, set PMU_QOS_FILE or set qos_file");
   load_profiles_once(file);
-  DomainParticipantQos pqos = PARTICIPANT_QOS_DEFAULT;
-  pqos.name(participant_name);
-  if (secure_) add_security(pqos, security);
-  if (transport == Transport::UdpOnly) {
-    pqos.transport().use_builtin_transports = false;
-    pqos.transport().user_transports.push_back(std::make_shared<eprosima::fastdds::rtps::UDPv4TransportDescriptor>());
-  } else if (transport == Transport::ShmOnly) {
-    pqos.transport().use_builtin_transports = false;
-    pqos.transport().user_transports.push_back(
-        std::make_shared<eprosima::fastdds::rtps::SharedMemTransportDescriptor>());
+  // Transports, discovery, interfaces and security: dds_participant.hpp says what each sets.
+  DomainParticipantQos pqos;
+  try {
+    pqos = participant_qos(participant_name, transport, network, security);
+  } catch (const NetworkError& e) {
+    throw DdsError(e.what());
   }
   participant_ = DomainParticipantFactory::get_instance()->create_participant(static_cast<DomainId_t>(domain), pqos);
   if (!participant_)
     throw DdsError("cannot create a DDS participant on domain " + std::to_string(domain) +
-                   (secure_ ? " with DDS-Security (see the Fast DDS SECURITY error above)" : ""));
+                   (secure_ ? " with DDS-Security (see the Fast DDS SECURITY error above)" : "") +
+                   (network.mode == DiscoveryMode::Multicast && network.interface_addresses.empty()
+                        ? ""
+                        : " (" + network.summary + ")"));
   PublisherQos pub_qos = PUBLISHER_QOS_DEFAULT;
   for (const auto& p : partitions.publisher) pub_qos.partition().push_back(p.c_str());
   SubscriberQos sub_qos = SUBSCRIBER_QOS_DEFAULT;

@@ -98,7 +98,7 @@ std::string summary(const std::vector<BusRuntime>& buses) {
   return "serving " + std::to_string(devices) + " PMU(s) on " + std::to_string(buses.size()) + " bus(es)";
 }
 
-int run(const service::Config& cfg) {
+int run(const service::Config& cfg, const pmu::dds::ResolvedNetwork& network) {
   // Signals arrive through a signalfd read by this thread; block them before any thread
   // starts so every thread inherits the mask.
   sigset_t signals;
@@ -116,9 +116,10 @@ int run(const service::Config& cfg) {
     for (const auto& d : b.devices) longest = std::max(longest, d.period);
   if (longest == milliseconds{0}) longest = milliseconds(1000);
 
+  spdlog::info("DDS: {}", network.summary);
   const auto partitions = service::vehicle_partitions(cfg.vehicle);
   pmu::dds::DdsContext participant(cfg.domain, cfg.qos_file, "pmu-service", cfg.security.files, cfg.dds_transport,
-                                   {partitions, partitions});
+                                   network, {partitions, partitions});
   if (participant.secure())
     spdlog::info("DDS-Security on: identity {}, permissions {}", cfg.security.files.identity_certificate,
                  cfg.security.files.permissions);
@@ -215,6 +216,19 @@ bool security_files_ok(const service::Config& cfg) {
   return true;
 }
 
+// discovery: and interfaces: with every name looked up (interfaces, host names), before any
+// participant or bus is opened; --check-config does it too. A failure ends the start with
+// exit status 1, like a bus that cannot be opened: the interface or the name server may be
+// there at a later start (systemd restarts the unit), unlike a config error (status 2).
+std::optional<pmu::dds::ResolvedNetwork> resolved_network(const service::Config& cfg) {
+  try {
+    return pmu::dds::resolve_network(cfg.network, pmu::dds::system_lookup());
+  } catch (const pmu::dds::NetworkError& e) {
+    std::fprintf(stderr, "pmu-service: %s\n", e.what());
+    return std::nullopt;
+  }
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -253,13 +267,16 @@ int main(int argc, char** argv) {
   }
   service::setup_logging(level);
   if (!security_files_ok(cfg)) return 2;
+  const auto network = resolved_network(cfg);
+  if (!network) return 1;
   if (check_only) {
     std::printf("%s: configuration OK (%zu bus(es)%s)\n", cfg.source.c_str(), cfg.buses.size(),
                 cfg.security.files.empty() ? "" : ", DDS-Security files OK");
+    std::printf("%s: DDS %s\n", cfg.source.c_str(), network->summary.c_str());
     return 0;
   }
   try {
-    return run(cfg);
+    return run(cfg, *network);
   } catch (const std::exception& e) {
     spdlog::critical("cannot start: {}", e.what());
     return 1;

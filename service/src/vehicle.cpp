@@ -22,7 +22,12 @@ std::vector<std::string> vehicle_partitions(const std::string& vehicle) {
   return {vehicle};
 }
 
-std::vector<std::string> every_vehicle_partitions() { return {"", "*"}; }
+std::vector<std::string> every_vehicle_partitions() {
+  // Every name a vehicle can have starts with one of these characters; "*" would also match
+  // partitions that are not vehicles, such as the one a closing DdsContext parks its writers
+  // in (dds_context.cpp), and keep its readers matched to writers being deleted.
+  return {"", "[A-Za-z0-9_.-]*"};
+}
 
 bool partitions_address_only(const std::vector<std::string>& writer_partitions, const std::string& vehicle) {
   if (vehicle.empty()) {

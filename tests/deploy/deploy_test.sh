@@ -10,7 +10,9 @@
 #      second run changes nothing and an edited config is kept;
 #   3. systemd-analyze verify accepts the unit (ExecStart= pointed at PMU_SERVICE, since
 #      /usr/bin/pmu-service is not installed here) and its offline security exposure is
-#      at most 1.5 (measured 1.3 with systemd 252), when systemd-analyze exists.
+#      at most 1.5 (measured 1.3 with systemd 252), when systemd-analyze exists; the same
+#      for pmu-discovery-server.service (measured 1.1), whose ExecStart= uses exactly the
+#      variables discovery-server.env sets, and whose program takes those arguments.
 # Exits non-zero on the first failure.
 
 set -euo pipefail
@@ -32,7 +34,8 @@ step() { echo "--- $*"; }
 fail() { echo "FAIL: $*" >&2; exit 1; }
 
 [ -x "$service_bin" ] || fail "$service_bin is not an executable"
-for f in pmu-service.yaml qos.xml install.sh README.md systemd/pmu-service.service systemd/80-can0.network; do
+for f in pmu-service.yaml qos.xml install.sh README.md systemd/pmu-service.service systemd/80-can0.network \
+         systemd/pmu-discovery-server.service discovery-server.env; do
   [ -f "$deploy/$f" ] || fail "deploy/$f is missing"
 done
 [ -x "$install_sh" ] || fail "deploy/install.sh is not executable"
@@ -64,6 +67,26 @@ out=$("$service_bin" --config "$full" --check-config 2>&1) ||
   fail "pmu-service rejected the example with its commented parts enabled: $out"
 echo "$out"
 grep -q "configuration OK (2 bus(es))" <<<"$out" || fail "unexpected check-config output: $out"
+
+step "check-config with the discovery and interfaces examples switched on"
+# The unicast example (its host name swapped for one that resolves everywhere) with the
+# interface example on lo, then the server example.
+unicast="$work/unicast.yaml"
+awk '/^# discovery:$/ { n++ } { if (n == 1 && /^# (discovery:|  mode:|  peers:)/) sub(/^# /, ""); print }' \
+    "$deploy/pmu-service.yaml" | sed -e 's/gcs\.local\]$/localhost]/' -e 's/^# interfaces: \[eth1\]$/interfaces: [lo]/' > "$unicast"
+[ "$(diff "$deploy/pmu-service.yaml" "$unicast" | grep -c '^>' || true)" -eq 4 ] ||
+  fail "expected 4 discovery/interfaces example lines to switch on (were the commented examples changed?)"
+out=$("$service_bin" --config "$unicast" --check-config 2>&1) || fail "pmu-service rejected the unicast example: $out"
+echo "$out"
+grep -q "DDS unicast discovery to 192.168.10.2, 192.168.10.7:7412, 127.0.0.1; DDS over UDP only on 127.0.0.1 (lo)$" \
+  <<<"$out" || fail "unexpected check-config output for the unicast example: $out"
+server="$work/server.yaml"
+awk '/^# discovery:$/ { n++ } { if (n == 2 && /^# (discovery:|  mode:|  servers:)/) sub(/^# /, ""); print }' \
+    "$deploy/pmu-service.yaml" > "$server"
+out=$("$service_bin" --config "$server" --check-config 2>&1) || fail "pmu-service rejected the server example: $out"
+echo "$out"
+grep -q "DDS server discovery through Discovery Server id 0 at 192.168.10.1:11811$" <<<"$out" ||
+  fail "unexpected check-config output for the server example: $out"
 
 step "check-config rejects a misspelt key"
 bad="$work/bad.yaml"
@@ -103,6 +126,13 @@ expect 644 /etc/pmu-dds/qos.xml
 expect 644 /etc/pmu-dds/pmu-service.yaml
 expect 644 /etc/pmu-dds/pmu-service.yaml.example
 expect 644 /usr/lib/systemd/system/pmu-service.service
+expect 644 /usr/lib/systemd/system/pmu-discovery-server.service
+expect 644 /etc/pmu-dds/discovery-server.env
+expect 644 /etc/pmu-dds/discovery-server.env.example
+cmp -s "$deploy/discovery-server.env" "$dest/etc/pmu-dds/discovery-server.env" ||
+  fail "installed discovery-server.env differs from deploy/discovery-server.env"
+grep -qx "ExecStart=/usr/bin/fast-discovery-server -i \${PMU_DISCOVERY_SERVER_ID} -l \${PMU_DISCOVERY_SERVER_ADDRESS} -p \${PMU_DISCOVERY_SERVER_PORT}" \
+  "$dest/usr/lib/systemd/system/pmu-discovery-server.service" || fail "installed discovery server unit has an unexpected ExecStart="
 expect 644 /etc/systemd/network/80-can0.network
 expect 644 /usr/share/doc/pmu-dds/README.md
 expect 644 /usr/share/doc/pmu-dds/security.md
@@ -121,9 +151,12 @@ step "install.sh again: nothing to do, an edited config is kept"
 out=$(DESTDIR="$dest" "$install_sh" --build-dir "$build_dir" 2>&1) || fail "second install.sh run failed: $out"
 grep -q "nothing to do" <<<"$out" || fail "second run changed something: $out"
 echo "# edited on site" >> "$dest/etc/pmu-dds/pmu-service.yaml"
+echo "PMU_DISCOVERY_SERVER_ID=1" >> "$dest/etc/pmu-dds/discovery-server.env"
 out=$(DESTDIR="$dest" "$install_sh" --build-dir "$build_dir" 2>&1) || fail "third install.sh run failed: $out"
 tail -n 1 "$dest/etc/pmu-dds/pmu-service.yaml" | grep -q "edited on site" || fail "install.sh overwrote an edited config"
 grep -q "kept .*pmu-service.yaml" <<<"$out" || fail "install.sh did not report keeping the config: $out"
+tail -n 1 "$dest/etc/pmu-dds/discovery-server.env" | grep -q "PMU_DISCOVERY_SERVER_ID=1" ||
+  fail "install.sh overwrote an edited discovery-server.env"
 
 step "install.sh --prefix /usr/local"
 local_dest=$(mktemp -d "$work/prefix.XXXXXX")
@@ -151,8 +184,54 @@ if command -v systemd-analyze >/dev/null 2>&1; then
   else
     echo "skipped: this systemd-analyze has no --offline ($out)"
   fi
+
+  # The Discovery Server unit runs Debian's fast-discovery-server (fastdds-tools, which
+  # scripts/setup.sh installs); verify needs the program to exist.
+  ds_unit="$deploy/systemd/pmu-discovery-server.service"
+  if [ -x /usr/bin/fast-discovery-server ]; then
+    step "systemd-analyze verify pmu-discovery-server.service"
+    cp "$ds_unit" "$unit_dir/pmu-discovery-server.service"
+    systemd-analyze verify "$unit_dir/pmu-discovery-server.service" ||
+      fail "systemd-analyze verify rejected pmu-discovery-server.service"
+  else
+    echo "--- skipped systemd-analyze verify pmu-discovery-server.service: /usr/bin/fast-discovery-server missing (fastdds-tools)"
+  fi
+  step "systemd-analyze security --offline=true pmu-discovery-server.service"
+  if out=$(systemd-analyze security --offline=true "$ds_unit" 2>&1); then
+    score_line=$(grep "Overall exposure level" <<<"$out") || fail "no exposure level in: $out"
+    echo "$score_line"
+    score=$(sed -E 's/.*: ([0-9]+\.[0-9]+).*/\1/' <<<"$score_line")
+    awk -v s="$score" 'BEGIN { exit !(s <= 1.5) }' || fail "discovery server exposure $score is above 1.5: the unit was weakened"
+  else
+    echo "skipped: this systemd-analyze has no --offline ($out)"
+  fi
 else
   echo "--- skipped systemd-analyze checks: systemd-analyze is not installed"
+fi
+
+# ---- 4. the Discovery Server's settings --------------------------------------------------
+step "discovery-server.env sets what the unit's ExecStart= uses, and the server accepts it"
+used=$(grep "^ExecStart=" "$deploy/systemd/pmu-discovery-server.service" | grep -o '\${[A-Z_]*}' | tr -d '${}' | sort -u)
+set_in_env=$(grep -E '^[A-Z_]+=' "$deploy/discovery-server.env" | cut -d= -f1 | sort -u)
+[ "$used" = "$set_in_env" ] || fail "the unit uses [$(echo $used)] but discovery-server.env sets [$(echo $set_in_env)]"
+grep -vE '^(#.*|[A-Z_]+=[^ ]*|)$' "$deploy/discovery-server.env" &&
+  fail "discovery-server.env has lines systemd's EnvironmentFile= would not read as NAME=value"
+if [ -x /usr/bin/fast-discovery-server ]; then
+  # The shipped values (address swapped for loopback and the port for a free one, so the
+  # test binds nothing outside this host nor a port in use): the server starts and says so.
+  # SIGINT is how the unit stops it (KillSignal=).
+  ( set -a; . "$deploy/discovery-server.env"; set +a
+    port=$(python3 -c 'import socket; s=socket.socket(socket.AF_INET, socket.SOCK_DGRAM); s.bind(("127.0.0.1", 0)); print(s.getsockname()[1])')
+    /usr/bin/fast-discovery-server -i "$PMU_DISCOVERY_SERVER_ID" -l 127.0.0.1 -p "$port" > "$work/ds.out" 2>&1 &
+    pid=$!
+    for _ in $(seq 100); do grep -q "Server is running" "$work/ds.out" && break; sleep 0.1; done
+    kill -INT "$pid"; wait "$pid" || true
+    grep -q "Server is running" "$work/ds.out" || fail "fast-discovery-server did not start with the shipped id: $(cat "$work/ds.out")"
+    grep -q "Server shut down" "$work/ds.out" || fail "fast-discovery-server did not stop cleanly on SIGINT: $(cat "$work/ds.out")"
+    grep -q "Server ID: *$PMU_DISCOVERY_SERVER_ID\$" "$work/ds.out" || fail "unexpected server id: $(cat "$work/ds.out")" )
+  cat "$work/ds.out"
+else
+  echo "--- skipped running fast-discovery-server: not installed (fastdds-tools)"
 fi
 
 echo "deploy files OK"

@@ -42,7 +42,7 @@ struct VehicleService {
   VehicleService(int domain, const std::string& vehicle)
       : network(clock),
         pmus(network.attach("pmu-sim"), clock),
-        dds(domain, "", "pmu-service-" + vehicle, {}, dds::Transport::Default,
+        dds(domain, "", "pmu-service-" + vehicle, {}, dds::Transport::Default, {},
             {vehicle_partitions(vehicle), vehicle_partitions(vehicle)}),
         publisher(dds, 3s, vehicle),
         worker(bus_config(), network.attach("sim0"), clock, Timeouts{}, publisher),
@@ -91,7 +91,7 @@ struct VehicleService {
 // A ground station: reads in `read` partitions, writes commands in `write` partitions.
 struct Ground {
   Ground(int domain, const std::string& name, dds::Partitions partitions)
-      : dds(domain, "", name, {}, dds::Transport::Default, std::move(partitions)),
+      : dds(domain, "", name, {}, dds::Transport::Default, {}, std::move(partitions)),
         writer(dds.writer(dds.topic(topics::kCommand, TypeSupport(new pmu::CommandPubSubType())), qos_profiles::kCommand)),
         replies(dds.reader(dds.topic(topics::kCommandReply, TypeSupport(new pmu::CommandReplyPubSubType())),
                            qos_profiles::kCommand)),

@@ -54,8 +54,8 @@ const BadCase kBad[] = {
     {"buses: [\n", "bad.yaml:2: YAML syntax error: end of sequence flow not found"},
     {"domain: 0\n", "bad.yaml:1: no buses: the service needs at least one bus"},
     {"domian: 0\nbuses: []\n",
-     "bad.yaml:1: unknown key 'domian' in the top level (known: domain, vehicle, low_rate_period, qos_file, dds_transport, log_level, buses, "
-     "timeouts, policy, security)"},
+     "bad.yaml:1: unknown key 'domian' in the top level (known: domain, vehicle, low_rate_period, qos_file, dds_transport, log_level, "
+     "buses, timeouts, policy, security, discovery, interfaces)"},
     {"domain: 0\nvehicle: uav*\nbuses: []\n",
      "bad.yaml:2: vehicle 'uav*' contains '*'; a vehicle name is letters, digits, '_', '-' and '.' (it is also a DDS "
      "partition name, where other characters are patterns)"},
@@ -128,6 +128,198 @@ TEST(Config, EveryBadValueIsRefusedWithItsLine) {
     } catch (const ConfigError& e) {
       EXPECT_EQ(std::string(e.what()), c.message);
     }
+  }
+}
+
+// discovery: and interfaces: (interface.md 2.1). Each case is appended to a valid bus
+// section of three lines, so the first line of a case is line 4.
+const char* const kBus = "buses:\n  - interface: can0\n    discover: true\n";
+
+const BadCase kBadNetwork[] = {
+    {"discovery: unicast\n", "bad.yaml:4: discovery must be a mapping: mode (multicast, unicast or server), peers, servers"},
+    {"discovery:\n", "bad.yaml:4: discovery must be a mapping: mode (multicast, unicast or server), peers, servers"},
+    {"discovery:\n  mode: broadcast\n", "bad.yaml:5: discovery mode 'broadcast' is not one of multicast, unicast, server"},
+    {"discovery:\n  mode:\n  peers: [10.0.0.1]\n", "bad.yaml:5: discovery mode must be multicast, unicast or server"},
+    {"discovery:\n  mode: [unicast]\n", "bad.yaml:5: discovery mode must be multicast, unicast or server"},
+    {"discovery:\n  mode: unicast\n  peer: [10.0.0.1]\n",
+     "bad.yaml:6: unknown key 'peer' in discovery (known: mode, peers, servers)"},
+    {"discovery:\n  mode: unicast\n",
+     "bad.yaml:5: discovery mode unicast needs peers: a list of IPv4 addresses or host names, each with an optional "
+     ":PORT"},
+    {"discovery:\n  peers: [10.0.0.1]\n",
+     "bad.yaml:5: peers are for discovery mode unicast, not multicast (set mode: unicast, or remove peers)"},
+    {"discovery:\n  mode: multicast\n  peers: [10.0.0.1]\n",
+     "bad.yaml:6: peers are for discovery mode unicast, not multicast (set mode: unicast, or remove peers)"},
+    {"discovery:\n  mode: server\n  servers: [10.0.0.1]\n  peers: [10.0.0.2]\n",
+     "bad.yaml:7: peers are for discovery mode unicast, not server (set mode: unicast, or remove peers)"},
+    {"discovery:\n  mode: unicast\n  servers: [10.0.0.1]\n",
+     "bad.yaml:6: servers are for discovery mode server, not unicast (set mode: server, or remove servers)"},
+    {"discovery:\n  mode: server\n",
+     "bad.yaml:5: discovery mode server needs servers: the Discovery Servers' ADDRESS[:PORT] (port 11811 if none), in "
+     "server id order"},
+    {"discovery:\n  mode: unicast\n  peers: []\n", "bad.yaml:6: peers must name at least one peer, e.g. [192.168.10.2, "
+                                                  "\"10.0.0.7:7412\", gcs.local]"},
+    {"discovery:\n  mode: unicast\n  peers:\n",
+     "bad.yaml:6: peers must be a list, e.g. [192.168.10.2, \"10.0.0.7:7412\", gcs.local]"},
+    {"discovery:\n  mode: unicast\n  peers: 10.0.0.1\n",
+     "bad.yaml:6: peers must be a list, e.g. [192.168.10.2, \"10.0.0.7:7412\", gcs.local]"},
+    {"discovery:\n  mode: unicast\n  peers:\n    - {host: 10.0.0.1}\n",
+     "bad.yaml:7: peer must be a single address, e.g. [192.168.10.2, \"10.0.0.7:7412\", gcs.local]"},
+    {"discovery:\n  mode: unicast\n  peers: [10.0.0.256]\n",
+     "bad.yaml:6: peer '10.0.0.256': '10.0.0.256' is not an IPv4 address (four numbers 0..255: 192.168.10.2)"},
+    {"discovery:\n  mode: unicast\n  peers: [10.0.1]\n",
+     "bad.yaml:6: peer '10.0.1': '10.0.1' is not an IPv4 address (four numbers 0..255: 192.168.10.2)"},
+    {"discovery:\n  mode: unicast\n  peers: [010.0.0.1]\n",
+     "bad.yaml:6: peer '010.0.0.1': '010.0.0.1' is not an IPv4 address (four numbers 0..255: 192.168.10.2)"},
+    {"discovery:\n  mode: unicast\n  peers: [\"10.0.0.1:0\"]\n",
+     "bad.yaml:6: peer '10.0.0.1:0': port 0 out of range 1..65535"},
+    {"discovery:\n  mode: unicast\n  peers: [\"10.0.0.1:65536\"]\n",
+     "bad.yaml:6: peer '10.0.0.1:65536': port 65536 out of range 1..65535"},
+    {"discovery:\n  mode: unicast\n  peers: [\"10.0.0.1:99999999999999999999\"]\n",
+     "bad.yaml:6: peer '10.0.0.1:99999999999999999999': port 99999999999999999999 out of range 1..65535"},
+    {"discovery:\n  mode: unicast\n  peers: [\"10.0.0.1:-1\"]\n",
+     "bad.yaml:6: peer '10.0.0.1:-1': port '-1' is not a number"},
+    {"discovery:\n  mode: unicast\n  peers: [\"10.0.0.1:\"]\n", "bad.yaml:6: peer '10.0.0.1:': no port after the ':'"},
+    {"discovery:\n  mode: unicast\n  peers: [\":7412\"]\n", "bad.yaml:6: peer ':7412': no address before the ':'"},
+    {"discovery:\n  mode: unicast\n  peers: [bad_host]\n",
+     "bad.yaml:6: peer 'bad_host': 'bad_host' is not an IPv4 address or a host name (letters, digits, '-' and '.')"},
+    {"discovery:\n  mode: unicast\n  peers: [-gcs.local]\n",
+     "bad.yaml:6: peer '-gcs.local': '-gcs.local' is not an IPv4 address or a host name (letters, digits, '-' and "
+     "'.')"},
+    {"discovery:\n  mode: unicast\n  peers: [\"[::1]:7412\"]\n",
+     "bad.yaml:6: peer '[::1]:7412': IPv6 is not supported (Fast DDS's UDPv4 transport carries DDS here): give an IPv4 "
+     "address or a host name"},
+    {"discovery:\n  mode: unicast\n  peers: [239.255.0.1]\n",
+     "bad.yaml:6: peer '239.255.0.1': '239.255.0.1' is a multicast address, not a host's"},
+    {"discovery:\n  mode: unicast\n  peers: [0.0.0.0]\n",
+     "bad.yaml:6: peer '0.0.0.0': '0.0.0.0' is not a host's address"},
+    {"discovery:\n  mode: unicast\n  peers: [255.255.255.255]\n",
+     "bad.yaml:6: peer '255.255.255.255': '255.255.255.255' is the broadcast address"},
+    {"discovery:\n  mode: unicast\n  peers:\n    - 10.0.0.1\n    - \"10.0.0.1:7412\"\n    - 10.0.0.1\n",
+     "bad.yaml:9: peer '10.0.0.1' appears twice in peers"},
+    {"discovery:\n  mode: unicast\n  peers: [GCS.local, gcs.local]\n",
+     "bad.yaml:6: peer 'gcs.local' appears twice in peers"},
+    {"discovery:\n  mode: server\n  servers: [\"10.0.0.1:11811\", \"10.0.0.1:11811\"]\n",
+     "bad.yaml:6: server '10.0.0.1:11811' appears twice in servers"},
+    {"discovery:\n  mode: server\n  servers: [\"10.0.0.1:0\"]\n",
+     "bad.yaml:6: server '10.0.0.1:0': port 0 out of range 1..65535"},
+    {"dds_transport: shm\ndiscovery:\n  mode: unicast\n  peers: [10.0.0.1]\n",
+     "bad.yaml:6: discovery mode unicast reaches other hosts over UDP, but dds_transport is shm (shared memory only): "
+     "set dds_transport to udp or default"},
+    {"interfaces: []\n", "bad.yaml:4: interfaces must name at least one interface, e.g. [eth1, 192.168.10.1]"},
+    {"interfaces:\n", "bad.yaml:4: interfaces must be a list, e.g. [eth1, 192.168.10.1]"},
+    {"interfaces: eth1\n", "bad.yaml:4: interfaces must be a list, e.g. [eth1, 192.168.10.1]"},
+    {"interfaces: [eth1/2]\n",
+     "bad.yaml:4: interface 'eth1/2': 'eth1/2' is not an interface name (1..15 characters, no '/', ':' or space) or an "
+     "IPv4 address"},
+    {"interfaces: [\"eth0:1\"]\n",
+     "bad.yaml:4: interface 'eth0:1': 'eth0:1' is not an interface name (1..15 characters, no '/', ':' or space) or an "
+     "IPv4 address"},
+    {"interfaces: [averyveryverylongname]\n",
+     "bad.yaml:4: interface 'averyveryverylongname': 'averyveryverylongname' is not an interface name (1..15 "
+     "characters, no '/', ':' or space) or an IPv4 address"},
+    {"interfaces: [192.168.1]\n",
+     "bad.yaml:4: interface '192.168.1': '192.168.1' is not an IPv4 address (four numbers 0..255)"},
+    {"interfaces: [0.0.0.0]\n", "bad.yaml:4: interface '0.0.0.0': '0.0.0.0' is not a host's address"},
+    {"interfaces:\n  - eth1\n  - 192.168.10.1\n  - eth1\n", "bad.yaml:7: interface 'eth1' appears twice in interfaces"},
+    {"dds_transport: shm\ninterfaces: [eth1]\n",
+     "bad.yaml:5: interfaces restrict DDS over UDP, but dds_transport is shm (shared memory only, no network): set "
+     "dds_transport to udp or default, or remove interfaces"},
+};
+
+TEST(ConfigNetwork, EveryBadValueIsRefusedWithItsLine) {
+  for (const auto& c : kBadNetwork) {
+    const std::string yaml = std::string(kBus) + c.yaml;
+    SCOPED_TRACE(yaml);
+    try {
+      (void)parse_config(yaml, "bad.yaml");
+      ADD_FAILURE() << "accepted";
+    } catch (const ConfigError& e) {
+      EXPECT_EQ(std::string(e.what()), c.message);
+    }
+  }
+}
+
+TEST(ConfigNetwork, DiscoveryServerWithSecurityIsRefusedAtTheModeLine) {
+  const std::string security =
+      "security:\n  identity_ca: a\n  identity_certificate: b\n  private_key: c\n  permissions_ca: d\n"
+      "  governance: e\n  permissions: f\n";
+  const std::string server = "discovery:\n  mode: server\n  servers: [10.0.0.1]\n";
+  for (const std::string& yaml : {std::string(kBus) + security + server, std::string(kBus) + server + security}) {
+    SCOPED_TRACE(yaml);
+    try {
+      (void)parse_config(yaml, "bad.yaml");
+      ADD_FAILURE() << "accepted";
+    } catch (const ConfigError& e) {
+      const std::string line = yaml.find("security") < yaml.find("discovery") ? "12" : "5";
+      EXPECT_EQ(std::string(e.what()),
+                "bad.yaml:" + line +
+                    ": discovery mode server cannot be combined with DDS-Security in Fast DDS 2.9.1: secure "
+                    "participants find nothing through a Discovery Server (an unauthenticated server is ignored, "
+                    "and a secure one loses the GUID prefix its id gives it); use unicast peers");
+    }
+  }
+  // Unicast peers and DDS-Security go together.
+  EXPECT_EQ(parse_config(std::string(kBus) + security + "discovery:\n  mode: unicast\n  peers: [10.0.0.1]\n", "ok.yaml")
+                .network.mode,
+            dds::DiscoveryMode::Unicast);
+}
+
+TEST(ConfigNetwork, AbsentKeysMeanMulticastOnEveryInterfaceAsBefore) {
+  const Config c = parse_config(kGood, "good.yaml");
+  EXPECT_EQ(c.network.mode, dds::DiscoveryMode::Multicast);
+  EXPECT_TRUE(c.network.peers.empty());
+  EXPECT_TRUE(c.network.servers.empty());
+  EXPECT_TRUE(c.network.interfaces.empty());
+  EXPECT_EQ(parse_config(std::string(kBus) + "discovery:\n  mode: multicast\n", "m.yaml").network.mode,
+            dds::DiscoveryMode::Multicast);
+}
+
+TEST(ConfigNetwork, UnicastPeersWithAndWithoutPortsAndTheirLines) {
+  const Config c = parse_config(std::string(kBus) +
+                                    "discovery:\n  mode: unicast\n  peers: [192.168.10.2, \"10.0.0.7:7412\", gcs.local,"
+                                    " 10.0.0.7:7413]\ninterfaces:\n  - eth1\n  - 192.168.10.1\n",
+                                "/etc/pmu-dds/pmu-service.yaml");
+  const auto& n = c.network;
+  EXPECT_EQ(n.mode, dds::DiscoveryMode::Unicast);
+  ASSERT_EQ(n.peers.size(), 4u);
+  EXPECT_EQ(n.peers[0].host, "192.168.10.2");
+  EXPECT_EQ(n.peers[0].port, 0);
+  EXPECT_EQ(n.peers[1].host, "10.0.0.7");
+  EXPECT_EQ(n.peers[1].port, 7412);
+  EXPECT_EQ(n.peers[2].host, "gcs.local");
+  EXPECT_EQ(n.peers[3].port, 7413) << "unquoted HOST:PORT in a flow list is one string for yaml-cpp";
+  EXPECT_EQ(n.peers[1].text, "10.0.0.7:7412");
+  EXPECT_EQ(n.peers[1].where, "/etc/pmu-dds/pmu-service.yaml:6");
+  ASSERT_EQ(n.interfaces.size(), 2u);
+  EXPECT_EQ(n.interfaces[0].host, "eth1");
+  EXPECT_EQ(n.interfaces[1].host, "192.168.10.1");
+  EXPECT_EQ(n.interfaces[1].where, "/etc/pmu-dds/pmu-service.yaml:9");
+}
+
+TEST(ConfigNetwork, ServersInIdOrder) {
+  const Config c = parse_config(std::string(kBus) + "discovery:\n  mode: server\n  servers:\n    - \"10.0.0.1:11811\"\n"
+                                                    "    - ds2.local\n",
+                                "s.yaml");
+  ASSERT_EQ(c.network.servers.size(), 2u);
+  EXPECT_EQ(c.network.mode, dds::DiscoveryMode::Server);
+  EXPECT_EQ(c.network.servers[0].host, "10.0.0.1");
+  EXPECT_EQ(c.network.servers[0].port, 11811);
+  EXPECT_EQ(c.network.servers[1].host, "ds2.local");
+  EXPECT_EQ(c.network.servers[1].port, 0) << "11811 is filled in when resolved";
+  EXPECT_EQ(c.network.servers[1].where, "s.yaml:8");
+}
+
+TEST(ConfigNetwork, AtMost256ServersTheIdsOfAGuidPrefixByte) {
+  std::string yaml = std::string(kBus) + "discovery:\n  mode: server\n  servers:\n";
+  for (int i = 0; i < 257; ++i)
+    yaml += "    - \"10.0." + std::to_string(i / 200) + "." + std::to_string(i % 200 + 1) + "\"\n";
+  try {
+    (void)parse_config(yaml, "s.yaml");
+    ADD_FAILURE() << "accepted";
+  } catch (const ConfigError& e) {
+    // Servers start on line 7; the 257th (index 256) is on line 263.
+    EXPECT_EQ(std::string(e.what()), "s.yaml:263: more than 256 servers (server ids are 0..255)");
   }
 }
 

@@ -158,7 +158,8 @@ int run_command(const GlobalOptions& o, const CommandSpec& spec) {
   const auto deadline = Clock::now() + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(timeout));
   const std::string vehicle = o.vehicle.value_or(std::string());
   // Reading every vehicle's health (without --vehicle) lets a failure name the vehicles there are.
-  pmu::dds::DdsContext dds(o.domain, o.qos_file, "pmuctl", o.security, pmu::dds::Transport::Default, partitions_for(o));
+  pmu::dds::DdsContext dds(o.domain, o.qos_file, "pmuctl", o.security, pmu::dds::Transport::Default, o.network,
+                           partitions_for(o));
   DataReader& replies = dds.reader(dds.topic(topics::kCommandReply, TypeSupport(new idl::Guarded<pmu::CommandReplyPubSubType>())),
                                    qos_profiles::kCommand);
   DataWriter& writer =

@@ -212,7 +212,8 @@ std::string device_label(const std::string& vehicle, const std::string& bus, std
 int run_watch(const GlobalOptions& o, long count) {
   std::signal(SIGINT, on_interrupt);
   std::signal(SIGTERM, on_interrupt);
-  pmu::dds::DdsContext dds(o.domain, o.qos_file, "pmuctl", o.security, pmu::dds::Transport::Default, partitions_for(o));
+  pmu::dds::DdsContext dds(o.domain, o.qos_file, "pmuctl", o.security, pmu::dds::Transport::Default, o.network,
+                           partitions_for(o));
   std::vector<std::unique_ptr<TelemetryReader>> readers;
   // --low-rate: only the low-rate topics' writers match, so only their samples cross the link.
   const bool low = o.low_rate;
@@ -276,7 +277,8 @@ int run_watch(const GlobalOptions& o, long count) {
 }
 
 int run_list(const GlobalOptions& o) {
-  pmu::dds::DdsContext dds(o.domain, o.qos_file, "pmuctl", o.security, pmu::dds::Transport::Default, partitions_for(o));
+  pmu::dds::DdsContext dds(o.domain, o.qos_file, "pmuctl", o.security, pmu::dds::Transport::Default, o.network,
+                           partitions_for(o));
   StateCollector<pmu::Health, pmu::HealthPubSubType> health(dds, topics::kHealth);
   StateCollector<pmu::DeviceInfo, pmu::DeviceInfoPubSubType> info(dds, topics::kInfo);
   if (int rc = collect(o, health, 3.0)) return rc;
@@ -309,13 +311,15 @@ int run_list(const GlobalOptions& o) {
 }
 
 int run_info(const GlobalOptions& o) {
-  pmu::dds::DdsContext dds(o.domain, o.qos_file, "pmuctl", o.security, pmu::dds::Transport::Default, partitions_for(o));
+  pmu::dds::DdsContext dds(o.domain, o.qos_file, "pmuctl", o.security, pmu::dds::Transport::Default, o.network,
+                           partitions_for(o));
   StateCollector<pmu::DeviceInfo, pmu::DeviceInfoPubSubType> c(dds, topics::kInfo);
   return print_state(o, c, "info");
 }
 
 int run_health(const GlobalOptions& o) {
-  pmu::dds::DdsContext dds(o.domain, o.qos_file, "pmuctl", o.security, pmu::dds::Transport::Default, partitions_for(o));
+  pmu::dds::DdsContext dds(o.domain, o.qos_file, "pmuctl", o.security, pmu::dds::Transport::Default, o.network,
+                           partitions_for(o));
   StateCollector<pmu::Health, pmu::HealthPubSubType> c(dds, topics::kHealth);
   return print_state(o, c, "health");
 }
@@ -326,7 +330,8 @@ int run_config_get(const GlobalOptions& o, const std::string& parameter) {
     std::fprintf(stderr, "pmuctl: unknown parameter '%s'\n", parameter.c_str());
     return 2;
   }
-  pmu::dds::DdsContext dds(o.domain, o.qos_file, "pmuctl", o.security, pmu::dds::Transport::Default, partitions_for(o));
+  pmu::dds::DdsContext dds(o.domain, o.qos_file, "pmuctl", o.security, pmu::dds::Transport::Default, o.network,
+                           partitions_for(o));
   StateCollector<pmu::Config, pmu::ConfigPubSubType> c(dds, topics::kConfig);
   if (parameter.empty()) return print_state(o, c, "config");
   if (int rc = collect(o, c, 3.0)) return rc;

@@ -8,6 +8,7 @@
 #include <string>
 
 #include "pmu/service/dds_context.hpp"
+#include "pmu/service/dds_network.hpp"
 #include "pmu/service/dds_security.hpp"
 
 namespace pmu::tools {
@@ -24,6 +25,7 @@ struct GlobalOptions {
   std::optional<double> timeout;        // s; verbs have their own default
   std::string qos_file;                 // empty: the installed qos.xml
   pmu::dds::SecurityFiles security;     // empty: no DDS-Security (--security-dir/--identity)
+  pmu::dds::ResolvedNetwork network;    // discovery and interfaces (--peer, --discovery-server, --interface)
 };
 
 // The partitions of pmuctl's participant for these options (service/vehicle.hpp).

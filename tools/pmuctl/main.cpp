@@ -20,6 +20,7 @@
 #include "pmuctl/log_decoder.hpp"
 #include "pmu/service/command.hpp"
 #include "pmu/service/vehicle.hpp"
+#include "pmuctl/network_options.hpp"
 #include "pmu/sysconf_dir.hpp"
 
 namespace {
@@ -144,6 +145,18 @@ int main(int argc, char** argv) {
   app.add_option("--identity", identity,
                  "DDS-Security identity in that folder: ground-station (commands) or mission-computer "
                  "(read-only) (default: $PMU_SECURITY_IDENTITY)");
+  pmu::tools::NetworkOptions network;
+  app.add_option("--peer", network.peers,
+                 "Unicast discovery (multicast off): ADDR[:PORT] of a host to discover, an IPv4 address or host "
+                 "name; repeat for more (default: $PMU_DDS_PEERS, comma separated)")
+      ->allow_extra_args(false);
+  app.add_option("--discovery-server", network.discovery_servers,
+                 "Client of Fast DDS Discovery Server(s) ADDR[:PORT][,ADDR[:PORT]...] (port 11811 if none; "
+                 "server id = position, as `fastdds discovery -i ID`) (default: $PMU_DISCOVERY_SERVER)");
+  app.add_option("--interface", network.interfaces,
+                 "DDS over UDP only on this interface (name or IPv4 address); repeat for more "
+                 "(default: $PMU_DDS_INTERFACES, comma separated; none: every interface)")
+      ->allow_extra_args(false);
 
   auto* watch = app.add_subcommand("watch", "Live telemetry: a refreshing table, or one JSON object per sample");
   long count = 0;
@@ -218,6 +231,8 @@ int main(int argc, char** argv) {
   }
   if (!setup_security(g, security_dir, identity)) return 2;
   if (!setup_vehicle(g, vehicle_option, vehicle)) return 2;
+  if (!pmu::tools::resolve_network_options(network, pmu::dds::system_lookup(), !g.security.empty(), g.network))
+    return 2;
   try {
     if (*watch) return pmu::tools::run_watch(g, count);
     if (app.got_subcommand("list")) return pmu::tools::run_list(g);

@@ -14,6 +14,7 @@
 
 #include "pmu/codec/messages.hpp"
 #include "pmu/service/capacity.hpp"
+#include "pmu/service/dds_network.hpp"
 #include "pmu/service/dds_transport.hpp"
 #include "pmu/service/dds_security.hpp"
 #include "pmu/service/policy.hpp"
@@ -86,6 +87,9 @@ struct Config {
   // UDPv4); udp: UDPv4 only, e.g. when readers run as other users (SHM segments are
   // owner-only in Fast DDS 2.9).
   dds::Transport dds_transport = dds::Transport::Default;
+  // `discovery:` (multicast, unicast peers, Discovery Server clients) and `interfaces:` (the
+  // UDP allowlist); names are resolved at start (dds::resolve_network), not here.
+  dds::NetworkConfig network;
   std::string log_level = "info";
   std::vector<BusConfig> buses;
   Timeouts timeouts;

@@ -23,6 +23,7 @@
 #include <string>
 #include <vector>
 
+#include "pmu/service/dds_network.hpp"
 #include "pmu/service/dds_security.hpp"
 #include "pmu/service/dds_transport.hpp"
 
@@ -49,9 +50,10 @@ struct Partitions {
 class DdsContext {
  public:
   // `security` empty: no DDS-Security (as before). Relative paths are made absolute.
+  // `network`: discovery and interface allowlist (dds_network.hpp); default multicast, all.
   DdsContext(int domain, const std::string& qos_file, const std::string& participant_name,
              const SecurityFiles& security = {}, Transport transport = Transport::Default,
-             const Partitions& partitions = {});
+             const ResolvedNetwork& network = {}, const Partitions& partitions = {});
   ~DdsContext();
   DdsContext(const DdsContext&) = delete;
   DdsContext& operator=(const DdsContext&) = delete;

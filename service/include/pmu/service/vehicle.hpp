@@ -28,7 +28,8 @@ std::string vehicle_name_problem(std::string_view name);
 std::vector<std::string> vehicle_partitions(const std::string& vehicle);
 
 // The partitions of a reader that sees every vehicle: the default partition and every named
-// one. Fast DDS matches a reader's "*" only with writers that name a partition, hence "".
+// one (a pattern that matches every vehicle name and nothing else pmu-dds uses). Fast DDS
+// matches a reader's pattern only with writers that name a partition, hence "".
 std::vector<std::string> every_vehicle_partitions();
 
 // True when a command writer's partitions are exactly those a client of `vehicle` uses. The

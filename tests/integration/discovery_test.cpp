@@ -1,0 +1,372 @@
+// Discovery and interfaces over real Fast DDS (interface.md section 2.1): unicast peers with
+// multicast off, Fast DDS's Discovery Server (the `fastdds discovery` program, started here),
+// the interface allowlist, and pmu-service + pmuctl with those settings.
+//
+// In-process participants use UDP only and this program turns Fast DDS's intraprocess
+// delivery off (main below), so everything between them crosses the loopback interface as
+// between two hosts. Each test runs in its own process on a DDS domain of its own
+// (pmu::test::exclusive_dds_domain) and, for the server, on a free UDP port.
+#include <arpa/inet.h>
+#include <gtest/gtest.h>
+#include <ifaddrs.h>
+#include <netinet/in.h>
+#include <signal.h>
+#include <sys/socket.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <fastdds/dds/core/status/PublicationMatchedStatus.hpp>
+#include <fastdds/dds/core/status/SubscriptionMatchedStatus.hpp>
+#include <fastdds/dds/subscriber/SampleInfo.hpp>
+#include <fastrtps/xmlparser/XMLProfileManager.h>
+#include <filesystem>
+#include <fstream>
+#include <set>
+#include <sstream>
+#include <string>
+#include <thread>
+
+#include "pmu/idl/telemetryPubSubTypes.h"
+#include "pmu/idl/topics.hpp"
+#include "pmu/service/dds_context.hpp"
+#include "pmu/service/dds_network.hpp"
+#include "support/domain.hpp"
+#include "support/json_lines.hpp"
+#include "support/process.hpp"
+#include "support/wait.hpp"
+
+namespace pmu::dds {
+namespace {
+
+using namespace eprosima::fastdds::dds;
+using namespace std::chrono_literals;
+
+constexpr const char* kDiscoveryServer = "/usr/bin/fast-discovery-server";  // fastdds-tools
+
+int test_domain() { return pmu::test::exclusive_dds_domain(); }
+
+// A free UDP port on loopback for the Discovery Server (bound, read back, released).
+std::uint16_t free_udp_port() {
+  const int s = ::socket(AF_INET, SOCK_DGRAM | SOCK_CLOEXEC, 0);
+  sockaddr_in a{};
+  a.sin_family = AF_INET;
+  a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+  socklen_t len = sizeof a;
+  if (s < 0 || ::bind(s, reinterpret_cast<sockaddr*>(&a), sizeof a) != 0 ||
+      ::getsockname(s, reinterpret_cast<sockaddr*>(&a), &len) != 0)
+    ADD_FAILURE() << "no free UDP port";
+  ::close(s);
+  return ntohs(a.sin_port);
+}
+
+// True when nothing listens on the domain's multicast discovery port (7400 + 250 * domain):
+// a participant with multicast discovery binds it (with SO_REUSEADDR, so a bind without it
+// fails while the participant lives).
+bool multicast_port_free(int domain) {
+  const int s = ::socket(AF_INET, SOCK_DGRAM | SOCK_CLOEXEC, 0);
+  sockaddr_in a{};
+  a.sin_family = AF_INET;
+  a.sin_port = htons(static_cast<std::uint16_t>(7400 + 250 * domain));
+  a.sin_addr.s_addr = htonl(INADDR_ANY);
+  const bool free = ::bind(s, reinterpret_cast<sockaddr*>(&a), sizeof a) == 0;
+  ::close(s);
+  return free;
+}
+
+ResolvedNetwork unicast_to_loopback() {
+  ResolvedNetwork n;
+  n.mode = DiscoveryMode::Unicast;
+  n.peers = {{"127.0.0.1", 0}};
+  return n;
+}
+
+ResolvedNetwork client_of(std::uint16_t port) {
+  ResolvedNetwork n;
+  n.mode = DiscoveryMode::Server;
+  n.servers = {ResolvedServer{{{"127.0.0.1", port}}}};
+  return n;
+}
+
+// One participant writing pmu/voltages (a pmu-service stand-in) or reading it (a pmuctl
+// stand-in), with the contract's telemetry profile.
+struct Side {
+  Side(const std::string& name, const ResolvedNetwork& network, Transport transport = Transport::UdpOnly)
+      : dds(test_domain(), "", name, {}, transport, network),
+        topic(dds.topic(topics::kVoltages, TypeSupport(new pmu::VoltagesPubSubType()))) {}
+  DataWriter& writer() { return w ? *w : *(w = &dds.writer(topic, qos_profiles::kTelemetry)); }
+  DataReader& reader() { return r ? *r : *(r = &dds.reader(topic, qos_profiles::kTelemetry)); }
+  bool matched() {
+    if (w) {
+      PublicationMatchedStatus s;
+      w->get_publication_matched_status(s);
+      return s.current_count > 0;
+    }
+    SubscriptionMatchedStatus s;
+    r->get_subscription_matched_status(s);
+    return s.current_count > 0;
+  }
+  DdsContext dds;
+  Topic& topic;
+  DataWriter* w = nullptr;
+  DataReader* r = nullptr;
+};
+
+// Writes a sample every 50 ms until the reader has one (best effort: a sample written
+// before matching is lost, so keep writing).
+bool exchange(Side& pub, Side& sub, std::chrono::seconds timeout) {
+  pmu::Voltages v;
+  v.bus("sim0");
+  v.address(1);
+  v.avionics(12.5f);
+  return pmu::test::wait_until(
+      [&] {
+        pub.writer().write(&v);
+        pmu::Voltages got;
+        SampleInfo info;
+        while (sub.reader().take_next_sample(&got, &info) == ReturnCode_t::RETCODE_OK)
+          if (info.valid_data && got.avionics() == 12.5f) return true;
+        return false;
+      },
+      timeout, 50ms);
+}
+
+// ---- unicast peers -------------------------------------------------------------------------
+
+TEST(UnicastDiscovery, PeersOnLoopbackFindEachOtherWithNoMulticastSocket) {
+  Side service("unicast-publisher", unicast_to_loopback());
+  Side client("unicast-subscriber", unicast_to_loopback());
+  service.writer();
+  client.reader();
+  ASSERT_TRUE(exchange(service, client, 20s)) << "no sample over unicast discovery";
+  // Both live and matched, and neither has the multicast discovery port open.
+  EXPECT_TRUE(multicast_port_free(test_domain()));
+}
+
+TEST(UnicastDiscovery, WithoutAPeerAtTheirPortsTheyFindNobody) {
+  // Peers at a port where no participant listens: nothing reaches the well-known ports, and
+  // with multicast off nothing else would find them.
+  ResolvedNetwork nowhere;
+  nowhere.mode = DiscoveryMode::Unicast;
+  nowhere.peers = {{"127.0.0.1", 9}};  // discard
+  Side service("unicast-lonely-publisher", nowhere);
+  Side client("unicast-lonely-subscriber", nowhere);
+  service.writer();
+  client.reader();
+  std::this_thread::sleep_for(4s);  // more than Fast DDS's initial announcements (5 x 100 ms) and a period (3 s)
+  EXPECT_FALSE(service.matched());
+  EXPECT_FALSE(client.matched());
+}
+
+// ---- Discovery Server ----------------------------------------------------------------------
+
+// `fastdds discovery -i ID -l 127.0.0.1 -p PORT` runs this program: the fastdds command is a
+// Python wrapper that starts it as a child, so a signal to the wrapper would leave the
+// server running. Stopped with SIGINT, its clean shutdown (SIGTERM would kill it).
+struct Server {
+  Server(int id, std::uint16_t port)
+      : child({kDiscoveryServer, "-i", std::to_string(id), "-l", "127.0.0.1", "-p", std::to_string(port)},
+              options()) {}
+  ~Server() {
+    child.signal(SIGINT);
+    child.wait_for(5s);
+  }
+  static pmu::test::ChildOptions options() {
+    pmu::test::ChildOptions o;
+    o.stdout_path = "/dev/null";
+    return o;
+  }
+  pmu::test::Child child;
+};
+
+TEST(DiscoveryServer, ClientsFindEachOtherOnlyThroughTheServerWithTheIdOfTheirPosition) {
+  if (::access(kDiscoveryServer, X_OK) != 0)
+    GTEST_SKIP() << kDiscoveryServer << " is missing: install Debian's fastdds-tools (scripts/setup.sh does)";
+  const std::uint16_t port = free_udp_port();
+  Side service("ds-client-publisher", client_of(port));
+  Side client("ds-client-subscriber", client_of(port));
+  service.writer();
+  client.reader();
+
+  // No server: clients send discovery only to it, so they never meet.
+  std::this_thread::sleep_for(4s);
+  EXPECT_FALSE(service.matched()) << "matched without the server";
+  EXPECT_FALSE(client.matched()) << "matched without the server";
+
+  {
+    // A server with id 1 where the list's first (id 0) is expected: its GUID prefix is not
+    // the one the clients look for, so it serves them nothing.
+    Server wrong(1, port);
+    std::this_thread::sleep_for(4s);
+    EXPECT_FALSE(client.matched()) << "matched through a server of another id";
+  }
+
+  Server server(0, port);
+  ASSERT_TRUE(exchange(service, client, 20s)) << "no sample through the Discovery Server";
+  EXPECT_TRUE(multicast_port_free(test_domain()));
+}
+
+// ---- the interface allowlist ---------------------------------------------------------------
+
+// The local IPv4 addresses of this process's UDP sockets, from /proc: its socket inodes
+// (/proc/self/fd) looked up in /proc/net/udp ("0100007F:1F90" is 127.0.0.1:8080).
+std::set<std::string> udp_addresses_of_this_process() {
+  std::set<std::string> inodes;
+  for (const auto& e : std::filesystem::directory_iterator("/proc/self/fd")) {
+    std::error_code ec;
+    const std::string target = std::filesystem::read_symlink(e.path(), ec).string();
+    if (!ec && target.rfind("socket:[", 0) == 0) inodes.insert(target.substr(8, target.size() - 9));
+  }
+  std::set<std::string> addresses;
+  std::ifstream udp("/proc/net/udp");
+  std::string line;
+  std::getline(udp, line);  // header
+  while (std::getline(udp, line)) {
+    std::istringstream f(line);
+    std::string slot, local, remote, state, queues, timer, retransmits, uid, timeout, inode;
+    f >> slot >> local >> remote >> state >> queues >> timer >> retransmits >> uid >> timeout >> inode;
+    if (!inodes.count(inode)) continue;
+    in_addr a{};
+    // The kernel prints the address as the number in memory: read back, it is network order.
+    a.s_addr = static_cast<in_addr_t>(std::stoul(local.substr(0, 8), nullptr, 16));
+    addresses.insert(::inet_ntoa(a));
+  }
+  return addresses;
+}
+
+bool has_non_loopback_ipv4() {
+  for (const auto& a : system_lookup().local_addresses())
+    if (a.address.rfind("127.", 0) != 0) return true;
+  return false;
+}
+
+TEST(InterfaceAllowlist, ParticipantsBindOnlyTheAllowedAddresses) {
+  if (!has_non_loopback_ipv4()) GTEST_SKIP() << "this machine has only loopback: nothing to leave out";
+  ASSERT_TRUE(udp_addresses_of_this_process().empty()) << "a UDP socket before any participant";
+  // Restricted to loopback through the same resolve_network the programs use; found by
+  // unicast peers (multicast on lo is not guaranteed).
+  NetworkConfig config;
+  config.mode = DiscoveryMode::Unicast;
+  config.peers = {Address{"127.0.0.1", "127.0.0.1", 0, "test"}};
+  config.interfaces = {Address{"lo", "lo", 0, "test"}};
+  const ResolvedNetwork loopback_only = resolve_network(config, system_lookup());
+  ASSERT_EQ(loopback_only.interface_addresses, std::vector<std::string>{"127.0.0.1"});
+  // Fast DDS's default transports (shared memory and UDP, pmuctl's): with an allowlist
+  // its builtin UDP transport, which has none, must not be there as well.
+  {
+    Side reader("allowlist-reader", loopback_only, Transport::Default);
+    reader.reader();
+    Side writer("allowlist-writer", loopback_only, Transport::Default);
+    writer.writer();
+    ASSERT_TRUE(exchange(writer, reader, 20s)) << "no sample between two loopback-only participants";
+    // Every UDP socket, for discovery, data and sending, on loopback: none on 0.0.0.0 or
+    // on this machine's other addresses.
+    EXPECT_EQ(udp_addresses_of_this_process(), std::set<std::string>{"127.0.0.1"});
+  }
+  // UDP only: the same.
+  {
+    Side reader("allowlist-udp-reader", loopback_only);
+    reader.reader();
+    Side writer("allowlist-udp-writer", loopback_only);
+    writer.writer();
+    ASSERT_TRUE(exchange(writer, reader, 20s)) << "no sample between two loopback-only participants over UDP";
+    EXPECT_EQ(udp_addresses_of_this_process(), std::set<std::string>{"127.0.0.1"});
+  }
+  // The same participant without an allowlist listens on every address (what the
+  // allowlist kept it from doing above).
+  Side unrestricted("allowlist-unrestricted", unicast_to_loopback());
+  unrestricted.writer();
+  const auto all = udp_addresses_of_this_process();
+  EXPECT_TRUE(std::any_of(all.begin(), all.end(), [](const std::string& a) { return a.rfind("127.", 0) != 0; }))
+      << "expected sockets beyond loopback without an allowlist";
+}
+
+// ---- pmu-service and pmuctl ----------------------------------------------------------------
+
+// A config file for `pmu-service --bus sim` (which replaces its buses) with these lines.
+struct ConfigFile {
+  explicit ConfigFile(const std::string& lines) {
+    char name[] = "/tmp/pmu-discovery-XXXXXX.yaml";
+    const int fd = ::mkstemps(name, 5);
+    path = name;
+    const std::string yaml =
+        lines + "buses:\n  - interface: sim\n    devices:\n      - address: 1\n        period: 0.5\n";
+    if (fd < 0 || ::write(fd, yaml.data(), yaml.size()) != static_cast<ssize_t>(yaml.size())) ADD_FAILURE() << path;
+    ::close(fd);
+  }
+  ~ConfigFile() { ::unlink(path.c_str()); }
+  std::string path;
+};
+
+// `ENV pmuctl --domain D OPTIONS watch --json --count 5`: five telemetry lines of sim0/1.
+void expect_watch(const std::string& env, const std::string& options, const std::string& domain) {
+  const auto r = pmu::test::run_capture("env -u PMU_DDS_PEERS -u PMU_DISCOVERY_SERVER -u PMU_DDS_INTERFACES " + env +
+                                        " " + PMUCTL_PATH + " --domain " + domain + " " + options +
+                                        " watch --json --count 5 --timeout 30");
+  ASSERT_EQ(r.status, 0) << r.out;
+  std::size_t lines = 0;
+  for (const auto& j : pmu::test::json_lines(r.out)) {
+    ASSERT_FALSE(j.is_discarded()) << r.out;
+    EXPECT_EQ(j["bus"], "sim0");
+    EXPECT_EQ(j["address"], 1);
+    ++lines;
+  }
+  EXPECT_EQ(lines, 5u) << r.out;
+}
+
+TEST(DiscoveryEndToEnd, ServiceWithUnicastPeersFeedsPmuctlWithPeer) {
+  const std::string domain = std::to_string(test_domain());
+  ConfigFile config("domain: " + domain + "\ndds_transport: udp\ndiscovery: {mode: unicast, peers: [127.0.0.1]}\n");
+  pmu::test::ChildOptions o;
+  o.stderr_path = config.path + ".log";
+  pmu::test::Child service({PMU_SERVICE_PATH, "--config", config.path, "--bus", "sim"}, o);
+  expect_watch("", "--peer 127.0.0.1", domain);
+  EXPECT_TRUE(multicast_port_free(std::stoi(domain))) << "pmu-service or pmuctl opened the multicast port";
+  service.stop(5s);
+  std::ifstream log(o.stderr_path);
+  const std::string text((std::istreambuf_iterator<char>(log)), std::istreambuf_iterator<char>());
+  ::unlink(o.stderr_path.c_str());
+  EXPECT_NE(text.find("DDS: unicast discovery to 127.0.0.1"), std::string::npos) << text;
+}
+
+TEST(DiscoveryEndToEnd, ServiceAndPmuctlAsClientsOfADiscoveryServer) {
+  if (::access(kDiscoveryServer, X_OK) != 0)
+    GTEST_SKIP() << kDiscoveryServer << " is missing: install Debian's fastdds-tools (scripts/setup.sh does)";
+  const std::string domain = std::to_string(test_domain());
+  const std::string port = std::to_string(free_udp_port());
+  Server server(0, static_cast<std::uint16_t>(std::stoi(port)));
+  ConfigFile config("domain: " + domain + "\ndds_transport: udp\ndiscovery:\n  mode: server\n  servers: [\"127.0.0.1:" +
+                    port + "\"]\n");
+  pmu::test::Child service({PMU_SERVICE_PATH, "--config", config.path, "--bus", "sim", "--log-level", "warn"});
+  // The variable, as an operator's shell profile would set it.
+  expect_watch("PMU_DISCOVERY_SERVER=127.0.0.1:" + port, "", domain);
+  EXPECT_TRUE(service.running());
+}
+
+TEST(DiscoveryEndToEnd, PmuctlOptionsWinOverTheEnvironment) {
+  // A bad PMU_DDS_PEERS is not even read when --discovery-server is given, nor a bad
+  // PMU_DDS_INTERFACES with --interface: pmuctl gets as far as looking for the service.
+  const std::string domain = std::to_string(test_domain());
+  const auto r = pmu::test::run_capture("env PMU_DDS_PEERS=bad_host PMU_DDS_INTERFACES=bad/if " +
+                                        std::string(PMUCTL_PATH) + " --domain " + domain +
+                                        " --discovery-server 127.0.0.1:1 --interface lo --timeout 0.5 list "
+                                        "2>&1 >/dev/null");
+  EXPECT_NE(r.status, 0);
+  EXPECT_EQ(r.out, "pmuctl: no pmu-service on domain " + domain + "\n");
+}
+
+}  // namespace
+}  // namespace pmu::dds
+
+int main(int argc, char** argv) {
+  ::testing::InitGoogleTest(&argc, argv);
+  // Everything between participants goes through UDP, none of it through Fast DDS's
+  // in-process shortcut: what is tested is what two hosts would exchange.
+  eprosima::fastrtps::LibrarySettingsAttributes library;
+  library.intraprocess_delivery = eprosima::fastrtps::INTRAPROCESS_OFF;
+  eprosima::fastrtps::xmlparser::XMLProfileManager::library_settings(library);
+  ::signal(SIGPIPE, SIG_IGN);
+  return RUN_ALL_TESTS();
+}

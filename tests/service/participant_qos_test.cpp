@@ -1,0 +1,194 @@
+// participant_qos (dds_participant.hpp): the Fast DDS settings each discovery mode, interface
+// allowlist and transport choice produce, read back from the QoS a participant would be
+// created with. Creating no participant, it needs no network.
+#include <gtest/gtest.h>
+
+#include <fastdds/rtps/attributes/ServerAttributes.h>
+#include <fastdds/rtps/transport/UDPv4TransportDescriptor.h>
+#include <fastdds/rtps/transport/shared_mem/SharedMemTransportDescriptor.h>
+#include <fastrtps/utils/IPLocator.h>
+
+#include <map>
+#include <sstream>
+
+#include "pmu/service/dds_participant.hpp"
+
+namespace pmu::dds {
+namespace {
+
+using eprosima::fastdds::dds::DomainParticipantQos;
+using eprosima::fastdds::rtps::SharedMemTransportDescriptor;
+using eprosima::fastdds::rtps::UDPv4TransportDescriptor;
+using eprosima::fastrtps::rtps::DiscoveryProtocol_t;
+using eprosima::fastrtps::rtps::IPLocator;
+using eprosima::fastrtps::rtps::Locator_t;
+
+std::string text(const Locator_t& l) {
+  return IPLocator::toIPv4string(l) + ":" + std::to_string(l.port);
+}
+
+std::vector<std::string> texts(const eprosima::fastrtps::rtps::LocatorList_t& list) {
+  std::vector<std::string> v;
+  for (const auto& l : list) {
+    EXPECT_EQ(l.kind, LOCATOR_KIND_UDPv4);
+    v.push_back(text(l));
+  }
+  return v;
+}
+
+const UDPv4TransportDescriptor* udp_of(const DomainParticipantQos& q) {
+  for (const auto& t : q.transport().user_transports)
+    if (auto* u = dynamic_cast<const UDPv4TransportDescriptor*>(t.get())) return u;
+  return nullptr;
+}
+
+bool has_shm(const DomainParticipantQos& q) {
+  for (const auto& t : q.transport().user_transports)
+    if (dynamic_cast<const SharedMemTransportDescriptor*>(t.get())) return true;
+  return false;
+}
+
+ResolvedNetwork unicast(std::vector<Ipv4Endpoint> peers) {
+  ResolvedNetwork n;
+  n.mode = DiscoveryMode::Unicast;
+  n.peers = std::move(peers);
+  return n;
+}
+
+ResolvedNetwork server(std::vector<ResolvedServer> servers) {
+  ResolvedNetwork n;
+  n.mode = DiscoveryMode::Server;
+  n.servers = std::move(servers);
+  return n;
+}
+
+TEST(ParticipantQos, MulticastIsFastDdsDefaultUntouched) {
+  const DomainParticipantQos q = participant_qos("pmu-service", Transport::Default, {}, {});
+  const DomainParticipantQos fast_dds_default;
+  EXPECT_EQ(q.name().to_string(), "pmu-service");
+  EXPECT_TRUE(q.wire_protocol() == fast_dds_default.wire_protocol());
+  EXPECT_TRUE(q.transport().use_builtin_transports);
+  EXPECT_TRUE(q.transport().user_transports.empty());
+  EXPECT_EQ(q.wire_protocol().builtin.discovery_config.discoveryProtocol, DiscoveryProtocol_t::SIMPLE);
+  EXPECT_TRUE(q.wire_protocol().builtin.metatrafficMulticastLocatorList.empty()) << "Fast DDS fills in its defaults";
+  EXPECT_TRUE(q.properties() == fast_dds_default.properties()) << "no security";
+}
+
+TEST(ParticipantQos, UnicastSendsOnlyToPeersAndListensOnlyOnUnicast) {
+  const DomainParticipantQos q =
+      participant_qos("pmuctl", Transport::UdpOnly, unicast({{"127.0.0.1", 0}, {"10.0.0.7", 7412}}), {});
+  const auto& b = q.wire_protocol().builtin;
+  EXPECT_EQ(b.discovery_config.discoveryProtocol, DiscoveryProtocol_t::SIMPLE);
+  // Port 0: Fast DDS expands it to the domain's well-known unicast ports (participant ids 0..3).
+  EXPECT_EQ(texts(b.initialPeersList), (std::vector<std::string>{"127.0.0.1:0", "10.0.0.7:7412"}));
+  // An explicit metatraffic list without multicast: Fast DDS adds no 239.255.0.1 of its own.
+  EXPECT_TRUE(b.metatrafficMulticastLocatorList.empty());
+  EXPECT_EQ(texts(b.metatrafficUnicastLocatorList), (std::vector<std::string>{"0.0.0.0:0"}));
+  EXPECT_TRUE(b.discovery_config.m_DiscoveryServers.empty());
+  EXPECT_FALSE(q.transport().use_builtin_transports);
+  ASSERT_EQ(q.transport().user_transports.size(), 1u);
+  ASSERT_NE(udp_of(q), nullptr);
+  EXPECT_TRUE(udp_of(q)->interfaceWhiteList.empty());
+  // Default transports stay Fast DDS's builtin ones in unicast mode.
+  const auto d = participant_qos("x", Transport::Default, unicast({{"127.0.0.1", 0}}), {});
+  EXPECT_TRUE(d.transport().use_builtin_transports);
+}
+
+TEST(ParticipantQos, ServerModeIsAClientOfEachServerByPositionWithFastddsDiscoveryPrefixes) {
+  const DomainParticipantQos q = participant_qos(
+      "pmu-service", Transport::Default,
+      server({{{{"10.0.0.1", 11811}}}, {{{"192.168.10.20", 14520}, {"192.168.11.20", 14520}}}}), {});
+  const auto& b = q.wire_protocol().builtin;
+  EXPECT_EQ(b.discovery_config.discoveryProtocol, DiscoveryProtocol_t::CLIENT);
+  const auto& servers = b.discovery_config.m_DiscoveryServers;
+  ASSERT_EQ(servers.size(), 2u);
+  auto it = servers.begin();
+  std::ostringstream p0, p1;
+  p0 << it->guidPrefix;
+  EXPECT_EQ(p0.str(), "44.53.00.5f.45.50.52.4f.53.49.4d.41") << "fastdds discovery -i 0";
+  EXPECT_EQ(texts(it->metatrafficUnicastLocatorList), (std::vector<std::string>{"10.0.0.1:11811"}));
+  EXPECT_TRUE(it->metatrafficMulticastLocatorList.empty());
+  ++it;
+  p1 << it->guidPrefix;
+  EXPECT_EQ(p1.str(), "44.53.01.5f.45.50.52.4f.53.49.4d.41") << "fastdds discovery -i 1";
+  EXPECT_EQ(texts(it->metatrafficUnicastLocatorList),
+            (std::vector<std::string>{"192.168.10.20:14520", "192.168.11.20:14520"}));
+  EXPECT_TRUE(b.metatrafficMulticastLocatorList.empty());
+  EXPECT_EQ(texts(b.metatrafficUnicastLocatorList), (std::vector<std::string>{"0.0.0.0:0"}));
+  EXPECT_TRUE(b.initialPeersList.empty());
+}
+
+TEST(ParticipantQos, AllowlistReplacesTheBuiltinTransportsSoNoneBypassesIt) {
+  ResolvedNetwork n;
+  n.interface_addresses = {"192.168.10.1", "127.0.0.1"};
+  // Default: shared memory (same host, no network interface) beside the restricted UDPv4.
+  const DomainParticipantQos d = participant_qos("pmu-service", Transport::Default, n, {});
+  EXPECT_FALSE(d.transport().use_builtin_transports) << "Fast DDS's builtin UDPv4 would use every interface";
+  EXPECT_EQ(d.transport().user_transports.size(), 2u);
+  EXPECT_TRUE(has_shm(d));
+  ASSERT_NE(udp_of(d), nullptr);
+  EXPECT_EQ(udp_of(d)->interfaceWhiteList, (std::vector<std::string>{"192.168.10.1", "127.0.0.1"}));
+  // udp: the restricted UDPv4 alone.
+  const DomainParticipantQos u = participant_qos("pmu-service", Transport::UdpOnly, n, {});
+  EXPECT_EQ(u.transport().user_transports.size(), 1u);
+  EXPECT_FALSE(has_shm(u));
+  EXPECT_EQ(udp_of(u)->interfaceWhiteList, (std::vector<std::string>{"192.168.10.1", "127.0.0.1"}));
+  // The allowlist goes with every discovery mode.
+  n.mode = DiscoveryMode::Unicast;
+  n.peers = {{"192.168.10.2", 0}};
+  EXPECT_EQ(udp_of(participant_qos("x", Transport::UdpOnly, n, {}))->interfaceWhiteList.size(), 2u);
+}
+
+TEST(ParticipantQos, SharedMemoryOnlyCannotCarryUnicastServerOrAnAllowlist) {
+  EXPECT_THROW((void)participant_qos("x", Transport::ShmOnly, unicast({{"127.0.0.1", 0}}), {}), NetworkError);
+  EXPECT_THROW((void)participant_qos("x", Transport::ShmOnly, server({{{{"127.0.0.1", 11811}}}}), {}), NetworkError);
+  ResolvedNetwork n;
+  n.interface_addresses = {"127.0.0.1"};
+  EXPECT_THROW((void)participant_qos("x", Transport::ShmOnly, n, {}), NetworkError);
+  const DomainParticipantQos s = participant_qos("x", Transport::ShmOnly, {}, {});
+  EXPECT_FALSE(s.transport().use_builtin_transports);
+  EXPECT_TRUE(has_shm(s));
+  EXPECT_EQ(udp_of(s), nullptr);
+}
+
+TEST(ParticipantQos, SecurityPluginsWithMulticastUnicastAndAnAllowlist) {
+  SecurityFiles f;
+  f.identity_ca = "/pki/identity_ca.pem";
+  f.identity_certificate = "/pki/svc/cert.pem";
+  f.private_key = "/pki/svc/key.pem";
+  f.permissions_ca = "/pki/permissions_ca.pem";
+  f.governance = "/pki/governance.p7s";
+  f.permissions = "/pki/svc/permissions.p7s";
+  ResolvedNetwork allowlisted;
+  allowlisted.interface_addresses = {"127.0.0.1"};
+  const ResolvedNetwork modes[] = {{}, unicast({{"127.0.0.1", 0}}), allowlisted};
+  for (const auto& n : modes) {
+    SCOPED_TRACE(to_string(n.mode));
+    const DomainParticipantQos q = participant_qos("pmu-service", Transport::UdpOnly, n, f);
+    std::map<std::string, std::string> p;  // the dds.sec.* ones (Fast DDS adds its own others)
+    for (const auto& prop : q.properties().properties())
+      if (prop.name().rfind("dds.sec.", 0) == 0) p[prop.name()] = prop.value();
+    EXPECT_EQ(p.size(), 9u);
+    EXPECT_EQ(p["dds.sec.auth.plugin"], "builtin.PKI-DH");
+    EXPECT_EQ(p["dds.sec.access.plugin"], "builtin.Access-Permissions");
+    EXPECT_EQ(p["dds.sec.crypto.plugin"], "builtin.AES-GCM-GMAC");
+    EXPECT_EQ(p["dds.sec.auth.builtin.PKI-DH.private_key"], "file:///pki/svc/key.pem");
+  }
+}
+
+// Fast DDS 2.9.1 cannot serve secure participants through a Discovery Server
+// (dds_network.hpp, kServerWithSecurity): refused, never built.
+TEST(ParticipantQos, DiscoveryServerWithSecurityIsRefused) {
+  SecurityFiles f;
+  f.identity_ca = "/pki/identity_ca.pem";
+  try {
+    (void)participant_qos("x", Transport::UdpOnly, server({{{{"127.0.0.1", 11811}}}}), f);
+    ADD_FAILURE() << "built";
+  } catch (const NetworkError& e) {
+    EXPECT_EQ(std::string(e.what()).rfind("Discovery Server mode cannot be combined with DDS-Security", 0), 0u)
+        << e.what();
+  }
+}
+
+}  // namespace
+}  // namespace pmu::dds
