@@ -29,6 +29,13 @@
 # purpose: Fast DDS 2.9.1 lacks the fix for CVE-2023-24010, so with one CA for identities
 # and permissions any participant could sign its own permissions.
 #
+# Vehicles: each pmu-service sits in the DDS partition named after its vehicle (the unnamed
+# vehicle: the default partition), and Fast DDS 2.9 creates a writer or reader only in
+# partitions that the identity's allow rule grants: each partition the endpoint asks for is
+# matched (fnmatch) against the granted patterns, and a rule without <partitions> grants the
+# default partition alone. So every rule here grants "*", which matches every name and the
+# default partition too.
+#
 # Exit status: 0 on success, 1 on an error, 2 on bad usage.
 
 set -euo pipefail
@@ -226,7 +233,8 @@ rule_xml() {  # rule_xml publish|subscribe TOPIC...
   local kind=$1; shift
   printf '        <%s>\n          <topics>\n' "$kind"
   topics_xml "$@"
-  printf '          </topics>\n        </%s>\n' "$kind"
+  printf '          </topics>\n          <partitions>\n            <partition>*</partition>\n'
+  printf '          </partitions>\n        </%s>\n' "$kind"
 }
 not_before=$(date -u +%Y-%m-%dT%H:%M:%S)
 not_after=$(date -u -d "+$days days" +%Y-%m-%dT%H:%M:%S)
@@ -236,7 +244,8 @@ permissions() {  # permissions NAME -> the permissions XML of NAME on stdout
   cat <<XML
 <?xml version="1.0" encoding="UTF-8"?>
 <!-- pmu-dds permissions of $n (made by deploy/security/make_pki.sh). Signed by the
-     Permissions CA into permissions.p7s. Anything not allowed here is denied. -->
+     Permissions CA into permissions.p7s. Anything not allowed here is denied. Partitions
+     are vehicles: "*" is every vehicle. -->
 <dds xmlns:xsi="http://www.w3.org/2001/XMLSchema-instance"
      xsi:noNamespaceSchemaLocation="http://www.omg.org/spec/DDS-Security/20170801/omg_shared_ca_permissions.xsd">
   <permissions>

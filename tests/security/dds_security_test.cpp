@@ -640,6 +640,41 @@ TEST(ServiceProgram, SecurePmuServiceWithPmuctlAndTheExampleClient) {
   EXPECT_EQ(r.status, 2) << "the example as mission-computer may not command: " << r.out;
 }
 
+// ---- vehicles: permissions confine an identity to some vehicles (docs/interface.md 5) -------
+
+pmu::test::RunResult pmuctl(const std::string& pki, const std::string& args) {
+  return sh(std::string(PMUCTL_PATH) + " --domain " + std::to_string(test_domain()) + " --security-dir " + pki + " " +
+            args);
+}
+
+// Both vehicles' services, as processes, with the pmu-service identity of the PKI in `pki`.
+struct TwoVehicles {
+  explicit TwoVehicles(const std::string& pki)
+      : uav1(service_process(write_config("uav1", dds::security_files_in(pki, "pmu-service"), "", "uav1"))),
+        uav2(service_process(write_config("uav2", dds::security_files_in(pki, "pmu-service"), "", "uav2"))) {}
+  pmu::test::Child uav1, uav2;
+};
+
+// The default PKI (every grant "*") with the default pmuctl: it reads every vehicle (the
+// partitions "" and "*") and commands each one named with --vehicle.
+TEST(SecureVehicles, TheDefaultGroundStationReadsAndCommandsEveryVehicle) {
+  const TwoVehicles services(Pki::get().dir());
+  pmu::test::RunResult r;
+  for (int attempt = 0; attempt < 10; ++attempt) {  // the first call waits for both services
+    r = pmuctl(Pki::get().dir(), "--identity ground-station --timeout 15 list");
+    if (r.out.find("uav1") != std::string::npos && r.out.find("uav2") != std::string::npos) break;
+  }
+  EXPECT_EQ(r.status, 0) << r.out;
+  EXPECT_NE(r.out.find("uav1"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("uav2"), std::string::npos) << r.out;
+  for (const std::string vehicle : {"uav1", "uav2"}) {
+    r = pmuctl(Pki::get().dir(), "--identity ground-station --vehicle " + vehicle +
+                                     " --timeout 30 config set payload_voltage 23");
+    EXPECT_EQ(r.status, 0) << vehicle << ": " << r.out;
+    EXPECT_NE(r.out.find("COMPLETED"), std::string::npos) << vehicle << ": " << r.out;
+  }
+}
+
 }  // namespace
 }  // namespace pmu::service
 

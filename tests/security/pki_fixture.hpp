@@ -91,11 +91,14 @@ class Pki {
   std::map<std::string, std::string> extra_;
 };
 
-// A pmu-service config: the built-in simulated PMU on this test's domain, with `f`.
-inline std::string write_config(const std::string& name, const SecurityFiles& f, const std::string& extra = "") {
+// A pmu-service config: the built-in simulated PMU on this test's domain, with `f`; `extra`
+// goes into the security section, `vehicle` is the config's `vehicle` (none when empty).
+inline std::string write_config(const std::string& name, const SecurityFiles& f, const std::string& extra = "",
+                                const std::string& vehicle = "") {
   const std::string path = Pki::get().root() + "/" + name + ".yaml";
   std::ofstream out(path);
-  out << "domain: " << test_domain() << "\nbuses:\n  - interface: sim\n    name: sim0\n    devices:\n"
+  out << "domain: " << test_domain() << "\n" << (vehicle.empty() ? "" : "vehicle: " + vehicle + "\n")
+      << "buses:\n  - interface: sim\n    name: sim0\n    devices:\n"
       << "      - address: 1\n        period: 0.5\nsecurity:\n"
       << "  identity_ca: " << f.identity_ca << "\n  identity_certificate: " << f.identity_certificate
       << "\n  private_key: " << f.private_key << "\n  permissions_ca: " << f.permissions_ca

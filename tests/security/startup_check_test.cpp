@@ -9,7 +9,9 @@
 
 #include <chrono>
 #include <fstream>
+#include <set>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "pki_fixture.hpp"
@@ -229,6 +231,75 @@ TEST(StartupCheck, DomainOutsideGovernanceAndPermissions) {
   const auto issues = dds::check_security_files(Pki::get().files("pmu-service"), o);
   expect_error(issues, "governance", "has no domain_rule for DDS domain " + std::to_string(test_domain() + 1));
   expect_error(issues, "permissions", "allows nothing on DDS domain");
+}
+
+// ---- vehicles: the partitions of every rule ---------------------------------------------------
+
+// What one permissions.xml grants: its subject, the topics to publish and to subscribe, and
+// the partitions of each <publish>/<subscribe> entry ({"(none)"} for an entry without
+// <partitions>, which Fast DDS 2.9 reads as the default partition alone).
+struct Granted {
+  std::string subject;
+  std::set<std::string> publish, subscribe;
+  std::vector<std::set<std::string>> partitions;
+};
+
+Granted read_permissions(const std::string& path) {
+  Granted g;
+  tinyxml2::XMLDocument doc;
+  if (doc.LoadFile(path.c_str()) != tinyxml2::XML_SUCCESS) {
+    ADD_FAILURE() << path << ": not XML";
+    return g;
+  }
+  const auto* grant = doc.RootElement()->FirstChildElement("permissions")->FirstChildElement("grant");
+  g.subject = grant->FirstChildElement("subject_name")->GetText();
+  for (const auto* rule = grant->FirstChildElement("allow_rule"); rule; rule = rule->NextSiblingElement("allow_rule"))
+    for (const auto* entry = rule->FirstChildElement(); entry; entry = entry->NextSiblingElement()) {
+      const std::string k = entry->Name();
+      if (k != "publish" && k != "subscribe") continue;
+      for (const auto* t = entry->FirstChildElement("topics")->FirstChildElement("topic"); t;
+           t = t->NextSiblingElement("topic"))
+        (k == "publish" ? g.publish : g.subscribe).insert(t->GetText());
+      std::set<std::string> parts;
+      const auto* ps = entry->FirstChildElement("partitions");
+      if (!ps) parts.insert("(none)");
+      for (const auto* p = ps ? ps->FirstChildElement("partition") : nullptr; p; p = p->NextSiblingElement("partition"))
+        parts.insert(p->GetText() ? p->GetText() : "");
+      g.partitions.push_back(parts);
+    }
+  return g;
+}
+
+// The topics of `role` in the contract (publish, subscribe).
+std::pair<std::set<std::string>, std::set<std::string>> contract_topics(const std::string& role) {
+  std::set<std::string> publish, subscribe;
+  for (const auto& t : kContractTopics) {
+    if (allowed(role, t, true)) publish.insert(t);
+    if (allowed(role, t, false)) subscribe.insert(t);
+  }
+  return {publish, subscribe};
+}
+
+// `identity` of the PKI in `dir` has the rights of `role` (contract topics) and every entry
+// grants exactly `partitions`.
+void expect_grant(const std::string& dir, const std::string& identity, const std::string& role,
+                  const std::set<std::string>& partitions) {
+  SCOPED_TRACE(dir + " " + identity);
+  const Granted g = read_permissions(dir + "/" + identity + "/permissions.xml");
+  EXPECT_EQ(g.subject, "CN=" + identity + ",O=pmu-dds");
+  const auto [publish, subscribe] = contract_topics(role);
+  EXPECT_EQ(g.publish, publish);
+  EXPECT_EQ(g.subscribe, subscribe);
+  EXPECT_FALSE(g.partitions.empty());
+  for (const auto& p : g.partitions) EXPECT_EQ(p, partitions);
+}
+
+// Without options every identity may use every vehicle: "*" matches every partition name and
+// the default partition (Fast DDS 2.9 compares with fnmatch("*", "") == 0). A rule without
+// <partitions> would allow the default partition alone, and pmuctl, which reads every
+// vehicle in partitions "" and "*", could not start.
+TEST(PermissionsDocuments, EveryRuleGrantsEveryVehicleByDefault) {
+  for (const char* id : {"pmu-service", "ground-station", "mission-computer"}) expect_grant(Pki::get().dir(), id, id, {"*"});
 }
 
 // ---- the programs ---------------------------------------------------------------------------
