@@ -9,6 +9,7 @@
 
 #include <chrono>
 #include <fstream>
+#include <optional>
 #include <set>
 #include <string>
 #include <utility>
@@ -300,6 +301,35 @@ void expect_grant(const std::string& dir, const std::string& identity, const std
 // vehicle in partitions "" and "*", could not start.
 TEST(PermissionsDocuments, EveryRuleGrantsEveryVehicleByDefault) {
   for (const char* id : {"pmu-service", "ground-station", "mission-computer"}) expect_grant(Pki::get().dir(), id, id, {"*"});
+  const auto g = dds::topic_grant(Pki::get().files("ground-station"), "pmu/command_reply", false);
+  ASSERT_TRUE(g.has_value());
+  EXPECT_TRUE(g->allowed);
+  EXPECT_EQ(g->partitions, std::vector<std::string>{"*"});
+  EXPECT_EQ(dds::partition_not_granted({"", "*"}, g->partitions), std::nullopt);
+  const auto mc = dds::topic_grant(Pki::get().files("mission-computer"), "pmu/command", true);
+  ASSERT_TRUE(mc.has_value());
+  EXPECT_FALSE(mc->allowed);
+}
+
+// Fast DDS 2.9 (Permissions.cpp is_partition_in_criterias): every partition an endpoint asks
+// for (none: the default partition "") must match one granted entry, the entry being the
+// fnmatch pattern.
+TEST(PartitionNotGranted, ComparesLikeFastDds) {
+  struct Case {
+    std::vector<std::string> asked, granted;
+    std::optional<std::string> refused;
+  };
+  const Case cases[] = {
+      {{}, {"*"}, std::nullopt},          {{"", "*"}, {"*"}, std::nullopt},   {{"uav1"}, {"*"}, std::nullopt},
+      {{"uav1"}, {"uav1"}, std::nullopt}, {{}, {""}, std::nullopt},           {{}, {"uav1"}, ""},
+      {{"", "*"}, {"uav1"}, ""},          {{"*"}, {"uav1"}, "*"},             {{"uav2"}, {"uav1"}, "uav2"},
+      {{"uav?"}, {"uav1"}, "uav?"},       {{"uav1"}, {""}, "uav1"},           {{"uav2"}, {"uav1", "uav2"}, std::nullopt},
+  };
+  for (const auto& c : cases) {
+    std::string asked;
+    for (const auto& a : c.asked) asked += "'" + a + "' ";
+    EXPECT_EQ(dds::partition_not_granted(c.asked, c.granted), c.refused) << "asked " << asked;
+  }
 }
 
 // ---- the programs ---------------------------------------------------------------------------
