@@ -72,6 +72,18 @@ class Pki {
   std::string lax() { return (extra_["lax"] = "", variant("lax", "lax")); }
   std::string single_ca() { return (extra_["single-ca"] = "", variant("single-ca", "single-ca")); }
 
+  // A second PKI of its own (own CAs) made by make_pki.sh with `args` on this test's domain,
+  // e.g. made("fleet", "--ground-station ground-uav1=uav1"), made on first use.
+  std::string made(const std::string& name, const std::string& args) {
+    const std::string out = root_ + "/" + name;
+    if (made_.insert(name).second) {
+      const auto r = sh(std::string("bash ") + PMU_SOURCE_DIR + "/deploy/security/make_pki.sh " + out + " --domain " +
+                        std::to_string(test_domain()) + " " + args);
+      if (r.status != 0) ADD_FAILURE() << "make_pki.sh " << args << ": " << r.out;
+    }
+    return out;
+  }
+
   ~Pki() {
     if (!root_.empty() && !std::getenv("PMU_KEEP_TEST_PKI")) sh("rm -rf '" + root_ + "'");
   }

@@ -311,6 +311,61 @@ TEST(PermissionsDocuments, EveryRuleGrantsEveryVehicleByDefault) {
   EXPECT_FALSE(mc->allowed);
 }
 
+TEST(MakePki, VehiclesConfineTheThreeIdentities) {
+  // An empty name in the list is the unnamed vehicle: an empty <partition>, the default one.
+  const std::string with_unnamed = Pki::get().made("vehicles-unnamed", "--vehicles ,uav1,uav2");
+  for (const char* id : {"pmu-service", "ground-station", "mission-computer"})
+    expect_grant(with_unnamed, id, id, {"", "uav1", "uav2"});
+  // Named vehicles only: the default partition is not granted.
+  const std::string named = Pki::get().made("vehicles-named", "--vehicles uav1");
+  for (const char* id : {"pmu-service", "ground-station", "mission-computer"}) expect_grant(named, id, id, {"uav1"});
+  EXPECT_TRUE(check(dds::security_files_in(named, "pmu-service")).empty());
+}
+
+TEST(MakePki, GroundStationsConfinedToTheirVehicles) {
+  const std::string dir =
+      Pki::get().made("fleet", "--ground-station ground-uav1=uav1 --ground-station ground-b=uav2,uav3");
+  expect_grant(dir, "ground-uav1", "ground-station", {"uav1"});
+  expect_grant(dir, "ground-b", "ground-station", {"uav2", "uav3"});
+  for (const char* id : {"pmu-service", "ground-station", "mission-computer"}) expect_grant(dir, id, id, {"*"});
+  const auto f = dds::security_files_in(dir, "ground-uav1");
+  EXPECT_TRUE(check(f).empty()) << describe(check(f));
+  // What DdsContext's messages are made of, read from the signed document.
+  const auto g = dds::topic_grant(f, "pmu/command", true);
+  ASSERT_TRUE(g.has_value());
+  EXPECT_EQ(g->grant, "ground-uav1");
+  EXPECT_TRUE(g->allowed);
+  EXPECT_EQ(g->partitions, std::vector<std::string>{"uav1"});
+  const auto mc = dds::topic_grant(dds::security_files_in(dir, "mission-computer"), "pmu/command", true);
+  ASSERT_TRUE(mc.has_value());
+  EXPECT_FALSE(mc->allowed);
+}
+
+TEST(MakePki, RefusesBadVehicleAndIdentityNames) {
+  struct Case {
+    const char* args;
+    const char* message;
+  };
+  const Case cases[] = {
+      {"--vehicles 'uav*'", "--vehicles: vehicle 'uav*' contains '*'; a vehicle name is letters, digits"},
+      {"--vehicles uav1,a-name-longer-than-15", "--vehicles: vehicle 'a-name-longer-than-15' is 21 characters"},
+      {"--ground-station ground-uav1", "--ground-station 'ground-uav1': expected NAME=VEHICLE[,VEHICLE...]"},
+      {"--ground-station 'g=uav[12]'", "--ground-station g: vehicle 'uav[12]' contains '['"},
+      {"--ground-station pmu-service=uav1", "--ground-station: 'pmu-service' is taken"},
+      {"--ground-station ca=uav1", "--ground-station: 'ca' is taken"},
+      {"--ground-station ../x=uav1", "--ground-station: identity name '../x' must be 1..64 letters"},
+      {"--ground-station g=uav1 --ground-station g=uav2", "--ground-station g given twice"},
+  };
+  for (const auto& c : cases) {
+    SCOPED_TRACE(c.args);
+    const std::string out = Pki::get().root() + "/refused";
+    const auto r = sh(std::string("bash ") + PMU_SOURCE_DIR + "/deploy/security/make_pki.sh " + out + " " + c.args);
+    EXPECT_EQ(r.status, 2) << r.out;
+    EXPECT_NE(r.out.find(std::string("make_pki.sh: ") + c.message), std::string::npos) << r.out;
+    EXPECT_NE(::access(out.c_str(), F_OK), 0) << "nothing is made on bad usage";
+  }
+}
+
 // Fast DDS 2.9 (Permissions.cpp is_partition_in_criterias): every partition an endpoint asks
 // for (none: the default partition "") must match one granted entry, the entry being the
 // fnmatch pattern.
