@@ -55,6 +55,18 @@ void unmatch_writers_before_deleting_them(Publisher& publisher) {
   (void)publisher.set_qos(qos);  // if refused, the deletion runs as before: nothing else to do
 }
 
+// `"uav1"`, or `the default partition` for "", in messages.
+std::string partition_text(const std::string& p) {
+  return p.empty() ? std::string("the default partition") : "partition \"" + p + "\"";
+}
+
+// `"", "uav1"`: the granted patterns, as the permissions spell them.
+std::string patterns_text(const std::vector<std::string>& patterns) {
+  std::string s;
+  for (const auto& p : patterns) s += (s.empty() ? "\"" : ", \"") + p + "\"";
+  return s;
+}
+
 }  // namespace
 
 std::string default_qos_file() {
@@ -68,7 +80,7 @@ std::string default_qos_file() {
 DdsContext::DdsContext(int domain, const std::string& qos_file, const std::string& participant_name,
                        const SecurityFiles& security, Transport transport, const ResolvedNetwork& network,
                        const Partitions& partitions)
-    : domain_(domain), secure_(!security.empty()) {
+    : domain_(domain), secure_(!security.empty()), security_(security), partitions_(partitions) {
   const std::string file = qos_file.empty() ? default_qos_file() : qos_file;
   qos_file_ = file;
   if (file.empty()) throw DdsError("no QoS profile file: install deploy/qos.xml as " PMU_SYSCONFDIR "/qos.xml, set PMU_QOS_FILE or set qos_file");
@@ -120,9 +132,7 @@ Topic& DdsContext::topic(const std::string& name, TypeSupport type) {
 
 DataWriter& DdsContext::writer(Topic& topic, const std::string& profile, DataWriterListener* listener) {
   DataWriter* w = publisher_->create_datawriter_with_profile(&topic, profile, listener);
-  if (!w)
-    throw DdsError("cannot create a writer for " + topic.get_name() + " with QoS profile '" + profile + "'" +
-                   (secure_ ? " (DDS-Security: this identity's permissions may not allow publishing it)" : ""));
+  if (!w) refused(topic.get_name(), profile, true);
   const DataWriterQos q = w->get_qos();
   if (const auto s = capacity_shortfall(profile, EndpointKind::Writer, q.resource_limits(), q.history()); !s.empty()) {
     publisher_->delete_datawriter(w);
@@ -134,9 +144,7 @@ DataWriter& DdsContext::writer(Topic& topic, const std::string& profile, DataWri
 
 DataReader& DdsContext::reader(Topic& topic, const std::string& profile, DataReaderListener* listener) {
   DataReader* r = subscriber_->create_datareader_with_profile(&topic, profile, listener);
-  if (!r)
-    throw DdsError("cannot create a reader for " + topic.get_name() + " with QoS profile '" + profile + "'" +
-                   (secure_ ? " (DDS-Security: this identity's permissions may not allow subscribing to it)" : ""));
+  if (!r) refused(topic.get_name(), profile, false);
   const DataReaderQos q = r->get_qos();
   if (const auto s = capacity_shortfall(profile, EndpointKind::Reader, q.resource_limits(), q.history()); !s.empty()) {
     subscriber_->delete_datareader(r);
@@ -144,6 +152,28 @@ DataReader& DdsContext::reader(Topic& topic, const std::string& profile, DataRea
                    ": raise its <resourceLimitsQos> (deploy/qos.xml says how each number is derived)");
   }
   return *r;
+}
+
+void DdsContext::refused(const std::string& topic, const std::string& profile, bool publish) const {
+  const std::string what = std::string("cannot create a ") + (publish ? "writer" : "reader") + " for " + topic +
+                           " with QoS profile '" + profile + "'";
+  if (!secure_) throw DdsError(what);
+  // Fast DDS says why only in its log (its Access-Permissions plugin's "... partition not
+  // found in rule"); the permissions document says it too, so the message can name it.
+  const std::string verb = publish ? "publishing" : "subscribing to";
+  const std::vector<std::string>& partitions = publish ? partitions_.publisher : partitions_.subscriber;
+  const auto grant = topic_grant(security_, topic, publish);
+  if (grant && !grant->allowed)
+    throw DdsError(what + " (DDS-Security: this identity's permissions do not allow " + verb + " it: grant '" +
+                   grant->grant + "' has no allow rule for " + topic + ")");
+  if (grant) {
+    if (const auto p = partition_not_granted(partitions, grant->partitions))
+      throw PartitionNotGranted(what + " (DDS-Security: this identity's permissions do not allow " + verb + " it in " +
+                                    partition_text(*p) + ": grant '" + grant->grant + "' allows it only in " +
+                                    patterns_text(grant->partitions) + ")",
+                                *p);
+  }
+  throw DdsError(what + " (DDS-Security: this identity's permissions may not allow " + verb + " it)");
 }
 
 }  // namespace pmu::dds

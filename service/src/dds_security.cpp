@@ -9,6 +9,7 @@
 #include <openssl/x509.h>
 #include <openssl/x509_vfy.h>
 #include <openssl/x509v3.h>
+#include <fnmatch.h>
 #include <sys/stat.h>
 #include <tinyxml2.h>
 
@@ -148,6 +149,48 @@ class Checker {
       if (!permissions.empty() && identity) check_permissions(permissions, identity.get());
     }
     return std::move(issues_);
+  }
+
+  // topic_grant() of dds_security.hpp. The issues found on the way are not reported: this
+  // only explains a refusal after the start-up check passed.
+  std::optional<TopicGrant> topic_grant(const std::string& topic, bool publish) {
+    if (files_.empty()) return std::nullopt;
+    Cert identity = load_cert("identity_certificate", files_.identity_certificate);
+    Cert permissions_ca = load_cert("permissions_ca", files_.permissions_ca);
+    if (!identity || !permissions_ca) return std::nullopt;
+    const std::string xml = verified_content("permissions", files_.permissions, permissions_ca.get());
+    tinyxml2::XMLDocument doc;
+    if (xml.empty() || doc.Parse(xml.data(), xml.size()) != tinyxml2::XML_SUCCESS) return std::nullopt;
+    const auto* perms = doc.RootElement() ? doc.RootElement()->FirstChildElement("permissions") : nullptr;
+    const auto wanted = dn_parts(subject_of(identity.get()));
+    for (auto* g = perms ? perms->FirstChildElement("grant") : nullptr; g; g = g->NextSiblingElement("grant")) {
+      if (dn_parts(text_of(g->FirstChildElement("subject_name"))) != wanted) continue;
+      TopicGrant result;
+      result.grant = g->Attribute("name") ? g->Attribute("name") : "";
+      const char* kind = publish ? "publish" : "subscribe";
+      for (auto* rule = g->FirstChildElement(); rule; rule = rule->NextSiblingElement()) {
+        const bool allow = std::strcmp(rule->Name(), "allow_rule") == 0;
+        if (!allow && std::strcmp(rule->Name(), "deny_rule") != 0) continue;
+        bool names_topic = false;
+        std::vector<std::string> partitions;
+        for (auto* c = rule->FirstChildElement(kind); c; c = c->NextSiblingElement(kind)) {
+          const auto* topics = c->FirstChildElement("topics");
+          for (auto* t = topics ? topics->FirstChildElement("topic") : nullptr; t; t = t->NextSiblingElement("topic"))
+            names_topic = names_topic || (t->GetText() && ::fnmatch(t->GetText(), topic.c_str(), FNM_NOESCAPE) == 0);
+          const auto* parts = c->FirstChildElement("partitions");
+          if (!parts) partitions.emplace_back();  // Fast DDS: no <partitions>, the default partition
+          for (auto* p = parts ? parts->FirstChildElement("partition") : nullptr; p;
+               p = p->NextSiblingElement("partition"))
+            partitions.emplace_back(p->GetText() ? p->GetText() : "");
+        }
+        if (!names_topic) continue;
+        result.allowed = allow;
+        if (allow) result.partitions = std::move(partitions);
+        return result;
+      }
+      return result;  // no rule names the topic: not allowed
+    }
+    return std::nullopt;
   }
 
  private:
@@ -431,6 +474,23 @@ class Checker {
 
 std::vector<SecurityIssue> check_security_files(const SecurityFiles& files, const SecurityCheckOptions& options) {
   return Checker(files, options).run();
+}
+
+std::optional<TopicGrant> topic_grant(const SecurityFiles& files, const std::string& topic, bool publish) {
+  const SecurityCheckOptions options;
+  return Checker(files, options).topic_grant(topic, publish);
+}
+
+std::optional<std::string> partition_not_granted(const std::vector<std::string>& partitions,
+                                                 const std::vector<std::string>& granted) {
+  const std::vector<std::string> asked = partitions.empty() ? std::vector<std::string>{""} : partitions;
+  for (const auto& p : asked) {
+    const bool ok = std::any_of(granted.begin(), granted.end(), [&](const std::string& pattern) {
+      return ::fnmatch(pattern.c_str(), p.c_str(), FNM_NOESCAPE) == 0;
+    });
+    if (!ok) return p;
+  }
+  return std::nullopt;
 }
 
 }  // namespace pmu::dds

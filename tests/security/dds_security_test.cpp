@@ -19,6 +19,7 @@
 #include <unistd.h>
 
 #include <atomic>
+#include <cctype>
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
@@ -47,6 +48,7 @@
 #include "pmu/service/dds_context.hpp"
 #include "pmu/service/dds_publisher.hpp"
 #include "pmu/service/dds_security.hpp"
+#include "pmu/service/vehicle.hpp"
 #include "pmu/sim/bus_runner.hpp"
 #include "pmu/transport/sim_bus.hpp"
 #include "pki_fixture.hpp"
@@ -71,14 +73,17 @@ using security_test::write_config;
 constexpr std::uint8_t kPayload = 0x02;  // output bit 1
 
 struct ServiceUnderTest {
-  // `bus_name` is the DDS key of every sample (also something to look for on the wire).
-  ServiceUnderTest(int domain, const SecurityFiles& files, const std::string& bus_name = "sim0")
+  // `bus_name` is the DDS key of every sample (also something to look for on the wire);
+  // `vehicle` the service's vehicle, and so its partition (vehicle.hpp).
+  ServiceUnderTest(int domain, const SecurityFiles& files, const std::string& bus_name = "sim0",
+                   const std::string& vehicle = "")
       : network(clock),
         pmus(network.attach("pmu-sim"), clock),
-        dds(domain, "", "pmu-service", files, dds::Transport::UdpOnly),
-        publisher(dds, 3s),
+        dds(domain, "", "pmu-service", files, dds::Transport::UdpOnly, {},
+            {vehicle_partitions(vehicle), vehicle_partitions(vehicle)}),
+        publisher(dds, 3s, vehicle),
         worker(bus_config(bus_name), network.attach(bus_name), clock, Timeouts{}, publisher),
-        endpoint(dds),
+        endpoint(dds, nullptr, vehicle),
         commands({&worker}, PolicyConfig{}, Timeouts{}, clock, [this](const CommandReplyData& r) { endpoint.publish(r); }) {
     sim::DeviceConfig d;
     d.address = 1;
@@ -130,8 +135,8 @@ struct ServiceUnderTest {
 // ---- clients -------------------------------------------------------------------------------
 
 struct Client {
-  Client(int domain, const SecurityFiles& files, const std::string& name)
-      : dds(domain, "", name, files, dds::Transport::UdpOnly) {}
+  Client(int domain, const SecurityFiles& files, const std::string& name, const dds::Partitions& partitions = {})
+      : dds(domain, "", name, files, dds::Transport::UdpOnly, {}, partitions) {}
   DataReader& voltages() {
     if (!voltages_)
       voltages_ = &dds.reader(dds.topic(topics::kVoltages, TypeSupport(new pmu::VoltagesPubSubType())),
@@ -183,9 +188,10 @@ bool wait_sample(DataReader& r, std::chrono::milliseconds timeout) {
   return pmu::test::wait_until([&] { return take_all<T>(r) > 0; }, timeout, 20ms);
 }
 
-pmu::Command command(const std::string& id, const std::string& bus = "sim0") {
+pmu::Command command(const std::string& id, const std::string& bus = "sim0", const std::string& vehicle = "") {
   pmu::Command c;
   c.request_id(id);
+  c.vehicle(vehicle);
   c.bus(bus);
   c.address(1);
   c.kind(pmu::DISABLE_OUTPUTS);  // switch the payload off
@@ -227,9 +233,10 @@ bool wait_command_link(Client& gs, std::chrono::milliseconds timeout) {
 }
 
 // The good ground station commands: the reply comes, and the PMU did it.
-void expect_ground_station_commands(ServiceUnderTest& svc, Client& gs, const std::string& id) {
+void expect_ground_station_commands(ServiceUnderTest& svc, Client& gs, const std::string& id,
+                                    const std::string& vehicle = "") {
   ASSERT_TRUE(wait_command_link(gs, 10s)) << "the ground station's command writer and reply reader never matched";
-  pmu::Command c = command(id);
+  pmu::Command c = command(id, "sim0", vehicle);
   ASSERT_EQ(gs.commands().write(&c), true);
   const auto reply = wait_reply(gs.replies(), id, 10s);
   ASSERT_TRUE(reply.has_value()) << "no reply to " << id;
@@ -622,7 +629,10 @@ TEST(ServiceProgram, SecurePmuServiceWithPmuctlAndTheExampleClient) {
   EXPECT_NE(r.out.find("sim0"), std::string::npos) << r.out;
   r = sh(pmuctl + d + sec + " --identity mission-computer --timeout 5 config set avionics_voltage 12");
   EXPECT_EQ(r.status, 2) << r.out;
-  EXPECT_NE(r.out.find("this identity's permissions may not allow"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("this identity's permissions do not allow subscribing to it: grant 'mission-computer' has "
+                       "no allow rule for pmu/command_reply"),
+            std::string::npos)
+      << r.out;
   r = sh(pmuctl + d + " --timeout 3 list");  // no security at all
   EXPECT_NE(r.status, 0) << "an unauthenticated pmuctl must not see the service: " << r.out;
   r = sh(pmuctl + d + sec + " list");
@@ -669,6 +679,175 @@ TEST(ServiceProgram, UnicastDiscoveryKeepsSecurityAndServerModeIsRefusedWithIt) 
   EXPECT_NE(r.out.find(server_cfg + ":15: discovery mode server cannot be combined with DDS-Security"),
             std::string::npos)
       << r.out;
+}
+
+// ---- vehicles: permissions confine an identity to some vehicles (docs/interface.md 5) -------
+
+pmu::test::RunResult pmuctl(const std::string& pki, const std::string& args) {
+  return sh(std::string(PMUCTL_PATH) + " --domain " + std::to_string(test_domain()) + " --security-dir " + pki + " " +
+            args);
+}
+
+// Both vehicles' services, as processes, with the pmu-service identity of the PKI in `pki`.
+struct TwoVehicles {
+  explicit TwoVehicles(const std::string& pki)
+      : uav1(service_process(write_config("uav1", dds::security_files_in(pki, "pmu-service"), "", "uav1"))),
+        uav2(service_process(write_config("uav2", dds::security_files_in(pki, "pmu-service"), "", "uav2"))) {}
+  pmu::test::Child uav1, uav2;
+};
+
+TEST(SecureVehicles, PmuctlConfinedToUav1CommandsUav1AndIsRefusedUav2) {
+  const std::string fleet = Pki::get().made("fleet", "--ground-station ground-uav1=uav1");
+  const TwoVehicles services(fleet);
+
+  auto r = pmuctl(fleet, "--identity ground-uav1 --vehicle uav1 --timeout 30 config set payload_voltage 23");
+  EXPECT_EQ(r.status, 0) << r.out;
+  EXPECT_NE(r.out.find("COMPLETED"), std::string::npos) << r.out;
+
+  // uav2 is not its vehicle: its own participant refuses the endpoints in partition "uav2"
+  // (the reply reader is the first pmuctl creates), before anything is sent.
+  r = pmuctl(fleet, "--identity ground-uav1 --vehicle uav2 --timeout 10 config set payload_voltage 23");
+  EXPECT_EQ(r.status, 2) << r.out;
+  EXPECT_NE(r.out.find("this identity's permissions do not allow subscribing to it in partition \"uav2\": grant "
+                       "'ground-uav1' allows it only in \"uav1\""),
+            std::string::npos)
+      << r.out;
+  EXPECT_NE(r.out.find("pmuctl: vehicle uav2 is not one of this identity's vehicles"), std::string::npos) << r.out;
+
+  // Reading every vehicle needs partition "*" (and the default one): refused, with the way out.
+  r = pmuctl(fleet, "--identity ground-uav1 --timeout 10 list");
+  EXPECT_EQ(r.status, 2) << r.out;
+  EXPECT_NE(r.out.find("name one of them with --vehicle"), std::string::npos) << r.out;
+
+  // uav2's PMU is as it was (read by the unconfined ground station; uav1's COMPLETED already
+  // means its PMU reported 23.0 back). A new pmuctl meets both services anew: on a loaded
+  // machine secure discovery takes a while, so the timeout is generous (it returns on success).
+  r = pmuctl(fleet, "--identity ground-station --vehicle uav2 --timeout 40 config get payload_voltage");
+  EXPECT_NE(r.out.find("uav2/sim0/1 payload_voltage = "), std::string::npos) << r.out;
+  EXPECT_EQ(r.out.find("payload_voltage = 23.0"), std::string::npos) << "uav2's PMU was changed: " << r.out;
+}
+
+// The default PKI (every grant "*") with the default pmuctl: it reads every vehicle (the
+// partitions "" and "*") and commands each one named with --vehicle.
+TEST(SecureVehicles, TheDefaultGroundStationReadsAndCommandsEveryVehicle) {
+  const TwoVehicles services(Pki::get().dir());
+  pmu::test::RunResult r;
+  for (int attempt = 0; attempt < 10; ++attempt) {  // the first call waits for both services
+    r = pmuctl(Pki::get().dir(), "--identity ground-station --timeout 15 list");
+    if (r.out.find("uav1") != std::string::npos && r.out.find("uav2") != std::string::npos) break;
+  }
+  EXPECT_EQ(r.status, 0) << r.out;
+  EXPECT_NE(r.out.find("uav1"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("uav2"), std::string::npos) << r.out;
+  for (const std::string vehicle : {"uav1", "uav2"}) {
+    r = pmuctl(Pki::get().dir(), "--identity ground-station --vehicle " + vehicle +
+                                     " --timeout 30 config set payload_voltage 23");
+    EXPECT_EQ(r.status, 0) << vehicle << ": " << r.out;
+    EXPECT_NE(r.out.find("COMPLETED"), std::string::npos) << vehicle << ": " << r.out;
+  }
+}
+
+// What Fast DDS makes of make_pki.sh --vehicles: an empty name (the unnamed vehicle) is an
+// empty <partition>, which grants the default partition; without it only the named ones.
+TEST(SecureVehicles, VehiclesGrantTheDefaultPartitionOnlyWithAnEmptyName) {
+  struct Case {
+    const char* pki_args;
+    std::vector<std::string> partitions;
+    bool allowed;
+  };
+  const Case cases[] = {
+      {"--vehicles ,uav1", {}, true},           {"--vehicles ,uav1", {"uav1"}, true},
+      {"--vehicles ,uav1", {"uav2"}, false},    {"--vehicles ,uav1", {"*"}, false},
+      {"--vehicles uav1", {}, false},           {"--vehicles uav1", {"uav1"}, true},
+      {"--vehicles uav1,uav2", {"uav2"}, true}, {"--vehicles uav1,uav2", {"", "*"}, false},
+  };
+  for (const auto& c : cases) {
+    const std::string args = c.pki_args;
+    std::string name;  // one PKI per argument list: "__vehicles__uav1" for "--vehicles ,uav1"
+    for (const char ch : args) name += std::isalnum(static_cast<unsigned char>(ch)) ? ch : '_';
+    const std::string dir = Pki::get().made(name, args);
+    std::string where;
+    for (const auto& p : c.partitions) where += "\"" + p + "\" ";
+    SCOPED_TRACE(args + ", a pmu/command writer in " + (where.empty() ? "the default partition" : where));
+    Client gs(test_domain(), dds::security_files_in(dir, "ground-station"), "ground-station", {c.partitions, {}});
+    bool created = true;
+    try {
+      gs.commands();
+    } catch (const dds::DdsError&) {
+      created = false;
+    }
+    EXPECT_EQ(created, c.allowed);
+  }
+}
+
+// A pmu/command writer on `dds`'s participant, in a publisher of partition "uav1", with the
+// DataWriterQos property "partitions" = `partitions`: Fast DDS 2.9 takes that property as
+// the writer's own partitions, for its access check and for what discovery announces
+// (DataWriterImpl::enable). Null when Fast DDS refuses it.
+DataWriter* writer_with_partitions_property(dds::DdsContext& dds, const std::string& partitions) {
+  PublisherQos pq = PUBLISHER_QOS_DEFAULT;
+  pq.partition().push_back("uav1");
+  Publisher* pub = dds.participant().create_publisher(pq);
+  DataWriterQos wq;
+  if (!pub || pub->get_datawriter_qos_from_profile(qos_profiles::kCommand, wq) != ReturnCode_t::RETCODE_OK)
+    return nullptr;
+  wq.properties().properties().emplace_back("partitions", partitions);
+  return pub->create_datawriter(&dds.topic(topics::kCommand, TypeSupport(new pmu::CommandPubSubType())), wq);
+}
+
+TEST(SecureVehicles, AConfinedIdentityCannotWriteToEveryVehicleNorToAnotherOne) {
+  const int domain = test_domain();
+  const std::string fleet = Pki::get().made("fleet", "--ground-station ground-uav1=uav1");
+  const auto service_files = dds::security_files_in(fleet, "pmu-service");
+  const auto confined = dds::security_files_in(fleet, "ground-uav1");
+  ServiceUnderTest uav1(domain, service_files, "sim0", "uav1");
+  ServiceUnderTest uav2(domain, service_files, "sim0", "uav2");
+
+  // What holds on Fast DDS 2.9.1: the identity's own participant refuses a command writer in
+  // partition "*" (fnmatch("uav1", "*") fails), also when the partition comes as the
+  // writer's "partitions" property, and one in "uav2". So no command of ground-uav1 is ever
+  // delivered to uav2's service; its own partition rule (DdsCommandEndpoint, tested in
+  // tests/integration/vehicle_test.cpp) is needed against peers granted "*" or without
+  // security, not against this one.
+  for (const std::string partition : {"*", "uav2"}) {
+    Client other(domain, confined, "ground-uav1-in-" + partition, {{partition}, {"uav1"}});
+    try {
+      other.commands();
+      ADD_FAILURE() << "Fast DDS let ground-uav1 create a pmu/command writer in partition \"" << partition << "\"";
+    } catch (const dds::PartitionNotGranted& e) {
+      EXPECT_EQ(e.partition(), partition) << e.what();
+      EXPECT_NE(std::string(e.what()).find("grant 'ground-uav1' allows it only in \"uav1\""), std::string::npos)
+          << e.what();
+    }
+  }
+  Client gs1(domain, confined, "ground-uav1", {{"uav1"}, {"uav1"}});
+  EXPECT_EQ(writer_with_partitions_property(gs1.dds, "*"), nullptr)
+      << "Fast DDS let ground-uav1 create a pmu/command writer whose own partitions are \"*\"";
+
+  // The controls: the identity commands its own vehicle, and uav2 takes commands from the
+  // unconfined ground station (its payload is then off).
+  expect_ground_station_commands(uav1, gs1, "ground-uav1-to-uav1", "uav1");
+  Client gs(domain, dds::security_files_in(fleet, "ground-station"), "ground-station", {{"uav2"}, {"uav2"}});
+  expect_ground_station_commands(uav2, gs, "ground-station-to-uav2", "uav2");
+  const std::uint64_t received = uav2.commands.counters().received;
+  const std::uint64_t handled = uav2.handled();
+  const std::uint64_t uav1_refused = uav1.endpoint.not_ours();
+
+  // A command naming uav2 on the writer it may have (partition "uav1") reaches uav1 alone,
+  // which does not execute another vehicle's command; uav2 never sees it.
+  for (int i = 0; i < 10; ++i) {
+    pmu::Command c = command("ground-uav1-to-uav2-" + std::to_string(i), "sim0", "uav2");
+    c.kind(pmu::ENABLE_OUTPUTS);  // uav2's payload back on: visible if it ran
+    gs1.commands().write(&c);
+  }
+  EXPECT_TRUE(pmu::test::wait_until([&] { return uav1.endpoint.not_ours() >= uav1_refused + 10; }, 10s))
+      << "uav1 did not see the 10 commands for uav2 (" << uav1.endpoint.not_ours() - uav1_refused << ")";
+  // Meant to let time pass: a moment more in which nothing may reach uav2.
+  std::this_thread::sleep_for(500ms);
+  EXPECT_EQ(uav2.endpoint.not_ours(), 0u) << "a command of ground-uav1 reached uav2's command reader";
+  EXPECT_EQ(uav2.commands.counters().received, received) << "uav2's command service received a command of ground-uav1";
+  EXPECT_EQ(uav2.outputs() & kPayload, 0) << "uav2's payload was switched back on";
+  EXPECT_EQ(uav2.handled(), handled) << "uav2's PMU handled a request meanwhile";
 }
 
 }  // namespace

@@ -72,6 +72,18 @@ class Pki {
   std::string lax() { return (extra_["lax"] = "", variant("lax", "lax")); }
   std::string single_ca() { return (extra_["single-ca"] = "", variant("single-ca", "single-ca")); }
 
+  // A second PKI of its own (own CAs) made by make_pki.sh with `args` on this test's domain,
+  // e.g. made("fleet", "--ground-station ground-uav1=uav1"), made on first use.
+  std::string made(const std::string& name, const std::string& args) {
+    const std::string out = root_ + "/" + name;
+    if (made_.insert(name).second) {
+      const auto r = sh(std::string("bash ") + PMU_SOURCE_DIR + "/deploy/security/make_pki.sh " + out + " --domain " +
+                        std::to_string(test_domain()) + " " + args);
+      if (r.status != 0) ADD_FAILURE() << "make_pki.sh " << args << ": " << r.out;
+    }
+    return out;
+  }
+
   ~Pki() {
     if (!root_.empty() && !std::getenv("PMU_KEEP_TEST_PKI")) sh("rm -rf '" + root_ + "'");
   }
@@ -91,11 +103,14 @@ class Pki {
   std::map<std::string, std::string> extra_;
 };
 
-// A pmu-service config: the built-in simulated PMU on this test's domain, with `f`.
-inline std::string write_config(const std::string& name, const SecurityFiles& f, const std::string& extra = "") {
+// A pmu-service config: the built-in simulated PMU on this test's domain, with `f`; `extra`
+// goes into the security section, `vehicle` is the config's `vehicle` (none when empty).
+inline std::string write_config(const std::string& name, const SecurityFiles& f, const std::string& extra = "",
+                                const std::string& vehicle = "") {
   const std::string path = Pki::get().root() + "/" + name + ".yaml";
   std::ofstream out(path);
-  out << "domain: " << test_domain() << "\nbuses:\n  - interface: sim\n    name: sim0\n    devices:\n"
+  out << "domain: " << test_domain() << "\n" << (vehicle.empty() ? "" : "vehicle: " + vehicle + "\n")
+      << "buses:\n  - interface: sim\n    name: sim0\n    devices:\n"
       << "      - address: 1\n        period: 0.5\nsecurity:\n"
       << "  identity_ca: " << f.identity_ca << "\n  identity_certificate: " << f.identity_certificate
       << "\n  private_key: " << f.private_key << "\n  permissions_ca: " << f.permissions_ca

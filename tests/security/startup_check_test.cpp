@@ -9,7 +9,10 @@
 
 #include <chrono>
 #include <fstream>
+#include <optional>
+#include <set>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "pki_fixture.hpp"
@@ -229,6 +232,159 @@ TEST(StartupCheck, DomainOutsideGovernanceAndPermissions) {
   const auto issues = dds::check_security_files(Pki::get().files("pmu-service"), o);
   expect_error(issues, "governance", "has no domain_rule for DDS domain " + std::to_string(test_domain() + 1));
   expect_error(issues, "permissions", "allows nothing on DDS domain");
+}
+
+// ---- vehicles: the partitions of every rule ---------------------------------------------------
+
+// What one permissions.xml grants: its subject, the topics to publish and to subscribe, and
+// the partitions of each <publish>/<subscribe> entry ({"(none)"} for an entry without
+// <partitions>, which Fast DDS 2.9 reads as the default partition alone).
+struct Granted {
+  std::string subject;
+  std::set<std::string> publish, subscribe;
+  std::vector<std::set<std::string>> partitions;
+};
+
+Granted read_permissions(const std::string& path) {
+  Granted g;
+  tinyxml2::XMLDocument doc;
+  if (doc.LoadFile(path.c_str()) != tinyxml2::XML_SUCCESS) {
+    ADD_FAILURE() << path << ": not XML";
+    return g;
+  }
+  const auto* grant = doc.RootElement()->FirstChildElement("permissions")->FirstChildElement("grant");
+  g.subject = grant->FirstChildElement("subject_name")->GetText();
+  for (const auto* rule = grant->FirstChildElement("allow_rule"); rule; rule = rule->NextSiblingElement("allow_rule"))
+    for (const auto* entry = rule->FirstChildElement(); entry; entry = entry->NextSiblingElement()) {
+      const std::string k = entry->Name();
+      if (k != "publish" && k != "subscribe") continue;
+      for (const auto* t = entry->FirstChildElement("topics")->FirstChildElement("topic"); t;
+           t = t->NextSiblingElement("topic"))
+        (k == "publish" ? g.publish : g.subscribe).insert(t->GetText());
+      std::set<std::string> parts;
+      const auto* ps = entry->FirstChildElement("partitions");
+      if (!ps) parts.insert("(none)");
+      for (const auto* p = ps ? ps->FirstChildElement("partition") : nullptr; p; p = p->NextSiblingElement("partition"))
+        parts.insert(p->GetText() ? p->GetText() : "");
+      g.partitions.push_back(parts);
+    }
+  return g;
+}
+
+// The topics of `role` in the contract (publish, subscribe).
+std::pair<std::set<std::string>, std::set<std::string>> contract_topics(const std::string& role) {
+  std::set<std::string> publish, subscribe;
+  for (const auto& t : kContractTopics) {
+    if (allowed(role, t, true)) publish.insert(t);
+    if (allowed(role, t, false)) subscribe.insert(t);
+  }
+  return {publish, subscribe};
+}
+
+// `identity` of the PKI in `dir` has the rights of `role` (contract topics) and every entry
+// grants exactly `partitions`.
+void expect_grant(const std::string& dir, const std::string& identity, const std::string& role,
+                  const std::set<std::string>& partitions) {
+  SCOPED_TRACE(dir + " " + identity);
+  const Granted g = read_permissions(dir + "/" + identity + "/permissions.xml");
+  EXPECT_EQ(g.subject, "CN=" + identity + ",O=pmu-dds");
+  const auto [publish, subscribe] = contract_topics(role);
+  EXPECT_EQ(g.publish, publish);
+  EXPECT_EQ(g.subscribe, subscribe);
+  EXPECT_FALSE(g.partitions.empty());
+  for (const auto& p : g.partitions) EXPECT_EQ(p, partitions);
+}
+
+// Without options every identity may use every vehicle: "*" matches every partition name and
+// the default partition (Fast DDS 2.9 compares with fnmatch("*", "") == 0). A rule without
+// <partitions> would allow the default partition alone, and pmuctl, which reads every
+// vehicle in partitions "" and "*", could not start.
+TEST(PermissionsDocuments, EveryRuleGrantsEveryVehicleByDefault) {
+  for (const char* id : {"pmu-service", "ground-station", "mission-computer"}) expect_grant(Pki::get().dir(), id, id, {"*"});
+  const auto g = dds::topic_grant(Pki::get().files("ground-station"), "pmu/command_reply", false);
+  ASSERT_TRUE(g.has_value());
+  EXPECT_TRUE(g->allowed);
+  EXPECT_EQ(g->partitions, std::vector<std::string>{"*"});
+  EXPECT_EQ(dds::partition_not_granted({"", "*"}, g->partitions), std::nullopt);
+  const auto mc = dds::topic_grant(Pki::get().files("mission-computer"), "pmu/command", true);
+  ASSERT_TRUE(mc.has_value());
+  EXPECT_FALSE(mc->allowed);
+}
+
+TEST(MakePki, VehiclesConfineTheThreeIdentities) {
+  // An empty name in the list is the unnamed vehicle: an empty <partition>, the default one.
+  const std::string with_unnamed = Pki::get().made("vehicles-unnamed", "--vehicles ,uav1,uav2");
+  for (const char* id : {"pmu-service", "ground-station", "mission-computer"})
+    expect_grant(with_unnamed, id, id, {"", "uav1", "uav2"});
+  // Named vehicles only: the default partition is not granted.
+  const std::string named = Pki::get().made("vehicles-named", "--vehicles uav1");
+  for (const char* id : {"pmu-service", "ground-station", "mission-computer"}) expect_grant(named, id, id, {"uav1"});
+  EXPECT_TRUE(check(dds::security_files_in(named, "pmu-service")).empty());
+}
+
+TEST(MakePki, GroundStationsConfinedToTheirVehicles) {
+  const std::string dir =
+      Pki::get().made("fleet", "--ground-station ground-uav1=uav1 --ground-station ground-b=uav2,uav3");
+  expect_grant(dir, "ground-uav1", "ground-station", {"uav1"});
+  expect_grant(dir, "ground-b", "ground-station", {"uav2", "uav3"});
+  for (const char* id : {"pmu-service", "ground-station", "mission-computer"}) expect_grant(dir, id, id, {"*"});
+  const auto f = dds::security_files_in(dir, "ground-uav1");
+  EXPECT_TRUE(check(f).empty()) << describe(check(f));
+  // What DdsContext's messages are made of, read from the signed document.
+  const auto g = dds::topic_grant(f, "pmu/command", true);
+  ASSERT_TRUE(g.has_value());
+  EXPECT_EQ(g->grant, "ground-uav1");
+  EXPECT_TRUE(g->allowed);
+  EXPECT_EQ(g->partitions, std::vector<std::string>{"uav1"});
+  const auto mc = dds::topic_grant(dds::security_files_in(dir, "mission-computer"), "pmu/command", true);
+  ASSERT_TRUE(mc.has_value());
+  EXPECT_FALSE(mc->allowed);
+}
+
+TEST(MakePki, RefusesBadVehicleAndIdentityNames) {
+  struct Case {
+    const char* args;
+    const char* message;
+  };
+  const Case cases[] = {
+      {"--vehicles 'uav*'", "--vehicles: vehicle 'uav*' contains '*'; a vehicle name is letters, digits"},
+      {"--vehicles uav1,a-name-longer-than-15", "--vehicles: vehicle 'a-name-longer-than-15' is 21 characters"},
+      {"--ground-station ground-uav1", "--ground-station 'ground-uav1': expected NAME=VEHICLE[,VEHICLE...]"},
+      {"--ground-station 'g=uav[12]'", "--ground-station g: vehicle 'uav[12]' contains '['"},
+      {"--ground-station pmu-service=uav1", "--ground-station: 'pmu-service' is taken"},
+      {"--ground-station ca=uav1", "--ground-station: 'ca' is taken"},
+      {"--ground-station ../x=uav1", "--ground-station: identity name '../x' must be 1..64 letters"},
+      {"--ground-station g=uav1 --ground-station g=uav2", "--ground-station g given twice"},
+  };
+  for (const auto& c : cases) {
+    SCOPED_TRACE(c.args);
+    const std::string out = Pki::get().root() + "/refused";
+    const auto r = sh(std::string("bash ") + PMU_SOURCE_DIR + "/deploy/security/make_pki.sh " + out + " " + c.args);
+    EXPECT_EQ(r.status, 2) << r.out;
+    EXPECT_NE(r.out.find(std::string("make_pki.sh: ") + c.message), std::string::npos) << r.out;
+    EXPECT_NE(::access(out.c_str(), F_OK), 0) << "nothing is made on bad usage";
+  }
+}
+
+// Fast DDS 2.9 (Permissions.cpp is_partition_in_criterias): every partition an endpoint asks
+// for (none: the default partition "") must match one granted entry, the entry being the
+// fnmatch pattern.
+TEST(PartitionNotGranted, ComparesLikeFastDds) {
+  struct Case {
+    std::vector<std::string> asked, granted;
+    std::optional<std::string> refused;
+  };
+  const Case cases[] = {
+      {{}, {"*"}, std::nullopt},          {{"", "*"}, {"*"}, std::nullopt},   {{"uav1"}, {"*"}, std::nullopt},
+      {{"uav1"}, {"uav1"}, std::nullopt}, {{}, {""}, std::nullopt},           {{}, {"uav1"}, ""},
+      {{"", "*"}, {"uav1"}, ""},          {{"*"}, {"uav1"}, "*"},             {{"uav2"}, {"uav1"}, "uav2"},
+      {{"uav?"}, {"uav1"}, "uav?"},       {{"uav1"}, {""}, "uav1"},           {{"uav2"}, {"uav1", "uav2"}, std::nullopt},
+  };
+  for (const auto& c : cases) {
+    std::string asked;
+    for (const auto& a : c.asked) asked += "'" + a + "' ";
+    EXPECT_EQ(dds::partition_not_granted(c.asked, c.granted), c.refused) << "asked " << asked;
+  }
 }
 
 // ---- the programs ---------------------------------------------------------------------------

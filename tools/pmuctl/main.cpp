@@ -280,6 +280,17 @@ int main(int argc, char** argv) {
       spec.kind = pmu::REQUEST_MEASUREMENTS;
       return pmu::tools::run_command(g, spec);
     }
+  } catch (const pmu::dds::PartitionNotGranted& e) {
+    // A partition is a vehicle (service/vehicle.hpp): say it in the operator's terms.
+    std::fprintf(stderr, "pmuctl: %s\n", e.what());
+    if (!g.vehicle)
+      std::fprintf(stderr, "pmuctl: without --vehicle pmuctl reads every vehicle (partitions \"\" and \"*\") and "
+                           "commands the unnamed vehicle; this identity is confined to some vehicles: name one "
+                           "of them with --vehicle\n");
+    else
+      std::fprintf(stderr, "pmuctl: %s is not one of this identity's vehicles\n",
+                   g.vehicle->empty() ? "the unnamed vehicle" : ("vehicle " + *g.vehicle).c_str());
+    return 2;
   } catch (const std::exception& e) {
     std::fprintf(stderr, "pmuctl: %s\n", e.what());
     return 2;

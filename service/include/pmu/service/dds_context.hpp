@@ -34,6 +34,19 @@ class DdsError : public std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
+// Fast DDS refused a writer or reader, and the identity's permissions say why: they do not
+// grant `partition()` ("" is the default partition) for that topic. A program that maps
+// partitions to vehicles (pmuctl) can then say which vehicle the identity may not use.
+class PartitionNotGranted : public DdsError {
+ public:
+  PartitionNotGranted(const std::string& what, std::string partition)
+      : DdsError(what), partition_(std::move(partition)) {}
+  const std::string& partition() const noexcept { return partition_; }
+
+ private:
+  std::string partition_;
+};
+
 // The installed qos.xml: $PMU_QOS_FILE, else qos.xml in the configuration directory
 // (PMU_SYSCONFDIR, /etc/pmu-dds). Empty when none exists. Never the source tree: runs from a
 // build directory set PMU_QOS_FILE (scripts/run.sh and the tests do).
@@ -68,15 +81,22 @@ class DdsContext {
 
   // A writer/reader with the named profile of qos.xml. Throws DdsError when it fails, and
   // when the profile holds less than the declared capacity (capacity.hpp, dds_capacity.hpp).
+  // With DDS-Security the message says what the permissions do not allow (the topic, or
+  // which partition), and PartitionNotGranted is thrown when it is a partition.
   eprosima::fastdds::dds::DataWriter& writer(eprosima::fastdds::dds::Topic& topic, const std::string& profile,
                                              eprosima::fastdds::dds::DataWriterListener* listener = nullptr);
   eprosima::fastdds::dds::DataReader& reader(eprosima::fastdds::dds::Topic& topic, const std::string& profile,
                                              eprosima::fastdds::dds::DataReaderListener* listener = nullptr);
 
  private:
+  // Throws the DdsError for an endpoint Fast DDS refused ("cannot create a writer for ...").
+  [[noreturn]] void refused(const std::string& topic, const std::string& profile, bool publish) const;
+
   int domain_;
   std::string qos_file_;
   bool secure_ = false;
+  SecurityFiles security_;
+  Partitions partitions_;
   eprosima::fastdds::dds::DomainParticipant* participant_ = nullptr;
   eprosima::fastdds::dds::Publisher* publisher_ = nullptr;
   eprosima::fastdds::dds::Subscriber* subscriber_ = nullptr;

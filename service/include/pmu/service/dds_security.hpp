@@ -74,4 +74,27 @@ std::vector<SecurityIssue> check_security_files(const SecurityFiles& files, cons
 
 bool has_errors(const std::vector<SecurityIssue>& issues) noexcept;
 
+// What an identity's permissions grant for one topic, read the way Fast DDS 2.9's
+// Access-Permissions plugin reads them (Permissions.cpp, check_create_datawriter/reader): in
+// the grant for the certificate's subject, the first allow or deny rule whose <publish>
+// (<subscribe>) entries name the topic (fnmatch patterns) decides, and the partitions it
+// grants are those of all these entries; an entry without <partitions> grants the default
+// partition ("") alone. Fast DDS only logs why it refused an endpoint; this lets a message
+// say it. nullopt when the files give no answer (unreadable, not signed by permissions_ca,
+// no grant for the subject).
+struct TopicGrant {
+  std::string grant;                    // the grant's name attribute
+  bool allowed = false;                 // an allow rule names the topic (not a deny rule, not none)
+  std::vector<std::string> partitions;  // when allowed: the partition patterns granted
+};
+std::optional<TopicGrant> topic_grant(const SecurityFiles& files, const std::string& topic, bool publish);
+
+// The first of an endpoint's `partitions` (none: the default partition, "") that no pattern
+// of `granted` matches, compared as Fast DDS does (fnmatch, the granted entry is the
+// pattern); nullopt when every one is granted.
+//   partition_not_granted({"", "*"}, {"uav1"}) == ""        (the default partition)
+//   partition_not_granted({"uav1"}, {"*"})     == nullopt   ("*" matches every name and "")
+std::optional<std::string> partition_not_granted(const std::vector<std::string>& partitions,
+                                                 const std::vector<std::string>& granted);
+
 }  // namespace pmu::dds
