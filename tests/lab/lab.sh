@@ -552,7 +552,7 @@ scenario_cut_lifespan() {
   check_not_executed $CUT_TAGS
   # The premise of cutB: it was delivered after the restore and refused for its expiry.
   [ -n "$b" ] || fail "premise: cutB$attempt was never delivered after the restore, so its expiry was not what stopped it"
-  late=$(grep '"event":"late_reply"' "$GROUND_OUT" | sed 's/.*"id":"\([^"]*\)".*"result":"\([^"]*\)".*/\1 \2/' | tr '\n' ' ')
+  late=$(grep '"event":"late_reply"' "$GROUND_OUT" | sed 's/.*"id":"\([^"]*\)".*"result":"\([^"]*\)".*/\1 \2/' | tr '\n' ',' | sed 's/,$//')
   detail "$LATE_WAIT s after the restore: cutA$attempt (older than LIFESPAN) never delivered; cutB$attempt delivered late and refused: $(printf '%s' "$b" | cut -d' ' -f2-); pmu/config payload_voltage still 13.0; late replies at the client: ${late:-none}"
   after_cut_command post
   alive "$SVC" || fail "pmu-service died"
