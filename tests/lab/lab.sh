@@ -177,15 +177,16 @@ EOF
   [ -n "${2:-}" ] && printf '%s\n' "$2" >>"$1"
   return 0
 }
-# start_service HOST [EXTRA-YAML [pmu-service options...]]: SVC_PID, log $WORK/$SCEN.service.log
+# start_service HOST [EXTRA-YAML [pmu-service options...]]: SVC_PID and SVC_LOG of this one
+# (each service its own log, $WORK/$SCEN.serviceN.log: two vehicles' audit trails stay apart)
 NSVC=0
 start_service() {
   _h=$1; _extra=${2:-}; shift; [ $# -gt 0 ] && shift
   NSVC=$((NSVC + 1))
   service_config "$WORK/$SCEN.service$NSVC.yaml" "$_extra"
-  $NETNS_EXEC "$_h" pmu-service --config "$WORK/$SCEN.service$NSVC.yaml" --domain "$DOMAIN" "$@" >>"$WORK/$SCEN.service.log" 2>&1 &
+  SVC_LOG="$WORK/$SCEN.service$NSVC.log"
+  $NETNS_EXEC "$_h" pmu-service --config "$WORK/$SCEN.service$NSVC.yaml" --domain "$DOMAIN" "$@" >>"$SVC_LOG" 2>&1 &
   SVC_PID=$!
-  SVC_LOG="$WORK/$SCEN.service.log"
   track "$SVC_PID"
 }
 # pmuctl in HOST: ctl HOST ARGS... ($CTL_EXTRA: options every pmuctl of the scenario gets,
@@ -243,8 +244,8 @@ has_event_after() { [ -n "$(event_after "$1" "$2")" ]; }
 # ---- the audit trail -------------------------------------------------------------------
 # The service logs one `audit: command ID from SENDER: WHAT -> RESULT[: reason]` line per
 # command it decides (command_service.cpp `finish`), and `audit: duplicate command ID from
-# SENDER: answered again, not executed` per resend. audit_lines PREFIX prints, for every final
-# line whose id starts with PREFIX: "ID RESULT reason...".
+# SENDER: answered again, not executed` per resend. audit_lines PREFIX [LOG] prints, for every
+# final line whose id starts with PREFIX: "ID RESULT reason..." (LOG: the last service's).
 audit_lines() {
   awk -v p="$1" '
     /audit: command / && !/reuses that id/ {
@@ -253,12 +254,12 @@ audit_lines() {
       if (index(id, p) != 1) next
       r = s; sub(/.* -> /, "", r)
       print id, r
-    }' "$SVC_LOG"
+    }' "${2:-$SVC_LOG}"
 }
 duplicate_lines() {
   awk -v p="$1" '/audit: duplicate command / {
       s = substr($0, index($0, "audit: duplicate command ") + 25); sub(/ .*/, "", s)
-      if (index(s, p) == 1) print s }' "$SVC_LOG"
+      if (index(s, p) == 1) print s }' "${2:-$SVC_LOG}"
 }
 
 # ---- scenarios -------------------------------------------------------------------------
@@ -602,7 +603,7 @@ run_one() {  # NAME INDEX: runs a scenario under its time limit and prints its R
     77) echo "RESULT $name SKIP ${secs}s $(cat "$WORK/$name.skip" 2>/dev/null)" ;;
     *)
       if [ -f "$WORK/$name.fail" ]; then why=$(cat "$WORK/$name.fail"); else why="timed out after ${limit}s or crashed (status $rc)"; fi
-      for f in "$WORK/$name".service.log "$WORK/$name".ground.out.err "$WORK/$name".*.err; do
+      for f in "$WORK/$name".service*.log "$WORK/$name".ground.out.err "$WORK/$name".*.err; do
         [ -s "$f" ] && tail -n 6 "$f" | sed "s|^|[$name] $(basename "$f"): |"
       done
       echo "RESULT $name FAIL ${secs}s $why${d:+ (so far: $d)}"
