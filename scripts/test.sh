@@ -2,7 +2,9 @@
 # The one test command (README, .ci/run): installs what is missing, builds, runs every test.
 #   1. release build (-Werror): unit, CLI, transport, simulator, service, DDS integration and
 #      deploy tests, benchmark smoke runs, and the system tests: real SocketCAN on vcan in a
-#      qemu VM booting Debian's kernel (tests/system, about 3 minutes)
+#      qemu VM booting Debian's kernel (tests/system, about 3 minutes), and the network lab
+#      in the same VM: hosts in namespaces, a netem-impaired ground link (tests/lab, ctest
+#      lab_vm, labels lab and system, about 6 minutes)
 #   2. ASan+UBSan build: unit, CLI, transport, simulator and service tests under the sanitizers
 #      (the DDS integration tests run in the release build: Fast DDS itself is not built with ASan)
 #   3. ThreadSanitizer build: transport, simulator, service and DDS integration tests (threads:

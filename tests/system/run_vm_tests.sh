@@ -3,9 +3,12 @@
 # machine's kernel has no CAN), with an initramfs holding busybox, can-utils, iproute2,
 # the project's binaries and tests/system/scenarios.sh, and checks what the scenarios
 # print on the VM's console. See tests/system/README.md.
+# --suite lab boots the same kernel with the network lab instead (tests/lab/README.md):
+# veth, bridge and sch_netem, iproute2's ip and tc, pmu-service, pmuctl, lab_ground and
+# tests/lab/lab.sh, whose scenarios print the same RESULT lines.
 #
-#   run_vm_tests.sh [--build-dir DIR] [--source-dir DIR] [--scenario NAME]... [--list]
-#                   [--timeout S] [--log FILE] [--keep] [--verbose] [--service-log-level L]
+#   run_vm_tests.sh [--suite system|lab] [--build-dir DIR] [--source-dir DIR] [--scenario NAME]...
+#                   [--list] [--timeout S] [--log FILE] [--keep] [--verbose] [--service-log-level L]
 #
 # Exit status: 0 when every scenario passed (a SKIP is allowed only for a scenario that
 # waits for a pmuctl verb not written yet), 1 when a scenario failed or did not report,
@@ -16,6 +19,8 @@ set -euo pipefail
 script_dir=$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)
 source_dir=$(cd "$script_dir/../.." && pwd)
 build_dir=""
+suite=system
+list_only=0
 scenarios=()
 vm_timeout=${PMU_VM_TIMEOUT:-900}
 cache_dir=${PMU_VM_CACHE:-${HOME:-/tmp}/.cache/pmu-dds-vm}
@@ -34,12 +39,13 @@ skip() { echo "run_vm_tests: SKIP: $*" >&2; exit 77; }
 note() { echo "run_vm_tests: $*" >&2; }
 
 usage() {
-  sed -n '2,13p' "${BASH_SOURCE[0]}" | sed 's/^# \{0,1\}//'
+  sed -n '2,16p' "${BASH_SOURCE[0]}" | sed 's/^# \{0,1\}//'
   exit "${1:-0}"
 }
 
 while [ $# -gt 0 ]; do
   case "$1" in
+    --suite) suite=$2; shift 2 ;;
     --build-dir) build_dir=$2; shift 2 ;;
     --source-dir) source_dir=$2; shift 2 ;;
     --scenario) scenarios+=("$2"); shift 2 ;;
@@ -48,17 +54,42 @@ while [ $# -gt 0 ]; do
     --keep) keep=1; shift ;;
     --verbose) verbose=1; shift ;;
     --service-log-level) service_log=$2; shift 2 ;;
-    --list) sed -n 's/^ALL_SCENARIOS="\(.*\)"$/\1/p' "$script_dir/scenarios.sh" | tr ' ' '\n'; exit 0 ;;
+    --list) list_only=1; shift ;;
     -h|--help) usage 0 ;;
     *) echo "run_vm_tests: unknown argument '$1'" >&2; usage 2 ;;
   esac
 done
+# What differs between the suites: the scenario script, the kernel modules (each with what it
+# depends on), and which scenarios may SKIP. Both share the kernel, the cache and the verdict.
+# Every module of either suite is extracted into the one cache.
+all_modules="can can-raw can-dev vcan veth bridge sch_netem"
+case "$suite" in
+  system)
+    suite_script="$script_dir/scenarios.sh"
+    suite_modules="can can-raw can-dev vcan"
+    suite_title="system tests (real SocketCAN in a VM"
+    suite_label="system tests"
+    ;;
+  lab)
+    suite_script="$script_dir/../lab/lab.sh"
+    suite_modules="veth bridge sch_netem"
+    suite_title="network lab (namespaces and netem in a VM"
+    suite_label="network lab"
+    skip_allowed=" "
+    ;;
+  *) echo "run_vm_tests: unknown suite '$suite' (system or lab)" >&2; usage 2 ;;
+esac
+[ -f "$suite_script" ] || die "$suite_script not found"
+suite_script=$(cd "$(dirname "$suite_script")" && pwd)/$(basename "$suite_script")
+if [ "$list_only" = 1 ]; then
+  sed -n 's/^ALL_SCENARIOS="\(.*\)"$/\1/p' "$suite_script" | tr ' ' '\n'; exit 0
+fi
 [ -n "$build_dir" ] || build_dir="$source_dir/build-vm"
 build_dir=$(cd "$build_dir" 2>/dev/null && pwd) || die "build directory '$build_dir' does not exist"
-[ -n "$log_file" ] || log_file="$build_dir/system-vm-console.log"
+[ -n "$log_file" ] || log_file="$build_dir/$suite-vm-console.log"
 
-all_scenarios=$(sed -n 's/^ALL_SCENARIOS="\(.*\)"$/\1/p' "$script_dir/scenarios.sh")
-[ -n "$all_scenarios" ] || die "cannot read ALL_SCENARIOS from $script_dir/scenarios.sh"
+all_scenarios=$(sed -n 's/^ALL_SCENARIOS="\(.*\)"$/\1/p' "$suite_script")
+[ -n "$all_scenarios" ] || die "cannot read ALL_SCENARIOS from $suite_script"
 if [ ${#scenarios[@]} -eq 0 ]; then
   read -r -a scenarios <<<"$all_scenarios"
 else
@@ -81,14 +112,24 @@ for b in /bin/busybox /usr/bin/busybox; do
 done
 [ -n "$busybox_bin" ] || die "system tests need busybox-static (scripts/setup.sh installs it)"
 can_utils=()
-for t in candump cansend cangen; do
-  p=$(command -v "$t" || true)
-  [ -n "$p" ] || die "system tests need can-utils ($t not found; scripts/setup.sh installs it)"
-  can_utils+=("$p")
-done
+if [ "$suite" = system ]; then
+  for t in candump cansend cangen; do
+    p=$(command -v "$t" || true)
+    [ -n "$p" ] || die "system tests need can-utils ($t not found; scripts/setup.sh installs it)"
+    can_utils+=("$p")
+  done
+fi
 ip_bin=""
 for p in /usr/sbin/ip /sbin/ip /usr/bin/ip /bin/ip; do [ -x "$p" ] && { ip_bin=$p; break; }; done
 [ -n "$ip_bin" ] || die "system tests need iproute2's ip (scripts/setup.sh installs iproute2)"
+tc_bin="" tc_lib=""
+if [ "$suite" = lab ]; then
+  for p in /usr/sbin/tc /sbin/tc; do [ -x "$p" ] && { tc_bin=$p; break; }; done
+  [ -n "$tc_bin" ] || die "the lab needs iproute2's tc (scripts/setup.sh installs iproute2)"
+  # netem's delay distributions (normal.dist ...) are files tc reads from its library folder.
+  for d in /usr/lib/x86_64-linux-gnu/tc /usr/lib/tc /usr/lib64/tc; do [ -f "$d/normal.dist" ] && { tc_lib=$d; break; }; done
+  [ -n "$tc_lib" ] || die "the lab needs tc's distribution tables (normal.dist; iproute2)"
+fi
 
 find_binary() {  # NAME EXPECTED-RELATIVE-PATH
   local p="$build_dir/$2"
@@ -99,7 +140,11 @@ find_binary() {  # NAME EXPECTED-RELATIVE-PATH
 }
 svc_bin=$(find_binary pmu-service service/pmu-service)
 ctl_bin=$(find_binary pmuctl tools/pmuctl)
-sim_bin=$(find_binary pmu-sim tools/pmu-sim)
+if [ "$suite" = system ]; then
+  sim_bin=$(find_binary pmu-sim tools/pmu-sim)
+else
+  ground_bin=$(find_binary lab_ground tests/lab/lab_ground)
+fi
 qos_file="$source_dir/deploy/qos.xml"
 [ -f "$qos_file" ] || die "$qos_file not found (--source-dir?)"
 
@@ -189,9 +234,17 @@ extract_kernel() {  # DEB DEST MODULE...
   rm -rf "$dest"; mv "$tmp" "$dest"
 }
 
+# True when DIR's cache holds every module named (an older cache may lack the lab's).
+has_modules() {  # DIR MODULE...
+  local dir=$1 m; shift
+  [ -f "$dir/load-order" ] || return 1
+  for m in "$@"; do grep -qx "${m//_/-}" "$dir/load-order" || return 1; done
+}
+
 kernel_dir=""
 pkg=$(kernel_package)
-if [ -n "$pkg" ] && [ -f "$cache_dir/$pkg/load-order" ]; then
+# shellcheck disable=SC2086 # module lists are word lists
+if [ -n "$pkg" ] && has_modules "$cache_dir/$pkg" $suite_modules; then
   kernel_dir="$cache_dir/$pkg"
 elif [ -n "$pkg" ] || [ -n "${PMU_VM_KERNEL_DEB:-}" ]; then
   deb=${PMU_VM_KERNEL_DEB:-}
@@ -211,9 +264,10 @@ elif [ -n "$pkg" ] || [ -n "${PMU_VM_KERNEL_DEB:-}" ]; then
   else
     pkg=$(dpkg-deb -f "$deb" Package) || die "PMU_VM_KERNEL_DEB=$deb is not a .deb"
   fi
-  note "extracting vmlinuz and can, can-raw, can-dev, vcan from $(basename "$deb")"
-  extract_kernel "$deb" "$cache_dir/$pkg" can can-raw can-dev vcan ||
-    die "cannot extract the kernel and CAN modules from $deb"
+  note "extracting vmlinuz and $all_modules from $(basename "$deb")"
+  # shellcheck disable=SC2086
+  extract_kernel "$deb" "$cache_dir/$pkg" $all_modules ||
+    die "cannot extract the kernel and its modules from $deb"
   rm -f "$cache_dir/download/"*.deb  # the extracted files are all we keep
   kernel_dir="$cache_dir/$pkg"
 else
@@ -223,7 +277,23 @@ else
   [ -n "$kernel_dir" ] && [ -f "$kernel_dir/load-order" ] ||
     skip "cannot download linux-image-amd64's kernel package: apt-cache knows no linux-image-amd64 (run apt-get update, or set PMU_VM_KERNEL_DEB=/path/to/linux-image-*.deb)"
 fi
-note "kernel: $(basename "$kernel_dir"), modules: $(tr '\n' ' ' <"$kernel_dir/load-order")"
+# shellcheck disable=SC2086
+has_modules "$kernel_dir" $suite_modules ||
+  skip "the cached kernel $(basename "$kernel_dir") lacks modules of the $suite suite ($suite_modules) and no kernel package can be downloaded"
+# The suite's modules and everything they depend on, in the cached load order (dependencies first).
+suite_load_order() {
+  local want=" " queue m d
+  read -r -a queue <<<"$suite_modules"
+  while [ ${#queue[@]} -gt 0 ]; do
+    m=${queue[0]//_/-}; queue=("${queue[@]:1}")
+    case "$want" in *" $m "*) continue ;; esac
+    want+="$m "
+    for d in $(sed -n "s/^$m: //p" "$kernel_dir/deps"); do queue+=("$d"); done
+  done
+  while read -r m; do case "$want" in *" $m "*) echo "$m" ;; esac; done <"$kernel_dir/load-order"
+}
+suite_load_order >"$work/load-order"
+note "kernel: $(basename "$kernel_dir"), modules: $(tr '\n' ' ' <"$work/load-order")"
 
 # ---- the initramfs ---------------------------------------------------------------------
 root="$work/root"
@@ -249,15 +319,22 @@ copy_with_libs() {  # BINARY DEST-IN-ROOT
 }
 copy_with_libs "$svc_bin" opt/pmu/bin/pmu-service
 copy_with_libs "$ctl_bin" opt/pmu/bin/pmuctl
-copy_with_libs "$sim_bin" opt/pmu/bin/pmu-sim
+if [ "$suite" = system ]; then
+  copy_with_libs "$sim_bin" opt/pmu/bin/pmu-sim
+else
+  copy_with_libs "$ground_bin" opt/pmu/bin/lab_ground
+  copy_with_libs "$tc_bin" usr/sbin/tc   # busybox's tc knows no netem
+  rm -f "$root/bin/tc"
+  mkdir -p "$root/$tc_lib" && cp "$tc_lib"/*.dist "$root/$tc_lib/"
+fi
 for t in "${can_utils[@]}"; do copy_with_libs "$t" "usr/bin/$(basename "$t")"; done
 copy_with_libs "$ip_bin" usr/sbin/ip   # the real ip: busybox's cannot `type vcan`
 rm -f "$root/bin/ip"
 cp "$qos_file" "$root/etc/pmu-dds/qos.xml"
-while read -r m; do cp "$kernel_dir/modules/$m.ko" "$root/lib/modules/"; done <"$kernel_dir/load-order"
-cp "$kernel_dir/load-order" "$root/lib/modules/load-order"
-cp "$script_dir/scenarios.sh" "$root/scenarios.sh"
-chmod 755 "$root/scenarios.sh"
+while read -r m; do cp "$kernel_dir/modules/$m.ko" "$root/lib/modules/"; done <"$work/load-order"
+cp "$work/load-order" "$root/lib/modules/load-order"
+cp "$suite_script" "$root/$(basename "$suite_script")"
+chmod 755 "$root/$(basename "$suite_script")"
 echo "root:x:0:0:root:/root:/bin/sh" >"$root/etc/passwd"
 echo "root:x:0:" >"$root/etc/group"
 echo "127.0.0.1 localhost" >"$root/etc/hosts"
@@ -265,7 +342,8 @@ echo "pmu-vm" >"$root/etc/hostname"
 
 cat >"$root/init" <<'EOF'
 #!/bin/sh
-# PID 1 of the test VM: mount, load CAN, create vcan0, run the scenarios, power off.
+# PID 1 of the test VM: mount, load the modules, then either create vcan0 and run the system
+# scenarios, or run the network lab (/lab.sh); power off.
 # Debian's busybox runs its own applets before PATH: iproute2's ip is called by path.
 export PATH=/opt/pmu/bin:/usr/sbin:/usr/bin:/sbin:/bin HOME=/root
 mount -t proc proc /proc
@@ -283,6 +361,15 @@ while read -r m; do
   if ! insmod "/lib/modules/$m.ko"; then echo "VM: insmod $m.ko failed"; ok=0; fi
 done </lib/modules/load-order
 /usr/sbin/ip link set lo up
+if [ -f /lab.sh ]; then
+  # The network lab builds its namespaces, bridge and ground link itself (lab.sh lab_up).
+  if [ $ok = 1 ]; then
+    echo "VM: lab modules loaded: $(tr '\n' ' ' </lib/modules/load-order), $(/usr/sbin/ip -V)"
+    sh /lab.sh all
+  else
+    echo "RESULT setup FAIL could not load the lab's modules (veth, bridge, sch_netem)"
+  fi
+else
 /usr/sbin/ip link add vcan0 type vcan && /usr/sbin/ip link set vcan0 up || ok=0
 if [ $ok = 1 ]; then
   echo "VM: CAN ready: $(/usr/sbin/ip -br link show vcan0), $(/usr/sbin/ip -V)"
@@ -290,6 +377,7 @@ if [ $ok = 1 ]; then
 else
   echo "VM: CAN setup failed"
   echo "RESULT setup FAIL could not load the CAN modules or create vcan0"
+fi
 fi
 echo "VM: done, powering off"
 sync
@@ -325,7 +413,7 @@ fi
 
 # ---- verdict ---------------------------------------------------------------------------
 echo
-echo "== system tests (real SocketCAN in a VM, $(basename "$kernel_dir")) =="
+echo "== $suite_title, $(basename "$kernel_dir")) =="
 failed=0
 printf '%-18s %-5s %8s  %s\n' scenario result time detail
 for s in "${scenarios[@]}"; do
@@ -349,5 +437,5 @@ if grep -q '^RESULT setup FAIL' "$log_file"; then failed=1; grep '^RESULT setup'
 wall_end=$(date +%s.%N)
 awk -v a="$wall_start" -v b="$boot_start" -v c="$boot_end" -v d="$wall_end" \
   'BEGIN { printf "wall time: %.1f s total (preparing %.1f s, VM %.1f s)\n", d - a, b - a, c - b }'
-if [ $failed = 0 ]; then echo "system tests: PASS"; else echo "system tests: FAIL (console log: $log_file)"; fi
+if [ $failed = 0 ]; then echo "$suite_label: PASS"; else echo "$suite_label: FAIL (console log: $log_file)"; fi
 exit $failed

@@ -1,0 +1,646 @@
+#!/bin/sh
+# pmu-dds network lab: hosts made of network namespaces inside the test VM that
+# tests/system/run_vm_tests.sh --suite lab boots (Debian's kernel: veth, bridge and sch_netem
+# are loaded by /init). /init runs `sh /lab.sh all`. Written for busybox ash. The topology,
+# what each scenario asserts and the measured figures: tests/lab/README.md.
+#
+# The same protocol as tests/system/scenarios.sh: every scenario is an assertion with a time
+# bound and ends with
+#   RESULT <name> PASS|FAIL|SKIP <seconds>s <detail>
+# on the console. It runs in its own shell under `timeout`, with its own DDS domain; the
+# driver kills what it started and puts the ground link back to its impaired state after it.
+# Progress lines start with "[<name>]".
+#
+#   sh /lab.sh all          the scenarios named by pmu.scenarios=a,b on the kernel command
+#                           line (all when absent): the topology is built once, then each runs
+#   sh /lab.sh one NAME     a single scenario (what `all` runs for each)
+
+ALL_SCENARIOS="topology consumers commands cut cut_lifespan"
+
+export PATH=/opt/pmu/bin:/usr/sbin:/usr/bin:/sbin:/bin
+export PMU_QOS_FILE=/etc/pmu-dds/qos.xml
+WORK=/tmp/pmu-lab
+mkdir -p "$WORK"
+
+# ---- the ground link's impairment, each direction (netem on both ends of its veth) ------
+# Delay 300 ms with 50 ms jitter drawn from netem's `normal` table (standard deviation 50 ms,
+# no correlation; packets may be reordered), 10 % independent loss, 250 kbit/s.
+LINK_DELAY=300ms
+LINK_JITTER=50ms
+LINK_DISTRIBUTION=normal
+LINK_LOSS=10%
+LINK_RATE=250kbit
+
+# ---- addresses: one LAN segment (a bridge), so DDS's default multicast discovery works ----
+LAN_PREFIX=10.10.0
+# host name and its address on the LAN; gnd reaches the bridge through the ground link
+HOSTS="mc1 mc2 gnd"
+addr_of() { case $1 in mc1) echo "$LAN_PREFIX.1" ;; mc2) echo "$LAN_PREFIX.2" ;; gnd) echo "$LAN_PREFIX.3" ;; esac; }
+# The bridge-side end of each host's veth; gnd's is the ground link.
+port_of() { case $1 in gnd) echo gndlink ;; *) echo "$1-lan" ;; esac; }
+
+# ---- helpers ---------------------------------------------------------------------------
+
+# Debian's busybox shell runs its own applets before PATH: iproute2's ip and tc by path.
+ip() { /usr/sbin/ip "$@"; }
+tc() { /usr/sbin/tc "$@"; }
+# on HOST CMD...: CMD in HOST's network namespace, in the foreground. In the background
+# write `$NETNS_EXEC HOST CMD ... &` instead: `ip netns exec` execs CMD, so $! is CMD's pid
+# (a backgrounded function would leave $! the pid of a subshell, and killing it would not
+# stop CMD).
+NETNS_EXEC="/usr/sbin/ip netns exec"
+on() { _host=$1; shift; $NETNS_EXEC "$_host" "$@"; }
+
+log() { read -r _up _idle </proc/uptime; echo "[$SCEN] $_up $*"; }   # with the VM's uptime
+now() { read -r _up _idle </proc/uptime; echo "$_up"; }          # seconds since boot, 10 ms
+since() { awk -v a="$1" -v b="$(now)" 'BEGIN { printf "%.2f", b - a }'; }
+calc() { awk "BEGIN { printf \"%.2f\", $* }"; }                     # calc '1 + 2'
+true_that() { awk "BEGIN { exit !($*) }"; }                          # true_that '1.5 <= 2'
+fail() { echo "$*" >"$WORK/$SCEN.fail"; log "FAIL: $*"; diagnose; exit 1; }
+skip() { echo "$*" >"$WORK/$SCEN.skip"; log "SKIP: $*"; exit 77; }
+detail() { printf '%s; ' "$*" >>"$WORK/$SCEN.detail"; log "$*"; }
+# sleep_until T: sleeps until uptime T (returns at once when T has passed)
+sleep_until() { _rest=$(calc "$1 - $(now)"); true_that "$_rest > 0" && sleep "$_rest"; return 0; }
+
+# Value of KEY in one line of JSON (flat or nested, first occurrence), quotes removed.
+jv() { printf '%s\n' "$1" | sed -n "s/.*\"$2\":\([^,}]*\).*/\1/p" | tr -d '"'; }
+# The items of the JSON list KEY (strings), space separated.
+jlist() { printf '%s\n' "$1" | sed -n "s/.*\"$2\":\[\([^]]*\)\].*/\1/p" | tr -d '"' | tr ',' ' '; }
+same() {
+  awk -v a="$1" -v b="$2" 'BEGIN {
+    if (a == b) exit 0
+    if (a ~ /^-?[0-9.]+$/ && b ~ /^-?[0-9.]+$/ && (a - b) ^ 2 < 1e-6) exit 0
+    exit 1 }'
+}
+
+# Runs "$@" every 0.2 s until it succeeds or SECONDS pass.
+wait_until() {
+  _limit=$1; shift
+  _start=$(now)
+  while ! "$@"; do
+    true_that "$(since "$_start") >= $_limit" && return 1
+    sleep 0.2
+  done
+  return 0
+}
+
+track() { echo "$1" >>"$WORK/pids"; }
+alive() { [ -d "/proc/$1" ] && ! grep -q '^State:.*Z' "/proc/$1/status" 2>/dev/null; }
+
+# What the link and the processes look like at a failure, on the console.
+diagnose() {
+  log "diag: ground link: $(tc -s qdisc show dev "$(port_of gnd)" 2>&1 | tr '\n' ' ' | cut -c1-300)"
+  log "diag: gnd side: $(on gnd /usr/sbin/tc -s qdisc show dev eth0 2>&1 | tr '\n' ' ' | cut -c1-300)"
+  log "diag: processes: $(for p in $(cat "$WORK/pids" 2>/dev/null); do alive "$p" && printf '%s ' "$p:$(tr '\0' ' ' <"/proc/$p/cmdline" | cut -c1-50)"; done)"
+}
+
+# busy and total jiffies of the whole VM
+vm_ticks() { awk '/^cpu / {print $2+$3+$4+$7+$8, $2+$3+$4+$5+$6+$7+$8}' /proc/stat; }
+# bytes netem passed on the ground link: toward gnd, toward the aircraft
+link_bytes() {
+  echo "$(tc -s qdisc show dev "$(port_of gnd)" | sed -n 's/.*Sent \([0-9]*\) bytes.*/\1/p' | head -n1)" \
+    "$(on gnd /usr/sbin/tc -s qdisc show dev eth0 | sed -n 's/.*Sent \([0-9]*\) bytes.*/\1/p' | head -n1)"
+}
+
+# ---- the topology ----------------------------------------------------------------------
+
+# The netem qdisc of one end of the ground link, as a tc command line (without "tc").
+netem_line() {  # DEV LOSS
+  echo "qdisc replace dev $1 root netem delay $LINK_DELAY $LINK_JITTER distribution $LINK_DISTRIBUTION loss $2 rate $LINK_RATE"
+}
+# set_link_loss LOSS: both directions of the ground link (10% normally, 100% for a cut).
+# A cut is loss 100 %, not the veth down: a radio fade loses packets while both hosts keep
+# their interface, address and routes, so no socket sees an error and nothing on either
+# host reacts to a carrier change; only the packets vanish (and those already in netem's
+# queue still arrive, as they would from the air).
+# The two ends are changed by two `tc -batch` processes started with the lab (one in the root
+# namespace, one in gnd) that read commands from fifos on fds 7 and 8: a change is two shell
+# builtins, so it lands within milliseconds. Starting tc (and `ip netns exec`) for it took
+# up to 3 s on the emulated VM of a loaded host, which moved cuts by as much.
+set_link_loss() {
+  netem_line "$(port_of gnd)" "$1" >&7
+  netem_line eth0 "$1" >&8
+}
+# restore_after SECONDS: the link back to LINK_LOSS SECONDS from now, from a background
+# subshell that only sleeps and writes to the tc processes; `restored` then waits for it and
+# sets T_UP to the uptime at which it wrote.
+restore_after() {
+  rm -f "$WORK/$SCEN.restored"
+  (sleep "$1"; set_link_loss "$LINK_LOSS"; read -r _u _i </proc/uptime; echo "$_u" >"$WORK/$SCEN.restored") &
+  RESTORER=$!
+}
+restored() { wait "$RESTORER"; T_UP=$(cat "$WORK/$SCEN.restored"); }
+
+lab_up() {
+  ip link add br0 type bridge || return 1
+  # No IGMP snooping: nothing on this segment is a querier, and every port must get the
+  # DDS discovery multicast (239.255.0.1) as a plain switch would flood it.
+  echo 0 >/sys/class/net/br0/bridge/multicast_snooping
+  ip link set br0 up || return 1
+  for h in $HOSTS; do
+    ip netns add "$h" || return 1
+    port=$(port_of "$h")
+    ip link add "$port" type veth peer name eth0 netns "$h" || return 1
+    ip link set "$port" master br0 up || return 1
+    on "$h" /usr/sbin/ip link set lo up || return 1
+    on "$h" /usr/sbin/ip addr add "$(addr_of "$h")/24" dev eth0 || return 1
+    on "$h" /usr/sbin/ip link set eth0 up || return 1
+    # A default route on the one interface: multicast (discovery) leaves through it.
+    on "$h" /usr/sbin/ip route add default dev eth0 || return 1
+  done
+  # shellcheck disable=SC2046 # netem_line is a word list
+  tc $(netem_line "$(port_of gnd)" "$LINK_LOSS") || return 1
+  # shellcheck disable=SC2046
+  on gnd /usr/sbin/tc $(netem_line eth0 "$LINK_LOSS") || return 1
+  # The tc processes behind set_link_loss; their fds 7 and 8 are opened by the caller.
+  rm -f "$WORK/tc-air" "$WORK/tc-gnd"; mkfifo "$WORK/tc-air" "$WORK/tc-gnd"
+  /usr/sbin/tc -force -batch - <"$WORK/tc-air" >>"$WORK/tc.log" 2>&1 &
+  $NETNS_EXEC gnd /usr/sbin/tc -force -batch - <"$WORK/tc-gnd" >>"$WORK/tc.log" 2>&1 &
+}
+
+# ---- the programs ----------------------------------------------------------------------
+
+# The service's config: the built-in simulated PMU (address 1, every packet every 0.5 s),
+# UDP only (the hosts share nothing but the network), plus EXTRA (YAML lines, e.g. a
+# `vehicle:` or `discovery:` section a later check adds).
+service_config() {  # FILE [EXTRA]
+  cat >"$1" <<EOF
+dds_transport: udp
+log_level: ${PMU_SERVICE_LOG_LEVEL:-info}
+buses:
+  - interface: sim
+    name: sim0
+    devices:
+      - address: 1
+        period: 0.5
+EOF
+  [ -n "${2:-}" ] && printf '%s\n' "$2" >>"$1"
+  return 0
+}
+# start_service HOST [EXTRA-YAML [pmu-service options...]]: SVC_PID and SVC_LOG of this one
+# (each service its own log, $WORK/$SCEN.serviceN.log: two vehicles' audit trails stay apart)
+NSVC=0
+start_service() {
+  _h=$1; _extra=${2:-}; shift; [ $# -gt 0 ] && shift
+  NSVC=$((NSVC + 1))
+  service_config "$WORK/$SCEN.service$NSVC.yaml" "$_extra"
+  SVC_LOG="$WORK/$SCEN.service$NSVC.log"
+  $NETNS_EXEC "$_h" pmu-service --config "$WORK/$SCEN.service$NSVC.yaml" --domain "$DOMAIN" "$@" >>"$SVC_LOG" 2>&1 &
+  SVC_PID=$!
+  track "$SVC_PID"
+}
+# pmuctl in HOST: ctl HOST ARGS... ($CTL_EXTRA: options every pmuctl of the scenario gets,
+# e.g. a later --vehicle or --peer)
+CTL_EXTRA=""
+# shellcheck disable=SC2086 # CTL_EXTRA is a word list
+ctl() { _h=$1; shift; on "$_h" pmuctl --domain "$DOMAIN" --json $CTL_EXTRA "$@"; }
+
+# A background `pmuctl watch --json` in HOST whose every line is prefixed with the VM uptime
+# at which it was read: start_watch HOST NAME; the lines go to $WORK/$SCEN.NAME.stream.
+start_watch() {
+  _s="$WORK/$SCEN.$2.stream"
+  rm -f "$_s.fifo"; mkfifo "$_s.fifo"; : >"$_s"
+  (while IFS= read -r l; do read -r u _ </proc/uptime; echo "$u $l"; done <"$_s.fifo" >"$_s") &
+  track $!
+  # shellcheck disable=SC2086
+  $NETNS_EXEC "$1" pmuctl --domain "$DOMAIN" --json $CTL_EXTRA watch >"$_s.fifo" 2>"$_s.err" &
+  track $!
+}
+# Lines of stream NAME read at or after uptime T (and before U, if given).
+stream_between() { awk -v a="$2" -v b="${3:-1e18}" '$1 >= a && $1 < b' "$WORK/$SCEN.$1.stream"; }
+stream_has_after() { [ -n "$(stream_between "$1" "$2" | head -n1)" ]; }
+first_after() { stream_between "$1" "$2" | awk '{print $1; exit}'; }
+
+# The ground station (lab_ground --stdin) in HOST, fed through a fifo held open on fd 3:
+# start_ground HOST [lab_ground options]; its JSON lines go to $GROUND_OUT.
+start_ground() {
+  _h=$1; shift
+  GROUND_OUT="$WORK/$SCEN.ground.out"
+  rm -f "$WORK/$SCEN.ground.in"; mkfifo "$WORK/$SCEN.ground.in"; : >"$GROUND_OUT"
+  $NETNS_EXEC "$_h" lab_ground --stdin --domain "$DOMAIN" "$@" <"$WORK/$SCEN.ground.in" >"$GROUND_OUT" 2>"$GROUND_OUT.err" &
+  GROUND_PID=$!
+  track "$GROUND_PID"
+  exec 3>"$WORK/$SCEN.ground.in"
+}
+# ground_batch TAG LIMIT [key=value...]: runs one batch and waits up to LIMIT s for its
+# summary line, left in BATCH. ground_queue TAG [key=value...] only hands it over (lab_ground
+# runs batches one after another; with at=T a batch starts at uptime T), ground_wait TAG
+# LIMIT waits for its summary.
+ground_queue() { _tag=$1; shift; echo "batch tag=$_tag $*" >&3; }
+ground_wait() {
+  wait_until "$2" batch_done "$1" || fail "lab_ground printed no summary of batch $1 within $2 s ($(tail -n2 "$GROUND_OUT.err" | tr '\n' ' '))"
+}
+ground_batch() {
+  _tag=$1 _limit=$2; shift 2
+  ground_queue "$_tag" "$@"
+  ground_wait "$_tag" "$_limit"
+}
+batch_done() { BATCH=$(grep "\"batch\":\"$1\"" "$GROUND_OUT" | tail -n1); [ -n "$BATCH" ]; }
+# The uptime of the first event line of lab_ground matching PATTERN at or after T.
+# (lab_ground's JSON keys come sorted: "change","current","endpoint","event","t".)
+event_after() { grep '"event"' "$GROUND_OUT" | grep -- "$1" | sed 's/.*"t":\([0-9.]*\).*/\1/' | awk -v a="$2" '$1 >= a {print; exit}'; }
+has_event_after() { [ -n "$(event_after "$1" "$2")" ]; }
+
+# ---- the audit trail -------------------------------------------------------------------
+# The service logs one `audit: command ID from SENDER: WHAT -> RESULT[: reason]` line per
+# command it decides (command_service.cpp `finish`), and `audit: duplicate command ID from
+# SENDER: answered again, not executed` per resend. audit_lines PREFIX [LOG] prints, for every
+# final line whose id starts with PREFIX: "ID RESULT reason..." (LOG: the last service's).
+audit_lines() {
+  awk -v p="$1" '
+    /audit: command / && !/reuses that id/ {
+      s = substr($0, index($0, "audit: command ") + 15)
+      id = s; sub(/ .*/, "", id)
+      if (index(id, p) != 1) next
+      r = s; sub(/.* -> /, "", r)
+      print id, r
+    }' "${2:-$SVC_LOG}"
+}
+duplicate_lines() {
+  awk -v p="$1" '/audit: duplicate command / {
+      s = substr($0, index($0, "audit: duplicate command ") + 25); sub(/ .*/, "", s)
+      if (index(s, p) == 1) print s }' "${2:-$SVC_LOG}"
+}
+
+# ---- scenarios -------------------------------------------------------------------------
+
+# The lab itself: netem on both ends of the ground link, the LAN unimpaired, the round trip
+# over the ground link what the impairment says (2 x 300 ms).
+scenario_topology() {
+  for end in "$(port_of gnd)" "eth0 in gnd"; do
+    case $end in
+      "eth0 in gnd") q=$(on gnd /usr/sbin/tc qdisc show dev eth0) ;;
+      *) q=$(tc qdisc show dev "$end") ;;
+    esac
+    for want in "delay 300ms" "50ms" "loss 10%" "rate 250Kbit"; do
+      printf '%s' "$q" | grep -q "$want" || fail "ground link ($end): no '$want' in: $q"
+    done
+  done
+  detail "netem on both ends of the ground link: $(tc qdisc show dev "$(port_of gnd)" | sed 's/.*netem [^ ]* [^ ]* //')"
+  # Minimum round trips: the LAN's shows it unimpaired, the ground link's that both
+  # directions carry the delay (2 x 300 ms, jitter 50 ms); averages on an emulated VM also
+  # carry the host's load.
+  lan=$(on mc2 ping -c 5 -i 0.2 -W 2 "$(addr_of mc1)" 2>&1 | sed -n 's/.*min\/avg\/max = \([^ ]*\).*/\1/p')
+  [ -n "$lan" ] || fail "mc2 cannot ping mc1 over the LAN bridge"
+  true_that "$(echo "$lan" | cut -d/ -f1) < 100" || fail "LAN round trip mc2-mc1 min/avg/max $lan ms: the LAN should be unimpaired"
+  # 10 pings, 10 % loss each way: a few may go.
+  gl=$(on gnd ping -c 10 -i 0.3 -W 3 "$(addr_of mc1)" 2>&1)
+  rtt=$(printf '%s\n' "$gl" | sed -n 's/.*min\/avg\/max = \([^ ]*\).*/\1/p')
+  [ -n "$rtt" ] || fail "gnd cannot ping mc1 over the ground link: $(printf '%s' "$gl" | tail -n2 | tr '\n' ' ')"
+  log "ping gnd->mc1: $(printf '%s\n' "$gl" | grep -o 'seq=[0-9]* ttl=[0-9]* time=[0-9.]*' | sed 's/ ttl=[0-9]*//' | tr '\n' ' ')"
+  true_that "$(echo "$rtt" | cut -d/ -f1) >= 400" || fail "ground link round trip min/avg/max $rtt ms: the impairment makes it about 600 ms"
+  detail "ping mc2->mc1 min/avg/max $lan ms (LAN); gnd->mc1 $rtt ms, $(printf '%s\n' "$gl" | grep -o '[0-9]* packets received') of 10 (ground link)"
+}
+
+# Both consumers receive every topic: mc2 over the LAN, gnd over the impaired ground link;
+# a late joiner in gnd gets the state topics (TRANSIENT_LOCAL) promptly.
+LATE_JOIN_BOUND=20   # s from starting `pmuctl config get` / `info` in gnd to its output (README: measured)
+scenario_consumers() {
+  start_service mc1
+  t0=$(now)
+  for h in mc2 gnd; do
+    # shellcheck disable=SC2086
+    $NETNS_EXEC "$h" pmuctl --domain "$DOMAIN" --json $CTL_EXTRA --timeout 90 watch --count 60 >"$WORK/$SCEN.$h.watch" 2>"$WORK/$SCEN.$h.watch.err" &
+    eval "watch_$h=\$!"
+    track $!
+  done
+  for h in mc2 gnd; do
+    eval "p=\$watch_$h"
+    wait "$p" || fail "$h: pmuctl watch --count 60 failed: $(tail -n1 "$WORK/$SCEN.$h.watch.err")"
+    for topic in voltages currents battery_energy temperatures status; do
+      line=$(grep -m1 "\"topic\":\"$topic\",\"bus\":\"sim0\",\"address\":1," "$WORK/$SCEN.$h.watch")
+      [ -n "$line" ] || fail "$h: no pmu/$topic sample from sim0/1 among $(wc -l <"$WORK/$SCEN.$h.watch")"
+    done
+    av=$(jv "$(grep -m1 '"topic":"voltages"' "$WORK/$SCEN.$h.watch")" avionics)
+    same "$av" 12.0 || fail "$h: pmu/voltages avionics '$av', the simulator sends 12.0"
+  done
+  detail "mc2 and gnd: all five telemetry topics from sim0/1 in 60 samples each, $(since "$t0") s after the service started"
+  for h in mc2 gnd; do
+    h_line=$(ctl "$h" --timeout 20 health 2>"$WORK/$SCEN.err" | head -n1)
+    [ "$(jv "$h_line" state)" = ONLINE ] || fail "$h: pmu/health state '$(jv "$h_line" state)', want ONLINE ($(tail -n1 "$WORK/$SCEN.err"))"
+    i_line=$(ctl "$h" --timeout 20 info 2>"$WORK/$SCEN.err" | head -n1)
+    serial=$(jv "$i_line" serial_number)
+    case "$serial" in '' | *[!0-9]*) fail "$h: pmu/info serial_number '$serial' ($(tail -n1 "$WORK/$SCEN.err"))" ;; esac
+    c_line=$(ctl "$h" --timeout 20 config get 2>"$WORK/$SCEN.err" | head -n1)
+    same "$(jv "$c_line" payload_voltage)" 12.0 || fail "$h: pmu/config payload_voltage '$(jv "$c_line" payload_voltage)', want 12.0 ($(tail -n1 "$WORK/$SCEN.err"))"
+    eval "serial_$h=$serial"
+  done
+  [ "$serial_mc2" = "$serial_gnd" ] || fail "pmu/info serial $serial_mc2 in mc2 but $serial_gnd in gnd"
+  detail "mc2 and gnd: pmu/health ONLINE, pmu/info serial $serial_gnd, pmu/config payload_voltage 12.0"
+  # The late joiner: a new participant in gnd, the service up for at least 20 s.
+  sleep_until "$(calc "$t0 + 20")"
+  for verb in "config get" info; do
+    a=$(now)
+    line=$(ctl gnd --timeout 30 $verb 2>"$WORK/$SCEN.err" | head -n1)
+    took=$(since "$a")
+    case $verb in
+      info) same "$(jv "$line" serial_number)" "$serial_gnd" || fail "late joiner in gnd: pmuctl info gave '$line' ($(tail -n1 "$WORK/$SCEN.err"))" ;;
+      *) same "$(jv "$line" payload_voltage)" 12.0 || fail "late joiner in gnd: pmuctl config get gave '$line' ($(tail -n1 "$WORK/$SCEN.err"))" ;;
+    esac
+    true_that "$took <= $LATE_JOIN_BOUND" || fail "late joiner in gnd: pmuctl $verb took $took s (bound $LATE_JOIN_BOUND s)"
+    detail "late joiner in gnd ($(calc "$a - $t0") s after the service started): pmuctl $verb answered in $took s (bound $LATE_JOIN_BOUND s, includes discovery over the ground link and pmuctl's 0.3 s settle)"
+  done
+}
+
+# 500 commands from the ground over the impaired link, pipelined, resent with the same id
+# when unanswered: exactly 500 final replies, all COMPLETED with the value read back, and
+# the audit trail shows each id executed exactly once (resends answered again, not executed).
+BULK_COUNT=500
+BULK_WINDOW=8      # in flight at once
+BULK_RESEND=1.5    # s without a final reply before a resend with the same id
+BULK_DEADLINE=200  # s for the whole batch
+# The device's side as a second witness, next to the audit trail (which the service writes
+# itself): pmu/health frames_sent counts every frame sent to the PMU. Each execution of a set
+# is two frames, the set and the get that reads it back; with `retries: 0` no get is sent
+# twice (the in-process simulated PMU answers at once; a 5 s reply timeout covers a stalled
+# emulated VM: 2 s was once too short at a host load of 21), streaming needs no polls, so the
+# count must grow by exactly 2 x 500.
+COMMANDS_TIMEOUTS='timeouts:
+  reply: 5.0
+  retries: 0'
+field_ready() { F0=$(frames_sent); case "$F0" in '' | *[!0-9]*) return 1 ;; esac; }
+frames_settled() { _before=$F0; sleep 1.5; field_ready && [ "$F0" = "$_before" ]; }
+frames_sent() { jv "$(ctl mc2 --timeout 20 health 2>/dev/null | head -n1)" frames_sent; }
+scenario_commands() {
+  start_service mc1 "$COMMANDS_TIMEOUTS"
+  t0=$(now)
+  wait_until 60 field_ready || fail "no pmu/health with frames_sent in mc2 within 60 s"
+  # The start-up reading (identity, every parameter) sends frames too: wait until it is over.
+  wait_until 60 frames_settled || fail "pmu/health frames_sent still growing 60 s after the start ($F0)"
+  f0=$F0
+  out="$WORK/$SCEN.ground.out"
+  set -- $(vm_ticks); vb0=$1 vt0=$2; l0=$(link_bytes)
+  $NETNS_EXEC gnd lab_ground --domain "$DOMAIN" --tag bulk --count "$BULK_COUNT" --window "$BULK_WINDOW" \
+    --resend "$BULK_RESEND" --deadline "$BULK_DEADLINE" --expires-in 60 --wait-match 90 \
+    --values 12.5,13.5 >"$out" 2>"$out.err" &
+  track $!
+  wait $! || fail "lab_ground exited with status $?: $(tail -n2 "$out.err" | tr '\n' ' ')"
+  set -- $(vm_ticks); vb1=$1 vt1=$2; l1=$(link_bytes)
+  s=$(grep '"batch":"bulk"' "$out" | tail -n1)
+  [ -n "$s" ] || fail "lab_ground printed no summary: $(tail -n2 "$out" "$out.err" | tr '\n' ' ')"
+  log "summary: $(printf '%s' "$s" | cut -c1-600)"
+  [ "$(jv "$s" matched_before_first_send)" = true ] || fail "the ground station did not match the service within 90 s"
+  sent=$(jv "$s" sent); finals=$(jv "$s" final_replies); completed=$(jv "$s" COMPLETED)
+  resends=$(jv "$s" resends); dups=$(jv "$s" duplicates)
+  p50=$(jv "$s" p50); p99=$(jv "$s" p99); max=$(jv "$s" max)
+  took=$(calc "$(jv "$s" t_end) - $(jv "$s" t_first_send)")
+  [ "$sent" = "$BULK_COUNT" ] || fail "sent $sent commands of $BULK_COUNT before the ${BULK_DEADLINE} s deadline"
+  [ "$finals" = "$BULK_COUNT" ] || fail "$finals final replies for $BULK_COUNT commands; without a reply: $(jlist "$s" no_reply | cut -c1-200)"
+  [ "$completed" = "$BULK_COUNT" ] || fail "$completed of $BULK_COUNT COMPLETED (results: $(printf '%s' "$s" | sed 's/.*"results":\({[^}]*}\).*/\1/'))"
+  [ -z "$(jlist "$s" value_mismatch)" ] || fail "COMPLETED without the value read back: $(jlist "$s" value_mismatch | cut -c1-200)"
+  detail "$BULK_COUNT commands (payload_voltage 12.5/13.5, $BULK_WINDOW in flight, resend after ${BULK_RESEND} s) in $took s: $finals final replies, all COMPLETED with the value read back; $resends resends, $dups duplicate replies"
+  detail "round trip p50 $p50 ms, p99 $p99 ms, max $max ms (min $(jv "$s" min), p90 $(jv "$s" p90))"
+  # What limited it: the link (250 kbit/s each way) or the emulated CPUs.
+  set -- $l0 $l1
+  detail "meanwhile: VM CPUs $(calc "100 * ($vb1 - $vb0) / ($vt1 - $vt0)") % busy; ground link $(calc "($3 - $1) * 8 / 1000 / $took") kbit/s to gnd, $(calc "($4 - $2) * 8 / 1000 / $took") kbit/s to the aircraft (cap 250)"
+  # The audit trail: every id exactly one final line, COMPLETED; nothing else of this batch.
+  audit_lines bulk- >"$WORK/$SCEN.audit"
+  bad=$(awk -v n="$BULK_COUNT" '
+    { id = $1; num = substr(id, 6) + 0
+      if (substr(id, 6) != num "" || num < 1 || num > n) { print "unexpected id " id; next }
+      c[num]++; if ($2 != "COMPLETED") print id " " $2 }
+    END { for (i = 1; i <= n; i++) { if (!c[i]) print "bulk-" i " never executed"; else if (c[i] > 1) print "bulk-" i " executed " c[i] " times" } }' "$WORK/$SCEN.audit")
+  [ -z "$bad" ] || fail "audit trail: $(printf '%s\n' "$bad" | head -n 5 | tr '\n' ';') ($(printf '%s\n' "$bad" | wc -l) problems)"
+  dup_lines=$(duplicate_lines bulk- | wc -l)
+  dup_ids=$(duplicate_lines bulk- | sort -u | wc -l)
+  # Each resend the service received is one `answered again, not executed` line; a resend can
+  # only be received, not multiplied, so there are never more such lines than resends.
+  [ "$dup_lines" -le "$resends" ] || fail "audit trail: $dup_lines 'answered again' lines for $resends resends"
+  detail "audit trail: each of the $BULK_COUNT ids executed exactly once, COMPLETED; $dup_lines resends of $dup_ids ids answered again, not executed"
+  sleep 2   # pmu/health is published once a second
+  f1=$(frames_sent)
+  case "$f0$f1" in '' | *[!0-9]*) fail "pmu/health frames_sent unreadable ('$f0', '$f1')" ;; esac
+  [ $((f1 - f0)) -eq $((2 * BULK_COUNT)) ] ||
+    fail "pmu/health frames_sent grew by $((f1 - f0)) during the batch; $BULK_COUNT sets executed once each send $((2 * BULK_COUNT))"
+  detail "pmu/health frames_sent $f0 -> $f1: exactly 2 frames (set, read-back) per command"
+  # The premise of "never executed twice": resends happened. With 10 % loss each way they are
+  # hundreds (the reliable, in-order streams hold replies behind every repair: README).
+  [ "$resends" -gt 0 ] || fail "premise: no request was resent, so nothing tested that a resend is not executed again"
+}
+
+# Shared by the two cut scenarios: the service in mc1, telemetry watched in gnd, the ground
+# station in gnd; one command before the cut (its value, 13.0, is what pmu/config must still
+# show after the cut).
+cut_setup() {
+  start_service mc1
+  SVC=$SVC_PID
+  start_watch gnd gnd
+  start_ground gnd
+  wait_until 90 stream_has_after gnd 0 || fail "no telemetry in gnd within 90 s of the start"
+  ground_batch pre 60 count=1 values=13.0 timeout=30 resend=1.5 wait-match=60
+  [ "$(jv "$BATCH" COMPLETED)" = 1 ] || fail "the command before the cut did not complete: $BATCH"
+}
+
+# cut_command OFFSET TAG VALUE EXPIRES_IN TIMEOUT: queues one command for OFFSET s into the
+# cut that sets payload_voltage to VALUE (a value no other command uses), sent once (no
+# resend), without waiting for a match, given up by the client after TIMEOUT s.
+cut_command() {
+  ground_queue "$2" at="$(calc "$T_CUT + $1")" count=1 values="$3" expires-in="$4" timeout="$5" resend=0 wait-match=0
+  CUT_TAGS="$CUT_TAGS $2"
+}
+# Each must have ended as a TIMEOUT at the client, before the restore.
+check_cut_timeouts() {
+  SENT_AT=""
+  for tag in $CUT_TAGS; do
+    ground_wait "$tag" 30
+    [ "$(jlist "$BATCH" client_timeouts)" = "$tag-1" ] || fail "$tag: not a TIMEOUT at the client: $BATCH"
+    true_that "$(jv "$BATCH" t_end) <= $T_UP" || fail "$tag: the client gave up only $(calc "$(jv "$BATCH" t_end) - $T_UP") s after the restore"
+    SENT_AT="$SENT_AT $tag@$(calc "$(jv "$BATCH" t_first_send) - $T_CUT")s"
+  done
+}
+
+# After the cut: none of the cut commands executed (audit trail: no final line, or REJECTED as
+# expired), and pmu/config still has the value of the last command before the cut.
+check_not_executed() {  # TAG...
+  for tag in "$@"; do
+    lines=$(audit_lines "$tag-")
+    [ -z "$lines" ] && continue
+    printf '%s\n' "$lines" | grep -v ' REJECTED: expired ' >/dev/null &&
+      fail "audit trail: a command sent during the cut was executed late: $(printf '%s' "$lines" | tr '\n' ';')"
+  done
+  c_line=$(ctl gnd --timeout 30 config get 2>/dev/null | head -n1)
+  same "$(jv "$c_line" payload_voltage)" 13.0 ||
+    fail "pmu/config payload_voltage is '$(jv "$c_line" payload_voltage)' after the cut; the last command that may run set 13.0"
+}
+
+after_cut_command() {
+  ground_batch "$1" 60 count=1 values=12.0 timeout=30 resend=1.5 wait-match=30
+  [ "$(jv "$BATCH" COMPLETED)" = 1 ] || fail "the command after the restore did not complete: $BATCH"
+}
+
+# The ground link cut for 30 s (longer than the DDS participant lease, 20 s by default, so
+# discovery is lost) and restored: the service is not restarted, discovery and telemetry
+# come back within RESUME_BOUND, commands sent during the cut are TIMEOUTs at the client and
+# never executed, and a command after the restore completes.
+CUT_SECONDS=30
+RESUME_BOUND=20   # s from the restore to rediscovery and to the first telemetry sample in gnd
+LATE_WAIT=15      # s after the restore for anything that could still arrive (LIFESPAN 10 s)
+scenario_cut() {
+  cut_setup
+  set_link_loss 100%
+  T_CUT=$(now)
+  restore_after "$CUT_SECONDS"
+  CUT_TAGS=""
+  # cutA: no expires_at (the service's 10 s default from receipt). cutB, cutC: 3 s ahead.
+  cut_command 1 cutA 17.0 0 4
+  cut_command 12 cutB 17.5 3 4
+  cut_command 24 cutC 18.5 3 4
+  restored
+  lost=$(event_after '"current":0,"endpoint":"commands"' "$T_CUT")
+  during=$(stream_between gnd "$(calc "$T_CUT + 2")" "$T_UP" | wc -l)
+  [ "$during" -eq 0 ] || fail "$during telemetry samples reached gnd during the cut: the cut did not cut"
+  check_cut_timeouts
+  detail "ground link cut (netem loss 100 % both ways) for $(calc "$T_UP - $T_CUT") s; commands sent into it at$SENT_AT all TIMEOUT at the client; no telemetry in gnd during it"
+  wait_until "$RESUME_BOUND" stream_has_after gnd "$T_UP" || fail "no telemetry in gnd within $RESUME_BOUND s of the restore"
+  tele=$(calc "$(first_after gnd "$T_UP") - $T_UP")
+  if [ -n "$lost" ]; then
+    detail "the ground station lost the service's command reader $(calc "$lost - $T_CUT") s into the cut (participant lease)"
+    wait_until "$RESUME_BOUND" has_event_after '"current":1,"endpoint":"commands"' "$T_UP" ||
+      fail "the ground station's command writer did not match the service again within $RESUME_BOUND s of the restore"
+    back=$(event_after '"current":1,"endpoint":"commands"' "$T_UP")
+    disc="$(calc "$back - $T_UP") s"
+  else
+    back=$T_UP
+    disc="never lost"
+  fi
+  detail "after the restore: telemetry in gnd after $tele s, the command writer matched again after $disc (bound $RESUME_BOUND s)"
+  # Anything DDS could still deliver comes within a few repair rounds of the new match.
+  sleep_until "$(calc "$T_UP + $LATE_WAIT")"
+  sleep_until "$(calc "$back + 5")"
+  check_not_executed $CUT_TAGS
+  late=$(grep -c '"event":"late_reply"' "$GROUND_OUT")
+  after_cut_command post
+  alive "$SVC" && [ "$(pidof pmu-service)" = "$SVC" ] || fail "pmu-service is not the same process (pid $SVC, now '$(pidof pmu-service)')"
+  detail "$(since "$T_UP") s after the restore: none of$CUT_TAGS in the audit trail as executed, pmu/config payload_voltage still 13.0, $late late replies; a command after the restore COMPLETED in $(jv "$BATCH" p50) ms; same pid $SVC"
+}
+
+# A cut shorter than the DDS participant lease (20 s): the match survives, so DDS's
+# reliability would deliver the requests written into the cut once the link is back.
+# LIFESPAN (10 s, qos.xml `command`) and the expiry (expires_at) are what keep them from
+# running late: cutA has no expires_at and is 10.7 s old, older than LIFESPAN, at the
+# restore; cutB expired 1.5 s before the restore but is 3.5 s old, younger than LIFESPAN, so
+# DDS delivers it and the service must refuse it.
+# The lease is 20 s from the last announcement (every 3 s) that got through: when the
+# announcements just before the cut were lost (10 % each), it may end within 11 s. Then the
+# match is lost, DDS delivers nothing, and the attempt proves nothing about LIFESPAN or the
+# expiry: it is repeated once with new ids, and a second loss fails the scenario.
+SHORT_CUT_SECONDS=11
+scenario_cut_lifespan() {
+  cut_setup
+  for attempt in 1 2; do
+    set_link_loss 100%
+    T_CUT=$(now)
+    restore_after "$SHORT_CUT_SECONDS"
+    CUT_TAGS=""
+    cut_command 0.3 "cutA$attempt" 17.0 0 4
+    cut_command 7.5 "cutB$attempt" 17.5 2 3
+    restored
+    log "cut from $T_CUT to $T_UP"
+    lost=$(event_after '"current":0,"endpoint":"commands"' "$T_CUT")
+    check_cut_timeouts
+    [ -z "$lost" ] && break
+    detail "attempt $attempt: the match was lost $(calc "$lost - $T_CUT") s into the $(calc "$T_UP - $T_CUT") s cut (announcements lost before it); repeating"
+    [ "$attempt" = 2 ] && fail "premise: the match was lost in both attempts; LIFESPAN and the expiry were not exercised"
+    wait_until "$RESUME_BOUND" has_event_after '"current":1,"endpoint":"commands"' "$T_UP" || fail "no match again after the restore"
+    sleep_until "$(calc "$T_UP + $LATE_WAIT")"
+    check_not_executed $CUT_TAGS
+  done
+  detail "ground link cut for $(calc "$T_UP - $T_CUT") s, the match kept; commands sent into it at$SENT_AT all TIMEOUT at the client"
+  sleep_until "$(calc "$T_UP + $LATE_WAIT")"
+  b=$(audit_lines "cutB$attempt-")
+  a=$(audit_lines "cutA$attempt-")
+  [ -z "$a" ] || fail "cutA$attempt, older than LIFESPAN at the restore, reached the service: $a"
+  check_not_executed $CUT_TAGS
+  # The premise of cutB: it was delivered after the restore and refused for its expiry.
+  [ -n "$b" ] || fail "premise: cutB$attempt was never delivered after the restore, so its expiry was not what stopped it"
+  late=$(grep '"event":"late_reply"' "$GROUND_OUT" | sed 's/.*"id":"\([^"]*\)".*"result":"\([^"]*\)".*/\1 \2/' | tr '\n' ',' | sed 's/,$//')
+  detail "$LATE_WAIT s after the restore: cutA$attempt (older than LIFESPAN) never delivered; cutB$attempt delivered late and refused: $(printf '%s' "$b" | cut -d' ' -f2-); pmu/config payload_voltage still 13.0; late replies at the client: ${late:-none}"
+  after_cut_command post
+  alive "$SVC" || fail "pmu-service died"
+  detail "a command after the restore COMPLETED; same pid"
+}
+
+# ---- driver ----------------------------------------------------------------------------
+
+scenario_limit() {  # seconds a scenario may take in the (slow, emulated) VM
+  case "$1" in
+    commands) echo 300 ;;
+    cut | cut_lifespan) echo 200 ;;
+    topology) echo 60 ;;
+    *) echo 150 ;;
+  esac
+}
+
+kill_started() {
+  [ -f "$WORK/pids" ] || return 0
+  for p in $(cat "$WORK/pids"); do kill "$p" 2>/dev/null; done
+  _tries=0
+  while [ $_tries -lt 30 ]; do
+    left=""
+    for p in $(cat "$WORK/pids"); do alive "$p" && left="$left $p"; done
+    [ -z "$left" ] && break
+    sleep 0.1; _tries=$((_tries + 1))
+  done
+  for p in $left; do kill -9 "$p" 2>/dev/null; done
+  rm -f "$WORK/pids"
+}
+
+run_one() {  # NAME INDEX: runs a scenario under its time limit and prints its RESULT line
+  name=$1
+  limit=$(scenario_limit "$name")
+  rm -f "$WORK/$name".*
+  echo "SCENARIO $name (limit ${limit}s)"
+  start=$(now)
+  DOMAIN=$((40 + $2)) timeout "$limit" sh "$0" one "$name"
+  rc=$?
+  secs=$(since "$start")
+  kill_started
+  set_link_loss "$LINK_LOSS"   # a failed cut must not leave the link cut
+  rm -f /dev/shm/fastrtps_* /dev/shm/sem.fastrtps_* 2>/dev/null
+  d=$(cat "$WORK/$name.detail" 2>/dev/null | sed 's/; $//')
+  case $rc in
+    0) echo "RESULT $name PASS ${secs}s $d" ;;
+    77) echo "RESULT $name SKIP ${secs}s $(cat "$WORK/$name.skip" 2>/dev/null)" ;;
+    *)
+      if [ -f "$WORK/$name.fail" ]; then why=$(cat "$WORK/$name.fail"); else why="timed out after ${limit}s or crashed (status $rc)"; fi
+      for f in "$WORK/$name".service*.log "$WORK/$name".ground.out.err "$WORK/$name".*.err; do
+        [ -s "$f" ] && tail -n 6 "$f" | sed "s|^|[$name] $(basename "$f"): |"
+      done
+      echo "RESULT $name FAIL ${secs}s $why${d:+ (so far: $d)}"
+      ;;
+  esac
+}
+
+case "${1:-all}" in
+  one)
+    SCEN=$2
+    : "${DOMAIN:=40}"
+    rm -f "$WORK/pids"
+    "scenario_$SCEN"
+    exit 0
+    ;;
+  all)
+    list=$(sed -n 's/.*pmu\.scenarios=\([^ ]*\).*/\1/p' /proc/cmdline | tr ',' ' ')
+    level=$(sed -n 's/.*pmu\.service_log=\([^ ]*\).*/\1/p' /proc/cmdline)
+    [ -n "$level" ] && export PMU_SERVICE_LOG_LEVEL=$level
+    [ -n "$list" ] || list=$ALL_SCENARIOS
+    SCEN=setup
+    if ! lab_up >"$WORK/setup.log" 2>&1; then
+      sed 's/^/[setup] /' "$WORK/setup.log"
+      echo "RESULT setup FAIL 0s could not build the lab's namespaces, bridge and ground link"
+      exit 0
+    fi
+    # Held open for the whole run (every scenario inherits them): set_link_loss writes here.
+    exec 7>"$WORK/tc-air" 8>"$WORK/tc-gnd"
+    echo "LAB: hosts $HOSTS on bridge br0 ($LAN_PREFIX.0/24); ground link $(port_of gnd)<->gnd:eth0 netem delay $LINK_DELAY $LINK_JITTER $LINK_DISTRIBUTION loss $LINK_LOSS rate $LINK_RATE each way"
+    i=0
+    for s in $list; do
+      i=$((i + 1))
+      case " $ALL_SCENARIOS " in
+        *" $s "*) SCEN=$s run_one "$s" "$i" ;;
+        *) echo "RESULT $s FAIL 0s no such scenario (known: $ALL_SCENARIOS)" ;;
+      esac
+    done
+    ;;
+  *) echo "usage: $0 all | one NAME" >&2; exit 2 ;;
+esac
