@@ -298,7 +298,9 @@ sign() {  # sign IN OUT: S/MIME, signed by the Permissions CA, content inside
 sign "$out/governance.xml" "$out/governance.p7s"
 
 # ---- permissions ---------------------------------------------------------------------------
-telemetry=(pmu/voltages pmu/currents pmu/battery_energy pmu/temperatures pmu/status)
+telemetry=(pmu/voltages pmu/currents pmu/battery_energy pmu/temperatures pmu/status
+           pmu/low_rate/voltages pmu/low_rate/currents pmu/low_rate/battery_energy pmu/low_rate/temperatures
+           pmu/low_rate/status)
 state=(pmu/config pmu/info pmu/health)
 
 topics_xml() { for t in "$@"; do printf '            <topic>%s</topic>\n' "$t"; done; }

@@ -214,7 +214,7 @@ EOF
   out=$(pmuctl_on gnd --security-dir "$pki" --identity mission-computer --vehicle uav1 --timeout 10 config set payload_voltage 21 2>&1)
   echo "$out" | grep -q 'COMPLETED' && fail "the mission-computer identity commanded: $out"
   out=$(pmuctl_on gnd --vehicle uav1 --json watch --count 1 --timeout 8 2>&1)
-  echo "$out" | grep -q '"topic"' && fail "a participant without a certificate received telemetry"
+  echo "$out" | grep -q '"topic"' && fail "a participant without a certificate received telemetry: $(echo "$out" | head -2)"
   grep -q 'audit: command .*payload_voltage=21' "$work/air1.log" && fail "the audit trail has the mission computer's command"
   detail="ground-station commands across hosts; mission-computer reads only; no certificate, no data"
   stop_services
