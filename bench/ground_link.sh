@@ -49,6 +49,8 @@ gnd=pmu-gnd-$tag
 work=$(mktemp -d /tmp/pmu-ground-link.XXXXXX)
 pids=()
 cleanup() {
+  # Whatever still runs in the namespaces, then what was started here.
+  for p in $(ip netns pids "$air" 2>/dev/null) $(ip netns pids "$gnd" 2>/dev/null); do kill "$p" 2>/dev/null || true; done
   for p in "${pids[@]}"; do kill "$p" 2>/dev/null || true; done
   wait 2>/dev/null || true
   ip netns del "$air" 2>/dev/null || true

@@ -43,7 +43,7 @@ cmake --build build/fuzz -j"$jobs"
 
 step "sanitizer tests"
 ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
-  ctest --test-dir build/asan --output-on-failure -j"$jobs" -LE 'fuzz|bench|integration|deploy|system'
+  ctest --test-dir build/asan --output-on-failure -j"$jobs" -LE 'fuzz|bench|integration|deploy|system|lab'
 
 step "ThreadSanitizer tests"
 # setarch -R: TSan's fixed memory layout fails under the high mmap randomisation of some

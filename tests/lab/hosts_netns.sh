@@ -36,7 +36,7 @@ done
 skip() { echo "hosts_netns.sh: SKIP: $*" >&2; exit 77; }
 [ "$(id -u)" = 0 ] || skip "needs root for network namespaces"
 command -v nft >/dev/null || skip "nft not found (scripts/setup.sh installs nftables)"
-command -v fastdds >/dev/null || skip "fastdds not found (scripts/setup.sh installs fastdds-tools)"
+command -v fast-discovery-server >/dev/null || skip "fast-discovery-server not found (scripts/setup.sh installs fastdds-tools)"
 svc=$(find "$build_dir" -type f -name pmu-service -perm -u+x | head -n1)
 ctl=$(find "$build_dir" -type f -name pmuctl -perm -u+x | head -n1)
 [ -x "$svc" ] && [ -x "$ctl" ] || { echo "hosts_netns.sh: build pmu-service and pmuctl in $build_dir first" >&2; exit 2; }
@@ -53,7 +53,15 @@ work=$(mktemp -d /tmp/pmu-hosts.XXXXXX)
 pids=()
 ns() { echo "pmu-$1-$tag"; }
 
+# Everything still running in a host's namespace (ip netns pids), killed and waited for.
+kill_in() {  # HOST [SIGNAL]
+  local p
+  for p in $(ip netns pids "$(ns "$1")" 2>/dev/null); do kill "-${2:-TERM}" "$p" 2>/dev/null || true; done
+  for _ in $(seq 50); do [ -z "$(ip netns pids "$(ns "$1")" 2>/dev/null)" ] && return 0; sleep 0.1; done
+  for p in $(ip netns pids "$(ns "$1")" 2>/dev/null); do kill -KILL "$p" 2>/dev/null || true; done
+}
 cleanup() {
+  for h in "${!addr[@]}"; do kill_in "$h"; done
   for p in "${pids[@]}"; do kill "$p" 2>/dev/null || true; done
   wait 2>/dev/null || true
   for h in "${!addr[@]}"; do ip netns del "$(ns "$h")" 2>/dev/null || true; done
@@ -102,16 +110,11 @@ start_service() {  # HOST VEHICLE
   { echo "domain: $domain"; echo "vehicle: $v"; echo "qos_file: $PMU_QOS_FILE"; echo "dds_transport: udp"
     echo "log_level: info"; cat
     printf 'buses:\n  - interface: sim\n    name: can0\n    devices:\n      - address: 1\n        period: 0.5\n'; } > "$cfg"
-  on "$h" "$svc" --config "$cfg" > "$work/$h.log" 2>&1 &
+  # ip netns exec execs the program: $! is the service itself.
+  ip netns exec "$(ns "$h")" "$svc" --config "$cfg" > "$work/$h.log" 2>&1 &
   pids+=($!)
-  eval "svc_$h=$!"
 }
-stop_services() {
-  for h in air1 air2; do
-    local v="svc_$h"
-    if [ -n "${!v:-}" ]; then kill "${!v}" 2>/dev/null || true; wait "${!v}" 2>/dev/null || true; eval "svc_$h="; fi
-  done
-}
+stop_services() { kill_in air1; kill_in air2; }  # kill_in waits until each namespace is empty
 
 result() {  # NAME START FAILURES DETAIL
   local t; t=$(( $(date +%s) - $2 ))
@@ -175,9 +178,9 @@ EOF
 
 check_discovery_server() {
   drop_multicast
-  on ds fastdds discovery -i 0 -l "${addr[ds]}" -p 11811 > "$work/ds.log" 2>&1 &
-  local ds_pid=$!
-  pids+=("$ds_pid")
+  # The server itself (`fastdds discovery` is a wrapper that outlives a signal); SIGINT stops it.
+  ip netns exec "$(ns ds)" fast-discovery-server -i 0 -l "${addr[ds]}" -p 11811 > "$work/ds.log" 2>&1 &
+  pids+=($!)
   start_service air1 uav1 <<EOF
 discovery:
   mode: server
@@ -190,7 +193,7 @@ EOF
   echo "$out" | grep -q '"result":"COMPLETED"' || fail "discovery server: command: $out"
   detail="multicast dropped; service and ground found each other through fastdds discovery on ${addr[ds]}"
   stop_services
-  kill "$ds_pid" 2>/dev/null; wait "$ds_pid" 2>/dev/null
+  kill_in ds INT
   allow_multicast
 }
 
@@ -208,6 +211,11 @@ security:
 EOF
   local out
   out=$(pmuctl_on gnd --security-dir "$pki" --identity ground-station --vehicle uav1 --timeout 30 --json config set payload_voltage 20 2>&1)
+  # One more participant if the first met no service: once in a loaded full run the secure
+  # handshake had not completed within 30 s (seen once, not reproduced alone). What is checked
+  # is that the command gets through at all, and once.
+  echo "$out" | grep -q '"result":"COMPLETED"' ||
+    out=$(pmuctl_on gnd --security-dir "$pki" --identity ground-station --vehicle uav1 --timeout 30 --json config set payload_voltage 20 2>&1)
   echo "$out" | grep -q '"result":"COMPLETED"' || fail "ground-station identity: command: $(echo "$out" | tail -3)"
   out=$(pmuctl_on gnd --security-dir "$pki" --identity mission-computer --vehicle uav1 --json watch --count 5 --timeout 30 2>&1)
   [ "$(echo "$out" | grep -c '"topic"')" -eq 5 ] || fail "mission-computer identity: telemetry: $(echo "$out" | tail -3)"
