@@ -290,7 +290,7 @@ check_every_topic() {  # FILE ADDRESS...
   _f=$1; shift
   for a in "$@"; do
     for topic in voltages currents battery_energy temperatures status; do
-      grep -q "\"topic\":\"$topic\",\"bus\":\"$IFACE\",\"address\":$a," "$_f" ||
+      grep -q "\"topic\":\"$topic\",\"vehicle\":\"\",\"bus\":\"$IFACE\",\"address\":$a," "$_f" ||
         fail "no pmu/$topic sample from address $a among $(wc -l <"$_f")"
     done
   done
