@@ -106,11 +106,10 @@ struct DdsCommandEndpoint::Impl final : public DataReaderListener {
     std::string why;
     if (s.vehicle != vehicle) {
       why = "is for vehicle '" + printable(s.vehicle) + "'";
-    } else if (const auto p = writers.partitions_of(s.sender); !p) {
-      // Fast DDS reports a writer in discovery before its data arrives; one it has not
-      // reported cannot be judged, so it is not trusted (its client's resend is).
-      why = "came from a writer discovery has not reported (yet)";
-    } else if (!partitions_address_only(*p, vehicle)) {
+    } else if (const auto p = writers.partitions_of(s.sender); p && !partitions_address_only(*p, vehicle)) {
+      // A writer discovery has not reported is judged by `vehicle` alone: a sample's writer
+      // GUID need not be the one discovery announced (a writer may set its own sample
+      // identity), and refusing those refused every command of such clients.
       why = "was written in " + partition_list(*p) + ", not in " + partition_list(vehicle_partitions(vehicle)) +
             " alone";
     } else {
