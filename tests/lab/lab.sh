@@ -52,40 +52,13 @@ NETNS_EXEC="/usr/sbin/ip netns exec"
 on() { _host=$1; shift; $NETNS_EXEC "$_host" "$@"; }
 
 log() { read -r _up _idle </proc/uptime; echo "[$SCEN] $_up $*"; }   # with the VM's uptime
-now() { read -r _up _idle </proc/uptime; echo "$_up"; }          # seconds since boot, 10 ms
-since() { awk -v a="$1" -v b="$(now)" 'BEGIN { printf "%.2f", b - a }'; }
-calc() { awk "BEGIN { printf \"%.2f\", $* }"; }                     # calc '1 + 2'
-true_that() { awk "BEGIN { exit !($*) }"; }                          # true_that '1.5 <= 2'
-fail() { echo "$*" >"$WORK/$SCEN.fail"; log "FAIL: $*"; diagnose; exit 1; }
-skip() { echo "$*" >"$WORK/$SCEN.skip"; log "SKIP: $*"; exit 77; }
-detail() { printf '%s; ' "$*" >>"$WORK/$SCEN.detail"; log "$*"; }
+# Shared with tests/system/scenarios.sh; run_vm_tests.sh puts it beside this script in the VM.
+. "$(dirname "$0")/scenario_lib.sh"
 # sleep_until T: sleeps until uptime T (returns at once when T has passed)
 sleep_until() { _rest=$(calc "$1 - $(now)"); true_that "$_rest > 0" && sleep "$_rest"; return 0; }
 
-# Value of KEY in one line of JSON (flat or nested, first occurrence), quotes removed.
-jv() { printf '%s\n' "$1" | sed -n "s/.*\"$2\":\([^,}]*\).*/\1/p" | tr -d '"'; }
 # The items of the JSON list KEY (strings), space separated.
 jlist() { printf '%s\n' "$1" | sed -n "s/.*\"$2\":\[\([^]]*\)\].*/\1/p" | tr -d '"' | tr ',' ' '; }
-same() {
-  awk -v a="$1" -v b="$2" 'BEGIN {
-    if (a == b) exit 0
-    if (a ~ /^-?[0-9.]+$/ && b ~ /^-?[0-9.]+$/ && (a - b) ^ 2 < 1e-6) exit 0
-    exit 1 }'
-}
-
-# Runs "$@" every 0.2 s until it succeeds or SECONDS pass.
-wait_until() {
-  _limit=$1; shift
-  _start=$(now)
-  while ! "$@"; do
-    true_that "$(since "$_start") >= $_limit" && return 1
-    sleep 0.2
-  done
-  return 0
-}
-
-track() { echo "$1" >>"$WORK/pids"; }
-alive() { [ -d "/proc/$1" ] && ! grep -q '^State:.*Z' "/proc/$1/status" 2>/dev/null; }
 
 # What the link and the processes look like at a failure, on the console.
 diagnose() {
@@ -571,59 +544,15 @@ scenario_limit() {  # seconds a scenario may take in the (slow, emulated) VM
   esac
 }
 
-kill_started() {
-  [ -f "$WORK/pids" ] || return 0
-  for p in $(cat "$WORK/pids"); do kill "$p" 2>/dev/null; done
-  _tries=0
-  while [ $_tries -lt 30 ]; do
-    left=""
-    for p in $(cat "$WORK/pids"); do alive "$p" && left="$left $p"; done
-    [ -z "$left" ] && break
-    sleep 0.1; _tries=$((_tries + 1))
-  done
-  for p in $left; do kill -9 "$p" 2>/dev/null; done
-  rm -f "$WORK/pids"
-}
-
-run_one() {  # NAME INDEX: runs a scenario under its time limit and prints its RESULT line
-  name=$1
-  limit=$(scenario_limit "$name")
-  rm -f "$WORK/$name".*
-  echo "SCENARIO $name (limit ${limit}s)"
-  start=$(now)
-  DOMAIN=$((40 + $2)) timeout "$limit" sh "$0" one "$name"
-  rc=$?
-  secs=$(since "$start")
-  kill_started
-  set_link_loss "$LINK_LOSS"   # a failed cut must not leave the link cut
-  rm -f /dev/shm/fastrtps_* /dev/shm/sem.fastrtps_* 2>/dev/null
-  d=$(cat "$WORK/$name.detail" 2>/dev/null | sed 's/; $//')
-  case $rc in
-    0) echo "RESULT $name PASS ${secs}s $d" ;;
-    77) echo "RESULT $name SKIP ${secs}s $(cat "$WORK/$name.skip" 2>/dev/null)" ;;
-    *)
-      if [ -f "$WORK/$name.fail" ]; then why=$(cat "$WORK/$name.fail"); else why="timed out after ${limit}s or crashed (status $rc)"; fi
-      for f in "$WORK/$name".service*.log "$WORK/$name".ground.out.err "$WORK/$name".*.err; do
-        [ -s "$f" ] && tail -n 6 "$f" | sed "s|^|[$name] $(basename "$f"): |"
-      done
-      echo "RESULT $name FAIL ${secs}s $why${d:+ (so far: $d)}"
-      ;;
-  esac
-}
+# A failed cut must not leave the link cut.
+after_scenario() { set_link_loss "$LINK_LOSS"; }
+FAIL_LOGS="service*.log ground.out.err *.err"
+DOMAIN_BASE=40
 
 case "${1:-all}" in
-  one)
-    SCEN=$2
-    : "${DOMAIN:=40}"
-    rm -f "$WORK/pids"
-    "scenario_$SCEN"
-    exit 0
-    ;;
+  one) run_scenario "$2" ;;
   all)
-    list=$(sed -n 's/.*pmu\.scenarios=\([^ ]*\).*/\1/p' /proc/cmdline | tr ',' ' ')
-    level=$(sed -n 's/.*pmu\.service_log=\([^ ]*\).*/\1/p' /proc/cmdline)
-    [ -n "$level" ] && export PMU_SERVICE_LOG_LEVEL=$level
-    [ -n "$list" ] || list=$ALL_SCENARIOS
+    pick_scenarios
     SCEN=setup
     if ! lab_up >"$WORK/setup.log" 2>&1; then
       sed 's/^/[setup] /' "$WORK/setup.log"
@@ -633,14 +562,7 @@ case "${1:-all}" in
     # Held open for the whole run (every scenario inherits them): set_link_loss writes here.
     exec 7>"$WORK/tc-air" 8>"$WORK/tc-gnd"
     echo "LAB: hosts $HOSTS on bridge br0 ($LAN_PREFIX.0/24); ground link $(port_of gnd)<->gnd:eth0 netem delay $LINK_DELAY $LINK_JITTER $LINK_DISTRIBUTION loss $LINK_LOSS rate $LINK_RATE each way"
-    i=0
-    for s in $list; do
-      i=$((i + 1))
-      case " $ALL_SCENARIOS " in
-        *" $s "*) SCEN=$s run_one "$s" "$i" ;;
-        *) echo "RESULT $s FAIL 0s no such scenario (known: $ALL_SCENARIOS)" ;;
-      esac
-    done
+    run_list $SCENARIOS
     ;;
   *) echo "usage: $0 all | one NAME" >&2; exit 2 ;;
 esac

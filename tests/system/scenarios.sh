@@ -28,11 +28,6 @@ mkdir -p "$WORK"
 ip() { /usr/sbin/ip "$@"; }
 
 log() { echo "[$SCEN] $*"; }
-now() { read -r _up _idle </proc/uptime; echo "$_up"; }          # seconds since boot, 10 ms
-since() { awk -v a="$1" -v b="$(now)" 'BEGIN { printf "%.2f", b - a }'; }
-calc() { awk "BEGIN { printf \"%.2f\", $* }"; }                     # calc '1 + 2'
-true_that() { awk "BEGIN { exit !($*) }"; }                          # true_that '1.5 <= 2'
-fail() { echo "$*" >"$WORK/$SCEN.fail"; log "FAIL: $*"; diagnose; exit 1; }
 # What the bus and the service look like at a failure, on the console.
 diagnose() {
   log "diag: $(ip -br link show "$IFACE" 2>&1)"
@@ -41,32 +36,7 @@ diagnose() {
   log "diag: processes: $(for p in $(cat "$WORK/pids" 2>/dev/null); do alive "$p" && printf '%s ' "$p:$(tr '\0' ' ' <"/proc/$p/cmdline" | cut -c1-40)"; done)"
   log "diag: health: $(ctl --timeout 5 health 2>&1 | head -n 3 | tr '\n' ' ')"
 }
-skip() { echo "$*" >"$WORK/$SCEN.skip"; log "SKIP: $*"; exit 77; }
-detail() { printf '%s; ' "$*" >>"$WORK/$SCEN.detail"; log "$*"; }
-
-# Value of KEY in a one-line JSON object (the flat `values` of pmuctl --json), quotes removed.
-jv() { printf '%s\n' "$1" | sed -n "s/.*\"$2\":\([^,}]*\).*/\1/p" | tr -d '"'; }
-# Numbers compare with a tolerance, everything else as text.
-same() {
-  awk -v a="$1" -v b="$2" 'BEGIN {
-    if (a == b) exit 0
-    if (a ~ /^-?[0-9.]+$/ && b ~ /^-?[0-9.]+$/ && (a - b) ^ 2 < 1e-6) exit 0
-    exit 1 }'
-}
-
-# Runs "$@" every 0.2 s until it succeeds or SECONDS pass.
-wait_until() {
-  _limit=$1; shift
-  _start=$(now)
-  while ! "$@"; do
-    true_that "$(since "$_start") >= $_limit" && return 1
-    sleep 0.2
-  done
-  return 0
-}
-
-track() { echo "$1" >>"$WORK/pids"; }
-alive() { [ -d "/proc/$1" ] && ! grep -q '^State:.*Z' "/proc/$1/status" 2>/dev/null; }
+. "$(dirname "$0")/scenario_lib.sh"
 
 NSIM=0
 start_sim() {  # pmu-sim options
@@ -463,72 +433,20 @@ scenario_limit() {  # seconds a scenario may take in the (slow, emulated) VM
   esac
 }
 
-kill_started() {
-  [ -f "$WORK/pids" ] || return 0
-  for p in $(cat "$WORK/pids"); do kill "$p" 2>/dev/null; done
-  _tries=0
-  while [ $_tries -lt 30 ]; do
-    left=""
-    for p in $(cat "$WORK/pids"); do alive "$p" && left="$left $p"; done
-    [ -z "$left" ] && break
-    sleep 0.1; _tries=$((_tries + 1))
-  done
-  for p in $left; do kill -9 "$p" 2>/dev/null; done
-  rm -f "$WORK/pids"
-}
-
 restore_bus() {
   ip link show "$IFACE" >/dev/null 2>&1 || ip link add "$IFACE" type vcan
   ip link set "$IFACE" up
 }
 
-run_one() {  # NAME INDEX: runs a scenario under its time limit and prints its RESULT line
-  name=$1
-  limit=$(scenario_limit "$name")
-  rm -f "$WORK/$name".*
-  echo "SCENARIO $name (limit ${limit}s)"
-  start=$(now)
-  DOMAIN=$((20 + $2)) timeout "$limit" sh "$0" one "$name"
-  rc=$?
-  secs=$(since "$start")
-  kill_started
-  restore_bus
-  rm -f /dev/shm/fastrtps_* /dev/shm/sem.fastrtps_* 2>/dev/null
-  d=$(cat "$WORK/$name.detail" 2>/dev/null | sed 's/; $//')
-  case $rc in
-    0) echo "RESULT $name PASS ${secs}s $d" ;;
-    77) echo "RESULT $name SKIP ${secs}s $(cat "$WORK/$name.skip" 2>/dev/null)" ;;
-    *)
-      if [ -f "$WORK/$name.fail" ]; then why=$(cat "$WORK/$name.fail"); else why="timed out after ${limit}s or crashed (status $rc)"; fi
-      for f in "$WORK/$name".service.log "$WORK/$name".sim*.log "$WORK/$name".stream.err; do
-        [ -s "$f" ] && tail -n 8 "$f" | sed "s|^|[$name] $(basename "$f"): |"
-      done
-      echo "RESULT $name FAIL ${secs}s $why${d:+ (so far: $d)}"
-      ;;
-  esac
-}
+after_scenario() { restore_bus; }
+FAIL_LOGS="service.log sim*.log stream.err"
+DOMAIN_BASE=20
 
 case "${1:-all}" in
-  one)
-    SCEN=$2
-    : "${DOMAIN:=20}"
-    rm -f "$WORK/pids"
-    "scenario_$SCEN"
-    exit 0
-    ;;
+  one) run_scenario "$2" ;;
   all)
-    list=$(sed -n 's/.*pmu\.scenarios=\([^ ]*\).*/\1/p' /proc/cmdline | tr ',' ' ')
-    level=$(sed -n 's/.*pmu\.service_log=\([^ ]*\).*/\1/p' /proc/cmdline)
-    [ -n "$level" ] && export PMU_SERVICE_LOG_LEVEL=$level
-    [ -n "$list" ] || list=$ALL_SCENARIOS
-    i=0
-    for s in $list; do
-      i=$((i + 1))
-      case " $ALL_SCENARIOS " in
-        *" $s "*) SCEN=$s run_one "$s" "$i" ;;
-        *) echo "RESULT $s FAIL 0s no such scenario (known: $ALL_SCENARIOS)" ;;
-      esac
-    done
+    pick_scenarios
+    run_list $SCENARIOS
     ;;
   *) echo "usage: $0 all | one NAME" >&2; exit 2 ;;
 esac
