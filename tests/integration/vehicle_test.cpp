@@ -20,15 +20,10 @@
 #include "pmu/idl/telemetry.h"
 #include "pmu/idl/telemetryPubSubTypes.h"
 #include "pmu/idl/topics.hpp"
-#include "pmu/service/bus_worker.hpp"
-#include "pmu/service/command_service.hpp"
-#include "pmu/service/dds_commands.hpp"
 #include "pmu/service/dds_context.hpp"
-#include "pmu/service/dds_publisher.hpp"
 #include "pmu/service/vehicle.hpp"
-#include "pmu/sim/bus_runner.hpp"
-#include "pmu/transport/sim_bus.hpp"
 #include "support/domain.hpp"
+#include "support/in_process_service.hpp"
 #include "support/wait.hpp"
 
 namespace pmu::service {
@@ -37,56 +32,13 @@ namespace {
 using namespace eprosima::fastdds::dds;
 using namespace std::chrono_literals;
 
-// One vehicle's pmu-service, assembled as main.cpp does, on its own simulated bus.
-struct VehicleService {
-  VehicleService(int domain, const std::string& vehicle)
-      : network(clock),
-        pmus(network.attach("pmu-sim"), clock),
-        dds(domain, "", "pmu-service-" + vehicle, {}, dds::Transport::Default, {},
-            {vehicle_partitions(vehicle), vehicle_partitions(vehicle)}),
-        publisher(dds, 3s, vehicle),
-        worker(bus_config(), network.attach("sim0"), clock, Timeouts{}, publisher),
-        endpoint(dds, &publisher, vehicle),
-        service({&worker}, PolicyConfig{}, Timeouts{}, clock, [this](const CommandReplyData& r) { endpoint.publish(r); }) {
-    sim::DeviceConfig d;
-    d.address = 1;
-    pmus.add(d);
-    pmus.start();
-    thread = std::thread([this] { worker.run(); });
-    endpoint.start(service);
-  }
-  ~VehicleService() {
-    endpoint.stop();
-    worker.stop();
-    thread.join();
-    pmus.stop();
-  }
-  static BusConfig bus_config() {
-    BusConfig bus;
-    bus.name = "sim0";
-    bus.interface = "sim";
-    DeviceConfig d;
-    d.address = 1;
-    bus.devices.push_back(d);
-    return bus;
-  }
-  // The stored raw value: what a set changes on the unit itself.
-  std::uint32_t payload_voltage() {
-    std::uint32_t v = 0;
-    pmus.with_model(1, [&](sim::PmuModel& m) { v = m.parameter(codec::Parameter::PayloadVoltage); });
-    return v;
-  }
+using VehicleService = pmu::test::InProcessService;
 
-  transport::SystemClock clock;
-  transport::SimulatedNetwork network;
-  sim::BusRunner pmus;
-  dds::DdsContext dds;
-  DdsPublisher publisher;
-  BusWorker worker;
-  DdsCommandEndpoint endpoint;
-  CommandService service;
-  std::thread thread;
-};
+std::unique_ptr<VehicleService> vehicle_service(int domain, const std::string& vehicle) {
+  VehicleService::Options o;
+  o.vehicle = vehicle;
+  return std::make_unique<VehicleService>(domain, o);
+}
 
 // A ground station: reads in `read` partitions, writes commands in `write` partitions.
 struct Ground {
@@ -143,7 +95,7 @@ class Vehicles : public ::testing::Test {
  protected:
   void SetUp() override {
     domain_ = pmu::test::exclusive_dds_domain();
-    for (const char* v : {"", "uav1", "uav2"}) services_[v] = std::make_unique<VehicleService>(domain_, v);
+    for (const char* v : {"", "uav1", "uav2"}) services_[v] = vehicle_service(domain_, v);
   }
   // Waits until `g` has the command readers it should match, and every service has told its
   // state (the start-up reading is over: a set is answered against a known configuration).
@@ -200,9 +152,9 @@ TEST_F(Vehicles, AGroundStationWithDefaultSettingsSeesEveryVehicleAndWhichSample
 TEST_F(Vehicles, ACommandReachesOnlyItsVehicleWhichGivesTheOneReply) {
   Ground g(domain_, "ground-uav1", only("uav1"));
   ready(g, 1);  // its partition holds uav1's command reader alone
-  const auto before_unnamed = services_[""]->payload_voltage();
-  const auto before_uav1 = services_["uav1"]->payload_voltage();
-  const auto before_uav2 = services_["uav2"]->payload_voltage();
+  const auto before_unnamed = services_[""]->parameter(codec::Parameter::PayloadVoltage);
+  const auto before_uav1 = services_["uav1"]->parameter(codec::Parameter::PayloadVoltage);
+  const auto before_uav2 = services_["uav2"]->parameter(codec::Parameter::PayloadVoltage);
   g.send("to-uav1", "uav1", kNewPayloadVoltage);
   std::vector<pmu::CommandReply> replies;
   ASSERT_TRUE(pmu::test::wait_until(
@@ -216,17 +168,17 @@ TEST_F(Vehicles, ACommandReachesOnlyItsVehicleWhichGivesTheOneReply) {
   ASSERT_EQ(replies.size(), 1u);
   EXPECT_EQ(replies[0].vehicle().to_string(), "uav1");
   EXPECT_EQ(replies[0].result(), pmu::COMPLETED) << replies[0].reason();
-  EXPECT_NE(services_["uav1"]->payload_voltage(), before_uav1);
-  EXPECT_EQ(services_[""]->payload_voltage(), before_unnamed);
-  EXPECT_EQ(services_["uav2"]->payload_voltage(), before_uav2);
-  EXPECT_EQ(services_["uav2"]->service.counters().received, 0u) << "uav2's service received uav1's command";
-  EXPECT_EQ(services_[""]->service.counters().received, 0u);
+  EXPECT_NE(services_["uav1"]->parameter(codec::Parameter::PayloadVoltage), before_uav1);
+  EXPECT_EQ(services_[""]->parameter(codec::Parameter::PayloadVoltage), before_unnamed);
+  EXPECT_EQ(services_["uav2"]->parameter(codec::Parameter::PayloadVoltage), before_uav2);
+  EXPECT_EQ(services_["uav2"]->commands.counters().received, 0u) << "uav2's service received uav1's command";
+  EXPECT_EQ(services_[""]->commands.counters().received, 0u);
 }
 
 TEST_F(Vehicles, TheUnnamedVehicleIsCommandedAsBeforeVehiclesExisted) {
   Ground g(domain_, "ground-unnamed", only(""));
   ready(g, 1);
-  const auto before = services_[""]->payload_voltage();
+  const auto before = services_[""]->parameter(codec::Parameter::PayloadVoltage);
   g.send("to-unnamed", "", kNewPayloadVoltage);
   std::vector<pmu::CommandReply> replies;
   ASSERT_TRUE(pmu::test::wait_until(
@@ -237,7 +189,7 @@ TEST_F(Vehicles, TheUnnamedVehicleIsCommandedAsBeforeVehiclesExisted) {
       20s));
   EXPECT_EQ(replies[0].vehicle().to_string(), "");
   EXPECT_EQ(replies[0].result(), pmu::COMPLETED) << replies[0].reason();
-  EXPECT_NE(services_[""]->payload_voltage(), before);
+  EXPECT_NE(services_[""]->parameter(codec::Parameter::PayloadVoltage), before);
 }
 
 // A command in uav2's partition that names uav1, and one written in partition "*" (which
@@ -247,7 +199,7 @@ TEST_F(Vehicles, ACommandNotAddressedToThisVehicleAloneIsNeitherExecutedNorAnswe
   Ground wildcard(domain_, "ground-wildcard", {{"*"}, every_vehicle_partitions()});
   ready(wrong_name, 1);
   ready(wildcard, 2);  // uav1's and uav2's: "*" matches every named partition
-  const auto before = services_["uav2"]->payload_voltage();
+  const auto before = services_["uav2"]->parameter(codec::Parameter::PayloadVoltage);
   wrong_name.send("named-uav1-sent-to-uav2", "uav1", kNewPayloadVoltage);
   wildcard.send("wildcard-for-uav2", "uav2", kNewPayloadVoltage);
   auto& uav1 = services_["uav1"]->endpoint;
@@ -256,14 +208,14 @@ TEST_F(Vehicles, ACommandNotAddressedToThisVehicleAloneIsNeitherExecutedNorAnswe
   // which names uav2.
   ASSERT_TRUE(pmu::test::wait_until([&] { return uav2.not_ours() == 2 && uav1.not_ours() == 1; }, 20s))
       << "uav1 ignored " << uav1.not_ours() << ", uav2 ignored " << uav2.not_ours() << "; received: unnamed "
-      << services_[""]->service.counters().received << ", uav1 " << services_["uav1"]->service.counters().received
-      << ", uav2 " << services_["uav2"]->service.counters().received;
+      << services_[""]->commands.counters().received << ", uav1 " << services_["uav1"]->commands.counters().received
+      << ", uav2 " << services_["uav2"]->commands.counters().received;
   std::this_thread::sleep_for(500ms);  // a reply, which must not come, would be here by now
   EXPECT_TRUE(wrong_name.take_replies().empty());
   EXPECT_TRUE(wildcard.take_replies().empty());
-  EXPECT_EQ(services_["uav2"]->payload_voltage(), before);
-  EXPECT_EQ(services_["uav2"]->service.counters().received, 0u);
-  EXPECT_EQ(services_["uav1"]->service.counters().received, 0u);
+  EXPECT_EQ(services_["uav2"]->parameter(codec::Parameter::PayloadVoltage), before);
+  EXPECT_EQ(services_["uav2"]->commands.counters().received, 0u);
+  EXPECT_EQ(services_["uav1"]->commands.counters().received, 0u);
 }
 
 }  // namespace

@@ -58,6 +58,7 @@
 #include "pmu/idl/commandPubSubTypes.h"
 #include "pmu/idl/guarded_type.hpp"
 #include "pmu/idl/topics.hpp"
+#include "pmu/service/command.hpp"
 #include "pmu/service/dds_context.hpp"
 
 namespace {
@@ -75,17 +76,10 @@ double boottime() {
 
 double seconds_between(Clock::time_point a, Clock::time_point b) { return std::chrono::duration<double>(b - a).count(); }
 
+// The service's names for its results; pmu::CommandResult has the same order (static_assert
+// in service/src/dds_commands.cpp). The names are literals, so data() ends in NUL.
 const char* result_name(pmu::CommandResult r) {
-  switch (r) {
-    case pmu::COMPLETED: return "COMPLETED";
-    case pmu::REJECTED: return "REJECTED";
-    case pmu::DENIED: return "DENIED";
-    case pmu::UNSUPPORTED: return "UNSUPPORTED";
-    case pmu::TIMEOUT: return "TIMEOUT";
-    case pmu::FAILED: return "FAILED";
-    case pmu::IN_PROGRESS: return "IN_PROGRESS";
-  }
-  return "FAILED";
+  return pmu::service::to_string(static_cast<pmu::service::CommandResult>(r)).data();
 }
 
 // One line per event or summary; the listener threads and the main thread both print.

@@ -50,6 +50,7 @@
 #include "pmu/service/dds_security.hpp"
 #include "pmu/service/vehicle.hpp"
 #include "pmu/sim/bus_runner.hpp"
+#include "support/in_process_service.hpp"
 #include "pmu/transport/sim_bus.hpp"
 #include "pki_fixture.hpp"
 #include "support/process.hpp"
@@ -72,64 +73,21 @@ using security_test::write_config;
 
 constexpr std::uint8_t kPayload = 0x02;  // output bit 1
 
-struct ServiceUnderTest {
+// Over UDP only: the wire capture looks at loopback.
+struct ServiceUnderTest : pmu::test::InProcessService {
   // `bus_name` is the DDS key of every sample (also something to look for on the wire);
   // `vehicle` the service's vehicle, and so its partition (vehicle.hpp).
   ServiceUnderTest(int domain, const SecurityFiles& files, const std::string& bus_name = "sim0",
                    const std::string& vehicle = "")
-      : network(clock),
-        pmus(network.attach("pmu-sim"), clock),
-        dds(domain, "", "pmu-service", files, dds::Transport::UdpOnly, {},
-            {vehicle_partitions(vehicle), vehicle_partitions(vehicle)}),
-        publisher(dds, 3s, vehicle),
-        worker(bus_config(bus_name), network.attach(bus_name), clock, Timeouts{}, publisher),
-        endpoint(dds, nullptr, vehicle),
-        commands({&worker}, PolicyConfig{}, Timeouts{}, clock, [this](const CommandReplyData& r) { endpoint.publish(r); }) {
-    sim::DeviceConfig d;
-    d.address = 1;
-    d.parameters.set_raw(codec::Parameter::PacketPeriod, 5);  // 0.5 s
-    d.parameters.set_raw(codec::Parameter::PacketsStreamed, 0x1F);
-    pmus.add(d);
-    pmus.start();
-    thread = std::thread([this] { worker.run(); });
-    endpoint.start(commands);
-  }
-  ~ServiceUnderTest() {
-    endpoint.stop();
-    worker.stop();
-    thread.join();
-    pmus.stop();
-  }
-  static BusConfig bus_config(const std::string& name) {
-    BusConfig b;
-    b.name = name;
-    b.interface = "sim";
-    DeviceConfig d;
-    d.address = 1;
-    d.period = 500ms;
-    b.devices.push_back(d);
-    return b;
-  }
-  std::uint8_t outputs() {
-    std::uint8_t o = 0;
-    pmus.with_model(1, [&](sim::PmuModel& m) { o = m.outputs(); });
+      : InProcessService(domain, options(files, bus_name, vehicle)) {}
+  static Options options(const SecurityFiles& files, const std::string& bus_name, const std::string& vehicle) {
+    Options o;
+    o.vehicle = vehicle;
+    o.bus_name = bus_name;
+    o.security = files;
+    o.transport = dds::Transport::UdpOnly;
     return o;
   }
-  std::uint64_t handled() {
-    std::uint64_t n = 0;
-    pmus.with_model(1, [&](sim::PmuModel& m) { n = m.counters().handled; });
-    return n;
-  }
-
-  transport::SystemClock clock;
-  transport::SimulatedNetwork network;
-  sim::BusRunner pmus;
-  dds::DdsContext dds;
-  DdsPublisher publisher;
-  BusWorker worker;
-  DdsCommandEndpoint endpoint;
-  CommandService commands;
-  std::thread thread;
 };
 
 // ---- clients -------------------------------------------------------------------------------

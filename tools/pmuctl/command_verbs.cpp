@@ -18,6 +18,7 @@
 #include "pmu/idl/state.h"
 #include "pmu/idl/statePubSubTypes.h"
 #include "pmu/idl/topics.hpp"
+#include "pmu/service/command.hpp"
 #include "pmu/service/dds_context.hpp"
 #include "pmuctl/dds_json.hpp"
 
@@ -27,17 +28,10 @@ namespace {
 using namespace eprosima::fastdds::dds;
 using Clock = std::chrono::steady_clock;
 
+// The service's names for its results; pmu::CommandResult has the same order (static_assert
+// in service/src/dds_commands.cpp). The names are literals, so data() ends in NUL.
 const char* result_name(pmu::CommandResult r) {
-  switch (r) {
-    case pmu::COMPLETED: return "COMPLETED";
-    case pmu::REJECTED: return "REJECTED";
-    case pmu::DENIED: return "DENIED";
-    case pmu::UNSUPPORTED: return "UNSUPPORTED";
-    case pmu::TIMEOUT: return "TIMEOUT";
-    case pmu::FAILED: return "FAILED";
-    case pmu::IN_PROGRESS: return "IN_PROGRESS";
-  }
-  return "FAILED";
+  return pmu::service::to_string(static_cast<pmu::service::CommandResult>(r)).data();
 }
 
 std::string request_id() {
