@@ -78,6 +78,18 @@ struct Ground {
     return out;
   }
 
+  // Replies as soon as at least one came, or none after `timeout`.
+  std::vector<pmu::CommandReply> first_replies(std::chrono::seconds timeout) {
+    std::vector<pmu::CommandReply> got;
+    pmu::test::wait_until(
+        [&] {
+          for (auto& r : take_replies()) got.push_back(r);
+          return !got.empty();
+        },
+        timeout);
+    return got;
+  }
+
   dds::DdsContext dds;
   DataWriter& writer;
   DataReader& replies;
@@ -156,13 +168,8 @@ TEST_F(Vehicles, ACommandReachesOnlyItsVehicleWhichGivesTheOneReply) {
   const auto before_uav1 = services_["uav1"]->parameter(codec::Parameter::PayloadVoltage);
   const auto before_uav2 = services_["uav2"]->parameter(codec::Parameter::PayloadVoltage);
   g.send("to-uav1", "uav1", kNewPayloadVoltage);
-  std::vector<pmu::CommandReply> replies;
-  ASSERT_TRUE(pmu::test::wait_until(
-      [&] {
-        for (auto& r : g.take_replies()) replies.push_back(r);
-        return !replies.empty();
-      },
-      20s));
+  auto replies = g.first_replies(20s);
+  ASSERT_FALSE(replies.empty()) << "no reply";
   std::this_thread::sleep_for(500ms);  // a second reply, which must not come, would be here by now
   for (auto& r : g.take_replies()) replies.push_back(r);
   ASSERT_EQ(replies.size(), 1u);
@@ -180,13 +187,8 @@ TEST_F(Vehicles, TheUnnamedVehicleIsCommandedAsBeforeVehiclesExisted) {
   ready(g, 1);
   const auto before = services_[""]->parameter(codec::Parameter::PayloadVoltage);
   g.send("to-unnamed", "", kNewPayloadVoltage);
-  std::vector<pmu::CommandReply> replies;
-  ASSERT_TRUE(pmu::test::wait_until(
-      [&] {
-        for (auto& r : g.take_replies()) replies.push_back(r);
-        return !replies.empty();
-      },
-      20s));
+  auto replies = g.first_replies(20s);
+  ASSERT_FALSE(replies.empty()) << "no reply";
   EXPECT_EQ(replies[0].vehicle().to_string(), "");
   EXPECT_EQ(replies[0].result(), pmu::COMPLETED) << replies[0].reason();
   EXPECT_NE(services_[""]->parameter(codec::Parameter::PayloadVoltage), before);
