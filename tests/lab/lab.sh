@@ -281,7 +281,7 @@ scenario_consumers() {
     eval "p=\$watch_$h"
     wait "$p" || fail "$h: pmuctl watch --count 60 failed: $(tail -n1 "$WORK/$SCEN.$h.watch.err")"
     for topic in voltages currents battery_energy temperatures status; do
-      line=$(grep -m1 "\"topic\":\"$topic\",\"bus\":\"sim0\",\"address\":1," "$WORK/$SCEN.$h.watch")
+      line=$(grep -m1 "\"topic\":\"$topic\",\"vehicle\":\"\",\"bus\":\"sim0\",\"address\":1," "$WORK/$SCEN.$h.watch")
       [ -n "$line" ] || fail "$h: no pmu/$topic sample from sim0/1 among $(wc -l <"$WORK/$SCEN.$h.watch")"
     done
     av=$(jv "$(grep -m1 '"topic":"voltages"' "$WORK/$SCEN.$h.watch")" avionics)
