@@ -8,6 +8,14 @@ set(CMAKE_INSTALL_SYSCONFDIR /etc CACHE PATH "read-only single-machine data (/et
 include(GNUInstallDirs)
 set(PMU_SYSCONFDIR "${CMAKE_INSTALL_FULL_SYSCONFDIR}/pmu-dds" CACHE PATH
     "Where pmu-service and pmuctl look for pmu-service.yaml and qos.xml")
+# Read-only data for clients: the IDL and a copy of qos.xml. A machine with only the client
+# tools (pmu-dds-tools, no daemon and so no /etc/pmu-dds) finds its QoS profiles here.
+set(PMU_DATADIR "${CMAKE_INSTALL_FULL_DATADIR}/pmu-dds" CACHE PATH
+    "Where the IDL and the clients' fallback qos.xml are installed")
+# Debian bookworm's systemd and debhelper expect package units in /lib/systemd/system, while
+# an install under /usr/local wants PREFIX/lib/systemd/system: debian/rules sets it.
+set(PMU_SYSTEMD_UNITDIR "${CMAKE_INSTALL_PREFIX}/lib/systemd/system" CACHE PATH
+    "Where the systemd units are installed")
 
 # The binaries learn the directory from this one generated header, so nothing else in the
 # sources names it and no build-tree path reaches an installed binary.

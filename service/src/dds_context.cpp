@@ -74,6 +74,9 @@ std::string default_qos_file() {
   // Only installed places: a binary that also looked in its build tree would carry that
   // path into the package. Runs from a build directory set PMU_QOS_FILE.
   if (const char* installed = PMU_SYSCONFDIR "/qos.xml"; readable(installed)) return installed;
+  // The client tools are packaged without the daemon's /etc/pmu-dds (pmu-dds-tools): their
+  // copy of the profiles is read-only data. The site's edited /etc file still wins.
+  if (const char* shipped = PMU_DATADIR "/qos.xml"; readable(shipped)) return shipped;
   return {};
 }
 
@@ -83,7 +86,7 @@ DdsContext::DdsContext(int domain, const std::string& qos_file, const std::strin
     : domain_(domain), secure_(!security.empty()), security_(security), partitions_(partitions) {
   const std::string file = qos_file.empty() ? default_qos_file() : qos_file;
   qos_file_ = file;
-  if (file.empty()) throw DdsError("no QoS profile file: install deploy/qos.xml as " PMU_SYSCONFDIR "/qos.xml, set PMU_QOS_FILE or set qos_file");
+  if (file.empty()) throw DdsError("no QoS profile file: neither " PMU_SYSCONFDIR "/qos.xml nor " PMU_DATADIR "/qos.xml exists; install deploy/qos.xml, set PMU_QOS_FILE or set qos_file");
   load_profiles_once(file);
   // Transports, discovery, interfaces and security: dds_participant.hpp says what each sets.
   DomainParticipantQos pqos;

@@ -137,7 +137,7 @@ int main(int argc, char** argv) {
   app.add_flag("--json", g.json, "Machine-readable output: one JSON object per line");
   app.add_option("--timeout", timeout, "Seconds to wait (state verbs: default 3; watch: forever)")
       ->check(CLI::PositiveNumber);
-  app.add_option("--qos-file", g.qos_file, "QoS profiles (default: $PMU_QOS_FILE or " PMU_SYSCONFDIR "/qos.xml)");
+  app.add_option("--qos-file", g.qos_file, "QoS profiles (default: $PMU_QOS_FILE, else " PMU_SYSCONFDIR "/qos.xml, else " PMU_DATADIR "/qos.xml)");
   std::string security_dir, identity;
   app.add_option("--security-dir", security_dir,
                  "DDS-Security: the folder deploy/security/make_pki.sh made (default: $PMU_SECURITY_DIR; "

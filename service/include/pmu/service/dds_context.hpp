@@ -48,7 +48,8 @@ class PartitionNotGranted : public DdsError {
 };
 
 // The installed qos.xml: $PMU_QOS_FILE, else qos.xml in the configuration directory
-// (PMU_SYSCONFDIR, /etc/pmu-dds). Empty when none exists. Never the source tree: runs from a
+// (PMU_SYSCONFDIR, /etc/pmu-dds), else the read-only copy the client tools ship (PMU_DATADIR,
+// /usr/share/pmu-dds). Empty when none exists. Never the source tree: runs from a
 // build directory set PMU_QOS_FILE (scripts/run.sh and the tests do).
 std::string default_qos_file();
 
