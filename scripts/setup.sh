@@ -16,7 +16,19 @@ packages=(
   # The VM of the system tests and the network lab (tests/lab: iproute2's ip and tc with
   # netem's distribution tables go into it; its kernel is downloaded, not installed)
   qemu-system-x86 busybox-static cpio kmod
+  # Debian packages (scripts/package.sh): debhelper, lintian; arm64 cross-built, its tests
+  # under qemu-user
+  debhelper dpkg-dev lintian crossbuild-essential-arm64 qemu-user-static
 )
+# The arm64 build dependencies, from multiarch (dpkg --add-architecture arm64). yaml-cpp's
+# -dev is not Multi-Arch: same, so the arm64 build takes the runtime library and the amd64
+# headers (cmake/yaml_cpp.cmake); debian/control says the same.
+arm64_packages=(
+  libfastrtps-dev:arm64 libfastcdr-dev:arm64 libspdlog-dev:arm64 libfmt-dev:arm64
+  libsystemd-dev:arm64 libyaml-cpp0.7:arm64 libssl-dev:arm64 libtinyxml2-dev:arm64
+  libgtest-dev:arm64 libgmock-dev:arm64 pkg-config:arm64
+)
+packages+=("${arm64_packages[@]}")
 
 missing=()
 for p in "${packages[@]}"; do
@@ -25,7 +37,10 @@ for p in "${packages[@]}"; do
   fi
 done
 
-if [ ${#missing[@]} -eq 0 ]; then
+add_arm64=0
+dpkg --print-foreign-architectures | grep -qx arm64 || add_arm64=1
+
+if [ ${#missing[@]} -eq 0 ] && [ "$add_arm64" -eq 0 ]; then
   echo "setup: all ${#packages[@]} packages present"
   exit 0
 fi
@@ -34,6 +49,10 @@ SUDO=""
 if [ "$(id -u)" -ne 0 ]; then
   command -v sudo >/dev/null || { echo "setup: need root (or sudo) to install: ${missing[*]}" >&2; exit 1; }
   SUDO="sudo"
+fi
+if [ "$add_arm64" -eq 1 ]; then
+  echo "setup: adding the arm64 architecture (dpkg multiarch, for the arm64 packages)"
+  $SUDO dpkg --add-architecture arm64
 fi
 echo "setup: installing ${missing[*]}"
 export DEBIAN_FRONTEND=noninteractive

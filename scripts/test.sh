@@ -11,6 +11,11 @@
 #      bus workers, DDS listeners, pmu-service's shutdown); Fast DDS is not instrumented, so
 #      tests/tsan.supp lists what must be suppressed, each entry with its reason
 #   4. clang libFuzzer build: each fuzz target for a bounded time over its kept corpus
+#   5. Debian packages (scripts/package.sh, lintian-clean): amd64 without tests (step 1
+#      runs them all), arm64 cross-built with its unit, transport, sim and service tests
+#      under qemu-user; the release tests then run the arm64 pmu-service from its package
+#      against this build's pmuctl (label package), and the system tests install the amd64
+#      packages (build/packages/amd64)
 # Set PMU_FUZZ_SECONDS to change the fuzz time per target (default 30).
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
@@ -39,11 +44,12 @@ cmake --build build/tsan -j"$jobs" --target transport_tests sim_tests service_te
 step "libFuzzer build (clang-14)"
 CC=clang-14 CXX=clang++-14 cmake -S . -B build/fuzz -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo \
   -DPMU_FUZZ=ON -DPMU_BUILD_BENCH=OFF >/dev/null
-cmake --build build/fuzz -j"$jobs"
+# Only what the fuzz runs use: the rest is built and tested by the gcc builds above.
+cmake --build build/fuzz -j"$jobs" --target fuzz_decode_frame fuzz_candump_line fuzz_command_path
 
 step "sanitizer tests"
 ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
-  ctest --test-dir build/asan --output-on-failure -j"$jobs" -LE 'fuzz|bench|integration|deploy|system|lab'
+  ctest --test-dir build/asan --output-on-failure -j"$jobs" -LE 'fuzz|bench|integration|deploy|system|lab|package'
 
 step "ThreadSanitizer tests"
 # setarch -R: TSan's fixed memory layout fails under the high mmap randomisation of some
@@ -61,6 +67,12 @@ TSAN_OPTIONS="suppressions=$root/tests/tsan.supp halt_on_error=1 second_deadlock
 
 step "fuzz runs"
 ctest --test-dir build/fuzz --output-on-failure -L fuzz
+
+step "amd64 packages"
+DEB_BUILD_OPTIONS=nocheck "$root/scripts/package.sh" --arch amd64
+
+step "arm64 packages (tests under qemu-user)"
+"$root/scripts/package.sh" --arch arm64
 
 step "release tests"
 ctest --test-dir build/release --output-on-failure -j"$jobs"
