@@ -7,6 +7,7 @@
 
 #include <cstdint>
 #include <optional>
+#include <string>
 #include <vector>
 
 #include "pmu/codec/ids.hpp"
@@ -61,5 +62,11 @@ std::optional<struct can_frame> read_frame(int fd);
 
 // Whether `fd` is readable right now (poll with timeout 0).
 bool readable(int fd);
+
+// Why SO_TIMESTAMPNS and SO_RXQ_OVFL cannot be enabled on a socket here, or nullopt when
+// they can. A Linux kernel accepts both on any socket; qemu-user, under which the arm64
+// package build runs these tests, does not translate them (ENOPROTOOPT), so the tests of
+// the code that requires them skip there and run in the native builds.
+std::optional<std::string> socket_options_missing();
 
 }  // namespace pmu::transport::test
