@@ -10,6 +10,9 @@
 #      is COMPLETED with that value read back by the service, and `config get` agrees;
 #   3. the service stops on SIGTERM with exit status 0.
 # Missing debs are a failure, not a skip: CI builds them first (scripts/test.sh).
+# One concession to the emulator: bookworm's qemu-user cannot pass IP_MULTICAST_IF to the
+# kernel, without which Fast DDS opens no UDP output at all, so the service runs with
+# qemu_multicast_if.c preloaded (cross-compiled here; that file says what it changes).
 set -euo pipefail
 
 if [ $# -ne 3 ]; then
@@ -28,6 +31,8 @@ debs=("$deb_dir"/pmu-dds_*_arm64.deb)
 emulator=$(command -v qemu-aarch64-static) || fail "qemu-aarch64-static not found (scripts/setup.sh installs qemu-user-static)"
 [ -x "$pmuctl" ] || fail "pmuctl '$pmuctl' is not an executable"
 [ -f "$qos" ] || fail "QoS file '$qos' does not exist"
+cross_cc=$(command -v aarch64-linux-gnu-gcc) ||
+  fail "aarch64-linux-gnu-gcc not found (scripts/setup.sh installs crossbuild-essential-arm64)"
 
 work=$(mktemp -d)
 service_pid=
@@ -46,11 +51,16 @@ machine=$(readelf -h "$service" | sed -n 's/^ *Machine: *//p')
 config="$work/root/etc/pmu-dds/pmu-service.yaml"
 grep -q '^dds_transport: udp$' "$config" || fail "the packaged $config does not set dds_transport: udp"
 
+shim="$work/qemu_multicast_if.so"
+"$cross_cc" -shared -fPIC -O2 -Wall -Wextra -Werror -o "$shim" "$(dirname "$0")/qemu_multicast_if.c" ||
+  fail "cannot cross-compile tests/package/qemu_multicast_if.c"
+
 domain=$((RANDOM % 200 + 20))
 step "arm64 pmu-service under $emulator, simulated bus, DDS domain $domain"
 log="$work/service.log"
 # The packaged config and QoS profiles; --bus sim replaces the config's CAN buses.
-PMU_QOS_FILE="$work/root/etc/pmu-dds/qos.xml" QEMU_LD_PREFIX=/ \
+# QEMU_SET_ENV: the preload is for the emulated program, not for qemu itself.
+PMU_QOS_FILE="$work/root/etc/pmu-dds/qos.xml" QEMU_LD_PREFIX=/ QEMU_SET_ENV="LD_PRELOAD=$shim" \
   "$emulator" "$service" --config "$config" --bus sim --domain "$domain" >"$log" 2>&1 &
 service_pid=$!
 
