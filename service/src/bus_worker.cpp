@@ -92,7 +92,7 @@ void BusWorker::on_event(const transport::BusEvent& event) {
                   "{}: bus {} (was {})", config_.name, transport::to_string(event.state),
                   transport::to_string(event.previous));
       break;
-    case transport::BusEventKind::Reopened: spdlog::info("{}: interface back, socket reopened", config_.name); break;
+    case transport::BusEventKind::Reopened: spdlog::info("{}: interface present, socket bound", config_.name); break;
     case transport::BusEventKind::SocketError:
       // Identical lines collapse in the logger's duplicate filter during a flood.
       spdlog::warn("{}: socket error: {}", config_.name, std::strerror(event.error));

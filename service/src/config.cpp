@@ -6,6 +6,8 @@
 #include <charconv>
 #include <cctype>
 #include <cmath>
+#include <cstdlib>
+#include <cstring>
 #include <fstream>
 #include <initializer_list>
 #include <set>
@@ -23,6 +25,7 @@ constexpr std::size_t kMaxBusName = 15;  // the IDL key is string<15>; IFNAMSIZ 
 
 struct Ctx {
   std::string source;
+  ConfigEnvironment env;
 
   [[noreturn]] void fail(const YAML::Node& at, const std::string& what) const {
     // yaml-cpp marks are 0-based; editors count from 1.
@@ -222,7 +225,26 @@ void parse_policy(const Ctx& c, const YAML::Node& n, PolicyConfig& p) {
   }
 }
 
-// security: the six files (all or none) and warn_days. Paths relative to the config file.
+// `credential:NAME` in a security path: the file systemd's LoadCredential=NAME:... gave the
+// unit, so a root-only key reaches the transient service user without being readable by it
+// where it is stored. Resolved here, once, so the rest of the service sees a plain path.
+constexpr const char* kCredentialPrefix = "credential:";
+
+std::string credential_path(const Ctx& c, const YAML::Node& at, const char* key, const std::string& name) {
+  if (name.empty() || name == "." || name == ".." || name.find('/') != std::string::npos)
+    c.fail(at, std::string(key) + ": '" + name +
+                   "' is not a credential name (credential:NAME, NAME as in LoadCredential=NAME:PATH, no '/')");
+  if (!c.env.credentials_directory || c.env.credentials_directory->empty())
+    c.fail(at, std::string(key) + ": credential:" + name +
+                   " needs $CREDENTIALS_DIRECTORY, which is not set: the service was not started by systemd with "
+                   "LoadCredential=" + name + ":PATH (deploy/security/README.md)");
+  std::string dir = *c.env.credentials_directory;
+  if (dir.back() != '/') dir += '/';
+  return dir + name;
+}
+
+// security: the six files (all or none) and warn_days. Paths relative to the config file,
+// or credential:NAME.
 void parse_security(const Ctx& c, const YAML::Node& key, const YAML::Node& n, SecurityConfig& sec) {
   if (!n.IsMap()) c.fail(key, "security must be a mapping of the six files (see deploy/security/README.md)");
   c.only_keys(n, "security", {"identity_ca", "identity_certificate", "private_key", "permissions_ca", "governance",
@@ -239,7 +261,11 @@ void parse_security(const Ctx& c, const YAML::Node& key, const YAML::Node& n, Se
     }
     std::string path = c.scalar<std::string>(v, ref.key, "a path");
     if (path.empty()) c.fail(v, std::string(ref.key) + " must be a path to a file, not empty");
-    if (path.front() != '/') path = base + path;
+    if (path.rfind(kCredentialPrefix, 0) == 0) {
+      path = credential_path(c, v, ref.key, path.substr(std::strlen(kCredentialPrefix)));
+    } else if (path.front() != '/') {
+      path = base + path;
+    }
     sec.files.*ref.path = path;
     sec.key_lines[ref.key] = c.line_of(v);
   }
@@ -339,8 +365,8 @@ bool is_log_level(const std::string& level) {
   return std::find(std::begin(kLogLevels), std::end(kLogLevels), level) != std::end(kLogLevels);
 }
 
-Config parse_config(const std::string& text, const std::string& source) {
-  const Ctx c{source};
+Config parse_config(const std::string& text, const std::string& source, const ConfigEnvironment& env) {
+  const Ctx c{source, env};
   YAML::Node root;
   try {
     root = YAML::Load(text);
@@ -428,7 +454,9 @@ Config load_config(const std::string& path) {
   std::stringstream text;
   text << in.rdbuf();
   if (in.bad()) throw ConfigError(path + ": cannot read the config file");
-  return parse_config(text.str(), path);
+  ConfigEnvironment env;
+  if (const char* dir = std::getenv("CREDENTIALS_DIRECTORY"); dir != nullptr) env.credentials_directory = dir;
+  return parse_config(text.str(), path, env);
 }
 
 Config default_sim_config() {

@@ -60,6 +60,12 @@ std::unique_ptr<transport::CanBus> open_bus(const service::BusConfig& bus, const
                  ? transport::SocketCanBus::adopt(transport::UniqueFd(std::stoi(bus.interface.substr(3))), bus.name,
                                                   options, clock)
                  : transport::SocketCanBus::open(bus.interface, options, clock);
+    if (!b->has_socket()) {
+      spdlog::warn("{}: interface {} does not exist yet: waiting for it (pmu/health bus_state DOWN), bound when it "
+                   "appears",
+                   bus.name, bus.interface);
+      return b;
+    }
     const auto& r = b->report();
     spdlog::info("{}: SocketCAN open, receive buffer {} bytes{}, kernel filters {}, timestamps {}", bus.name,
                  r.receive_buffer_bytes, r.receive_buffer_forced ? " (forced)" : "", r.kernel_filters ? "on" : "off",

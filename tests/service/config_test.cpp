@@ -383,6 +383,45 @@ security:
   EXPECT_EQ(parse_config(kGood, "good.yaml").security.warn_days, 30);
 }
 
+// A root-only key reaches the service's transient user as a systemd credential.
+TEST(Config, SecurityFileFromASystemdCredential) {
+  const auto yaml = [](const std::string& key_path) {
+    return "buses:\n  - interface: can0\n    discover: true\nsecurity:\n  identity_ca: ca.pem\n"
+           "  identity_certificate: cert.pem\n  private_key: " +
+           key_path + "\n  permissions_ca: pca.pem\n  governance: gov.p7s\n  permissions: perm.p7s\n";
+  };
+  ConfigEnvironment systemd;
+  systemd.credentials_directory = "/run/credentials/pmu-service.service";
+  const Config c = parse_config(yaml("credential:pmu-service-key.pem"), "/etc/pmu-dds/pmu-service.yaml", systemd);
+  EXPECT_EQ(c.security.files.private_key, "/run/credentials/pmu-service.service/pmu-service-key.pem");
+  EXPECT_EQ(c.security.files.identity_certificate, "/etc/pmu-dds/cert.pem") << "other paths as before";
+
+  const struct {
+    std::string path;
+    ConfigEnvironment env;
+    std::string error;
+  } bad[] = {
+      {"credential:k.pem", {},
+       "a.yaml:7: private_key: credential:k.pem needs $CREDENTIALS_DIRECTORY, which is not set: the service was not "
+       "started by systemd with LoadCredential=k.pem:PATH (deploy/security/README.md)"},
+      {"'credential:'", systemd,
+       "a.yaml:7: private_key: '' is not a credential name (credential:NAME, NAME as in LoadCredential=NAME:PATH, "
+       "no '/')"},
+      {"credential:../key.pem", systemd,
+       "a.yaml:7: private_key: '../key.pem' is not a credential name (credential:NAME, NAME as in "
+       "LoadCredential=NAME:PATH, no '/')"},
+  };
+  for (const auto& b : bad) {
+    SCOPED_TRACE(b.path);
+    try {
+      (void)parse_config(yaml(b.path), "a.yaml", b.env);
+      ADD_FAILURE() << "accepted";
+    } catch (const ConfigError& e) {
+      EXPECT_EQ(std::string(e.what()), b.error);
+    }
+  }
+}
+
 TEST(Config, VehicleIsTheUnnamedOneUnlessNamed) {
   EXPECT_EQ(parse_config("buses:\n  - interface: sim\n    discover: true\n", "a.yaml").vehicle, "");
   EXPECT_EQ(parse_config("vehicle:\nbuses:\n  - interface: sim\n    discover: true\n", "a.yaml").vehicle, "");

@@ -13,7 +13,7 @@
 #                                 command line (all when absent), one after another
 #   sh /scenarios.sh one NAME     a single scenario (what `all` runs for each)
 
-ALL_SCENARIOS="telemetry link_down_up iface_recreate sim_restart two_pmus discovery flood commands_candump"
+ALL_SCENARIOS="telemetry link_down_up iface_recreate iface_absent_at_start sim_restart two_pmus discovery flood commands_candump"
 
 export PATH=/opt/pmu/bin:/usr/sbin:/usr/bin:/sbin:/bin
 export PMU_QOS_FILE=/etc/pmu-dds/qos.xml
@@ -208,6 +208,30 @@ scenario_iface_recreate() {
   reconnects=$(jv "$(state_line health 1)" reconnects)
   alive "$pid" && [ "$(pidof pmu-service)" = "$pid" ] || fail "pmu-service is not the same process (pid $pid, now '$(pidof pmu-service)')"
   detail "bus_state DOWN seen $seen s after ip link del; old pmu-sim $sim_state; telemetry resumed $resume s after ip link add (includes starting pmu-sim); ONLINE/UP again, reconnects=$reconnects; same pid $pid"
+}
+
+# The service started while its interface does not exist (a CAN controller probed late,
+# another interface named in the config): it starts and stays up, DOWN, without waiting
+# or exiting, and binds by name once the interface appears (issue 14: the unit has no
+# device ordering).
+scenario_iface_absent_at_start() {
+  ip link del "$IFACE" || fail "cannot delete $IFACE"
+  start_service --bus "socketcan:$IFACE"
+  pid=$SVC_PID
+  wait_until 30 field_is health 1 bus_state DOWN ||
+    fail "health bus_state '$LAST' 30 s after starting on the absent $IFACE, want DOWN"
+  grep -q "interface $IFACE does not exist yet" "$WORK/$SCEN.service.log" ||
+    fail "the service log does not say it waits for $IFACE"
+  alive "$pid" || fail "pmu-service exited with $IFACE absent"
+  ip link add "$IFACE" type vcan && ip link set "$IFACE" up || fail "cannot create $IFACE"
+  tadd=$(now)
+  start_sim
+  start_stream
+  wait_until 20 stream_has_after "$tadd" || fail "no telemetry within 20 s of creating $IFACE"
+  resume=$(calc "$(first_after "$tadd") - $tadd")
+  wait_until 15 field_is health 1 bus_state UP || fail "health bus_state '$LAST' 15 s after creating $IFACE"
+  alive "$pid" && [ "$(pidof pmu-service)" = "$pid" ] || fail "pmu-service is not the same process (pid $pid, now '$(pidof pmu-service)')"
+  detail "started with $IFACE absent: running, health bus_state DOWN; telemetry $resume s after ip link add (includes starting pmu-sim and pmuctl); bus_state UP; same pid $pid"
 }
 
 # The simulator is killed for at least 5 s (until health reports OFFLINE), then started

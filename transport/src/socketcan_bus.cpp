@@ -139,6 +139,15 @@ std::unique_ptr<SocketCanBus> SocketCanBus::open(const std::string& interface,
     throw_setup(EINVAL, interface, "not a valid interface name");
   auto bus = std::make_unique<SocketCanBus>(Private{}, interface, interface, options, clock, ops);
   Opened opened = bus->open_bound_socket();
+  if (opened.error == ENODEV) {
+    // The interface does not exist yet (a USB or SPI controller not probed, a vcan not
+    // made): the service runs DOWN and maintain() binds by name once it appears, so the
+    // unit needs no device ordering and another interface is a config change only.
+    // Anything else (no CAN in the kernel, a refused option) stays a start-up error.
+    bus->state_ = BusState::Down;
+    bus->next_reopen_ = std::chrono::steady_clock::time_point::min();
+    return bus;
+  }
   if (opened.error != 0) throw_setup(opened.error, interface, opened.step);
   if (const int error = bus->attach_socket(std::move(opened.socket)); error != 0)
     throw_setup(error, interface, "epoll_ctl(socket)");

@@ -97,11 +97,18 @@ struct Config {
   SecurityConfig security;
 };
 
-// Parses `path`. Throws ConfigError("path:line: ...") for every problem: unknown keys,
-// wrong types, values out of range, duplicate names/addresses.
+// What a config may refer to outside its own text, read once at the edge (load_config).
+struct ConfigEnvironment {
+  // $CREDENTIALS_DIRECTORY: where systemd put the unit's LoadCredential= files. A security
+  // path `credential:NAME` is that directory's NAME; unset, such a path is refused.
+  std::optional<std::string> credentials_directory;
+};
+
+// Parses `path` with this process's environment. Throws ConfigError("path:line: ...") for
+// every problem: unknown keys, wrong types, values out of range, duplicate names/addresses.
 Config load_config(const std::string& path);
 // Parses YAML text; `source` names it in messages.
-Config parse_config(const std::string& text, const std::string& source);
+Config parse_config(const std::string& text, const std::string& source, const ConfigEnvironment& env = {});
 
 // What `pmu-service --bus sim` with no config runs: one simulated PMU at address 1 on a bus
 // named "sim0", streaming every packet every 0.5 s.

@@ -75,9 +75,11 @@ class SocketCanBus final : public CanBus {
 
  public:
   // Opens CAN_RAW on `interface` ("can0"), installs filters, enables error frames,
-  // timestamps and drop counting, and binds. Throws std::system_error naming the interface
-  // and the failing step, e.g. "can0: socket(PF_CAN, SOCK_RAW, CAN_RAW): Address family not
-  // supported by protocol" on a kernel without CAN.
+  // timestamps and drop counting, and binds. An interface that does not exist (ENODEV) is
+  // not an error: the bus starts DOWN without a socket (has_socket() false) and maintain()
+  // binds it by name when it appears. Other failures throw std::system_error naming the
+  // interface and the failing step, e.g. "can0: socket(PF_CAN, SOCK_RAW, CAN_RAW): Address
+  // family not supported by protocol" on a kernel without CAN.
   static std::unique_ptr<SocketCanBus> open(const std::string& interface,
                                             const SocketCanOptions& options, const Clock& clock,
                                             SocketOps& ops = system_socket_ops());
