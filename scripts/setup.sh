@@ -16,6 +16,9 @@ packages=(
   # The VM of the system tests and the network lab (tests/lab: iproute2's ip and tc with
   # netem's distribution tables go into it; its kernel is downloaded, not installed)
   qemu-system-x86 busybox-static cpio kmod
+  # The systemd system test (tests/systemd): a bookworm root file system made with mmdebstrap
+  # and written into an image with mkfs.ext4 -d
+  mmdebstrap e2fsprogs
 )
 
 missing=()
