@@ -336,6 +336,7 @@ cat >"$payload/run.sh" <<'EOF'
 #!/bin/sh
 # Started by pmu-vm-test.service once multi-user.target is reached.
 cd /run/payload || exit 1
+echo   # the firmware's last escape sequence leaves the console mid-line
 echo "VM: systemd $(systemctl --version | head -n1 | cut -d' ' -f2), kernel $(uname -r), $(nproc) cpu(s), multi-user.target reached $(cut -d' ' -f1 /proc/uptime) s after the kernel started"
 sh /run/payload/scenarios.sh all
 echo "VM: done, powering off"
