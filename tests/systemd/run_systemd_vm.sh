@@ -262,6 +262,8 @@ done
 # ---- rootfs recipe end
 
 build_rootfs() {
+  # --mode=root: the image's files must belong to root, as mkfs.ext4 -d copies ownership.
+  [ "$(id -u)" = 0 ] || die "building the root file system needs root (mmdebstrap --mode=root); run once as root to fill $rootfs_cache"
   [ -n "$kernel_pkg" ] || die "apt-cache knows no linux-image-amd64 (run apt-get update): cannot choose the VM's kernel"
   local tmp="$rootfs_cache/tmp-$key" includes
   rm -rf "$tmp"; mkdir -p "$tmp"

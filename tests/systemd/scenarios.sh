@@ -150,7 +150,8 @@ scenario_install() {
   [ -f "$CONF" ] || fail "$CONF not installed"
   [ "$(systemctl is-enabled pmu-service 2>&1)" = enabled ] || fail "pmu-service is '$(systemctl is-enabled pmu-service 2>&1)' after install, not enabled"
   wait_until 20 active || fail "pmu-service is $(prop ActiveState)/$(prop SubState) after install with the shipped config (can0 absent), not active"
-  detail "enabled, active with the shipped config (interface can0 absent): $(prop StatusText)"
+  wait_until 30 field_is bus_state DOWN --bus can0 health || fail "health of can0 (absent): bus_state '$LAST', want DOWN ($LAST_LINE)"
+  detail "enabled, active with the shipped config (interface can0 absent, health bus_state DOWN): $(prop StatusText)"
 }
 
 # Type=notify: active means READY=1 arrived; STATUS= text; a dynamic user, not root.
@@ -329,7 +330,8 @@ EOF
   five_topics "$WORK/$SCEN.out" || fail "secure watch: not all five topics among 15 samples"
   detail "with $dsrc the service is active with the key from its credential; $OPUSER as ground-station reads all five topics"
   # Without an identity the service is invisible.
-  if ctl --timeout 8 watch --count 1 >"$WORK/$SCEN.out" 2>&1; then fail "pmuctl without an identity read telemetry from the secure service"; fi
+  ctl --timeout 8 watch --count 1 >"$WORK/$SCEN.out" 2>/dev/null
+  grep -q '"topic"' "$WORK/$SCEN.out" && fail "pmuctl without an identity read telemetry from the secure service: $(head -c 120 "$WORK/$SCEN.out")"
   # The service's dynamic user (same name, so the same transient uid while it runs).
   uid=$(awk '/^Uid:/ {print $2}' "/proc/$pid/status")
   out=$(systemd-run --quiet --wait --pipe -p DynamicUser=yes -p User=pmu-service sh -c "id -u; cat $KEY >/dev/null && echo READ-OK" 2>&1)
