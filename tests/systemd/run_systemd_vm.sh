@@ -175,90 +175,21 @@ FailureAction=poweroff-force
 WantedBy=multi-user.target
 EOF
   chroot "$r" systemctl enable pmu-vm-test.service >/dev/null 2>&1
-  # Only vmlinuz and the initramfs leave the image; the modules stay for modprobe (vcan,
-  # can-dev, ...), minus the large trees a VM with virtio and vcan never loads: a smaller
-  # image to write. (Not dpkg path-exclude: mmdebstrap's essential stage trips over it.)
-  local k
-  for k in "$r"/lib/modules/*/; do
-    (cd "$k/kernel" && rm -rf sound drivers/{gpu,media,infiniband,staging,net/wireless,net/ethernet,scsi,usb,bluetooth,isdn,iio,hid,input,mtd,platform,hwmon,thunderbolt,video} net/{wireless,mac80211,bluetooth} fs/{btrfs,xfs,ocfs2,nfs,smb})
-    chroot "$r" depmod -a "$(basename "$k")"
-  done
   rm -rf "$r"/var/cache/apt/archives/*.deb "$r"/var/lib/apt/lists/* "$r"/usr/share/doc/* "$r"/usr/share/man/* "$r"/usr/share/locale/*
 }
-# ---- rootfs recipe end/p' "${BASH_SOURCE[0]}")
-key=$(sha256sum <<<"$recipe" | cut -c1-16)
-rootfs_cache="$cache_root/systemd-rootfs"
-img_dir="$rootfs_cache/$key"
-
-# ---- rootfs recipe begin
-# Runs in the new root after the essential packages, before the others: the initramfs
-# only needs to find an ext4 root on virtio (MODULES=list keeps it small and quick to make
-# under a loaded machine's dpkg).
-essential_hook() {
-  local r=$1
-  mkdir -p "$r/etc/initramfs-tools/conf.d" "$r/etc/initramfs-tools/hooks"
-  printf 'MODULES=list\nCOMPRESS=gzip\n' >"$r/etc/initramfs-tools/conf.d/pmu-vm"
-  cat >"$r/etc/initramfs-tools/hooks/pmu-vm" <<'EOF'
-#!/bin/sh
-[ "$1" = prereqs ] && exit 0
-. /usr/share/initramfs-tools/hook-functions
-manual_add_modules virtio_pci virtio_blk ext4
-EOF
-  chmod 755 "$r/etc/initramfs-tools/hooks/pmu-vm"
-}
-# Runs last: the system the scenarios expect.
-customize_hook() {
-  local r=$1
-  echo pmu-vm >"$r/etc/hostname"
-  printf '127.0.0.1 localhost\n127.0.1.1 pmu-vm\n' >"$r/etc/hosts"
-  : >"$r/etc/fstab"
-  chroot "$r" systemctl enable systemd-networkd.service >/dev/null 2>&1
-  # deploy/README.md's advice for a machine whose networkd manages only CAN links: without
-  # a link required for online, wait-online would hold network-online.target (and so
-  # pmu-service, which wants it) for its 2 min timeout.
-  chroot "$r" systemctl disable systemd-networkd-wait-online.service >/dev/null 2>&1 || true
-  # The console belongs to the scenario lines, not to a login prompt.
-  chroot "$r" systemctl mask serial-getty@ttyS0.service getty@tty1.service >/dev/null 2>&1
-  # The test runner: after boot, mount the second disk (the packages and scenarios of this
-  # run) and run its run.sh with its output on the serial console; power off either way.
-  cat >"$r/etc/systemd/system/pmu-vm-test.service" <<'EOF'
-[Unit]
-Description=pmu-dds systemd VM test (scenarios from the payload disk)
-After=multi-user.target
-[Service]
-Type=oneshot
-ExecStartPre=/bin/mkdir -p /run/payload
-ExecStartPre=/bin/mount -o ro /dev/vdb /run/payload
-ExecStart=/bin/sh /run/payload/run.sh
-StandardOutput=tty
-StandardError=tty
-TTYPath=/dev/ttyS0
-SuccessAction=poweroff-force
-FailureAction=poweroff-force
-[Install]
-WantedBy=multi-user.target
-EOF
-  chroot "$r" systemctl enable pmu-vm-test.service >/dev/null 2>&1
-  # Only vmlinuz and the initramfs leave the image; the modules stay for modprobe (vcan,
-  # can-dev, ...), minus the large trees a VM with virtio and vcan never loads: a smaller
-  # image to write. (Not dpkg path-exclude: mmdebstrap's essential stage trips over it.)
-  local k
-  for k in "$r"/lib/modules/*/; do
-    (cd "$k/kernel" && rm -rf sound drivers/{gpu,media,infiniband,staging,net/wireless,net/ethernet,scsi,usb,bluetooth,isdn,iio,hid,input,mtd,platform,hwmon,thunderbolt,video} net/{wireless,mac80211,bluetooth} fs/{btrfs,xfs,ocfs2,nfs,smb})
-    chroot "$r" depmod -a "$(basename "$k")"
-  done
-  rm -rf "$r"/var/cache/apt/archives/*.deb "$r"/var/lib/apt/lists/* "$r"/usr/share/doc/* "$r"/usr/share/man/* "$r"/usr/share/locale/*
-}
-# Files never unpacked: a smaller image, written faster. The kernel's modules stay for
-# modprobe (vcan, can-dev, ...) minus the trees a VM with virtio and vcan never loads;
-# the kernel package's postinst runs depmod over what is left.
-excludes=(/usr/share/doc/* /usr/share/man/* /usr/share/locale/* /usr/share/info/*)
+# Only vmlinuz and the initramfs leave the image; the kernel's modules stay for modprobe
+# (vcan, can-dev, ...), minus the large trees a VM with virtio and vcan never loads, which
+# dpkg does not even unpack (the kernel's postinst runs depmod over the rest).
+mm_opts=()
 for d in sound drivers/gpu drivers/media drivers/infiniband drivers/staging drivers/net/wireless \
          drivers/net/ethernet drivers/scsi drivers/usb drivers/bluetooth drivers/isdn drivers/iio \
          drivers/hid drivers/input drivers/mtd drivers/platform drivers/hwmon drivers/thunderbolt \
          drivers/video net/wireless net/mac80211 net/bluetooth fs/btrfs fs/xfs fs/ocfs2 fs/nfs fs/smb; do
-  excludes+=("/lib/modules/*/kernel/$d/*")
+  mm_opts+=("--dpkgopt=path-exclude=/lib/modules/*/kernel/$d/*")
 done
+# dpkg syncs every file it writes; on a busy machine that is most of the build, and this
+# image is thrown away on any doubt. mmdebstrap's eatmydata hook turns the syncs off.
+[ -d /usr/share/mmdebstrap/hooks/eatmydata ] && mm_opts+=(--hook-dir=/usr/share/mmdebstrap/hooks/eatmydata)
 # ---- rootfs recipe end
 
 build_rootfs() {
@@ -275,7 +206,7 @@ build_rootfs() {
   # list, downloads only what changed: downloading is most of a cold build here.
   mkdir -p "$rootfs_cache/debs"
   if ! mmdebstrap --variant=minbase --mode=root --format=directory --include="$includes" \
-      --skip=essential/unlink \
+      --skip=essential/unlink "${mm_opts[@]}" \
       --setup-hook='mkdir -p "$1"/var/cache/apt/archives/' \
       --setup-hook="sync-in $rootfs_cache/debs /var/cache/apt/archives/" \
       --customize-hook="sync-out /var/cache/apt/archives $rootfs_cache/debs" \
