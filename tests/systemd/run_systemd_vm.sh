@@ -231,6 +231,9 @@ build_rootfs() {
 }
 
 mkdir -p "$rootfs_cache" || die "cannot create $rootfs_cache (set PMU_VM_CACHE)"
+# Two runs at once (two worktrees, say) must not build into the same directory.
+exec 9>"$rootfs_cache/.lock"
+flock 9
 rootfs_state=warm
 if [ "$rebuild" = 1 ] || [ ! -f "$img_dir/root.img" ]; then
   rootfs_state=cold
@@ -240,6 +243,7 @@ if [ "$rebuild" = 1 ] || [ ! -f "$img_dir/root.img" ]; then
     case "${d%/}" in "$img_dir"|"$rootfs_cache/debs") ;; *) rm -rf "$d" ;; esac
   done
 fi
+flock -u 9
 phase "rootfs ($rootfs_state)"
 
 # ---- this run's payload: a second disk with the packages and the scenarios -------------
