@@ -200,7 +200,7 @@ build_rootfs() {
   rm -rf "$tmp"; mkdir -p "$tmp"
   includes=$(tr ' ' '\n' <<<"$base_packages $dep_packages $kernel_pkg" | grep -v '^$' | paste -sd, -)
   note "building the root file system (mmdebstrap bookworm, cache key $key): $includes"
-  # mmdebstrap runs hooks with sh; these are bash (brace lists), hence `bash FILE NAME ROOT`.
+  # mmdebstrap runs a hook with sh -c; these functions are bash, hence `bash FILE NAME ROOT`.
   { declare -f essential_hook customize_hook; echo '"$@"'; } >"$tmp/hooks.sh"
   # The downloaded packages are kept (debs/) so that a new recipe, e.g. a changed package
   # list, downloads only what changed: downloading is most of a cold build here.
