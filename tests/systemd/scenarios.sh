@@ -49,8 +49,9 @@ service_procs() { for c in /proc/[0-9]*/comm; do [ "$(cat "$c" 2>/dev/null)" = p
 
 # pmuctl as the unprivileged operator; JSON, one object per line.
 ctl() { runuser -u "$OPUSER" -- pmuctl --json "$@"; }
-# The first JSON line of a state verb: state_line VERB... (records it in LAST_LINE)
-field_is() {  # KEY WANT VERB...: the first line's KEY equals WANT (value seen in LAST)
+# True when KEY in the first JSON line of `pmuctl VERB...` equals WANT; keeps that line in
+# LAST_LINE and the value in LAST for the failure message.
+field_is() {  # KEY WANT VERB...
   _k=$1 _w=$2; shift 2
   LAST_LINE=$(ctl --timeout 10 "$@" 2>/dev/null | head -n1)
   LAST=$(jv "$LAST_LINE" "$_k")
@@ -113,7 +114,7 @@ need_service() {
   fi
   active || fail "pmu-service is $(prop ActiveState) after start"
 }
-# Telemetry of all five topics from vcan0's PMU reaches the operator (N samples read).
+# Every telemetry topic appears in a `pmuctl watch --json` capture.
 five_topics() {  # FILE: pmuctl watch --json output
   for t in voltages currents battery_energy temperatures status; do
     grep -q "\"topic\":\"$t\"" "$1" || return 1
