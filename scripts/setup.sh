@@ -19,6 +19,9 @@ packages=(
   # Debian packages (scripts/package.sh): debhelper, lintian; arm64 cross-built, its tests
   # under qemu-user
   debhelper dpkg-dev lintian crossbuild-essential-arm64 qemu-user-static
+  # The systemd system test (tests/systemd): a bookworm root file system made with mmdebstrap
+  # and written into an image with mkfs.ext4 -d
+  mmdebstrap e2fsprogs
 )
 # The arm64 build dependencies, from multiarch (dpkg --add-architecture arm64). yaml-cpp's
 # -dev is not Multi-Arch: same, so the arm64 build takes the runtime library and the amd64
