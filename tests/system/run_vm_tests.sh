@@ -37,6 +37,7 @@ die() { echo "run_vm_tests: $*" >&2; exit 2; }
 # the test as skipped (SKIP_RETURN_CODE 77) and the reason is the last line of its output.
 skip() { echo "run_vm_tests: SKIP: $*" >&2; exit 77; }
 note() { echo "run_vm_tests: $*" >&2; }
+. "$(dirname "${BASH_SOURCE[0]}")/vm_host_lib.sh"
 
 usage() {
   sed -n '2,16p' "${BASH_SOURCE[0]}" | sed 's/^# \{0,1\}//'
@@ -161,13 +162,6 @@ trap 'exit 130' INT TERM
 # ---- the Debian kernel and its CAN modules (downloaded once into the cache) ------------
 mkdir -p "$cache_dir" || die "cannot create cache directory $cache_dir (set PMU_VM_CACHE)"
 
-kernel_package() {  # the linux-image-X-amd64 that linux-image-amd64 depends on
-  local dep
-  dep=$(apt-cache depends linux-image-amd64 2>/dev/null | sed -n 's/^ *Depends: \(linux-image-[0-9][^ ]*\)$/\1/p' | head -n1 || true)
-  [ -n "$dep" ] || dep=$(apt-cache show linux-image-amd64 2>/dev/null |
-    sed -n 's/^Depends: .*\(linux-image-[0-9][^ ,]*-amd64\).*/\1/p' | head -n1 || true)
-  echo "$dep"
-}
 
 # Extracts vmlinuz and MODULES (names) plus every module they depend on (modinfo -F
 # depends, followed recursively) into DEST, and writes DEST/load-order: dependencies first.
@@ -405,35 +399,13 @@ timeout -k 10 "$vm_timeout" qemu-system-x86_64 -accel tcg -m 1024 -smp 2 -nograp
 qemu_status=${PIPESTATUS[0]}
 set -e
 boot_end=$(date +%s.%N)
-if [ "$qemu_status" = 124 ] || [ "$qemu_status" = 137 ]; then
-  note "the VM did not finish within ${vm_timeout}s (killed)"
-elif [ "$qemu_status" != 0 ]; then
-  note "qemu exited with status $qemu_status; last console lines:"
-  tail -n 20 "$log_file" >&2
-fi
+qemu_outcome "$qemu_status" "$vm_timeout" "$log_file"
 
 # ---- verdict ---------------------------------------------------------------------------
 echo
 echo "== $suite_title, $(basename "$kernel_dir")) =="
 failed=0
-printf '%-18s %-5s %8s  %s\n' scenario result time detail
-for s in "${scenarios[@]}"; do
-  line=$(grep -E "^RESULT $s (PASS|FAIL|SKIP)( |$)" "$log_file" | tail -n1 || true)
-  if [ -z "$line" ]; then
-    status=FAIL; secs="-"; detail="no RESULT line (VM crashed, hung or timed out; see $log_file)"
-  else
-    status=$(awk '{print $3}' <<<"$line")
-    rest=$(cut -d' ' -f4- <<<"$line")
-    secs=$(awk '{print $1}' <<<"$rest")
-    detail=$(cut -s -d' ' -f2- <<<"$rest")
-  fi
-  case "$status" in
-    PASS) ;;
-    SKIP) case "$skip_allowed" in *" $s "*) ;; *) failed=1; detail="SKIP not allowed here: $detail" ;; esac ;;
-    *) failed=1 ;;
-  esac
-  printf '%-18s %-5s %8s  %s\n' "$s" "$status" "${secs:--}" "$detail"
-done
+print_verdict "$log_file" "$skip_allowed" "${scenarios[@]}" || failed=1
 if grep -q '^RESULT setup FAIL' "$log_file"; then failed=1; grep '^RESULT setup' "$log_file"; fi
 wall_end=$(date +%s.%N)
 awk -v a="$wall_start" -v b="$boot_start" -v c="$boot_end" -v d="$wall_end" \

@@ -29,6 +29,7 @@ rebuild=0
 die() { echo "run_systemd_vm: $*" >&2; exit 2; }
 skip() { echo "run_systemd_vm: SKIP: $*" >&2; exit 77; }
 note() { echo "run_systemd_vm: $*" >&2; }
+. "$(dirname "${BASH_SOURCE[0]}")/../system/vm_host_lib.sh"
 usage() { sed -n '2,14p' "${BASH_SOURCE[0]}" | sed 's/^# \{0,1\}//'; exit "${1:-0}"; }
 
 while [ $# -gt 0 ]; do
@@ -102,7 +103,7 @@ note "packages: $(basename "$deb_main") $(basename "$deb_tools") (from $deb_dir)
 # root); it is installed in the image so that networkd's vcan and the CAN modules load
 # the ordinary way (modprobe from /lib/modules), and its vmlinuz and an initramfs made by
 # initramfs-tools in the image boot the VM.
-kernel_pkg=$(apt-cache depends linux-image-amd64 2>/dev/null | sed -n 's/^ *Depends: \(linux-image-[0-9][^ ]*\)$/\1/p' | head -n1 || true)
+kernel_pkg=$(kernel_package)
 base_packages="systemd udev dbus libnss-systemd kmod iproute2 can-utils openssl initramfs-tools"
 # The packages' own run-time dependencies are installed in the image ahead of time, so
 # that the test's `dpkg -i` needs no archive; the packages themselves are not.
@@ -302,32 +303,14 @@ timeout -k 10 "$vm_timeout" qemu-system-x86_64 -accel tcg -m 1024 -smp 2 -nograp
 qemu_status=${PIPESTATUS[0]}
 set -e
 phase "VM"
-if [ "$qemu_status" = 124 ] || [ "$qemu_status" = 137 ]; then
-  note "the VM did not finish within ${vm_timeout}s (killed)"
-elif [ "$qemu_status" != 0 ]; then
-  note "qemu exited with status $qemu_status; last console lines:"
-  tail -n 20 "$log_file" >&2
-fi
+qemu_outcome "$qemu_status" "$vm_timeout" "$log_file"
 
 # ---- verdict (the RESULT protocol of tests/system) -------------------------------------
 echo
 echo "== systemd system test (packages under a real systemd in a VM, $kernel_pkg) =="
 failed=0
-printf '%-16s %-5s %8s  %s\n' scenario result time detail
-for s in "${scenarios[@]}"; do
-  line=$(grep -E "^RESULT $s (PASS|FAIL|SKIP)( |$)" "$log_file" | tail -n1 || true)
-  if [ -z "$line" ]; then
-    status=FAIL; secs="-"; detail="no RESULT line (VM crashed, hung or timed out; see $log_file)"
-  else
-    status=$(awk '{print $3}' <<<"$line")
-    rest=$(cut -d' ' -f4- <<<"$line")
-    secs=$(awk '{print $1}' <<<"$rest")
-    detail=$(cut -s -d' ' -f2- <<<"$rest")
-  fi
-  # No scenario here may skip: each checks something the packages must do.
-  [ "$status" = PASS ] || failed=1
-  printf '%-16s %-5s %8s  %s\n' "$s" "$status" "${secs:--}" "$detail"
-done
+# No scenario here may skip: each checks something the packages must do.
+print_verdict "$log_file" " " "${scenarios[@]}" || failed=1
 phase "verdict"
 total=$(awk -v a="$t0" -v b="$(date +%s.%N)" 'BEGIN { printf "%.1f", b - a }')
 printf 'wall time: %s s total (' "$total"
