@@ -182,6 +182,7 @@ codec::Result<CommandRequest, std::string> parse_command(const CommandSample& s,
   CommandRequest r;
   r.request_id = s.request_id;
   r.sender = s.sender;
+  r.vehicle = s.vehicle;
   r.bus = s.bus;
   r.address = s.address;
   r.action = *act;
@@ -189,6 +190,14 @@ codec::Result<CommandRequest, std::string> parse_command(const CommandSample& s,
   r.confirm = *confirm;
   return r;
 }
+
+namespace {
+// VEHICLE/BUS/ADDRESS as pmuctl shows devices; the unnamed vehicle's are BUS/ADDRESS.
+std::string device_path(const std::string& vehicle, const std::string& bus, std::uint16_t address) {
+  std::string p = vehicle.empty() ? std::string() : printable(vehicle) + "/";
+  return p + printable(bus) + "/" + std::to_string(address);
+}
+}  // namespace
 
 std::string describe(const CommandRequest& r) {
   std::string s(to_string(r.kind()));
@@ -213,7 +222,7 @@ std::string describe(const CommandRequest& r) {
         }
       },
       r.action);
-  s += " to " + printable(r.bus) + "/" + std::to_string(r.address);
+  s += " to " + device_path(r.vehicle, r.bus, r.address);
   if (r.confirm) s += " (confirmed)";
   return s;
 }
@@ -225,7 +234,7 @@ std::string describe(const CommandSample& s) {
   char buf[96];
   std::snprintf(buf, sizeof buf, " value=%g outputs=0x%02X groups=0x%02X", s.value, s.outputs, s.groups);
   out += buf;
-  return out + " to " + printable(s.bus) + "/" + std::to_string(s.address);
+  return out + " to " + device_path(s.vehicle, s.bus, s.address);
 }
 
 std::string printable(std::string_view text, std::size_t max) {

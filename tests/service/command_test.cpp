@@ -627,8 +627,17 @@ TEST(Commands, EveryCommandAndItsResultIsInTheAuditTrail) {
     auto denied = c.req(CommandKind::Reset);
     denied.sender = "ground-station-7";
     c.run(denied);
+    // In a fleet the line names the vehicle too, as pmuctl names its devices.
+    auto fleet = set_param(c, "avionics_voltage", 21.0);
+    fleet.vehicle = "uav1";
+    fleet.sender = "ground-station-7";
+    c.run(fleet);
   }
   const std::string text = log.text();
+  EXPECT_NE(text.find("audit: command t-3 from ground-station-7: set_parameter avionics_voltage=21 to uav1/sim0/1 -> "
+                      "COMPLETED"),
+            std::string::npos)
+      << text;
   EXPECT_NE(text.find("audit: command t-1 from ground-station-7: set_parameter avionics_voltage=20 to sim0/1 -> COMPLETED"),
             std::string::npos)
       << text;

@@ -108,6 +108,9 @@ static_assert(std::variant_size_v<CommandAction> == kCommandKindCount);
 struct CommandRequest {
   std::string request_id;
   std::string sender;
+  // The vehicle the command names (the endpoint passed on only this service's own): kept so
+  // a fleet's audit lines say which vehicle executed what.
+  std::string vehicle;
   std::string bus;
   std::uint16_t address = 0;
   CommandAction action;
