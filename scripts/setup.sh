@@ -12,7 +12,7 @@ packages=(
   libspdlog-dev libfmt-dev libsystemd-dev libcli11-dev libyaml-cpp-dev nlohmann-json3-dev
   libssl-dev libtinyxml2-dev openssl
   cyclonedds-dev cyclonedds-tools
-  can-utils iproute2 nftables python3 python3-can
+  can-utils iproute2 python3 python3-can
   # The VM of the system tests and the network lab (tests/lab: iproute2's ip and tc with
   # netem's distribution tables go into it; its kernel is downloaded, not installed)
   qemu-system-x86 busybox-static cpio kmod

@@ -15,7 +15,7 @@
 #                           line (all when absent): the topology is built once, then each runs
 #   sh /lab.sh one NAME     a single scenario (what `all` runs for each)
 
-ALL_SCENARIOS="topology consumers commands cut cut_lifespan"
+ALL_SCENARIOS="topology consumers commands cut cut_lifespan fleet unicast discovery_server security"
 
 export PATH=/opt/pmu/bin:/usr/sbin:/usr/bin:/sbin:/bin
 export PMU_QOS_FILE=/etc/pmu-dds/qos.xml
@@ -533,20 +533,170 @@ scenario_cut_lifespan() {
   detail "a command after the restore COMPLETED; same pid"
 }
 
+# ---- across hosts: a fleet, discovery without multicast, DDS-Security --------------------
+# Each over the same impaired ground link as the scenarios above: the ground station is gnd.
+
+# Multicast stops at the bridge, as on a routed network or a radio link that carries none:
+# no port is flooded with multicast frames, while broadcast (ARP) and unicast still pass
+# (the ports' multicast_flood flag; the bridge does no snooping, so every multicast frame is
+# a flood). DDS's default discovery is multicast: a set-up that works now found its peers
+# another way.
+multicast_flood() {  # on|off
+  _v=1; [ "$1" = off ] && _v=0
+  for _h in $HOSTS; do echo "$_v" >"/sys/class/net/$(port_of "$_h")/brport/multicast_flood" || return 1; done
+}
+# The control of the set-ups without multicast: a ground participant with the default
+# (multicast) discovery finds no service within 10 s, so what then works proves the set-up.
+check_multicast_stopped() {
+  _o=$(ctl gnd --vehicle uav1 --timeout 10 watch --count 1 2>&1)
+  printf '%s' "$_o" | grep -q '"topic"' &&
+    fail "control: with multicast stopped at the bridge, multicast discovery still found the service: $(printf '%s' "$_o" | head -c 200)"
+  return 0
+}
+# set_on HOST VEHICLE VALUE: pmuctl config set payload_voltage (pmuctl resends with the same
+# id every second until answered); true when COMPLETED. CMD_OUT: what pmuctl printed.
+set_on() {
+  CMD_OUT=$(ctl "$1" --vehicle "$2" --timeout 60 config set payload_voltage "$3" 2>&1)
+  printf '%s' "$CMD_OUT" | grep -q '"result":"COMPLETED"'
+}
+# telemetry_from HOST VEHICLE COUNT: COUNT samples of VEHICLE arrive in HOST (within 60 s)
+telemetry_from() {
+  _n=$(ctl "$1" --vehicle "$2" --timeout 60 watch --count "$3" 2>"$WORK/$SCEN.err" | grep -c "\"topic\":.*\"vehicle\":\"$2\"")
+  [ "$_n" -eq "$3" ]
+}
+# The audit line of a payload_voltage=VALUE command executed on VEHICLE's sim0/1, in LOG.
+executed_in() { grep -q "audit: command .*: set_parameter payload_voltage=$2 to $1/sim0/1 -> COMPLETED" "$3"; }
+ran_value_in() { grep -q "audit: command .*payload_voltage=$1 " "$2"; }
+
+# Two aircraft with the same bus and address (sim0/1), uav1 in mc1 and uav2 in mc2, on the
+# ground station's network: gnd sees both, each command is executed by its vehicle only,
+# and every telemetry sample is attributed to the right vehicle (each vehicle's payload
+# voltage follows its own setpoint, so a sample under the wrong name would show the other's).
+vehicles_listed() {
+  SEEN=$(ctl gnd --timeout 20 list 2>/dev/null | grep '"bus":"sim0","address":1' | sed -n 's/.*"vehicle":"\([^"]*\)".*/\1/p' | sort -u | tr '\n' ' ')
+  [ "$SEEN" = "uav1 uav2 " ]
+}
+scenario_fleet() {
+  start_service mc1 "vehicle: uav1"; LOG1=$SVC_LOG
+  start_service mc2 "vehicle: uav2"; LOG2=$SVC_LOG
+  t0=$(now)
+  wait_until 90 vehicles_listed || fail "gnd: pmuctl list shows vehicle(s) '$SEEN' with sim0/1; want uav1 and uav2"
+  detail "gnd lists uav1/sim0/1 and uav2/sim0/1 $(since "$t0") s after the start"
+  set_on gnd uav1 13.5 || fail "gnd: uav1's command: $CMD_OUT"
+  printf '%s' "$CMD_OUT" | grep -q '"vehicle":"uav1"' || fail "uav1's reply does not name uav1: $CMD_OUT"
+  set_on gnd uav2 14.5 || fail "gnd: uav2's command: $CMD_OUT"
+  executed_in uav1 13.5 "$LOG1" || fail "uav1's audit trail lacks its command (payload_voltage=13.5)"
+  executed_in uav2 14.5 "$LOG2" || fail "uav2's audit trail lacks its command (payload_voltage=14.5)"
+  ran_value_in 13.5 "$LOG2" && fail "uav2 executed uav1's command: $(grep 'payload_voltage=13.5' "$LOG2")"
+  ran_value_in 14.5 "$LOG1" && fail "uav1 executed uav2's command: $(grep 'payload_voltage=14.5' "$LOG1")"
+  detail "a command to each over the ground link: each executed by its vehicle only (audit trails)"
+  # Every vehicle's samples in one watch without --vehicle; the first of each vehicle may
+  # have been written before its command, so it is not judged.
+  ctl gnd --timeout 60 watch --count 60 >"$WORK/$SCEN.watch" 2>"$WORK/$SCEN.err"
+  bad=$(grep '"topic":"voltages"' "$WORK/$SCEN.watch" | sed -n 's/.*"vehicle":"\([^"]*\)".*"payload":\([^,}]*\).*/\1 \2/p' |
+    awk '{ n[$1]++; if (n[$1] == 1) next
+           want = ($1 == "uav1") ? 13.5 : ($1 == "uav2") ? 14.5 : -1
+           if ($2 + 0 != want) print $1 " payload " $2 }
+         END { if (!n["uav1"]) print "no uav1 sample"; if (!n["uav2"]) print "no uav2 sample" }')
+  [ -z "$bad" ] || fail "gnd: pmu/voltages attributed wrongly: $(printf '%s' "$bad" | head -n 3 | tr '\n' ';')"
+  detail "gnd: every pmu/voltages sample of each vehicle shows that vehicle's own payload setpoint ($(grep -c '"vehicle":"uav1"' "$WORK/$SCEN.watch") uav1, $(grep -c '"vehicle":"uav2"' "$WORK/$SCEN.watch") uav2 samples of 60)"
+  for v in uav1 uav2; do
+    c=$(ctl gnd --vehicle $v --timeout 30 config get 2>/dev/null | head -n1)
+    want=13.5; [ $v = uav2 ] && want=14.5
+    same "$(jv "$c" payload_voltage)" "$want" || fail "gnd: pmu/config of $v: $c"
+  done
+  detail "pmu/config: uav1 13.5, uav2 14.5"
+}
+
+# Unicast initial peers, multicast stopped at the bridge: the control shows multicast
+# discovery finds nothing; the service (peer: gnd) and pmuctl in gnd (--peer mc1) then
+# exchange telemetry and a command over the ground link.
+scenario_unicast() {
+  multicast_flood off || fail "cannot stop multicast flooding on the bridge"
+  start_service mc1 "vehicle: uav1"
+  check_multicast_stopped
+  kill "$SVC_PID"; wait "$SVC_PID" 2>/dev/null
+  detail "control: multicast stopped at the bridge, multicast discovery finds no service in 10 s"
+  start_service mc1 "vehicle: uav1
+discovery:
+  mode: unicast
+  peers: [$(addr_of gnd)]"
+  CTL_EXTRA="--peer $(addr_of mc1)"
+  t0=$(now)
+  telemetry_from gnd uav1 10 || fail "unicast peers: no 10 samples in gnd within 60 s ($(tail -n1 "$WORK/$SCEN.err"))"
+  detail "unicast peers: 10 samples in gnd $(since "$t0") s after the start"
+  set_on gnd uav1 13.5 || fail "unicast peers: command: $CMD_OUT"
+  executed_in uav1 13.5 "$SVC_LOG" || fail "unicast peers: the command is not in the audit trail"
+  detail "a command from gnd COMPLETED and executed once"
+}
+
+# The Discovery Server in mc2 (fast-discovery-server, fastdds-tools), multicast stopped:
+# the service in mc1 and pmuctl in gnd are its clients and find each other through it.
+DS_PORT=11811
+scenario_discovery_server() {
+  multicast_flood off || fail "cannot stop multicast flooding on the bridge"
+  $NETNS_EXEC mc2 fast-discovery-server -i 0 -l "$(addr_of mc2)" -p "$DS_PORT" >"$WORK/$SCEN.ds.log" 2>&1 &
+  track $!
+  start_service mc1 "vehicle: uav1
+discovery:
+  mode: server
+  servers: [\"$(addr_of mc2):$DS_PORT\"]"
+  check_multicast_stopped
+  detail "control: without the server, a ground participant finds no service in 10 s"
+  CTL_EXTRA="--discovery-server $(addr_of mc2):$DS_PORT"
+  t0=$(now)
+  telemetry_from gnd uav1 10 || fail "discovery server: no 10 samples in gnd within 60 s ($(tail -n1 "$WORK/$SCEN.err"))"
+  detail "discovery server in mc2: 10 samples in gnd $(since "$t0") s after asking"
+  set_on gnd uav1 13.5 || fail "discovery server: command: $CMD_OUT"
+  executed_in uav1 13.5 "$SVC_LOG" || fail "discovery server: the command is not in the audit trail"
+  detail "a command from gnd COMPLETED and executed once"
+}
+
+# DDS-Security across the ground link (the PKI run_vm_tests.sh made with make_pki.sh): the
+# ground-station identity commands; the mission-computer identity reads but its command is
+# never executed; a participant without a certificate receives nothing.
+PKI=/etc/pmu-dds/pki
+scenario_security() {
+  [ -f "$PKI/governance.p7s" ] || fail "no PKI in $PKI (run_vm_tests.sh makes it with make_pki.sh)"
+  start_service mc1 "vehicle: uav1
+security:
+  identity_ca: $PKI/identity_ca.pem
+  identity_certificate: $PKI/pmu-service/cert.pem
+  private_key: $PKI/pmu-service/key.pem
+  permissions_ca: $PKI/permissions_ca.pem
+  governance: $PKI/governance.p7s
+  permissions: $PKI/pmu-service/permissions.p7s"
+  t0=$(now)
+  CTL_EXTRA="--security-dir $PKI --identity ground-station"
+  set_on gnd uav1 13.5 || fail "ground-station identity: command: $CMD_OUT"
+  executed_in uav1 13.5 "$SVC_LOG" || fail "ground-station identity: the command is not in the audit trail"
+  detail "ground-station identity: a command COMPLETED over the ground link $(since "$t0") s after the start"
+  CTL_EXTRA="--security-dir $PKI --identity mission-computer"
+  telemetry_from gnd uav1 5 || fail "mission-computer identity: no 5 samples in gnd ($(tail -n1 "$WORK/$SCEN.err"))"
+  CMD_OUT=$(ctl gnd --vehicle uav1 --timeout 15 config set payload_voltage 15.5 2>&1)
+  printf '%s' "$CMD_OUT" | grep -q COMPLETED && fail "the mission-computer identity commanded: $CMD_OUT"
+  ran_value_in 15.5 "$SVC_LOG" && fail "the mission-computer identity's command reached the service: $(grep 'payload_voltage=15.5' "$SVC_LOG")"
+  detail "mission-computer identity: telemetry yes, its command never reached the service"
+  CTL_EXTRA=""
+  o=$(ctl gnd --vehicle uav1 --timeout 10 watch --count 1 2>&1)
+  printf '%s' "$o" | grep -q '"topic"' && fail "a participant without a certificate received telemetry: $(printf '%s' "$o" | head -c 200)"
+  detail "without a certificate: nothing in 10 s"
+}
+
 # ---- driver ----------------------------------------------------------------------------
 
 scenario_limit() {  # seconds a scenario may take in the (slow, emulated) VM
   case "$1" in
     commands) echo 300 ;;
-    cut | cut_lifespan) echo 200 ;;
+    cut | cut_lifespan | fleet | security) echo 200 ;;
     topology) echo 60 ;;
     *) echo 150 ;;
   esac
 }
 
-# A failed cut must not leave the link cut.
-after_scenario() { set_link_loss "$LINK_LOSS"; }
-FAIL_LOGS="service*.log ground.out.err *.err"
+# A failed cut must not leave the link cut, nor a scenario without multicast the bridge so.
+after_scenario() { set_link_loss "$LINK_LOSS"; multicast_flood on; }
+FAIL_LOGS="service*.log ground.out.err *.err ds.log"
 DOMAIN_BASE=40
 
 case "${1:-all}" in

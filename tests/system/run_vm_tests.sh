@@ -4,8 +4,9 @@
 # the project's binaries and tests/system/scenarios.sh, and checks what the scenarios
 # print on the VM's console. See tests/system/README.md.
 # --suite lab boots the same kernel with the network lab instead (tests/lab/README.md):
-# veth, bridge and sch_netem, iproute2's ip and tc, pmu-service, pmuctl, lab_ground and
-# tests/lab/lab.sh, whose scenarios print the same RESULT lines.
+# veth, bridge and sch_netem, iproute2's ip and tc, pmu-service, pmuctl, lab_ground,
+# fast-discovery-server, a DDS-Security PKI (make_pki.sh) and tests/lab/lab.sh, whose
+# scenarios print the same RESULT lines.
 #
 #   run_vm_tests.sh [--suite system|lab] [--build-dir DIR] [--source-dir DIR] [--scenario NAME]...
 #                   [--list] [--timeout S] [--log FILE] [--keep] [--verbose] [--service-log-level L]
@@ -130,6 +131,9 @@ if [ "$suite" = lab ]; then
   # netem's delay distributions (normal.dist ...) are files tc reads from its library folder.
   for d in /usr/lib/x86_64-linux-gnu/tc /usr/lib/tc /usr/lib64/tc; do [ -f "$d/normal.dist" ] && { tc_lib=$d; break; }; done
   [ -n "$tc_lib" ] || die "the lab needs tc's distribution tables (normal.dist; iproute2)"
+  ds_bin=$(command -v fast-discovery-server || true)
+  [ -n "$ds_bin" ] || die "the lab needs fast-discovery-server (scripts/setup.sh installs fastdds-tools)"
+  command -v openssl >/dev/null || die "the lab needs openssl for its DDS-Security PKI (scripts/setup.sh installs it)"
 fi
 
 find_binary() {  # NAME EXPECTED-RELATIVE-PATH
@@ -320,6 +324,11 @@ else
   copy_with_libs "$tc_bin" usr/sbin/tc   # busybox's tc knows no netem
   rm -f "$root/bin/tc"
   mkdir -p "$root/$tc_lib" && cp "$tc_lib"/*.dist "$root/$tc_lib/"
+  copy_with_libs "$ds_bin" usr/bin/fast-discovery-server
+  # The security scenario's PKI, made fresh for every run (valid two days, every lab domain).
+  "$source_dir/deploy/security/make_pki.sh" "$root/etc/pmu-dds/pki" --domain 0-232 --days 2 >"$work/pki.log" 2>&1 ||
+    die "make_pki.sh failed: $(tail -n3 "$work/pki.log")"
+  rm -rf "$root/etc/pmu-dds/pki/ca"   # the CA keys stay out of the image
 fi
 for t in "${can_utils[@]}"; do copy_with_libs "$t" "usr/bin/$(basename "$t")"; done
 copy_with_libs "$ip_bin" usr/sbin/ip   # the real ip: busybox's cannot `type vcan`
