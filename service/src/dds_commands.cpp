@@ -1,6 +1,5 @@
 #include "pmu/service/dds_commands.hpp"
 
-#include <fastdds/dds/domain/DomainParticipantListener.hpp>
 #include <fastdds/dds/subscriber/DataReaderListener.hpp>
 #include <fastdds/dds/subscriber/SampleInfo.hpp>
 #include <spdlog/spdlog.h>
@@ -48,40 +47,11 @@ std::string partition_list(const std::vector<std::string>& names) {
   return "partition(s) " + out;
 }
 
-// The partitions every remote pmu/command writer announced in discovery, by writer GUID (the
-// text CommandSample::sender holds).
-class CommandWriters final : public DomainParticipantListener {
- public:
-  void on_publisher_discovery(DomainParticipant*, eprosima::fastrtps::rtps::WriterDiscoveryInfo&& info) override {
-    if (info.info.topicName().to_string() != topics::kCommand) return;
-    const auto guid = text_of(info.info.guid());
-    std::lock_guard<std::mutex> lock(mutex_);
-    using Status = eprosima::fastrtps::rtps::WriterDiscoveryInfo::DISCOVERY_STATUS;
-    if (info.status == Status::REMOVED_WRITER)
-      partitions_.erase(guid);
-    else
-      partitions_[guid] = info.info.m_qos.m_partition.names();
-  }
-
-  // nullopt: the writer was not (yet) seen in discovery.
-  std::optional<std::vector<std::string>> partitions_of(const std::string& guid) const {
-    std::lock_guard<std::mutex> lock(mutex_);
-    const auto it = partitions_.find(guid);
-    if (it == partitions_.end()) return std::nullopt;
-    return it->second;
-  }
-
- private:
-  mutable std::mutex mutex_;
-  std::map<std::string, std::vector<std::string>> partitions_;
-};
-
 }  // namespace
 
 struct DdsCommandEndpoint::Impl final : public DataReaderListener {
   dds::DdsContext& dds;
   std::string vehicle;
-  CommandWriters writers;
   std::atomic<std::uint64_t> not_ours{0};  // commands for another vehicle or from another partition
   // (the rate limit below is used under service_mutex)
   RateLimit not_ours_reports{kMalformedLogInterval};
@@ -102,16 +72,17 @@ struct DdsCommandEndpoint::Impl final : public DataReaderListener {
   // Only this vehicle's commands are answered: a command for another vehicle is that
   // vehicle's service's to answer, and one from a writer outside this vehicle's partition
   // (a pattern such as "*" reaches every vehicle) is not addressed to this vehicle alone.
-  bool ours(const CommandSample& s) {
+  // `partitions`: those the sample's writer announced (RemoteWriters); a writer discovery
+  // never reported cannot be judged, so its commands are not taken either.
+  bool ours(const CommandSample& s, const std::optional<std::vector<std::string>>& partitions) {
     std::string why;
     if (s.vehicle != vehicle) {
       why = "is for vehicle '" + printable(s.vehicle) + "'";
-    } else if (const auto p = writers.partitions_of(s.sender); p && !partitions_address_only(*p, vehicle)) {
-      // A writer discovery has not reported is judged by `vehicle` alone: a sample's writer
-      // GUID need not be the one discovery announced (a writer may set its own sample
-      // identity), and refusing those refused every command of such clients.
-      why = "was written in " + partition_list(*p) + ", not in " + partition_list(vehicle_partitions(vehicle)) +
-            " alone";
+    } else if (!partitions) {
+      why = "came from a writer discovery never reported (its partitions are unknown)";
+    } else if (!partitions_address_only(*partitions, vehicle)) {
+      why = "was written in " + partition_list(*partitions) + ", not in " +
+            partition_list(vehicle_partitions(vehicle)) + " alone";
     } else {
       return true;
     }
@@ -134,7 +105,7 @@ struct DdsCommandEndpoint::Impl final : public DataReaderListener {
       // that hands it over anyway gives an empty Received. Either way it was counted.
       if (!info.valid_data || !received.sample) continue;
       received.sample->sender = guid_of(info);
-      if (ours(*received.sample)) service->submit(*received.sample);
+      if (ours(*received.sample, dds.remote_writers().partitions_of(info))) service->submit(*received.sample);
     }
     report_malformed();
   }
@@ -176,8 +147,6 @@ struct DdsCommandEndpoint::Impl final : public DataReaderListener {
 
 DdsCommandEndpoint::DdsCommandEndpoint(dds::DdsContext& dds, DdsPublisher* failures, std::string vehicle)
     : impl_(std::make_unique<Impl>(dds, failures, std::move(vehicle))) {
-  // Discovery callbacks only: the entities' statuses stay with their own listeners.
-  dds.participant().set_listener(&impl_->writers, StatusMask::none());
   impl_->writer = &dds.writer(dds.topic(topics::kCommandReply, TypeSupport(new pmu::CommandReplyPubSubType())),
                               qos_profiles::kCommand);
 }
@@ -193,7 +162,6 @@ void DdsCommandEndpoint::stop() {
 
 DdsCommandEndpoint::~DdsCommandEndpoint() {
   stop();
-  impl_->dds.participant().set_listener(nullptr);
 }
 
 void DdsCommandEndpoint::start(CommandService& service) {

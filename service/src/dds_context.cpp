@@ -95,7 +95,9 @@ DdsContext::DdsContext(int domain, const std::string& qos_file, const std::strin
   } catch (const NetworkError& e) {
     throw DdsError(e.what());
   }
-  participant_ = DomainParticipantFactory::get_instance()->create_participant(static_cast<DomainId_t>(domain), pqos);
+  // The listener from the start: discovery is not replayed to one set later.
+  participant_ = DomainParticipantFactory::get_instance()->create_participant(static_cast<DomainId_t>(domain), pqos,
+                                                                              &remote_writers_, StatusMask::none());
   if (!participant_)
     throw DdsError("cannot create a DDS participant on domain " + std::to_string(domain) +
                    (secure_ ? " with DDS-Security (see the Fast DDS SECURITY error above)" : "") +

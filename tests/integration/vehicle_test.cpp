@@ -220,5 +220,35 @@ TEST_F(Vehicles, ACommandNotAddressedToThisVehicleAloneIsNeitherExecutedNorAnswe
   EXPECT_EQ(services_["uav1"]->commands.counters().received, 0u);
 }
 
+// A ground station in "*" already on the domain when the service starts: its writer is
+// discovered while the service is still starting, before the command endpoint exists. Its
+// partitions must still be known (the participant records writers from its creation), so
+// its command, which names the service's own vehicle, is refused like any from "*".
+TEST(VehiclesEarlyPeer, AWildcardWriterFoundBeforeTheCommandEndpointExistedIsStillRefused) {
+  const int domain = pmu::test::exclusive_dds_domain();
+  Ground wildcard(domain, "ground-wildcard-early", {{"*"}, every_vehicle_partitions()});
+  VehicleService::Options o;
+  o.vehicle = "uav1";
+  o.endpoint_delay = 3s;
+  VehicleService uav1(domain, o);
+  ASSERT_TRUE(pmu::test::wait_until([&] { return wildcard.command_readers() == 1; }, 20s));
+  // The start-up reading must be over, so that a command let through would be executed.
+  ASSERT_TRUE(pmu::test::wait_until(
+      [&] {
+        pmu::Config c;
+        SampleInfo i;
+        return wildcard.configs.take_next_sample(&c, &i) == ReturnCode_t::RETCODE_OK && i.valid_data;
+      },
+      30s));
+  const auto before = uav1.parameter(codec::Parameter::PayloadVoltage);
+  wildcard.send("early-wildcard", "uav1", kNewPayloadVoltage);
+  ASSERT_TRUE(pmu::test::wait_until([&] { return uav1.endpoint.not_ours() == 1; }, 20s))
+      << "not refused; received " << uav1.commands.counters().received;
+  std::this_thread::sleep_for(500ms);  // a reply, which must not come, would be here by now
+  EXPECT_TRUE(wildcard.take_replies().empty());
+  EXPECT_EQ(uav1.parameter(codec::Parameter::PayloadVoltage), before);
+  EXPECT_EQ(uav1.commands.counters().received, 0u);
+}
+
 }  // namespace
 }  // namespace pmu::service

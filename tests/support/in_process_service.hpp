@@ -30,6 +30,10 @@ class InProcessService {
     std::string bus_name = "sim0";   // the `bus` key of every sample
     dds::SecurityFiles security;     // empty: no DDS-Security
     dds::Transport transport = dds::Transport::Default;
+    // A pause between creating the participant and the command endpoint: discovery of the
+    // peers already on the domain is then over before the endpoint exists, as it can be in
+    // pmu-service when its start-up is slow.
+    std::chrono::milliseconds endpoint_delay{0};
   };
 
   InProcessService(int domain, const Options& o)
@@ -39,6 +43,7 @@ class InProcessService {
             {service::vehicle_partitions(o.vehicle), service::vehicle_partitions(o.vehicle)}),
         publisher(dds, std::chrono::seconds(3), o.vehicle),
         worker(bus_config(o.bus_name), network.attach(o.bus_name), clock, service::Timeouts{}, publisher),
+        pause_(o.endpoint_delay),
         endpoint(dds, &publisher, o.vehicle),
         commands({&worker}, service::PolicyConfig{}, service::Timeouts{}, clock,
                  [this](const service::CommandReplyData& r) { endpoint.publish(r); }) {
@@ -83,6 +88,13 @@ class InProcessService {
   dds::DdsContext dds;
   service::DdsPublisher publisher;
   service::BusWorker worker;
+
+ private:
+  struct Pause {
+    explicit Pause(std::chrono::milliseconds d) { std::this_thread::sleep_for(d); }
+  } pause_;
+
+ public:
   service::DdsCommandEndpoint endpoint;
   service::CommandService commands;
 

@@ -24,6 +24,7 @@
 #include <vector>
 
 #include "pmu/service/dds_network.hpp"
+#include "pmu/service/dds_remote_writers.hpp"
 #include "pmu/service/dds_security.hpp"
 #include "pmu/service/dds_transport.hpp"
 
@@ -75,6 +76,9 @@ class DdsContext {
   eprosima::fastdds::dds::DomainParticipant& participant() { return *participant_; }
   int domain() const noexcept { return domain_; }
   bool secure() const noexcept { return secure_; }
+  // Every remote writer discovery reported since the participant was created, with its
+  // partitions (dds_remote_writers.hpp).
+  const RemoteWriters& remote_writers() const noexcept { return remote_writers_; }
 
   // Registers the type (once) and creates the topic (once). `type` is e.g.
   // new pmu::VoltagesPubSubType(). Throws DdsError at start-up when it fails.
@@ -98,6 +102,7 @@ class DdsContext {
   bool secure_ = false;
   SecurityFiles security_;
   Partitions partitions_;
+  RemoteWriters remote_writers_;  // the participant's listener: outlives it
   eprosima::fastdds::dds::DomainParticipant* participant_ = nullptr;
   eprosima::fastdds::dds::Publisher* publisher_ = nullptr;
   eprosima::fastdds::dds::Subscriber* subscriber_ = nullptr;

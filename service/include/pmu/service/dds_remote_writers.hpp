@@ -1,0 +1,35 @@
+#pragma once
+// RemoteWriters: the partitions every remote DataWriter announced in discovery, by the
+// writer's GUID. DdsContext installs it when it creates the participant, so no writer is
+// missed: Fast DDS does not replay discovery to a listener set later, and a writer found in
+// the moment between the participant's creation and such a listener would stay unknown.
+// Fast DDS reports a writer (PDP::addWriterProxyData) before it pairs it with local readers,
+// so a sample from a matched writer always finds its writer here.
+
+#include <fastdds/dds/domain/DomainParticipantListener.hpp>
+#include <fastdds/dds/subscriber/SampleInfo.hpp>
+#include <map>
+#include <mutex>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace pmu::dds {
+
+class RemoteWriters final : public eprosima::fastdds::dds::DomainParticipantListener {
+ public:
+  void on_publisher_discovery(eprosima::fastdds::dds::DomainParticipant*,
+                              eprosima::fastrtps::rtps::WriterDiscoveryInfo&& info) override;
+
+  // The partitions of the writer that wrote the sample `info` describes (its publication
+  // handle, which Fast DDS sets from the writer on the wire, unlike the sample identity a
+  // writer may choose); nullopt when discovery never reported that writer.
+  std::optional<std::vector<std::string>> partitions_of(const eprosima::fastdds::dds::SampleInfo& info) const;
+  std::size_t size() const;
+
+ private:
+  mutable std::mutex mutex_;
+  std::map<std::string, std::vector<std::string>> partitions_;  // GUID text -> partitions
+};
+
+}  // namespace pmu::dds

@@ -1,0 +1,43 @@
+#include "pmu/service/dds_remote_writers.hpp"
+
+#include <fastdds/rtps/common/InstanceHandle.h>
+
+#include <sstream>
+
+namespace pmu::dds {
+namespace {
+
+std::string text_of(const eprosima::fastrtps::rtps::GUID_t& guid) {
+  std::ostringstream out;
+  out << guid;
+  return out.str();
+}
+
+}  // namespace
+
+void RemoteWriters::on_publisher_discovery(eprosima::fastdds::dds::DomainParticipant*,
+                                           eprosima::fastrtps::rtps::WriterDiscoveryInfo&& info) {
+  using Status = eprosima::fastrtps::rtps::WriterDiscoveryInfo::DISCOVERY_STATUS;
+  const auto guid = text_of(info.info.guid());
+  std::lock_guard<std::mutex> lock(mutex_);
+  if (info.status == Status::REMOVED_WRITER)
+    partitions_.erase(guid);
+  else
+    partitions_[guid] = info.info.m_qos.m_partition.names();
+}
+
+std::optional<std::vector<std::string>> RemoteWriters::partitions_of(
+    const eprosima::fastdds::dds::SampleInfo& info) const {
+  const auto guid = text_of(eprosima::fastrtps::rtps::iHandle2GUID(info.publication_handle));
+  std::lock_guard<std::mutex> lock(mutex_);
+  const auto it = partitions_.find(guid);
+  if (it == partitions_.end()) return std::nullopt;
+  return it->second;
+}
+
+std::size_t RemoteWriters::size() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return partitions_.size();
+}
+
+}  // namespace pmu::dds
