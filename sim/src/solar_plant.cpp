@@ -15,6 +15,9 @@ constexpr double kStcIrradiance = 1000.0;  // W/m2 at which panel_vmp / panel_im
 // A bus with no battery on it (only MPPTs simulated): a 12-cell pack's nominal voltage.
 constexpr double kNominalBusVoltage = 12 * 3.7;
 constexpr double kFull = 0.9999;  // state of charge at which the BMS calls the pack full
+// An empty pack's BMS reconnects the load only once it has this much charge again, so it
+// does not chatter on and off around zero.
+constexpr double kReconnect = 0.05;
 
 // Open-circuit voltage of a Li-ion (NMC) cell against state of charge, rising everywhere so a
 // rising charge always shows as a rising voltage.
@@ -38,6 +41,17 @@ double cell_spread(int cell) noexcept { return static_cast<double>((cell * 7) % 
 // Offsets of the pack's four temperature sensors from its mean temperature.
 constexpr double kSensorOffset[4] = {0.0, 0.8, 1.6, -0.5};
 
+// The pack's terminal voltage: its cells in series, each at its open-circuit voltage plus
+// the drop (or rise) across its resistance.
+double cell_voltage(const BatterySimConfig& c, double soc, double current, int cell) noexcept {
+  return cell_ocv(soc) + cell_spread(cell) + current * c.cell_resistance;
+}
+double pack_voltage(const BatterySimConfig& c, double soc, double current) noexcept {
+  double v = 0;
+  for (int i = 1; i <= std::clamp(c.cells, 0, kMaxCells); ++i) v += cell_voltage(c, soc, current, i);
+  return v;
+}
+
 struct Panel {
   double voltage = 0, current = 0;
 };
@@ -60,7 +74,8 @@ double available_power(const MpptSimConfig& c, double irradiance) noexcept {
 SolarPlant::SolarPlant(const SolarWorld& world, TimePoint now) noexcept : world_(world), start_(now), last_(now) {}
 
 void SolarPlant::add_battery(const BatterySimConfig& config) noexcept {
-  batteries_[config.node] = Battery{config, std::clamp(config.initial_soc, 0.0, 1.0)};
+  const double soc = std::clamp(config.initial_soc, 0.0, 1.0);
+  batteries_[config.node] = Battery{config, soc, soc <= 0};
 }
 void SolarPlant::remove_battery(std::uint8_t node) noexcept { batteries_.erase(node); }
 void SolarPlant::add_mppt(const MpptSimConfig& config) noexcept { mppts_[config.device] = config; }
@@ -89,23 +104,37 @@ SolarPlant::Flows SolarPlant::flows() const noexcept {
     return f;
   }
   bool full = true, empty = true;
-  double volts = 0;
   for (const auto& [node, b] : batteries_) {
     full = full && b.soc >= kFull;
-    empty = empty && b.soc <= 0;
-    volts += b.config.cells * cell_ocv(b.soc);
-  }
-  f.bus_voltage = volts / static_cast<double>(batteries_.size());
-  const double drawn = empty ? 0.0 : load;  // an empty pack's BMS disconnects the load
-  double in = f.bus_voltage > 0 ? available / f.bus_voltage : 0;
-  if (full && in > drawn) {
-    f.limit = in > 0 ? drawn / in : 0;
-    in = drawn;
+    empty = empty && b.load_cut;
   }
   const auto n = static_cast<double>(batteries_.size());
-  f.charge_per_battery = in / n;
-  f.discharge_per_battery = drawn / n;
+  const auto bus_voltage = [&](double current_per_battery) {
+    double v = 0;
+    for (const auto& [node, b] : batteries_) v += pack_voltage(b.config, b.soc, current_per_battery);
+    return v / n;
+  };
+  const double drawn = empty ? 0.0 : load;  // an empty pack's BMS disconnects the load
+  // The current depends on the terminal voltage (power / V) and the voltage on the current
+  // (I * R): a few rounds of substitution settle it well below the fields' resolution.
+  f.bus_voltage = bus_voltage(0);
+  for (int round = 0; round < 4; ++round) {
+    double in = f.bus_voltage > 0 ? available / f.bus_voltage : 0;
+    f.limit = 1;
+    if (full && in > drawn) {
+      f.limit = in > 0 ? drawn / in : 0;
+      in = drawn;
+    }
+    f.charge_per_battery = in / n;
+    f.discharge_per_battery = drawn / n;
+    f.bus_voltage = bus_voltage(f.charge_per_battery - f.discharge_per_battery);
+  }
   return f;
+}
+
+void SolarPlant::update_cut(Battery& b) noexcept {
+  if (b.soc <= 0) b.load_cut = true;
+  if (b.soc >= kReconnect) b.load_cut = false;
 }
 
 void SolarPlant::step(Duration dt) noexcept {
@@ -114,6 +143,7 @@ void SolarPlant::step(Duration dt) noexcept {
   for (auto& [node, b] : batteries_) {
     const double net = f.charge_per_battery - f.discharge_per_battery;
     if (b.config.capacity_ah > 0) b.soc = std::clamp(b.soc + net * hours / b.config.capacity_ah, 0.0, 1.0);
+    update_cut(b);
   }
 }
 
@@ -143,7 +173,11 @@ void SolarPlant::set_world(const SolarWorld& world, TimePoint now) noexcept {
 
 void SolarPlant::set_state_of_charge(std::uint8_t node, double soc, TimePoint now) noexcept {
   advance(now);
-  if (auto it = batteries_.find(node); it != batteries_.end()) it->second.soc = std::clamp(soc, 0.0, 1.0);
+  if (auto it = batteries_.find(node); it != batteries_.end()) {
+    it->second.soc = std::clamp(soc, 0.0, 1.0);
+    it->second.load_cut = false;
+    update_cut(it->second);
+  }
 }
 
 std::optional<double> SolarPlant::state_of_charge(std::uint8_t node) const noexcept {
@@ -165,10 +199,9 @@ BatteryReading SolarPlant::battery(std::uint8_t node) const noexcept {
   r.time_to_go = r.current < -0.01 ? std::min(65534.0, b.soc * b.config.capacity_ah / -r.current * 60.0)
                                    : kTimeToGoNotDischarging;
   r.cells = std::clamp(b.config.cells, 0, kMaxCells);
-  const double ocv = cell_ocv(b.soc);
   r.cell_voltage_low = 1e9;
   for (int i = 0; i < r.cells; ++i) {
-    const double v = ocv + cell_spread(i + 1) + r.current * b.config.cell_resistance;
+    const double v = cell_voltage(b.config, b.soc, r.current, i + 1);
     r.cell_voltages[static_cast<std::size_t>(i)] = v;
     r.voltage += v;
     r.cell_voltage_high = std::max(r.cell_voltage_high, v);
@@ -186,7 +219,7 @@ BatteryReading SolarPlant::battery(std::uint8_t node) const noexcept {
   if (r.current > 0.05) r.bms_state |= bms_bit::Charging;
   if (r.current < -0.05) r.bms_state |= bms_bit::Discharging;
   if (b.soc >= kFull) r.bms_state |= bms_bit::Full;
-  if (b.soc <= 0) r.bms_state |= bms_bit::Empty;
+  if (b.load_cut) r.bms_state |= bms_bit::Empty;
   r.power_level = r.state_of_charge;
   return r;
 }

@@ -8,7 +8,8 @@
 // current; its cells' voltage follows a Li-ion open-circuit curve of the state of charge plus
 // I*R (a few mV of fixed spread between cells), the pack voltage is their sum and the
 // temperatures rise with current above the ambient. A full battery makes the MPPTs limit
-// their output to the load; an empty one is disconnected from the load by its BMS.
+// their output to the load; an empty one is disconnected from the load by its BMS until it
+// has 5 % again.
 //
 // Pure like PmuModel: time is passed in (advance(now)), nothing is read from a clock. The
 // models call advance() before each frame, so whichever device sends first moves the world.
@@ -31,7 +32,7 @@ namespace bms_bit {
 inline constexpr std::uint32_t Charging = 1u << 0;
 inline constexpr std::uint32_t Discharging = 1u << 1;
 inline constexpr std::uint32_t Full = 1u << 2;
-inline constexpr std::uint32_t Empty = 1u << 3;  // load disconnected
+inline constexpr std::uint32_t Empty = 1u << 3;  // load disconnected (empty, until 5 %)
 }  // namespace bms_bit
 
 // 0x302/0x07 when the battery is not discharging (no time to empty): the uint16's largest.
@@ -111,6 +112,7 @@ class SolarPlant {
   struct Battery {
     BatterySimConfig config;
     double soc = 0;
+    bool load_cut = false;  // the BMS disconnected the load (empty), until kReconnect
   };
   // Where the power goes at the present state.
   struct Flows {
@@ -122,6 +124,7 @@ class SolarPlant {
   Flows flows() const noexcept;
   double irradiance_at(TimePoint t) const noexcept;
   void step(Duration dt) noexcept;
+  static void update_cut(Battery& b) noexcept;
 
   SolarWorld world_;
   std::optional<double> fixed_irradiance_;
