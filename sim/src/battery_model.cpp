@@ -84,12 +84,12 @@ BatteryModel::BatteryModel(const BatterySimConfig& config, std::shared_ptr<Solar
     : config_(config), plant_(std::move(plant)), last_(now) {
   check(config_);
   if (!plant_) plant_ = std::make_shared<SolarPlant>(SolarWorld{}, now);
-  plant_->add_battery(config_);
+  token_ = plant_->add_battery(config_);
   sender_ = std::make_unique<Sender>(Sender{detail::Spread(config_.period, frames_per_period(), now),
                                             detail::CanOpenSender(std::move(sink))});
 }
 
-BatteryModel::~BatteryModel() { plant_->remove_battery(config_.node); }
+BatteryModel::~BatteryModel() { plant_->remove_battery(config_.node, token_); }
 
 std::size_t BatteryModel::frames_per_period() const noexcept {
   return kFixedBefore + static_cast<std::size_t>(config_.cells) + 1;

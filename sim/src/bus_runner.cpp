@@ -47,16 +47,16 @@ SolarPlant& BusRunner::plant() {
 void BusRunner::add_battery(const BatterySimConfig& config) {
   std::lock_guard<std::recursive_mutex> lock(mutex_);
   plant();
-  // The old model leaves the plant first, or its destructor would take the new one's place.
-  batteries_.erase(config.node);
-  batteries_[config.node] = std::make_unique<BatteryModel>(config, plant_, sink(), clock_.steady_now());
+  // Built before the old one goes, so a refused config leaves the old device running.
+  auto model = std::make_unique<BatteryModel>(config, plant_, sink(), clock_.steady_now());
+  batteries_[config.node] = std::move(model);
 }
 
 void BusRunner::add_mppt(const MpptSimConfig& config) {
   std::lock_guard<std::recursive_mutex> lock(mutex_);
   plant();
-  mppts_.erase(config.device);
-  mppts_[config.device] = std::make_unique<MpptModel>(config, plant_, sink(), clock_.steady_now());
+  auto model = std::make_unique<MpptModel>(config, plant_, sink(), clock_.steady_now());
+  mppts_[config.device] = std::move(model);
 }
 
 void BusRunner::on_frame(const transport::ReceivedFrame& frame) {

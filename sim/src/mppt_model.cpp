@@ -69,12 +69,12 @@ MpptModel::MpptModel(const MpptSimConfig& config, std::shared_ptr<SolarPlant> pl
     : config_(config), plant_(std::move(plant)), last_(now) {
   check(config_);
   if (!plant_) plant_ = std::make_shared<SolarPlant>(SolarWorld{}, now);
-  plant_->add_mppt(config_);
+  token_ = plant_->add_mppt(config_);
   sender_ = std::make_unique<Sender>(Sender{detail::Spread(config_.period, frames_per_period(), now),
                                             detail::CanOpenSender(std::move(sink))});
 }
 
-MpptModel::~MpptModel() { plant_->remove_mppt(config_.device); }
+MpptModel::~MpptModel() { plant_->remove_mppt(config_.device, token_); }
 
 void MpptModel::tick(TimePoint now) noexcept {
   now = std::max(now, last_);

@@ -73,13 +73,26 @@ double available_power(const MpptSimConfig& c, double irradiance) noexcept {
 
 SolarPlant::SolarPlant(const SolarWorld& world, TimePoint now) noexcept : world_(world), start_(now), last_(now) {}
 
-void SolarPlant::add_battery(const BatterySimConfig& config) noexcept {
+std::uint64_t SolarPlant::add_battery(const BatterySimConfig& config) noexcept {
   const double soc = std::clamp(config.initial_soc, 0.0, 1.0);
-  batteries_[config.node] = Battery{config, soc, soc <= 0};
+  batteries_[config.node] = Battery{config, soc, soc <= 0, next_token_};
+  return next_token_++;
 }
-void SolarPlant::remove_battery(std::uint8_t node) noexcept { batteries_.erase(node); }
-void SolarPlant::add_mppt(const MpptSimConfig& config) noexcept { mppts_[config.device] = config; }
-void SolarPlant::remove_mppt(std::uint8_t device) noexcept { mppts_.erase(device); }
+
+void SolarPlant::remove_battery(std::uint8_t node, std::uint64_t token) noexcept {
+  const auto it = batteries_.find(node);
+  if (it != batteries_.end() && it->second.token == token) batteries_.erase(it);
+}
+
+std::uint64_t SolarPlant::add_mppt(const MpptSimConfig& config) noexcept {
+  mppts_[config.device] = Mppt{config, next_token_};
+  return next_token_++;
+}
+
+void SolarPlant::remove_mppt(std::uint8_t device, std::uint64_t token) noexcept {
+  const auto it = mppts_.find(device);
+  if (it != mppts_.end() && it->second.token == token) mppts_.erase(it);
+}
 
 double SolarPlant::irradiance_at(TimePoint t) const noexcept {
   if (fixed_irradiance_) return std::max(0.0, *fixed_irradiance_);
@@ -95,7 +108,7 @@ SolarPlant::Flows SolarPlant::flows() const noexcept {
   Flows f;
   const double g = irradiance();
   double available = 0;
-  for (const auto& [device, c] : mppts_) available += available_power(c, g);
+  for (const auto& [device, m] : mppts_) available += available_power(m.config, g);
   const double load = std::max(0.0, world_.load_current);
   if (batteries_.empty()) {
     // MPPTs alone: they can only feed the load directly.
@@ -228,7 +241,7 @@ MpptReading SolarPlant::mppt(std::uint8_t device) const noexcept {
   MpptReading r;
   const auto it = mppts_.find(device);
   if (it == mppts_.end()) return r;
-  const MpptSimConfig& c = it->second;
+  const MpptSimConfig& c = it->second.config;
   const Flows f = flows();
   const Panel p = panel_at(c, irradiance());
   r.output_voltage = f.bus_voltage;

@@ -6,6 +6,7 @@
 #include <chrono>
 #include <map>
 #include <set>
+#include <stdexcept>
 
 #include "pmu/codec/canopen.hpp"
 #include "pmu/sim/bus_runner.hpp"
@@ -113,6 +114,19 @@ TEST(RunnerSolar, AddingAgainReplacesTheDevice) {
   double soc = -1;
   ASSERT_TRUE(h.runner.with_battery(2, [&](BatteryModel& b) { soc = b.plant().state_of_charge(2).value_or(-1); }));
   EXPECT_NEAR(soc, 0.25, 0.01) << "the replacement is in the plant, not removed with the old model";
+
+  // A refused replacement leaves the device that was there.
+  BatterySimConfig bad = four;
+  bad.cells = 16;
+  EXPECT_THROW(h.runner.add_battery(bad), std::invalid_argument);
+  MpptSimConfig bad_mppt;
+  bad_mppt.panels = 5;
+  EXPECT_THROW(h.runner.add_mppt(bad_mppt), std::invalid_argument);
+  EXPECT_FALSE(h.runner.with_mppt(0, [](MpptModel&) {}));
+  h.run(1000ms);
+  per_id = h.take();
+  EXPECT_EQ(per_id[0x482], 4);
+  EXPECT_EQ(per_id[0x302], 6);
 }
 
 TEST(RunnerSolar, TheRunnerWakesAtTheDevicesDeadlines) {

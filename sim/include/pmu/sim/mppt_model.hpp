@@ -53,6 +53,7 @@ class MpptModel {
   struct Sender;
   std::unique_ptr<Sender> sender_;
   TimePoint last_;
+  std::uint64_t token_ = 0;  // our entry in the plant
 };
 
 }  // namespace pmu::sim

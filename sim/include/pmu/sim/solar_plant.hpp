@@ -84,11 +84,13 @@ class SolarPlant {
   explicit SolarPlant(const SolarWorld& world, TimePoint now) noexcept;
 
   // A device joins (or replaces the one with its node / device number). Only the models
-  // call these; configs are checked by the models' constructors.
-  void add_battery(const BatterySimConfig& config) noexcept;
-  void remove_battery(std::uint8_t node) noexcept;
-  void add_mppt(const MpptSimConfig& config) noexcept;
-  void remove_mppt(std::uint8_t device) noexcept;
+  // call these; configs are checked by the models' constructors. The token returned makes
+  // remove_* a no-op for a device already replaced, so a replacement may be built before
+  // the model it replaces is destroyed.
+  std::uint64_t add_battery(const BatterySimConfig& config) noexcept;
+  void remove_battery(std::uint8_t node, std::uint64_t token) noexcept;
+  std::uint64_t add_mppt(const MpptSimConfig& config) noexcept;
+  void remove_mppt(std::uint8_t device, std::uint64_t token) noexcept;
 
   // Integrates the batteries' charge up to `now` (steps of at most 1 s, with the currents at
   // each step's start). Times before the last one are ignored.
@@ -113,6 +115,11 @@ class SolarPlant {
     BatterySimConfig config;
     double soc = 0;
     bool load_cut = false;  // the BMS disconnected the load (empty), until kReconnect
+    std::uint64_t token = 0;
+  };
+  struct Mppt {
+    MpptSimConfig config;
+    std::uint64_t token = 0;
   };
   // Where the power goes at the present state.
   struct Flows {
@@ -129,7 +136,8 @@ class SolarPlant {
   SolarWorld world_;
   std::optional<double> fixed_irradiance_;
   std::map<std::uint8_t, Battery> batteries_;
-  std::map<std::uint8_t, MpptSimConfig> mppts_;
+  std::map<std::uint8_t, Mppt> mppts_;
+  std::uint64_t next_token_ = 1;
   TimePoint start_;
   TimePoint last_;
 };
