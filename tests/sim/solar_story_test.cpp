@@ -190,6 +190,29 @@ TEST(SolarStory, AnEmptyBatteryDisconnectsTheLoad) {
   EXPECT_GT(*h.plant->state_of_charge(2), 0.0);
 }
 
+TEST(SolarStory, ParallelBatteriesShareChargeAndLoad) {
+  SolarHarness h(world(12.0));
+  h.plant->set_irradiance(1000.0, h.now);
+  BatterySimConfig a = pack(0.5), b = pack(0.5);
+  b.node = 3;  // ids 0x203.. : decode() knows node 2 only, so read node 3 from the plant
+  h.add(a);
+  h.add(b);
+  h.add(mppt(0));
+  h.run(2s);
+  const BatteryReading ra = h.plant->battery(2), rb = h.plant->battery(3);
+  EXPECT_NEAR(ra.current_discharge, 6.0, 1e-9);
+  EXPECT_NEAR(rb.current_discharge, 6.0, 1e-9);
+  EXPECT_NEAR(ra.current_charge, rb.current_charge, 1e-9);
+  EXPECT_NEAR(ra.current_charge * 2, h.plant->mppt(0).output_current, 1e-6) << "the one MPPT feeds both";
+  std::vector<CanOpenMessage> node2;
+  for (const auto& s : h.sent) {
+    const auto m = codec::canopen::decode(s.frame);
+    if (m) node2.push_back(*m);
+  }
+  h.sent.clear();
+  EXPECT_NEAR(latest(node2).at("current_discharge"), 6.0, 0.01);
+}
+
 TEST(SolarStory, ByDefaultTheSunVariesSlowly) {
   SolarWorld w;
   w.irradiance_mean = 500;
