@@ -28,12 +28,35 @@ BusRunner::BusRunner(std::unique_ptr<transport::CanBus> bus, const transport::Cl
 
 BusRunner::~BusRunner() { stop(); }
 
+FrameSink BusRunner::sink() {
+  // A real bus does not echo a node's own frames back to it: send without expecting them.
+  return [this](const codec::CanFrame& f) { (void)bus_->send(f, milliseconds(10)); };
+}
+
 void BusRunner::add(const DeviceConfig& config) {
   std::lock_guard<std::recursive_mutex> lock(mutex_);
-  // A real bus does not echo a node's own frames back to it: send without expecting them.
-  auto model = std::make_unique<PmuModel>(
-      config, [this](const codec::CanFrame& f) { (void)bus_->send(f, milliseconds(10)); }, clock_.steady_now());
+  auto model = std::make_unique<PmuModel>(config, sink(), clock_.steady_now());
   models_[config.address] = std::move(model);
+}
+
+SolarPlant& BusRunner::plant() {
+  if (!plant_) plant_ = std::make_shared<SolarPlant>(SolarWorld{}, clock_.steady_now());
+  return *plant_;
+}
+
+void BusRunner::add_battery(const BatterySimConfig& config) {
+  std::lock_guard<std::recursive_mutex> lock(mutex_);
+  plant();
+  // Built before the old one goes, so a refused config leaves the old device running.
+  auto model = std::make_unique<BatteryModel>(config, plant_, sink(), clock_.steady_now());
+  batteries_[config.node] = std::move(model);
+}
+
+void BusRunner::add_mppt(const MpptSimConfig& config) {
+  std::lock_guard<std::recursive_mutex> lock(mutex_);
+  plant();
+  auto model = std::make_unique<MpptModel>(config, plant_, sink(), clock_.steady_now());
+  mppts_[config.device] = std::move(model);
 }
 
 void BusRunner::on_frame(const transport::ReceivedFrame& frame) {
@@ -45,12 +68,14 @@ void BusRunner::on_event(const transport::BusEvent&) {}
 
 void BusRunner::wake_at_next_deadline() {
   std::lock_guard<std::recursive_mutex> lock(mutex_);
-  if (models_.empty()) {
+  if (models_.empty() && batteries_.empty() && mppts_.empty()) {
     loop_.disarm(deadline_timer_);
     return;
   }
   auto earliest = transport::EventLoop::TimePoint::max();
   for (const auto& [address, model] : models_) earliest = std::min(earliest, model->next_deadline());
+  for (const auto& [node, model] : batteries_) earliest = std::min(earliest, model->next_deadline());
+  for (const auto& [device, model] : mppts_) earliest = std::min(earliest, model->next_deadline());
   loop_.schedule(deadline_timer_, earliest);
 }
 
@@ -58,6 +83,8 @@ void BusRunner::end_turn() {
   std::lock_guard<std::recursive_mutex> lock(mutex_);
   const auto now = clock_.steady_now();
   for (auto& [address, model] : models_) model->tick(now);
+  for (auto& [node, model] : batteries_) model->tick(now);
+  for (auto& [device, model] : mppts_) model->tick(now);
   bus_->maintain(now);
 }
 
@@ -87,6 +114,22 @@ bool BusRunner::with_model(std::uint16_t address, const std::function<void(PmuMo
   std::lock_guard<std::recursive_mutex> lock(mutex_);
   auto it = models_.find(address);
   if (it == models_.end()) return false;
+  fn(*it->second);
+  return true;
+}
+
+bool BusRunner::with_battery(std::uint8_t node, const std::function<void(BatteryModel&)>& fn) {
+  std::lock_guard<std::recursive_mutex> lock(mutex_);
+  auto it = batteries_.find(node);
+  if (it == batteries_.end()) return false;
+  fn(*it->second);
+  return true;
+}
+
+bool BusRunner::with_mppt(std::uint8_t device, const std::function<void(MpptModel&)>& fn) {
+  std::lock_guard<std::recursive_mutex> lock(mutex_);
+  auto it = mppts_.find(device);
+  if (it == mppts_.end()) return false;
   fn(*it->second);
   return true;
 }

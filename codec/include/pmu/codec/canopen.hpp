@@ -1,7 +1,8 @@
 #pragma once
-// Decode-only support for the solar-boat battery (MG) and MPPT frames
+// Decoding of the solar-boat battery (MG) and MPPT frames
 // (spec/solar-boat-canopen-battery-mppt.txt). These share a bus with the PMU on some
-// airframes; we read them, never write them.
+// airframes; the service reads them, never writes them. The simulator builds them with
+// canopen_encode.hpp, from the same rows (src/canopen_table.hpp).
 //
 // Where the document is ambiguous we take the CANopen reading, and tests pin each choice:
 //  * Byte order: little-endian for the index (Data[1] low, Data[2] high) and for values in
