@@ -68,11 +68,16 @@ TSAN_OPTIONS="suppressions=$root/tests/tsan.supp halt_on_error=1 second_deadlock
 step "fuzz runs"
 ctest --test-dir build/fuzz --output-on-failure -L fuzz
 
+# These packages only feed the tests (systemd_vm, package_*): built without debug
+# information and without -dbgsym packages, which is most of a C++ link's time and output.
+# What ships is built by scripts/package.sh alone, with both.
+no_debug=(DEB_CFLAGS_APPEND=-g0 DEB_CXXFLAGS_APPEND=-g0)
+
 step "amd64 packages"
-DEB_BUILD_OPTIONS=nocheck "$root/scripts/package.sh" --arch amd64
+env "${no_debug[@]}" DEB_BUILD_OPTIONS="nocheck noautodbgsym" "$root/scripts/package.sh" --arch amd64
 
 step "arm64 packages (tests under qemu-user)"
-"$root/scripts/package.sh" --arch arm64
+env "${no_debug[@]}" DEB_BUILD_OPTIONS=noautodbgsym "$root/scripts/package.sh" --arch arm64
 
 step "release tests"
 ctest --test-dir build/release --output-on-failure -j"$jobs"
