@@ -28,6 +28,7 @@
 #include "pmu/service/dds_commands.hpp"
 #include "pmu/service/dds_context.hpp"
 #include "pmu/service/dds_publisher.hpp"
+#include "pmu/service/receive_filters.hpp"
 #include "pmu/service/logging.hpp"
 #include "pmu/service/systemd.hpp"
 #include "pmu/service/vehicle.hpp"
@@ -55,8 +56,7 @@ std::unique_ptr<transport::CanBus> open_bus(const service::BusConfig& bus, const
                                             BusRuntime& rt) {
   if (bus.interface != "sim") {
     transport::SocketCanOptions options;
-    // CANopen ids only where batteries or MPPTs are served: elsewhere the kernel drops them.
-    options.filters = transport::default_filters(bus.wants_canopen());
+    options.filters = service::receive_filters(bus);
     auto b = bus.interface.rfind("fd:", 0) == 0
                  ? transport::SocketCanBus::adopt(transport::UniqueFd(std::stoi(bus.interface.substr(3))), bus.name,
                                                   options, clock)

@@ -6,6 +6,7 @@
 
 #include "canopen_frames.hpp"
 #include "harness.hpp"
+#include "pmu/service/receive_filters.hpp"
 
 namespace pmu::service::test {
 namespace {
@@ -97,6 +98,34 @@ TEST(CanOpenWorker, BusStateReachesBatteriesToo) {
   const auto* report = h.sink.last_health(2, DeviceKind::Battery);
   ASSERT_NE(report, nullptr);
   EXPECT_EQ(report->bus_state, transport::BusState::BusOff);
+}
+
+}  // namespace
+}  // namespace pmu::service::test
+
+namespace pmu::service::test {
+namespace {
+
+// A SocketCAN bus installs these filters (main.cpp): before, every bus got the PMUs' filter
+// alone, so on a real bus no battery or MPPT frame reached the service.
+TEST(CanOpenWorker, ABusThatServesBatteriesOrMpptsReceivesTheirIds) {
+  const codec::CanFrame battery = canopen_frame(0x302, 0x2005, 0x01, {0x39, 0x30});
+  const codec::CanFrame mppt = canopen_frame(mppt_id(7, 1), 0, 0x01, {10});
+  codec::CanFrame pmu_voltages;
+  pmu_voltages.id = 0x1E000001;
+  pmu_voltages.extended = true;
+  pmu_voltages.length = 7;
+
+  const BusConfig pmus_only = sim_bus({device(1)});
+  EXPECT_TRUE(transport::accepts(receive_filters(pmus_only), pmu_voltages));
+  EXPECT_FALSE(transport::accepts(receive_filters(pmus_only), battery));
+
+  for (const auto& bus : {bus_with({BatteryConfig{}}, {}), bus_with({}, {MpptConfig{}}), bus_with({}, {}, true)}) {
+    const auto filters = receive_filters(bus);
+    EXPECT_TRUE(transport::accepts(filters, pmu_voltages));
+    EXPECT_TRUE(transport::accepts(filters, battery));
+    EXPECT_TRUE(transport::accepts(filters, mppt));
+  }
 }
 
 }  // namespace
