@@ -485,6 +485,14 @@ Config parse_config(const std::string& text, const std::string& source, const Co
                  " devices in one service (the capacity its DDS writers are sized for, "
                  "pmu::service::kMaxDevicesPerService); split them across services");
     devices += b.devices.size();
+    // Batteries and MPPTs are instances of pmu/health too.
+    const std::size_t canopen = b.batteries.size() + b.mppts.size();
+    if (devices + canopen > kMaxDevicesPerService)
+      c.fail(bn[b.batteries.empty() ? "mppts" : "batteries"],
+             "more than " + std::to_string(kMaxDevicesPerService) +
+                 " devices (PMUs, batteries and MPPTs) in one service (the capacity its DDS writers are sized for, "
+                 "pmu::service::kMaxDevicesPerService); split them across services");
+    devices += canopen;
     if (!names.insert(b.name).second) c.fail(bn, "bus name '" + b.name + "' appears twice");
     if (b.interface != "sim" && !interfaces.insert(b.interface).second)
       c.fail(bn, "interface '" + b.interface + "' is used by two buses (the service owns each bus alone)");

@@ -412,6 +412,23 @@ TEST(Config, MoreDevicesThanTheDdsWritersHoldAreRefusedAtTheFirstOneTooMany) {
   }
 }
 
+TEST(Config, BatteriesAndMpptsCountTowardsTheDevicesTheDdsWritersHold) {
+  // 255 PMUs leave room for one more pmu/health instance: a battery fits, a battery and an
+  // MPPT do not. can0 holds 1..127 (lines 4..130), can1 128..255 (lines 133..260), then
+  // `batteries:` (261) and its list (262).
+  const std::string pmus = many_devices(static_cast<int>(kMaxDevicesPerService) - 1);
+  const Config c = parse_config(pmus + "    batteries:\n      - node: 2\n", "fleet.yaml");
+  EXPECT_EQ(c.buses[1].batteries.size(), 1u);
+  try {
+    (void)parse_config(pmus + "    batteries:\n      - node: 2\n    mppts:\n      - device: 0\n", "fleet.yaml");
+    ADD_FAILURE() << "accepted";
+  } catch (const ConfigError& e) {
+    EXPECT_EQ(std::string(e.what()),
+              "fleet.yaml:262: more than 256 devices (PMUs, batteries and MPPTs) in one service (the capacity its DDS "
+              "writers are sized for, pmu::service::kMaxDevicesPerService); split them across services");
+  }
+}
+
 TEST(Config, SecuritySectionAllSixFilesRelativeToTheConfigFile) {
   const char* yaml = R"(buses:
   - interface: can0
