@@ -119,15 +119,15 @@ TEST(DdsCanOpen, HealthHasAnInstancePerDeviceKind) {
       [&] {
         while (health.take_next_sample(&s, &si) == ReturnCode_t::RETCODE_OK)
           if (si.valid_data) seen[{static_cast<int>(s.kind()), s.address()}] = s.state();
-        return seen.size() == 4 && seen[{pmu::MPPT, 2}] == pmu::OFFLINE;
+        return seen.size() == 4 && seen[{pmu::KIND_MPPT, 2}] == pmu::OFFLINE;
       },
       20s, 5ms);
   ASSERT_TRUE(all) << seen.size() << " instances";
   // PMU 1, battery 2 and MPPT 4 share numbers' ranges: the kind keeps them apart.
-  EXPECT_EQ((seen[{pmu::PMU, 1}]), pmu::ONLINE);
-  EXPECT_EQ((seen[{pmu::BATTERY, 2}]), pmu::ONLINE);
-  EXPECT_EQ((seen[{pmu::MPPT, 4}]), pmu::ONLINE);
-  EXPECT_EQ((seen[{pmu::MPPT, 2}]), pmu::OFFLINE) << "configured but silent";
+  EXPECT_EQ((seen[{pmu::KIND_PMU, 1}]), pmu::ONLINE);
+  EXPECT_EQ((seen[{pmu::KIND_BATTERY, 2}]), pmu::ONLINE);
+  EXPECT_EQ((seen[{pmu::KIND_MPPT, 4}]), pmu::ONLINE);
+  EXPECT_EQ((seen[{pmu::KIND_MPPT, 2}]), pmu::OFFLINE) << "configured but silent";
 }
 
 }  // namespace

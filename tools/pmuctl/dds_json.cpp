@@ -125,9 +125,9 @@ namespace pmu::tools {
 
 const char* to_string(pmu::DeviceKind k) {
   switch (k) {
-    case pmu::PMU: return "pmu";
-    case pmu::BATTERY: return "battery";
-    case pmu::MPPT: return "mppt";
+    case pmu::KIND_PMU: return "pmu";
+    case pmu::KIND_BATTERY: return "battery";
+    case pmu::KIND_MPPT: return "mppt";
   }
   return "pmu";
 }

@@ -51,7 +51,7 @@ struct DeviceId {
   std::string vehicle;
   std::string bus;
   std::uint16_t address;
-  pmu::DeviceKind kind = pmu::PMU;
+  pmu::DeviceKind kind = pmu::KIND_PMU;
   bool operator<(const DeviceId& o) const {
     return std::tie(vehicle, bus, kind, address) < std::tie(o.vehicle, o.bus, o.kind, o.address);
   }
@@ -64,28 +64,34 @@ DeviceId id_of(const T& s) {
 DeviceId id_of(const pmu::Health& s) {
   return {s.vehicle().to_string(), s.bus().to_string(), s.address(), s.kind()};
 }
-DeviceId id_of(const pmu::Battery& s) { return {s.vehicle().to_string(), s.bus().to_string(), s.node(), pmu::BATTERY}; }
-DeviceId id_of(const pmu::BatteryCells& s) {
-  return {s.vehicle().to_string(), s.bus().to_string(), s.node(), pmu::BATTERY};
+DeviceId id_of(const pmu::Battery& s) {
+  return {s.vehicle().to_string(), s.bus().to_string(), s.node(), pmu::KIND_BATTERY};
 }
-DeviceId id_of(const pmu::Mppt& s) { return {s.vehicle().to_string(), s.bus().to_string(), s.device(), pmu::MPPT}; }
+DeviceId id_of(const pmu::BatteryCells& s) {
+  return {s.vehicle().to_string(), s.bus().to_string(), s.node(), pmu::KIND_BATTERY};
+}
+DeviceId id_of(const pmu::Mppt& s) {
+  return {s.vehicle().to_string(), s.bus().to_string(), s.device(), pmu::KIND_MPPT};
+}
 
 // --address names a PMU: batteries and MPPTs are selected by vehicle and bus alone, and
 // drop out when a PMU is named.
 bool selected(const GlobalOptions& o, const DeviceId& d) {
   return (!o.vehicle || *o.vehicle == d.vehicle) && (o.bus.empty() || o.bus == d.bus) &&
-         (!o.address || (d.kind == pmu::PMU && *o.address == d.address));
+         (!o.address || (d.kind == pmu::KIND_PMU && *o.address == d.address));
 }
 
 // "can0/1" for a PMU, "can0/battery2" and "can0/mppt4" for the others.
 std::string label(const DeviceId& d) {
-  if (d.kind == pmu::PMU) return device_label(d.vehicle, d.bus, d.address);
+  if (d.kind == pmu::KIND_PMU) return device_label(d.vehicle, d.bus, d.address);
   return (d.vehicle.empty() ? std::string() : d.vehicle + "/") + d.bus + "/" + to_string(d.kind) +
          std::to_string(d.address);
 }
 
 // The JSON key of a device's number: the contract's key name of its type.
-const char* number_key(pmu::DeviceKind k) { return k == pmu::BATTERY ? "node" : k == pmu::MPPT ? "device" : "address"; }
+const char* number_key(pmu::DeviceKind k) {
+  return k == pmu::KIND_BATTERY ? "node" : k == pmu::KIND_MPPT ? "device" : "address";
+}
 
 // Reads every sample of one state topic (TRANSIENT_LOCAL: the service's current values
 // arrive at once) and keeps the latest per device.
@@ -336,7 +342,7 @@ int run_list(const GlobalOptions& o) {
                     static_cast<double>(h.last_frame_age()));
       // A battery or MPPT shows its kind with its number ("battery2"): it has no serial or firmware.
       const std::string number =
-          key.kind == pmu::PMU ? std::to_string(key.address) : to_string(key.kind) + std::to_string(key.address);
+          key.kind == pmu::KIND_PMU ? std::to_string(key.address) : to_string(key.kind) + std::to_string(key.address);
       std::printf("%-15s %-15s %9s %8s %8s %-9s %-6s %s\n", key.vehicle.empty() ? "-" : key.vehicle.c_str(),
                   key.bus.c_str(), number.c_str(), serial.c_str(), fw.c_str(), to_string(h.state()),
                   to_string(h.bus_state()), age);
