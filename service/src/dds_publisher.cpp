@@ -105,9 +105,10 @@ struct DdsPublisher::Writers {
   DataWriter* config;
   DataWriter* info;
   DataWriter* health;
-  DataWriter* battery;
-  DataWriter* battery_cells;
-  DataWriter* mppt;
+  // Null when the service serves no battery or MPPT (not offered).
+  DataWriter* battery = nullptr;
+  DataWriter* battery_cells = nullptr;
+  DataWriter* mppt = nullptr;
   // Bus workers run in threads of their own and share these writers and the rest below.
   std::mutex mutex;
   std::set<std::tuple<std::string, DeviceKind, std::uint16_t>> admitted;
@@ -116,7 +117,8 @@ struct DdsPublisher::Writers {
 };
 
 DdsPublisher::DdsPublisher(dds::DdsContext& dds, std::chrono::milliseconds telemetry_deadline, std::string vehicle,
-                           std::chrono::milliseconds low_rate_period, std::chrono::milliseconds canopen_deadline)
+                           std::chrono::milliseconds low_rate_period,
+                           std::optional<std::chrono::milliseconds> canopen_deadline)
     : w_(std::make_unique<Writers>(low_rate_period)) {
   w_->vehicle = std::move(vehicle);
   auto telemetry = [&](const char* name, TypeSupport type, std::chrono::milliseconds deadline) {
@@ -147,9 +149,12 @@ DdsPublisher::DdsPublisher(dds::DdsContext& dds, std::chrono::milliseconds telem
     w_->low[3] = telemetry(topics::kLowRateTemperatures, TypeSupport(new pmu::TemperaturesPubSubType()), low);
     w_->low[4] = telemetry(topics::kLowRateStatus, TypeSupport(new pmu::StatusPubSubType()), low);
   }
-  w_->battery = telemetry(topics::kBattery, TypeSupport(new pmu::BatteryPubSubType()), canopen_deadline);
-  w_->battery_cells = telemetry(topics::kBatteryCells, TypeSupport(new pmu::BatteryCellsPubSubType()), canopen_deadline);
-  w_->mppt = telemetry(topics::kMppt, TypeSupport(new pmu::MpptPubSubType()), canopen_deadline);
+  if (canopen_deadline) {
+    const auto cd = *canopen_deadline;
+    w_->battery = telemetry(topics::kBattery, TypeSupport(new pmu::BatteryPubSubType()), cd);
+    w_->battery_cells = telemetry(topics::kBatteryCells, TypeSupport(new pmu::BatteryCellsPubSubType()), cd);
+    w_->mppt = telemetry(topics::kMppt, TypeSupport(new pmu::MpptPubSubType()), cd);
+  }
   w_->config = state(topics::kConfig, TypeSupport(new pmu::ConfigPubSubType()));
   w_->info = state(topics::kInfo, TypeSupport(new pmu::DeviceInfoPubSubType()));
   w_->health = state(topics::kHealth, TypeSupport(new pmu::HealthPubSubType()));
@@ -327,6 +332,7 @@ namespace pmu::service {
 
 void DdsPublisher::write_at(DataWriter* writer, void* sample, const DeviceKey& key,
                             std::chrono::system_clock::time_point when) {
+  if (writer == nullptr) return;  // topics not offered: no session can produce these samples
   const ReturnCode_t rc = writer->write_w_timestamp(sample, HANDLE_NIL, dds_time(when));
   count(rc == ReturnCode_t::RETCODE_OK, writer->get_topic()->get_name().c_str(), key, why(rc));
 }

@@ -124,7 +124,9 @@ int run(const service::Config& cfg, const pmu::dds::ResolvedNetwork& network) {
   if (longest == milliseconds{0}) longest = milliseconds(1000);
   // Batteries and MPPTs send each value once per their period; a heard one is taken as 1 s.
   milliseconds canopen_longest{1000};
+  bool canopen = false;
   for (const auto& b : cfg.buses) {
+    canopen |= b.wants_canopen();
     for (const auto& d : b.batteries) canopen_longest = std::max(canopen_longest, d.period);
     for (const auto& d : b.mppts) canopen_longest = std::max(canopen_longest, d.period);
     canopen_longest = std::max(canopen_longest, b.canopen_publish_period);
@@ -137,7 +139,8 @@ int run(const service::Config& cfg, const pmu::dds::ResolvedNetwork& network) {
   if (participant.secure())
     spdlog::info("DDS-Security on: identity {}, permissions {}", cfg.security.files.identity_certificate,
                  cfg.security.files.permissions);
-  service::DdsPublisher publisher(participant, 3 * longest, cfg.vehicle, cfg.low_rate_period, 3 * canopen_longest);
+  service::DdsPublisher publisher(participant, 3 * longest, cfg.vehicle, cfg.low_rate_period,
+                                  canopen ? std::optional<milliseconds>(3 * canopen_longest) : std::nullopt);
 
   std::vector<BusRuntime> buses(cfg.buses.size());
   for (std::size_t i = 0; i < cfg.buses.size(); ++i) {

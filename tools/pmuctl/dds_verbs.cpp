@@ -261,11 +261,18 @@ int run_watch(const GlobalOptions& o, long count) {
       dds, low ? topics::kLowRateStatus : topics::kStatus));
   // Batteries and MPPTs have no low-rate topics: their canopen_publish_period already holds
   // them to a few samples a second.
+  // DDS-Security permissions made before these topics existed do not grant them: then watch
+  // shows the PMUs and says what it leaves out, rather than nothing at all.
   if (!low) {
-    readers.push_back(std::make_unique<TypedTelemetryReader<pmu::Battery, pmu::BatteryPubSubType>>(dds, topics::kBattery));
-    readers.push_back(
-        std::make_unique<TypedTelemetryReader<pmu::BatteryCells, pmu::BatteryCellsPubSubType>>(dds, topics::kBatteryCells));
-    readers.push_back(std::make_unique<TypedTelemetryReader<pmu::Mppt, pmu::MpptPubSubType>>(dds, topics::kMppt));
+    try {
+      readers.push_back(
+          std::make_unique<TypedTelemetryReader<pmu::Battery, pmu::BatteryPubSubType>>(dds, topics::kBattery));
+      readers.push_back(std::make_unique<TypedTelemetryReader<pmu::BatteryCells, pmu::BatteryCellsPubSubType>>(
+          dds, topics::kBatteryCells));
+      readers.push_back(std::make_unique<TypedTelemetryReader<pmu::Mppt, pmu::MpptPubSubType>>(dds, topics::kMppt));
+    } catch (const pmu::dds::DdsError& e) {
+      std::fprintf(stderr, "pmuctl: not showing batteries and MPPTs: %s\n", e.what());
+    }
   }
 
   const bool refresh = !o.json && isatty(STDOUT_FILENO);

@@ -11,6 +11,7 @@
 #include <chrono>
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <string>
 
 #include "pmu/service/dds_context.hpp"
@@ -25,10 +26,12 @@ class DdsPublisher final : public StateSink {
   // `vehicle`: the first key of every sample (vehicle.hpp). `low_rate_period` > 0: also the
   // low-rate telemetry topics, one sample per device and packet per period (low_rate.hpp).
   // `canopen_deadline`: DEADLINE of pmu/battery, pmu/battery_cells and pmu/mppt (3 x the
-  // longest battery/MPPT period, or the publish period if longer).
+  // longest battery/MPPT period, or the publish period if longer); nullopt: a service that
+  // serves no battery or MPPT does not offer those topics, so DDS-Security permissions made
+  // before they existed still let it start.
   DdsPublisher(dds::DdsContext& dds, std::chrono::milliseconds telemetry_deadline, std::string vehicle = {},
                std::chrono::milliseconds low_rate_period = {},
-               std::chrono::milliseconds canopen_deadline = std::chrono::seconds(3));
+               std::optional<std::chrono::milliseconds> canopen_deadline = std::chrono::seconds(3));
   ~DdsPublisher() override;
 
   void on_telemetry(const DeviceKey& key, const codec::PmuMessage& message,
