@@ -7,9 +7,11 @@
 #include <atomic>
 #include <chrono>
 #include <cmath>
+#include <fastdds/dds/core/status/SubscriptionMatchedStatus.hpp>
 #include <fastdds/dds/subscriber/SampleInfo.hpp>
 #include <functional>
 #include <map>
+#include <optional>
 #include <set>
 #include <thread>
 
@@ -128,6 +130,35 @@ TEST(DdsCanOpen, HealthHasAnInstancePerDeviceKind) {
   EXPECT_EQ((seen[{pmu::KIND_BATTERY, 2}]), pmu::ONLINE);
   EXPECT_EQ((seen[{pmu::KIND_MPPT, 4}]), pmu::ONLINE);
   EXPECT_EQ((seen[{pmu::KIND_MPPT, 2}]), pmu::OFFLINE) << "configured but silent";
+}
+
+}  // namespace
+}  // namespace pmu::service::test
+
+namespace pmu::service::test {
+namespace {
+
+// A service with no battery or MPPT does not offer their topics (so permissions made before
+// they existed still let it start): a reader of pmu/battery finds no writer, while the same
+// service's pmu/health writer is found.
+TEST(DdsCanOpen, AServiceWithoutBatteriesOrMpptsDoesNotOfferTheirTopics) {
+  dds::DdsContext service_side(test_domain(), "", "pmu-service-no-canopen");
+  DdsPublisher publisher(service_side, 3s, "", {}, std::nullopt);
+  dds::DdsContext client(test_domain(), "", "reader-no-canopen");
+  auto& battery =
+      client.reader(client.topic(topics::kBattery, TypeSupport(new pmu::BatteryPubSubType())), qos_profiles::kTelemetry);
+  auto& mppt = client.reader(client.topic(topics::kMppt, TypeSupport(new pmu::MpptPubSubType())), qos_profiles::kTelemetry);
+  auto& health =
+      client.reader(client.topic(topics::kHealth, TypeSupport(new pmu::HealthPubSubType())), qos_profiles::kState);
+  auto matched = [](DataReader& r) {
+    SubscriptionMatchedStatus st;
+    r.get_subscription_matched_status(st);
+    return st.current_count;
+  };
+  ASSERT_TRUE(pmu::test::wait_until([&] { return matched(health) > 0; }, 10s, 10ms));
+  std::this_thread::sleep_for(500ms);  // discovery of the other writers, had there been any
+  EXPECT_EQ(matched(battery), 0);
+  EXPECT_EQ(matched(mppt), 0);
 }
 
 }  // namespace
