@@ -300,7 +300,7 @@ sign "$out/governance.xml" "$out/governance.p7s"
 # ---- permissions ---------------------------------------------------------------------------
 telemetry=(pmu/voltages pmu/currents pmu/battery_energy pmu/temperatures pmu/status
            pmu/low_rate/voltages pmu/low_rate/currents pmu/low_rate/battery_energy pmu/low_rate/temperatures
-           pmu/low_rate/status)
+           pmu/low_rate/status pmu/battery pmu/battery_cells pmu/mppt)
 state=(pmu/config pmu/info pmu/health)
 
 topics_xml() { for t in "$@"; do printf '            <topic>%s</topic>\n' "$t"; done; }

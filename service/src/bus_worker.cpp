@@ -17,6 +17,7 @@ using std::chrono::milliseconds;
 constexpr milliseconds kTick{20};  // session timers need no finer grain than this
 constexpr milliseconds kMaintainInterval{250};
 constexpr milliseconds kDiscoveryInterval{10000};
+constexpr milliseconds kHeardCanOpenPeriod{1000};  // listen_canopen: a device not in the config
 
 }  // namespace
 
@@ -33,6 +34,8 @@ BusWorker::BusWorker(BusConfig config, std::unique_ptr<transport::CanBus> bus, c
   if (error != 0) throw std::system_error(error, std::generic_category(), "epoll_ctl");
   const auto now = clock_.steady_now();
   for (const auto& d : config_.devices) add_session(d);
+  for (const auto& b : config_.batteries) add_canopen_session({config_.name, b.node, DeviceKind::Battery}, b.period);
+  for (const auto& m : config_.mppts) add_canopen_session({config_.name, m.device, DeviceKind::Mppt}, m.period);
   // Both due at the first turn. Of two timers due together the one added first fires first:
   // discovery before maintenance, their order when they were checks at the end of a turn.
   if (config_.discover)
@@ -53,6 +56,34 @@ DeviceSession& BusWorker::add_session(const DeviceConfig& device) {
   return ref;
 }
 
+CanOpenSession& BusWorker::add_canopen_session(DeviceKey key, milliseconds period) {
+  const auto id = std::make_pair(key.kind, key.address);
+  auto s = std::make_unique<CanOpenSession>(std::move(key), period, config_.canopen_publish_period, timeouts_, sink_,
+                                            clock_.steady_now());
+  auto& ref = *s;
+  canopen_[id] = std::move(s);
+  ref.on_bus_state(bus_->state(), clock_.steady_now());
+  return ref;
+}
+
+CanOpenSession* BusWorker::canopen_session(DeviceKind kind, std::uint16_t id) {
+  auto it = canopen_.find({kind, id});
+  return it == canopen_.end() ? nullptr : it->second.get();
+}
+
+void BusWorker::on_canopen_frame(const transport::ReceivedFrame& rx) {
+  auto key = canopen_device(config_.name, rx.frame);
+  if (!key) return;  // neither a PMU's nor a battery's or MPPT's
+  CanOpenSession* s = canopen_session(key->kind, key->address);
+  if (!s && config_.listen_canopen) {
+    spdlog::info("{}: heard a {} at {} {}", config_.name, to_string(key->kind),
+                 key->kind == DeviceKind::Mppt ? "device" : "node", key->address);
+    s = &add_canopen_session(*key, kHeardCanOpenPeriod);
+  }
+  if (!s) return;  // one the config does not serve
+  s->on_frame(rx.frame, clock_.steady_now(), rx.timestamp);
+}
+
 DeviceSession* BusWorker::session(std::uint16_t address) {
   auto it = sessions_.find(address);
   return it == sessions_.end() ? nullptr : it->second.get();
@@ -66,7 +97,10 @@ std::vector<std::uint16_t> BusWorker::addresses() const {
 
 void BusWorker::on_frame(const transport::ReceivedFrame& rx) {
   const auto id = codec::parse_id(rx.frame.id, rx.frame.extended);
-  if (!id.id) return;  // CANopen or unknown packets: not a PMU conversation
+  if (!id.id) {  // not a PMU conversation: perhaps a battery or MPPT
+    on_canopen_frame(rx);
+    return;
+  }
   const auto now = clock_.steady_now();
   const std::uint16_t address = id.id->address;
   if (address == codec::kBroadcastAddress) return;  // a broadcast request, not an answer
@@ -103,6 +137,7 @@ void BusWorker::on_event(const transport::BusEvent& event) {
   }
   const auto now = clock_.steady_now();
   for (auto& [a, s] : sessions_) s->on_bus_state(event.state, now);
+  for (auto& [id, s] : canopen_) s->on_bus_state(event.state, now);
 }
 
 void BusWorker::discover() {
@@ -122,6 +157,10 @@ void BusWorker::end_turn() {
   const auto now = clock_.steady_now();
   const auto counters = bus_->counters();
   for (auto& [a, s] : sessions_) {
+    s->on_bus_counters(counters);
+    s->tick(now);
+  }
+  for (auto& [id, s] : canopen_) {
     s->on_bus_counters(counters);
     s->tick(now);
   }

@@ -131,8 +131,48 @@ DeviceConfig parse_device(const Ctx& c, const YAML::Node& n) {
   return d;
 }
 
+// Seconds between a battery's or MPPT's frames of one value. Their firmware sets it, not us,
+// so any rate a CAN bus can carry is accepted.
+std::chrono::milliseconds canopen_period(const Ctx& c, const YAML::Node& n) {
+  return std::chrono::milliseconds(std::lround(c.number(n, "period", 0.01, 3600) * 1000));
+}
+
+void parse_batteries(const Ctx& c, const YAML::Node& n, BusConfig& b) {
+  if (!n.IsSequence()) c.fail(n, "batteries must be a list, e.g. [{node: 2, period: 1.0}]");
+  std::set<std::uint8_t> seen;
+  for (const auto& item : n) {
+    c.only_keys(item, "battery", {"node", "period"});
+    BatteryConfig bat;
+    const auto node = item["node"];
+    if (!node) c.fail(item, "battery needs a node (2: COB-IDs 0x202, 0x302, 0x402, 0x482)");
+    // The document defines the BMS's frames for node 2 only; another node's would never be
+    // decoded, and the battery would sit OFFLINE for a reason nobody could see.
+    bat.node = static_cast<std::uint8_t>(c.integer(node, "node", 2, 2));
+    if (const auto p = item["period"]) bat.period = canopen_period(c, p);
+    if (!seen.insert(bat.node).second)
+      c.fail(item, "battery node " + std::to_string(bat.node) + " appears twice on bus " + b.name);
+    b.batteries.push_back(bat);
+  }
+}
+
+void parse_mppts(const Ctx& c, const YAML::Node& n, BusConfig& b) {
+  if (!n.IsSequence()) c.fail(n, "mppts must be a list, e.g. [{device: 0, period: 1.0}]");
+  std::set<std::uint8_t> seen;
+  for (const auto& item : n) {
+    c.only_keys(item, "mppt", {"device", "period"});
+    MpptConfig m;
+    const auto device = item["device"];
+    if (!device) c.fail(item, "mppt needs a device (0..7, set by the MPPT's resistors)");
+    m.device = static_cast<std::uint8_t>(c.integer(device, "device", 0, 7));
+    if (const auto p = item["period"]) m.period = canopen_period(c, p);
+    if (!seen.insert(m.device).second)
+      c.fail(item, "mppt device " + std::to_string(m.device) + " appears twice on bus " + b.name);
+    b.mppts.push_back(m);
+  }
+}
+
 BusConfig parse_bus(const Ctx& c, const YAML::Node& n) {
-  c.only_keys(n, "bus", {"name", "interface", "bitrate", "devices", "discover"});
+  c.only_keys(n, "bus", {"name", "interface", "bitrate", "devices", "discover", "batteries", "mppts", "listen_canopen"});
   BusConfig b;
   b.source_line = c.line_of(n);
   const auto iface = n["interface"];
@@ -170,7 +210,11 @@ BusConfig parse_bus(const Ctx& c, const YAML::Node& n) {
       b.devices.push_back(d);
     }
   }
-  if (b.devices.empty() && !b.discover) c.fail(n, "bus " + b.name + " has no devices and discover is off");
+  if (const auto v = n["batteries"]) parse_batteries(c, v, b);
+  if (const auto v = n["mppts"]) parse_mppts(c, v, b);
+  if (const auto v = n["listen_canopen"]) b.listen_canopen = c.scalar<bool>(v, "listen_canopen", "true or false");
+  if (b.devices.empty() && !b.discover && !b.wants_canopen())
+    c.fail(n, "bus " + b.name + " has no devices, batteries or mppts, and discover and listen_canopen are off");
   return b;
 }
 
@@ -377,7 +421,8 @@ Config parse_config(const std::string& text, const std::string& source, const Co
   cfg.source = source;
   if (root.IsNull()) throw ConfigError(source + ":1: the file is empty");
   c.only_keys(root, "the top level", {"domain", "vehicle", "low_rate_period", "qos_file", "dds_transport", "log_level",
-                                      "buses", "timeouts", "policy", "security", "discovery", "interfaces"});
+                                      "buses", "timeouts", "policy", "security", "discovery", "interfaces",
+                                      "canopen_publish_period"});
   if (const auto v = root["domain"]) cfg.domain = static_cast<int>(c.integer(v, "domain", 0, 232));
   if (const auto v = root["vehicle"]) {
     // `vehicle:` with nothing after it is YAML null: the unnamed vehicle, like no key.
@@ -391,6 +436,10 @@ Config parse_config(const std::string& text, const std::string& source, const Co
     if (p != 0 && p < 0.1) c.fail(v, "low_rate_period " + v.Scalar() + " is below 0.1 s (0 turns the low-rate topics off)");
     cfg.low_rate_period = std::chrono::milliseconds(std::lround(p * 1000));
   }
+  std::chrono::milliseconds canopen_publish_period = BusConfig{}.canopen_publish_period;
+  if (const auto v = root["canopen_publish_period"])
+    canopen_publish_period =
+        std::chrono::milliseconds(std::lround(c.number(v, "canopen_publish_period", 0, 3600) * 1000));
   if (const auto v = root["qos_file"]) cfg.qos_file = c.scalar<std::string>(v, "qos_file", "a path");
   if (const auto v = root["dds_transport"]) {
     const auto t = c.scalar<std::string>(v, "dds_transport", "default, udp or shm");
@@ -427,6 +476,7 @@ Config parse_config(const std::string& text, const std::string& source, const Co
   std::size_t devices = 0;
   for (const auto& bn : buses) {
     BusConfig b = parse_bus(c, bn);
+    b.canopen_publish_period = canopen_publish_period;
     // The QoS profiles hold kMaxDevicesPerService instances per writer; past that Fast DDS
     // would refuse the extra PMUs' samples at run time.
     if (devices + b.devices.size() > kMaxDevicesPerService)
@@ -435,6 +485,14 @@ Config parse_config(const std::string& text, const std::string& source, const Co
                  " devices in one service (the capacity its DDS writers are sized for, "
                  "pmu::service::kMaxDevicesPerService); split them across services");
     devices += b.devices.size();
+    // Batteries and MPPTs are instances of pmu/health too.
+    const std::size_t canopen = b.batteries.size() + b.mppts.size();
+    if (devices + canopen > kMaxDevicesPerService)
+      c.fail(bn[b.batteries.empty() ? "mppts" : "batteries"],
+             "more than " + std::to_string(kMaxDevicesPerService) +
+                 " devices (PMUs, batteries and MPPTs) in one service (the capacity its DDS writers are sized for, "
+                 "pmu::service::kMaxDevicesPerService); split them across services");
+    devices += canopen;
     if (!names.insert(b.name).second) c.fail(bn, "bus name '" + b.name + "' appears twice");
     if (b.interface != "sim" && !interfaces.insert(b.interface).second)
       c.fail(bn, "interface '" + b.interface + "' is used by two buses (the service owns each bus alone)");

@@ -5,10 +5,15 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <limits>
+#include <string_view>
 #include <mutex>
 #include <set>
+#include <tuple>
 #include <utility>
 
+#include "pmu/idl/canopen.h"
+#include "pmu/idl/canopenPubSubTypes.h"
 #include "pmu/idl/command.h"
 #include "pmu/idl/commandPubSubTypes.h"
 #include "pmu/idl/state.h"
@@ -54,6 +59,36 @@ void set_key(T& s, const std::string& vehicle, const DeviceKey& k) {
   s.address(k.address);
 }
 
+// The battery's node or the MPPT's device id fits an octet (node 1..127, device 0..7).
+std::uint8_t octet_id(const DeviceKey& k) { return static_cast<std::uint8_t>(k.address & 0xFF); }
+
+// A CANopen state's value by its contract name: float fields carry NaN when not received,
+// integer and boolean fields 0 (the `received` mask tells them apart).
+template <std::size_t N>
+class Values {
+ public:
+  Values(const CanOpenValues<N>& state, const CanOpenValue (&table)[N]) : state_(state), table_(table) {}
+  float real(std::string_view name) const {
+    const auto i = slot(name);
+    return i < N ? f(state_.values[i]) : std::numeric_limits<float>::quiet_NaN();
+  }
+  std::uint32_t u32(std::string_view name) const {
+    const auto i = slot(name);
+    return i < N && state_.received(i) ? static_cast<std::uint32_t>(state_.values[i]) : 0;
+  }
+  std::uint8_t u8(std::string_view name) const { return static_cast<std::uint8_t>(u32(name) & 0xFF); }
+  bool flag(std::string_view name) const { return u32(name) != 0; }
+
+ private:
+  std::size_t slot(std::string_view name) const {
+    for (std::size_t i = 0; i < N; ++i)
+      if (table_[i].name == name) return i;
+    return N;
+  }
+  const CanOpenValues<N>& state_;
+  const CanOpenValue (&table_)[N];
+};
+
 }  // namespace
 
 struct DdsPublisher::Writers {
@@ -70,15 +105,20 @@ struct DdsPublisher::Writers {
   DataWriter* config;
   DataWriter* info;
   DataWriter* health;
+  // Null when the service serves no battery or MPPT (not offered).
+  DataWriter* battery = nullptr;
+  DataWriter* battery_cells = nullptr;
+  DataWriter* mppt = nullptr;
   // Bus workers run in threads of their own and share these writers and the rest below.
   std::mutex mutex;
-  std::set<std::pair<std::string, std::uint16_t>> admitted;
+  std::set<std::tuple<std::string, DeviceKind, std::uint16_t>> admitted;
   RateLimit failure_reports{kReportInterval};
   RateLimit refusal_reports{kReportInterval};
 };
 
 DdsPublisher::DdsPublisher(dds::DdsContext& dds, std::chrono::milliseconds telemetry_deadline, std::string vehicle,
-                           std::chrono::milliseconds low_rate_period)
+                           std::chrono::milliseconds low_rate_period,
+                           std::optional<std::chrono::milliseconds> canopen_deadline)
     : w_(std::make_unique<Writers>(low_rate_period)) {
   w_->vehicle = std::move(vehicle);
   auto telemetry = [&](const char* name, TypeSupport type, std::chrono::milliseconds deadline) {
@@ -109,6 +149,12 @@ DdsPublisher::DdsPublisher(dds::DdsContext& dds, std::chrono::milliseconds telem
     w_->low[3] = telemetry(topics::kLowRateTemperatures, TypeSupport(new pmu::TemperaturesPubSubType()), low);
     w_->low[4] = telemetry(topics::kLowRateStatus, TypeSupport(new pmu::StatusPubSubType()), low);
   }
+  if (canopen_deadline) {
+    const auto cd = *canopen_deadline;
+    w_->battery = telemetry(topics::kBattery, TypeSupport(new pmu::BatteryPubSubType()), cd);
+    w_->battery_cells = telemetry(topics::kBatteryCells, TypeSupport(new pmu::BatteryCellsPubSubType()), cd);
+    w_->mppt = telemetry(topics::kMppt, TypeSupport(new pmu::MpptPubSubType()), cd);
+  }
   w_->config = state(topics::kConfig, TypeSupport(new pmu::ConfigPubSubType()));
   w_->info = state(topics::kInfo, TypeSupport(new pmu::DeviceInfoPubSubType()));
   w_->health = state(topics::kHealth, TypeSupport(new pmu::HealthPubSubType()));
@@ -117,9 +163,10 @@ DdsPublisher::DdsPublisher(dds::DdsContext& dds, std::chrono::milliseconds telem
 DdsPublisher::~DdsPublisher() = default;
 
 bool DdsPublisher::admit(const DeviceKey& key) {
-  if (w_->admitted.count({key.bus, key.address})) return true;
+  const auto id = std::make_tuple(key.bus, key.kind, key.address);
+  if (w_->admitted.count(id)) return true;
   if (w_->admitted.size() < service::kMaxDevicesPerService) {
-    w_->admitted.insert({key.bus, key.address});
+    w_->admitted.insert(id);
     return true;
   }
   const auto refused = refused_.fetch_add(1, std::memory_order_relaxed) + 1;
@@ -262,6 +309,7 @@ void DdsPublisher::on_info(const DeviceKey& key, const InfoState& i) {
 void DdsPublisher::on_health(const DeviceKey& key, const HealthReport& h) {
   pmu::Health s;
   set_key(s, w_->vehicle, key);
+  s.kind(static_cast<pmu::DeviceKind>(static_cast<int>(key.kind)));
   s.state(static_cast<pmu::HealthState>(static_cast<int>(h.state)));
   s.bus_state(static_cast<pmu::BusState>(static_cast<int>(h.bus_state)));
   s.last_frame_age(f(h.last_frame_age));
@@ -276,6 +324,98 @@ void DdsPublisher::on_health(const DeviceKey& key, const HealthReport& h) {
   if (!admit(key)) return;
   s.publish_failures(failures_.load(std::memory_order_relaxed));
   count(w_->health->write(&s), topics::kHealth, key, "write returned false");
+}
+
+}  // namespace pmu::service
+
+namespace pmu::service {
+
+void DdsPublisher::write_at(DataWriter* writer, void* sample, const DeviceKey& key,
+                            std::chrono::system_clock::time_point when) {
+  if (writer == nullptr) return;  // topics not offered: no session can produce these samples
+  const ReturnCode_t rc = writer->write_w_timestamp(sample, HANDLE_NIL, dds_time(when));
+  count(rc == ReturnCode_t::RETCODE_OK, writer->get_topic()->get_name().c_str(), key, why(rc));
+}
+
+void DdsPublisher::on_battery(const DeviceKey& key, const BatteryState& b, std::chrono::system_clock::time_point newest) {
+  pmu::Battery s;
+  s.vehicle(w_->vehicle);
+  s.bus(key.bus);
+  s.node(octet_id(key));
+  const Values<kBatteryValueCount> v(b, kBatteryValues);
+  s.voltage(v.real("voltage"));
+  s.current(v.real("current"));
+  s.current_discharge(v.real("current_discharge"));
+  s.current_charge(v.real("current_charge"));
+  s.state_of_charge(v.real("state_of_charge"));
+  s.time_to_go(v.real("time_to_go"));
+  s.cell_temperature_high(v.real("cell_temperature_high"));
+  s.cell_temperature_low(v.real("cell_temperature_low"));
+  s.cell_voltage_high(v.real("cell_voltage_high"));
+  s.cell_voltage_low(v.real("cell_voltage_low"));
+  s.bms_state(v.u32("bms_state"));
+  s.temperature_1(v.real("temperature_1"));
+  s.temperature_2(v.real("temperature_2"));
+  s.temperature_3(v.real("temperature_3"));
+  s.temperature_4(v.real("temperature_4"));
+  s.power_level(v.real("power_level"));
+  s.received(b.received_mask());
+  std::lock_guard<std::mutex> lock(w_->mutex);
+  if (!admit(key)) return;
+  write_at(w_->battery, &s, key, newest);
+}
+
+void DdsPublisher::on_battery_cells(const DeviceKey& key, const BatteryCellsState& c,
+                                    std::chrono::system_clock::time_point newest) {
+  pmu::BatteryCells s;
+  s.vehicle(w_->vehicle);
+  s.bus(key.bus);
+  s.node(octet_id(key));
+  for (std::size_t cell = 0; cell < c.volts.size(); ++cell) {
+    if (std::isnan(c.volts[cell])) continue;
+    pmu::BatteryCell one;
+    one.cell(static_cast<std::uint8_t>(cell));
+    one.cell_voltage(f(c.volts[cell]));
+    s.cells().push_back(one);
+  }
+  std::lock_guard<std::mutex> lock(w_->mutex);
+  if (!admit(key)) return;
+  write_at(w_->battery_cells, &s, key, newest);
+}
+
+void DdsPublisher::on_mppt(const DeviceKey& key, const MpptState& m, std::chrono::system_clock::time_point newest) {
+  pmu::Mppt s;
+  s.vehicle(w_->vehicle);
+  s.bus(key.bus);
+  s.device(octet_id(key));
+  const Values<kMpptValueCount> v(m, kMpptValues);
+  s.voltage_output_raw(v.real("voltage_output_raw"));
+  s.current_output_raw(v.real("current_output_raw"));
+  s.voltage_out_sw_raw(v.real("voltage_out_sw_raw"));
+  s.mppt_state(v.u8("mppt_state"));
+  s.safety_enabled(v.flag("safety_enabled"));
+  s.pwm_enabled(v.flag("pwm_enabled"));
+  s.temperature(v.real("temperature"));
+  s.voltage_panel_1_raw(v.real("voltage_panel_1_raw"));
+  s.current_panel_1_raw(v.real("current_panel_1_raw"));
+  s.duty_cycle_panel_1(v.real("duty_cycle_panel_1"));
+  s.channel_1_active(v.u8("channel_1_active"));
+  s.voltage_panel_2_raw(v.real("voltage_panel_2_raw"));
+  s.current_panel_2_raw(v.real("current_panel_2_raw"));
+  s.duty_cycle_panel_2(v.real("duty_cycle_panel_2"));
+  s.channel_2_active(v.u8("channel_2_active"));
+  s.voltage_panel_3_raw(v.real("voltage_panel_3_raw"));
+  s.current_panel_3_raw(v.real("current_panel_3_raw"));
+  s.duty_cycle_panel_3(v.real("duty_cycle_panel_3"));
+  s.channel_3_active(v.u8("channel_3_active"));
+  s.voltage_panel_4_raw(v.real("voltage_panel_4_raw"));
+  s.current_panel_4_raw(v.real("current_panel_4_raw"));
+  s.duty_cycle_panel_4(v.real("duty_cycle_panel_4"));
+  s.channel_4_active(v.u8("channel_4_active"));
+  s.received(m.received_mask());
+  std::lock_guard<std::mutex> lock(w_->mutex);
+  if (!admit(key)) return;
+  write_at(w_->mppt, &s, key, newest);
 }
 
 }  // namespace pmu::service

@@ -17,6 +17,15 @@ const char* to_string(HealthState s) noexcept {
   return "UNKNOWN";
 }
 
+const char* to_string(DeviceKind k) noexcept {
+  switch (k) {
+    case DeviceKind::Pmu: return "pmu";
+    case DeviceKind::Battery: return "battery";
+    case DeviceKind::Mppt: return "mppt";
+  }
+  return "pmu";
+}
+
 HealthTracker::HealthTracker(std::chrono::steady_clock::time_point created, const Timeouts& timeouts) noexcept
     : stale_periods_(timeouts.stale_periods), offline_periods_(timeouts.offline_periods), created_(created),
       next_publish_(created) {}

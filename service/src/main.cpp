@@ -28,6 +28,7 @@
 #include "pmu/service/dds_commands.hpp"
 #include "pmu/service/dds_context.hpp"
 #include "pmu/service/dds_publisher.hpp"
+#include "pmu/service/receive_filters.hpp"
 #include "pmu/service/logging.hpp"
 #include "pmu/service/systemd.hpp"
 #include "pmu/service/vehicle.hpp"
@@ -55,7 +56,7 @@ std::unique_ptr<transport::CanBus> open_bus(const service::BusConfig& bus, const
                                             BusRuntime& rt) {
   if (bus.interface != "sim") {
     transport::SocketCanOptions options;
-    options.filters = transport::default_filters(false);
+    options.filters = service::receive_filters(bus);
     auto b = bus.interface.rfind("fd:", 0) == 0
                  ? transport::SocketCanBus::adopt(transport::UniqueFd(std::stoi(bus.interface.substr(3))), bus.name,
                                                   options, clock)
@@ -121,6 +122,15 @@ int run(const service::Config& cfg, const pmu::dds::ResolvedNetwork& network) {
   for (const auto& b : cfg.buses)
     for (const auto& d : b.devices) longest = std::max(longest, d.period);
   if (longest == milliseconds{0}) longest = milliseconds(1000);
+  // Batteries and MPPTs send each value once per their period; a heard one is taken as 1 s.
+  milliseconds canopen_longest{1000};
+  bool canopen = false;
+  for (const auto& b : cfg.buses) {
+    canopen |= b.wants_canopen();
+    for (const auto& d : b.batteries) canopen_longest = std::max(canopen_longest, d.period);
+    for (const auto& d : b.mppts) canopen_longest = std::max(canopen_longest, d.period);
+    canopen_longest = std::max(canopen_longest, b.canopen_publish_period);
+  }
 
   spdlog::info("DDS: {}", network.summary);
   const auto partitions = service::vehicle_partitions(cfg.vehicle);
@@ -129,7 +139,8 @@ int run(const service::Config& cfg, const pmu::dds::ResolvedNetwork& network) {
   if (participant.secure())
     spdlog::info("DDS-Security on: identity {}, permissions {}", cfg.security.files.identity_certificate,
                  cfg.security.files.permissions);
-  service::DdsPublisher publisher(participant, 3 * longest, cfg.vehicle, cfg.low_rate_period);
+  service::DdsPublisher publisher(participant, 3 * longest, cfg.vehicle, cfg.low_rate_period,
+                                  canopen ? std::optional<milliseconds>(3 * canopen_longest) : std::nullopt);
 
   std::vector<BusRuntime> buses(cfg.buses.size());
   for (std::size_t i = 0; i < cfg.buses.size(); ++i) {

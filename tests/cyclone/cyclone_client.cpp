@@ -8,6 +8,11 @@
 // Prints one line per check ("ok ..." or "MISS ..."), then a "summary" line of key=value
 // figures (tests/cyclone/measure_repair.sh reads them). Exit status: 0 nothing missed,
 // 1 something missed, 2 bad usage or no DDS.
+//
+// With --canopen-bus NAME it checks the batteries and MPPTs instead (interface.md 3.1):
+// pmu/battery, pmu/battery_cells and pmu/mppt deliver the values tests/cyclone/canopen_feeder.py
+// puts on that bus (NaN and the `received` bits for what it never sends), and pmu/health
+// has the battery and the MPPT as instances of their own kind.
 #include <dds/dds.h>
 #include <unistd.h>
 
@@ -21,6 +26,9 @@
 #include <thread>
 #include <vector>
 
+#include <cmath>
+
+#include "canopen.h"
 #include "command.h"
 #include "state.h"
 #include "telemetry.h"
@@ -44,12 +52,13 @@ struct Options {
   long reply_ms = 5000;
   long command_delay_ms = -1;  // after the client's start; -1: right after matching
   long resend_ms = 1000;       // resend a request (same id) unanswered this long; 0: never
+  std::string canopen_bus;     // non-empty: check batteries and MPPTs on this bus instead
 };
 
 [[noreturn]] void usage(const char* why) {
   std::fprintf(stderr,
                "cyclone_client: %s\nusage: cyclone_client [--domain N] [--bus NAME] [--address N] [--state-ms MS] "
-               "[--telemetry-ms MS] [--reply-ms MS] [--command-delay-ms MS] [--resend-ms MS]\n",
+               "[--telemetry-ms MS] [--reply-ms MS] [--command-delay-ms MS] [--resend-ms MS] [--canopen-bus NAME]\n",
                why);
   std::exit(2);
 }
@@ -86,6 +95,8 @@ Options parse(int argc, char** argv) {
       o.command_delay_ms = number("--command-delay-ms", v, 0, 600000);
     else if (k == "--resend-ms")
       o.resend_ms = number("--resend-ms", v, 0, 600000);
+    else if (k == "--canopen-bus")
+      o.canopen_bus = v;
     else
       usage(("unknown option " + k).c_str());
   }
@@ -226,6 +237,74 @@ void copy(char (&dst)[N], const std::string& s) {
 
 long ms(Clock::duration d) { return static_cast<long>(std::chrono::duration_cast<milliseconds>(d).count()); }
 
+// What canopen_feeder.py sends, read back as the contract says it arrives.
+struct CanOpenCheck {
+  const char* what;
+  bool done = false;
+  std::string detail = "no sample";
+};
+
+bool near(float a, double b) { return std::fabs(static_cast<double>(a) - b) < 1e-3; }
+
+int run_canopen(const Options& o, dds_entity_t pp) {
+  const dds_entity_t battery = reader(pp, &pmu_Battery_desc, "pmu/battery", telemetry_qos());
+  const dds_entity_t cells = reader(pp, &pmu_BatteryCells_desc, "pmu/battery_cells", telemetry_qos());
+  const dds_entity_t mppt = reader(pp, &pmu_Mppt_desc, "pmu/mppt", telemetry_qos());
+  const dds_entity_t health = reader(pp, &pmu_Health_desc, "pmu/health", state_qos());
+  CanOpenCheck checks[] = {{"pmu/battery"}, {"pmu/battery_cells"}, {"pmu/mppt"}, {"pmu/health battery"},
+                           {"pmu/health mppt"}};
+  const auto until = Clock::now() + milliseconds(o.telemetry_ms);
+  auto all = [&] {
+    for (const auto& c : checks)
+      if (!c.done) return false;
+    return true;
+  };
+  while (!all() && Clock::now() < until) {
+    take_all<pmu_Battery>(battery, [&](const pmu_Battery& s) {
+      if (o.canopen_bus != s.bus || s.node != 2) return;
+      // voltage (bit 0), state_of_charge (4), bms_state (10), power_level (15); current never sent.
+      const uint32_t want = (1u << 0) | (1u << 4) | (1u << 10) | (1u << 15);
+      if (s.received != want) {
+        checks[0].detail = "received " + std::to_string(s.received) + ", want " + std::to_string(want);
+        return;
+      }
+      const bool ok = near(s.voltage, 48.123) && near(s.state_of_charge, 87) && s.bms_state == 0x12345678u &&
+                      near(s.power_level, 77) && std::isnan(s.current);
+      checks[0].done = ok;
+      checks[0].detail = ok ? "voltage 48.123, state_of_charge 87, bms_state 0x12345678, power_level 77, current NaN"
+                            : "wrong values";
+    });
+    take_all<pmu_BatteryCells>(cells, [&](const pmu_BatteryCells& s) {
+      if (o.canopen_bus != s.bus || s.node != 2 || s.cells._length != 1) return;
+      const bool ok = s.cells._buffer[0].cell == 5 && near(s.cells._buffer[0].cell_voltage, 3.301);
+      checks[1].done = ok;
+      checks[1].detail = ok ? "cell 5 at 3.301 V" : "wrong cell";
+    });
+    take_all<pmu_Mppt>(mppt, [&](const pmu_Mppt& s) {
+      if (o.canopen_bus != s.bus || s.device != 4) return;
+      const uint32_t want = (1u << 0) | (1u << 4) | (1u << 13);
+      if (s.received != want) return;
+      const bool ok = near(s.voltage_output_raw, -100) && s.safety_enabled && near(s.duty_cycle_panel_2, 45) &&
+                      std::isnan(s.current_output_raw);
+      checks[2].done = ok;
+      checks[2].detail = ok ? "voltage_output_raw -100, safety_enabled, duty_cycle_panel_2 45" : "wrong values";
+    });
+    take_all<pmu_Health>(health, [&](const pmu_Health& s) {
+      if (o.canopen_bus != s.bus || s.state != pmu_ONLINE) return;
+      if (s.kind == pmu_KIND_BATTERY && s.address == 2) checks[3] = {"pmu/health battery", true, "node 2 ONLINE"};
+      if (s.kind == pmu_KIND_MPPT && s.address == 4) checks[4] = {"pmu/health mppt", true, "device 4 ONLINE"};
+    });
+    std::this_thread::sleep_for(milliseconds(5));
+  }
+  int misses = 0;
+  for (const auto& c : checks) {
+    misses += c.done ? 0 : 1;
+    std::printf("%s %s: %s\n", c.done ? "ok" : "MISS", c.what, c.detail.c_str());
+  }
+  std::printf("summary misses=%d\n", misses);
+  return misses == 0 ? 0 : 1;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -237,6 +316,7 @@ int main(int argc, char** argv) {
                  dds_strretcode(pp.get()));
     return 2;
   }
+  if (!o.canopen_bus.empty()) return run_canopen(o, pp.get());
   std::vector<Topic> telemetry = {Topic("pmu/voltages"), Topic("pmu/currents"), Topic("pmu/battery_energy"),
                                   Topic("pmu/temperatures"), Topic("pmu/status")};
   std::vector<Topic> state = {Topic("pmu/config"), Topic("pmu/info"), Topic("pmu/health")};

@@ -3,7 +3,8 @@
 #
 # Checks the shipped deployment files:
 #   1. pmu-service --check-config accepts deploy/pmu-service.yaml, also with its commented
-#      examples (polling device, discovery, simulated bus, qos_file) switched on, and
+#      examples (polling device, discovery, simulated bus, qos_file, batteries, MPPTs)
+#      switched on, and
 #      rejects a misspelt key (so the check really checks);
 #   2. deploy/install.sh --dry-run changes nothing; a DESTDIR install puts every file in
 #      place with the right modes, the installed binary accepts the installed config, a
@@ -67,6 +68,25 @@ out=$("$service_bin" --config "$full" --check-config 2>&1) ||
   fail "pmu-service rejected the example with its commented parts enabled: $out"
 echo "$out"
 grep -q "configuration OK (2 bus(es))" <<<"$out" || fail "unexpected check-config output: $out"
+
+step "check-config with the battery and MPPT examples switched on"
+canopen="$work/canopen.yaml"
+sed -e 's/^# canopen_publish_period:/canopen_publish_period:/' \
+    -e '/^ *# batteries:$/,/^ *#     period: 1.0$/ s/# //' \
+    -e '/^ *# mppts:$/,/^ *#     period: 1.0$/ s/# //' \
+    -e 's/^\( *\)# listen_canopen: false$/\1listen_canopen: true/' \
+    "$deploy/pmu-service.yaml" > "$canopen"
+# canopen_publish_period (1) + batteries (8 lines, 5 of them comments) + mppts (6, 3 of
+# them comments) + listen_canopen (1)
+changed_lines=$(diff "$deploy/pmu-service.yaml" "$canopen" | grep -c '^>' || true)
+[ "$changed_lines" -eq 16 ] ||
+  fail "expected 16 battery/MPPT example lines to switch on, got $changed_lines (were the commented examples changed?)"
+grep -q "^    batteries:$" "$canopen" && grep -q "^      - node: 2$" "$canopen" && grep -q "^      - device: 0$" "$canopen" ||
+  fail "the battery/MPPT examples did not switch on as keys of the bus"
+out=$("$service_bin" --config "$canopen" --check-config 2>&1) ||
+  fail "pmu-service rejected the battery and MPPT examples: $out"
+echo "$out"
+grep -q "configuration OK (1 bus(es))" <<<"$out" || fail "unexpected check-config output: $out"
 
 step "check-config with the discovery and interfaces examples switched on"
 # The unicast example (its host name swapped for one that resolves everywhere) with the

@@ -119,16 +119,18 @@ inline std::string write_config(const std::string& name, const SecurityFiles& f,
   return path;
 }
 
-// The contract's topics (interface.md sections 1 and 5.2).
+// The contract's topics (interface.md sections 1, 3.1 and 5.2).
 inline const std::set<std::string> kTelemetryAndState = {
     "pmu/voltages",          "pmu/currents",          "pmu/battery_energy",          "pmu/temperatures",
     "pmu/status",            "pmu/low_rate/voltages", "pmu/low_rate/currents",       "pmu/low_rate/battery_energy",
-    "pmu/low_rate/temperatures", "pmu/low_rate/status", "pmu/config", "pmu/info", "pmu/health"};
+    "pmu/low_rate/temperatures", "pmu/low_rate/status", "pmu/battery", "pmu/battery_cells", "pmu/mppt",
+    "pmu/config",            "pmu/info",              "pmu/health"};
 inline const char* const kContractTopics[] = {
     "pmu/voltages",          "pmu/currents",          "pmu/battery_energy",          "pmu/temperatures",
     "pmu/status",            "pmu/low_rate/voltages", "pmu/low_rate/currents",       "pmu/low_rate/battery_energy",
-    "pmu/low_rate/temperatures", "pmu/low_rate/status", "pmu/config", "pmu/info", "pmu/health",
-    "pmu/command",           "pmu/command_reply"};
+    "pmu/low_rate/temperatures", "pmu/low_rate/status", "pmu/battery", "pmu/battery_cells", "pmu/mppt",
+    "pmu/config",            "pmu/info",              "pmu/health",            "pmu/command",
+    "pmu/command_reply"};
 
 // What the issue asks: only the ground station commands; the service publishes telemetry,
 // state and replies; the mission computer only reads telemetry and state.

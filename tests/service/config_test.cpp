@@ -44,6 +44,44 @@ TEST(Config, GoodFileParses) {
   EXPECT_EQ(b.source_line, "good.yaml:7");
 }
 
+TEST(Config, BatteriesAndMpptsParse) {
+  const Config c = parse_config(R"(canopen_publish_period: 0.5
+buses:
+  - interface: can0
+    batteries:
+      - node: 2
+        period: 2.5
+    mppts:
+      - device: 0
+      - device: 7
+        period: 0.1
+  - interface: can1
+    listen_canopen: true
+)",
+                                "good.yaml");
+  ASSERT_EQ(c.buses.size(), 2u);
+  EXPECT_EQ(c.buses[0].canopen_publish_period, std::chrono::milliseconds(500));
+  EXPECT_EQ(c.buses[1].canopen_publish_period, std::chrono::milliseconds(500));
+  const BusConfig& b = c.buses[0];
+  EXPECT_TRUE(b.devices.empty());
+  ASSERT_EQ(b.batteries.size(), 1u);
+  EXPECT_EQ(b.batteries[0].node, 2);
+  EXPECT_EQ(b.batteries[0].period, std::chrono::milliseconds(2500));
+  ASSERT_EQ(b.mppts.size(), 2u);
+  EXPECT_EQ(b.mppts[0].device, 0);
+  EXPECT_EQ(b.mppts[0].period, std::chrono::milliseconds(1000));  // the default
+  EXPECT_EQ(b.mppts[1].device, 7);
+  EXPECT_EQ(b.mppts[1].period, std::chrono::milliseconds(100));
+  EXPECT_FALSE(b.listen_canopen);
+  EXPECT_TRUE(b.wants_canopen());
+  EXPECT_TRUE(c.buses[1].listen_canopen);
+  EXPECT_TRUE(c.buses[1].wants_canopen());
+  // Defaults: 0.2 s, and a PMU-only bus does not ask for CANopen frames.
+  const Config d = parse_config(kGood, "good.yaml");
+  EXPECT_EQ(d.buses[0].canopen_publish_period, std::chrono::milliseconds(200));
+  EXPECT_FALSE(d.buses[0].wants_canopen());
+}
+
 struct BadCase {
   const char* yaml;
   const char* message;  // the whole "FILE:LINE: ..." text
@@ -55,7 +93,7 @@ const BadCase kBad[] = {
     {"domain: 0\n", "bad.yaml:1: no buses: the service needs at least one bus"},
     {"domian: 0\nbuses: []\n",
      "bad.yaml:1: unknown key 'domian' in the top level (known: domain, vehicle, low_rate_period, qos_file, dds_transport, log_level, "
-     "buses, timeouts, policy, security, discovery, interfaces)"},
+     "buses, timeouts, policy, security, discovery, interfaces, canopen_publish_period)"},
     {"domain: 0\nvehicle: uav*\nbuses: []\n",
      "bad.yaml:2: vehicle 'uav*' contains '*'; a vehicle name is letters, digits, '_', '-' and '.' (it is also a DDS "
      "partition name, where other characters are patterns)"},
@@ -69,7 +107,28 @@ const BadCase kBad[] = {
     {"domain: x\nbuses: []\n", "bad.yaml:1: domain must be an integer, not 'x'"},
     {"buses: []\n", "bad.yaml:1: buses must be a non-empty list"},
     {"buses:\n  - name: a\n", "bad.yaml:2: bus needs an interface (a SocketCAN interface such as can0, or sim)"},
-    {"buses:\n  - interface: can0\n", "bad.yaml:2: bus can0 has no devices and discover is off"},
+    {"buses:\n  - interface: can0\n",
+     "bad.yaml:2: bus can0 has no devices, batteries or mppts, and discover and listen_canopen are off"},
+    {"buses:\n  - interface: can0\n    batteries:\n      - node: 3\n", "bad.yaml:4: node 3 out of range 2..2"},
+    {"buses:\n  - interface: can0\n    batteries:\n      - period: 1\n",
+     "bad.yaml:4: battery needs a node (2: COB-IDs 0x202, 0x302, 0x402, 0x482)"},
+    {"buses:\n  - interface: can0\n    batteries:\n      - node: 2\n      - node: 2\n",
+     "bad.yaml:5: battery node 2 appears twice on bus can0"},
+    {"buses:\n  - interface: can0\n    batteries:\n      - node: 2\n        period: 0\n",
+     "bad.yaml:5: period 0 out of range 0.01..3600"},
+    {"buses:\n  - interface: can0\n    batteries:\n      - node: 2\n        rate: 1\n",
+     "bad.yaml:5: unknown key 'rate' in battery (known: node, period)"},
+    {"buses:\n  - interface: can0\n    batteries: 2\n",
+     "bad.yaml:3: batteries must be a list, e.g. [{node: 2, period: 1.0}]"},
+    {"buses:\n  - interface: can0\n    mppts:\n      - device: 8\n", "bad.yaml:4: device 8 out of range 0..7"},
+    {"buses:\n  - interface: can0\n    mppts:\n      - period: 1\n",
+     "bad.yaml:4: mppt needs a device (0..7, set by the MPPT's resistors)"},
+    {"buses:\n  - interface: can0\n    mppts:\n      - device: 1\n      - device: 1\n",
+     "bad.yaml:5: mppt device 1 appears twice on bus can0"},
+    {"buses:\n  - interface: can0\n    listen_canopen: maybe\n",
+     "bad.yaml:3: listen_canopen must be true or false, not 'maybe'"},
+    {"canopen_publish_period: -0.1\nbuses:\n  - interface: can0\n    discover: true\n",
+     "bad.yaml:1: canopen_publish_period -0.1 out of range 0..3600"},
     {"buses:\n  - interface: can0\n    devices:\n      - adress: 1\n",
      "bad.yaml:4: unknown key 'adress' in device (known: address, mode, period, packets, configure_streaming)"},
     {"buses:\n  - interface: can0\n    devices:\n      - address: 65535\n",
@@ -350,6 +409,23 @@ TEST(Config, MoreDevicesThanTheDdsWritersHoldAreRefusedAtTheFirstOneTooMany) {
     EXPECT_EQ(std::string(e.what()),
               "fleet.yaml:262: more than 256 devices in one service (the capacity its DDS writers are sized for, "
               "pmu::service::kMaxDevicesPerService); split them across services");
+  }
+}
+
+TEST(Config, BatteriesAndMpptsCountTowardsTheDevicesTheDdsWritersHold) {
+  // 255 PMUs leave room for one more pmu/health instance: a battery fits, a battery and an
+  // MPPT do not. can0 holds 1..127 (lines 4..130), can1 128..255 (lines 133..260), then
+  // `batteries:` (261) and its list (262).
+  const std::string pmus = many_devices(static_cast<int>(kMaxDevicesPerService) - 1);
+  const Config c = parse_config(pmus + "    batteries:\n      - node: 2\n", "fleet.yaml");
+  EXPECT_EQ(c.buses[1].batteries.size(), 1u);
+  try {
+    (void)parse_config(pmus + "    batteries:\n      - node: 2\n    mppts:\n      - device: 0\n", "fleet.yaml");
+    ADD_FAILURE() << "accepted";
+  } catch (const ConfigError& e) {
+    EXPECT_EQ(std::string(e.what()),
+              "fleet.yaml:262: more than 256 devices (PMUs, batteries and MPPTs) in one service (the capacity its DDS "
+              "writers are sized for, pmu::service::kMaxDevicesPerService); split them across services");
   }
 }
 

@@ -21,15 +21,24 @@ class RecordingSink final : public StateSink {
   void on_config(const DeviceKey& k, const ConfigState& c) override { configs.push_back({k, c}); }
   void on_info(const DeviceKey& k, const InfoState& i) override { infos.push_back({k, i}); }
   void on_health(const DeviceKey& k, const HealthReport& h) override { healths.push_back({k, h}); }
+  void on_battery(const DeviceKey& k, const BatteryState& b, std::chrono::system_clock::time_point t) override {
+    batteries.push_back({k, b, t});
+  }
+  void on_battery_cells(const DeviceKey& k, const BatteryCellsState& c, std::chrono::system_clock::time_point t) override {
+    cells.push_back({k, c, t});
+  }
+  void on_mppt(const DeviceKey& k, const MpptState& m, std::chrono::system_clock::time_point t) override {
+    mppts.push_back({k, m, t});
+  }
 
   std::size_t count(codec::PacketId p, std::uint16_t address) const {
     std::size_t n = 0;
     for (const auto& t : telemetry) n += (t.message.packet == p && t.key.address == address) ? 1 : 0;
     return n;
   }
-  const HealthReport* last_health(std::uint16_t address) const {
+  const HealthReport* last_health(std::uint16_t address, DeviceKind kind = DeviceKind::Pmu) const {
     for (auto it = healths.rbegin(); it != healths.rend(); ++it)
-      if (it->first.address == address) return &it->second;
+      if (it->first.address == address && it->first.kind == kind) return &it->second;
     return nullptr;
   }
 
@@ -37,6 +46,15 @@ class RecordingSink final : public StateSink {
   std::vector<std::pair<DeviceKey, ConfigState>> configs;
   std::vector<std::pair<DeviceKey, InfoState>> infos;
   std::vector<std::pair<DeviceKey, HealthReport>> healths;
+  template <class State>
+  struct Sample {
+    DeviceKey key;
+    State state;
+    std::chrono::system_clock::time_point newest;
+  };
+  std::vector<Sample<BatteryState>> batteries;
+  std::vector<Sample<BatteryCellsState>> cells;
+  std::vector<Sample<MpptState>> mppts;
 };
 
 }  // namespace pmu::service::test

@@ -17,6 +17,12 @@ Json num(float v) {
   return std::strtod(buf, nullptr);
 }
 
+// Bit `n` of a CANopen type's `received` (interface.md 3.1) decides whether the value is shown.
+template <class V>
+Json if_received(std::uint32_t received, unsigned n, const V& v) {
+  return (received >> n) & 1u ? Json(v) : Json(nullptr);
+}
+
 }  // namespace
 
 Json values_of(const pmu::Voltages& s) {
@@ -111,6 +117,72 @@ Json values_of(const pmu::Health& s) {
               {"timeouts", s.timeouts()},
               {"reconnects", s.reconnects()},
               {"publish_failures", s.publish_failures()}};
+}
+
+}  // namespace pmu::tools
+
+namespace pmu::tools {
+
+const char* to_string(pmu::DeviceKind k) {
+  switch (k) {
+    case pmu::KIND_PMU: return "pmu";
+    case pmu::KIND_BATTERY: return "battery";
+    case pmu::KIND_MPPT: return "mppt";
+  }
+  return "pmu";
+}
+
+Json values_of(const pmu::Battery& s) {
+  const auto r = s.received();
+  return Json{{"voltage", num(s.voltage())},
+              {"current", num(s.current())},
+              {"current_discharge", num(s.current_discharge())},
+              {"current_charge", num(s.current_charge())},
+              {"state_of_charge", num(s.state_of_charge())},
+              {"time_to_go", num(s.time_to_go())},
+              {"cell_temperature_high", num(s.cell_temperature_high())},
+              {"cell_temperature_low", num(s.cell_temperature_low())},
+              {"cell_voltage_high", num(s.cell_voltage_high())},
+              {"cell_voltage_low", num(s.cell_voltage_low())},
+              {"bms_state", if_received(r, 10, s.bms_state())},
+              {"temperature_1", num(s.temperature_1())},
+              {"temperature_2", num(s.temperature_2())},
+              {"temperature_3", num(s.temperature_3())},
+              {"temperature_4", num(s.temperature_4())},
+              {"power_level", num(s.power_level())}};
+}
+
+Json values_of(const pmu::BatteryCells& s) {
+  Json cells = Json::array();
+  for (const auto& c : s.cells()) cells.push_back(Json{{"cell", c.cell()}, {"cell_voltage", num(c.cell_voltage())}});
+  return Json{{"cells", cells}};
+}
+
+Json values_of(const pmu::Mppt& s) {
+  const auto r = s.received();
+  return Json{{"voltage_output_raw", num(s.voltage_output_raw())},
+              {"current_output_raw", num(s.current_output_raw())},
+              {"voltage_out_sw_raw", num(s.voltage_out_sw_raw())},
+              {"mppt_state", if_received(r, 3, s.mppt_state())},
+              {"safety_enabled", if_received(r, 4, s.safety_enabled())},
+              {"pwm_enabled", if_received(r, 5, s.pwm_enabled())},
+              {"temperature", num(s.temperature())},
+              {"voltage_panel_1_raw", num(s.voltage_panel_1_raw())},
+              {"current_panel_1_raw", num(s.current_panel_1_raw())},
+              {"duty_cycle_panel_1", num(s.duty_cycle_panel_1())},
+              {"channel_1_active", if_received(r, 10, s.channel_1_active())},
+              {"voltage_panel_2_raw", num(s.voltage_panel_2_raw())},
+              {"current_panel_2_raw", num(s.current_panel_2_raw())},
+              {"duty_cycle_panel_2", num(s.duty_cycle_panel_2())},
+              {"channel_2_active", if_received(r, 14, s.channel_2_active())},
+              {"voltage_panel_3_raw", num(s.voltage_panel_3_raw())},
+              {"current_panel_3_raw", num(s.current_panel_3_raw())},
+              {"duty_cycle_panel_3", num(s.duty_cycle_panel_3())},
+              {"channel_3_active", if_received(r, 18, s.channel_3_active())},
+              {"voltage_panel_4_raw", num(s.voltage_panel_4_raw())},
+              {"current_panel_4_raw", num(s.current_panel_4_raw())},
+              {"duty_cycle_panel_4", num(s.duty_cycle_panel_4())},
+              {"channel_4_active", if_received(r, 22, s.channel_4_active())}};
 }
 
 }  // namespace pmu::tools

@@ -4,6 +4,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "pmu/idl/canopen.h"
 #include "pmu/idl/command.h"
 #include "pmu/idl/state.h"
 #include "pmu/idl/telemetry.h"
@@ -20,8 +21,14 @@ Json values_of(const pmu::Status& s);
 Json values_of(const pmu::Config& s);
 Json values_of(const pmu::DeviceInfo& s);
 Json values_of(const pmu::Health& s);
+// Batteries and MPPTs (interface.md 3.1): a value not received is null, for integer and
+// boolean fields too (their `received` bit), so no consumer mistakes "not yet" for 0.
+Json values_of(const pmu::Battery& s);
+Json values_of(const pmu::BatteryCells& s);
+Json values_of(const pmu::Mppt& s);
 
 const char* to_string(pmu::HealthState s);
 const char* to_string(pmu::BusState s);
+const char* to_string(pmu::DeviceKind k);  // "pmu", "battery", "mppt"
 
 }  // namespace pmu::tools

@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "pmu/codec/parameters.hpp"
+#include "pmu/idl/canopenPubSubTypes.h"
 #include "pmu/idl/guarded_type.hpp"
 #include "pmu/idl/commandPubSubTypes.h"
 #include "pmu/idl/statePubSubTypes.h"
@@ -35,11 +36,6 @@ extern "C" void on_interrupt(int) { g_interrupted = true; }
 
 double seconds_of(const eprosima::fastrtps::rtps::Time_t& t) { return t.seconds() + t.nanosec() / 1e9; }
 
-template <class T>
-bool selected(const GlobalOptions& o, const T& s) {
-  return (!o.vehicle || *o.vehicle == s.vehicle().to_string()) && (o.bus.empty() || o.bus == s.bus().to_string()) &&
-         (!o.address || *o.address == s.address());
-}
 
 // `no_address`: the words for "every device" ("any device", "no device").
 std::string device_name(const GlobalOptions& o, const char* no_address = "any device") {
@@ -49,19 +45,52 @@ std::string device_name(const GlobalOptions& o, const char* no_address = "any de
   return d;
 }
 
-// A device on DDS: the samples' keys.
+// A device on DDS: the samples' keys. `address` is a PMU's CAN address, a battery's node or
+// an MPPT's device id, told apart by `kind`.
 struct DeviceId {
   std::string vehicle;
   std::string bus;
   std::uint16_t address;
+  pmu::DeviceKind kind = pmu::KIND_PMU;
   bool operator<(const DeviceId& o) const {
-    return std::tie(vehicle, bus, address) < std::tie(o.vehicle, o.bus, o.address);
+    return std::tie(vehicle, bus, kind, address) < std::tie(o.vehicle, o.bus, o.kind, o.address);
   }
 };
 
 template <class T>
 DeviceId id_of(const T& s) {
   return {s.vehicle().to_string(), s.bus().to_string(), s.address()};
+}
+DeviceId id_of(const pmu::Health& s) {
+  return {s.vehicle().to_string(), s.bus().to_string(), s.address(), s.kind()};
+}
+DeviceId id_of(const pmu::Battery& s) {
+  return {s.vehicle().to_string(), s.bus().to_string(), s.node(), pmu::KIND_BATTERY};
+}
+DeviceId id_of(const pmu::BatteryCells& s) {
+  return {s.vehicle().to_string(), s.bus().to_string(), s.node(), pmu::KIND_BATTERY};
+}
+DeviceId id_of(const pmu::Mppt& s) {
+  return {s.vehicle().to_string(), s.bus().to_string(), s.device(), pmu::KIND_MPPT};
+}
+
+// --address names a PMU: batteries and MPPTs are selected by vehicle and bus alone, and
+// drop out when a PMU is named.
+bool selected(const GlobalOptions& o, const DeviceId& d) {
+  return (!o.vehicle || *o.vehicle == d.vehicle) && (o.bus.empty() || o.bus == d.bus) &&
+         (!o.address || (d.kind == pmu::KIND_PMU && *o.address == d.address));
+}
+
+// "can0/1" for a PMU, "can0/battery2" and "can0/mppt4" for the others.
+std::string label(const DeviceId& d) {
+  if (d.kind == pmu::KIND_PMU) return device_label(d.vehicle, d.bus, d.address);
+  return (d.vehicle.empty() ? std::string() : d.vehicle + "/") + d.bus + "/" + to_string(d.kind) +
+         std::to_string(d.address);
+}
+
+// The JSON key of a device's number: the contract's key name of its type.
+const char* number_key(pmu::DeviceKind k) {
+  return k == pmu::KIND_BATTERY ? "node" : k == pmu::KIND_MPPT ? "device" : "address";
 }
 
 // Reads every sample of one state topic (TRANSIENT_LOCAL: the service's current values
@@ -76,7 +105,7 @@ class StateCollector {
     T sample;
     SampleInfo info;
     while (reader_.take_next_sample(&sample, &info) == ReturnCode_t::RETCODE_OK) {
-      if (!info.valid_data || !selected(o, sample)) continue;
+      if (!info.valid_data || !selected(o, id_of(sample))) continue;
       latest_[id_of(sample)] = sample;
     }
   }
@@ -114,12 +143,15 @@ int collect(const GlobalOptions& o, Collector& c, double default_timeout) {
   return 1;
 }
 
-void print_json(const char* topic, const DeviceId& d, const Json& values, std::optional<double> time = std::nullopt) {
+// `with_kind`: the lines of verbs that show every kind of device (list, health) say which.
+void print_json(const char* topic, const DeviceId& d, const Json& values, std::optional<double> time = std::nullopt,
+                bool with_kind = false) {
   Json j;
   j["topic"] = topic;
   j["vehicle"] = d.vehicle;
   j["bus"] = d.bus;
-  j["address"] = d.address;
+  if (with_kind) j["kind"] = to_string(d.kind);
+  j[number_key(d.kind)] = d.address;
   if (time) j["time"] = *time;
   j["values"] = values;
   std::printf("%s\n", j.dump().c_str());
@@ -144,17 +176,17 @@ std::string text(const Json& v) {
 }
 
 void print_table(const DeviceId& d, const Json& values) {
-  std::printf("%s\n", device_label(d.vehicle, d.bus, d.address).c_str());
+  std::printf("%s\n", label(d).c_str());
   for (auto it = values.begin(); it != values.end(); ++it)
     std::printf("  %-24s %s\n", it.key().c_str(), text(it.value()).c_str());
 }
 
 template <class Collector>
-int print_state(const GlobalOptions& o, Collector& c, const char* topic) {
+int print_state(const GlobalOptions& o, Collector& c, const char* topic, bool with_kind = false) {
   if (int rc = collect(o, c, 3.0)) return rc;
   for (const auto& [key, s] : c.latest()) {
     if (o.json)
-      print_json(topic, key, values_of(s));
+      print_json(topic, key, values_of(s), std::nullopt, with_kind);
     else
       print_table(key, values_of(s));
   }
@@ -186,7 +218,7 @@ class TypedTelemetryReader final : public TelemetryReader {
     T sample;
     SampleInfo info;
     while (reader_.take_next_sample(&sample, &info) == ReturnCode_t::RETCODE_OK) {
-      if (!info.valid_data || !selected(o, sample)) continue;
+      if (!info.valid_data || !selected(o, id_of(sample))) continue;
       out = {name_, id_of(sample), seconds_of(info.source_timestamp), values_of(sample)};
       return true;
     }
@@ -227,6 +259,21 @@ int run_watch(const GlobalOptions& o, long count) {
       dds, low ? topics::kLowRateTemperatures : topics::kTemperatures));
   readers.push_back(std::make_unique<TypedTelemetryReader<pmu::Status, pmu::StatusPubSubType>>(
       dds, low ? topics::kLowRateStatus : topics::kStatus));
+  // Batteries and MPPTs have no low-rate topics: their canopen_publish_period already holds
+  // them to a few samples a second.
+  // DDS-Security permissions made before these topics existed do not grant them: then watch
+  // shows the PMUs and says what it leaves out, rather than nothing at all.
+  if (!low) {
+    try {
+      readers.push_back(
+          std::make_unique<TypedTelemetryReader<pmu::Battery, pmu::BatteryPubSubType>>(dds, topics::kBattery));
+      readers.push_back(std::make_unique<TypedTelemetryReader<pmu::BatteryCells, pmu::BatteryCellsPubSubType>>(
+          dds, topics::kBatteryCells));
+      readers.push_back(std::make_unique<TypedTelemetryReader<pmu::Mppt, pmu::MpptPubSubType>>(dds, topics::kMppt));
+    } catch (const pmu::dds::DdsError& e) {
+      std::fprintf(stderr, "pmuctl: not showing batteries and MPPTs: %s\n", e.what());
+    }
+  }
 
   const bool refresh = !o.json && isatty(STDOUT_FILENO);
   const auto deadline = o.timeout ? Clock::now() + std::chrono::duration<double>(*o.timeout) : Clock::time_point::max();
@@ -246,8 +293,7 @@ int run_watch(const GlobalOptions& o, long count) {
           std::string row;
           for (auto it = line.values.begin(); it != line.values.end(); ++it)
             row += " " + it.key() + "=" + text(it.value());
-          std::printf("%s %s %s%s\n", clock_text(line.time).c_str(),
-                      device_label(line.device.vehicle, line.device.bus, line.device.address).c_str(),
+          std::printf("%s %s %s%s\n", clock_text(line.time).c_str(), label(line.device).c_str(),
                       line.topic.c_str(), row.c_str());
         }
         latest[{line.device, line.topic}] = line;
@@ -259,8 +305,7 @@ int run_watch(const GlobalOptions& o, long count) {
       std::printf("\033[H\033[2J");  // home + clear: a refreshing table
       std::printf("pmuctl watch — domain %d — %ld samples (Ctrl-C to stop)\n\n", o.domain, seen);
       for (const auto& [key, l] : latest) {
-        std::printf("%s %s %-15s", clock_text(l.time).c_str(),
-                    device_label(l.device.vehicle, l.device.bus, l.device.address).c_str(), l.topic.c_str());
+        std::printf("%s %s %-15s", clock_text(l.time).c_str(), label(l.device).c_str(), l.topic.c_str());
         for (auto it = l.values.begin(); it != l.values.end(); ++it)
           std::printf(" %s=%s", it.key().c_str(), text(it.value()).c_str());
         std::printf("\n");
@@ -284,8 +329,8 @@ int run_list(const GlobalOptions& o) {
   if (int rc = collect(o, health, 3.0)) return rc;
   info.poll(o);
   if (!o.json)
-    std::printf("%-15s %-15s %7s %8s %8s %-9s %-6s %s\n", "VEHICLE", "BUS", "ADDRESS", "SERIAL", "FIRMWARE", "STATE", "BUS",
-                "LAST FRAME");
+    std::printf("%-15s %-15s %9s %8s %8s %-9s %-6s %s\n", "VEHICLE", "BUS", "ADDRESS", "SERIAL", "FIRMWARE", "STATE",
+                "BUS", "LAST FRAME");
   for (const auto& [key, h] : health.latest()) {
     const auto it = info.latest().find(key);
     std::string fw = "-", serial = "-";
@@ -297,13 +342,16 @@ int run_list(const GlobalOptions& o) {
       Json j = values_of(h);
       j["serial_number"] = it != info.latest().end() ? Json(it->second.serial_number()) : Json(nullptr);
       j["firmware"] = it != info.latest().end() ? Json(fw) : Json(nullptr);
-      print_json("list", key, j);
+      print_json("list", key, j, std::nullopt, true);
     } else {
       char age[32];
       std::snprintf(age, sizeof age, h.last_frame_age() < 0 ? "never" : "%.1f s ago",
                     static_cast<double>(h.last_frame_age()));
-      std::printf("%-15s %-15s %7u %8s %8s %-9s %-6s %s\n", key.vehicle.empty() ? "-" : key.vehicle.c_str(),
-                  key.bus.c_str(), key.address, serial.c_str(), fw.c_str(), to_string(h.state()),
+      // A battery or MPPT shows its kind with its number ("battery2"): it has no serial or firmware.
+      const std::string number =
+          key.kind == pmu::KIND_PMU ? std::to_string(key.address) : to_string(key.kind) + std::to_string(key.address);
+      std::printf("%-15s %-15s %9s %8s %8s %-9s %-6s %s\n", key.vehicle.empty() ? "-" : key.vehicle.c_str(),
+                  key.bus.c_str(), number.c_str(), serial.c_str(), fw.c_str(), to_string(h.state()),
                   to_string(h.bus_state()), age);
     }
   }
@@ -321,7 +369,7 @@ int run_health(const GlobalOptions& o) {
   pmu::dds::DdsContext dds(o.domain, o.qos_file, "pmuctl", o.security, pmu::dds::Transport::Default, o.network,
                            partitions_for(o));
   StateCollector<pmu::Health, pmu::HealthPubSubType> c(dds, topics::kHealth);
-  return print_state(o, c, "health");
+  return print_state(o, c, "health", true);
 }
 
 int run_config_get(const GlobalOptions& o, const std::string& parameter) {
@@ -340,7 +388,7 @@ int run_config_get(const GlobalOptions& o, const std::string& parameter) {
     if (o.json)
       print_json("config", key, Json{{parameter, v}});
     else
-      std::printf("%s %s = %s\n", device_label(key.vehicle, key.bus, key.address).c_str(), parameter.c_str(),
+      std::printf("%s %s = %s\n", label(key).c_str(), parameter.c_str(),
                   text(v).c_str());
   }
   return 0;

@@ -19,6 +19,10 @@ inline constexpr const char* kLowRateCurrents = "pmu/low_rate/currents";
 inline constexpr const char* kLowRateBatteryEnergy = "pmu/low_rate/battery_energy";
 inline constexpr const char* kLowRateTemperatures = "pmu/low_rate/temperatures";
 inline constexpr const char* kLowRateStatus = "pmu/low_rate/status";
+// Batteries and MPPTs on the PMUs' buses (CANopen frames): docs/interface.md 3.1.
+inline constexpr const char* kBattery = "pmu/battery";
+inline constexpr const char* kBatteryCells = "pmu/battery_cells";
+inline constexpr const char* kMppt = "pmu/mppt";
 inline constexpr const char* kCommand = "pmu/command";
 inline constexpr const char* kCommandReply = "pmu/command_reply";
 

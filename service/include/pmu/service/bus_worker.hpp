@@ -12,6 +12,10 @@
 // is sent at start and every 10 s; every address that answers
 // gets a session with the bus's discovery settings. New units plugged in later are found
 // by the same periodic broadcast.
+//
+// Batteries and MPPTs (CANopen frames, read-only): each configured one has a CanOpenSession
+// from the start (so a silent one goes OFFLINE); with `listen_canopen`, one heard but not
+// configured gets a session at its first frame, with a period of 1 s.
 
 #include <atomic>
 #include <chrono>
@@ -20,6 +24,7 @@
 #include <memory>
 #include <vector>
 
+#include "pmu/service/canopen_session.hpp"
 #include "pmu/service/config.hpp"
 #include "pmu/service/device_session.hpp"
 #include "pmu/transport/can_bus.hpp"
@@ -51,6 +56,8 @@ class BusWorker final : private transport::BusHandler {
   // Worker thread only (or before run()):
   DeviceSession* session(std::uint16_t address);
   std::vector<std::uint16_t> addresses() const;
+  // The battery (node) or MPPT (device id) session, or null.
+  CanOpenSession* canopen_session(DeviceKind kind, std::uint16_t id);
 
   // Devices served now (configured and discovered). Thread-safe: sessions_ belongs to the
   // worker thread, so the worker publishes its size here after every change, for the
@@ -66,6 +73,8 @@ class BusWorker final : private transport::BusHandler {
   void on_frame(const transport::ReceivedFrame& frame) override;
   void on_event(const transport::BusEvent& event) override;
   DeviceSession& add_session(const DeviceConfig& device);
+  CanOpenSession& add_canopen_session(DeviceKey key, std::chrono::milliseconds period);
+  void on_canopen_frame(const transport::ReceivedFrame& frame);
   void discover();  // the broadcast firmware request (a loop timer, when config_.discover)
   void rekey_moved_sessions();
   void end_turn();  // ticks every session; the watchdog's progress
@@ -76,6 +85,7 @@ class BusWorker final : private transport::BusHandler {
   Timeouts timeouts_;
   StateSink& sink_;
   std::map<std::uint16_t, std::unique_ptr<DeviceSession>> sessions_;
+  std::map<std::pair<DeviceKind, std::uint16_t>, std::unique_ptr<CanOpenSession>> canopen_;
 
   transport::EventLoop loop_;
   std::size_t turn_frames_ = 0;  // frames drained in the run_once() turn in progress

@@ -43,6 +43,21 @@ struct DeviceConfig {
   bool configure_streaming = false;
 };
 
+// A battery (MG BMS) on the bus, read-only (spec/solar-boat-canopen-battery-mppt.txt). The
+// document gives one set of COB-IDs (0x202, 0x302, 0x402, 0x482): node 2.
+struct BatteryConfig {
+  std::uint8_t node = 2;
+  // Seconds between a BMS's frames of one value: health goes STALE after stale_periods and
+  // OFFLINE after offline_periods of these without a frame.
+  std::chrono::milliseconds period{1000};
+};
+
+// An MPPT on the bus, read-only; `device` 0..7 selects COB-IDs 0x4E6 + 8 x device (and + 1).
+struct MpptConfig {
+  std::uint8_t device = 0;
+  std::chrono::milliseconds period{1000};  // as BatteryConfig::period
+};
+
 struct BusConfig {
   std::string name;       // the DDS key `bus`; at most 15 characters
   std::string interface;  // SocketCAN interface, or "sim" for the built-in simulated PMU
@@ -50,6 +65,16 @@ struct BusConfig {
   std::vector<DeviceConfig> devices;
   bool discover = false;  // find PMUs by a broadcast firmware request at start
   DeviceConfig discovered_defaults;  // settings for PMUs found by discovery
+  std::vector<BatteryConfig> batteries;
+  std::vector<MpptConfig> mppts;
+  // Also serve batteries and MPPTs heard on the bus but not listed (with a period of 1 s).
+  bool listen_canopen = false;
+  // True when the bus serves any battery or MPPT: its receive filters must pass CANopen ids.
+  // pmu/battery, pmu/battery_cells and pmu/mppt get at most one sample per device per this
+  // period (0: one per bus-loop turn that brought a value). The config's top-level
+  // canopen_publish_period, the same for every bus.
+  std::chrono::milliseconds canopen_publish_period{200};
+  bool wants_canopen() const noexcept { return listen_canopen || !batteries.empty() || !mppts.empty(); }
   std::string source_line;           // "FILE:LINE" of the bus entry, for later messages
 };
 

@@ -11,6 +11,7 @@
 #include <chrono>
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <string>
 
 #include "pmu/service/dds_context.hpp"
@@ -24,8 +25,13 @@ class DdsPublisher final : public StateSink {
   // (3 x the longest packet period served). Throws dds::DdsError at start-up.
   // `vehicle`: the first key of every sample (vehicle.hpp). `low_rate_period` > 0: also the
   // low-rate telemetry topics, one sample per device and packet per period (low_rate.hpp).
+  // `canopen_deadline`: DEADLINE of pmu/battery, pmu/battery_cells and pmu/mppt (3 x the
+  // longest battery/MPPT period, or the publish period if longer); nullopt: a service that
+  // serves no battery or MPPT does not offer those topics, so DDS-Security permissions made
+  // before they existed still let it start.
   DdsPublisher(dds::DdsContext& dds, std::chrono::milliseconds telemetry_deadline, std::string vehicle = {},
-               std::chrono::milliseconds low_rate_period = {});
+               std::chrono::milliseconds low_rate_period = {},
+               std::optional<std::chrono::milliseconds> canopen_deadline = std::chrono::seconds(3));
   ~DdsPublisher() override;
 
   void on_telemetry(const DeviceKey& key, const codec::PmuMessage& message,
@@ -33,6 +39,11 @@ class DdsPublisher final : public StateSink {
   void on_config(const DeviceKey& key, const ConfigState& config) override;
   void on_info(const DeviceKey& key, const InfoState& info) override;
   void on_health(const DeviceKey& key, const HealthReport& health) override;
+  void on_battery(const DeviceKey& key, const BatteryState& battery,
+                  std::chrono::system_clock::time_point newest) override;
+  void on_battery_cells(const DeviceKey& key, const BatteryCellsState& cells,
+                        std::chrono::system_clock::time_point newest) override;
+  void on_mppt(const DeviceKey& key, const MpptState& mppt, std::chrono::system_clock::time_point newest) override;
 
   // A write to another of the service's topics (pmu/command_reply) failed: counted in
   // publish_failures and logged like the publisher's own. Thread-safe.
@@ -50,6 +61,9 @@ class DdsPublisher final : public StateSink {
   struct Writers;
   // Both called with Writers::mutex held.
   bool admit(const DeviceKey& key);
+  // Writes with a source timestamp and counts the result.
+  void write_at(eprosima::fastdds::dds::DataWriter* writer, void* sample, const DeviceKey& key,
+                std::chrono::system_clock::time_point when);
   void count(bool ok, const char* topic, const DeviceKey& key, const char* why);
   std::unique_ptr<Writers> w_;
   std::atomic<std::uint64_t> written_{0};

@@ -1,5 +1,5 @@
 #pragma once
-// What the service knows of one PMU, in codec terms. Conversion to the DDS types of
+// What the service knows of one PMU (and, canopen_state.hpp, of batteries and MPPTs), in codec terms. Conversion to the DDS types of
 // interface.md happens in dds_*.cpp only; the rest of the service and its tests use these.
 
 #include <array>
@@ -10,14 +10,24 @@
 
 #include "pmu/codec/decode.hpp"
 #include "pmu/codec/parameters.hpp"
+#include "pmu/service/canopen_state.hpp"
 #include "pmu/transport/can_bus.hpp"
 
 namespace pmu::service {
 
+// What a device on a bus is. PMUs are addressed by CAN address; a battery by its CANopen
+// node, an MPPT by its device id (0..7): the three number ranges overlap, so the kind is part
+// of every device's key (pmu/health's `kind`).
+enum class DeviceKind : std::uint8_t { Pmu, Battery, Mppt };
+const char* to_string(DeviceKind k) noexcept;
+
 struct DeviceKey {
   std::string bus;
-  std::uint16_t address = 0;
-  friend bool operator==(const DeviceKey& a, const DeviceKey& b) { return a.bus == b.bus && a.address == b.address; }
+  std::uint16_t address = 0;  // PMU: CAN address; battery: CANopen node; MPPT: device id
+  DeviceKind kind = DeviceKind::Pmu;
+  friend bool operator==(const DeviceKey& a, const DeviceKey& b) {
+    return a.bus == b.bus && a.address == b.address && a.kind == b.kind;
+  }
 };
 
 // Stored parameters as last read from (or verified on) the device, raw wire values.
@@ -72,6 +82,13 @@ class StateSink {
   virtual void on_config(const DeviceKey& key, const ConfigState& config) = 0;
   virtual void on_info(const DeviceKey& key, const InfoState& info) = 0;
   virtual void on_health(const DeviceKey& key, const HealthReport& health) = 0;
+  // A battery's or MPPT's assembled values changed (canopen_session.hpp); `newest` is the
+  // receive time of the newest frame that contributed.
+  virtual void on_battery(const DeviceKey& key, const BatteryState& battery,
+                          std::chrono::system_clock::time_point newest) = 0;
+  virtual void on_battery_cells(const DeviceKey& key, const BatteryCellsState& cells,
+                                std::chrono::system_clock::time_point newest) = 0;
+  virtual void on_mppt(const DeviceKey& key, const MpptState& mppt, std::chrono::system_clock::time_point newest) = 0;
 };
 
 }  // namespace pmu::service
