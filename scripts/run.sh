@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Quick start: installs what is missing, builds, starts pmu-service on the built-in simulated
-# PMU and shows its live telemetry with `pmuctl watch` (Ctrl-C stops both).
+# power system (a PMU, the battery's BMS and two MPPTs: deploy/examples/sim-power-system.yaml)
+# and shows its live telemetry with `pmuctl watch` (Ctrl-C stops both).
 #   scripts/run.sh [--domain N] [extra pmuctl watch options, e.g. --json --count 20]
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
@@ -15,10 +16,10 @@ cmake -S . -B build/release -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo >/dev/nul
 cmake --build build/release -j"$(nproc)" --target pmu-service pmuctl
 
 log=$(mktemp -t pmu-service.XXXXXX.log)
-build/release/service/pmu-service --bus sim --domain "$domain" >"$log" 2>&1 &
+build/release/service/pmu-service --config deploy/examples/sim-power-system.yaml --domain "$domain" >"$log" 2>&1 &
 service=$!
 trap 'kill -TERM $service 2>/dev/null; wait $service 2>/dev/null || true; echo "pmu-service log: $log"' EXIT
-echo "pmu-service (pid $service) runs on the simulated PMU, DDS domain $domain; log: $log"
+echo "pmu-service (pid $service) runs on the simulated PMU, battery and MPPTs, DDS domain $domain; log: $log"
 sleep 1
 kill -0 $service 2>/dev/null || { cat "$log"; exit 1; }
 build/release/tools/pmuctl --domain "$domain" list

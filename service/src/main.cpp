@@ -95,6 +95,22 @@ std::unique_ptr<transport::CanBus> open_bus(const service::BusConfig& bus, const
     addresses.push_back(dev.address);
   }
   spdlog::info("{}: built-in simulated PMU at address(es) {}", bus.name, fmt::join(addresses, ", "));
+  // The bus's batteries and MPPTs are simulated too, on one solar plant: sun on the panels
+  // charges the battery, the load discharges it (sim/README.md).
+  for (const auto& battery : bus.batteries) {
+    sim::BatterySimConfig c;
+    c.node = battery.node;
+    c.period = battery.period;
+    rt.simulator->add_battery(c);
+    spdlog::info("{}: built-in simulated battery (BMS) at node {}", bus.name, battery.node);
+  }
+  for (const auto& mppt : bus.mppts) {
+    sim::MpptSimConfig c;
+    c.device = mppt.device;
+    c.period = mppt.period;
+    rt.simulator->add_mppt(c);
+    spdlog::info("{}: built-in simulated MPPT, device {}", bus.name, mppt.device);
+  }
   return rt.network->attach(bus.name);
 }
 
