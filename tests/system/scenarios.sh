@@ -13,7 +13,7 @@
 #                                 command line (all when absent), one after another
 #   sh /scenarios.sh one NAME     a single scenario (what `all` runs for each)
 
-ALL_SCENARIOS="telemetry link_down_up iface_recreate iface_absent_at_start sim_restart two_pmus discovery flood commands_candump"
+ALL_SCENARIOS="telemetry link_down_up iface_recreate iface_absent_at_start sim_restart two_pmus discovery flood commands_candump power_system"
 
 export PATH=/opt/pmu/bin:/usr/sbin:/usr/bin:/sbin:/bin
 export PMU_QOS_FILE=/etc/pmu-dds/qos.xml
@@ -449,6 +449,68 @@ EOF
 }
 
 # ---- driver ----------------------------------------------------------------------------
+
+# The whole power system over real SocketCAN: pmu-sim plays the PMU, the battery's BMS
+# (node 2) and MPPTs 0 and 1 on vcan0; the service serves pmu/battery, pmu/battery_cells and
+# pmu/mppt with received values and lists every device ONLINE. Then the battery goes silent
+# (pmu-sim restarted without it): it leaves ONLINE within BMS_SILENT_BOUND while the MPPTs
+# are ONLINE again, and the service keeps running.
+BMS_SILENT_BOUND=10   # s: stale_periods (3) x the battery's period (1 s), plus the VM's slack
+# The state of the list line of KIND whose KEY (address, node or device) is VALUE, in LIST_OUT.
+kind_state() {
+  printf '%s\n' "$LIST_OUT" | grep "\"kind\":\"$1\",\"$2\":$3," | sed -n 's/.*"state":"\([A-Z]*\)".*/\1/p' | head -n1
+}
+power_listed() {
+  LIST_OUT=$(ctl --timeout 10 list 2>/dev/null)
+  [ "$(kind_state pmu address 1)" = ONLINE ] && [ "$(kind_state battery node 2)" = ONLINE ] &&
+    [ "$(kind_state mppt device 0)" = ONLINE ] && [ "$(kind_state mppt device 1)" = ONLINE ]
+}
+battery_silent() {
+  LIST_OUT=$(ctl --timeout 10 list 2>/dev/null)
+  _s=$(kind_state battery node 2)
+  [ -n "$_s" ] && [ "$_s" != ONLINE ]
+}
+mppts_back_battery_not() {
+  LIST_OUT=$(ctl --timeout 10 list 2>/dev/null)
+  [ "$(kind_state mppt device 0)" = ONLINE ] && [ "$(kind_state mppt device 1)" = ONLINE ] &&
+    [ "$(kind_state battery node 2)" != ONLINE ]
+}
+scenario_power_system() {
+  printf 'buses:\n  - interface: %s\n    devices:\n      - address: 1\n    batteries:\n      - node: 2\n        period: 1.0\n    mppts:\n      - device: 0\n      - device: 1\n' "$IFACE" >"$WORK/$SCEN.yaml"
+  start_sim --battery 2 --mppt 0 --mppt 1
+  start_service --config "$WORK/$SCEN.yaml"
+  pid=$SVC_PID
+  t0=$(now)
+  wait_until 90 power_listed || fail "pmuctl list does not show the PMU, battery 2 and MPPTs 0, 1 ONLINE within 90 s: $(printf '%s' "$LIST_OUT" | cut -c1-600 | tr '\n' ' ')"
+  detail "list: PMU 1, battery node 2, MPPTs 0 and 1 ONLINE $(since "$t0") s after the start"
+  ctl --timeout 60 watch --count 80 >"$WORK/$SCEN.watch" 2>/dev/null || fail "pmuctl watch --count 80 failed"
+  bat=$(grep -m1 "\"topic\":\"battery\",\"vehicle\":\"\",\"bus\":\"$IFACE\",\"node\":2," "$WORK/$SCEN.watch")
+  [ -n "$bat" ] || fail "no pmu/battery sample from $IFACE node 2 among 80"
+  for k in voltage current state_of_charge cell_voltage_high cell_voltage_low; do
+    v=$(jv "$bat" "$k")
+    case "$v" in '' | null | nan | *[!0-9.-]*) fail "pmu/battery $k is '$v', not a received value" ;; esac
+  done
+  soc=$(jv "$bat" state_of_charge)
+  true_that "$soc >= 0 && $soc <= 100" || fail "pmu/battery state_of_charge $soc is not a percentage"
+  cells=$(grep -m1 '"topic":"battery_cells"' "$WORK/$SCEN.watch" | grep -o '"cell":' | wc -l)
+  [ "$cells" -eq 12 ] || fail "pmu/battery_cells holds $cells cells; pmu-sim's battery has 12"
+  for d in 0 1; do
+    m=$(grep -m1 "\"topic\":\"mppt\",\"vehicle\":\"\",\"bus\":\"$IFACE\",\"device\":$d," "$WORK/$SCEN.watch")
+    [ -n "$m" ] || fail "no pmu/mppt sample from device $d among 80"
+    case "$(jv "$m" voltage_output_raw)" in '' | null | *[!0-9.]*) fail "pmu/mppt $d voltage_output_raw is '$(jv "$m" voltage_output_raw)'" ;; esac
+  done
+  detail "pmu/battery (SoC $soc %, $(jv "$bat" voltage) V), pmu/battery_cells ($cells cells), pmu/mppt 0 and 1, all with received values"
+  # The BMS goes silent: pmu-sim again, without the battery.
+  kill "$SIM_PID"; wait "$SIM_PID" 2>/dev/null
+  start_sim --mppt 0 --mppt 1
+  t1=$(now)
+  wait_until "$BMS_SILENT_BOUND" battery_silent || fail "battery 2 still '$(kind_state battery node 2)' $BMS_SILENT_BOUND s after its BMS went silent"
+  took=$(since "$t1")
+  state=$(kind_state battery node 2)
+  wait_until 20 mppts_back_battery_not || fail "after the restart without the battery: $(printf '%s' "$LIST_OUT" | tr '\n' ' ' | cut -c1-500)"
+  alive "$pid" || fail "pmu-service died"
+  detail "BMS silent: battery 2 $state after $took s (bound $BMS_SILENT_BOUND s); MPPTs ONLINE again; same pid"
+}
 
 scenario_limit() {  # seconds a scenario may take in the (slow, emulated) VM
   case "$1" in
