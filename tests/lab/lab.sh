@@ -573,7 +573,7 @@ ran_value_in() { grep -q "audit: command .*payload_voltage=$1 " "$2"; }
 # and every telemetry sample is attributed to the right vehicle (each vehicle's payload
 # voltage follows its own setpoint, so a sample under the wrong name would show the other's).
 vehicles_listed() {
-  SEEN=$(ctl gnd --timeout 20 list 2>/dev/null | grep '"bus":"sim0","address":1' | sed -n 's/.*"vehicle":"\([^"]*\)".*/\1/p' | sort -u | tr '\n' ' ')
+  SEEN=$(ctl gnd --timeout 20 list 2>/dev/null | grep '"bus":"sim0",' | grep '"kind":"pmu","address":1,' | sed -n 's/.*"vehicle":"\([^"]*\)".*/\1/p' | sort -u | tr '\n' ' ')
   [ "$SEEN" = "uav1 uav2 " ]
 }
 scenario_fleet() {
