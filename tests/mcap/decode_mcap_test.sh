@@ -19,6 +19,11 @@ schemas=$(grep -o '"schema":"[^"]*"' "$work/indexed.jsonl" | sort -u | tr '\n' '
 [ "$schemas" = '"schema":"pmu::BatteryEnergy" "schema":"pmu::Currents" "schema":"pmu::Status" "schema":"pmu::Temperatures" "schema":"pmu::Voltages" ' ] \
   || { echo "FAIL: schema names $schemas"; exit 1; }
 
+# Undecodable lines are named (FILE:LINE: reason) and the rest is written.
+"$PMUCTL" decode --mcap "$work/bad.mcap" "$DATA/bad_lines.log" 2> "$work/err" || { echo "FAIL: bad_lines.log: $(cat "$work/err")"; exit 1; }
+grep -q "bad_lines.log:4: unknown packet 0x05 in id 1E050001" "$work/err" || { echo "FAIL: message: $(cat "$work/err")"; exit 1; }
+[ "$(read_mcap "$work/bad.mcap" | grep -c '"topic"')" -eq 2 ] || { echo "FAIL: bad_lines.log should give 2 messages"; exit 1; }
+
 # An output that cannot be created: named, exit 2, nothing written.
 if "$PMUCTL" decode --mcap "$work/no/such/dir/x.mcap" "$DATA/every_packet.log" 2> "$work/err"; then
   echo "FAIL: decode --mcap into a missing folder succeeded"; exit 1

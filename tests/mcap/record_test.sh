@@ -51,6 +51,10 @@ fi
 [ $status -eq 2 ] && grep -q "cannot create $work/missing/x.mcap: No such file or directory" "$work/err" ||
   fail "unwritable path: $status $(cat "$work/err")"
 
+"$ctl" --domain "$domain" --bus sim0 record "$work/x.mcap" 2>"$work/err"; status=$?
+[ $status -eq 2 ] && grep -q "bus and --address do not apply" "$work/err" && [ ! -e "$work/x.mcap" ] ||
+  fail "--bus: $status $(cat "$work/err")"
+
 # 4. Disk full while recording (root: a small tmpfs, nearly filled).
 if [ "$(id -u)" -ne 0 ]; then
   echo "note: disk-full case skipped: mounting a small tmpfs needs root"
