@@ -71,6 +71,10 @@ else
   else
     fail "the stream reader refused the file the full disk left"
   fi
+  # Full before the first chunk: nothing that looks like a recording stays.
+  "$ctl" --domain "$domain" record "$work/small/start.mcap" 2>"$work/start.err"; status=$?
+  [ $status -eq 1 ] && grep -q "No space left on device (disk full)" "$work/start.err" && [ ! -e "$work/small/start.mcap" ] ||
+    fail "record onto a full disk: $status, $(ls "$work/small"), $(cat "$work/start.err")"
 fi
 [ $failures -eq 0 ] || { tail -n 20 "$work/service.log" >&2; exit 1; }
 echo "record: PASS"

@@ -51,10 +51,11 @@ int run_decode_mcap(const std::string& log, const std::string& out, std::optiona
   const auto topics = telemetry_topics();
   McapRecording rec;
   if (const auto why = rec.open(partial, topics); !why.empty()) {
-    std::fprintf(stderr, "pmuctl decode --mcap: %s\n", why.c_str());
+    std::fprintf(stderr, "pmuctl decode --mcap: %s; %s not written\n", why.c_str(), out.c_str());
+    const bool created = rec.created();
     rec.close();
     ::unlink(partial.c_str());
-    return 2;
+    return created ? 1 : 2;  // created, then the disk was full: not the caller's input
   }
   auto give_up = [&](const std::string& why) {
     std::fprintf(stderr, "pmuctl decode --mcap: %s; %s not written\n", why.c_str(), out.c_str());

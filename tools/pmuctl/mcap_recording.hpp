@@ -30,6 +30,8 @@ class McapRecording {
   std::string close();
 
   bool failed() const { return writer_ && writer_->failed(); }
+  // open() created the file (it failed later, e.g. disk full: the caller removes it).
+  bool created() const { return sink_.is_open() || writer_ != nullptr; }
   std::string error() const;  // "" or what failed and where
   std::string progress() const;  // "1234 messages, 56.7 kB (voltages 200, currents 200, ...)"
   std::uint64_t messages() const { return writer_ ? writer_->message_count() : 0; }

@@ -104,8 +104,10 @@ int run_record(const GlobalOptions& o, const std::string& path, const std::vecto
   auto shared = std::make_unique<Shared>();  // outlives the participant and its listeners
   if (const auto why = shared->rec.open(path, topics); !why.empty()) {
     std::fprintf(stderr, "pmuctl record: %s\n", why.c_str());
+    const bool created = shared->rec.created();
     shared->rec.close();
-    return 2;
+    if (created) ::unlink(path.c_str());  // nothing recorded: no file that looks like a recording
+    return created ? 1 : 2;
   }
   std::vector<std::unique_ptr<TopicListener>> listeners;
   {
