@@ -43,21 +43,42 @@ done
 add_arm64=0
 dpkg --print-foreign-architectures | grep -qx arm64 || add_arm64=1
 
+SUDO=""
+if [ "$(id -u)" -ne 0 ]; then SUDO="sudo"; fi
+need_root() {
+  [ -z "$SUDO" ] || command -v sudo >/dev/null || { echo "setup: need root (or sudo) to install: $*" >&2; exit 1; }
+}
+
 if [ ${#missing[@]} -eq 0 ] && [ "$add_arm64" -eq 0 ]; then
   echo "setup: all ${#packages[@]} packages present"
-  exit 0
+else
+  need_root "${missing[*]}"
+  if [ "$add_arm64" -eq 1 ]; then
+    echo "setup: adding the arm64 architecture (dpkg multiarch, for the arm64 packages)"
+    $SUDO dpkg --add-architecture arm64
+  fi
+  echo "setup: installing ${missing[*]}"
+  export DEBIAN_FRONTEND=noninteractive
+  $SUDO apt-get update -q
+  $SUDO apt-get install -y -q --no-install-recommends "${missing[@]}"
 fi
 
-SUDO=""
-if [ "$(id -u)" -ne 0 ]; then
-  command -v sudo >/dev/null || { echo "setup: need root (or sudo) to install: ${missing[*]}" >&2; exit 1; }
-  SUDO="sudo"
+# The MCAP tests (tests/mcap) read pmuctl's files with the ecosystem's own npm packages on
+# Node.js. Node.js may come from elsewhere (NodeSource bundles npm): Debian's nodejs and npm
+# are installed only when the commands are missing. The packages come from the lock file
+# (npm ci), and only when it changed since the last install.
+if ! command -v node >/dev/null || ! command -v npm >/dev/null; then
+  need_root nodejs npm
+  echo "setup: installing nodejs npm (Debian) for tests/mcap"
+  export DEBIAN_FRONTEND=noninteractive
+  $SUDO apt-get update -q
+  $SUDO apt-get install -y -q --no-install-recommends nodejs npm
 fi
-if [ "$add_arm64" -eq 1 ]; then
-  echo "setup: adding the arm64 architecture (dpkg multiarch, for the arm64 packages)"
-  $SUDO dpkg --add-architecture arm64
+mcap_dir="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)/tests/mcap"
+stamp="$mcap_dir/node_modules/.package-lock.json"
+if [ ! -f "$stamp" ] || [ "$mcap_dir/package-lock.json" -nt "$stamp" ]; then
+  echo "setup: npm ci in tests/mcap (@mcap/core, @foxglove/omgidl-parser, @foxglove/omgidl-serialization)"
+  (cd "$mcap_dir" && npm ci --no-audit --no-fund --loglevel=error)
+else
+  echo "setup: tests/mcap npm packages present"
 fi
-echo "setup: installing ${missing[*]}"
-export DEBIAN_FRONTEND=noninteractive
-$SUDO apt-get update -q
-$SUDO apt-get install -y -q --no-install-recommends "${missing[@]}"

@@ -24,6 +24,7 @@
 #include "pmu/service/capacity.hpp"
 #include "pmu/service/low_rate.hpp"
 #include "pmu/service/rate_limit.hpp"
+#include "pmu/service/telemetry_samples.hpp"
 
 namespace pmu::service {
 namespace {
@@ -214,53 +215,27 @@ void DdsPublisher::on_telemetry(const DeviceKey& key, const codec::PmuMessage& m
   if (const auto* v = std::get_if<codec::Voltages>(&m.payload)) {
     pmu::Voltages s;
     set_key(s, w_->vehicle, key);
-    s.avionics(f(v->avionics));
-    s.output_28v(f(v->output_28v));
-    s.payload(f(v->payload));
-    s.servo(f(v->servo));
-    s.battery_a(f(v->battery_a));
-    s.battery_b(f(v->battery_b));
-    s.generator(f(v->generator));
+    fill(s, *v);
     write(w_->voltages, &s, 0);
   } else if (const auto* c = std::get_if<codec::Currents>(&m.payload)) {
     pmu::Currents s;
     set_key(s, w_->vehicle, key);
-    s.avionics(f(c->avionics));
-    s.output_28v(f(c->output_28v));
-    s.payload(f(c->payload));
-    s.servo(f(c->servo));
-    s.battery_a(f(c->battery_a));
-    s.battery_b(f(c->battery_b));
+    fill(s, *c);
     write(w_->currents, &s, 1);
   } else if (const auto* e = std::get_if<codec::BatteryEnergy>(&m.payload)) {
     pmu::BatteryEnergy s;
     set_key(s, w_->vehicle, key);
-    s.battery_a_mah(e->battery_a_mah);
-    s.battery_b_mah(e->battery_b_mah);
+    fill(s, *e);
     write(w_->energy, &s, 2);
   } else if (const auto* t = std::get_if<codec::Temperatures>(&m.payload)) {
     pmu::Temperatures s;
     set_key(s, w_->vehicle, key);
-    s.internal(f(t->internal));
-    s.battery_a(f(t->battery_a));  // NaN stays NaN: "no sensor"
-    s.battery_b(f(t->battery_b));
-    s.generator(f(t->generator));
-    s.starter(f(t->starter));
+    fill(s, *t);
     write(w_->temperatures, &s, 3);
   } else if (const auto* st = std::get_if<codec::Status>(&m.payload)) {
     pmu::Status s;
     set_key(s, w_->vehicle, key);
-    s.generator_rpm(st->generator_rpm);
-    s.generation_enabled(st->generation_enabled);
-    s.thermal_shutdown(st->thermal_shutdown);
-    s.soa_shutdown(st->soa_shutdown);
-    s.start_button(st->start_button);
-    s.payload_shed(st->payload_shed);
-    s.starter_ready(st->starter_ready);
-    s.avionics_servo_on(st->avionics_servo_on());
-    s.payload_on(st->payload_on());
-    s.charger_a_on(st->charger_a_on());
-    s.charger_b_on(st->charger_b_on());
+    fill(s, *st);
     write(w_->status, &s, 4);
   }
 }

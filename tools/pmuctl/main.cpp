@@ -18,6 +18,8 @@
 #include "pmuctl/command_verbs.hpp"
 #include "pmuctl/dds_verbs.hpp"
 #include "pmuctl/log_decoder.hpp"
+#include "pmuctl/mcap_decode.hpp"
+#include "pmuctl/record_verb.hpp"
 #include "pmu/service/command.hpp"
 #include "pmu/service/vehicle.hpp"
 #include "pmuctl/network_options.hpp"
@@ -212,6 +214,20 @@ int main(int argc, char** argv) {
   decode->add_option("--firmware", firmware,
                      "Firmware X.Y assumed for devices whose firmware reply is not in the log "
                      "(default: current, 1.17)");
+  std::string mcap_out;
+  decode->add_option("--mcap", mcap_out,
+                     "Write the PMU telemetry frames as an MCAP file with the channels of `record` "
+                     "(candump -L logs: the log time is the frame's timestamp) instead of printing them");
+
+  auto* record = app.add_subcommand(
+      "record", "Record the topics into an MCAP file (Foxglove, Lichtblick, PlotJuggler) until Ctrl-C or SIGTERM");
+  std::string record_path;
+  record->add_option("file", record_path, "The MCAP file to write (replaced if it exists)")->required();
+  std::vector<std::string> record_topics;
+  record->add_option("--topic", record_topics,
+                     "Only this topic (pmu/voltages or voltages; also low_rate/..., command, command_reply); "
+                     "repeat for more (default: telemetry, state, health, battery and MPPT topics)")
+      ->allow_extra_args(false);
 
   CLI11_PARSE(app, argc, argv);
   if (address >= 0) g.address = static_cast<std::uint16_t>(address);
@@ -227,6 +243,7 @@ int main(int argc, char** argv) {
         return 2;
       }
     }
+    if (!mcap_out.empty()) return pmu::tools::run_decode_mcap(path, mcap_out, options.firmware);
     return run_decode(path, options);
   }
   if (!setup_security(g, security_dir, identity)) return 2;
@@ -235,6 +252,7 @@ int main(int argc, char** argv) {
     return 2;
   try {
     if (*watch) return pmu::tools::run_watch(g, count);
+    if (*record) return pmu::tools::run_record(g, record_path, record_topics);
     if (app.got_subcommand("list")) return pmu::tools::run_list(g);
     if (app.got_subcommand("info")) return pmu::tools::run_info(g);
     if (app.got_subcommand("health")) return pmu::tools::run_health(g);

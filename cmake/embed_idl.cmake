@@ -1,0 +1,26 @@
+# cmake -DOUT=file.hpp -DIDL_FILES="a.idl;b.idl" -P embed_idl.cmake
+# Writes a header with each IDL file's text as the `omgidl` schema of MCAP channels
+# (pmuctl record / decode --mcap): preprocessor lines are dropped (the files include nothing;
+# an #include would have to be resolved here), the rest is kept as written.
+set(body "#pragma once\n// Generated from idl/*.idl by cmake/embed_idl.cmake at build time; not committed.\n#include <string_view>\n\nnamespace pmu::idl_text {\n\n")
+foreach(idl ${IDL_FILES})
+  get_filename_component(stem ${idl} NAME_WE)
+  file(STRINGS ${idl} lines)
+  set(text "")
+  foreach(line IN LISTS lines)
+    if(line MATCHES "^[ \t]*#include")
+      message(FATAL_ERROR "${idl}: #include is not resolved by embed_idl.cmake; inline the definitions or extend it")
+    endif()
+    if(NOT line MATCHES "^[ \t]*#")
+      string(APPEND text "${line}\n")
+    endif()
+  endforeach()
+  if(text MATCHES "\\)pmuidl\"")
+    message(FATAL_ERROR "${idl} contains the raw-string delimiter )pmuidl\"")
+  endif()
+  string(APPEND body "inline constexpr std::string_view k_${stem} = R\"pmuidl(${text})pmuidl\";\n\n")
+endforeach()
+string(APPEND body "}  // namespace pmu::idl_text\n")
+file(WRITE ${OUT}.tmp "${body}")
+file(COPY_FILE ${OUT}.tmp ${OUT} ONLY_IF_DIFFERENT)
+file(REMOVE ${OUT}.tmp)

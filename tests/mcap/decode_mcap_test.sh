@@ -1,0 +1,50 @@
+#!/usr/bin/env bash
+# pmuctl decode --mcap, read back by @mcap/core and decoded by the omgidl packages, gives the
+# values pmuctl decode --json prints; bad outputs are refused with nothing left behind.
+#   decode_mcap_test.sh PMUCTL DATA_DIR
+set -euo pipefail
+PMUCTL=$1 DATA=$2
+. "$(dirname "$0")/mcap_env.sh"
+work=$(mktemp -d)
+trap 'umount "$work/small" 2>/dev/null || true; rm -rf "$work"' EXIT
+
+"$PMUCTL" decode --mcap "$work/every.mcap" "$DATA/every_packet.log"
+read_mcap "$work/every.mcap" > "$work/indexed.jsonl"
+read_mcap --stream "$work/every.mcap" > "$work/stream.jsonl"
+"$PMUCTL" decode --json "$DATA/every_packet.log" > "$work/decode.jsonl" 2>/dev/null
+node "$MCAP_TESTS_DIR/compare_decode.mjs" "$work/indexed.jsonl" "$work/decode.jsonl"
+node "$MCAP_TESTS_DIR/compare_decode.mjs" "$work/stream.jsonl" "$work/decode.jsonl"
+tail -1 "$work/indexed.jsonl" | grep -q '"statistics":{"message_count":"5"' || { echo "FAIL: summary"; tail -1 "$work/indexed.jsonl"; exit 1; }
+schemas=$(grep -o '"schema":"[^"]*"' "$work/indexed.jsonl" | sort -u | tr '\n' ' ')
+[ "$schemas" = '"schema":"pmu::BatteryEnergy" "schema":"pmu::Currents" "schema":"pmu::Status" "schema":"pmu::Temperatures" "schema":"pmu::Voltages" ' ] \
+  || { echo "FAIL: schema names $schemas"; exit 1; }
+
+# Undecodable lines are named (FILE:LINE: reason) and the rest is written.
+"$PMUCTL" decode --mcap "$work/bad.mcap" "$DATA/bad_lines.log" 2> "$work/err" || { echo "FAIL: bad_lines.log: $(cat "$work/err")"; exit 1; }
+grep -q "bad_lines.log:4: unknown packet 0x05 in id 1E050001" "$work/err" || { echo "FAIL: message: $(cat "$work/err")"; exit 1; }
+[ "$(read_mcap "$work/bad.mcap" | grep -c '"topic"')" -eq 2 ] || { echo "FAIL: bad_lines.log should give 2 messages"; exit 1; }
+
+# An output that cannot be created: named, exit 2, nothing written.
+if "$PMUCTL" decode --mcap "$work/no/such/dir/x.mcap" "$DATA/every_packet.log" 2> "$work/err"; then
+  echo "FAIL: decode --mcap into a missing folder succeeded"; exit 1
+fi
+grep -q "cannot create $work/no/such/dir/x.mcap.partial-[0-9]*: No such file or directory" "$work/err" \
+  || { echo "FAIL: message: $(cat "$work/err")"; exit 1; }
+
+# A full disk: a 64 kB tmpfs (root only). The error names the file and the cause, and
+# neither OUT nor a partial file remains.
+if [ "$(id -u)" -ne 0 ]; then
+  echo "note: disk-full case skipped: mounting a small tmpfs needs root"
+else
+  mkdir "$work/small"
+  mount -t tmpfs -o size=64k tmpfs "$work/small"
+  for _ in $(seq 400); do cat "$DATA/every_packet.log"; done > "$work/big.log"
+  if "$PMUCTL" decode --mcap "$work/small/big.mcap" "$work/big.log" 2> "$work/err"; then
+    echo "FAIL: decode --mcap onto a full disk succeeded"; exit 1
+  fi
+  grep -q "writing $work/small/big.mcap.partial-[0-9]*: No space left on device (disk full)" "$work/err" \
+    || { echo "FAIL: message: $(cat "$work/err")"; exit 1; }
+  grep -q "big.mcap not written" "$work/err" || { echo "FAIL: message: $(cat "$work/err")"; exit 1; }
+  [ -z "$(ls -A "$work/small")" ] || { echo "FAIL: left behind: $(ls -A "$work/small")"; exit 1; }
+fi
+echo "PASS"

@@ -1,0 +1,51 @@
+#pragma once
+// An MCAP file of contract topics (mcap_topics.hpp) for `pmuctl record` and `decode --mcap`:
+// the file, its schemas and channels, per-topic counts for the progress line, and errors in
+// words ("writing rec.mcap: No space left on device after 1.2 MB").
+// No DDS: samples arrive as CDR bytes. Not thread-safe (record serialises calls).
+
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "pmu/mcap/sink.hpp"
+#include "pmu/mcap/writer.hpp"
+#include "pmuctl/mcap_topics.hpp"
+
+namespace pmu::tools {
+
+class McapRecording {
+ public:
+  // Creates `path` and writes the header, one schema per type and one channel per topic.
+  // "" on success, else what failed and where.
+  std::string open(const std::string& path, const std::vector<const RecordedTopic*>& topics);
+
+  // `topic`: index into open()'s list. `time_ns`: since the Unix epoch, the message's log and
+  // publish time. False once the file cannot be written (error()).
+  bool write(std::size_t topic, std::uint64_t time_ns, const std::uint8_t* data, std::size_t size);
+  // The chunk so far to the file, so a crash keeps it.
+  bool flush();
+  // Summary and footer; "" or what failed. After a write error, ends the file as well as it can.
+  std::string close();
+
+  bool failed() const { return writer_ && writer_->failed(); }
+  // open() created the file (it failed later, e.g. disk full: the caller removes it).
+  bool created() const { return sink_.is_open() || writer_ != nullptr; }
+  std::string error() const;  // "" or what failed and where
+  std::string progress() const;  // "1234 messages, 56.7 kB (voltages 200, currents 200, ...)"
+  std::uint64_t messages() const { return writer_ ? writer_->message_count() : 0; }
+
+ private:
+  std::string path_;
+  pmu::mcap::FileSink sink_;
+  std::unique_ptr<pmu::mcap::Writer> writer_;
+  std::vector<const RecordedTopic*> topics_;
+  std::vector<std::uint16_t> channels_;
+  std::vector<std::uint64_t> counts_;
+};
+
+// "56.7 kB"
+std::string human_bytes(std::uint64_t n);
+
+}  // namespace pmu::tools
