@@ -568,6 +568,17 @@ telemetry_from() {
 executed_in() { grep -q "audit: command .*: set_parameter payload_voltage=$2 to $1/sim0/1 -> COMPLETED" "$3"; }
 ran_value_in() { grep -q "audit: command .*payload_voltage=$1 " "$2"; }
 
+# ground_served SETUP: with CTL_EXTRA set for the set-up, gnd gets 10 samples of uav1 and a
+# command that uav1's service (the last started) executes.
+ground_served() {
+  _t0=$(now)
+  telemetry_from gnd uav1 10 || fail "$1: no 10 samples in gnd within 60 s ($(tail -n1 "$WORK/$SCEN.err"))"
+  detail "$1: 10 samples in gnd $(since "$_t0") s after asking"
+  set_on gnd uav1 13.5 || fail "$1: command: $CMD_OUT"
+  executed_in uav1 13.5 "$SVC_LOG" || fail "$1: the command is not in the audit trail"
+  detail "a command from gnd COMPLETED and executed once"
+}
+
 # Two aircraft with the same bus and address (sim0/1), uav1 in mc1 and uav2 in mc2, on the
 # ground station's network: gnd sees both, each command is executed by its vehicle only,
 # and every telemetry sample is attributed to the right vehicle (each vehicle's payload
@@ -622,12 +633,7 @@ discovery:
   mode: unicast
   peers: [$(addr_of gnd)]"
   CTL_EXTRA="--peer $(addr_of mc1)"
-  t0=$(now)
-  telemetry_from gnd uav1 10 || fail "unicast peers: no 10 samples in gnd within 60 s ($(tail -n1 "$WORK/$SCEN.err"))"
-  detail "unicast peers: 10 samples in gnd $(since "$t0") s after the start"
-  set_on gnd uav1 13.5 || fail "unicast peers: command: $CMD_OUT"
-  executed_in uav1 13.5 "$SVC_LOG" || fail "unicast peers: the command is not in the audit trail"
-  detail "a command from gnd COMPLETED and executed once"
+  ground_served "unicast peers"
 }
 
 # The Discovery Server in mc2 (fast-discovery-server, fastdds-tools), multicast stopped:
@@ -644,12 +650,7 @@ discovery:
   check_multicast_stopped
   detail "control: without the server, a ground participant finds no service in 10 s"
   CTL_EXTRA="--discovery-server $(addr_of mc2):$DS_PORT"
-  t0=$(now)
-  telemetry_from gnd uav1 10 || fail "discovery server: no 10 samples in gnd within 60 s ($(tail -n1 "$WORK/$SCEN.err"))"
-  detail "discovery server in mc2: 10 samples in gnd $(since "$t0") s after asking"
-  set_on gnd uav1 13.5 || fail "discovery server: command: $CMD_OUT"
-  executed_in uav1 13.5 "$SVC_LOG" || fail "discovery server: the command is not in the audit trail"
-  detail "a command from gnd COMPLETED and executed once"
+  ground_served "discovery server in mc2"
 }
 
 # DDS-Security across the ground link (the PKI run_vm_tests.sh made with make_pki.sh): the
