@@ -35,9 +35,4 @@ std::optional<std::vector<std::string>> RemoteWriters::partitions_of(
   return it->second;
 }
 
-std::size_t RemoteWriters::size() const {
-  std::lock_guard<std::mutex> lock(mutex_);
-  return partitions_.size();
-}
-
 }  // namespace pmu::dds

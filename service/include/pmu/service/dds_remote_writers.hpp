@@ -25,7 +25,6 @@ class RemoteWriters final : public eprosima::fastdds::dds::DomainParticipantList
   // handle, which Fast DDS sets from the writer on the wire, unlike the sample identity a
   // writer may choose); nullopt when discovery never reported that writer.
   std::optional<std::vector<std::string>> partitions_of(const eprosima::fastdds::dds::SampleInfo& info) const;
-  std::size_t size() const;
 
  private:
   mutable std::mutex mutex_;
