@@ -9,7 +9,8 @@
 # meaningless. Then times both (wall, user+sys; R alternating runs, default 3, the best
 # counts), checks one output line per input line each time, and prints one result row
 # (JSON, for bench/report.py) on stdout; progress on stderr.
-# The issue sets no target for the ratio, so the row has none.
+# Target (per-frame cost issue): >= 1,000,000 frames/s on the 1,000,000-frame log; the
+# python-can reference is there to show the figure is not the machine's alone.
 set -euo pipefail
 frames=1000000
 check_lines=5000
@@ -113,11 +114,12 @@ print(json.dumps({
     "value": round(pm_rate, 1), "unit": "frames/s",
     "reference": round(py_rate, 1),
     "reference_name": f"python-can {can.__version__} reader + struct",
-    "ratio": round(pm_rate / py_rate, 2), "target": "", "met": None,
+    "ratio": round(pm_rate / py_rate, 2), "target": ">= 1,000,000 frames/s",
+    "met": pm_rate >= 1_000_000 if frames >= 1_000_000 else None,
     "note": (f"Best wall time of {len(pm_runs)} alternating runs each, start-up included, JSON lines written "
              f"to a file: pmuctl {pm_wall:.2f} s (user+sys {pm_user + pm_sys:.2f} s; runs {walls(pm_runs)} s), "
              f"bench/python_can_decode.py on Python {platform.python_version()} {py_wall:.2f} s "
              f"(user+sys {py_user + py_sys:.2f} s; runs {walls(py_runs)} s). Both decoders were checked "
-             "to agree before timing. The issue sets no target for this ratio."),
+             "to agree before timing."),
 }))
 PY

@@ -131,6 +131,23 @@ TEST(PmuctlDecode, TableOutputHasAHeaderAndOneRowPerLine) {
   EXPECT_NE(r.lines[1].find("avionics=12.3 V"), std::string::npos);
 }
 
+// The JSON lines are written without a document tree (json_line.hpp); each must be exactly
+// the bytes nlohmann's dump gives for the same members, which is what it printed before and
+// what scripts comparing decodings rely on.
+TEST(PmuctlDecode, JsonLinesAreByteForByteNlohmannDumps) {
+  for (const std::string& log : {data("every_packet.log"), data("bad_lines.log"), data("screen_format.log"),
+                                data("../../bench/testdata/all_packets.log")}) {
+    const CliRun r = run("decode --json " + log);
+    ASSERT_EQ(r.status, 0) << log;
+    ASSERT_FALSE(r.lines.empty()) << log;
+    for (std::size_t i = 0; i < r.lines.size(); ++i) {
+      const auto parsed = nlohmann::ordered_json::parse(r.lines[i]);
+      EXPECT_EQ(r.lines[i], parsed.dump(-1, ' ', false, nlohmann::ordered_json::error_handler_t::replace))
+          << log << " output line " << i + 1;
+    }
+  }
+}
+
 TEST(PmuctlDecode, MissingFileAndBadFirmwareOptionFail) {
   EXPECT_NE(run("decode /nonexistent/file.log").status, 0);
   EXPECT_NE(run("decode --firmware 1.x " + data("every_packet.log")).status, 0);

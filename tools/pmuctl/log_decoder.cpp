@@ -3,37 +3,29 @@
 #include <cinttypes>
 #include <cmath>
 #include <cstdio>
-#include <nlohmann/json.hpp>
 
 #include "pmu/codec/candump.hpp"
 #include "pmu/codec/canopen.hpp"
 #include "pmu/codec/decode.hpp"
 #include "pmuctl/frame_fields.hpp"
+#include "pmuctl/json_line.hpp"
 
 namespace pmu::tools {
 namespace {
 
-using Json = nlohmann::ordered_json;
-
 class JsonFields final : public FieldSink {
  public:
-  explicit JsonFields(Json& obj) : obj_(obj) {}
+  explicit JsonFields(JsonLine& obj) : obj_(obj) {}
   void field(std::string_view name, const FieldValue& v, std::string_view) override {
-    Json& slot = obj_[std::string(name)];
     switch (v.kind) {
-      case FieldValue::Kind::Number:
-        if (std::isnan(v.number))
-          slot = nullptr;
-        else
-          slot = v.number;
-        break;
-      case FieldValue::Kind::Integer: slot = v.integer; break;
-      case FieldValue::Kind::Boolean: slot = v.boolean; break;
+      case FieldValue::Kind::Number: obj_.number(name, v.number); break;  // NaN: null
+      case FieldValue::Kind::Integer: obj_.integer(name, v.integer); break;
+      case FieldValue::Kind::Boolean: obj_.boolean(name, v.boolean); break;
     }
   }
 
  private:
-  Json& obj_;
+  JsonLine& obj_;
 };
 
 class TableFields final : public FieldSink {
@@ -71,10 +63,20 @@ class TableFields final : public FieldSink {
   bool first_ = true;
 };
 
-std::string hex_id(const codec::CanFrame& f) {
-  char buf[16];
-  std::snprintf(buf, sizeof buf, f.extended ? "%08X" : "%03X", f.id);
-  return buf;
+// "%08X" / "%03X" of the id, without printf: it is on every line.
+struct HexId {
+  char text[9];
+  std::size_t size;
+  std::string_view view() const { return {text, size}; }
+};
+
+HexId hex_id(const codec::CanFrame& f) {
+  static constexpr char digits[] = "0123456789ABCDEF";
+  HexId h{};
+  h.size = f.extended ? 8 : 3;
+  std::uint32_t id = f.id;
+  for (std::size_t i = h.size; i-- > 0; id >>= 4) h.text[i] = digits[id & 0xF];
+  return h;
 }
 
 std::string time_text(const codec::CandumpLine& l) {
@@ -84,18 +86,13 @@ std::string time_text(const codec::CandumpLine& l) {
   return buf;
 }
 
-void json_header(Json& j, const codec::CandumpLine& l) {
+void json_header(JsonLine& j, const codec::CandumpLine& l) {
   if (l.has_time)
-    j["time"] = static_cast<double>(l.seconds) + l.microseconds / 1e6;
+    j.number("time", static_cast<double>(l.seconds) + l.microseconds / 1e6);
   else
-    j["time"] = nullptr;
-  j["interface"] = std::string(l.interface);
-  j["id"] = hex_id(l.frame);
-}
-
-void append_json(std::string& out, const Json& j) {
-  out += j.dump(-1, ' ', false, Json::error_handler_t::replace);
-  out += '\n';
+    j.null("time");
+  j.string("interface", l.interface);
+  j.string("id", hex_id(l.frame).view());
 }
 
 }  // namespace
@@ -119,10 +116,7 @@ void LogDecoder::decode_line(std::string_view line, std::string& out) {
   auto report_error = [&](const std::string& reason) {
     ++counts_.errors;
     if (options_.json) {
-      Json j;
-      j["line"] = n;
-      j["error"] = reason;
-      append_json(out, j);
+      JsonLine(out).integer("line", static_cast<std::int64_t>(n)).string("error", reason).end();
     } else {
       out += "line " + std::to_string(n) + ": error: " + reason + '\n';
     }
@@ -138,20 +132,19 @@ void LogDecoder::decode_line(std::string_view line, std::string& out) {
     ++counts_.frames;
     const char* packet = m->source == codec::canopen::Source::Battery ? "battery" : "mppt";
     if (options_.json) {
-      Json j;
+      JsonLine j(out);
       json_header(j, l);
-      j["packet"] = packet;
-      if (m->source == codec::canopen::Source::Mppt) j["device"] = m->device;
-      j["index"] = m->index;
-      j["subindex"] = m->subindex;
-      j["command_byte"] = m->command_byte;
-      JsonFields fields(j["values"] = Json::object());
+      j.string("packet", packet);
+      if (m->source == codec::canopen::Source::Mppt) j.integer("device", m->device);
+      j.integer("index", m->index).integer("subindex", m->subindex).integer("command_byte", m->command_byte);
+      j.begin_object("values");
+      JsonFields fields(j);
       visit_fields(*m, fields);
-      append_json(out, j);
+      j.end_object().end();
     } else {
       char buf[128];
       std::snprintf(buf, sizeof buf, "%-18s %-6.*s %-8s %5s  %-23s ", time_text(l).c_str(),
-                    static_cast<int>(l.interface.size()), l.interface.data(), hex_id(l.frame).c_str(), "-", packet);
+                    static_cast<int>(l.interface.size()), l.interface.data(), std::string(hex_id(l.frame).view()).c_str(), "-", packet);
       out += buf;
       TableFields fields(out);
       visit_fields(*m, fields);
@@ -175,27 +168,31 @@ void LogDecoder::decode_line(std::string_view line, std::string& out) {
   const std::string_view packet = codec::packet_name(m->packet);
 
   if (options_.json) {
-    Json j;
+    JsonLine j(out);
     json_header(j, l);
-    j["address"] = m->address;
-    j["packet"] = packet;
+    j.integer("address", m->address).string("packet", packet);
     if (m->request) {
-      j["request"] = true;
+      j.boolean("request", true);
     } else {
-      JsonFields fields(j["values"] = Json::object());
+      j.begin_object("values");
+      JsonFields fields(j);
       visit_fields(*m, fields);
+      j.end_object();
     }
     if (status) {
-      j["bit6_meaning"] = bit6_meaning_name(status->interpretation.bit6);
-      j["firmware"] = fw ? Json(codec::to_string(*fw)) : Json(nullptr);
+      j.string("bit6_meaning", bit6_meaning_name(status->interpretation.bit6));
+      if (fw)
+        j.string("firmware", codec::to_string(*fw));
+      else
+        j.null("firmware");
     }
-    if (!note.empty()) j["note"] = note;
-    append_json(out, j);
+    if (!note.empty()) j.string("note", note);
+    j.end();
     return;
   }
   char buf[128];
   std::snprintf(buf, sizeof buf, "%-18s %-6.*s %-8s %5u  %-23.*s ", time_text(l).c_str(),
-                static_cast<int>(l.interface.size()), l.interface.data(), hex_id(l.frame).c_str(), m->address,
+                static_cast<int>(l.interface.size()), l.interface.data(), std::string(hex_id(l.frame).view()).c_str(), m->address,
                 static_cast<int>(packet.size()), packet.data());
   out += buf;
   if (m->request) out += "(request)";
