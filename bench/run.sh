@@ -52,7 +52,9 @@ echo "pmu_bench: offline decode of $frames frames" >&2
 
 cpu=$(sed -n 's/^model name[[:space:]]*: //p' /proc/cpuinfo | head -n1)
 mem=$(awk '/MemTotal/ {printf "%.0f GiB", $2 / 1048576}' /proc/meminfo)
-fastdds=$(dpkg-query -W -f='${Version}' libfastrtps2.9 2>/dev/null || echo unknown)
+# One line per architecture installed (the arm64 cross-build adds one): the first will do.
+fastdds=$(dpkg-query -W -f='${Version}\n' libfastrtps2.9 2>/dev/null | head -n1)
+fastdds=${fastdds:-unknown}
 echo "Machine: $cpu, $(nproc) cores, $mem; $(uname -sr); Fast DDS $fastdds; $(date -u +%Y-%m-%d)"
 read -r steal1 total1 < <(steal)
 echo "CPU steal during the run: $(awk -v s=$((steal1 - steal0)) -v t=$((total1 - total0)) 'BEGIN {printf "%.1f", t ? 100 * s / t : 0}') % of the machine's CPU time (time the hypervisor gave to other guests)"

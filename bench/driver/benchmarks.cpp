@@ -56,13 +56,14 @@ struct Stream {
 };
 
 struct Durations {
-  double idle, latency, throughput;
+  double idle, latency, throughput, realistic;
   int startups, commands;
 };
 
 Durations durations(const Settings& s) {
-  Durations d = s.quick ? Durations{1.0, 1.0, 1.0, 1, 20} : Durations{10.0, 10.0, 30.0, 5, 1000};
+  Durations d = s.quick ? Durations{1.0, 1.0, 1.0, 2.0, 1, 20} : Durations{10.0, 10.0, 30.0, 60.0, 5, 1000};
   if (s.latency_seconds > 0) d.latency = s.latency_seconds;
+  if (s.realistic_seconds > 0) d.realistic = s.realistic_seconds;
   if (s.startups > 0) d.startups = s.startups;
   return d;
 }
@@ -152,15 +153,34 @@ std::string loss_note(const Stream& st) {
   return out;
 }
 
-void latency_rows(Rows& rows, const std::string& transport, const Stream& svc, const Stream& ref) {
-  const std::string ref_name = "bare Fast DDS writer -> reader, " + transport;
-  const std::string what = "CAN->DDS latency at 7,634 frames/s, " + transport;
-  const double r50 = svc.lat.p50_us / ref.lat.p50_us, r99 = svc.lat.p99_us / ref.lat.p99_us;
-  rows.push_back(row(what + ", p50", svc.lat.p50_us, "us", ref.lat.p50_us, ref_name, "ratio <= 1.25", r50 <= 1.25,
-                     "service: " + loss_note(svc) + "; reference: " + loss_note(ref)));
-  rows.push_back(row(what + ", p99", svc.lat.p99_us, "us", ref.lat.p99_us, ref_name, "ratio <= 1.25", r99 <= 1.25));
-  rows.push_back(row(what + ", p99.9", svc.lat.p999_us, "us", ref.lat.p999_us, ref_name, "", std::nullopt));
+// The service's frame takes the socketpair hop and then a DDS hop; the bare reference has
+// only the DDS hop. So each percentile is held against (bare DDS hop + socketpair hop) at
+// that percentile (per-frame cost issue: p50 <= 1.1x, p99 <= 1.5x, p99.9 <= 3x).
+void latency_rows(Rows& rows, const std::string& what, const std::string& transport, const Stream& svc,
+                  const Stream& ref, const Percentiles& hop) {
+  const std::string ref_name = "bare Fast DDS writer -> reader + socketpair hop, " + transport;
+  const std::string note = "service: " + loss_note(svc) + "; reference: " + loss_note(ref) + "; bare DDS hop p50 " +
+                           fmt_us(ref.lat.p50_us) + ", p99 " + fmt_us(ref.lat.p99_us) + ", p99.9 " +
+                           fmt_us(ref.lat.p999_us) + "; socketpair hop p50 " + fmt_us(hop.p50_us) + ", p99 " +
+                           fmt_us(hop.p99_us) + ", p99.9 " + fmt_us(hop.p999_us);
+  const auto one = [&](const char* pct, double value, double reference, double limit, const std::string& n) {
+    char target[32];
+    std::snprintf(target, sizeof target, "ratio <= %.1f", limit);
+    rows.push_back(row(what + ", " + transport + ", " + pct, value, "us", reference, ref_name, target,
+                       value / reference <= limit, n));
+  };
+  one("p50", svc.lat.p50_us, ref.lat.p50_us + hop.p50_us, 1.1, note);
+  one("p99", svc.lat.p99_us, ref.lat.p99_us + hop.p99_us, 1.5, "");
+  one("p99.9", svc.lat.p999_us, ref.lat.p999_us + hop.p999_us, 3.0, "");
 }
+
+void cpu_row(Rows& rows, const std::string& transport, const Stream& svc, const Stream& ref) {
+  rows.push_back(row("CPU at 7,634 frames/s, " + transport, svc.cpu_percent, "%", ref.cpu_percent,
+                     "bare writer, 7,634 samples/s, " + transport, "ratio <= 1.05",
+                     svc.cpu_percent / ref.cpu_percent <= 1.05, "% of one core, user+system from /proc"));
+}
+
+const char* const kSaturatedLatency = "CAN->DDS latency at 7,634 frames/s";
 
 // The socketpair hop by itself: half the round trip of a frame through peer-pong, one
 // frame at a time at 1,000/s. The service's path has this hop and a DDS hop; the bare
@@ -186,7 +206,7 @@ Percentiles socketpair_hop(const Settings& s, int count) {
 
 // Latency and CPU at a saturated bus over one transport, service and reference.
 void latency_phase(const Settings& s, Rows& rows, WriteTimes& times, dds::Transport t, const std::string& name,
-                   int domain, int ref_domain) {
+                   int domain, int ref_domain, const Percentiles& hop) {
   progress("latency over " + name);
   dds::DdsContext dds(domain, s.qos_file, "pmu-bench", {}, t);
   VoltagesProbe probe(dds, &times);
@@ -196,13 +216,33 @@ void latency_phase(const Settings& s, Rows& rows, WriteTimes& times, dds::Transp
   sleep_s(1.0);
   const Durations d = durations(s);
   const Stream st = service_stream(svc, probe, times, kSaturatedBus, d.latency);
+  progress("reference: bare writer at 7,634 samples/s over " + name);
   dds::DdsContext ref_dds(ref_domain, s.qos_file, "pmu-bench-ref", {}, t);
   VoltagesProbe ref_probe(ref_dds, nullptr);
   const Stream ref = peer_stream(s, ref_probe, ref_domain, t, kSaturatedBus, d.latency,
                                  std::string("peer-") + transport_name(t));
-  latency_rows(rows, name, st, ref);
-  rows.push_back(row("CPU at 7,634 frames/s, " + name, st.cpu_percent, "%", ref.cpu_percent,
-                     "bare writer, 7,634 samples/s, " + name, "", std::nullopt));
+  latency_rows(rows, kSaturatedLatency, name, st, ref, hop);
+  cpu_row(rows, name, st, ref);
+}
+
+// What a mission computer sees most of the time: one PMU streaming its five packets every
+// 0.1 s (PP 0.1 s), timed on a numbered voltages frame added every 0.1 s; the reference is
+// the bare writer at 10 samples/s. At this rate every frame finds the service asleep.
+void realistic_phase(const Settings& s, Rows& rows, WriteTimes& times, int domain, int ref_domain,
+                     const Percentiles& hop) {
+  progress("latency at a realistic rate over SHM (one PMU, 5 packets every 0.1 s)");
+  const Durations d = durations(s);
+  dds::DdsContext dds(domain, s.qos_file, "pmu-bench", {}, kShm);
+  VoltagesProbe probe(dds, &times);
+  ServiceRun svc(s, domain, kShm, "service-realistic", FakePmuLoad{1, 1});
+  if (!svc.wait_ready(seconds(20)) || !probe.wait_matched(seconds(20)))
+    throw std::runtime_error("pmu-service at a realistic rate did not start");
+  sleep_s(1.0);
+  const Stream st = service_stream(svc, probe, times, 10, d.realistic);
+  dds::DdsContext ref_dds(ref_domain, s.qos_file, "pmu-bench-ref", {}, kShm);
+  VoltagesProbe ref_probe(ref_dds, nullptr);
+  const Stream ref = peer_stream(s, ref_probe, ref_domain, kShm, 10, d.realistic, "peer-realistic");
+  latency_rows(rows, "CAN->DDS latency, one PMU at 5 packets every 0.1 s", "SHM", st, ref, hop);
 }
 
 // Start-up: exec -> READY=1 on the notify socket, and exec -> the first pmu/voltages sample
@@ -289,6 +329,19 @@ Rows run_all(const Settings& s) {
   }
   const int d_shm = s.domain_base, d_ref_shm = s.domain_base + 2;
   WriteTimes times;
+  progress("socketpair hop");
+  const Percentiles hop = socketpair_hop(s, s.quick ? 200 : 5000);
+  rows.push_back(row("socketpair hop alone (write -> another process wakes and reads), p50", hop.p50_us, "us",
+                     std::nullopt, "", "", std::nullopt,
+                     "half the round trip through a process that echoes each frame, 1,000/s; p99 " +
+                         fmt_us(hop.p99_us) + ", p99.9 " + fmt_us(hop.p999_us) +
+                         ". The service's frames take this hop before their DDS hop; the bare reference has "
+                         "only the DDS hop, so the latency rows hold the service against DDS hop + this hop"));
+  if (s.latency_only) {
+    latency_phase(s, rows, times, kShm, "SHM", d_shm, d_ref_shm, hop);
+    realistic_phase(s, rows, times, d_shm, d_ref_shm, hop);
+    return rows;
+  }
 
   startup_rows(s, d, rows, kShm, "SHM", d_shm);
   // The shipped config (deploy/pmu-service.yaml) runs DDS over UDP: what a systemd start sees.
@@ -391,16 +444,8 @@ Rows run_all(const Settings& s) {
 
     rows.push_back(row("CPU idle (one PMU streaming 5 packets/s)", idle_cpu, "%", ref_idle.cpu_percent,
                        "bare writer, 5 samples/s", "< 0.5 %", idle_cpu < 0.5, "% of one core, user+system from /proc"));
-    rows.push_back(row("CPU at 7,634 frames/s, SHM", shm.cpu_percent, "%", ref_shm.cpu_percent,
-                       "bare writer, 7,634 samples/s, SHM", "< 15 %", shm.cpu_percent < 15));
-    latency_rows(rows, "SHM", shm, ref_shm);
-    progress("socketpair hop");
-    const Percentiles hop = socketpair_hop(s, s.quick ? 200 : 5000);
-    rows.push_back(row("socketpair hop alone (write -> another process wakes and reads), p50", hop.p50_us, "us",
-                       std::nullopt, "", "", std::nullopt,
-                       "half the round trip through a process that echoes each frame; p99 " + fmt_us(hop.p99_us) +
-                           ". The service's frames take this hop before their DDS hop; the bare reference has "
-                           "only the DDS hop, so latency ratio ~ (DDS + hop + service work) / DDS"));
+    cpu_row(rows, "SHM", shm, ref_shm);
+    latency_rows(rows, kSaturatedLatency, "SHM", shm, ref_shm, hop);
     rows.push_back(row("highest zero-loss rate over " + std::to_string(static_cast<int>(d.throughput)) + " s", best,
                        "frames/s", ref_best, "bare writer, SHM", ">= 30,000 frames/s", best >= 30000,
                        trials + "; " + ref_trials + ". A saturated 1 Mbit/s bus carries 7,634 frames/s."));
@@ -416,8 +461,10 @@ Rows run_all(const Settings& s) {
                        static_cast<double>(footprint.threads) / ref_footprint.threads <= 1.5));
   }
 
-  latency_phase(s, rows, times, dds::Transport::UdpOnly, "UDP", s.domain_base + 1, s.domain_base + 3);
-  latency_phase(s, rows, times, dds::Transport::Default, "default transports", s.domain_base + 1, s.domain_base + 3);
+  realistic_phase(s, rows, times, d_shm, d_ref_shm, hop);
+  latency_phase(s, rows, times, dds::Transport::UdpOnly, "UDP", s.domain_base + 1, s.domain_base + 3, hop);
+  latency_phase(s, rows, times, dds::Transport::Default, "default transports", s.domain_base + 1, s.domain_base + 3,
+                hop);
   scale_rows(s, rows, s.domain_base, s.domain_base + 2);  // their earlier users are gone by now
   return rows;
 }

@@ -32,6 +32,11 @@ int main(int argc, char** argv) {
       ->check(CLI::Range(1, 1000));
   run->add_flag("--startup-only", s.startup_only, "measure start-up alone (each start is printed on stderr)");
   run->add_flag("--scale-only", s.scale_only, "only the rows of how CPU and memory grow with PMUs and subscribers");
+  run->add_flag("--latency-only", s.latency_only,
+                "only the latency and CPU rows over SHM, at 7,634 frames/s and at a realistic rate (to profile)");
+  run->add_option("--realistic-seconds", s.realistic_seconds,
+                  "length of each realistic-rate run (one PMU, 5 packets every 0.1 s; default 60, quick 2)")
+      ->check(CLI::Range(1.0, 3600.0));
 
   PeerOptions p;
   std::string transport = "default";

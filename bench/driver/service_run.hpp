@@ -24,6 +24,8 @@ struct Settings {
   int startups = 0;             // > 0: how many starts the start-up rows take the median of
   bool startup_only = false;    // the start-up rows alone (to study start-up)
   bool scale_only = false;      // the scale rows alone (scale_bench.hpp)
+  bool latency_only = false;    // the latency rows over SHM alone, saturated and realistic (to profile)
+  double realistic_seconds = 0; // > 0: length of the realistic-rate runs (default 60, quick 2)
 };
 
 // The config file's name of a transport: default, udp, shm.
