@@ -5,7 +5,9 @@
 //
 //   node serve_client.mjs URL check WATCH.jsonl SECONDS
 //     serverInfo, the advertised channels and their schemas, error statuses for bad requests;
-//     subscribes to pmu/voltages, pmu/health and pmu/battery and checks their messages:
+//     subscribes to pmu/voltages, pmu/health, pmu/battery, pmu/info and pmu/config and checks
+//     their messages (the state topics', published once long before this client came, must
+//     arrive at once, as DDS gives a late joiner the current state):
 //     keys and field names as `pmuctl watch --json` prints them (WATCH.jsonl, recorded over
 //     the same seconds), the same values for the same samples, timestamps of now.
 //   node serve_client.mjs URL count SECONDS OUT.json
@@ -96,7 +98,7 @@ function start() {
   if (started) return;
   started = true;
   if (mode === "check") {
-    for (const t of ["pmu/voltages", "pmu/health", "pmu/battery"]) subscribe(t);
+    for (const t of ["pmu/voltages", "pmu/health", "pmu/battery", "pmu/info", "pmu/config"]) subscribe(t);
     // Requests the server must refuse with a status of level error, and go on serving.
     ws.send("not json");
     ws.send(JSON.stringify({ op: "fly" }));
@@ -195,6 +197,14 @@ function finishCheck() {
   const health = received.get("pmu/health") ?? [];
   if (!health.length) problem("no pmu/health message (state: TRANSIENT_LOCAL gives the current one at once)");
   for (const m of health) if (m.values.bus !== "sim0") problem(`health bus ${m.values.bus}`);
+  const info = received.get("pmu/info") ?? [];
+  if (info.length !== 1) problem(`${info.length} pmu/info messages, not the one current sample of the one PMU`);
+  for (const m of info)
+    if (m.values.bus !== "sim0" || m.values.address !== 1 || !(m.values.firmware_major >= 1))
+      problem(`info ${m.values.bus}/${m.values.address} firmware ${m.values.firmware_major}.${m.values.firmware_minor}`);
+  const config = received.get("pmu/config") ?? [];
+  if (!config.length) problem("no pmu/config message: the current state was not sent to a late subscriber");
+  for (const m of config) if (!(m.values.packet_period > 0)) problem(`config packet_period ${m.values.packet_period}`);
   finish(() =>
     console.log(
       `serve_client check: ${channels.size} channels; ${[...received].map(([t, l]) => `${t} ${l.length}`).join(", ")}; ` +

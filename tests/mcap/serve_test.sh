@@ -59,9 +59,9 @@ foxglove)
     fail "no refusal line: $(cat "$work/serve.err")"
 
   # pmuctl watch over the same seconds: the values the client must find in its messages.
-  "$ctl" --domain "$domain" --json --timeout 9 watch >"$work/watch.jsonl" 2>"$work/watch.err" &
+  "$ctl" --domain "$domain" --json --timeout 10 watch >"$work/watch.jsonl" 2>"$work/watch.err" &
   watcher=$!; pids+=($watcher)
-  sleep 1
+  sleep 2  # serve has pmu/info and pmu/config by now: the client is a late joiner
   node "$here/serve_client.mjs" "ws://127.0.0.1:$port" check "$work/watch.jsonl" 6 || fail "serve_client check"
   wait "$watcher"
   grep -q "client 127.0.0.1:[0-9]* connected" "$work/serve.err" || fail "no connect line"

@@ -33,9 +33,12 @@ constexpr int kSocketSendBuffer = 64 * 1024;
 // Largest client message: subscribe requests are small.
 constexpr std::size_t kMaxClientMessage = 1024 * 1024;
 
+using Instance = std::array<std::uint8_t, 16>;
+
 struct Pending {
   std::uint32_t channel;
   std::uint64_t time_ns;
+  Instance instance;
   std::vector<std::uint8_t> payload;
 };
 
@@ -48,11 +51,12 @@ struct Client {
 }  // namespace
 
 struct FoxgloveServer::Impl {
-  Impl(std::vector<foxglove::Channel> c, ServeOptions o, std::string n)
-      : channels(std::move(c)), options(std::move(o)), name(std::move(n)),
+  Impl(std::vector<foxglove::Channel> c, std::vector<bool> l, ServeOptions o, std::string n)
+      : channels(std::move(c)), latched(std::move(l)), options(std::move(o)), name(std::move(n)),
         server_info(foxglove::server_info_json(name)), advertise(foxglove::advertise_json(channels)) {}
 
   std::vector<foxglove::Channel> channels;
+  std::vector<bool> latched;  // by channel id
   ServeOptions options;
   std::string name;
   std::string server_info;
@@ -61,6 +65,9 @@ struct FoxgloveServer::Impl {
   Server server;
   std::thread thread;
   std::map<Hdl, Client, std::owner_less<Hdl>> clients;  // the server thread's only
+  // The last message of each instance of the latched channels (one per device: bounded by the
+  // devices the domain has). The server thread's only.
+  std::map<std::pair<std::uint32_t, Instance>, Pending> last_state;
 
   std::mutex pending_mutex;  // publish() and the drain
   std::deque<Pending> pending;
@@ -133,12 +140,18 @@ struct FoxgloveServer::Impl {
     const auto it = clients.find(h);
     const auto con = connection(h);
     if (it == clients.end() || !con) return;
+    auto& client = it->second;
     const std::string& payload = msg->get_payload();
+    std::vector<bool> had(channels.size());
+    for (std::uint32_t c = 0; c < channels.size(); ++c) had[c] = client.subscriptions.subscription(c).has_value();
     const auto replies =
         msg->get_opcode() == websocketpp::frame::opcode::text
-            ? it->second.subscriptions.on_text(payload)
-            : it->second.subscriptions.on_binary(reinterpret_cast<const std::uint8_t*>(payload.data()), payload.size());
+            ? client.subscriptions.on_text(payload)
+            : client.subscriptions.on_binary(reinterpret_cast<const std::uint8_t*>(payload.data()), payload.size());
     for (const auto& r : replies) con->send(r, websocketpp::frame::opcode::text);
+    // A new subscription to a state channel gets the current state at once.
+    for (const auto& [key, sample] : last_state)
+      if (!had[key.first]) send_to(client, con, sample);
   }
 
   void drain() {
@@ -149,40 +162,43 @@ struct FoxgloveServer::Impl {
       pending_bytes = 0;
       drain_posted = false;
     }
-    for (const auto& p : batch) deliver(p);
+    for (auto& p : batch) {
+      for (auto& [h, client] : clients)
+        if (const auto con = connection(h)) send_to(client, con, p);
+      if (p.channel < latched.size() && latched[p.channel])
+        last_state[{p.channel, p.instance}] = std::move(p);
+    }
   }
 
-  void deliver(const Pending& p) {
-    for (auto& [h, client] : clients) {
-      const auto sub = client.subscriptions.subscription(p.channel);
-      if (!sub) continue;
-      const auto con = connection(h);
-      if (!con || con->get_state() != websocketpp::session::state::open) continue;
-      const std::string frame = foxglove::message_data(*sub, p.time_ns, p.payload.data(), p.payload.size());
-      const auto v = client.backlog.offer(con->get_buffered_amount(), frame.size());
-      if (v.change == ClientBacklog::Change::Began)
-        std::fprintf(stderr, "pmuctl serve: client %s is not reading (%s queued): dropping its messages until it "
-                             "catches up\n", client.label.c_str(), human_bytes(con->get_buffered_amount()).c_str());
-      if (!v.send) {
-        ++dropped;
-        continue;
-      }
-      if (v.change == ClientBacklog::Change::Ended) {
-        std::fprintf(stderr, "pmuctl serve: client %s reads again; %llu messages were dropped for it\n",
-                     client.label.c_str(), static_cast<unsigned long long>(v.dropped));
-        con->send(foxglove::status_json(StatusLevel::Warning,
-                                        std::to_string(v.dropped) + " messages were dropped for this client: it did "
-                                        "not read them in time (pmuctl serve holds " +
-                                            human_bytes(options.client_queue) + " per client)"),
-                  websocketpp::frame::opcode::text);
-      }
-      if (!con->send(frame, websocketpp::frame::opcode::binary)) ++forwarded;
+  // One message for one client, if it subscribed to the channel and its queue has room.
+  void send_to(Client& client, const Server::connection_ptr& con, const Pending& p) {
+    const auto sub = client.subscriptions.subscription(p.channel);
+    if (!sub || con->get_state() != websocketpp::session::state::open) return;
+    const std::string frame = foxglove::message_data(*sub, p.time_ns, p.payload.data(), p.payload.size());
+    const auto v = client.backlog.offer(con->get_buffered_amount(), frame.size());
+    if (v.change == ClientBacklog::Change::Began)
+      std::fprintf(stderr, "pmuctl serve: client %s is not reading (%s queued): dropping its messages until it "
+                           "catches up\n", client.label.c_str(), human_bytes(con->get_buffered_amount()).c_str());
+    if (!v.send) {
+      ++dropped;
+      return;
     }
+    if (v.change == ClientBacklog::Change::Ended) {
+      std::fprintf(stderr, "pmuctl serve: client %s reads again; %llu messages were dropped for it\n",
+                   client.label.c_str(), static_cast<unsigned long long>(v.dropped));
+      con->send(foxglove::status_json(StatusLevel::Warning,
+                                      std::to_string(v.dropped) + " messages were dropped for this client: it did "
+                                      "not read them in time (pmuctl serve holds " +
+                                          human_bytes(options.client_queue) + " per client)"),
+                websocketpp::frame::opcode::text);
+    }
+    if (!con->send(frame, websocketpp::frame::opcode::binary)) ++forwarded;
   }
 };
 
-FoxgloveServer::FoxgloveServer(std::vector<foxglove::Channel> channels, ServeOptions options, std::string name)
-    : impl_(std::make_unique<Impl>(std::move(channels), std::move(options), std::move(name))) {}
+FoxgloveServer::FoxgloveServer(std::vector<foxglove::Channel> channels, std::vector<bool> latched,
+                               ServeOptions options, std::string name)
+    : impl_(std::make_unique<Impl>(std::move(channels), std::move(latched), std::move(options), std::move(name))) {}
 
 FoxgloveServer::~FoxgloveServer() { stop(); }
 
@@ -233,7 +249,8 @@ std::string FoxgloveServer::start() {
   return {};
 }
 
-void FoxgloveServer::publish(std::uint32_t channel, std::uint64_t time_ns, std::vector<std::uint8_t>&& payload) {
+void FoxgloveServer::publish(std::uint32_t channel, std::uint64_t time_ns, const std::array<std::uint8_t, 16>& instance,
+                             std::vector<std::uint8_t>&& payload) {
   Impl& m = *impl_;
   bool post = false;
   {
@@ -243,7 +260,7 @@ void FoxgloveServer::publish(std::uint32_t channel, std::uint64_t time_ns, std::
       return;
     }
     m.pending_bytes += payload.size();
-    m.pending.push_back(Pending{channel, time_ns, std::move(payload)});
+    m.pending.push_back(Pending{channel, time_ns, instance, std::move(payload)});
     post = !m.drain_posted;
     m.drain_posted = true;
   }

@@ -14,6 +14,7 @@
 // status messages; a client that fails or vanishes is just removed.
 // Security: no TLS and no authentication; it listens on 127.0.0.1 unless told otherwise.
 
+#include <array>
 #include <cstddef>
 #include <cstdint>
 #include <memory>
@@ -33,16 +34,21 @@ class FoxgloveServer {
     std::uint64_t dropped = 0;     // for clients that did not read, and samples the server thread had no room for
   };
 
-  // `name`: serverInfo's name.
-  FoxgloveServer(std::vector<foxglove::Channel> channels, ServeOptions options, std::string name);
+  // `latched[i]`: channel i carries state (TRANSIENT_LOCAL in DDS): the server keeps the last
+  // message of each instance and sends those to a client when it subscribes, as DDS gives a
+  // late-joining reader the current state. `name`: serverInfo's name.
+  FoxgloveServer(std::vector<foxglove::Channel> channels, std::vector<bool> latched, ServeOptions options,
+                 std::string name);
   ~FoxgloveServer();  // stop()
   FoxgloveServer(const FoxgloveServer&) = delete;
   FoxgloveServer& operator=(const FoxgloveServer&) = delete;
 
   // Listens and starts the server thread. "" or what failed, naming the address and port.
   std::string start();
-  // Any thread. `channel`: an advertised channel id; `time_ns`: the message's timestamp.
-  void publish(std::uint32_t channel, std::uint64_t time_ns, std::vector<std::uint8_t>&& payload);
+  // Any thread. `channel`: an advertised channel id; `time_ns`: the message's timestamp;
+  // `instance`: the DDS instance (for latched channels).
+  void publish(std::uint32_t channel, std::uint64_t time_ns, const std::array<std::uint8_t, 16>& instance,
+               std::vector<std::uint8_t>&& payload);
   Counters counters() const;
   // Closes every connection (going away), waits for them briefly, ends the server thread.
   void stop();

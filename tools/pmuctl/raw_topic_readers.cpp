@@ -24,8 +24,11 @@ class TopicListener final : public DataReaderListener {
     while (reader->take_next_sample(&sample, &info) == ReturnCode_t::RETCODE_OK) {
       if (!info.valid_data) continue;
       const auto& t = info.source_timestamp;
-      const std::uint64_t ns = static_cast<std::uint64_t>(t.seconds()) * std::uint64_t{1000000000} + t.nanosec();
-      sink_(topic_, ns, sample);
+      RawSampleInfo raw;
+      raw.topic = topic_;
+      raw.time_ns = static_cast<std::uint64_t>(t.seconds()) * std::uint64_t{1000000000} + t.nanosec();
+      for (std::size_t i = 0; i < raw.instance.size(); ++i) raw.instance[i] = info.instance_handle.value[i];
+      sink_(raw, sample);
     }
   }
 

@@ -7,6 +7,7 @@
 // The sink runs on Fast DDS's listener threads: it must not block (record takes a mutex held
 // only for a memory copy; serve queues the bytes for its server thread).
 
+#include <array>
 #include <cstdint>
 #include <functional>
 #include <memory>
@@ -23,9 +24,14 @@
 
 namespace pmu::tools {
 
-// `topic`: index into the list given to RawTopicReaders. `time_ns`: the sample's source
-// timestamp, ns since the Unix epoch. The sink may take (move from) `sample.bytes`.
-using RawSampleSink = std::function<void(std::size_t topic, std::uint64_t time_ns, RawSample& sample)>;
+// What a reader knows of a sample besides its bytes.
+struct RawSampleInfo {
+  std::size_t topic = 0;                   // index into the list given to RawTopicReaders::open
+  std::uint64_t time_ns = 0;               // the DDS source timestamp, ns since the Unix epoch
+  std::array<std::uint8_t, 16> instance{};  // the DDS instance (the sample's keys: one device)
+};
+// The sink may take (move from) `sample.bytes`.
+using RawSampleSink = std::function<void(const RawSampleInfo& info, RawSample& sample)>;
 
 // A RawSampleType for the contract's DDS type name ("pmu::Voltages"); the name must be one of
 // recorded_topics()'s.

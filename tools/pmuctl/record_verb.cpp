@@ -37,10 +37,10 @@ int run_record(const GlobalOptions& o, const std::string& path, const std::vecto
     return created ? 1 : 2;
   }
   Shared& s = *shared;
-  RawTopicReaders readers([&s](std::size_t topic, std::uint64_t ns, RawSample& sample) {
+  RawTopicReaders readers([&s](const RawSampleInfo& info, RawSample& sample) {
     std::lock_guard<std::mutex> lock(s.mutex);
     if (s.closed || s.rec.failed()) return;
-    s.rec.write(topic, ns, sample.bytes.data(), sample.bytes.size());
+    s.rec.write(info.topic, info.time_ns, sample.bytes.data(), sample.bytes.size());
   });
   {
     pmu::dds::DdsContext dds(o.domain, o.qos_file, "pmuctl-record", o.security, pmu::dds::Transport::Default,

@@ -3,7 +3,9 @@
 #include <unistd.h>
 
 #include <cstdio>
+#include <string_view>
 
+#include "pmu/idl/topics.hpp"
 #include "pmu/service/dds_context.hpp"
 #include "pmuctl/foxglove_server.hpp"
 #include "pmuctl/raw_topic_readers.hpp"
@@ -24,19 +26,22 @@ int run_serve(const GlobalOptions& o, const ServeOptions& serve, const std::vect
   if (!forwarded_topics(o, names, "serve", topics)) return 2;
   // Channel id = index into `topics`, which is also the readers' topic index.
   std::vector<foxglove::Channel> channels;
-  for (std::uint32_t i = 0; i < topics.size(); ++i)
+  std::vector<bool> latched;
+  for (std::uint32_t i = 0; i < topics.size(); ++i) {
     channels.push_back(foxglove::Channel{i, topics[i]->topic, topics[i]->type_name, topics[i]->idl});
+    latched.push_back(std::string_view(topics[i]->qos_profile) == pmu::qos_profiles::kState);
+  }
 
   const StopSignals stop;  // before the server's and Fast DDS's threads
-  FoxgloveServer server(std::move(channels), serve, "pmuctl serve (pmu-dds)");
+  FoxgloveServer server(std::move(channels), std::move(latched), serve, "pmuctl serve (pmu-dds)");
   if (const auto why = server.start(); !why.empty()) {
     std::fprintf(stderr, "pmuctl serve: %s\n", why.c_str());
     return 1;
   }
   // Declared after the server, so destroyed before it: no listener calls publish() on a
   // server that is gone.
-  RawTopicReaders readers([&server](std::size_t topic, std::uint64_t ns, RawSample& sample) {
-    server.publish(static_cast<std::uint32_t>(topic), ns, std::move(sample.bytes));
+  RawTopicReaders readers([&server](const RawSampleInfo& info, RawSample& sample) {
+    server.publish(static_cast<std::uint32_t>(info.topic), info.time_ns, info.instance, std::move(sample.bytes));
   });
   {
     pmu::dds::DdsContext dds(o.domain, o.qos_file, "pmuctl-serve", o.security, pmu::dds::Transport::Default,
