@@ -36,11 +36,11 @@ wait_serving() {
   done
   return 1
 }
-# SIGINT, then the exit status must be 0 and the last line say it stopped.
+# SIGINT (or the signal given), then the exit status must be 0 and the last line say it stopped.
 stop_server() {
-  kill -INT "$1"
+  kill -"${3:-INT}" "$1"
   wait "$1"; local status=$?
-  [ $status -eq 0 ] || fail "serve exited $status after SIGINT: $(tail -n 5 "$2")"
+  [ $status -eq 0 ] || fail "serve exited $status after SIG${3:-INT}: $(tail -n 5 "$2")"
   grep -q "pmuctl serve: stopped; " "$2" || fail "no final line: $(tail -n 5 "$2")"
 }
 
@@ -91,19 +91,26 @@ slow)
   wait "$slow" || fail "slow client: $(cat "$work/slow.out")"
   sleep 1
   cat "$work/slow.out"
-  # The normal client got pmu/voltages of 40 PMUs at 10/s every second, the slow one notwithstanding.
+  # The normal client got pmu/voltages of 40 PMUs at 10/s every second (at least a quarter of
+  # that on a loaded machine), the slow one notwithstanding.
   node -e '
     const r = JSON.parse(require("fs").readFileSync(process.argv[1], "utf8"));
     const full = r.per_second.slice(1, -1);  // whole seconds only
-    const low = full.filter((n) => n < 200);
+    const low = full.filter((n) => n < 100);  // 400 expected; a stall gives 0
     if (full.length < 5 || low.length) { console.error(`per second: ${r.per_second}`); process.exit(1); }' \
     "$work/count.json" || fail "the normal client did not keep receiving"
   grep -q "client 127.0.0.1:[0-9]* is not reading (.* queued): dropping its messages" "$work/serve.err" ||
     fail "no line saying the slow client's messages are dropped: $(cat "$work/serve.err")"
   grep -Eq "client 127.0.0.1:[0-9]+ disconnected; [1-9][0-9]* messages were dropped for it" "$work/serve.err" ||
     fail "no line with the count dropped: $(cat "$work/serve.err")"
-  stop_server "$server" "$work/serve.err"
-  grep -Eq "stopped; 0 clients, [1-9][0-9]* messages forwarded, [1-9][0-9]* dropped" "$work/serve.err" ||
+  # SIGTERM while a client that does not read is still connected: it is not waited for long.
+  python3 "$here/ws_raw.py" "$port" slow 60 >/dev/null 2>&1 &
+  pids+=($!)
+  sleep 3
+  start=$(date +%s)
+  stop_server "$server" "$work/serve.err" TERM
+  [ $(($(date +%s) - start)) -le 5 ] || fail "SIGTERM took $(($(date +%s) - start)) s with a stuck client"
+  grep -Eq "stopped; [0-9]+ clients?, [1-9][0-9]* messages forwarded, [1-9][0-9]* dropped" "$work/serve.err" ||
     fail "final counts: $(tail -n 1 "$work/serve.err")"
   grep -q "publish_failures\|refused" "$work/service.log" && fail "the service could not publish: $(grep -m3 "refused" "$work/service.log")"
   ;;
