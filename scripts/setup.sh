@@ -10,6 +10,8 @@ packages=(
   libgtest-dev libgmock-dev libbenchmark-dev
   libfastrtps-dev libfastcdr-dev fastddsgen fastdds-tools
   libspdlog-dev libfmt-dev libsystemd-dev libcli11-dev libyaml-cpp-dev nlohmann-json3-dev
+  # pmuctl serve: a WebSocket server (header-only) on standalone asio
+  libwebsocketpp-dev libasio-dev
   libssl-dev libtinyxml2-dev openssl
   cyclonedds-dev cyclonedds-tools
   can-utils iproute2 python3 python3-can
@@ -29,7 +31,7 @@ packages=(
 arm64_packages=(
   libfastrtps-dev:arm64 libfastcdr-dev:arm64 libspdlog-dev:arm64 libfmt-dev:arm64
   libsystemd-dev:arm64 libyaml-cpp0.7:arm64 libssl-dev:arm64 libtinyxml2-dev:arm64
-  libgtest-dev:arm64 libgmock-dev:arm64 pkg-config:arm64
+  libgtest-dev:arm64 libgmock-dev:arm64 pkg-config:arm64 libwebsocketpp-dev:arm64
 )
 packages+=("${arm64_packages[@]}")
 
@@ -77,7 +79,7 @@ fi
 mcap_dir="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)/tests/mcap"
 stamp="$mcap_dir/node_modules/.package-lock.json"
 if [ ! -f "$stamp" ] || [ "$mcap_dir/package-lock.json" -nt "$stamp" ]; then
-  echo "setup: npm ci in tests/mcap (@mcap/core, @foxglove/omgidl-parser, @foxglove/omgidl-serialization)"
+  echo "setup: npm ci in tests/mcap (@mcap/core, @foxglove/ws-protocol, ws, @foxglove/omgidl-parser, @foxglove/omgidl-serialization)"
   (cd "$mcap_dir" && npm ci --no-audit --no-fund --loglevel=error)
 else
   echo "setup: tests/mcap npm packages present"

@@ -20,6 +20,7 @@
 #include "pmuctl/log_decoder.hpp"
 #include "pmuctl/mcap_decode.hpp"
 #include "pmuctl/record_verb.hpp"
+#include "pmuctl/serve_verb.hpp"
 #include "pmu/service/command.hpp"
 #include "pmu/service/vehicle.hpp"
 #include "pmuctl/network_options.hpp"
@@ -229,6 +230,23 @@ int main(int argc, char** argv) {
                      "repeat for more (default: telemetry, state, health, battery and MPPT topics)")
       ->allow_extra_args(false);
 
+  auto* serve = app.add_subcommand(
+      "serve", "Serve the topics live to Foxglove or Lichtblick (Foxglove WebSocket protocol) until Ctrl-C or SIGTERM");
+  std::string serve_listen = "127.0.0.1", serve_port = "8765", serve_queue = "1024";
+  serve->add_option("--listen", serve_listen,
+                    "IP address to listen on (0.0.0.0: every interface; there is no TLS nor authentication)")
+      ->type_name("ADDR")
+      ->capture_default_str();
+  serve->add_option("--port", serve_port, "TCP port (Foxglove's default)")->type_name("N")->capture_default_str();
+  serve->add_option("--client-queue", serve_queue,
+                    "kB held for a client that does not read; beyond, its messages are dropped")
+      ->type_name("KB")
+      ->capture_default_str();
+  std::vector<std::string> serve_topics;
+  serve->add_option("--topic", serve_topics, "Only this topic, as for record; repeat for more (default: record's)")
+      ->type_name("NAME")
+      ->allow_extra_args(false);
+
   CLI11_PARSE(app, argc, argv);
   if (address >= 0) g.address = static_cast<std::uint16_t>(address);
   if (timeout > 0) g.timeout = timeout;
@@ -246,6 +264,14 @@ int main(int argc, char** argv) {
     if (!mcap_out.empty()) return pmu::tools::run_decode_mcap(path, mcap_out, options.firmware);
     return run_decode(path, options);
   }
+  pmu::tools::ServeOptions serve_options;
+  if (*serve) {
+    if (const auto why = pmu::tools::parse_serve_options(serve_listen, serve_port, serve_queue, serve_options);
+        !why.empty()) {
+      std::fprintf(stderr, "pmuctl serve: %s\n", why.c_str());
+      return 2;
+    }
+  }
   if (!setup_security(g, security_dir, identity)) return 2;
   if (!setup_vehicle(g, vehicle_option, vehicle)) return 2;
   if (!pmu::tools::resolve_network_options(network, pmu::dds::system_lookup(), !g.security.empty(), g.network))
@@ -253,6 +279,7 @@ int main(int argc, char** argv) {
   try {
     if (*watch) return pmu::tools::run_watch(g, count);
     if (*record) return pmu::tools::run_record(g, record_path, record_topics);
+    if (*serve) return pmu::tools::run_serve(g, serve_options, serve_topics);
     if (app.got_subcommand("list")) return pmu::tools::run_list(g);
     if (app.got_subcommand("info")) return pmu::tools::run_info(g);
     if (app.got_subcommand("health")) return pmu::tools::run_health(g);

@@ -1,5 +1,7 @@
 #include "pmuctl/mcap_topics.hpp"
 
+#include <algorithm>
+
 #include "pmu/idl/idl_text.hpp"
 #include "pmu/idl/topics.hpp"
 
@@ -40,6 +42,24 @@ const RecordedTopic* find_recorded_topic(std::string_view name) {
     if (name == full || (full.substr(0, 4) == "pmu/" && name == full.substr(4))) return &t;
   }
   return nullptr;
+}
+
+std::vector<const RecordedTopic*> select_topics(const std::vector<std::string>& names, std::string& error) {
+  std::vector<const RecordedTopic*> topics;
+  for (const auto& n : names) {
+    const auto* t = find_recorded_topic(n);
+    if (!t) {
+      std::string known;
+      for (const auto& k : recorded_topics()) known += (known.empty() ? "" : ", ") + std::string(k.topic);
+      error = "--topic " + n + " is not a topic of the contract (" + known + ")";
+      return {};
+    }
+    if (std::find(topics.begin(), topics.end(), t) == topics.end()) topics.push_back(t);
+  }
+  if (topics.empty())
+    for (const auto& t : recorded_topics())
+      if (t.by_default) topics.push_back(&t);
+  return topics;
 }
 
 }  // namespace pmu::tools

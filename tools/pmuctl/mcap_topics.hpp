@@ -4,6 +4,7 @@
 // schema text = the idl/ file that defines the type (docs/interface.md, "MCAP recordings").
 // No DDS here: the names and texts only.
 
+#include <string>
 #include <string_view>
 #include <vector>
 
@@ -22,5 +23,11 @@ const std::vector<RecordedTopic>& recorded_topics();
 // By its name ("pmu/voltages") or its last part after "pmu/" ("voltages", "low_rate/voltages");
 // nullptr when none.
 const RecordedTopic* find_recorded_topic(std::string_view name);
+
+// The topics `--topic NAME` options name (each once, in the order given), or every topic
+// recorded by default when there are none: the selection of both `record` and `serve`.
+// Empty, with `error` set ("--topic x is not a topic of the contract (pmu/voltages, ...)"),
+// when a name is unknown.
+std::vector<const RecordedTopic*> select_topics(const std::vector<std::string>& names, std::string& error);
 
 }  // namespace pmu::tools
