@@ -9,6 +9,7 @@
 
 #include "pmu/service/dds_capacity.hpp"
 #include "pmu/service/dds_participant.hpp"
+#include "pmu/service/dds_type_objects.hpp"
 #include "pmu/sysconf_dir.hpp"
 
 namespace pmu::dds {
@@ -88,6 +89,9 @@ DdsContext::DdsContext(int domain, const std::string& qos_file, const std::strin
   qos_file_ = file;
   if (file.empty()) throw DdsError("no QoS profile file: neither " PMU_SYSCONFDIR "/qos.xml nor " PMU_DATADIR "/qos.xml exists; install deploy/qos.xml, set PMU_QOS_FILE or set qos_file");
   load_profiles_once(file);
+  // Before any endpoint exists: Fast DDS copies a type's object into the endpoint's discovery
+  // data when the endpoint is created, from what is registered then.
+  register_type_objects();
   // Transports, discovery, interfaces and security: dds_participant.hpp says what each sets.
   DomainParticipantQos pqos;
   try {
@@ -127,6 +131,7 @@ DdsContext::~DdsContext() {
 Topic& DdsContext::topic(const std::string& name, TypeSupport type) {
   if (auto it = topics_.find(name); it != topics_.end()) return *it->second;
   const std::string type_name = type.get_type_name();
+  announce_type_object(type);  // never TypeInformation; the type object when it is self-contained
   if (type.register_type(participant_) != ReturnCode_t::RETCODE_OK)
     throw DdsError("cannot register DDS type " + type_name);
   Topic* t = participant_->create_topic(name, type_name, TOPIC_QOS_DEFAULT);
