@@ -83,7 +83,7 @@ std::string default_qos_file() {
 
 DdsContext::DdsContext(int domain, const std::string& qos_file, const std::string& participant_name,
                        const SecurityFiles& security, Transport transport, const ResolvedNetwork& network,
-                       const Partitions& partitions)
+                       const Partitions& partitions, const std::vector<std::string>& statistics)
     : domain_(domain), secure_(!security.empty()), security_(security), partitions_(partitions) {
   const std::string file = qos_file.empty() ? default_qos_file() : qos_file;
   qos_file_ = file;
@@ -92,10 +92,18 @@ DdsContext::DdsContext(int domain, const std::string& qos_file, const std::strin
   // Before any endpoint exists: Fast DDS copies a type's object into the endpoint's discovery
   // data when the endpoint is created, from what is registered then.
   register_type_objects();
-  // Transports, discovery, interfaces and security: dds_participant.hpp says what each sets.
+  // Fast DDS creates statistics writers in the default partition when the participant is
+  // enabled; a writer the permissions refuse is only logged, and the topic stays silent.
+  if (secure_)
+    for (const auto& topic : statistics)
+      if (const auto grant = topic_grant(security_, topic, true); !grant || !grant->allowed ||
+                                                                   partition_not_granted({}, grant->partitions))
+        throw DdsError("dds_statistics: this identity's permissions do not allow publishing " + topic +
+                       " in the default partition (DDS-Security; docs/interface.md 4.5 says what to grant)");
+  // Transports, discovery, interfaces, security and statistics: dds_participant.hpp says what each sets.
   DomainParticipantQos pqos;
   try {
-    pqos = participant_qos(participant_name, transport, network, security);
+    pqos = participant_qos(participant_name, transport, network, security, statistics);
   } catch (const NetworkError& e) {
     throw DdsError(e.what());
   }

@@ -7,6 +7,8 @@
 //   DDS's DynamicTypes API, and decodes samples by the contract's field names. This is what
 //   Fast DDS Monitor, PlotJuggler's Fast DDS plugin and DDS Record & Replay do. Without the
 //   service's register_type_objects() no type is announced and the test fails (checked).
+// - Statistics: with config `dds_statistics` the service's participant writes the listed Fast
+//   DDS statistics topics (the writers appear in discovery) and no others; without it, none.
 #include <gtest/gtest.h>
 
 #include <chrono>
@@ -19,6 +21,7 @@
 #include <fastdds/dds/subscriber/SampleInfo.hpp>
 #include <fastdds/dds/subscriber/Subscriber.hpp>
 #include <fastdds/dds/topic/Topic.hpp>
+#include <fastdds/statistics/topic_names.hpp>
 #include <fastrtps/types/DynamicData.h>
 #include <fastrtps/types/DynamicDataFactory.h>
 #include <fastrtps/types/DynamicPubSubType.h>
@@ -30,6 +33,8 @@
 #include <mutex>
 #include <set>
 #include <string>
+#include <sys/wait.h>
+#include <thread>
 #include <unistd.h>
 #include <vector>
 
@@ -41,6 +46,7 @@ namespace {
 
 using namespace eprosima::fastdds::dds;
 namespace types = eprosima::fastrtps::types;
+namespace stats = eprosima::fastdds::statistics;
 using eprosima::fastrtps::rtps::GuidPrefix_t;
 using namespace std::chrono_literals;
 
@@ -243,6 +249,60 @@ TEST(TypeObject, ReaderBuiltFromTheDiscoveredTypeDecodesVoltages) {
   EXPECT_TRUE(generator == 0.0f || std::fabs(generator - 48.0f) < 1.0f) << "generator = " << generator;
   const float avionics = data->get_float32_value(id("avionics"));
   EXPECT_TRUE(avionics == 0.0f || std::fabs(avionics - 12.0f) < 0.5f) << "avionics = " << avionics;
+}
+
+// Waits until the service's participant has announced its telemetry writers (then every
+// writer it creates at start-up has been announced), and returns its writers' topics.
+std::set<std::string> service_writer_topics(ToolParticipant& tool) {
+  std::set<std::string> topics;
+  EXPECT_TRUE(pmu::test::wait_until(
+      [&] {
+        topics = tool.discovery().writer_topics_of("pmu-service");
+        return topics.count("pmu/voltages") && topics.count("pmu/health") && topics.count("pmu/command_reply");
+      },
+      30s))
+      << "pmu-service's writers were never discovered";
+  return topics;
+}
+
+std::set<std::string> statistics_topics(const std::set<std::string>& topics) {
+  std::set<std::string> s;
+  for (const auto& t : topics)
+    if (t.rfind("_fastdds_statistics_", 0) == 0) s.insert(t);
+  return s;
+}
+
+TEST(Statistics, ConfiguredTopicsAreWrittenAndNoOthers) {
+  const int domain = pmu::test::exclusive_dds_domain();
+  ConfigFile config(sim_config(std::string("dds_statistics: [") + stats::HISTORY_LATENCY_TOPIC + ", " +
+                               stats::PUBLICATION_THROUGHPUT_TOPIC + "]\n"));
+  auto service = start_service(domain, config);
+  ToolParticipant tool(domain);
+  ASSERT_NE(tool.get(), nullptr);
+
+  const std::set<std::string> wanted = {stats::HISTORY_LATENCY_TOPIC, stats::PUBLICATION_THROUGHPUT_TOPIC};
+  std::set<std::string> seen;
+  EXPECT_TRUE(pmu::test::wait_until(
+      [&] { return (seen = statistics_topics(tool.discovery().writer_topics_of("pmu-service"))) == wanted; }, 30s));
+  (void)service_writer_topics(tool);
+  std::this_thread::sleep_for(1s);  // anything else would have been announced with the rest
+  EXPECT_EQ(statistics_topics(tool.discovery().writer_topics_of("pmu-service")), wanted);
+  // Fast DDS deletes its statistics writers with the participant: a clean stop.
+  const auto status = service.stop(10s);
+  ASSERT_TRUE(status.has_value()) << "pmu-service had to be killed";
+  EXPECT_TRUE(WIFEXITED(*status) && WEXITSTATUS(*status) == 0) << "wait status " << *status;
+}
+
+TEST(Statistics, NoneWithoutTheConfigKey) {
+  const int domain = pmu::test::exclusive_dds_domain();
+  ConfigFile config(sim_config(""));
+  auto service = start_service(domain, config);
+  ToolParticipant tool(domain);
+  ASSERT_NE(tool.get(), nullptr);
+
+  (void)service_writer_topics(tool);
+  std::this_thread::sleep_for(1s);
+  EXPECT_EQ(statistics_topics(tool.discovery().writer_topics_of("pmu-service")), std::set<std::string>{});
 }
 
 }  // namespace

@@ -69,9 +69,12 @@ class DdsContext {
  public:
   // `security` empty: no DDS-Security (as before). Relative paths are made absolute.
   // `network`: discovery and interface allowlist (dds_network.hpp); default multicast, all.
+  // `statistics`: the Fast DDS statistics topics to write (dds_statistics.hpp), checked
+  // names; with DDS-Security the permissions must allow publishing each, or DdsError says so.
   DdsContext(int domain, const std::string& qos_file, const std::string& participant_name,
              const SecurityFiles& security = {}, Transport transport = Transport::Default,
-             const ResolvedNetwork& network = {}, const Partitions& partitions = {});
+             const ResolvedNetwork& network = {}, const Partitions& partitions = {},
+             const std::vector<std::string>& statistics = {});
   ~DdsContext();
   DdsContext(const DdsContext&) = delete;
   DdsContext& operator=(const DdsContext&) = delete;
