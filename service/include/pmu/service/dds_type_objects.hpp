@@ -12,8 +12,10 @@
 //
 // announce_type_object(type): what a TypeSupport of ours announces in discovery (call it
 // after register_type_objects). Never the XTypes 1.2 TypeInformation (PID 0x75), which Fast
-// DDS 2.9.1 sends by default: Eclipse Cyclone DDS 0.10.2 acts on it and then does not match
-// (the issue; docs/interface.md 4.4). The type object (PIDs 0x72 and 0x69, which other vendors
+// DDS 2.9.1 sends by default: Eclipse Cyclone DDS 0.10.2 cannot parse Fast DDS 2.9.1's
+// (its log: "invalid parameter list ... pid 75 (TYPE_INFORMATION) invalid") and drops the
+// whole endpoint announcement, so it matches nothing of ours (measured with it on: the
+// crossvendor client missed all 9 of its checks). The type object (PIDs 0x72 and 0x69, which other vendors
 // skip) only when it is self-contained (type_object_is_self_contained): every Fast DDS 2.9.1
 // participant that does not know a type builds a DynamicType from each type object it
 // discovers (PDP::check_and_notify_type_discovery), and for a member whose type is only named
