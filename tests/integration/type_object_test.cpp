@@ -183,7 +183,7 @@ TEST(TypeObject, ReaderBuiltFromTheDiscoveredTypeDecodesVoltages) {
 
   // Type objects only of the self-contained types (dds_type_objects.hpp): a Fast DDS 2.9.1
   // participant that does not know our types, like this one, would drop the enum members of
-  // Health, Command and CommandReply and crash on BatteryCells' sequence of Cell.
+  // Health, Command and CommandReply and crash on BatteryCells' sequence of BatteryCell.
   const std::set<std::string> self_contained = {
       "pmu/voltages", "pmu/currents", "pmu/battery_energy", "pmu/temperatures", "pmu/status",
       "pmu/low_rate/voltages", "pmu/low_rate/currents", "pmu/low_rate/battery_energy", "pmu/low_rate/temperatures",
