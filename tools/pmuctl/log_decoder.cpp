@@ -68,6 +68,7 @@ struct HexId {
   char text[9];
   std::size_t size;
   std::string_view view() const { return {text, size}; }
+  const char* c_str() const { return text; }  // text[size] is the NUL of the zeroed array
 };
 
 HexId hex_id(const codec::CanFrame& f) {
@@ -144,7 +145,7 @@ void LogDecoder::decode_line(std::string_view line, std::string& out) {
     } else {
       char buf[128];
       std::snprintf(buf, sizeof buf, "%-18s %-6.*s %-8s %5s  %-23s ", time_text(l).c_str(),
-                    static_cast<int>(l.interface.size()), l.interface.data(), std::string(hex_id(l.frame).view()).c_str(), "-", packet);
+                    static_cast<int>(l.interface.size()), l.interface.data(), hex_id(l.frame).c_str(), "-", packet);
       out += buf;
       TableFields fields(out);
       visit_fields(*m, fields);
@@ -192,7 +193,7 @@ void LogDecoder::decode_line(std::string_view line, std::string& out) {
   }
   char buf[128];
   std::snprintf(buf, sizeof buf, "%-18s %-6.*s %-8s %5u  %-23.*s ", time_text(l).c_str(),
-                static_cast<int>(l.interface.size()), l.interface.data(), std::string(hex_id(l.frame).view()).c_str(), m->address,
+                static_cast<int>(l.interface.size()), l.interface.data(), hex_id(l.frame).c_str(), m->address,
                 static_cast<int>(packet.size()), packet.data());
   out += buf;
   if (m->request) out += "(request)";
