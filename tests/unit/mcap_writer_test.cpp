@@ -3,9 +3,13 @@
 // small reader written here from the spec.
 
 #include <gtest/gtest.h>
+#include <sys/mount.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <cerrno>
+#include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <map>
 #include <string>
@@ -13,6 +17,7 @@
 
 #include "pmu/mcap/crc32.hpp"
 #include "pmu/mcap/records.hpp"
+#include "pmu/mcap/sink.hpp"
 #include "pmu/mcap/writer.hpp"
 
 namespace {
@@ -234,17 +239,23 @@ TEST(McapWriter, DiskFullCutsBackToTheLastChunkAndEndsTheFile) {
   const std::uint8_t d[40] = {};
   ASSERT_TRUE(w.write(c, 1, 1, d, sizeof d));  // the first chunk (with schema and channel) is written
   const std::size_t good = sink.bytes.size();
-  sink.capacity = good + 30;  // the next chunk does not fit; DataEnd + Footer + magic (50 bytes) neither
+  // The disk fills: the next chunk does not fit, nor would DataEnd + Footer + magic (50
+  // bytes) in what is left, but the writer reserved room for them with the chunk before.
+  sink.capacity = good + 30;
   EXPECT_FALSE(w.write(c, 2, 2, d, sizeof d));
   EXPECT_TRUE(w.failed());
   EXPECT_EQ(w.error(), ENOSPC);
   EXPECT_EQ(sink.bytes.size(), good);  // nothing half-written remains
   EXPECT_FALSE(w.write(c, 3, 3, d, sizeof d));
   EXPECT_FALSE(w.close());
-  EXPECT_EQ(sink.bytes.size(), good);
-  EXPECT_EQ(parse(sink.bytes).messages.size(), 1u);
+  EXPECT_EQ(w.error(), ENOSPC);  // the first failure is the one reported
+  EXPECT_EQ(sink.bytes.size(), good + 50);
+  const Parsed p = parse(sink.bytes);
+  EXPECT_TRUE(p.footer);
+  EXPECT_EQ(p.messages.size(), 1u);
+  EXPECT_EQ(p.summary_start, 0u);  // no summary: it did not fit
 
-  sink.capacity = static_cast<std::size_t>(-1);  // room for the end records: written after all
+  // Room for the end records but not the summary: the same ending.
   pmu::mcap::MemorySink sink2;
   auto w2 = make(sink2, 64);
   ASSERT_TRUE(w2.open());
@@ -252,11 +263,69 @@ TEST(McapWriter, DiskFullCutsBackToTheLastChunkAndEndsTheFile) {
   ASSERT_TRUE(w2.write(c2, 1, 1, d, sizeof d));
   sink2.capacity = sink2.bytes.size() + 100;
   EXPECT_FALSE(w2.write(c2, 2, 2, d, 40));
-  EXPECT_FALSE(w2.write(c2, 2, 2, d, 40));
   EXPECT_FALSE(w2.close());
   const Parsed p2 = parse(sink2.bytes);
   EXPECT_TRUE(p2.footer);
   EXPECT_EQ(p2.messages.size(), 1u);
+}
+
+TEST(McapWriter, ASummaryThatDoesNotFitLeavesTheShortEnding) {
+  pmu::mcap::MemorySink sink;
+  auto w = make(sink);
+  ASSERT_TRUE(w.open());
+  const auto c = w.add_channel(w.add_schema("s", "omgidl", std::string(500, 'x')), "t", "cdr");
+  const std::uint8_t d[40] = {};
+  ASSERT_TRUE(w.write(c, 1, 1, d, sizeof d));
+  ASSERT_TRUE(w.flush());
+  sink.capacity = sink.bytes.size() + 60;  // the summary repeats the 500-byte schema
+  EXPECT_FALSE(w.close());
+  EXPECT_EQ(w.error(), ENOSPC);
+  const Parsed p = parse(sink.bytes);
+  EXPECT_TRUE(p.footer);
+  EXPECT_EQ(p.messages.size(), 1u);
+}
+
+// The same on a real file system, where space is handed out in whole pages: whatever size
+// the chunks have, the file that fills a small tmpfs ends with a footer. Without the
+// reservation, a chunk that fails after the last page filled left no room for the ending.
+TEST(McapFileSink, EveryFileThatFillsATmpfsEndsWithAFooter) {
+  if (::geteuid() != 0) GTEST_SKIP() << "mounting a tmpfs needs root";
+  char dir_template[] = "/tmp/mcap-full-XXXXXX";
+  const char* dir = ::mkdtemp(dir_template);
+  ASSERT_NE(dir, nullptr);
+  if (::mount("tmpfs", dir, "tmpfs", 0, "size=16k") != 0) {
+    const int e = errno;
+    ::rmdir(dir);
+    GTEST_SKIP() << "mount tmpfs: " << std::strerror(e);
+  }
+  const std::string path = std::string(dir) + "/full.mcap";
+  std::vector<std::string> problems;
+  for (std::size_t payload = 1; payload <= 400; payload += 7) {
+    pmu::mcap::FileSink sink;
+    ASSERT_EQ(sink.open(path), 0);
+    auto w = make(sink, 1);  // every message its own chunk
+    ASSERT_TRUE(w.open());
+    const auto c = w.add_channel(w.add_schema("s", "omgidl", ""), "t", "cdr");
+    const std::vector<std::uint8_t> d(payload, 0x5a);
+    std::uint64_t written = 0;
+    while (w.write(c, written + 1, written + 1, d.data(), d.size()) && written < 100000) ++written;
+    EXPECT_EQ(w.error(), ENOSPC) << "payload " << payload;
+    EXPECT_FALSE(w.close());
+    sink.close();
+    std::FILE* f = std::fopen(path.c_str(), "rb");
+    ASSERT_NE(f, nullptr);
+    Bytes bytes(32768);
+    bytes.resize(std::fread(bytes.data(), 1, bytes.size(), f));
+    std::fclose(f);
+    const Parsed p = parse(bytes);
+    if (!p.footer || p.messages.size() != written)
+      problems.push_back("payload " + std::to_string(payload) + ": " + std::to_string(p.messages.size()) + " of " +
+                         std::to_string(written) + " messages, footer " + (p.footer ? "yes" : "no"));
+    ::unlink(path.c_str());
+  }
+  ::umount(dir);
+  ::rmdir(dir);
+  EXPECT_TRUE(problems.empty()) << problems.size() << " files, first: " << problems.front();
 }
 
 }  // namespace

@@ -9,11 +9,23 @@ namespace pmu::mcap {
 
 Writer::Writer(Sink& sink, WriterOptions options) : sink_(sink), options_(std::move(options)) {}
 
-bool Writer::emit(const Bytes& block, bool data_section) {
+namespace {
+// DataEnd (1 + 8 + 4), Footer (1 + 8 + 20) and the magic: what ends a file whose summary did not fit.
+constexpr std::uint64_t kEndingSize = 13 + 29 + 8;
+}  // namespace
+
+bool Writer::emit(const Bytes& block, bool data_section, bool reserve_ending) {
   if (error_ != 0) return false;
+  // The block and, after it, room for the ending: when the disk fills, the failure comes here,
+  // before anything is written, and the room reserved with the previous block is still there.
+  if (const int e = reserve_ending ? sink_.reserve(offset_, block.size() + kEndingSize) : 0; e != 0) {
+    error_ = e;
+    return false;
+  }
   if (const int e = sink_.write(block.data(), block.size()); e != 0) {
     error_ = e;
     sink_.truncate(offset_);  // the file ends at the last complete block again
+    sink_.reserve(offset_, kEndingSize);  // truncating freed what was reserved past the end
     return false;
   }
   if (data_section) data_crc_ = crc32(data_crc_, block.data(), block.size());
@@ -89,24 +101,32 @@ bool Writer::flush() {
   return true;
 }
 
+Bytes Writer::ending_without_summary() const {
+  Bytes end;
+  append_data_end(end, data_crc_);
+  append_footer(end, 0, 0, 0, false);
+  end.insert(end.end(), std::begin(kMagic), std::end(kMagic));
+  return end;
+}
+
 bool Writer::close() {
   if (closed_) return error_ == 0;
   closed_ = true;
   if (!opened_) return false;
-  if (error_ != 0) {
-    // Disk full or the like: try to end the data properly so the complete chunks stay
-    // readable by every reader; without a summary (it may not fit either).
-    const int first = error_;
-    error_ = 0;
-    Bytes end;
-    append_data_end(end, 0);
-    append_footer(end, 0, 0, 0, false);
-    end.insert(end.end(), std::begin(kMagic), std::end(kMagic));
-    emit(end, false);
-    error_ = first;
-    return false;
+  if (error_ == 0 && flush()) {
+    Bytes summary = summary_and_footer();
+    if (emit(summary, false)) return true;
   }
-  if (!flush()) return false;
+  // Disk full or the like: end the data properly so the complete chunks stay readable by
+  // every reader, without a summary (it did not fit).
+  const int first = error_;
+  error_ = 0;
+  emit(ending_without_summary(), false, false);  // into the room reserved with the last block
+  error_ = first;
+  return false;
+}
+
+Bytes Writer::summary_and_footer() {
   Bytes b;
   append_data_end(b, data_crc_);
   const std::uint64_t summary_start = offset_ + b.size();
@@ -131,7 +151,7 @@ bool Writer::close() {
   const std::uint32_t crc = crc32(0, b.data() + summary_at, b.size() - summary_at);
   append_footer(b, summary_start, summary_offset_start, crc, true);
   b.insert(b.end(), std::begin(kMagic), std::end(kMagic));
-  return emit(b, false);
+  return b;
 }
 
 }  // namespace pmu::mcap

@@ -47,7 +47,9 @@ class Writer {
              std::size_t size);
   // Writes the chunk being filled (if it holds anything): what was written so far survives a crash.
   bool flush();
-  // The last chunk, DataEnd, Summary, Summary Offsets, Footer, magic. False on a write error.
+  // The last chunk, DataEnd, Summary, Summary Offsets, Footer, magic. False on a write error;
+  // then (disk full, say) the file still ends with DataEnd, a Footer without summary and the
+  // magic right after its last complete chunk, in space reserved before every block.
   bool close();
 
   bool failed() const noexcept { return error_ != 0; }
@@ -56,7 +58,9 @@ class Writer {
   std::uint64_t message_count() const noexcept { return stats_.message_count; }
 
  private:
-  bool emit(const Bytes& block, bool data_section);
+  bool emit(const Bytes& block, bool data_section, bool reserve_ending = true);
+  Bytes ending_without_summary() const;
+  Bytes summary_and_footer();  // DataEnd, the summary section, its offsets, Footer, magic
 
   Sink& sink_;
   WriterOptions options_;
