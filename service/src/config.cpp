@@ -16,6 +16,7 @@
 
 #include "pmu/codec/firmware.hpp"
 #include "pmu/codec/messages.hpp"
+#include "pmu/service/dds_statistics.hpp"
 #include "pmu/service/vehicle.hpp"
 
 namespace pmu::service {
@@ -401,6 +402,30 @@ void parse_interfaces(const Ctx& c, const YAML::Node& key, const YAML::Node& n, 
   net.interfaces = parse_address_list(c, n.IsNull() ? key : n, "interfaces", "interface", "[eth1, 192.168.10.1]");
 }
 
+// dds_statistics: `all`, or a list of Fast DDS statistics topic names (dds_statistics.hpp).
+// Fast DDS only logs a name it does not know and goes on without it; here it is refused at
+// its line, with the names that exist.
+std::vector<std::string> parse_statistics(const Ctx& c, const YAML::Node& key, const YAML::Node& n) {
+  const auto& known = dds::statistics_topic_names();
+  if (n.IsScalar() && n.Scalar() == "all") return known;
+  if (n.IsNull()) c.fail(key, "dds_statistics must be all or a list of statistics topic names (may be empty: [])");
+  if (!n.IsSequence()) c.fail(n, "dds_statistics must be all or a list of statistics topic names, e.g. [" +
+                                     known.front() + "]");
+  std::vector<std::string> topics;
+  for (const auto& item : n) {
+    const auto name = c.scalar<std::string>(item, "statistics topic", "a name");
+    if (!dds::is_statistics_topic(name)) {
+      std::string list;
+      for (const auto& k : known) list += (list.empty() ? "" : ", ") + k;
+      c.fail(item, "unknown statistics topic '" + name + "' (known: " + list + ")");
+    }
+    if (std::find(topics.begin(), topics.end(), name) != topics.end())
+      c.fail(item, "statistics topic '" + name + "' appears twice in dds_statistics");
+    topics.push_back(name);
+  }
+  return topics;
+}
+
 const char* const kLogLevels[] = {"trace", "debug", "info", "warn", "error", "critical", "off"};
 
 }  // namespace
@@ -422,7 +447,7 @@ Config parse_config(const std::string& text, const std::string& source, const Co
   if (root.IsNull()) throw ConfigError(source + ":1: the file is empty");
   c.only_keys(root, "the top level", {"domain", "vehicle", "low_rate_period", "qos_file", "dds_transport", "log_level",
                                       "buses", "timeouts", "policy", "security", "discovery", "interfaces",
-                                      "canopen_publish_period"});
+                                      "canopen_publish_period", "dds_statistics"});
   if (const auto v = root["domain"]) cfg.domain = static_cast<int>(c.integer(v, "domain", 0, 232));
   if (const auto v = root["vehicle"]) {
     // `vehicle:` with nothing after it is YAML null: the unnamed vehicle, like no key.
@@ -459,6 +484,7 @@ Config parse_config(const std::string& text, const std::string& source, const Co
     const auto key = kv.first.as<std::string>();
     if (key == "discovery") parse_discovery(c, kv.first, kv.second, cfg.dds_transport, cfg.network);
     if (key == "interfaces") parse_interfaces(c, kv.first, kv.second, cfg.dds_transport, cfg.network);
+    if (key == "dds_statistics") cfg.dds_statistics = parse_statistics(c, kv.first, kv.second);
   }
   if (const auto v = root["timeouts"]) parse_timeouts(c, v, cfg.timeouts);
   if (const auto v = root["policy"]) parse_policy(c, v, cfg.policy);

@@ -1,5 +1,7 @@
 #include "pmu/service/dds_participant.hpp"
 
+#include "pmu/service/dds_statistics.hpp"
+
 #include <fastdds/rtps/attributes/ServerAttributes.h>
 #include <fastdds/rtps/transport/UDPv4TransportDescriptor.h>
 #include <fastdds/rtps/transport/shared_mem/SharedMemTransportDescriptor.h>
@@ -57,11 +59,12 @@ void add_security(DomainParticipantQos& pqos, const SecurityFiles& f) {
 }  // namespace
 
 DomainParticipantQos participant_qos(const std::string& name, Transport transport, const ResolvedNetwork& network,
-                                     const SecurityFiles& security) {
+                                     const SecurityFiles& security, const std::vector<std::string>& statistics) {
   using namespace eprosima::fastdds::rtps;
   DomainParticipantQos qos;
   qos.name(name);
   if (!security.empty()) add_security(qos, security);
+  if (!statistics.empty()) qos.properties().properties().emplace_back("fastdds.statistics", statistics_property(statistics));
 
   const bool allowlist = !network.interface_addresses.empty();
   if (transport == Transport::ShmOnly && (allowlist || network.mode != DiscoveryMode::Multicast))

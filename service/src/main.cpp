@@ -28,6 +28,7 @@
 #include "pmu/service/dds_commands.hpp"
 #include "pmu/service/dds_context.hpp"
 #include "pmu/service/dds_publisher.hpp"
+#include "pmu/service/dds_statistics.hpp"
 #include "pmu/service/receive_filters.hpp"
 #include "pmu/service/logging.hpp"
 #include "pmu/service/systemd.hpp"
@@ -151,7 +152,9 @@ int run(const service::Config& cfg, const pmu::dds::ResolvedNetwork& network) {
   spdlog::info("DDS: {}", network.summary);
   const auto partitions = service::vehicle_partitions(cfg.vehicle);
   pmu::dds::DdsContext participant(cfg.domain, cfg.qos_file, "pmu-service", cfg.security.files, cfg.dds_transport,
-                                   network, {partitions, partitions});
+                                   network, {partitions, partitions}, cfg.dds_statistics);
+  if (!cfg.dds_statistics.empty())
+    spdlog::info("DDS: Fast DDS statistics on: {}", pmu::dds::statistics_property(cfg.dds_statistics));
   if (participant.secure())
     spdlog::info("DDS-Security on: identity {}, permissions {}", cfg.security.files.identity_certificate,
                  cfg.security.files.permissions);

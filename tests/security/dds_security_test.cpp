@@ -303,6 +303,22 @@ TEST(Permissions, EveryIdentityMayCreateExactlyTheWritersAndReadersTheContractAl
 // The governance document says what the issue asks.
 // ---- the right identities work ------------------------------------------------------------
 
+// Config dds_statistics under DDS-Security (interface.md 4.5): make_pki.sh grants no identity
+// the statistics topics, and Fast DDS would only log the refused writers, so the participant
+// is not created at all and the message says what the permissions lack.
+TEST(Permissions, StatisticsTopicsThePermissionsDoNotGrantAreRefusedAtStartUp) {
+  try {
+    dds::DdsContext p(test_domain(), "", "statistics-not-granted", Pki::get().files("pmu-service"),
+                      dds::Transport::UdpOnly, {}, {}, {"_fastdds_statistics_history2history_latency"});
+    ADD_FAILURE() << "created";
+  } catch (const dds::DdsError& e) {
+    EXPECT_EQ(std::string(e.what()),
+              "dds_statistics: this identity's permissions do not allow publishing "
+              "_fastdds_statistics_history2history_latency in the default partition (DDS-Security; "
+              "docs/interface.md 4.5 says what to grant)");
+  }
+}
+
 TEST(SecureDds, GroundStationCommandsAndMissionComputerReadsTelemetry) {
   const int domain = test_domain();
   ServiceUnderTest svc(domain, Pki::get().files("pmu-service"));

@@ -2,6 +2,7 @@
 #include <gtest/gtest.h>
 
 #include "pmu/service/config.hpp"
+#include "pmu/service/dds_statistics.hpp"
 
 namespace pmu::service {
 namespace {
@@ -93,7 +94,7 @@ const BadCase kBad[] = {
     {"domain: 0\n", "bad.yaml:1: no buses: the service needs at least one bus"},
     {"domian: 0\nbuses: []\n",
      "bad.yaml:1: unknown key 'domian' in the top level (known: domain, vehicle, low_rate_period, qos_file, dds_transport, log_level, "
-     "buses, timeouts, policy, security, discovery, interfaces, canopen_publish_period)"},
+     "buses, timeouts, policy, security, discovery, interfaces, canopen_publish_period, dds_statistics)"},
     {"domain: 0\nvehicle: uav*\nbuses: []\n",
      "bad.yaml:2: vehicle 'uav*' contains '*'; a vehicle name is letters, digits, '_', '-' and '.' (it is also a DDS "
      "partition name, where other characters are patterns)"},
@@ -511,6 +512,52 @@ TEST(Config, MissingFileSaysSo) {
     ADD_FAILURE() << "accepted";
   } catch (const ConfigError& e) {
     EXPECT_EQ(std::string(e.what()), "/nonexistent/pmu.yaml: cannot open the config file");
+  }
+}
+
+// dds_statistics (interface.md 4.5): Fast DDS's statistics topic names, or all; Fast DDS
+// itself would only log a wrong name, so the config refuses it at its line.
+TEST(ConfigStatistics, OffUnlessNamedAllOrAList) {
+  EXPECT_TRUE(parse_config(kBus, "s.yaml").dds_statistics.empty());
+  EXPECT_TRUE(parse_config(std::string("dds_statistics: []\n") + kBus, "s.yaml").dds_statistics.empty());
+  EXPECT_EQ(parse_config(std::string("dds_statistics: all\n") + kBus, "s.yaml").dds_statistics,
+            dds::statistics_topic_names());
+  EXPECT_EQ(dds::statistics_topic_names().size(), 17u) << "every topic of Fast DDS 2.9.1's topic_names.hpp";
+  const Config c = parse_config(std::string("dds_statistics:\n  - _fastdds_statistics_history2history_latency\n"
+                                            "  - _fastdds_statistics_physical_data\n") + kBus, "s.yaml");
+  EXPECT_EQ(c.dds_statistics, (std::vector<std::string>{"_fastdds_statistics_history2history_latency",
+                                                         "_fastdds_statistics_physical_data"}));
+  EXPECT_EQ(dds::statistics_property(c.dds_statistics),
+            "_fastdds_statistics_history2history_latency;_fastdds_statistics_physical_data");
+}
+
+TEST(ConfigStatistics, UnknownOrRepeatedTopicIsRefusedAtItsLine) {
+  const BadCase bad[] = {
+      {"dds_statistics:\n  - _fastdds_statistics_history2history_latency\n  - history2history_latency\n",
+       "bad.yaml:3: unknown statistics topic 'history2history_latency' (known: "
+       "_fastdds_statistics_history2history_latency, _fastdds_statistics_network_latency, "
+       "_fastdds_statistics_publication_throughput, _fastdds_statistics_subscription_throughput, "
+       "_fastdds_statistics_rtps_sent, _fastdds_statistics_rtps_lost, _fastdds_statistics_resent_datas, "
+       "_fastdds_statistics_heartbeat_count, _fastdds_statistics_acknack_count, _fastdds_statistics_nackfrag_count, "
+       "_fastdds_statistics_gap_count, _fastdds_statistics_data_count, _fastdds_statistics_pdp_packets, "
+       "_fastdds_statistics_edp_packets, _fastdds_statistics_discovered_entity, _fastdds_statistics_sample_datas, "
+       "_fastdds_statistics_physical_data)"},
+      {"dds_statistics: [_fastdds_statistics_rtps_sent, _fastdds_statistics_rtps_sent]\n",
+       "bad.yaml:1: statistics topic '_fastdds_statistics_rtps_sent' appears twice in dds_statistics"},
+      {"dds_statistics: yes\n",
+       "bad.yaml:1: dds_statistics must be all or a list of statistics topic names, e.g. "
+       "[_fastdds_statistics_history2history_latency]"},
+      {"dds_statistics:\n",
+       "bad.yaml:1: dds_statistics must be all or a list of statistics topic names (may be empty: [])"},
+  };
+  for (const auto& c : bad) {
+    SCOPED_TRACE(c.yaml);
+    try {
+      (void)parse_config(std::string(c.yaml) + kBus, "bad.yaml");
+      ADD_FAILURE() << "accepted";
+    } catch (const ConfigError& e) {
+      EXPECT_EQ(std::string(e.what()), c.message);
+    }
   }
 }
 

@@ -3,6 +3,8 @@
 // created with. Creating no participant, it needs no network.
 #include <gtest/gtest.h>
 
+#include <optional>
+
 #include <fastdds/rtps/attributes/ServerAttributes.h>
 #include <fastdds/rtps/transport/UDPv4TransportDescriptor.h>
 #include <fastdds/rtps/transport/shared_mem/SharedMemTransportDescriptor.h>
@@ -174,6 +176,20 @@ TEST(ParticipantQos, SecurityPluginsWithMulticastUnicastAndAnAllowlist) {
     EXPECT_EQ(p["dds.sec.crypto.plugin"], "builtin.AES-GCM-GMAC");
     EXPECT_EQ(p["dds.sec.auth.builtin.PKI-DH.private_key"], "file:///pki/svc/key.pem");
   }
+}
+
+// Config dds_statistics (interface.md 4.5): the property Fast DDS reads when it enables the
+// participant, and nothing without it.
+TEST(ParticipantQos, StatisticsTopicsBecomeTheFastddsStatisticsProperty) {
+  const auto value = [](const DomainParticipantQos& q) -> std::optional<std::string> {
+    for (const auto& prop : q.properties().properties())
+      if (prop.name() == "fastdds.statistics") return prop.value();
+    return std::nullopt;
+  };
+  EXPECT_EQ(value(participant_qos("pmu-service", Transport::Default, {}, {})), std::nullopt);
+  EXPECT_EQ(value(participant_qos("pmu-service", Transport::Default, {}, {},
+                                  {"_fastdds_statistics_history2history_latency", "_fastdds_statistics_rtps_sent"})),
+            "_fastdds_statistics_history2history_latency;_fastdds_statistics_rtps_sent");
 }
 
 // Fast DDS 2.9.1 cannot serve secure participants through a Discovery Server

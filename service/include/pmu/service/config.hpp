@@ -115,6 +115,9 @@ struct Config {
   // `discovery:` (multicast, unicast peers, Discovery Server clients) and `interfaces:` (the
   // UDP allowlist); names are resolved at start (dds::resolve_network), not here.
   dds::NetworkConfig network;
+  // `dds_statistics`: the Fast DDS statistics topics the participant writes, for Fast DDS
+  // Monitor (dds_statistics.hpp); empty (the default): none.
+  std::vector<std::string> dds_statistics;
   std::string log_level = "info";
   std::vector<BusConfig> buses;
   Timeouts timeouts;

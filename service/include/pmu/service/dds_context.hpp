@@ -6,6 +6,9 @@
 // Start-up only throws (DdsError: "cannot load QoS profiles from X", "cannot create
 // participant on domain N"); afterwards calls return null or a ReturnCode like Fast DDS.
 //
+// Type objects: the constructor registers the contract's type objects (dds_type_objects.hpp)
+// before anything else, so the endpoints of every program that uses DdsContext announce them.
+//
 // Security: with SecurityFiles (dds_security.hpp) the participant uses DDS-Security's
 // builtin plugins (PKI-DH authentication, Access-Permissions, AES-GCM-GMAC crypto) with
 // those files. Check them first (check_security_files): Fast DDS only says that the
@@ -66,9 +69,12 @@ class DdsContext {
  public:
   // `security` empty: no DDS-Security (as before). Relative paths are made absolute.
   // `network`: discovery and interface allowlist (dds_network.hpp); default multicast, all.
+  // `statistics`: the Fast DDS statistics topics to write (dds_statistics.hpp), checked
+  // names; with DDS-Security the permissions must allow publishing each, or DdsError says so.
   DdsContext(int domain, const std::string& qos_file, const std::string& participant_name,
              const SecurityFiles& security = {}, Transport transport = Transport::Default,
-             const ResolvedNetwork& network = {}, const Partitions& partitions = {});
+             const ResolvedNetwork& network = {}, const Partitions& partitions = {},
+             const std::vector<std::string>& statistics = {});
   ~DdsContext();
   DdsContext(const DdsContext&) = delete;
   DdsContext& operator=(const DdsContext&) = delete;
@@ -81,7 +87,9 @@ class DdsContext {
   const RemoteWriters& remote_writers() const noexcept { return remote_writers_; }
 
   // Registers the type (once) and creates the topic (once). `type` is e.g.
-  // new pmu::VoltagesPubSubType(). Throws DdsError at start-up when it fails.
+  // new pmu::VoltagesPubSubType(). Its endpoints announce its type object when it is
+  // self-contained, never its TypeInformation (dds_type_objects.hpp says why). Throws
+  // DdsError at start-up when it fails.
   eprosima::fastdds::dds::Topic& topic(const std::string& name, eprosima::fastdds::dds::TypeSupport type);
 
   // A writer/reader with the named profile of qos.xml. Throws DdsError when it fails, and

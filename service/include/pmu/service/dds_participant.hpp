@@ -24,6 +24,8 @@
 // reaches a network interface); UdpOnly has UDPv4 alone.
 // Security: the DDS-Security plugin properties when `security` is not empty, with multicast
 // and unicast discovery and with an allowlist.
+// Statistics: property `fastdds.statistics` = the topics joined by ';' when `statistics` is
+// not empty (dds_statistics.hpp); nothing otherwise.
 //
 // Throws NetworkError for a combination that cannot work (ShmOnly with unicast or server
 // discovery, or with an allowlist; server discovery with DDS-Security, kServerWithSecurity
@@ -31,6 +33,7 @@
 
 #include <fastdds/dds/domain/qos/DomainParticipantQos.hpp>
 #include <string>
+#include <vector>
 
 #include "pmu/service/dds_network.hpp"
 #include "pmu/service/dds_security.hpp"
@@ -40,6 +43,7 @@ namespace pmu::dds {
 
 eprosima::fastdds::dds::DomainParticipantQos participant_qos(const std::string& name, Transport transport,
                                                              const ResolvedNetwork& network,
-                                                             const SecurityFiles& security);
+                                                             const SecurityFiles& security,
+                                                             const std::vector<std::string>& statistics = {});
 
 }  // namespace pmu::dds

@@ -1,0 +1,48 @@
+// Which of the contract's types announce their type object (dds_type_objects.hpp): those a
+// Fast DDS 2.9.1 participant can turn into a DynamicType from the object alone. The others
+// name a member's type only by hash, which made such a participant drop the member (enums)
+// or crash (BatteryCells' sequence of BatteryCell; tests/integration/type_object_test.cpp runs a
+// service with every kind of device against one).
+#include <gtest/gtest.h>
+
+#include <fastdds/dds/topic/TypeSupport.hpp>
+
+#include "pmu/idl/canopenPubSubTypes.h"
+#include "pmu/idl/commandPubSubTypes.h"
+#include "pmu/idl/statePubSubTypes.h"
+#include "pmu/idl/telemetryPubSubTypes.h"
+#include "pmu/service/dds_type_objects.hpp"
+
+namespace pmu::dds {
+namespace {
+
+using eprosima::fastdds::dds::TypeSupport;
+
+TEST(TypeObjects, SelfContainedAreExactlyTheTypesWithoutMembersNamedByHash) {
+  register_type_objects();
+  register_type_objects();  // idempotent
+  for (const char* t : {"pmu::Voltages", "pmu::Currents", "pmu::BatteryEnergy", "pmu::Temperatures", "pmu::Status",
+                        "pmu::Config", "pmu::DeviceInfo", "pmu::Battery", "pmu::Mppt", "pmu::BatteryCell"})
+    EXPECT_TRUE(type_object_is_self_contained(t)) << t;
+  for (const char* t : {"pmu::Health", "pmu::BatteryCells", "pmu::Command", "pmu::CommandReply",
+                        "pmu::DeviceKind", "pmu::NoSuchType"})
+    EXPECT_FALSE(type_object_is_self_contained(t)) << t;
+}
+
+TEST(TypeObjects, NeverTypeInformationAndTheObjectOnlyWhenSelfContained) {
+  register_type_objects();
+  TypeSupport voltages(new pmu::VoltagesPubSubType());
+  TypeSupport cells(new pmu::BatteryCellsPubSubType());
+  TypeSupport health(new pmu::HealthPubSubType());
+  for (TypeSupport* t : {&voltages, &cells, &health}) {
+    ASSERT_TRUE((*t)->auto_fill_type_information()) << "Fast DDS 2.9.1's default, which this changes";
+    announce_type_object(*t);
+    EXPECT_FALSE((*t)->auto_fill_type_information()) << t->get_type_name();
+  }
+  EXPECT_TRUE(voltages->auto_fill_type_object());
+  EXPECT_FALSE(cells->auto_fill_type_object());
+  EXPECT_FALSE(health->auto_fill_type_object());
+}
+
+}  // namespace
+}  // namespace pmu::dds
