@@ -11,6 +11,7 @@
 //   DDS statistics topics (the writers appear in discovery) and no others; without it, none.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -188,13 +189,20 @@ TEST(TypeObject, ReaderBuiltFromTheDiscoveredTypeDecodesVoltages) {
       "pmu/voltages", "pmu/currents", "pmu/battery_energy", "pmu/temperatures", "pmu/status",
       "pmu/low_rate/voltages", "pmu/low_rate/currents", "pmu/low_rate/battery_energy", "pmu/low_rate/temperatures",
       "pmu/low_rate/status", "pmu/config", "pmu/info", "pmu/battery", "pmu/mppt"};
-  std::set<std::string> with_types;
-  EXPECT_TRUE(pmu::test::wait_until([&] { return (with_types = tool.discovery().topics_with_types()) == self_contained; },
-                                    30s));
-  const auto writers = tool.discovery().writer_topics_of("pmu-service");
-  for (const char* t : {"pmu/health", "pmu/battery_cells", "pmu/command_reply"})
-    EXPECT_TRUE(writers.count(t)) << t << " was not announced at all";
-  EXPECT_EQ(tool.discovery().topics_with_types(), self_contained);
+  // The writers are discovered one by one: wait for all of them, those without a type too.
+  const std::vector<std::string> untyped = {"pmu/health", "pmu/battery_cells", "pmu/command_reply"};
+  std::set<std::string> with_types, writers;
+  const bool all_seen = pmu::test::wait_until(
+      [&] {
+        with_types = tool.discovery().topics_with_types();
+        writers = tool.discovery().writer_topics_of("pmu-service");
+        return with_types == self_contained &&
+               std::all_of(untyped.begin(), untyped.end(), [&](const auto& t) { return writers.count(t) > 0; });
+      },
+      30s);
+  EXPECT_TRUE(all_seen);
+  for (const auto& t : untyped) EXPECT_TRUE(writers.count(t)) << t << " was not announced at all";
+  EXPECT_EQ(with_types, self_contained);
 
   // The type as the tools show it: its name, the contract's field names in order, the keys.
   EXPECT_EQ(type->get_name(), "pmu::Voltages");
