@@ -447,7 +447,7 @@ Config parse_config(const std::string& text, const std::string& source, const Co
   if (root.IsNull()) throw ConfigError(source + ":1: the file is empty");
   c.only_keys(root, "the top level", {"domain", "vehicle", "low_rate_period", "qos_file", "dds_transport", "log_level",
                                       "buses", "timeouts", "policy", "security", "discovery", "interfaces",
-                                      "canopen_publish_period", "dds_statistics"});
+                                      "canopen_publish_period", "dds_statistics", "dds_type_objects"});
   if (const auto v = root["domain"]) cfg.domain = static_cast<int>(c.integer(v, "domain", 0, 232));
   if (const auto v = root["vehicle"]) {
     // `vehicle:` with nothing after it is YAML null: the unnamed vehicle, like no key.
@@ -475,6 +475,7 @@ Config parse_config(const std::string& text, const std::string& source, const Co
     else if (t != "default")
       c.fail(v, "dds_transport '" + t + "' is not one of default, udp, shm");
   }
+  if (const auto v = root["dds_type_objects"]) cfg.dds_type_objects = c.scalar<bool>(v, "dds_type_objects", "true or false");
   if (const auto v = root["log_level"]) {
     cfg.log_level = c.scalar<std::string>(v, "log_level", "a level");
     if (!is_log_level(cfg.log_level))

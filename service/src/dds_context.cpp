@@ -83,15 +83,15 @@ std::string default_qos_file() {
 
 DdsContext::DdsContext(int domain, const std::string& qos_file, const std::string& participant_name,
                        const SecurityFiles& security, Transport transport, const ResolvedNetwork& network,
-                       const Partitions& partitions, const std::vector<std::string>& statistics)
-    : domain_(domain), secure_(!security.empty()), security_(security), partitions_(partitions) {
+                       const Partitions& partitions, const std::vector<std::string>& statistics, bool type_objects)
+    : domain_(domain), type_objects_(type_objects), secure_(!security.empty()), security_(security), partitions_(partitions) {
   const std::string file = qos_file.empty() ? default_qos_file() : qos_file;
   qos_file_ = file;
   if (file.empty()) throw DdsError("no QoS profile file: neither " PMU_SYSCONFDIR "/qos.xml nor " PMU_DATADIR "/qos.xml exists; install deploy/qos.xml, set PMU_QOS_FILE or set qos_file");
   load_profiles_once(file);
   // Before any endpoint exists: Fast DDS copies a type's object into the endpoint's discovery
   // data when the endpoint is created, from what is registered then.
-  register_type_objects();
+  if (type_objects_) register_type_objects();
   // Fast DDS creates statistics writers in the default partition when the participant is
   // enabled; a writer the permissions refuse is only logged, and the topic stays silent.
   if (secure_)
@@ -139,7 +139,7 @@ DdsContext::~DdsContext() {
 Topic& DdsContext::topic(const std::string& name, TypeSupport type) {
   if (auto it = topics_.find(name); it != topics_.end()) return *it->second;
   const std::string type_name = type.get_type_name();
-  announce_type_object(type);  // never TypeInformation; the type object when it is self-contained
+  announce_type_object(type, type_objects_);  // never TypeInformation; the type object when asked and self-contained
   if (type.register_type(participant_) != ReturnCode_t::RETCODE_OK)
     throw DdsError("cannot register DDS type " + type_name);
   Topic* t = participant_->create_topic(name, type_name, TOPIC_QOS_DEFAULT);

@@ -65,9 +65,9 @@ bool type_object_is_self_contained(const std::string& type_name) {
   return true;
 }
 
-void announce_type_object(eprosima::fastdds::dds::TypeSupport& type) {
+void announce_type_object(eprosima::fastdds::dds::TypeSupport& type, bool enabled) {
   type->auto_fill_type_information(false);
-  type->auto_fill_type_object(type_object_is_self_contained(type.get_type_name()));
+  type->auto_fill_type_object(enabled && type_object_is_self_contained(type.get_type_name()));
 }
 
 }  // namespace pmu::dds

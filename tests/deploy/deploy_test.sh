@@ -4,6 +4,7 @@
 # Checks the shipped deployment files:
 #   1. pmu-service --check-config accepts deploy/pmu-service.yaml, also with its commented
 #      examples (polling device, discovery, simulated bus, qos_file, dds_statistics,
+#      dds_type_objects,
 #      batteries, MPPTs)
 #      switched on, and
 #      rejects a misspelt key (so the check really checks);
@@ -57,15 +58,16 @@ step "check-config with the commented examples switched on"
 full="$work/full.yaml"
 sed -e 's/^# qos_file:/qos_file:/' \
     -e 's/^# dds_statistics:/dds_statistics:/' \
+    -e 's/^# dds_type_objects:/dds_type_objects:/' \
     -e '/^ *discover: false$/d' \
     -e '/^ *# discover:$/,/^ *#   packets:/ s/# //' \
     -e '/^ *# - address: 2$/,/^ *#   packets:/ s/# //' \
     -e '/^ *# - interface: sim$/,/^ *#       period: 0.5$/ s/# //' \
     "$deploy/pmu-service.yaml" > "$full"
 changed_lines=$(diff "$deploy/pmu-service.yaml" "$full" | grep -c '^>' || true)
-# qos_file (1) + dds_statistics (1) + discover mapping (4) + polling device (4) + sim bus (5)
-[ "$changed_lines" -eq 15 ] ||
-  fail "expected 15 example lines to switch on, got $changed_lines (were the commented examples changed?)"
+# qos_file (1) + dds_statistics (1) + dds_type_objects (1) + discover mapping (4) + polling device (4) + sim bus (5)
+[ "$changed_lines" -eq 16 ] ||
+  fail "expected 16 example lines to switch on, got $changed_lines (were the commented examples changed?)"
 out=$("$service_bin" --config "$full" --check-config 2>&1) ||
   fail "pmu-service rejected the example with its commented parts enabled: $out"
 echo "$out"

@@ -7,6 +7,7 @@
 //   DDS's DynamicTypes API, and decodes samples by the contract's field names. This is what
 //   Fast DDS Monitor, PlotJuggler's Fast DDS plugin and DDS Record & Replay do. Without the
 //   service's register_type_objects() no type is announced and the test fails (checked).
+//   With config `dds_type_objects: true` only: without it no writer announces a type.
 // - Statistics: with config `dds_statistics` the service's participant writes the listed Fast
 //   DDS statistics topics (the writers appear in discovery) and no others; without it, none.
 #include <gtest/gtest.h>
@@ -172,7 +173,7 @@ const std::vector<std::string> kVoltagesFields = {"vehicle",  "bus",       "addr
 
 TEST(TypeObject, ReaderBuiltFromTheDiscoveredTypeDecodesVoltages) {
   const int domain = pmu::test::exclusive_dds_domain();
-  ConfigFile config(sim_config(""));
+  ConfigFile config(sim_config("dds_type_objects: true\n"));
   auto service = start_service(domain, config);
   ToolParticipant tool(domain);
   ASSERT_NE(tool.get(), nullptr);
@@ -278,6 +279,28 @@ std::set<std::string> statistics_topics(const std::set<std::string>& topics) {
   for (const auto& t : topics)
     if (t.rfind("_fastdds_statistics_", 0) == 0) s.insert(t);
   return s;
+}
+
+// The default: the service's writers are all discovered, none with a type object.
+TEST(TypeObject, NoneAnnouncedWithoutTheConfigKey) {
+  const int domain = pmu::test::exclusive_dds_domain();
+  ConfigFile config(sim_config(""));
+  auto service = start_service(domain, config);
+  ToolParticipant tool(domain);
+  ASSERT_NE(tool.get(), nullptr);
+  const std::vector<std::string> expected = {"pmu/voltages", "pmu/health", "pmu/battery", "pmu/battery_cells",
+                                             "pmu/mppt", "pmu/config", "pmu/info", "pmu/command_reply"};
+  std::set<std::string> writers;
+  EXPECT_TRUE(pmu::test::wait_until(
+      [&] {
+        writers = tool.discovery().writer_topics_of("pmu-service");
+        return std::all_of(expected.begin(), expected.end(), [&](const auto& t) { return writers.count(t) > 0; });
+      },
+      30s))
+      << writers.size() << " writers discovered";
+  ASSERT_TRUE(service.running());
+  EXPECT_TRUE(tool.discovery().topics_with_types().empty());
+  EXPECT_EQ(tool.discovery().type_of("pmu/voltages"), nullptr);
 }
 
 TEST(Statistics, ConfiguredTopicsAreWrittenAndNoOthers) {

@@ -94,7 +94,7 @@ const BadCase kBad[] = {
     {"domain: 0\n", "bad.yaml:1: no buses: the service needs at least one bus"},
     {"domian: 0\nbuses: []\n",
      "bad.yaml:1: unknown key 'domian' in the top level (known: domain, vehicle, low_rate_period, qos_file, dds_transport, log_level, "
-     "buses, timeouts, policy, security, discovery, interfaces, canopen_publish_period, dds_statistics)"},
+     "buses, timeouts, policy, security, discovery, interfaces, canopen_publish_period, dds_statistics, dds_type_objects)"},
     {"domain: 0\nvehicle: uav*\nbuses: []\n",
      "bad.yaml:2: vehicle 'uav*' contains '*'; a vehicle name is letters, digits, '_', '-' and '.' (it is also a DDS "
      "partition name, where other characters are patterns)"},
@@ -512,6 +512,26 @@ TEST(Config, MissingFileSaysSo) {
     ADD_FAILURE() << "accepted";
   } catch (const ConfigError& e) {
     EXPECT_EQ(std::string(e.what()), "/nonexistent/pmu.yaml: cannot open the config file");
+  }
+}
+
+// dds_type_objects (interface.md 4.4): off unless true.
+TEST(ConfigTypeObjects, OffUnlessTrueAndRefusedAtItsLineWhenNotABoolean) {
+  EXPECT_FALSE(parse_config(kBus, "s.yaml").dds_type_objects);
+  EXPECT_TRUE(parse_config(std::string("dds_type_objects: true\n") + kBus, "s.yaml").dds_type_objects);
+  EXPECT_FALSE(parse_config(std::string("dds_type_objects: false\n") + kBus, "s.yaml").dds_type_objects);
+  const BadCase bad[] = {
+      {"domain: 3\ndds_type_objects: all\n", "bad.yaml:2: dds_type_objects must be true or false, not 'all'"},
+      {"dds_type_objects: [true]\n", "bad.yaml:1: dds_type_objects must be true or false"},
+  };
+  for (const auto& c : bad) {
+    SCOPED_TRACE(c.yaml);
+    try {
+      (void)parse_config(std::string(c.yaml) + kBus, "bad.yaml");
+      ADD_FAILURE() << "accepted";
+    } catch (const ConfigError& e) {
+      EXPECT_EQ(std::string(e.what()), c.message);
+    }
   }
 }
 

@@ -36,12 +36,22 @@ TEST(TypeObjects, NeverTypeInformationAndTheObjectOnlyWhenSelfContained) {
   TypeSupport health(new pmu::HealthPubSubType());
   for (TypeSupport* t : {&voltages, &cells, &health}) {
     ASSERT_TRUE((*t)->auto_fill_type_information()) << "Fast DDS 2.9.1's default, which this changes";
-    announce_type_object(*t);
+    announce_type_object(*t, true);
     EXPECT_FALSE((*t)->auto_fill_type_information()) << t->get_type_name();
   }
   EXPECT_TRUE(voltages->auto_fill_type_object());
   EXPECT_FALSE(cells->auto_fill_type_object());
   EXPECT_FALSE(health->auto_fill_type_object());
+}
+
+// Off (dds_type_objects absent): nothing, though the objects are registered in this process.
+TEST(TypeObjects, NothingAnnouncedWhenNotEnabled) {
+  register_type_objects();
+  TypeSupport voltages(new pmu::VoltagesPubSubType());
+  ASSERT_TRUE(voltages->auto_fill_type_object()) << "Fast DDS 2.9.1's default, which this changes";
+  announce_type_object(voltages, false);
+  EXPECT_FALSE(voltages->auto_fill_type_object());
+  EXPECT_FALSE(voltages->auto_fill_type_information());
 }
 
 }  // namespace

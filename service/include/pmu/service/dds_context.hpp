@@ -6,8 +6,9 @@
 // Start-up only throws (DdsError: "cannot load QoS profiles from X", "cannot create
 // participant on domain N"); afterwards calls return null or a ReturnCode like Fast DDS.
 //
-// Type objects: the constructor registers the contract's type objects (dds_type_objects.hpp)
-// before anything else, so the endpoints of every program that uses DdsContext announce them.
+// Type objects: with `type_objects` the constructor registers the contract's type objects
+// (dds_type_objects.hpp) before anything else, and the context's endpoints announce them;
+// without (the default) no endpoint announces a type object or TypeInformation.
 //
 // Security: with SecurityFiles (dds_security.hpp) the participant uses DDS-Security's
 // builtin plugins (PKI-DH authentication, Access-Permissions, AES-GCM-GMAC crypto) with
@@ -71,10 +72,11 @@ class DdsContext {
   // `network`: discovery and interface allowlist (dds_network.hpp); default multicast, all.
   // `statistics`: the Fast DDS statistics topics to write (dds_statistics.hpp), checked
   // names; with DDS-Security the permissions must allow publishing each, or DdsError says so.
+  // `type_objects`: announce the self-contained types' type objects (see above).
   DdsContext(int domain, const std::string& qos_file, const std::string& participant_name,
              const SecurityFiles& security = {}, Transport transport = Transport::Default,
              const ResolvedNetwork& network = {}, const Partitions& partitions = {},
-             const std::vector<std::string>& statistics = {});
+             const std::vector<std::string>& statistics = {}, bool type_objects = false);
   ~DdsContext();
   DdsContext(const DdsContext&) = delete;
   DdsContext& operator=(const DdsContext&) = delete;
@@ -87,8 +89,9 @@ class DdsContext {
   const RemoteWriters& remote_writers() const noexcept { return remote_writers_; }
 
   // Registers the type (once) and creates the topic (once). `type` is e.g.
-  // new pmu::VoltagesPubSubType(). Its endpoints announce its type object when it is
-  // self-contained, never its TypeInformation (dds_type_objects.hpp says why). Throws
+  // new pmu::VoltagesPubSubType(). Its endpoints announce its type object when the context
+  // was made with type_objects and the type is self-contained, never its TypeInformation
+  // (dds_type_objects.hpp says why). Throws
   // DdsError at start-up when it fails.
   eprosima::fastdds::dds::Topic& topic(const std::string& name, eprosima::fastdds::dds::TypeSupport type);
 
@@ -106,6 +109,7 @@ class DdsContext {
   [[noreturn]] void refused(const std::string& topic, const std::string& profile, bool publish) const;
 
   int domain_;
+  bool type_objects_;
   std::string qos_file_;
   bool secure_ = false;
   SecurityFiles security_;
