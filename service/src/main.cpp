@@ -279,7 +279,13 @@ int main(int argc, char** argv) {
   app.add_option("--domain", domain, "DDS domain id (0..232)")->check(CLI::Range(0, 232));
   app.add_option("--log-level", log_level, "trace, debug, info, warn, error, critical or off");
   app.add_flag("--check-config", check_only, "Validate the configuration and exit");
-  CLI11_PARSE(app, argc, argv);
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    // app.exit prints the help or the reason; bad usage is exit status 2 (the man page),
+    // not CLI11's own codes (105 for a value out of range).
+    return app.exit(e) == 0 ? 0 : 2;
+  }
 
   service::Config cfg;
   try {

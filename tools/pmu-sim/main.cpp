@@ -50,7 +50,13 @@ int main(int argc, char** argv) {
   app.add_option("--load", load, "Amps drawn from the batteries (default 5)")->check(CLI::Range(0.0, 300.0));
   app.add_option("--sun", sun, "Fixed irradiance in W/m2 (default: a slow cycle, 300..900 over 10 minutes)")
       ->check(CLI::Range(0.0, 1500.0));
-  CLI11_PARSE(app, argc, argv);
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    // app.exit prints the help or the reason; bad usage is exit status 2 (the man page),
+    // not CLI11's own codes (105 for a value out of range).
+    return app.exit(e) == 0 ? 0 : 2;
+  }
 
   const auto fw = pmu::codec::parse_firmware(firmware);
   if (!fw) {

@@ -247,7 +247,13 @@ int main(int argc, char** argv) {
       ->type_name("NAME")
       ->allow_extra_args(false);
 
-  CLI11_PARSE(app, argc, argv);
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    // app.exit prints the help or the reason; bad usage is exit status 2 (the man page),
+    // not CLI11's own codes (105 for a value out of range).
+    return app.exit(e) == 0 ? 0 : 2;
+  }
   if (address >= 0) g.address = static_cast<std::uint16_t>(address);
   if (timeout > 0) g.timeout = timeout;
 
