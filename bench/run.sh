@@ -6,7 +6,8 @@
 #   bench/run.sh [--quick] [--build-dir DIR] [--no-build]
 #     --quick      one short pass of everything (what the test command runs)
 #     --no-build   use the binaries already in the build folder
-# Takes about 11 minutes in full (the zero-loss search runs 30 s per rate tried; the scale
+# Takes about 11 minutes in full (the zero-loss search runs 30 s per rate tried, the realistic
+# rate 60 s for the service, the bare writer and the socketpair hop each; the scale
 # rows, 1-100 PMUs and 1-16 subscriber processes, about 3.5 minutes).
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
