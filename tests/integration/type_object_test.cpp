@@ -167,21 +167,47 @@ pmu::test::Child start_service(int domain, const ConfigFile& config) {
       {PMU_SERVICE_PATH, "--config", config.path, "--domain", std::to_string(domain), "--log-level", "warn"}, o);
 }
 
+// pmu-service on its simulated power system (sim_config with `extra`) and, on the same
+// domain, a participant of a tool that knows none of our types.
+struct ServiceAndTool {
+  explicit ServiceAndTool(const std::string& extra)
+      : domain(pmu::test::exclusive_dds_domain()), config(sim_config(extra)), service(start_service(domain, config)),
+        tool(domain) {}
+  int domain;
+  ConfigFile config;
+  pmu::test::Child service;
+  ToolParticipant tool;
+};
+
+// Waits until the service's writers of `topics` have all been discovered (they come one by
+// one, in no fixed order), and returns the topics of its writers discovered by then.
+std::set<std::string> service_writer_topics(ToolParticipant& tool, const std::vector<std::string>& topics = {
+                                                                        "pmu/voltages", "pmu/health",
+                                                                        "pmu/command_reply"}) {
+  std::set<std::string> found;
+  EXPECT_TRUE(pmu::test::wait_until(
+      [&] {
+        found = tool.discovery().writer_topics_of("pmu-service");
+        return std::all_of(topics.begin(), topics.end(), [&](const auto& t) { return found.count(t) > 0; });
+      },
+      30s))
+      << "of pmu-service's writers only these were discovered: " << ::testing::PrintToString(found);
+  return found;
+}
+
 // The contract's fields of pmu::Voltages in order (interface.md 1): keys first.
 const std::vector<std::string> kVoltagesFields = {"vehicle",  "bus",       "address",   "avionics", "output_28v",
                                                   "payload",  "servo",     "battery_a", "battery_b", "generator"};
 
 TEST(TypeObject, ReaderBuiltFromTheDiscoveredTypeDecodesVoltages) {
-  const int domain = pmu::test::exclusive_dds_domain();
-  ConfigFile config(sim_config("dds_type_objects: true\n"));
-  auto service = start_service(domain, config);
-  ToolParticipant tool(domain);
+  ServiceAndTool run("dds_type_objects: true\n");
+  auto& tool = run.tool;
   ASSERT_NE(tool.get(), nullptr);
 
   types::DynamicType_ptr type;
   ASSERT_TRUE(pmu::test::wait_until([&] { return (type = tool.discovery().type_of("pmu/voltages")) != nullptr; }, 30s))
       << "pmu-service's pmu/voltages writer announced no complete type object";
-  ASSERT_TRUE(service.running());
+  ASSERT_TRUE(run.service.running());
 
   // Type objects only of the self-contained types (dds_type_objects.hpp): a Fast DDS 2.9.1
   // participant that does not know our types, like this one, would drop the enum members of
@@ -190,20 +216,12 @@ TEST(TypeObject, ReaderBuiltFromTheDiscoveredTypeDecodesVoltages) {
       "pmu/voltages", "pmu/currents", "pmu/battery_energy", "pmu/temperatures", "pmu/status",
       "pmu/low_rate/voltages", "pmu/low_rate/currents", "pmu/low_rate/battery_energy", "pmu/low_rate/temperatures",
       "pmu/low_rate/status", "pmu/config", "pmu/info", "pmu/battery", "pmu/mppt"};
-  // The writers are discovered one by one: wait for all of them, those without a type too.
-  const std::vector<std::string> untyped = {"pmu/health", "pmu/battery_cells", "pmu/command_reply"};
-  std::set<std::string> with_types, writers;
-  const bool all_seen = pmu::test::wait_until(
-      [&] {
-        with_types = tool.discovery().topics_with_types();
-        writers = tool.discovery().writer_topics_of("pmu-service");
-        return with_types == self_contained &&
-               std::all_of(untyped.begin(), untyped.end(), [&](const auto& t) { return writers.count(t) > 0; });
-      },
-      30s);
-  EXPECT_TRUE(all_seen);
-  for (const auto& t : untyped) EXPECT_TRUE(writers.count(t)) << t << " was not announced at all";
-  EXPECT_EQ(with_types, self_contained);
+  std::set<std::string> with_types;
+  EXPECT_TRUE(pmu::test::wait_until([&] { return (with_types = tool.discovery().topics_with_types()) == self_contained; },
+                                    30s));
+  // The writers without a type are announced too, and may come after the typed ones.
+  (void)service_writer_topics(tool, {"pmu/health", "pmu/battery_cells", "pmu/command_reply"});
+  EXPECT_EQ(tool.discovery().topics_with_types(), self_contained);
 
   // The type as the tools show it: its name, the contract's field names in order, the keys.
   EXPECT_EQ(type->get_name(), "pmu::Voltages");
@@ -260,20 +278,6 @@ TEST(TypeObject, ReaderBuiltFromTheDiscoveredTypeDecodesVoltages) {
   EXPECT_TRUE(avionics == 0.0f || std::fabs(avionics - 12.0f) < 0.5f) << "avionics = " << avionics;
 }
 
-// Waits until the service's participant has announced its telemetry writers (then every
-// writer it creates at start-up has been announced), and returns its writers' topics.
-std::set<std::string> service_writer_topics(ToolParticipant& tool) {
-  std::set<std::string> topics;
-  EXPECT_TRUE(pmu::test::wait_until(
-      [&] {
-        topics = tool.discovery().writer_topics_of("pmu-service");
-        return topics.count("pmu/voltages") && topics.count("pmu/health") && topics.count("pmu/command_reply");
-      },
-      30s))
-      << "pmu-service's writers were never discovered";
-  return topics;
-}
-
 std::set<std::string> statistics_topics(const std::set<std::string>& topics) {
   std::set<std::string> s;
   for (const auto& t : topics)
@@ -283,32 +287,20 @@ std::set<std::string> statistics_topics(const std::set<std::string>& topics) {
 
 // The default: the service's writers are all discovered, none with a type object.
 TEST(TypeObject, NoneAnnouncedWithoutTheConfigKey) {
-  const int domain = pmu::test::exclusive_dds_domain();
-  ConfigFile config(sim_config(""));
-  auto service = start_service(domain, config);
-  ToolParticipant tool(domain);
+  ServiceAndTool run("");
+  auto& tool = run.tool;
   ASSERT_NE(tool.get(), nullptr);
-  const std::vector<std::string> expected = {"pmu/voltages", "pmu/health", "pmu/battery", "pmu/battery_cells",
-                                             "pmu/mppt", "pmu/config", "pmu/info", "pmu/command_reply"};
-  std::set<std::string> writers;
-  EXPECT_TRUE(pmu::test::wait_until(
-      [&] {
-        writers = tool.discovery().writer_topics_of("pmu-service");
-        return std::all_of(expected.begin(), expected.end(), [&](const auto& t) { return writers.count(t) > 0; });
-      },
-      30s))
-      << writers.size() << " writers discovered";
-  ASSERT_TRUE(service.running());
+  (void)service_writer_topics(tool, {"pmu/voltages", "pmu/health", "pmu/battery", "pmu/battery_cells", "pmu/mppt",
+                                     "pmu/config", "pmu/info", "pmu/command_reply"});
+  ASSERT_TRUE(run.service.running());
   EXPECT_TRUE(tool.discovery().topics_with_types().empty());
   EXPECT_EQ(tool.discovery().type_of("pmu/voltages"), nullptr);
 }
 
 TEST(Statistics, ConfiguredTopicsAreWrittenAndNoOthers) {
-  const int domain = pmu::test::exclusive_dds_domain();
-  ConfigFile config(sim_config(std::string("dds_statistics: [") + stats::HISTORY_LATENCY_TOPIC + ", " +
-                               stats::PUBLICATION_THROUGHPUT_TOPIC + "]\n"));
-  auto service = start_service(domain, config);
-  ToolParticipant tool(domain);
+  ServiceAndTool run(std::string("dds_statistics: [") + stats::HISTORY_LATENCY_TOPIC + ", " +
+                     stats::PUBLICATION_THROUGHPUT_TOPIC + "]\n");
+  auto& tool = run.tool;
   ASSERT_NE(tool.get(), nullptr);
 
   const std::set<std::string> wanted = {stats::HISTORY_LATENCY_TOPIC, stats::PUBLICATION_THROUGHPUT_TOPIC};
@@ -319,16 +311,14 @@ TEST(Statistics, ConfiguredTopicsAreWrittenAndNoOthers) {
   std::this_thread::sleep_for(1s);  // anything else would have been announced with the rest
   EXPECT_EQ(statistics_topics(tool.discovery().writer_topics_of("pmu-service")), wanted);
   // Fast DDS deletes its statistics writers with the participant: a clean stop.
-  const auto status = service.stop(10s);
+  const auto status = run.service.stop(10s);
   ASSERT_TRUE(status.has_value()) << "pmu-service had to be killed";
   EXPECT_TRUE(WIFEXITED(*status) && WEXITSTATUS(*status) == 0) << "wait status " << *status;
 }
 
 TEST(Statistics, NoneWithoutTheConfigKey) {
-  const int domain = pmu::test::exclusive_dds_domain();
-  ConfigFile config(sim_config(""));
-  auto service = start_service(domain, config);
-  ToolParticipant tool(domain);
+  ServiceAndTool run("");
+  auto& tool = run.tool;
   ASSERT_NE(tool.get(), nullptr);
 
   (void)service_writer_topics(tool);

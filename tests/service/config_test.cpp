@@ -88,6 +88,17 @@ struct BadCase {
   const char* message;  // the whole "FILE:LINE: ..." text
 };
 
+// `yaml`, parsed as bad.yaml, is refused with exactly `message`.
+void expect_refused(const std::string& yaml, const std::string& message) {
+  SCOPED_TRACE(yaml);
+  try {
+    (void)parse_config(yaml, "bad.yaml");
+    ADD_FAILURE() << "accepted";
+  } catch (const ConfigError& e) {
+    EXPECT_EQ(std::string(e.what()), message);
+  }
+}
+
 const BadCase kBad[] = {
     {"", "bad.yaml:1: the file is empty"},
     {"buses: [\n", "bad.yaml:2: YAML syntax error: end of sequence flow not found"},
@@ -180,15 +191,7 @@ const BadCase kBad[] = {
 };
 
 TEST(Config, EveryBadValueIsRefusedWithItsLine) {
-  for (const auto& c : kBad) {
-    SCOPED_TRACE(c.yaml);
-    try {
-      (void)parse_config(c.yaml, "bad.yaml");
-      ADD_FAILURE() << "accepted";
-    } catch (const ConfigError& e) {
-      EXPECT_EQ(std::string(e.what()), c.message);
-    }
-  }
+  for (const auto& c : kBad) expect_refused(c.yaml, c.message);
 }
 
 // discovery: and interfaces: (interface.md 2.1). Each case is appended to a valid bus
@@ -288,16 +291,7 @@ const BadCase kBadNetwork[] = {
 };
 
 TEST(ConfigNetwork, EveryBadValueIsRefusedWithItsLine) {
-  for (const auto& c : kBadNetwork) {
-    const std::string yaml = std::string(kBus) + c.yaml;
-    SCOPED_TRACE(yaml);
-    try {
-      (void)parse_config(yaml, "bad.yaml");
-      ADD_FAILURE() << "accepted";
-    } catch (const ConfigError& e) {
-      EXPECT_EQ(std::string(e.what()), c.message);
-    }
-  }
+  for (const auto& c : kBadNetwork) expect_refused(std::string(kBus) + c.yaml, c.message);
 }
 
 TEST(ConfigNetwork, DiscoveryServerWithSecurityIsRefusedAtTheModeLine) {
@@ -524,15 +518,7 @@ TEST(ConfigTypeObjects, OffUnlessTrueAndRefusedAtItsLineWhenNotABoolean) {
       {"domain: 3\ndds_type_objects: all\n", "bad.yaml:2: dds_type_objects must be true or false, not 'all'"},
       {"dds_type_objects: [true]\n", "bad.yaml:1: dds_type_objects must be true or false"},
   };
-  for (const auto& c : bad) {
-    SCOPED_TRACE(c.yaml);
-    try {
-      (void)parse_config(std::string(c.yaml) + kBus, "bad.yaml");
-      ADD_FAILURE() << "accepted";
-    } catch (const ConfigError& e) {
-      EXPECT_EQ(std::string(e.what()), c.message);
-    }
-  }
+  for (const auto& c : bad) expect_refused(c.yaml + std::string(kBus), c.message);
 }
 
 // dds_statistics (interface.md 4.5): Fast DDS's statistics topic names, or all; Fast DDS
@@ -570,15 +556,7 @@ TEST(ConfigStatistics, UnknownOrRepeatedTopicIsRefusedAtItsLine) {
       {"dds_statistics:\n",
        "bad.yaml:1: dds_statistics must be all or a list of statistics topic names (may be empty: [])"},
   };
-  for (const auto& c : bad) {
-    SCOPED_TRACE(c.yaml);
-    try {
-      (void)parse_config(std::string(c.yaml) + kBus, "bad.yaml");
-      ADD_FAILURE() << "accepted";
-    } catch (const ConfigError& e) {
-      EXPECT_EQ(std::string(e.what()), c.message);
-    }
-  }
+  for (const auto& c : bad) expect_refused(c.yaml + std::string(kBus), c.message);
 }
 
 TEST(Config, BusOverride) {

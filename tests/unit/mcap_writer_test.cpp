@@ -263,6 +263,7 @@ TEST(McapWriter, DiskFullCutsBackToTheLastChunkAndEndsTheFile) {
   ASSERT_TRUE(w2.write(c2, 1, 1, d, sizeof d));
   sink2.capacity = sink2.bytes.size() + 100;
   EXPECT_FALSE(w2.write(c2, 2, 2, d, 40));
+  EXPECT_FALSE(w2.write(c2, 2, 2, d, 40));
   EXPECT_FALSE(w2.close());
   const Parsed p2 = parse(sink2.bytes);
   EXPECT_TRUE(p2.footer);

@@ -9,23 +9,19 @@ namespace pmu::mcap {
 
 Writer::Writer(Sink& sink, WriterOptions options) : sink_(sink), options_(std::move(options)) {}
 
-namespace {
-// DataEnd (1 + 8 + 4), Footer (1 + 8 + 20) and the magic: what ends a file whose summary did not fit.
-constexpr std::uint64_t kEndingSize = 13 + 29 + 8;
-}  // namespace
-
 bool Writer::emit(const Bytes& block, bool data_section, bool reserve_ending) {
   if (error_ != 0) return false;
   // The block and, after it, room for the ending: when the disk fills, the failure comes here,
   // before anything is written, and the room reserved with the previous block is still there.
-  if (const int e = reserve_ending ? sink_.reserve(offset_, block.size() + kEndingSize) : 0; e != 0) {
+  const std::uint64_t ending = reserve_ending ? ending_without_summary().size() : 0;  // 50 bytes
+  if (const int e = reserve_ending ? sink_.reserve(offset_, block.size() + ending) : 0; e != 0) {
     error_ = e;
     return false;
   }
   if (const int e = sink_.write(block.data(), block.size()); e != 0) {
     error_ = e;
     sink_.truncate(offset_);  // the file ends at the last complete block again
-    sink_.reserve(offset_, kEndingSize);  // truncating freed what was reserved past the end
+    if (reserve_ending) sink_.reserve(offset_, ending);  // truncating freed what was reserved past the end
     return false;
   }
   if (data_section) data_crc_ = crc32(data_crc_, block.data(), block.size());

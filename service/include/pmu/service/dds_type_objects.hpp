@@ -17,16 +17,18 @@
 // datagram grows from 7.0 kB to 16.9 kB, from 5 IP fragments to 12 at a 1500-byte MTU. Over
 // a ground link with 10 % loss such a datagram arrives whole in 28 % of the tries instead of
 // 59 %; with them on, the network lab's fleet scenario failed twice in two runs (a late
-// pmuctl got no pmu/config in 30 s; gnd listed no vehicle in 90 s). Never the XTypes 1.2 TypeInformation (PID 0x75), which Fast
-// DDS 2.9.1 sends by default: Eclipse Cyclone DDS 0.10.2 cannot parse Fast DDS 2.9.1's
-// (its log: "invalid parameter list ... pid 75 (TYPE_INFORMATION) invalid") and drops the
-// whole endpoint announcement, so it matches nothing of ours (measured with it on: the
-// crossvendor client missed all 9 of its checks). The type object (PIDs 0x72 and 0x69, which other vendors
-// skip) only when it is self-contained (type_object_is_self_contained): every Fast DDS 2.9.1
-// participant that does not know a type builds a DynamicType from each type object it
-// discovers (PDP::check_and_notify_type_discovery), and for a member whose type is only named
-// by its hash it drops the member (an enum: pmu::Health's kind) or crashes in its receive
-// thread (measured: a sequence of a struct, pmu::BatteryCells' cells, SIGSEGV in
+// pmuctl got no pmu/config in 30 s; gnd listed no vehicle in 90 s).
+//
+// Never the XTypes 1.2 TypeInformation (PID 0x75), which Fast DDS 2.9.1 sends by default:
+// Eclipse Cyclone DDS 0.10.2 cannot parse Fast DDS 2.9.1's (its log: "invalid parameter list
+// ... pid 75 (TYPE_INFORMATION) invalid") and drops the whole endpoint announcement, so it
+// matches nothing of ours (measured with it on: the crossvendor client missed all 9 of its
+// checks). The type object (PIDs 0x72 and 0x69, which other vendors skip) only when it is
+// self-contained (type_object_is_self_contained): every Fast DDS 2.9.1 participant that does
+// not know a type builds a DynamicType from each type object it discovers
+// (PDP::check_and_notify_type_discovery), and for a member whose type is only named by its
+// hash it drops the member (an enum: pmu::Health's kind) or crashes in its receive thread
+// (measured: a sequence of a struct, pmu::BatteryCells' cells, SIGSEGV in
 // TypeObjectFactory::get_sequence_identifier). A third party's Fast DDS 2.9 client without
 // our type objects would be killed by discovering pmu/battery_cells.
 
