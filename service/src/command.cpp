@@ -222,7 +222,9 @@ std::string describe(const CommandRequest& r) {
         }
       },
       r.action);
-  s += " to " + device_path(r.vehicle, r.bus, r.address);
+  s += r.bus.empty() && r.address == codec::kBroadcastAddress
+           ? " to every PMU on every bus" + (r.vehicle.empty() ? std::string() : " of " + printable(r.vehicle))
+           : " to " + device_path(r.vehicle, r.bus, r.address);
   if (r.confirm) s += " (confirmed)";
   return s;
 }

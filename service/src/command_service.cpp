@@ -3,6 +3,7 @@
 #include <spdlog/spdlog.h>
 
 #include <cstdio>
+#include <memory>
 
 #include "pmu/codec/encode.hpp"
 #include "pmu/codec/ids.hpp"
@@ -109,6 +110,9 @@ void CommandService::submit(const CommandSample& s) {
   auto parsed = parse_command(s, Now{clock_.system_now(), clock_.steady_now()}, policy_.lifetimes);
   if (!parsed) return finish(key, s.sender, describe(s), make_reply(s, CommandResult::Rejected, parsed.error()));
   const CommandRequest& r = *parsed;
+  // parse_command lets only engine_stop through to the broadcast address; a stop is never
+  // judged nor held back by the rate limit.
+  if (r.bus.empty() && r.address == codec::kBroadcastAddress) return broadcast_on_every_bus(r);
   BusWorker* worker = worker_for(r.bus);
   if (!worker) return refuse(r, not_served(r));
   if (auto no = judge(r)) return refuse(r, *no);
@@ -186,6 +190,36 @@ void CommandService::broadcast(BusWorker& worker, const CommandRequest& r) {
   const auto sent = worker.bus().send(*codec::encode_engine_stop(r.address), timeouts_.send);
   if (sent.ok()) return answer(r, CommandResult::Completed, "stop sent to every PMU (broadcast)");
   answer(r, CommandResult::Failed, "bus refused the engine stop: " + std::string(transport::to_string(sent.status)));
+}
+
+void CommandService::broadcast_on_every_bus(const CommandRequest& r) {
+  if (workers_.empty()) return answer(r, CommandResult::Failed, "this service serves no bus");
+  // Each bus is sent to on its own worker's thread; the last one to finish answers, so the
+  // request still gets exactly one final reply.
+  struct Round {
+    std::mutex mutex;
+    std::size_t left;
+    std::string sent, refused;
+  };
+  auto round = std::make_shared<Round>();
+  round->left = workers_.size();
+  for (auto* w : workers_)
+    w->post([this, w, r, round] {
+      const auto sent = w->bus().send(*codec::encode_engine_stop(codec::kBroadcastAddress), timeouts_.send);
+      std::string done, failed;
+      {
+        std::lock_guard<std::mutex> lock(round->mutex);
+        std::string& list = sent.ok() ? round->sent : round->refused;
+        list += (list.empty() ? "" : ", ") + w->config().name +
+                (sent.ok() ? std::string() : " (" + std::string(transport::to_string(sent.status)) + ")");
+        if (--round->left > 0) return;
+        done = round->sent;
+        failed = round->refused;
+      }
+      if (failed.empty()) return answer(r, CommandResult::Completed, "stop sent to every PMU (broadcast) on " + done);
+      answer(r, CommandResult::Failed,
+             "bus refused the engine stop: " + failed + (done.empty() ? std::string() : "; sent on " + done));
+    });
 }
 
 std::optional<CommandService::Refusal> CommandService::check_device(BusWorker& worker, const DeviceSession* session,

@@ -362,6 +362,23 @@ TEST(Commands, DenyListRefusesEvenConfirmedCommandsButNeverEngineStop) {
   EXPECT_EQ(c.run(c.req(CommandKind::EngineStop)).result, CommandResult::Completed);
 }
 
+// An engine stop to the broadcast address that names no bus goes out on every bus the
+// service serves, with one reply; every other kind is refused at the boundary, frameless.
+TEST(Commands, BroadcastStopWithoutABusGoesOutOnEveryBus) {
+  Commands c({pmu(1)});
+  auto stop = c.req(CommandKind::EngineStop, codec::kBroadcastAddress);
+  stop.bus = "";
+  const auto r = c.run(stop);
+  EXPECT_EQ(r.result, CommandResult::Completed);
+  EXPECT_EQ(r.reason, "stop sent to every PMU (broadcast) on sim0");
+  EXPECT_EQ(c.sent(), (std::vector<std::string>{hex(frame(0x25, 0xFFFF, {}))}));
+  c.h.clear_sent();
+  auto get = c.req(CommandKind::GetSerial, codec::kBroadcastAddress);
+  get.bus = "";
+  EXPECT_EQ(c.run(get).result, CommandResult::Rejected);
+  EXPECT_TRUE(c.sent().empty());
+}
+
 TEST(Commands, RateLimitRejectsTheExcessWithAReasonButNeverEngineStop) {
   PolicyConfig p;
   p.rate_per_second = 1;

@@ -78,6 +78,8 @@ class CommandService {
   // ...and on the bus worker's thread:
   void run_on_worker(BusWorker& worker, const CommandRequest& r);
   void broadcast(BusWorker& worker, const CommandRequest& r);
+  // An engine stop to the broadcast address with no bus named: sent on every bus served.
+  void broadcast_on_every_bus(const CommandRequest& r);
   // Known, read (firmware known) and, for an address change, the new address free.
   std::optional<Refusal> check_device(BusWorker& worker, const DeviceSession* session, const CommandRequest& r);
 
