@@ -24,3 +24,18 @@ configure_file(${CMAKE_CURRENT_LIST_DIR}/sysconf_dir.hpp.in
 add_library(pmu_sysconf_dir INTERFACE)
 target_include_directories(pmu_sysconf_dir INTERFACE ${PROJECT_BINARY_DIR}/generated/include)
 add_library(pmu::sysconf_dir ALIAS pmu_sysconf_dir)
+
+# The release and contract versions every program's --version prints (pmu::version). The
+# release is the package's: a version in CMakeLists.txt that debian/changelog does not carry
+# would make `--version` lie about the installed package.
+set(PMU_CONTRACT_VERSION 3)
+file(STRINGS ${PROJECT_SOURCE_DIR}/debian/changelog pmu_changelog_head LIMIT_COUNT 1)
+if(NOT pmu_changelog_head MATCHES "^pmu-dds \\(${PROJECT_VERSION}-[^)]+\\)")
+  message(FATAL_ERROR "debian/changelog's newest entry (${pmu_changelog_head}) is not version ${PROJECT_VERSION} "
+                      "of CMakeLists.txt's project(): change both together")
+endif()
+configure_file(${CMAKE_CURRENT_LIST_DIR}/version.hpp.in
+               ${PROJECT_BINARY_DIR}/generated/include/pmu/version.hpp @ONLY)
+add_library(pmu_version INTERFACE)
+target_include_directories(pmu_version INTERFACE ${PROJECT_BINARY_DIR}/generated/include)
+add_library(pmu::version ALIAS pmu_version)

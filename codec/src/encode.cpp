@@ -138,9 +138,9 @@ Result<std::uint32_t, EncodeError> to_raw(Parameter p, double value, std::option
   if (s.kind == ParameterKind::Mask) {
     const double r = std::round(x);
     if (std::fabs(x - r) > kStepTolerance || r < 0 || r > 255) {
-      EncodeError e = error(EncodeErrorKind::OutOfRange, s.name, value);
-      e.min = 0;
-      e.max = 255;
+      // Said as the mask the spec defines (0..0x1F for PS), not the byte's 0..255.
+      EncodeError e = error(EncodeErrorKind::InvalidBits, s.name, value);
+      e.bits = s.raw_max;
       return Unexpected{e};
     }
     const auto raw = static_cast<std::uint32_t>(r);
@@ -302,6 +302,8 @@ std::string EncodeError::describe() const {
              number(min, decimals) + u;
     case EncodeErrorKind::InvalidBits:
       std::snprintf(hex, sizeof hex, "0x%02X", bits);
+      if (!(value >= 0) || value != std::round(value) || value > 255)
+        return f + ": value " + number(value, 0) + " is not a bit mask 0.." + hex;
       return f + " " + number(value, 0) + " has bits outside the defined mask " + hex;
     case EncodeErrorKind::Unsupported: {
       std::string s = f + " needs firmware " + (needs ? to_string(*needs) : std::string("newer"));

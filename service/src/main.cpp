@@ -35,6 +35,7 @@
 #include "pmu/service/vehicle.hpp"
 #include "pmu/sim/bus_runner.hpp"
 #include "pmu/sysconf_dir.hpp"
+#include "pmu/version.hpp"
 #include "pmu/transport/sim_bus.hpp"
 #include "pmu/transport/socketcan_bus.hpp"
 
@@ -270,6 +271,7 @@ std::optional<pmu::dds::ResolvedNetwork> resolved_network(const service::Config&
 
 int main(int argc, char** argv) {
   CLI::App app{"pmu-service: Millswood 250W PMUs on CAN, served on DDS"};
+  app.set_version_flag("--version", "pmu-service " PMU_VERSION_TEXT);
   std::string config_path, bus_spec, log_level;
   std::optional<int> domain;
   bool check_only = false;

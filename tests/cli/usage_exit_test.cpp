@@ -3,6 +3,7 @@
 // help exits 0. CLI11 alone would exit with its own codes (105 for a value out of range).
 #include <gtest/gtest.h>
 
+#include <fstream>
 #include <string>
 
 #include "support/process.hpp"
@@ -43,6 +44,28 @@ TEST(Usage, HelpExitsZero) {
     EXPECT_EQ(r.status, 0);
     EXPECT_NE(r.out.find("--help"), std::string::npos) << r.out;
   }
+}
+
+// --version names the program, the release of CMakeLists.txt (and debian/changelog, which
+// the configure step holds to it) and the contract version of docs/interface.md's head.
+TEST(Usage, VersionNamesTheReleaseAndTheContract) {
+  const struct {
+    const char* path;
+    const char* name;
+  } programs[] = {{PMUCTL_PATH, "pmuctl"}, {PMU_SERVICE_PATH, "pmu-service"}, {PMU_SIM_PATH, "pmu-sim"}};
+  for (const auto& p : programs) {
+    SCOPED_TRACE(p.name);
+    const auto r = pmu::test::run_capture(std::string(p.path) + " --version");
+    EXPECT_EQ(r.status, 0);
+    EXPECT_EQ(r.out, std::string(p.name) + " " PMU_RELEASE " (pmu-dds contract v" PMU_CONTRACT ")\n");
+  }
+}
+
+TEST(Usage, TheContractsHeadNamesTheVersionTheProgramsPrint) {
+  std::ifstream in(PMU_INTERFACE_MD);
+  std::string head;
+  ASSERT_TRUE(std::getline(in, head)) << PMU_INTERFACE_MD;
+  EXPECT_NE(head.find("(contract v" PMU_CONTRACT ")"), std::string::npos) << head;
 }
 
 }  // namespace

@@ -44,6 +44,32 @@ TEST(LogDecoder, ScreenFormatHasNullTime) {
   EXPECT_EQ(j["values"]["avionics_voltage"], 12.3);
 }
 
+// candump -td writes the time since the previous frame, -tz since its start: not dates.
+// They are decoded as given and counted, so that pmuctl can say so.
+TEST(LogDecoder, RelativeTimesAreCountedNotTakenForDates) {
+  LogDecoder d({true, std::nullopt});
+  const struct {
+    const char* line;
+    bool relative;
+  } lines[] = {
+      {"(000.000000) can0 1E000001#7BA07B3CC8C83F", true},
+      {"(000.100250) can0 1E000001#7BA07B3CC8C83F", true},
+      {"(99999999.999999) can0 1E000001#7BA07B3CC8C83F", true},
+      {"(100000000.000000) can0 1E000001#7BA07B3CC8C83F", false},
+      {"(1700000000.000000) can0 1E000001#7BA07B3CC8C83F", false},
+      {"  can0  1E000001   [2]  FA 0A", false},
+  };
+  std::uint64_t expected = 0;
+  for (const auto& l : lines) {
+    SCOPED_TRACE(l.line);
+    (void)decode_one(d, l.line);
+    expected += l.relative ? 1 : 0;
+    EXPECT_EQ(d.counts().relative_times, expected);
+  }
+  const json j = decode_one(d, "(000.100250) can0 1E000001#7BA07B3CC8C83F");
+  EXPECT_DOUBLE_EQ(j["time"].get<double>(), 0.10025);
+}
+
 TEST(LogDecoder, ZeroLengthRequestHasNoValues) {
   LogDecoder d({true, std::nullopt});
   const json j = decode_one(d, "(1.5) can0 1E31FFFF#");

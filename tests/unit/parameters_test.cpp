@@ -129,6 +129,26 @@ TEST(Parameters, PacketsStreamedMaskBits0To4) {
   EXPECT_FALSE(encode_set(Parameter::PacketsStreamed, -1, 1).ok());
 }
 
+// A value that is no mask at all is refused with the spec's mask, never the byte's 0..255.
+TEST(Parameters, ANonMaskValueIsRefusedWithTheDefinedMask) {
+  const struct {
+    double value;
+    const char* message;
+  } cases[] = {
+      {-1, "packets_streamed: value -1 is not a bit mask 0..0x1F"},
+      {1.5, "packets_streamed: value 1.5 is not a bit mask 0..0x1F"},
+      {256, "packets_streamed: value 256 is not a bit mask 0..0x1F"},
+      {0x20, "packets_streamed 32 has bits outside the defined mask 0x1F"},
+  };
+  for (const auto& c : cases) {
+    SCOPED_TRACE(c.value);
+    auto f = encode_set(Parameter::PacketsStreamed, c.value, 1);
+    ASSERT_FALSE(f.ok());
+    EXPECT_EQ(f.error().kind, EncodeErrorKind::InvalidBits);
+    EXPECT_EQ(f.error().describe(), c.message);
+  }
+}
+
 struct PowerUpCase {
   std::optional<FirmwareVersion> fw;
   std::uint8_t value;

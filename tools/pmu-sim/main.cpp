@@ -17,9 +17,11 @@
 #include "pmu/codec/ids.hpp"
 #include "pmu/sim/bus_runner.hpp"
 #include "pmu/transport/socketcan_bus.hpp"
+#include "pmu/version.hpp"
 
 int main(int argc, char** argv) {
   CLI::App app{"pmu-sim: a simulated Millswood 250W PMU (and solar-boat battery/MPPTs) on a SocketCAN interface"};
+  app.set_version_flag("--version", "pmu-sim " PMU_VERSION_TEXT);
   std::string iface, firmware = "1.17";
   std::vector<int> addresses;
   int serial = 1;

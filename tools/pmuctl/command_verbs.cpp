@@ -7,10 +7,12 @@
 #include <fastdds/dds/core/status/PublicationMatchedStatus.hpp>
 #include <fastdds/dds/core/status/SubscriptionMatchedStatus.hpp>
 #include <fastdds/dds/subscriber/SampleInfo.hpp>
+#include <optional>
 #include <set>
 #include <thread>
 #include <vector>
 
+#include "pmu/codec/ids.hpp"
 #include "pmu/codec/messages.hpp"
 #include "pmu/idl/guarded_type.hpp"
 #include "pmu/idl/command.h"
@@ -21,6 +23,8 @@
 #include "pmu/service/command.hpp"
 #include "pmu/service/dds_context.hpp"
 #include "pmuctl/dds_json.hpp"
+#include "pmuctl/exit_status.hpp"
+#include "pmuctl/service_presence.hpp"
 
 namespace pmu::tools {
 namespace {
@@ -43,31 +47,21 @@ std::string request_id() {
   return "pmuctl-" + std::string(host).substr(0, 24) + "-" + std::to_string(::getpid()) + "-" + std::to_string(ns);
 }
 
-std::string vehicle_text(const std::string& vehicle) {
-  return vehicle.empty() ? "the unnamed vehicle" : "vehicle " + vehicle;
-}
-
-// ": vehicles seen: uav1, uav2 (choose one with --vehicle)", or "" when none was seen.
-std::string other_vehicles(const std::set<std::string>& seen) {
-  if (seen.empty()) return {};
-  std::string list;
-  for (const auto& v : seen) list += (list.empty() ? "" : ", ") + (v.empty() ? std::string("(unnamed)") : v);
-  return "; vehicles seen: " + list + " (choose one with --vehicle)";
-}
-
-// Finds the device the command is for: --bus/--address when given, else the only PMU the
-// service knows. Returns false with a message a person can act on.
+// Finds the PMU the command is for: --bus/--address when both are given, else the only PMU
+// (Health.kind: batteries and MPPTs take no commands) the service of `vehicle` knows.
+// nullopt when found; else the exit status, after saying why in words a person can act on.
 // The vehicle is never guessed: a command names --vehicle, or goes to the unnamed vehicle.
-bool resolve_target(const GlobalOptions& o, const std::string& vehicle, pmu::dds::DdsContext& dds,
-                    Clock::time_point deadline, std::string& bus, std::uint16_t& address,
-                    std::set<std::string>& vehicles_seen) {
+std::optional<int> resolve_target(const GlobalOptions& o, const std::string& vehicle, pmu::dds::DdsContext& dds,
+                                  Clock::time_point deadline, std::string& bus, std::uint16_t& address) {
   if (!o.bus.empty() && o.address) {
     bus = o.bus;
     address = *o.address;
-    return true;
+    return std::nullopt;
   }
-  DataReader& r = dds.reader(dds.topic(topics::kHealth, TypeSupport(new idl::Guarded<pmu::HealthPubSubType>())), qos_profiles::kState);
+  DataReader& r = dds.reader(dds.topic(topics::kHealth, TypeSupport(new idl::Guarded<pmu::HealthPubSubType>())),
+                             qos_profiles::kState);
   std::set<std::pair<std::string, std::uint16_t>> seen;
+  std::set<std::string> vehicles_seen;
   std::optional<Clock::time_point> settle;
   while (Clock::now() < deadline) {
     pmu::Health h;
@@ -75,8 +69,8 @@ bool resolve_target(const GlobalOptions& o, const std::string& vehicle, pmu::dds
     while (r.take_next_sample(&h, &info) == ReturnCode_t::RETCODE_OK) {
       if (!info.valid_data) continue;
       vehicles_seen.insert(h.vehicle().to_string());
-      if (h.vehicle().to_string() == vehicle && (o.bus.empty() || o.bus == h.bus().to_string()) &&
-          (!o.address || *o.address == h.address()))
+      if (h.kind() == pmu::KIND_PMU && h.vehicle().to_string() == vehicle &&
+          (o.bus.empty() || o.bus == h.bus().to_string()) && (!o.address || *o.address == h.address()))
         seen.insert({h.bus().to_string(), h.address()});
     }
     if (!seen.empty() && !settle) settle = Clock::now() + std::chrono::milliseconds(300);
@@ -85,31 +79,24 @@ bool resolve_target(const GlobalOptions& o, const std::string& vehicle, pmu::dds
   }
   SubscriptionMatchedStatus st;
   r.get_subscription_matched_status(st);
-  if (st.current_count == 0) {
-    std::fprintf(stderr, "pmuctl: no pmu-service on domain %d\n", o.domain);
-    return false;
-  }
-  if (seen.empty() && !vehicles_seen.count(vehicle)) {
-    std::fprintf(stderr, "pmuctl: no pmu-service of %s on domain %d%s\n", vehicle_text(vehicle).c_str(), o.domain,
-                 other_vehicles(vehicles_seen).c_str());
-    return false;
-  }
-  if (seen.empty()) {
-    if (o.address)
-      std::fprintf(stderr, "pmuctl: device %u not seen%s\n", *o.address, o.bus.empty() ? "" : (" on " + o.bus).c_str());
-    else
-      std::fprintf(stderr, "pmuctl: the service knows no PMU%s\n", o.bus.empty() ? "" : (" on " + o.bus).c_str());
-    return false;
-  }
+  if (st.current_count == 0) return no_service(o, dds);
+  if (seen.empty() && !vehicles_seen.count(vehicle))
+    return fail(o, ExitStatus::BadUsage,
+                "no pmu-service of " + vehicle_text(vehicle) + " on domain " + std::to_string(o.domain) +
+                    vehicles_seen_text(vehicles_seen));
+  const std::string on_bus = o.bus.empty() ? std::string() : " on " + o.bus;
+  if (seen.empty())
+    return fail(o, ExitStatus::BadUsage,
+                o.address ? "PMU " + std::to_string(*o.address) + " not seen" + on_bus
+                          : "the service knows no PMU" + on_bus);
   if (seen.size() > 1) {
     std::string list;
     for (const auto& [b, a] : seen) list += (list.empty() ? "" : ", ") + b + "/" + std::to_string(a);
-    std::fprintf(stderr, "pmuctl: several PMUs (%s): choose one with --bus and --address\n", list.c_str());
-    return false;
+    return fail(o, ExitStatus::BadUsage, "several PMUs (" + list + "): choose one with --bus and --address");
   }
   bus = seen.begin()->first;
   address = seen.begin()->second;
-  return true;
+  return std::nullopt;
 }
 
 }  // namespace
@@ -147,6 +134,11 @@ bool group_mask(const std::vector<std::string>& names, std::uint8_t& mask) {
   return true;
 }
 
+std::string broadcast_refusal(const GlobalOptions& o, int kind) {
+  if (!o.address || *o.address != codec::kBroadcastAddress || kind == pmu::ENGINE_STOP) return {};
+  return "--address 65535 (broadcast) is only for `engine stop`: every other command names one PMU";
+}
+
 int run_command(const GlobalOptions& o, const CommandSpec& spec) {
   const double timeout = o.timeout.value_or(5.0);
   const auto deadline = Clock::now() + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(timeout));
@@ -159,10 +151,14 @@ int run_command(const GlobalOptions& o, const CommandSpec& spec) {
   DataWriter& writer =
       dds.writer(dds.topic(topics::kCommand, TypeSupport(new pmu::CommandPubSubType())), qos_profiles::kCommand);
 
-  std::string bus;
-  std::uint16_t address = 0;
-  std::set<std::string> vehicles_seen;
-  if (!resolve_target(o, vehicle, dds, deadline, bus, address, vehicles_seen)) return 2;
+  // A stop to the broadcast address needs no PMU seen: with --bus it goes to that bus, without
+  // to every bus of the service (bus ""), so an engine can be stopped whatever the service
+  // has read so far.
+  const bool broadcast = spec.kind == pmu::ENGINE_STOP && o.address && *o.address == codec::kBroadcastAddress;
+  std::string bus = broadcast ? o.bus : std::string();
+  std::uint16_t address = broadcast ? codec::kBroadcastAddress : 0;
+  if (!broadcast)
+    if (const auto failed = resolve_target(o, vehicle, dds, deadline, bus, address)) return *failed;
 
   // Send only once the service's command reader and reply writer are matched: a command
   // written before that would be lost, and a reply sent before it would never be seen.
@@ -173,9 +169,10 @@ int run_command(const GlobalOptions& o, const CommandSpec& spec) {
     replies.get_subscription_matched_status(sub);
     if (pub.current_count > 0 && sub.current_count > 0) break;
     if (Clock::now() >= deadline) {
-      std::fprintf(stderr, "pmuctl: no pmu-service of %s on domain %d accepts commands%s\n",
-                   vehicle_text(vehicle).c_str(), o.domain, other_vehicles(vehicles_seen).c_str());
-      return 2;
+      if (pub.current_count == 0 && sub.current_count == 0) return no_service(o, dds);
+      return fail(o, ExitStatus::NoAnswer,
+                  "no pmu-service of " + vehicle_text(vehicle) + " on domain " + std::to_string(o.domain) +
+                      " accepts commands" + vehicles_seen_text(vehicles_on_domain(dds)));
     }
     std::this_thread::sleep_for(std::chrono::milliseconds(10));
   }
@@ -197,10 +194,8 @@ int run_command(const GlobalOptions& o, const CommandSpec& spec) {
   c.expires_at(static_cast<std::uint64_t>(
       std::chrono::duration_cast<std::chrono::nanoseconds>(expires.time_since_epoch()).count()));
   c.confirm(spec.confirm);
-  if (!writer.write(&c)) {  // bool in Fast DDS 2.x
-    std::fprintf(stderr, "pmuctl: the command could not be written to DDS\n");
-    return 2;
-  }
+  if (!writer.write(&c))  // bool in Fast DDS 2.x
+    return fail(o, ExitStatus::NotDone, "the command could not be written to DDS");
 
   // A request that met no reply is sent again with the same id (interface.md 4.2: answered
   // again, never executed twice): a reader that matched a moment too late, or a service that
@@ -231,7 +226,7 @@ int run_command(const GlobalOptions& o, const CommandSpec& spec) {
                {"reason", r.reason().to_string()}};
         if (r.has_value()) j["value"] = r.value();
         if (!(r.value_text().size() == 0)) j["value_text"] = r.value_text().to_string();
-        std::printf("%s\n", j.dump().c_str());
+        std::printf("%s\n", j.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace).c_str());
       } else if (r.has_value() || !(r.value_text().size() == 0)) {
         if (!(r.value_text().size() == 0))
           std::printf("%s\n", r.value_text().c_str());
@@ -239,12 +234,22 @@ int run_command(const GlobalOptions& o, const CommandSpec& spec) {
           std::printf("%g\n", r.value());
       }
       std::fprintf(stderr, "%s%s%s\n", result_name(r.result()), (r.reason().size() == 0) ? "" : ": ", r.reason().c_str());
-      return r.result() == pmu::COMPLETED ? 0 : 1;
+      return static_cast<int>(r.result() == pmu::COMPLETED ? ExitStatus::Ok : ExitStatus::NotDone);
     }
     std::this_thread::sleep_for(std::chrono::milliseconds(5));
   }
-  std::fprintf(stderr, "pmuctl: no reply from pmu-service within %.1f s (request %s)\n", timeout, id.c_str());
-  return 3;
+  char waited[96];
+  std::snprintf(waited, sizeof waited, "no reply from pmu-service within %.1f s (request ", timeout);
+  const std::string message = waited + id + ")";
+  std::fprintf(stderr, "pmuctl: %s\n", message.c_str());
+  if (o.json) {
+    // The line of a reply that never came: the same keys, a null result.
+    Json j{{"request_id", id},     {"vehicle", vehicle},  {"bus", bus},
+           {"address", address},   {"result", nullptr},   {"reason", message},
+           {"exit_status", static_cast<int>(ExitStatus::NoAnswer)}};
+    std::printf("%s\n", j.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace).c_str());
+  }
+  return static_cast<int>(ExitStatus::NoAnswer);
 }
 
 }  // namespace pmu::tools

@@ -1,6 +1,7 @@
 #pragma once
 // pmuctl's command verbs (interface.md section 2): one pmu::Command, exactly one final
-// pmu::CommandReply. Exit status 0 only for COMPLETED; the result and reason go to stderr.
+// pmu::CommandReply. Exit status 0 only for COMPLETED (exit_status.hpp); the result and
+// reason go to stderr.
 
 #include <cstdint>
 #include <string>
@@ -21,6 +22,10 @@ struct CommandSpec {
 };
 
 int run_command(const GlobalOptions& o, const CommandSpec& spec);
+
+// Why --address 65535 may not go with this command kind, or "" when it may (engine stop alone,
+// or another address).
+std::string broadcast_refusal(const GlobalOptions& o, int kind);
 
 // "avionics_servo" -> bit 0 ... ; false (with a message on stderr) for an unknown name.
 bool output_mask(const std::vector<std::string>& names, std::uint8_t& mask);

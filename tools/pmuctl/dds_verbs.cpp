@@ -22,8 +22,11 @@
 #include "pmu/idl/telemetryPubSubTypes.h"
 #include "pmu/idl/topics.hpp"
 #include "pmu/service/dds_context.hpp"
+#include "pmu/service/command.hpp"
 #include "pmu/service/vehicle.hpp"
 #include "pmuctl/dds_json.hpp"
+#include "pmuctl/exit_status.hpp"
+#include "pmuctl/service_presence.hpp"
 
 namespace pmu::tools {
 namespace {
@@ -34,6 +37,13 @@ using Clock = std::chrono::steady_clock;
 std::atomic<bool> g_interrupted{false};
 extern "C" void on_interrupt(int) { g_interrupted = true; }
 
+// The names `config get` takes: pmu::Config's fields.
+std::string config_names() {
+  std::string names;
+  for (const auto& spec : codec::parameter_table()) names += std::string(spec.name) + ", ";
+  return names + "outputs, generation_enabled";
+}
+
 double seconds_of(const eprosima::fastrtps::rtps::Time_t& t) { return t.seconds() + t.nanosec() / 1e9; }
 
 
@@ -41,6 +51,14 @@ double seconds_of(const eprosima::fastrtps::rtps::Time_t& t) { return t.seconds(
 std::string device_name(const GlobalOptions& o, const char* no_address = "any device") {
   std::string d = o.address ? "device " + std::to_string(*o.address) : std::string(no_address);
   d += o.bus.empty() ? std::string() : " on " + o.bus;
+  if (o.vehicle) d += o.vehicle->empty() ? " of the unnamed vehicle" : " of vehicle " + *o.vehicle;
+  return d;
+}
+
+// "PMU 9 not seen on bus can0 of vehicle uav1", "no device seen on bus nope".
+std::string not_seen(const GlobalOptions& o) {
+  std::string d = o.address ? "PMU " + std::to_string(*o.address) + " not seen" : std::string("no device seen");
+  d += o.bus.empty() ? std::string() : " on bus " + o.bus;
   if (o.vehicle) d += o.vehicle->empty() ? " of the unnamed vehicle" : " of vehicle " + *o.vehicle;
   return d;
 }
@@ -124,7 +142,7 @@ class StateCollector {
 // Waits for the state of the selected devices: returns once samples arrived and a short
 // settle time passed (other devices' samples come in the same burst), or at the timeout.
 template <class Collector>
-int collect(const GlobalOptions& o, Collector& c, double default_timeout) {
+int collect(const GlobalOptions& o, const pmu::dds::DdsContext& dds, Collector& c, double default_timeout) {
   const auto deadline = Clock::now() + std::chrono::duration<double>(o.timeout.value_or(default_timeout));
   std::optional<Clock::time_point> settle;
   while (Clock::now() < deadline && !g_interrupted) {
@@ -134,13 +152,8 @@ int collect(const GlobalOptions& o, Collector& c, double default_timeout) {
     std::this_thread::sleep_for(std::chrono::milliseconds(20));
   }
   if (!c.latest().empty()) return 0;
-  if (!c.matched())
-    std::fprintf(stderr, "pmuctl: no pmu-service%s on domain %d\n",
-                 !o.vehicle ? "" : o.vehicle->empty() ? " of the unnamed vehicle" : (" of vehicle " + *o.vehicle).c_str(),
-                 o.domain);
-  else
-    std::fprintf(stderr, "pmuctl: %s not seen\n", device_name(o, "no device").c_str());
-  return 1;
+  if (!c.matched()) return no_service(o, dds);
+  return fail(o, ExitStatus::BadUsage, not_seen(o));
 }
 
 // `with_kind`: the lines of verbs that show every kind of device (list, health) say which.
@@ -182,8 +195,9 @@ void print_table(const DeviceId& d, const Json& values) {
 }
 
 template <class Collector>
-int print_state(const GlobalOptions& o, Collector& c, const char* topic, bool with_kind = false) {
-  if (int rc = collect(o, c, 3.0)) return rc;
+int print_state(const GlobalOptions& o, const pmu::dds::DdsContext& dds, Collector& c, const char* topic,
+                bool with_kind = false) {
+  if (int rc = collect(o, dds, c, 3.0)) return rc;
   for (const auto& [key, s] : c.latest()) {
     if (o.json)
       print_json(topic, key, values_of(s), std::nullopt, with_kind);
@@ -206,6 +220,7 @@ class TelemetryReader {
  public:
   virtual ~TelemetryReader() = default;
   virtual bool take(const GlobalOptions& o, TelemetryLine& out) = 0;
+  virtual bool matched() const = 0;
 };
 
 template <class T, class PubSub>
@@ -223,6 +238,11 @@ class TypedTelemetryReader final : public TelemetryReader {
       return true;
     }
     return false;
+  }
+  bool matched() const override {
+    SubscriptionMatchedStatus st;
+    reader_.get_subscription_matched_status(st);
+    return st.current_count > 0;
   }
 
  private:
@@ -315,10 +335,16 @@ int run_watch(const GlobalOptions& o, long count) {
     if (!any) std::this_thread::sleep_for(std::chrono::milliseconds(10));
   }
   if (seen == 0) {
-    std::fprintf(stderr, "pmuctl: no telemetry received from %s on domain %d\n", device_name(o).c_str(), o.domain);
-    return 1;
+    bool matched = false;
+    for (auto& r : readers) matched = matched || r->matched();
+    if (!matched) return no_service(o, dds);
+    return fail(o, ExitStatus::NotDone,
+                "no telemetry received from " + device_name(o) + " on domain " + std::to_string(o.domain));
   }
-  return count > 0 && seen < count ? 1 : 0;
+  if (count > 0 && seen < count)
+    return fail(o, ExitStatus::NotDone,
+                std::to_string(seen) + " of " + std::to_string(count) + " samples received before the timeout");
+  return 0;
 }
 
 int run_list(const GlobalOptions& o) {
@@ -326,7 +352,7 @@ int run_list(const GlobalOptions& o) {
                            partitions_for(o));
   StateCollector<pmu::Health, pmu::HealthPubSubType> health(dds, topics::kHealth);
   StateCollector<pmu::DeviceInfo, pmu::DeviceInfoPubSubType> info(dds, topics::kInfo);
-  if (int rc = collect(o, health, 3.0)) return rc;
+  if (int rc = collect(o, dds, health, 3.0)) return rc;
   info.poll(o);
   if (!o.json)
     std::printf("%-15s %-15s %9s %8s %8s %-9s %-6s %s\n", "VEHICLE", "BUS", "ADDRESS", "SERIAL", "FIRMWARE", "STATE",
@@ -362,27 +388,28 @@ int run_info(const GlobalOptions& o) {
   pmu::dds::DdsContext dds(o.domain, o.qos_file, "pmuctl", o.security, pmu::dds::Transport::Default, o.network,
                            partitions_for(o));
   StateCollector<pmu::DeviceInfo, pmu::DeviceInfoPubSubType> c(dds, topics::kInfo);
-  return print_state(o, c, "info");
+  return print_state(o, dds, c, "info");
 }
 
 int run_health(const GlobalOptions& o) {
   pmu::dds::DdsContext dds(o.domain, o.qos_file, "pmuctl", o.security, pmu::dds::Transport::Default, o.network,
                            partitions_for(o));
   StateCollector<pmu::Health, pmu::HealthPubSubType> c(dds, topics::kHealth);
-  return print_state(o, c, "health", true);
+  return print_state(o, dds, c, "health", true);
 }
 
 int run_config_get(const GlobalOptions& o, const std::string& parameter) {
   if (!parameter.empty() && !codec::parameter_from_name(parameter) && parameter != "outputs" &&
       parameter != "generation_enabled") {
-    std::fprintf(stderr, "pmuctl: unknown parameter '%s'\n", parameter.c_str());
-    return 2;
+    return fail(o, ExitStatus::BadUsage,
+                "unknown parameter '" + service::printable(parameter) + "'" +
+                    " (parameters: " + config_names() + ")");
   }
   pmu::dds::DdsContext dds(o.domain, o.qos_file, "pmuctl", o.security, pmu::dds::Transport::Default, o.network,
                            partitions_for(o));
   StateCollector<pmu::Config, pmu::ConfigPubSubType> c(dds, topics::kConfig);
-  if (parameter.empty()) return print_state(o, c, "config");
-  if (int rc = collect(o, c, 3.0)) return rc;
+  if (parameter.empty()) return print_state(o, dds, c, "config");
+  if (int rc = collect(o, dds, c, 3.0)) return rc;
   for (const auto& [key, s] : c.latest()) {
     const Json v = values_of(s)[parameter];
     if (o.json)

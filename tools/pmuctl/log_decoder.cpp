@@ -126,6 +126,7 @@ void LogDecoder::decode_line(std::string_view line, std::string& out) {
   const auto parsed = codec::parse_candump_line(line);
   if (!parsed) return report_error(std::string(parsed.error().reason));
   const codec::CandumpLine& l = *parsed;
+  if (l.has_time && l.seconds < kEarliestAbsoluteTime) ++counts_.relative_times;
 
   if (codec::canopen::is_canopen_id(l.frame.id, l.frame.extended)) {
     const auto m = codec::canopen::decode(l.frame);

@@ -23,7 +23,14 @@ struct DecodeCounts {
   std::uint64_t lines = 0;
   std::uint64_t frames = 0;  // lines decoded to a PMU or CANopen frame
   std::uint64_t errors = 0;  // lines reported as errors
+  // Lines timed before kEarliestAbsoluteTime: candump -td (deltas) or -tz (since its start)
+  // rather than -ta or -L, so their times are not dates. Printed as given; main says so.
+  std::uint64_t relative_times = 0;
 };
+
+// 1973-03-03 (10^8 s after 1970): no CAN log of this device is older, and candump's relative
+// times (-td, -tz) stay below it for three years of recording.
+inline constexpr std::int64_t kEarliestAbsoluteTime = 100000000;
 
 class LogDecoder {
  public:

@@ -4,7 +4,10 @@
 #include <sys/types.h>
 
 #include <CLI/CLI.hpp>
+#include <algorithm>
+#include <cctype>
 #include <cerrno>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
@@ -14,6 +17,7 @@
 
 #include "pmu/codec/firmware.hpp"
 #include "pmu/codec/messages.hpp"
+#include "pmu/codec/parameters.hpp"
 #include "pmu/idl/command.h"
 #include "pmuctl/command_verbs.hpp"
 #include "pmuctl/dds_verbs.hpp"
@@ -25,6 +29,9 @@
 #include "pmu/service/vehicle.hpp"
 #include "pmuctl/network_options.hpp"
 #include "pmu/sysconf_dir.hpp"
+#include "pmu/version.hpp"
+#include "pmuctl/exit_status.hpp"
+#include "pmuctl/option_values.hpp"
 
 namespace {
 
@@ -64,6 +71,11 @@ int run_decode(const std::string& path, const pmu::tools::DecodeOptions& options
     return 2;
   }
   const auto& c = decoder.counts();
+  if (c.relative_times > 0)
+    std::fprintf(stderr,
+                 "pmuctl decode: %llu lines have times before 1973, as candump -td (deltas) or -tz (since its "
+                 "start) writes them: printed as given, not as dates (candump -L or -ta logs absolute times)\n",
+                 static_cast<unsigned long long>(c.relative_times));
   std::fprintf(stderr, "pmuctl decode: %llu lines, %llu frames decoded, %llu errors\n",
                static_cast<unsigned long long>(c.lines), static_cast<unsigned long long>(c.frames),
                static_cast<unsigned long long>(c.errors));
@@ -126,9 +138,10 @@ int main(int argc, char** argv) {
   CLI::App app{"pmuctl: operate and inspect Millswood 250W PMUs served by pmu-service"};
   app.require_subcommand(1);
   app.fallthrough();  // global options may follow the verb: `pmuctl decode --json`
+  app.set_version_flag("--version", "pmuctl " PMU_VERSION_TEXT);
   pmu::tools::GlobalOptions g;
   int address = -1;
-  double timeout = -1;
+  std::string timeout;
   app.add_option("--domain", g.domain, "DDS domain id")->check(CLI::Range(0, 232));
   std::string vehicle;
   auto* vehicle_option = app.add_option(
@@ -136,10 +149,13 @@ int main(int argc, char** argv) {
       "Only this vehicle (config `vehicle` of its service); commands go to it (default: $PMU_VEHICLE; none: "
       "read every vehicle, command the unnamed one)");
   app.add_option("--bus", g.bus, "Only this bus (the service's name for it, e.g. can0)");
-  app.add_option("--address", address, "Only the PMU at this CAN address")->check(CLI::Range(0, int{pmu::codec::kMaxDeviceAddress}));
+  app.add_option("--address", address,
+                 "Only the PMU at this CAN address (0..65534); 65535 (broadcast) with `engine stop` alone: every "
+                 "PMU of the bus (--bus) or of the vehicle")
+      ->check(CLI::Range(0, int{pmu::codec::kBroadcastAddress}));
   app.add_flag("--json", g.json, "Machine-readable output: one JSON object per line");
-  app.add_option("--timeout", timeout, "Seconds to wait (state verbs: default 3; watch: forever)")
-      ->check(CLI::PositiveNumber);
+  app.add_option("--timeout", timeout, "Seconds to wait (state verbs: default 3; commands: 5; watch: forever)")
+      ->type_name("S");
   app.add_option("--qos-file", g.qos_file, "QoS profiles (default: $PMU_QOS_FILE, else " PMU_SYSCONFDIR "/qos.xml, else " PMU_DATADIR "/qos.xml)");
   std::string security_dir, identity;
   app.add_option("--security-dir", security_dir,
@@ -162,8 +178,8 @@ int main(int argc, char** argv) {
       ->allow_extra_args(false);
 
   auto* watch = app.add_subcommand("watch", "Live telemetry: a refreshing table, or one JSON object per sample");
-  long count = 0;
-  watch->add_option("--count", count, "Stop after N samples")->check(CLI::PositiveNumber);
+  std::string count_text;
+  watch->add_option("--count", count_text, "Stop after N samples")->type_name("N");
   watch->add_flag("--low-rate", g.low_rate,
                   "The low-rate topics pmu/low_rate/*: at most one sample per device and packet per the service's "
                   "low_rate_period (1 s by default), for slow links");
@@ -247,6 +263,18 @@ int main(int argc, char** argv) {
       ->type_name("NAME")
       ->allow_extra_args(false);
 
+  // CLI11 reads "-inf" or "-nan" as short options (-i...), so `config set avionics_voltage -inf`
+  // would say "value is required". No option of pmuctl looks like that, and no value can be
+  // infinite or NaN: say so here.
+  const bool json_asked = std::any_of(argv + 1, argv + argc, [](const char* a) { return std::strcmp(a, "--json") == 0; });
+  for (int i = 1; i < argc; ++i) {
+    char* end = nullptr;
+    const double v = argv[i][0] == '-' && std::isalpha(static_cast<unsigned char>(argv[i][1])) ? std::strtod(argv[i], &end) : 0;
+    if (end && *end == '\0' && !std::isfinite(v))
+      return pmu::tools::fail(json_asked, pmu::tools::ExitStatus::BadUsage,
+                              std::string("'") + argv[i] + "' is not a finite number (a value is a number in the "
+                              "parameter's unit)");
+  }
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -255,7 +283,17 @@ int main(int argc, char** argv) {
     return app.exit(e) == 0 ? 0 : 2;
   }
   if (address >= 0) g.address = static_cast<std::uint16_t>(address);
-  if (timeout > 0) g.timeout = timeout;
+  if (!timeout.empty()) {
+    const auto t = pmu::tools::parse_seconds("--timeout", timeout);
+    if (const auto* why = std::get_if<std::string>(&t)) return pmu::tools::fail(g, pmu::tools::ExitStatus::BadUsage, *why);
+    g.timeout = std::get<double>(t);
+  }
+  long count = 0;
+  if (!count_text.empty()) {
+    const auto n = pmu::tools::parse_count("--count", count_text);
+    if (const auto* why = std::get_if<std::string>(&n)) return pmu::tools::fail(g, pmu::tools::ExitStatus::BadUsage, *why);
+    count = std::get<long>(n);
+  }
 
   if (*decode) {
     pmu::tools::DecodeOptions options;
@@ -269,6 +307,24 @@ int main(int argc, char** argv) {
     }
     if (!mcap_out.empty()) return pmu::tools::run_decode_mcap(path, mcap_out, options.firmware);
     return run_decode(path, options);
+  }
+  {
+    const int kind = !*engine ? -1 : start_stop == "start" ? int{pmu::ENGINE_START} : int{pmu::ENGINE_STOP};
+    if (const auto why = pmu::tools::broadcast_refusal(g, kind); !why.empty())
+      return pmu::tools::fail(g, pmu::tools::ExitStatus::BadUsage, why);
+  }
+  if (*config_set && !pmu::codec::parameter_from_name(set_param)) {
+    // The two fields of pmu::Config that are not stored parameters have verbs of their own.
+    if (set_param == "outputs")
+      return pmu::tools::fail(g, pmu::tools::ExitStatus::BadUsage,
+                              "outputs are not a stored parameter: switch them with `pmuctl outputs set|enable|disable "
+                              "NAME...` (their state at power-up is the parameter power_up_state)");
+    if (set_param == "generation_enabled")
+      return pmu::tools::fail(g, pmu::tools::ExitStatus::BadUsage,
+                              "generation is not a stored parameter: switch it with `pmuctl generation on|off`");
+    return pmu::tools::fail(g, pmu::tools::ExitStatus::BadUsage,
+                            "unknown parameter '" + pmu::service::printable(set_param) + "' (parameters: " +
+                                parameter_names + ")");
   }
   pmu::tools::ServeOptions serve_options;
   if (*serve) {
@@ -295,10 +351,10 @@ int main(int argc, char** argv) {
     if (*config_set) {
       char* end = nullptr;
       spec.value = std::strtod(set_value.c_str(), &end);
-      if (set_value.empty() || *end != '\0') {
-        std::fprintf(stderr, "pmuctl: '%s' is not a number\n", set_value.c_str());
-        return 2;
-      }
+      if (set_value.empty() || *end != '\0' || !std::isfinite(spec.value))
+        return pmu::tools::fail(g, pmu::tools::ExitStatus::BadUsage,
+                                "'" + pmu::service::printable(set_value) + "' is not a finite number (a value is a "
+                                "number in the parameter's unit)");
       spec.kind = pmu::SET_PARAMETER;
       spec.parameter = set_param;
       return pmu::tools::run_command(g, spec);
@@ -343,8 +399,7 @@ int main(int argc, char** argv) {
                    g.vehicle->empty() ? "the unnamed vehicle" : ("vehicle " + *g.vehicle).c_str());
     return 2;
   } catch (const std::exception& e) {
-    std::fprintf(stderr, "pmuctl: %s\n", e.what());
-    return 2;
+    return pmu::tools::fail(g, pmu::tools::ExitStatus::BadUsage, e.what());
   }
   return 2;
 }

@@ -26,9 +26,18 @@ class RemoteWriters final : public eprosima::fastdds::dds::DomainParticipantList
   // writer may choose); nullopt when discovery never reported that writer.
   std::optional<std::vector<std::string>> partitions_of(const eprosima::fastdds::dds::SampleInfo& info) const;
 
+  // The partitions of every remote writer of `topic` discovery reported, matched or not: a
+  // client reading one vehicle still learns which vehicles' services are there.
+  std::vector<std::vector<std::string>> partitions_writing(const std::string& topic) const;
+
  private:
+  struct Writer {
+    std::vector<std::string> partitions;
+    std::string topic;
+  };
+  // Called from Fast DDS's discovery thread; read from any thread.
   mutable std::mutex mutex_;
-  std::map<std::string, std::vector<std::string>> partitions_;  // GUID text -> partitions
+  std::map<std::string, Writer> writers_;  // GUID text -> what it announced
 };
 
 }  // namespace pmu::dds

@@ -1,0 +1,160 @@
+// pmuctl's exit statuses, verb by verb, as pmuctl(1) and interface.md section 2 give them:
+// 0 done, 1 answered but not done, 2 bad usage or no such target, 3 nothing answered; and
+// with --json exactly one JSON line per result, failures included. On the demo power system
+// (deploy/examples/sim-power-system.yaml: a PMU, a battery and two MPPTs on one bus), PMU
+// commands find the one PMU, and an engine stop goes out in every situation.
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <fastdds/dds/core/status/PublicationMatchedStatus.hpp>
+#include <string>
+#include <thread>
+
+#include "pmu/idl/commandPubSubTypes.h"
+#include "pmu/idl/topics.hpp"
+#include "pmu/service/dds_context.hpp"
+#include "support/domain.hpp"
+#include "support/json_lines.hpp"
+#include "support/process.hpp"
+
+namespace {
+
+using namespace std::chrono_literals;
+
+struct Case {
+  const char* args;     // after `pmuctl --domain N`
+  int status;           // expected exit status
+  const char* message;  // part of stderr+stdout ("" for none)
+};
+
+std::string pmuctl(int domain) { return std::string(PMUCTL_PATH) + " --domain " + std::to_string(domain) + " "; }
+
+// Runs each case (each has exactly one result), and again with --json: then stdout is exactly
+// one JSON line, and a failure's line carries the same exit status.
+void run_cases(int domain, const Case* begin, const Case* end) {
+  for (const Case* c = begin; c != end; ++c) {
+    SCOPED_TRACE(c->args);
+    const auto r = pmu::test::run_capture(pmuctl(domain) + c->args, true);
+    EXPECT_EQ(r.status, c->status) << r.out;
+    EXPECT_NE(r.out.find(c->message), std::string::npos) << r.out;
+    const auto j = pmu::test::run_capture(pmuctl(domain) + "--json " + c->args + " 2>/dev/null");
+    EXPECT_EQ(j.status, c->status) << j.out;
+    const auto lines = pmu::test::json_lines(j.out);
+    ASSERT_EQ(lines.size(), 1u) << j.out;
+    ASSERT_FALSE(lines[0].is_discarded()) << j.out;
+    if (c->status >= 2) {
+      EXPECT_EQ(lines[0].value("exit_status", -1), c->status) << j.out;
+      EXPECT_TRUE(lines[0].contains("error") || lines[0].contains("reason")) << j.out;
+    } else {
+      EXPECT_TRUE(lines[0].contains("result")) << j.out;
+    }
+  }
+}
+
+class DemoPowerSystem : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    pmu::test::ChildOptions o;
+    o.stdout_path = o.stderr_path = "/dev/null";
+    service_ = pmu::test::Child({PMU_SERVICE_PATH, "--config", PMU_SOURCE_DIR "/deploy/examples/sim-power-system.yaml",
+                                 "--domain", std::to_string(domain_)},
+                                o);
+    // Ready once every device's health is there (the MPPTs report at 1 s).
+    for (int i = 0; i < 30; ++i) {
+      const auto r = pmu::test::run_capture(pmuctl(domain_) + "--timeout 5 --json list");
+      if (pmu::test::json_lines(r.out).size() == 4) return;
+      std::this_thread::sleep_for(200ms);
+    }
+    FAIL() << "the demo power system did not list its four devices";
+  }
+  void TearDown() override { (void)service_.stop(10s); }
+
+  const int domain_ = pmu::test::exclusive_dds_domain();
+  pmu::test::Child service_;
+};
+
+const Case kDemo[] = {
+    // PMU commands consider the PMU alone: the battery and MPPTs share its bus and addresses.
+    {"--timeout 10 engine stop", 0, "COMPLETED"},
+    {"--timeout 10 outputs get", 0, "COMPLETED"},
+    {"--timeout 10 --address 65535 engine stop", 0, "stop sent to every PMU (broadcast) on sim0"},
+    {"--timeout 10 --bus sim0 --address 65535 engine stop", 0, "stop sent to every PMU (broadcast)"},
+    {"--timeout 10 config set avionics_voltage 99", 1, "REJECTED"},
+    // Broadcast is for the stop alone.
+    {"--address 65535 outputs get", 2, "--address 65535 (broadcast) is only for `engine stop`"},
+    {"--address 65535 engine start", 2, "--address 65535 (broadcast) is only for `engine stop`"},
+    {"--address 65535 list", 2, "--address 65535 (broadcast) is only for `engine stop`"},
+    // No such target: 2, state verbs and commands alike.
+    {"--timeout 3 --address 9 info", 2, "PMU 9 not seen"},
+    {"--timeout 3 --address 9 config get", 2, "PMU 9 not seen"},
+    {"--timeout 3 --address 9 outputs get", 2, "PMU 9 not seen"},
+    {"--timeout 3 --bus nope list", 2, "no device seen on bus nope"},
+    {"--timeout 3 --vehicle uav9 outputs get", 2, "no pmu-service of vehicle uav9 on domain"},
+    {"--timeout 3 --vehicle uav9 list", 2, "vehicles seen: (unnamed)"},
+    {"config get no_such_parameter", 2, "unknown parameter 'no_such_parameter' (parameters: avionics_voltage"},
+    {"config set outputs 15", 2, "switch them with `pmuctl outputs set|enable|disable NAME...`"},
+    {"config set generation_enabled 1", 2, "`pmuctl generation on|off`"},
+    {"config set no_such_parameter 1", 2, "unknown parameter 'no_such_parameter'"},
+    {"config set avionics_voltage -inf", 2, "'-inf' is not a finite number"},
+    {"config set avionics_voltage nan", 2, "'nan' is not a finite number"},
+    {"--timeout 10 config set packets_streamed -1", 1, "packets_streamed: value -1 is not a bit mask 0..0x1F"},
+    // Option values.
+    {"--timeout 1e10 list", 2, "--timeout '1e10' is not a number of seconds"},
+    {"--timeout nan list", 2, "--timeout 'nan' is not a number of seconds"},
+    {"watch --count 0", 2, "--count '0' is not a whole number 1..1000000000"},
+};
+
+TEST_F(DemoPowerSystem, EveryVerbExitsAsTheTableSays) { run_cases(domain_, std::begin(kDemo), std::end(kDemo)); }
+
+TEST_F(DemoPowerSystem, ReadingVerbsExitZeroWithOneJsonLinePerDevice) {
+  for (const char* verb : {"list", "health"}) {
+    SCOPED_TRACE(verb);
+    const auto r = pmu::test::run_capture(pmuctl(domain_) + "--timeout 5 --json " + verb);
+    EXPECT_EQ(r.status, 0) << r.out;
+    EXPECT_EQ(pmu::test::json_lines(r.out).size(), 4u) << r.out;
+  }
+  const auto r = pmu::test::run_capture(pmuctl(domain_) + "--timeout 10 --json watch --count 3");
+  EXPECT_EQ(r.status, 0) << r.out;
+  EXPECT_EQ(pmu::test::json_lines(r.out).size(), 3u) << r.out;
+}
+
+// Nothing on the domain: every verb says so and exits 3.
+const Case kNobody[] = {
+    {"--timeout 1 list", 3, "no pmu-service on domain"},
+    {"--timeout 1 info", 3, "no pmu-service on domain"},
+    {"--timeout 1 health", 3, "no pmu-service on domain"},
+    {"--timeout 1 config get", 3, "no pmu-service on domain"},
+    {"--timeout 1 watch --count 1", 3, "no pmu-service on domain"},
+    {"--timeout 1 outputs get", 3, "no pmu-service on domain"},
+    {"--timeout 1 engine stop", 3, "no pmu-service on domain"},
+    {"--timeout 1 --address 65535 engine stop", 3, "no pmu-service on domain"},
+    {"--timeout 1 --vehicle uav1 list", 3, "no pmu-service of vehicle uav1 on domain"},
+};
+
+TEST(PmuctlExit, NothingOnTheDomainIsExitThreeForEveryVerb) {
+  run_cases(pmu::test::exclusive_dds_domain(), std::begin(kNobody), std::end(kNobody));
+}
+
+// A service that takes commands and never answers: the command verb exits 3, and its JSON
+// line is the reply's with a null result.
+TEST(PmuctlExit, NoReplyIsExitThreeWithOneJsonLine) {
+  using namespace eprosima::fastdds::dds;
+  const int domain = pmu::test::exclusive_dds_domain();
+  pmu::dds::DdsContext silent(domain, PMU_QOS_FILE, "silent-service");
+  (void)silent.reader(silent.topic(pmu::topics::kCommand, TypeSupport(new pmu::CommandPubSubType())),
+                      pmu::qos_profiles::kCommand);
+  (void)silent.writer(silent.topic(pmu::topics::kCommandReply, TypeSupport(new pmu::CommandReplyPubSubType())),
+                      pmu::qos_profiles::kCommand);
+  const auto r = pmu::test::run_capture(pmuctl(domain) + "--timeout 2 --json --bus can0 --address 1 outputs get");
+  EXPECT_EQ(r.status, 3) << r.out;
+  const auto lines = pmu::test::json_lines(r.out);
+  ASSERT_EQ(lines.size(), 1u) << r.out;
+  EXPECT_TRUE(lines[0]["result"].is_null()) << r.out;
+  EXPECT_EQ(lines[0]["bus"], "can0") << r.out;
+  EXPECT_EQ(lines[0]["exit_status"], 3) << r.out;
+  EXPECT_NE(lines[0]["reason"].get<std::string>().find("no reply from pmu-service within 2.0 s"), std::string::npos)
+      << r.out;
+}
+
+}  // namespace
