@@ -7,7 +7,7 @@ set -euo pipefail
 PMUCTL=$1 DATA=$2
 . "$(dirname "$0")/mcap_env.sh"
 work=$(mktemp -d)
-trap 'umount "$work/small" 2>/dev/null || true; rm -rf "$work"' EXIT
+trap 'umount "$work/small" "$work/ro" 2>/dev/null || true; rm -rf "$work"' EXIT
 
 "$PMUCTL" decode --mcap "$work/every.mcap" "$DATA/every_packet.log"
 read_mcap "$work/every.mcap" > "$work/indexed.jsonl"
@@ -41,6 +41,16 @@ status=0
 [ $status -eq 2 ] || { echo "FAIL: decode --mcap into a missing folder exited $status"; exit 1; }
 grep -q "cannot create $work/no/such/dir/x.mcap: No such file or directory" "$work/err" \
   || { echo "FAIL: message: $(cat "$work/err")"; exit 1; }
+
+# A folder that cannot be written (a read-only tmpfs, root only): exit 2, named.
+if [ "$(id -u)" -eq 0 ]; then
+  mkdir "$work/ro" && mount -t tmpfs -o ro tmpfs "$work/ro"
+  status=0
+  "$PMUCTL" decode --mcap "$work/ro/x.mcap" "$DATA/every_packet.log" 2> "$work/err" || status=$?
+  umount "$work/ro"
+  [ $status -eq 2 ] && grep -q "cannot create $work/ro/x.mcap: Read-only file system" "$work/err" \
+    || { echo "FAIL: read-only folder: $status $(cat "$work/err")"; exit 1; }
+fi
 
 # A full disk: a 64 kB tmpfs (root only). The error names the file and the cause, and
 # neither OUT nor a partial file remains.
