@@ -95,10 +95,10 @@ std::string OutputFile::open(const std::string& path) {
   struct stat st {};
   if (::stat(target_.c_str(), &st) != 0) {
     if (errno != ENOENT) return with_errno("cannot create " + shown(), errno);
-    return open_replacement(false, 0);
+    return open_replacement(nullptr);
   }
   switch (st.st_mode & S_IFMT) {
-    case S_IFREG: return open_replacement(true, st.st_mode & 0777);
+    case S_IFREG: return open_replacement(&st);
     case S_IFIFO: return open_stream(true);
     case S_IFCHR: return open_stream(false);
     case S_IFDIR: return shown() + " is a directory: name a file in it";
@@ -111,21 +111,25 @@ std::string OutputFile::open(const std::string& path) {
   }
 }
 
-std::string OutputFile::open_replacement(bool exists, unsigned mode) {
-  // The replacement gets the permissions of the file it replaces; one it could not write
-  // is not replaced behind its owner's back.
-  if (exists && ::access(target_.c_str(), W_OK) != 0) return with_errno("cannot write " + shown(), errno);
+std::string OutputFile::open_replacement(const struct stat* replaced) {
+  // The replacement gets the permissions (and, where allowed, the owner) of the file it
+  // replaces; one the user could not write is not replaced behind its owner's back.
+  if (replaced && ::access(target_.c_str(), W_OK) != 0) return with_errno("cannot write " + shown(), errno);
   std::string name = target_ + ".partial-XXXXXX";
   std::vector<char> buf(name.begin(), name.end());
   buf.push_back('\0');
   const int fd = ::mkostemp(buf.data(), O_CLOEXEC);  // O_EXCL: nothing that exists is reused
   if (fd < 0) return with_errno("cannot create " + shown(), errno);
-  if (!exists) {
+  mode_t mode;
+  if (replaced) {
+    mode = replaced->st_mode & 0777;
+    (void)::fchown(fd, replaced->st_uid, replaced->st_gid);  // EPERM unless root: then the user's own
+  } else {
     const mode_t mask = ::umask(0);  // mkostemp makes 0600; a new file gets what open(2) would give
     ::umask(mask);
-    mode = 0666 & ~static_cast<unsigned>(mask);
+    mode = 0666 & ~mask;
   }
-  (void)::fchmod(fd, static_cast<mode_t>(mode));  // failing leaves 0600: stricter, not wrong
+  (void)::fchmod(fd, mode);  // after fchown, which may clear set-id bits; failing leaves 0600: stricter
   sink_.adopt_own(fd);
   kind_ = Kind::Replace;
   writing_ = buf.data();

@@ -12,7 +12,7 @@
 //     socket, FIFO without a reader, terminal, unwritable file
 //
 // A regular file is replaced only by a complete one (rename(2) in its folder), with the old
-// file's permission bits; a file that cannot be written (access(2)) is refused rather than
+// file's permission bits (and owner, for root); a file that cannot be written (access(2)) is refused rather than
 // replaced. A block device is refused because writing it in place would overwrite the file
 // system it holds; a socket cannot be opened; a terminal would show binary.
 //
@@ -21,6 +21,8 @@
 // leaves nothing behind), except after a failed commit(); a process killed outright leaves
 // it, with the complete chunks written so far. Not thread-safe; open() reads the umask
 // (umask(2) sets it too), so call it before other threads create files.
+
+#include <sys/stat.h>
 
 #include <cstdint>
 #include <string>
@@ -60,7 +62,7 @@ class OutputFile {
  private:
   enum class Kind { None, Replace, Stream };
   std::string open_stream(bool fifo);
-  std::string open_replacement(bool exists, unsigned mode);
+  std::string open_replacement(const struct stat* replaced);  // nullptr: a new file
   std::string shown() const;  // "NAME", or "NAME (-> TARGET)" for a symlink
 
   FileSink sink_;
