@@ -52,7 +52,7 @@ class McapRecording {
   std::uint64_t messages() const { return writer_ ? writer_->message_count() : 0; }
 
  private:
-  pmu::mcap::OutputFile out_;
+  pmu::mcap::OutputFile out_;  // before writer_, which writes to its sink: destroyed after it
   std::unique_ptr<pmu::mcap::Writer> writer_;
   std::vector<const RecordedTopic*> topics_;
   std::vector<std::uint16_t> channels_;

@@ -9,11 +9,11 @@
 //     character device        never truncated, never renamed
 //   "-"                       standard output, as a stream        nothing         nothing
 //   directory, block device,  refused by open()
-//     socket, FIFO without a reader, terminal, unwritable file
+//     socket, FIFO without a reader, terminal, unwritable file, missing or unwritable folder
 //
 // A regular file is replaced only by a complete one (rename(2) in its folder), with the old
-// file's permission bits (and owner, for root); a file that cannot be written (access(2)) is refused rather than
-// replaced. A block device is refused because writing it in place would overwrite the file
+// file's permission bits (and owner, for root); a file that cannot be written (access(2)) is
+// refused rather than replaced. A block device is refused because writing it in place would overwrite the file
 // system it holds; a socket cannot be opened; a terminal would show binary.
 //
 // Nothing throws; every failure is a sentence naming the path. The destructor closes the
@@ -43,6 +43,7 @@ class OutputFile {
   // "" when the sink is ready, else why not ("cannot create rec.mcap: No such file or
   // directory", "out is a directory", ...); then nothing was created.
   std::string open(const std::string& path);
+  // Lives as long as the OutputFile: a Writer given it must go first.
   Sink& sink() noexcept { return sink_; }
 
   // fsync(2) and close(2). 0 or the errno.
