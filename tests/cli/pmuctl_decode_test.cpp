@@ -1,10 +1,22 @@
 // `pmuctl decode` run as a user runs it (interface.md section 2), on the logs in tests/data:
 // every packet of the spec decodes to the contract's names and values; one output line per
-// input line; bad lines are reported by number and decoding goes on.
+// input line; bad lines are reported by number and decoding goes on. `decode --mcap` onto
+// each kind of path (interface.md section 6, "Where the file goes") leaves everything it did
+// not create in place.
+#include <fcntl.h>
 #include <gtest/gtest.h>
+#include <sys/socket.h>
+#include <sys/stat.h>
+#include <sys/sysmacros.h>
+#include <sys/un.h>
+#include <unistd.h>
 
 #include <array>
 #include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <functional>
+#include <map>
 #include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
@@ -154,6 +166,159 @@ TEST(PmuctlDecode, MissingFileAndBadFirmwareOptionFail) {
   const CliRun old = run("decode --json --firmware 1.12 " + data("every_packet.log"));
   ASSERT_EQ(old.status, 0);
   EXPECT_EQ(json::parse(old.lines[4])["bit6_meaning"], "start_button");
+}
+
+// ---- decode --mcap onto each kind of path -------------------------------------------------
+
+const std::string kMagic("\x89MCAP0\r\n", 8);
+
+std::string slurp(const std::string& path) {
+  std::string s;
+  const int fd = ::open(path.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC);
+  if (fd < 0) return s;
+  char buf[4096];
+  ssize_t n;
+  while ((n = ::read(fd, buf, sizeof buf)) > 0) s.append(buf, static_cast<std::size_t>(n));
+  ::close(fd);
+  return s;
+}
+
+bool is_mcap(const std::string& b) {
+  return b.size() > 16 && b.compare(0, 8, kMagic) == 0 && b.compare(b.size() - 8, 8, kMagic) == 0;
+}
+
+struct Node {
+  mode_t type = 0;
+  ino_t inode = 0;
+  bool operator==(const Node& o) const { return type == o.type && inode == o.inode; }
+};
+
+// Every name in `dir` with its kind and inode: what was removed, renamed over or added.
+std::map<std::string, Node> names_in(const std::string& dir) {
+  std::map<std::string, Node> out;
+  const auto r = pmu::test::run_capture("ls -A '" + dir + "'");
+  std::size_t start = 0;
+  for (std::size_t i = 0; i < r.out.size(); ++i)
+    if (r.out[i] == '\n') {
+      const std::string name = r.out.substr(start, i - start);
+      start = i + 1;
+      struct stat st {};
+      if (::lstat((dir + "/" + name).c_str(), &st) == 0) out[name] = {static_cast<mode_t>(st.st_mode & S_IFMT), st.st_ino};
+    }
+  return out;
+}
+
+struct McapTarget {
+  const char* kind;
+  bool root;  // mknod
+  std::function<void(const std::string& dir)> make;  // makes dir/out (and what it points to)
+  const char* path;
+  int status;
+  const char* mcap_in;  // the file that then holds the recording ("" none)
+};
+
+void mknod_or_fail(const std::string& path, mode_t mode, unsigned major, unsigned minor) {
+  ASSERT_EQ(::mknod(path.c_str(), mode, makedev(major, minor)), 0) << path << ": " << std::strerror(errno);
+}
+
+const McapTarget kTargets[] = {
+    {"new file", false, [](const std::string&) {}, "out", 0, "out"},
+    {"regular file", false, [](const std::string& d) { std::fclose(std::fopen((d + "/out").c_str(), "w")); }, "out", 0,
+     "out"},
+    {"symlink", false,
+     [](const std::string& d) {
+       std::fclose(std::fopen((d + "/target").c_str(), "w"));
+       ASSERT_EQ(::symlink("target", (d + "/out").c_str()), 0);
+     },
+     "out", 0, "target"},
+    {"directory", false, [](const std::string& d) { ASSERT_EQ(::mkdir((d + "/out").c_str(), 0755), 0); }, "out", 2, ""},
+    {"missing folder", false, [](const std::string&) {}, "no/out", 2, ""},
+    {"FIFO without a reader", false, [](const std::string& d) { ASSERT_EQ(::mkfifo((d + "/out").c_str(), 0644), 0); },
+     "out", 2, ""},
+    {"socket", false,
+     [](const std::string& d) {
+       const int fd = ::socket(AF_UNIX, SOCK_STREAM | SOCK_CLOEXEC, 0);
+       sockaddr_un a{};
+       a.sun_family = AF_UNIX;
+       std::snprintf(a.sun_path, sizeof a.sun_path, "%s/out", d.c_str());
+       ASSERT_EQ(::bind(fd, reinterpret_cast<const sockaddr*>(&a), sizeof a), 0);
+       ::close(fd);
+     },
+     "out", 2, ""},
+    {"character device /dev/null", true, [](const std::string& d) { mknod_or_fail(d + "/out", S_IFCHR | 0666, 1, 3); },
+     "out", 0, ""},
+    {"character device /dev/full", true, [](const std::string& d) { mknod_or_fail(d + "/out", S_IFCHR | 0666, 1, 7); },
+     "out", 1, ""},
+    {"block device", true, [](const std::string& d) { mknod_or_fail(d + "/out", S_IFBLK | 0660, 7, 0); }, "out", 2, ""},
+};
+
+void decode_mcap_onto(const McapTarget& t) {
+  SCOPED_TRACE(t.kind);
+  char tmpl[] = "/tmp/pmuctl-decode-mcap-XXXXXX";
+  const std::string dir = ::mkdtemp(tmpl);
+  t.make(dir);
+  const auto before = names_in(dir);
+  const CliRun r = run("decode --mcap " + dir + "/" + t.path + " " + data("every_packet.log"));
+  EXPECT_EQ(r.status, t.status);
+  auto after = names_in(dir);
+  if (*t.mcap_in) {
+    EXPECT_TRUE(is_mcap(slurp(dir + "/" + t.mcap_in)));
+    const auto was = before.find(t.mcap_in);  // the one name that may change: renamed onto
+    if (was == before.end()) after.erase(t.mcap_in);
+    else after[t.mcap_in] = was->second;
+  }
+  EXPECT_EQ(after, before) << "names in " << dir << " changed";
+  std::system(("rm -rf '" + dir + "'").c_str());
+}
+
+TEST(PmuctlDecodeMcap, NothingItDidNotCreateIsRemovedRenamedOverOrTruncated) {
+  for (const McapTarget& t : kTargets)
+    if (!t.root) decode_mcap_onto(t);
+}
+
+TEST(PmuctlDecodeMcap, DeviceNodesAreWrittenInPlaceOrRefused) {
+  if (::geteuid() != 0) GTEST_SKIP() << "making device nodes (mknod) needs root";
+  for (const McapTarget& t : kTargets)
+    if (t.root) decode_mcap_onto(t);
+}
+
+// A FIFO with a reader gets the file in place (22 kB: within the pipe's buffer, so the reader
+// may read it after pmuctl has exited); the FIFO stays.
+TEST(PmuctlDecodeMcap, AFifoWithAReaderIsWrittenInPlace) {
+  char tmpl[] = "/tmp/pmuctl-decode-mcap-XXXXXX";
+  const std::string dir = ::mkdtemp(tmpl);
+  const std::string fifo = dir + "/out";
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0644), 0);
+  const int reader = ::open(fifo.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC);
+  ASSERT_GE(reader, 0);
+  const CliRun r = run("decode --mcap " + fifo + " " + data("every_packet.log"));
+  EXPECT_EQ(r.status, 0);
+  std::string got;
+  char buf[4096];
+  ssize_t n;
+  while ((n = ::read(reader, buf, sizeof buf)) > 0) got.append(buf, static_cast<std::size_t>(n));
+  ::close(reader);
+  EXPECT_TRUE(is_mcap(got)) << got.size() << " bytes";
+  struct stat st {};
+  ASSERT_EQ(::lstat(fifo.c_str(), &st), 0);
+  EXPECT_TRUE(S_ISFIFO(st.st_mode));
+  EXPECT_EQ(names_in(dir).size(), 1u);
+  std::system(("rm -rf '" + dir + "'").c_str());
+}
+
+// "-" is standard output, not a file named "-"; the size on stderr is what was written.
+TEST(PmuctlDecodeMcap, DashIsStandardOutput) {
+  char tmpl[] = "/tmp/pmuctl-decode-mcap-XXXXXX";
+  const std::string dir = ::mkdtemp(tmpl);
+  const auto r = pmu::test::run_capture("cd '" + dir + "' && " + PMUCTL_PATH + " decode --mcap - " +
+                                        data("every_packet.log") + " 2>stderr.txt");
+  EXPECT_EQ(r.status, 0);
+  EXPECT_TRUE(is_mcap(r.out));
+  EXPECT_NE(slurp(dir + "/stderr.txt").find("written to standard output (" + std::to_string(r.out.size()) + " bytes)"),
+            std::string::npos)
+      << slurp(dir + "/stderr.txt");
+  EXPECT_EQ(names_in(dir).size(), 1u) << "only stderr.txt";
+  std::system(("rm -rf '" + dir + "'").c_str());
 }
 
 }  // namespace

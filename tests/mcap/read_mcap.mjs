@@ -7,6 +7,7 @@
 // @foxglove/omgidl-serialization's MessageReader, as Foxglove and Lichtblick do.
 //
 //   node read_mcap.mjs FILE.mcap [--stream]
+// FILE "-" is standard input, read to its end (`pmuctl record - | node read_mcap.mjs - --stream`).
 // Exit status 0 when every message decoded, 1 otherwise (the reason on stderr).
 import { readFile, open } from "node:fs/promises";
 import { McapIndexedReader, McapStreamReader } from "@mcap/core";
@@ -15,7 +16,7 @@ import { MessageReader } from "@foxglove/omgidl-serialization";
 
 const args = process.argv.slice(2);
 const stream = args.includes("--stream");
-const file = args.find((a) => !a.startsWith("--"));
+const file = args.find((a) => a === "-" || !a.startsWith("-"));
 if (!file) {
   console.error("usage: node read_mcap.mjs FILE.mcap [--stream]");
   process.exit(2);
@@ -24,6 +25,13 @@ if (!file) {
 const schemas = new Map(); // schema id -> {name, encoding, data}
 const readers = new Map(); // channel id -> {topic, schema, reader}
 const channels = new Map();
+
+async function readAll(name) {
+  if (name !== "-") return readFile(name);
+  const parts = [];
+  for await (const part of process.stdin) parts.push(part);
+  return Buffer.concat(parts);
+}
 
 function readerFor(channelId) {
   if (readers.has(channelId)) return readers.get(channelId);
@@ -74,7 +82,7 @@ try {
   const end = { reader: stream ? "stream" : "indexed" };
   if (stream) {
     const reader = new McapStreamReader({ validateCrcs: true });
-    reader.append(await readFile(file));
+    reader.append(await readAll(file));
     let rec;
     let footer = false;
     while ((rec = reader.nextRecord())) {
@@ -86,11 +94,14 @@ try {
     end.footer = footer;
     end.complete = reader.done();
   } else {
-    const handle = await open(file, "r");
-    const size = (await handle.stat()).size;
+    // A file is read where it lies, as a viewer does; standard input from memory.
+    const bytes = file === "-" ? await readAll(file) : null;
+    const handle = bytes ? null : await open(file, "r");
+    const size = bytes ? bytes.length : (await handle.stat()).size;
     const readable = {
       size: async () => BigInt(size),
       read: async (offset, length) => {
+        if (bytes) return new Uint8Array(bytes.buffer, bytes.byteOffset + Number(offset), Number(length));
         const buf = new Uint8Array(Number(length));
         await handle.read(buf, 0, Number(length), Number(offset));
         return buf;
@@ -106,7 +117,7 @@ try {
       ? { message_count: st.messageCount.toString(), channel_count: st.channelCount, chunk_count: st.chunkCount }
       : null;
     end.topics = [...reader.channelsById.values()].map((c) => c.topic);
-    await handle.close();
+    if (handle) await handle.close();
   }
   end.messages = count;
   process.stdout.write(JSON.stringify({ end }) + "\n");

@@ -1,7 +1,10 @@
 #!/usr/bin/env bash
 # pmuctl record against pmu-service on the simulated power system: stopped by SIGINT the
 # file has a summary and @mcap/core reads it; killed with SIGKILL the stream reader still
-# reads its complete chunks; an unwritable path and a full disk are refused with what and where.
+# reads its complete chunks; an unwritable path and a full disk are refused with what and
+# where; onto each kind of path (interface.md section 6, "Where the file goes") nothing
+# record did not create is removed, renamed over or truncated; `record -` pipes the file
+# into a reader.
 #   record_test.sh PMU-SERVICE PMUCTL SOURCE-DIR
 set -uo pipefail
 svc=$1 ctl=$2 src=$3
@@ -26,19 +29,27 @@ kill -INT "$rec"
 wait "$rec"; status=$?
 [ $status -eq 0 ] || fail "record exited $status: $(cat "$work/rec.err")"
 grep -q "messages, .* written to $work/rec.mcap" "$work/rec.err" || fail "no final line: $(cat "$work/rec.err")"
+# The size printed is the file's, summary included.
+[ "$(grep -o '([0-9]* bytes)' "$work/rec.err")" = "($(stat -c %s "$work/rec.mcap") bytes)" ] ||
+  fail "size printed: $(tail -1 "$work/rec.err"), file: $(stat -c %s "$work/rec.mcap")"
 if read_mcap "$work/rec.mcap" >"$work/rec.jsonl"; then
   node "$MCAP_TESTS_DIR/check_recording.mjs" "$work/rec.jsonl" || fail "recording (indexed reader)"
 else
   fail "@mcap/core's indexed reader refused the file"
 fi
 
-# 2. SIGKILL: what a crash leaves is read up to the last complete chunk.
+# 2. SIGKILL: what a crash leaves is read up to the last complete chunk. It is the temporary
+# file; FILE, which existed, is as it was.
+echo "an earlier recording" >"$work/crash.mcap"
 "$ctl" --domain "$domain" record --topic voltages --topic battery --topic pmu/mppt --topic health "$work/crash.mcap" 2>/dev/null &
 rec=$!
 sleep 4.5
 kill -KILL "$rec"
 wait "$rec" 2>/dev/null
-if read_mcap --stream "$work/crash.mcap" >"$work/crash.jsonl"; then
+[ "$(cat "$work/crash.mcap")" = "an earlier recording" ] || fail "a killed recorder changed the file it was to replace"
+partial=$(ls "$work"/crash.mcap.partial-* 2>/dev/null)
+[ -n "$partial" ] || fail "a killed recorder left no temporary file: $(ls "$work")"
+if read_mcap --stream "$partial" >"$work/crash.jsonl"; then
   node "$MCAP_TESTS_DIR/check_recording.mjs" "$work/crash.jsonl" --crashed || fail "crashed recording (stream reader)"
 else
   fail "@mcap/core's stream reader refused the crashed file"
@@ -55,7 +66,83 @@ fi
 [ $status -eq 2 ] && grep -q "bus and --address do not apply" "$work/err" && [ ! -e "$work/x.mcap" ] ||
   fail "--bus: $status $(cat "$work/err")"
 
-# 4. Disk full while recording (root: a small tmpfs, nearly filled).
+# 4. Each kind of path. `kinds` lists what the folder holds (name, type, inode, size): it must
+# not change, except the one file a recording is renamed onto.
+kinds() { (cd "$1" && find . -mindepth 1 -printf '%p %y %i %s\n' | sort); }
+# record_into PATH: a short recording of voltages, stopped by SIGINT; $status, $work/one.err
+record_into() {
+  "$ctl" --domain "$domain" record --topic voltages "$1" 2>"$work/one.err" &
+  local r=$!
+  sleep 2.5
+  kill -INT "$r"
+  wait "$r"; status=$?
+}
+paths="$work/paths"
+mkdir "$paths" "$paths/dir"
+echo keep >"$paths/dir/inside"
+mkfifo "$paths/fifo"
+python3 -c 'import socket, sys; socket.socket(socket.AF_UNIX).bind(sys.argv[1])' "$paths/sock"
+ln -s target "$paths/link"
+echo "old target" >"$paths/target"
+if [ "$(id -u)" -eq 0 ]; then
+  mknod "$paths/full" c 1 7 && mknod "$paths/null" c 1 3 && mknod "$paths/block" b 7 0
+else
+  echo "note: device-node cases skipped: mknod needs root"
+fi
+before=$(kinds "$paths")
+# Refused before any participant (exit 2), or failing at the header (exit 1): nothing changes.
+for c in "dir 2 is a directory" "fifo 2 is a FIFO that nobody reads" "sock 2 is a socket" "block 2 is a block device" \
+         "full 1 No space left on device"; do
+  set -- $c
+  name=$1 want=$2 text=${c#* * }
+  [ -e "$paths/$name" ] || continue
+  # SIGKILL after 20 s: a recorder blocked opening a FIFO ignores SIGTERM (it takes it by sigwait)
+  timeout -s KILL 20 "$ctl" --domain "$domain" record "$paths/$name" 2>"$work/err"; status=$?
+  [ $status -eq "$want" ] && grep -q "$paths/$name.*$text" "$work/err" || fail "record onto $name: $status $(cat "$work/err")"
+  [ "$(kinds "$paths")" = "$before" ] || fail "record onto $name changed $paths: $(kinds "$paths")"
+done
+# A character device is written in place; it stays the device.
+if [ -e "$paths/null" ]; then
+  record_into "$paths/null"
+  [ $status -eq 0 ] || fail "record onto a character device exited $status: $(cat "$work/one.err")"
+  [ "$(kinds "$paths")" = "$before" ] || fail "record onto null changed $paths: $(kinds "$paths")"
+fi
+# A symlink stays a link; its target gets the recording.
+record_into "$paths/link"
+[ $status -eq 0 ] && [ -L "$paths/link" ] && [ "$(readlink "$paths/link")" = target ] ||
+  fail "record onto a symlink: $status, $(ls -l "$paths/link"), $(cat "$work/one.err")"
+read_mcap "$paths/target" >/dev/null || fail "the symlink's target is no recording"
+[ "$(kinds "$paths" | grep -v '^./target ')" = "$(echo "$before" | grep -v '^./target ')" ] ||
+  fail "record onto a symlink changed $paths: $(kinds "$paths")"
+# A FIFO with a reader is written in place, as a stream. The reader's open(2) may come after
+# record's: retry while record says nobody reads.
+read_mcap --stream - <"$paths/fifo" >"$work/fifo.jsonl" &
+reader=$!
+for _ in $(seq 100); do
+  record_into "$paths/fifo"
+  [ $status -eq 2 ] && grep -q "nobody reads" "$work/one.err" || break
+done
+[ $status -eq 2 ] && kill "$reader"
+wait "$reader" || fail "the FIFO's reader refused what it got"
+[ $status -eq 0 ] && tail -1 "$work/fifo.jsonl" | grep -q '"footer":true,"complete":true' ||
+  fail "record onto a FIFO: $status $(cat "$work/one.err") $(tail -1 "$work/fifo.jsonl")"
+[ -p "$paths/fifo" ] || fail "the FIFO is gone: $(ls -l "$paths")"
+
+# 5. `record -`: the file on standard output, piped into @mcap/core's stream reader; status
+# lines on stderr. No file named "-".
+( cd "$work" && { "$ctl" --domain "$domain" record --topic voltages - 2>"$work/dash.err" & echo $! >"$work/dash.pid"; wait $!; echo $? >"$work/dash.status"; } ) |
+  read_mcap --stream - >"$work/dash.jsonl" &
+pipeline=$!
+sleep 3
+kill -INT "$(cat "$work/dash.pid")"
+wait "$pipeline" || fail "the stream reader refused record's standard output: $(cat "$work/dash.err")"
+[ "$(cat "$work/dash.status")" = 0 ] || fail "record - exited $(cat "$work/dash.status"): $(cat "$work/dash.err")"
+tail -1 "$work/dash.jsonl" | grep -q '"footer":true,"complete":true' || fail "record -: $(tail -1 "$work/dash.jsonl")"
+grep -q '"topic":"pmu/voltages"' "$work/dash.jsonl" || fail "record -: no voltages"
+grep -q "written to standard output" "$work/dash.err" || fail "record -: $(cat "$work/dash.err")"
+[ ! -e "$work/-" ] || fail "record - made a file named -"
+
+# 6. Disk full while recording (root: a small tmpfs, nearly filled).
 if [ "$(id -u)" -ne 0 ]; then
   echo "note: disk-full case skipped: mounting a small tmpfs needs root"
 else
@@ -71,9 +158,11 @@ else
   else
     fail "the stream reader refused the file the full disk left"
   fi
-  # Full before the first chunk: nothing that looks like a recording stays.
+  # Full before the first chunk: nothing that looks like a recording stays, and record
+  # removes nothing but its own temporary file.
+  left=$(ls "$work/small")
   "$ctl" --domain "$domain" record "$work/small/start.mcap" 2>"$work/start.err"; status=$?
-  [ $status -eq 1 ] && grep -q "No space left on device (disk full)" "$work/start.err" && [ ! -e "$work/small/start.mcap" ] ||
+  [ $status -eq 1 ] && grep -q "No space left on device (disk full)" "$work/start.err" && [ "$(ls "$work/small")" = "$left" ] ||
     fail "record onto a full disk: $status, $(ls "$work/small"), $(cat "$work/start.err")"
 fi
 [ $failures -eq 0 ] || { tail -n 20 "$work/service.log" >&2; exit 1; }

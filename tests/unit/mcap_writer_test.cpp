@@ -286,6 +286,27 @@ TEST(McapWriter, ASummaryThatDoesNotFitLeavesTheShortEnding) {
   EXPECT_EQ(p.messages.size(), 1u);
 }
 
+// A stream (a pipe, a device) cannot be cut back after a write that failed half-way: the
+// writer then writes nothing more, even once the stream would take bytes again, so the
+// ending never follows half a chunk.
+TEST(McapWriter, AStreamThatFailedHalfWayGetsNothingMore) {
+  pmu::mcap::MemorySink sink;
+  sink.stream = true;
+  auto w = make(sink, 64);
+  ASSERT_TRUE(w.open());
+  const auto c = w.add_channel(w.add_schema("s", "omgidl", ""), "t", "cdr");
+  const std::uint8_t d[40] = {};
+  ASSERT_TRUE(w.write(c, 1, 1, d, sizeof d));
+  const std::size_t complete = sink.bytes.size();
+  sink.capacity = complete + 10;  // the next chunk breaks off after 10 bytes
+  EXPECT_FALSE(w.write(c, 2, 2, d, sizeof d));
+  ASSERT_EQ(sink.bytes.size(), complete + 10);
+  sink.capacity = static_cast<std::size_t>(-1);
+  EXPECT_FALSE(w.close());
+  EXPECT_EQ(sink.bytes.size(), complete + 10);
+  EXPECT_EQ(sink.reserved, 0u);
+}
+
 // The same on a real file system, where space is handed out in whole pages: whatever size
 // the chunks have, the file that fills a small tmpfs ends with a footer. Without the
 // reservation, a chunk that fails after the last page filled left no room for the ending.
@@ -303,7 +324,7 @@ TEST(McapFileSink, EveryFileThatFillsATmpfsEndsWithAFooter) {
   std::vector<std::string> problems;
   for (std::size_t payload = 1; payload <= 400; payload += 7) {
     pmu::mcap::FileSink sink;
-    ASSERT_EQ(sink.open(path), 0);
+    ASSERT_EQ(sink.create(path), 0);
     auto w = make(sink, 1);  // every message its own chunk
     ASSERT_TRUE(w.open());
     const auto c = w.add_channel(w.add_schema("s", "omgidl", ""), "t", "cdr");

@@ -234,12 +234,16 @@ int main(int argc, char** argv) {
   std::string mcap_out;
   decode->add_option("--mcap", mcap_out,
                      "Write the PMU telemetry frames as an MCAP file with the channels of `record` "
-                     "(candump -L logs: the log time is the frame's timestamp) instead of printing them");
+                     "(candump -L logs: the log time is the frame's timestamp) instead of printing them; "
+                     "a FIFO or a character device is written in place, - is standard output");
 
   auto* record = app.add_subcommand(
       "record", "Record the topics into an MCAP file (Foxglove, Lichtblick, PlotJuggler) until Ctrl-C or SIGTERM");
   std::string record_path;
-  record->add_option("file", record_path, "The MCAP file to write (replaced if it exists)")->required();
+  record->add_option("file", record_path,
+                     "The MCAP file (a regular file is replaced when the recording ends), a FIFO or a "
+                     "character device (written in place), or - for standard output")
+      ->required();
   std::vector<std::string> record_topics;
   record->add_option("--topic", record_topics,
                      "Only this topic (pmu/voltages or voltages; also low_rate/..., command, command_reply); "

@@ -3,6 +3,7 @@
 #include <unistd.h>
 
 #include <cerrno>
+#include <csignal>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
@@ -47,20 +48,22 @@ int run_decode_mcap(const std::string& log, const std::string& out, std::optiona
     std::fprintf(stderr, "pmuctl decode: cannot open %s: %s\n", log.c_str(), std::strerror(errno));
     return 2;
   }
-  const std::string partial = out + ".partial-" + std::to_string(::getpid());
   const auto topics = telemetry_topics();
+  // A reader of a pipe or FIFO that goes away gives EPIPE, said and exit status 1.
+  std::signal(SIGPIPE, SIG_IGN);
   McapRecording rec;
-  if (const auto why = rec.open(partial, topics); !why.empty()) {
-    std::fprintf(stderr, "pmuctl decode --mcap: %s; %s not written\n", why.c_str(), out.c_str());
+  if (const auto why = rec.open(out, topics); !why.empty()) {
+    std::fprintf(stderr, "pmuctl decode --mcap: %s; %s not written\n", why.c_str(), rec.name().c_str());
     const bool created = rec.created();
     rec.close();
-    ::unlink(partial.c_str());
+    rec.discard();
     return created ? 1 : 2;  // created, then the disk was full: not the caller's input
   }
   auto give_up = [&](const std::string& why) {
-    std::fprintf(stderr, "pmuctl decode --mcap: %s; %s not written\n", why.c_str(), out.c_str());
+    std::fprintf(stderr, "pmuctl decode --mcap: %s; %s %s\n", why.c_str(), rec.name().c_str(),
+                 rec.streaming() ? "got an incomplete file" : "not written");
     rec.close();
-    ::unlink(partial.c_str());
+    rec.discard();  // its own temporary file only; a stream keeps what it got
     return 1;
   };
 
@@ -118,22 +121,13 @@ int run_decode_mcap(const std::string& log, const std::string& out, std::optiona
   if (std::ferror(in.get())) return give_up("error reading " + log);
   if (errors > 10) std::fprintf(stderr, "pmuctl decode --mcap: ... %llu lines not decoded in all\n",
                                 static_cast<unsigned long long>(errors));
-  if (const auto why = rec.close(); !why.empty()) {
-    std::fprintf(stderr, "pmuctl decode --mcap: %s; %s not written\n", why.c_str(), out.c_str());
-    ::unlink(partial.c_str());
-    return 1;
-  }
-  if (::rename(partial.c_str(), out.c_str()) != 0) {
-    const int e = errno;
-    ::unlink(partial.c_str());
-    std::fprintf(stderr, "pmuctl decode --mcap: cannot rename %s to %s: %s\n", partial.c_str(), out.c_str(),
-                 std::strerror(e));
-    return 1;
-  }
+  if (const auto why = rec.close(); !why.empty()) return give_up(why);
+  if (const auto why = rec.commit(); !why.empty()) return give_up(why);
   std::fprintf(stderr,
-               "pmuctl decode --mcap: %llu lines, %llu telemetry samples written to %s, %llu frames not telemetry, "
-               "%llu without a timestamp (screen format: take logs with candump -L), %llu errors\n",
-               static_cast<unsigned long long>(lines), static_cast<unsigned long long>(written), out.c_str(),
+               "pmuctl decode --mcap: %llu lines, %llu telemetry samples written to %s (%llu bytes), %llu frames not "
+               "telemetry, %llu without a timestamp (screen format: take logs with candump -L), %llu errors\n",
+               static_cast<unsigned long long>(lines), static_cast<unsigned long long>(written), rec.name().c_str(),
+               static_cast<unsigned long long>(rec.bytes()),
                static_cast<unsigned long long>(skipped), static_cast<unsigned long long>(untimed),
                static_cast<unsigned long long>(errors));
   return 0;

@@ -16,9 +16,8 @@ std::string human_bytes(std::uint64_t n) {
 }
 
 std::string McapRecording::open(const std::string& path, const std::vector<const RecordedTopic*>& topics) {
-  path_ = path;
-  if (const int e = sink_.open(path); e != 0) return "cannot create " + path + ": " + std::strerror(e);
-  writer_ = std::make_unique<pmu::mcap::Writer>(sink_, pmu::mcap::WriterOptions{"", "pmuctl (pmu-dds)", 256 * 1024});
+  if (auto why = out_.open(path); !why.empty()) return why;
+  writer_ = std::make_unique<pmu::mcap::Writer>(out_.sink(), pmu::mcap::WriterOptions{"", "pmuctl (pmu-dds)", 256 * 1024});
   if (!writer_->open()) return error();
   std::map<std::string, std::uint16_t> schemas;  // by type name: topics of one type share it
   for (const auto* t : topics) {
@@ -48,17 +47,22 @@ std::string McapRecording::close() {
   const bool was_failed = writer_->failed();
   const bool ok = writer_->close();
   std::string why = ok ? std::string() : error();
-  if (const int e = sink_.close(); e != 0 && why.empty())
-    why = "closing " + path_ + ": " + std::strerror(e);
-  if (was_failed) why += " (the file holds the chunks written before it, up to " +
-                         human_bytes(writer_->bytes_written()) + ")";
+  if (const int e = out_.close(); e != 0 && why.empty())
+    why = "closing " + out_.name() + ": " + std::strerror(e);
+  if (was_failed)
+    why += std::string(out_.streaming() ? " (it got" : " (the file holds") + " the chunks written before it, " +
+           human_bytes(writer_->bytes_written()) + ")";
   return why;
 }
+
+std::string McapRecording::commit() { return out_.commit(); }
+
+void McapRecording::discard() { out_.discard(); }
 
 std::string McapRecording::error() const {
   if (!writer_ || !writer_->failed()) return {};
   const int e = writer_->error();
-  std::string s = "writing " + path_ + ": " + std::strerror(e);
+  std::string s = "writing " + out_.name() + ": " + std::strerror(e);
   if (e == ENOSPC) s += " (disk full)";
   return s + " after " + human_bytes(writer_->bytes_written());
 }

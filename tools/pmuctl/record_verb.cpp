@@ -2,6 +2,7 @@
 
 #include <unistd.h>
 
+#include <csignal>
 #include <cstdio>
 #include <memory>
 #include <mutex>
@@ -28,12 +29,16 @@ int run_record(const GlobalOptions& o, const std::string& path, const std::vecto
   if (!forwarded_topics(o, names, "record", topics)) return 2;
 
   const StopSignals stop;
+  // A reader of a pipe or FIFO that goes away gives EPIPE, said and exit status 1, instead
+  // of a silent death by SIGPIPE.
+  std::signal(SIGPIPE, SIG_IGN);
   auto shared = std::make_unique<Shared>();  // outlives the participant and its listeners
+  // Before any participant exists: a path that cannot be written is refused at once.
   if (const auto why = shared->rec.open(path, topics); !why.empty()) {
     std::fprintf(stderr, "pmuctl record: %s\n", why.c_str());
     const bool created = shared->rec.created();
     shared->rec.close();
-    if (created) ::unlink(path.c_str());  // nothing recorded: no file that looks like a recording
+    shared->rec.discard();  // nothing recorded: no file that looks like a recording (only its own)
     return created ? 1 : 2;
   }
   Shared& s = *shared;
@@ -47,7 +52,7 @@ int run_record(const GlobalOptions& o, const std::string& path, const std::vecto
                              o.network, partitions_for(o));
     readers.open(dds, topics);
     std::fprintf(stderr, "pmuctl record: recording %zu topics on domain %d into %s; Ctrl-C stops\n", topics.size(),
-                 o.domain, path.c_str());
+                 o.domain, shared->rec.name().c_str());
     const bool tty = ::isatty(STDERR_FILENO) == 1;
     int ticks = 0;
     for (;;) {
@@ -65,13 +70,18 @@ int run_record(const GlobalOptions& o, const std::string& path, const std::vecto
     if (tty) std::fprintf(stderr, "\n");
   }  // the participant and its readers end here: no listener runs after
   const std::string failure = shared->rec.error();
-  const std::string progress = shared->rec.progress();
   const std::string closing = shared->rec.close();
-  if (!failure.empty() || !closing.empty()) {
-    std::fprintf(stderr, "pmuctl record: %s\n", (failure.empty() ? closing : failure + "; " + closing).c_str());
+  // Also after a write error: the file is ended and holds what was recorded before it.
+  const std::string committing = shared->rec.commit();
+  std::string why;
+  for (const std::string* part : {&failure, &closing, &committing})
+    if (!part->empty()) why += (why.empty() ? "" : "; ") + *part;
+  if (!why.empty()) {
+    std::fprintf(stderr, "pmuctl record: %s\n", why.c_str());
     return 1;
   }
-  std::fprintf(stderr, "pmuctl record: %s written to %s\n", progress.c_str(), path.c_str());
+  std::fprintf(stderr, "pmuctl record: %s written to %s (%llu bytes)\n", shared->rec.progress().c_str(),
+               shared->rec.name().c_str(), static_cast<unsigned long long>(shared->rec.bytes()));
   return 0;
 }
 

@@ -20,8 +20,8 @@ bool Writer::emit(const Bytes& block, bool data_section, bool reserve_ending) {
   }
   if (const int e = sink_.write(block.data(), block.size()); e != 0) {
     error_ = e;
-    sink_.truncate(offset_);  // the file ends at the last complete block again
-    if (reserve_ending) sink_.reserve(offset_, ending);  // truncating freed what was reserved past the end
+    if (sink_.truncate(offset_) != 0) torn_ = true;  // the file ends at the last complete block again
+    else if (reserve_ending) sink_.reserve(offset_, ending);  // truncating freed what was reserved past the end
     return false;
   }
   if (data_section) data_crc_ = crc32(data_crc_, block.data(), block.size());
@@ -115,9 +115,11 @@ bool Writer::close() {
   }
   // Disk full or the like: end the data properly so the complete chunks stay readable by
   // every reader, without a summary (it did not fit).
+  // Not after part of a block that could not be cut off (a stream): the ending would follow
+  // half a record, and a reader would take its bytes for the record's.
   const int first = error_;
   error_ = 0;
-  emit(ending_without_summary(), false, false);  // into the room reserved with the last block
+  if (!torn_) emit(ending_without_summary(), false, false);  // into the room reserved with the last block
   error_ = first;
   return false;
 }

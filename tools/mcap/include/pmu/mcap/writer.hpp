@@ -6,7 +6,8 @@
 // Crash safety: each chunk and the message indexes after it go to the sink in one write, and
 // the sink passes them to the kernel at once. A process killed at any time leaves a file
 // whose complete chunks a stream reader reads; a failed write (disk full) is cut off again,
-// so the file never ends in half a record.
+// so the file never ends in half a record. A stream cannot be cut: after a failed write
+// nothing more is written to it.
 //
 // Errors: nothing throws. A failed write makes the writer failed(): later calls do nothing
 // and return false; error() is the errno. close() on a failed writer still tries to end the
@@ -65,6 +66,7 @@ class Writer {
   Sink& sink_;
   WriterOptions options_;
   int error_ = 0;
+  bool torn_ = false;  // a failed write could not be cut off: the sink ends in part of a block
   bool opened_ = false;
   bool closed_ = false;
   std::uint64_t offset_ = 0;     // bytes the sink took
