@@ -18,6 +18,7 @@
 #include "pmuctl/command_verbs.hpp"
 #include "pmuctl/dds_verbs.hpp"
 #include "pmuctl/log_decoder.hpp"
+#include "pmuctl/mask_names.hpp"
 #include "pmuctl/mcap_decode.hpp"
 #include "pmuctl/record_verb.hpp"
 #include "pmuctl/serve_verb.hpp"
@@ -181,7 +182,7 @@ int main(int argc, char** argv) {
   for (const auto& spec : pmu::codec::parameter_table())
     parameter_names += (parameter_names.empty() ? "" : ", ") + std::string(spec.name);
   config_set->add_option("param", set_param, parameter_names)->required();
-  config_set->add_option("value", set_value, "Value in the parameter's unit (V, s, degC, or a number/mask)")->required();
+  config_set->add_option("value", set_value, "Value in the parameter's unit (V, s, degC, a number); a mask: names a,b or none, or a number")->required();
 
   bool confirm = false;
   app.add_flag("--confirm", confirm, "Confirm a command the safety policy guards (avionics off, reset, engine start...)");
@@ -293,12 +294,12 @@ int main(int argc, char** argv) {
     pmu::tools::CommandSpec spec;
     spec.confirm = confirm;
     if (*config_set) {
-      char* end = nullptr;
-      spec.value = std::strtod(set_value.c_str(), &end);
-      if (set_value.empty() || *end != '\0') {
-        std::fprintf(stderr, "pmuctl: '%s' is not a number\n", set_value.c_str());
+      const auto parsed = pmu::tools::parse_config_value(set_param, set_value);
+      if (!parsed.value) {
+        std::fprintf(stderr, "pmuctl: %s\n", parsed.error.c_str());
         return 2;
       }
+      spec.value = *parsed.value;
       spec.kind = pmu::SET_PARAMETER;
       spec.parameter = set_param;
       return pmu::tools::run_command(g, spec);
