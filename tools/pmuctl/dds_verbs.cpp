@@ -304,14 +304,10 @@ int run_watch(const GlobalOptions& o, long count) {
       next_draw = Clock::now() + std::chrono::milliseconds(500);
       std::printf("\033[H\033[2J");  // home + clear: a refreshing table
       std::printf("pmuctl watch — domain %d — %ld samples (Ctrl-C to stop)\n\n", o.domain, seen);
-      std::vector<std::vector<std::string>> rows;
+      std::vector<WatchRow> rows;
       const double now = now_s();
-      for (const auto& [key, l] : latest) {
-        const auto state = health_of(l.device);
-        rows.push_back({label(l.device), l.topic, to_string(state.value_or(pmu::UNKNOWN)), age_text(now - l.time),
-                        row_values(l.values)});
-      }
-      for (const auto& r : aligned_columns(rows)) std::printf("%s\n", r.c_str());
+      for (const auto& [key, l] : latest) rows.push_back({label(l.device), l.topic, health_of(l.device), now - l.time, l.values});
+      for (const auto& r : watch_table(rows)) std::printf("%s\n", r.c_str());
       std::fflush(stdout);
     }
     if (!any) std::this_thread::sleep_for(std::chrono::milliseconds(10));

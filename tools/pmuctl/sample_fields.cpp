@@ -25,9 +25,11 @@ SampleField none(std::string_view name, const char* word) { return {std::string(
 
 SampleField real(std::string_view name, double v, std::string_view unit, const char* nan_word) {
   if (std::isnan(v)) return none(name, nan_word);
-  const auto f = static_cast<float>(v);
-  const std::string t = shortest(f);
-  return {std::string(name), Json(std::strtod(t.c_str(), nullptr)), t, std::string(unit)};
+  if (std::isinf(v)) return {std::string(name), nullptr, v > 0 ? "inf" : "-inf", std::string(unit)};  // JSON has none
+  const std::string t = shortest(static_cast<float>(v));
+  // A whole number keeps ".0", as the JSON prints it: a measurement, not a count.
+  const std::string text = t.find_first_of(".e") == std::string::npos ? t + ".0" : t;
+  return {std::string(name), Json(std::strtod(t.c_str(), nullptr)), text, std::string(unit)};
 }
 
 SampleField integer(std::string_view name, std::int64_t v, std::string_view unit = {}) {
@@ -171,7 +173,7 @@ SampleFields fields_of(const pmu::Config& s) {
       case P::PowerUpState: out.push_back(integer(spec.name, s.power_up_state())); break;
       case P::CrankingTime: {
         auto f = real(spec.name, s.cranking_time(), spec.unit, kNotReceived);
-        if (s.cranking_time() == 0) f.text = "0 (no timeout)", f.unit.clear();  // table 17
+        if (s.cranking_time() == 0) f.text = "0.0 (no timeout)", f.unit.clear();  // table 17
         out.push_back(f);
         break;
       }
@@ -244,8 +246,8 @@ SampleFields fields_of(const pmu::BatteryCells& s) {
   const std::size_t n = s.cells().size();
   std::string text = n == 0 ? std::string("none received") : std::to_string(n) + (n == 1 ? " cell" : " cells");
   if (lo <= hi) {
-    char buf[96];
-    std::snprintf(buf, sizeof buf, " %.3f..%.3f V, spread %.3f V", lo, hi, hi - lo);
+    char buf[64];
+    std::snprintf(buf, sizeof buf, " %.3f..%.3f V", lo, hi);
     text += buf;
   }
   return {{"cells", cells, text, ""}};

@@ -42,7 +42,7 @@ SampleFields fields_of(const pmu::DeviceInfo& s);
 SampleFields fields_of(const pmu::Health& s);
 SampleFields fields_of(const pmu::Battery& s);
 // One field, `cells`: the JSON array of {cell, cell_voltage}, and in tables a summary
-// ("12 cells 3.301..3.412 V, spread 0.111 V").
+// ("12 cells 3.301..3.412 V": count, lowest and highest).
 SampleFields fields_of(const pmu::BatteryCells& s);
 SampleFields fields_of(const pmu::Mppt& s);
 

@@ -47,6 +47,22 @@ std::vector<std::string> aligned_columns(const std::vector<std::vector<std::stri
   return lines;
 }
 
+std::vector<std::string> watch_table(const std::vector<WatchRow>& rows) {
+  std::vector<std::string> topics;
+  for (const auto& r : rows)
+    if (std::find(topics.begin(), topics.end(), r.topic) == topics.end()) topics.push_back(r.topic);
+  std::vector<std::string> lines;
+  for (const auto& t : topics) {
+    std::vector<std::vector<std::string>> cells;
+    for (const auto& r : rows)
+      if (r.topic == t)
+        cells.push_back({r.label, to_string(r.state.value_or(pmu::UNKNOWN)), age_text(r.age), row_values(r.values)});
+    lines.push_back(t + ":");
+    for (auto& l : aligned_columns(cells)) lines.push_back(std::move(l));
+  }
+  return lines;
+}
+
 std::string value_block(const std::string& label, const SampleFields& fields) {
   std::string out = label + "\n";
   for (const auto& f : fields) {

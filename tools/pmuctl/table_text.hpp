@@ -23,6 +23,18 @@ std::string freshness(std::optional<pmu::HealthState> state, double age_seconds)
 // "avionics=12.3V output_28v=28V ...": one watch row's values, units attached.
 std::string row_values(const SampleFields& fields);
 
+// One row of watch's refreshing table: a device's latest sample of one topic.
+struct WatchRow {
+  std::string label;  // "can0/1"
+  std::string topic;  // "voltages"
+  std::optional<pmu::HealthState> state;
+  double age = 0;     // s since the sample's source time
+  SampleFields values;
+};
+// The refreshing table: per topic, in the order the rows come, a "topic:" line, then one
+// line per device, its label, state and age aligned within the topic.
+std::vector<std::string> watch_table(const std::vector<WatchRow>& rows);
+
 // Rows of cells as lines, each column as wide as its widest cell, two spaces apart; the
 // last column is not padded. Rows may have fewer cells than others.
 std::vector<std::string> aligned_columns(const std::vector<std::vector<std::string>>& rows);
