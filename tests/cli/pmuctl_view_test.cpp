@@ -387,3 +387,29 @@ TEST(PmuctlView, StateVerbsShowOneValuePerLine) {
 
 }  // namespace
 }  // namespace pmu::tools
+
+namespace pmu::tools {
+namespace {
+
+// --json through dds_json.hpp: sentinels are null, raw counts integers; the rest as before.
+TEST(PmuctlViewJson, SentinelsAreNullAndRawCountsIntegers) {
+  pmu::Health h;
+  h.last_frame_age(-1.0f);
+  EXPECT_TRUE(values_of(h)["last_frame_age"].is_null()) << values_of(h);
+  pmu::Status st;
+  st.generator_rpm(65535);
+  EXPECT_TRUE(values_of(st)["generator_rpm"].is_null()) << values_of(st);
+  pmu::Battery b;
+  b.time_to_go(65535.0f * 60), b.received(1u << 5);
+  EXPECT_TRUE(values_of(b)["time_to_go"].is_null()) << values_of(b);
+  pmu::Mppt m;
+  m.voltage_output_raw(1234), m.received(1u << 0);
+  EXPECT_EQ(values_of(m)["voltage_output_raw"].dump(), "1234");
+  pmu::Temperatures t;
+  t.internal(30), t.battery_a(std::numeric_limits<float>::quiet_NaN());
+  EXPECT_TRUE(values_of(t)["battery_a"].is_null());
+  EXPECT_EQ(values_of(t)["internal"].dump(), "30.0");
+}
+
+}  // namespace
+}  // namespace pmu::tools

@@ -204,6 +204,11 @@ SampleFields fields_of(const pmu::Health& s) {
   SampleField age = s.last_frame_age() < 0 || std::isnan(s.last_frame_age())
                         ? none("last_frame_age", kNever)
                         : real("last_frame_age", s.last_frame_age(), "s", kNever);
+  if (age.json.is_number()) {
+    char tenths[32];  // the service's clock, not a measurement: 0.1 s is enough
+    std::snprintf(tenths, sizeof tenths, "%.1f", age.json.get<double>());
+    age.text = tenths;
+  }
   return {{"state", to_string(s.state()), to_string(s.state()), ""},
           {"bus_state", to_string(s.bus_state()), to_string(s.bus_state()), ""},
           age,
