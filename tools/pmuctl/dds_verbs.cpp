@@ -170,7 +170,6 @@ std::string clock_text(double t) {
   return buf;
 }
 
-
 template <class Collector>
 int print_state(const GlobalOptions& o, Collector& c, const char* topic, bool with_kind = false) {
   if (int rc = collect(o, c, 3.0)) return rc;
