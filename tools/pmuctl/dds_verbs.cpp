@@ -195,6 +195,7 @@ class TelemetryReader {
  public:
   virtual ~TelemetryReader() = default;
   virtual bool take(const GlobalOptions& o, TelemetryLine& out) = 0;
+  virtual const std::string& name() const = 0;  // the topic's last word(s): "voltages", "low_rate/voltages"
 };
 
 template <class T, class PubSub>
@@ -213,6 +214,7 @@ class TypedTelemetryReader final : public TelemetryReader {
     }
     return false;
   }
+  const std::string& name() const override { return name_; }
 
  private:
   std::string name_;
@@ -305,7 +307,10 @@ int run_watch(const GlobalOptions& o, long count) {
       std::printf("pmuctl watch — domain %d — %ld samples (Ctrl-C to stop)\n\n", o.domain, seen);
       std::vector<WatchRow> rows;
       const double now = now_s();
-      for (const auto& [key, l] : latest) rows.push_back({label(l.device), l.topic, health_of(l.device), now - l.time, l.values});
+      // Topics in the contract's order (the readers'), devices in order within each.
+      for (const auto& r : readers)
+        for (const auto& [key, l] : latest)
+          if (l.topic == r->name()) rows.push_back({label(l.device), l.topic, health_of(l.device), now - l.time, l.values});
       for (const auto& r : watch_table(rows)) std::printf("%s\n", r.c_str());
       std::fflush(stdout);
     }
