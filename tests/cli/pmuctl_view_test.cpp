@@ -146,6 +146,10 @@ TEST(PmuctlView, MpptRawCountsAreIntegers) {
   EXPECT_EQ(field(f, "voltage_output_raw").text, "1234");
   EXPECT_EQ(field(f, "current_output_raw").text, "-17");
   EXPECT_EQ(json_of(f).dump().find("1234.0"), std::string::npos) << json_of(f);
+  // What no MPPT sends (int16 counts) still prints, as a number.
+  auto huge = mppt();
+  huge.voltage_output_raw(1e30f);
+  EXPECT_EQ(field(fields_of(huge), "voltage_output_raw").text, "1e+30");
 }
 
 struct SentinelRow {

@@ -38,7 +38,7 @@ SampleField integer(std::string_view name, std::int64_t v, std::string_view unit
 
 SampleField flag(std::string_view name, bool v) { return {std::string(name), Json(v), v ? "yes" : "no", ""}; }
 
-// A PMU packet's values, named and united by the codec's table for it, in its order; the
+// A PMU packet's values, with the names and units of the codec's table for it, in its order; the
 // DDS type has the same fields in the same order (idl/telemetry.idl).
 template <class Packet, class V, std::size_t N>
 SampleFields measured(const std::array<V, N>& values, const char* nan_word) {
@@ -74,7 +74,8 @@ SampleField canopen_value(const service::CanOpenValue (&table)[N], std::size_t b
   const auto& c = table[bit];
   if (!((received >> bit) & 1u) || std::isnan(v)) return none(c.name, kNotReceived);
   if (is_bool) return flag(c.name, v != 0);
-  if (is_float && !c.unit.empty()) return real(c.name, v, c.unit, kNotReceived);
+  // Beyond int64 (no device sends that, a foreign writer might) llround is undefined.
+  if ((is_float && !c.unit.empty()) || !(std::fabs(v) < 9e18)) return real(c.name, v, c.unit, kNotReceived);
   return integer(c.name, std::llround(v), c.unit);
 }
 
