@@ -1,6 +1,6 @@
 #pragma once
 // JSON forms of the contract's DDS samples, keyed by the contract's field names
-// (interface.md), for `pmuctl --json` and for the table printer.
+// (interface.md), for `pmuctl --json`: the JSON column of sample_fields.hpp.
 
 #include <nlohmann/json.hpp>
 
@@ -23,6 +23,7 @@ Json values_of(const pmu::DeviceInfo& s);
 Json values_of(const pmu::Health& s);
 // Batteries and MPPTs (interface.md 3.1): a value not received is null, for integer and
 // boolean fields too (their `received` bit), so no consumer mistakes "not yet" for 0.
+// Sentinels are null too (sample_fields.hpp).
 Json values_of(const pmu::Battery& s);
 Json values_of(const pmu::BatteryCells& s);
 Json values_of(const pmu::Mppt& s);

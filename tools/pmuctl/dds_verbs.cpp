@@ -26,7 +26,9 @@
 #include "pmu/service/vehicle.hpp"
 #include "pmuctl/dds_json.hpp"
 #include "pmuctl/exit_status.hpp"
+#include "pmuctl/sample_fields.hpp"
 #include "pmuctl/service_presence.hpp"
+#include "pmuctl/table_text.hpp"
 
 namespace pmu::tools {
 namespace {
@@ -181,19 +183,6 @@ std::string clock_text(double t) {
   return buf;
 }
 
-std::string text(const Json& v) {
-  if (v.is_null()) return "none";
-  if (v.is_boolean()) return v.get<bool>() ? "yes" : "no";
-  if (v.is_string()) return v.get<std::string>();
-  return v.dump();
-}
-
-void print_table(const DeviceId& d, const Json& values) {
-  std::printf("%s\n", label(d).c_str());
-  for (auto it = values.begin(); it != values.end(); ++it)
-    std::printf("  %-24s %s\n", it.key().c_str(), text(it.value()).c_str());
-}
-
 template <class Collector>
 int print_state(const GlobalOptions& o, const pmu::dds::DdsContext& dds, Collector& c, const char* topic,
                 bool with_kind = false) {
@@ -202,7 +191,7 @@ int print_state(const GlobalOptions& o, const pmu::dds::DdsContext& dds, Collect
     if (o.json)
       print_json(topic, key, values_of(s), std::nullopt, with_kind);
     else
-      print_table(key, values_of(s));
+      std::printf("%s", value_block(label(key), fields_of(s)).c_str());
   }
   return 0;
 }
@@ -212,8 +201,8 @@ int print_state(const GlobalOptions& o, const pmu::dds::DdsContext& dds, Collect
 struct TelemetryLine {
   std::string topic;
   DeviceId device;
-  double time;
-  Json values;
+  double time;  // the sample's source timestamp, s since the Unix epoch
+  SampleFields values;
 };
 
 class TelemetryReader {
@@ -221,6 +210,7 @@ class TelemetryReader {
   virtual ~TelemetryReader() = default;
   virtual bool take(const GlobalOptions& o, TelemetryLine& out) = 0;
   virtual bool matched() const = 0;
+  virtual const std::string& name() const = 0;  // the topic's last word(s): "voltages", "low_rate/voltages"
 };
 
 template <class T, class PubSub>
@@ -234,7 +224,7 @@ class TypedTelemetryReader final : public TelemetryReader {
     SampleInfo info;
     while (reader_.take_next_sample(&sample, &info) == ReturnCode_t::RETCODE_OK) {
       if (!info.valid_data || !selected(o, id_of(sample))) continue;
-      out = {name_, id_of(sample), seconds_of(info.source_timestamp), values_of(sample)};
+      out = {name_, id_of(sample), seconds_of(info.source_timestamp), fields_of(sample)};
       return true;
     }
     return false;
@@ -244,6 +234,7 @@ class TypedTelemetryReader final : public TelemetryReader {
     reader_.get_subscription_matched_status(st);
     return st.current_count > 0;
   }
+  const std::string& name() const override { return name_; }
 
  private:
   std::string name_;
@@ -295,6 +286,17 @@ int run_watch(const GlobalOptions& o, long count) {
     }
   }
 
+  // Every row says its device's health and its values' age: a device gone OFFLINE keeps
+  // its last row, which must not look live.
+  StateCollector<pmu::Health, pmu::HealthPubSubType> health(dds, topics::kHealth);
+  const auto health_of = [&health](const DeviceId& d) -> std::optional<pmu::HealthState> {
+    const auto it = health.latest().find(d);
+    if (it == health.latest().end()) return std::nullopt;
+    return it->second.state();
+  };
+  const auto now_s = [] {
+    return std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count();
+  };
   const bool refresh = !o.json && isatty(STDOUT_FILENO);
   const auto deadline = o.timeout ? Clock::now() + std::chrono::duration<double>(*o.timeout) : Clock::time_point::max();
   std::map<std::pair<DeviceId, std::string>, TelemetryLine> latest;
@@ -302,19 +304,18 @@ int run_watch(const GlobalOptions& o, long count) {
   auto next_draw = Clock::now();
   while (!g_interrupted && Clock::now() < deadline && (count <= 0 || seen < count)) {
     bool any = false;
+    health.poll(o);
     TelemetryLine line;
     for (auto& r : readers) {
       while ((count <= 0 || seen < count) && r->take(o, line)) {
         any = true;
         ++seen;
         if (o.json) {
-          print_json(line.topic.c_str(), line.device, line.values, line.time);
+          print_json(line.topic.c_str(), line.device, json_of(line.values), line.time);
         } else if (!refresh) {
-          std::string row;
-          for (auto it = line.values.begin(); it != line.values.end(); ++it)
-            row += " " + it.key() + "=" + text(it.value());
-          std::printf("%s %s %s%s\n", clock_text(line.time).c_str(), label(line.device).c_str(),
-                      line.topic.c_str(), row.c_str());
+          std::printf("%s %s %s %s %s\n", clock_text(line.time).c_str(), label(line.device).c_str(),
+                      line.topic.c_str(), freshness(health_of(line.device), now_s() - line.time).c_str(),
+                      row_values(line.values).c_str());
         }
         latest[{line.device, line.topic}] = line;
       }
@@ -324,12 +325,13 @@ int run_watch(const GlobalOptions& o, long count) {
       next_draw = Clock::now() + std::chrono::milliseconds(500);
       std::printf("\033[H\033[2J");  // home + clear: a refreshing table
       std::printf("pmuctl watch — domain %d — %ld samples (Ctrl-C to stop)\n\n", o.domain, seen);
-      for (const auto& [key, l] : latest) {
-        std::printf("%s %s %-15s", clock_text(l.time).c_str(), label(l.device).c_str(), l.topic.c_str());
-        for (auto it = l.values.begin(); it != l.values.end(); ++it)
-          std::printf(" %s=%s", it.key().c_str(), text(it.value()).c_str());
-        std::printf("\n");
-      }
+      std::vector<WatchRow> rows;
+      const double now = now_s();
+      // Topics in the contract's order (the readers'), devices in order within each.
+      for (const auto& r : readers)
+        for (const auto& [key, l] : latest)
+          if (l.topic == r->name()) rows.push_back({label(l.device), l.topic, health_of(l.device), now - l.time, l.values});
+      for (const auto& r : watch_table(rows)) std::printf("%s\n", r.c_str());
       std::fflush(stdout);
     }
     if (!any) std::this_thread::sleep_for(std::chrono::milliseconds(10));
@@ -354,9 +356,8 @@ int run_list(const GlobalOptions& o) {
   StateCollector<pmu::DeviceInfo, pmu::DeviceInfoPubSubType> info(dds, topics::kInfo);
   if (int rc = collect(o, dds, health, 3.0)) return rc;
   info.poll(o);
-  if (!o.json)
-    std::printf("%-15s %-15s %9s %8s %8s %-9s %-6s %s\n", "VEHICLE", "BUS", "ADDRESS", "SERIAL", "FIRMWARE", "STATE",
-                "BUS", "LAST FRAME");
+  std::vector<std::vector<std::string>> rows{
+      {"VEHICLE", "BUS", "DEVICE", "SERIAL", "FIRMWARE", "STATE", "BUS STATE", "LAST FRAME"}};
   for (const auto& [key, h] : health.latest()) {
     const auto it = info.latest().find(key);
     std::string fw = "-", serial = "-";
@@ -370,17 +371,16 @@ int run_list(const GlobalOptions& o) {
       j["firmware"] = it != info.latest().end() ? Json(fw) : Json(nullptr);
       print_json("list", key, j, std::nullopt, true);
     } else {
-      char age[32];
-      std::snprintf(age, sizeof age, h.last_frame_age() < 0 ? "never" : "%.1f s ago",
-                    static_cast<double>(h.last_frame_age()));
+      const SampleField age = *find_field(fields_of(h), "last_frame_age");  // "never", or the age
       // A battery or MPPT shows its kind with its number ("battery2"): it has no serial or firmware.
       const std::string number =
           key.kind == pmu::KIND_PMU ? std::to_string(key.address) : to_string(key.kind) + std::to_string(key.address);
-      std::printf("%-15s %-15s %9s %8s %8s %-9s %-6s %s\n", key.vehicle.empty() ? "-" : key.vehicle.c_str(),
-                  key.bus.c_str(), number.c_str(), serial.c_str(), fw.c_str(), to_string(h.state()),
-                  to_string(h.bus_state()), age);
+      rows.push_back({key.vehicle.empty() ? "-" : key.vehicle, key.bus, number, serial, fw, to_string(h.state()),
+                      to_string(h.bus_state()), age.json.is_null() ? age.text : age_text(age.json.get<double>()) + " ago"});
     }
   }
+  if (!o.json)
+    for (const auto& line : aligned_columns(rows)) std::printf("%s\n", line.c_str());
   return 0;
 }
 
@@ -411,12 +411,13 @@ int run_config_get(const GlobalOptions& o, const std::string& parameter) {
   if (parameter.empty()) return print_state(o, dds, c, "config");
   if (int rc = collect(o, dds, c, 3.0)) return rc;
   for (const auto& [key, s] : c.latest()) {
-    const Json v = values_of(s)[parameter];
+    const SampleFields fields = fields_of(s);
+    const SampleField* f = find_field(fields, parameter);
+    if (!f) continue;
     if (o.json)
-      print_json("config", key, Json{{parameter, v}});
+      print_json("config", key, Json{{parameter, f->json}});
     else
-      std::printf("%s %s = %s\n", label(key).c_str(), parameter.c_str(),
-                  text(v).c_str());
+      std::printf("%s %s = %s\n", label(key).c_str(), parameter.c_str(), text_with_unit(*f).c_str());
   }
   return 0;
 }

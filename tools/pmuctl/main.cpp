@@ -22,6 +22,7 @@
 #include "pmuctl/command_verbs.hpp"
 #include "pmuctl/dds_verbs.hpp"
 #include "pmuctl/log_decoder.hpp"
+#include "pmuctl/mask_names.hpp"
 #include "pmuctl/mcap_decode.hpp"
 #include "pmuctl/record_verb.hpp"
 #include "pmuctl/serve_verb.hpp"
@@ -197,7 +198,7 @@ int main(int argc, char** argv) {
   for (const auto& spec : pmu::codec::parameter_table())
     parameter_names += (parameter_names.empty() ? "" : ", ") + std::string(spec.name);
   config_set->add_option("param", set_param, parameter_names)->required();
-  config_set->add_option("value", set_value, "Value in the parameter's unit (V, s, degC, or a number/mask)")->required();
+  config_set->add_option("value", set_value, "Value in the parameter's unit (V, s, degC, a number); a mask: names a,b or none, or a number")->required();
 
   bool confirm = false;
   app.add_flag("--confirm", confirm, "Confirm a command the safety policy guards (avionics off, reset, engine start...)");
@@ -353,12 +354,9 @@ int main(int argc, char** argv) {
     pmu::tools::CommandSpec spec;
     spec.confirm = confirm;
     if (*config_set) {
-      char* end = nullptr;
-      spec.value = std::strtod(set_value.c_str(), &end);
-      if (set_value.empty() || *end != '\0' || !std::isfinite(spec.value))
-        return pmu::tools::fail(g, pmu::tools::ExitStatus::BadUsage,
-                                "'" + pmu::service::printable(set_value) + "' is not a finite number (a value is a "
-                                "number in the parameter's unit)");
+      const auto parsed = pmu::tools::parse_config_value(set_param, set_value);
+      if (!parsed.value) return pmu::tools::fail(g, pmu::tools::ExitStatus::BadUsage, parsed.error);
+      spec.value = *parsed.value;
       spec.kind = pmu::SET_PARAMETER;
       spec.parameter = set_param;
       return pmu::tools::run_command(g, spec);
