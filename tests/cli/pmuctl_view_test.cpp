@@ -268,7 +268,10 @@ TEST(PmuctlView, ConfigSetReadsMaskNamesAndNumbers) {
       {"cranking_time", "0", 0, nullptr},
       {"power_up_state", "avionics_servo,foo",
        0, "power_up_state: unknown name 'foo' in 'avionics_servo,foo' (avionics_servo, payload, charger_a, charger_b, "
-          "battery_disconnect_detect, payload_shedding, soa_management, none, or a number 0..255)"},
+          "battery_disconnect_detect, payload_shedding, soa_management, none, or a number 0..0x7F)"},
+      {"packets_streamed", "-1", 0,
+       "packets_streamed: '-1' is not a mask (voltages, currents, battery_energy, temperatures, status, none, or a "
+       "number 0..0x1F)"},
       {"packets_streamed", "voltage", 0, "unknown name 'voltage'"},
       {"packets_streamed", "voltages,,status", 0, "packets_streamed: empty name in 'voltages,,status'"},
       {"packets_streamed", "voltages,", 0, "empty name"},

@@ -97,8 +97,9 @@ const Case kDemo[] = {
     {"config set generation_enabled 1", 2, "`pmuctl generation on|off`"},
     {"config set no_such_parameter 1", 2, "unknown parameter 'no_such_parameter'"},
     {"config set avionics_voltage -inf", 2, "'-inf' is not a finite number"},
-    {"config set avionics_voltage nan", 2, "'nan' is not a finite number"},
-    {"--timeout 10 config set packets_streamed -1", 1, "packets_streamed: value -1 is not a bit mask 0..0x1F"},
+    {"config set avionics_voltage nan", 2, "avionics_voltage: 'nan' is not a number"},
+    {"config set packets_streamed -1", 2, "packets_streamed: '-1' is not a mask"},
+    {"--timeout 10 config set packets_streamed 32", 1, "packets_streamed 32 has bits outside the defined mask 0x1F"},
     // Option values.
     {"--timeout 1e10 list", 2, "--timeout '1e10' is not a number of seconds"},
     {"--timeout nan list", 2, "--timeout 'nan' is not a number of seconds"},

@@ -27,10 +27,18 @@ const MaskNames kMasks[] = {
     {codec::spec_of(codec::Parameter::PowerUpState).name, kPowerUpNames.data(), kPowerUpNames.size()},
 };
 
+// The range said is the mask the names cover (0x1F for packets_streamed), never the byte's
+// 0..255: a number with other bits is refused by the codec with the firmware's own reason.
 std::string valid_names(const MaskNames& m) {
   std::string s;
-  for (std::size_t i = 0; i < m.count; ++i) s += std::string(m.bits[i].name) + ", ";
-  return s + "none, or a number 0..255";
+  unsigned defined = 0;
+  for (std::size_t i = 0; i < m.count; ++i) {
+    s += std::string(m.bits[i].name) + ", ";
+    defined |= m.bits[i].bit;
+  }
+  char hex[8];
+  std::snprintf(hex, sizeof hex, "0x%02X", defined);
+  return s + "none, or a number 0.." + hex;
 }
 
 // The whole of `text` as a number; nullopt when anything is left over.
