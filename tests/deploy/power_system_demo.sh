@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # The demo of scripts/run.sh serves the whole power system: pmu-service on
 # deploy/examples/sim-power-system.yaml publishes the PMU, the battery (its cells too) and
-# both MPPTs with received values, and `pmuctl list` shows every device ONLINE with its kind.
+# both MPPTs with received values, `pmuctl list` shows every device ONLINE with its kind, and
+# the README's bench session runs on it as written.
 #   power_system_demo.sh PMU-SERVICE PMUCTL SOURCE-DIR
 set -uo pipefail
 svc=$1 ctl=$2 src=$3
@@ -53,5 +54,39 @@ for want in '"kind":"pmu"' '"kind":"battery"' '"kind":"mppt"'; do
   grep "$want" "$work/list" | grep -q '"state":"ONLINE"' || fail "pmuctl list: no ONLINE line with $want: $(tr '\n' ' ' <"$work/list" | cut -c1-400)"
 done
 [ "$(grep -c '"kind":"mppt"' "$work/list")" -eq 2 ] || fail "pmuctl list: $(grep -c '"kind":"mppt"' "$work/list") MPPT lines, want 2"
+
+# The README's bench session, run as written against this demo: every line it shows after a
+# `$ pmuctl ...` prompt is printed by that command, in that order ("..." stands for lines
+# left out).
+python3 - "$src/README.md" "$ctl" "$domain" <<'PY' || failures=$((failures + 1))
+import re, subprocess, sys
+readme, ctl, domain = sys.argv[1:4]
+text = open(readme).read()
+section = text.split("### A bench check from the ground station", 1)[1]
+block = section.split("```", 2)[1].strip("\n").splitlines()
+steps = []
+for line in block:
+    if line.startswith("$ pmuctl "):
+        steps.append((line[len("$ pmuctl "):], []))
+    elif steps and line.strip() != "...":
+        steps[-1][1].append(line)
+problems = []
+if len(steps) < 5:
+    problems.append(f"only {len(steps)} commands found in the README's bench session")
+for args, expected in steps:
+    r = subprocess.run(f"{ctl} --domain {domain} --timeout 20 {args}", shell=True, capture_output=True, text=True)
+    got = (r.stdout + r.stderr).splitlines()
+    at = 0
+    for want in expected:
+        while at < len(got) and got[at].rstrip() != want.rstrip():
+            at += 1
+        if at == len(got):
+            problems.append(f"`pmuctl {args}` did not print {want!r}; it printed: {got[:12]}")
+            break
+        at += 1
+if problems:
+    print("FAIL: README bench session: " + "; ".join(problems), file=sys.stderr); sys.exit(1)
+print(f"README bench session: {len(steps)} commands as written")
+PY
 [ $failures -eq 0 ] || { tail -n 20 "$work/service.log" >&2; exit 1; }
 echo "power system demo: PASS"
