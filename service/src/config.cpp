@@ -565,7 +565,10 @@ Config parse_config(const std::string& text, const std::string& source, const Co
     const auto key = kv.first.as<std::string>();
     if (key == "discovery") parse_discovery(c, kv.first, kv.second, cfg.dds_transport, cfg.network);
     if (key == "interfaces") parse_interfaces(c, kv.first, kv.second, cfg.dds_transport, cfg.network);
-    if (key == "dds_statistics") cfg.dds_statistics = parse_statistics(c, kv.first, kv.second);
+    if (key == "dds_statistics") {
+      cfg.dds_statistics = parse_statistics(c, kv.first, kv.second);
+      cfg.dds_statistics_line = c.line_of(kv.first);
+    }
   }
   if (const auto v = root["timeouts"]) parse_timeouts(c, v, cfg.timeouts);
   if (const auto v = root["policy"]) parse_policy(c, v, cfg.policy);

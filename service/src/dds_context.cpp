@@ -59,6 +59,15 @@ std::string patterns_text(const std::vector<std::string>& patterns) {
 
 }  // namespace
 
+std::optional<std::string> statistics_topic_not_granted(const SecurityFiles& security,
+                                                        const std::vector<std::string>& topics) {
+  for (const auto& topic : topics)
+    if (const auto grant = topic_grant(security, topic, true); !grant || !grant->allowed ||
+                                                                partition_not_granted({}, grant->partitions))
+      return topic;
+  return std::nullopt;
+}
+
 std::string default_qos_file() {
   if (const char* env = std::getenv("PMU_QOS_FILE"); env && *env) return env;
   // Only installed places: a binary that also looked in its build tree would carry that
@@ -84,11 +93,9 @@ DdsContext::DdsContext(int domain, const std::string& qos_file, const std::strin
   // Fast DDS creates statistics writers in the default partition when the participant is
   // enabled; a writer the permissions refuse is only logged, and the topic stays silent.
   if (secure_)
-    for (const auto& topic : statistics)
-      if (const auto grant = topic_grant(security_, topic, true); !grant || !grant->allowed ||
-                                                                   partition_not_granted({}, grant->partitions))
-        throw DdsError("dds_statistics: this identity's permissions do not allow publishing " + topic +
-                       " in the default partition (DDS-Security; docs/interface.md 4.5 says what to grant)");
+    if (const auto topic = statistics_topic_not_granted(security_, statistics))
+      throw DdsError("dds_statistics: this identity's permissions do not allow publishing " + *topic +
+                     " in the default partition (DDS-Security; docs/interface.md 4.5 says what to grant)");
   // Transports, discovery, interfaces, security and statistics: dds_participant.hpp says what each sets.
   DomainParticipantQos pqos;
   try {

@@ -55,9 +55,20 @@ void check_qos(const Config& cfg, StartupCheck& out) {
 
 }  // namespace
 
+// Fast DDS would only log a statistics writer the permissions refuse; DdsContext refuses to
+// start with one (the same function decides). Needs permissions that passed check_security.
+void check_statistics_grants(const Config& cfg, StartupCheck& out) {
+  if (cfg.security.files.empty() || cfg.dds_statistics.empty() || !out.errors.empty()) return;
+  if (const auto topic = dds::statistics_topic_not_granted(cfg.security.files, cfg.dds_statistics))
+    out.errors.push_back(cfg.dds_statistics_line + ": dds_statistics: this identity's permissions (" +
+                         cfg.security.files.permissions + ") do not allow publishing " + *topic +
+                         " in the default partition (DDS-Security; docs/interface.md 4.5 says what to grant)");
+}
+
 StartupCheck check_startup(const Config& cfg) {
   StartupCheck out;
   check_security(cfg, out);
+  check_statistics_grants(cfg, out);
   check_qos(cfg, out);
   return out;
 }

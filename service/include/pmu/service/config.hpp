@@ -121,6 +121,7 @@ struct Config {
   // `dds_statistics`: the Fast DDS statistics topics the participant writes, for Fast DDS
   // Monitor (dds_statistics.hpp); empty (the default): none.
   std::vector<std::string> dds_statistics;
+  std::string dds_statistics_line;  // "FILE:LINE" of dds_statistics, for the start-up check
   // `dds_type_objects`: announce the contract's type objects in discovery, for eProsima's
   // dynamic-type tools (dds_type_objects.hpp). Off by default: they add about 10 kB of
   // discovery traffic per joining participant, which a lossy, narrow ground link pays for.

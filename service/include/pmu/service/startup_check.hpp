@@ -1,7 +1,8 @@
 #pragma once
 // What pmu-service checks before it opens a bus or the network. Every start runs it first and
 // `--check-config` runs it and stops, so the two cannot disagree: the DDS-Security files
-// (dds_security.hpp: present, readable, valid, not expired, one CA not reused), and the QoS
+// (dds_security.hpp: present, readable, valid, not expired, one CA not reused) and that their
+// permissions let the service publish its dds_statistics topics, and the QoS
 // profile file (dds_qos_file.hpp: found, well-formed, loaded by Fast DDS, holding every
 // profile the service makes endpoints with, each with the declared capacity). The config's
 // own checks (keys, values, documents, paths, credentials) ran when it was parsed.
