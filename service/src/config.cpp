@@ -5,13 +5,13 @@
 #include <yaml-cpp/yaml.h>
 
 #include <algorithm>
-#include <charconv>
 #include <cctype>
+#include <cerrno>
+#include <charconv>
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <cstring>
-#include <cerrno>
-#include <cstdio>
 #include <initializer_list>
 #include <map>
 #include <memory>
@@ -33,7 +33,7 @@ constexpr std::size_t kMaxBusName = 15;  // the IDL key is string<15>; IFNAMSIZ 
 // -?(0|[1-9][0-9]*): the one spelling of an integer that YAML 1.1 and a reader agree on.
 bool is_plain_decimal(const std::string& s) {
   const std::size_t start = !s.empty() && s[0] == '-' ? 1 : 0;
-  if (s.size() == start || s.size() - start > 18) return false;  // 18 digits fit a long
+  if (s.size() == start) return false;
   if (s[start] == '0' && s.size() > start + 1) return false;
   return std::all_of(s.begin() + static_cast<std::ptrdiff_t>(start), s.end(),
                      [](unsigned char ch) { return ch >= '0' && ch <= '9'; });
@@ -56,7 +56,7 @@ struct Ctx {
       if (std::none_of(keys.begin(), keys.end(), [&](const char* k) { return key == k; })) {
         std::string known;
         for (const char* k : keys) known += std::string(known.empty() ? "" : ", ") + k;
-        fail(kv.first, "unknown key '" + key + "' in " + where + " (known: " + known + ")");
+        fail(kv.first, "unknown key " + quoted(key) + " in " + where + " (known: " + known + ")");
       }
     }
   }
@@ -67,7 +67,7 @@ struct Ctx {
     try {
       return n.as<T>();
     } catch (const YAML::Exception&) {
-      fail(n, std::string(name) + " must be " + type + ", not '" + n.Scalar() + "'");
+      fail(n, std::string(name) + " must be " + type + ", not " + quoted(n.Scalar()) + "");
     }
   }
 
@@ -104,7 +104,7 @@ std::uint8_t parse_groups(const Ctx& c, const YAML::Node& n) {
     const auto name = c.scalar<std::string>(item, "packet", "a name");
     const auto bit = codec::bit_named(codec::kGroupNames, name);
     if (!bit)
-      c.fail(item, "unknown packet '" + name + "' (known: " + codec::names_of(codec::kGroupNames, 0xFF, ", ") + ")");
+      c.fail(item, "unknown packet " + quoted(name) + " (known: " + codec::names_of(codec::kGroupNames, 0xFF, ", ") + ")");
     mask = static_cast<std::uint8_t>(mask | *bit);
   }
   if (mask == 0) c.fail(n, "packets must name at least one packet");
@@ -134,7 +134,7 @@ void parse_device_settings(const Ctx& c, const YAML::Node& n, DeviceConfig& d) {
     else if (mode == "polling")
       d.mode = TelemetryMode::Polling;
     else
-      c.fail(m, "mode must be streaming or polling, not '" + mode + "'");
+      c.fail(m, "mode must be streaming or polling, not " + quoted(mode) + "");
   }
   if (const auto p = n["period"]) d.period = period_of(c, p, "period");
   if (const auto p = n["packets"]) d.groups = parse_groups(c, p);
@@ -260,7 +260,7 @@ void parse_policy(const Ctx& c, const YAML::Node& n, PolicyConfig& p) {
       const auto name = c.scalar<std::string>(item, "confirm rule", "a name");
       const auto rule = confirm_rule_from_name(name);
       if (!rule)
-        c.fail(item, "unknown confirm rule '" + name + "' (known: " + confirm_rule_names() + ")");
+        c.fail(item, "unknown confirm rule " + quoted(name) + " (known: " + confirm_rule_names() + ")");
       p.confirm[static_cast<std::size_t>(*rule)] = true;
     }
   }
@@ -269,7 +269,7 @@ void parse_policy(const Ctx& c, const YAML::Node& n, PolicyConfig& p) {
     for (const auto& item : v) {
       const auto name = c.scalar<std::string>(item, "command", "a name");
       const auto kind = command_kind_from_name(name);
-      if (!kind) c.fail(item, "unknown command '" + name + "' in deny");
+      if (!kind) c.fail(item, "unknown command " + quoted(name) + " in deny");
       if (*kind == CommandKind::EngineStop) c.fail(item, "engine_stop cannot be denied: it is the safety stop");
       p.deny[static_cast<std::size_t>(*kind)] = true;
     }
@@ -357,10 +357,10 @@ std::vector<dds::Address> parse_address_list(const Ctx& c, const YAML::Node& n, 
     a.text = item.Scalar();
     a.where = c.line_of(item);
     const std::string why = what == "interface" ? dds::parse_interface(a.text, a) : dds::parse_address(a.text, a);
-    if (!why.empty()) c.fail(item, what + " '" + a.text + "': " + why);
+    if (!why.empty()) c.fail(item, what + " " + quoted(a.text) + ": " + why);
     std::string host = a.host;  // host names are case-insensitive
     std::transform(host.begin(), host.end(), host.begin(), [](unsigned char ch) { return std::tolower(ch); });
-    if (!seen.insert({host, a.port}).second) c.fail(item, what + " '" + a.text + "' appears twice in " + key);
+    if (!seen.insert({host, a.port}).second) c.fail(item, what + " " + quoted(a.text) + " appears twice in " + key);
     out.push_back(std::move(a));
   }
   return out;
@@ -387,7 +387,7 @@ void parse_discovery(const Ctx& c, const YAML::Node& key, const YAML::Node& n, d
     else if (m == "server")
       net.mode = dds::DiscoveryMode::Server;
     else if (m != "multicast")
-      c.fail(mode, "discovery mode '" + m + "' is not one of multicast, unicast, server");
+      c.fail(mode, "discovery mode " + quoted(m) + " is not one of multicast, unicast, server");
   }
   const std::string mode_name = dds::to_string(net.mode);
   const YAML::Node at = mode ? mode : key;
@@ -440,10 +440,10 @@ std::vector<std::string> parse_statistics(const Ctx& c, const YAML::Node& key, c
     if (!dds::is_statistics_topic(name)) {
       std::string list;
       for (const auto& k : known) list += (list.empty() ? "" : ", ") + k;
-      c.fail(item, "unknown statistics topic '" + name + "' (known: " + list + ")");
+      c.fail(item, "unknown statistics topic " + quoted(name) + " (known: " + list + ")");
     }
     if (std::find(topics.begin(), topics.end(), name) != topics.end())
-      c.fail(item, "statistics topic '" + name + "' appears twice in dds_statistics");
+      c.fail(item, "statistics topic " + quoted(name) + " appears twice in dds_statistics");
     topics.push_back(name);
   }
   return topics;
@@ -553,13 +553,13 @@ Config parse_config(const std::string& text, const std::string& source, const Co
     else if (t == "shm")
       cfg.dds_transport = dds::Transport::ShmOnly;
     else if (t != "default")
-      c.fail(v, "dds_transport '" + t + "' is not one of default, udp, shm");
+      c.fail(v, "dds_transport " + quoted(t) + " is not one of default, udp, shm");
   }
   if (const auto v = root["dds_type_objects"]) cfg.dds_type_objects = c.scalar<bool>(v, "dds_type_objects", "true or false");
   if (const auto v = root["log_level"]) {
     cfg.log_level = c.scalar<std::string>(v, "log_level", "a level");
     if (!is_log_level(cfg.log_level))
-      c.fail(v, "log_level '" + cfg.log_level + "' is not one of trace, debug, info, warn, error, critical, off");
+      c.fail(v, "log_level " + quoted(cfg.log_level) + " is not one of trace, debug, info, warn, error, critical, off");
   }
   for (const auto& kv : root) {
     const auto key = kv.first.as<std::string>();
@@ -603,9 +603,9 @@ Config parse_config(const std::string& text, const std::string& source, const Co
                  " devices (PMUs, batteries and MPPTs) in one service (the capacity its DDS writers are sized for, "
                  "pmu::service::kMaxDevicesPerService); split them across services");
     devices += canopen;
-    if (!names.insert(b.name).second) c.fail(bn, "bus name '" + b.name + "' appears twice");
+    if (!names.insert(b.name).second) c.fail(bn, "bus name " + quoted(b.name) + " appears twice");
     if (b.interface != "sim" && !interfaces.insert(b.interface).second)
-      c.fail(bn, "interface '" + b.interface + "' is used by two buses (the service owns each bus alone)");
+      c.fail(bn, "interface " + quoted(b.interface) + " is used by two buses (the service owns each bus alone)");
     cfg.buses.push_back(std::move(b));
   }
   return cfg;
@@ -657,7 +657,7 @@ void override_bus(Config& config, const std::string& spec) {
   } else if (spec.rfind("socketcan:", 0) == 0) {
     iface = spec.substr(10);
     if (iface.empty() || iface.size() > kMaxBusName || iface == "sim")
-      throw ConfigError("--bus " + spec + ": '" + iface + "' is not a valid interface name");
+      throw ConfigError("--bus " + spec + ": " + quoted(iface) + " is not a valid interface name");
   } else if (spec.rfind("fd:", 0) == 0) {
     // An inherited fd carrying struct can_frame records (one end of a socketpair): how the
     // benchmarks drive the SocketCAN code path on a kernel without CAN.

@@ -595,6 +595,8 @@ TEST(Config, IntegersAreDecimalOnly) {
   }
   expect_refused("buses:\n  - interface: can0\n    devices:\n      - address: -1\n",
                  "bad.yaml:4: address -1 out of range 0..65534");
+  expect_refused("buses:\n  - interface: can0\n    devices:\n      - address: 99999999999999999999\n",
+                 "bad.yaml:4: address must be an integer, not '99999999999999999999'");
 }
 
 // Names are limited in bytes (the IDL's string<15>), shown whole when short, else as a
@@ -615,6 +617,9 @@ TEST(Config, NameLimitsAreBytesAndLongValuesAreShownShort) {
   expect_refused("vehicle: " + huge + "\nbuses:\n  - interface: can0\n    discover: true\n",
                  "bad.yaml:1: vehicle '" + std::string(24, 'v') + "...' (1000000 bytes) is 1000000 bytes; a vehicle "
                  "name has at most 15 (it is a DDS key, string<15>)");
+  expect_refused("log_level: " + huge + "\nbuses:\n  - interface: can0\n    discover: true\n",
+                 "bad.yaml:1: log_level '" + std::string(24, 'v') + "...' (1000000 bytes) is not one of trace, debug, "
+                 "info, warn, error, critical, off");
   expect_refused("vehicle: uav\xC3\xA9\nbuses:\n  - interface: can0\n    discover: true\n",
                  "bad.yaml:1: vehicle 'uav\xC3\xA9' contains '\xC3\xA9'; a vehicle name is letters, digits, '_', '-' and "
                  "'.' (it is also a DDS partition name, where other characters are patterns)");
