@@ -47,8 +47,8 @@ PARAMS = {0x10: ("B", 10), 0x11: ("B", 10), 0x12: ("B", 10), 0x13: ("B", 10), 0x
 CURRENT_FW = (1, 17)  # firmware assumed until a device's 0x31 reply is seen
 
 
-def temperature(raw, optional):
-    return None if optional and raw == NO_SENSOR else float(raw)
+def temperature(raw):
+    return None if raw == NO_SENSOR else float(raw)  # every temperature (interface.md 1)
 
 
 def decode_values(packet, data, fw):
@@ -67,11 +67,11 @@ def decode_values(packet, data, fw):
     if packet == 0x03:
         i, ba, bb, g, s = struct.unpack("5b", data)
         external = fw >= (1, 12)  # external sensors from firmware 1.12
-        return {"internal": float(i),
-                "battery_a": temperature(ba, True) if external else None,
-                "battery_b": temperature(bb, True) if external else None,
-                "generator": temperature(g, True) if external else None,
-                "starter": float(s)}
+        return {"internal": temperature(i),
+                "battery_a": temperature(ba) if external else None,
+                "battery_b": temperature(bb) if external else None,
+                "generator": temperature(g) if external else None,
+                "starter": temperature(s)}
     if packet == 0x04:
         rpm, f0, f1, f2 = struct.unpack(">HBBB", data)
         soa = fw >= (1, 16)  # flag register 0 bit 6: start button before 1.16

@@ -24,7 +24,7 @@ void decode_field(Packet& p, const std::uint8_t* d, bool external) noexcept {
   }
   const std::int32_t raw = read_field(f.wire, d + f.offset);
   if constexpr (std::is_floating_point_v<Value>) {
-    if constexpr (f.external_sensor) {
+    if constexpr (f.no_sensor) {
       if (raw == kNoSensorRaw) {
         p.*f.member = kNoSensor;
         return;

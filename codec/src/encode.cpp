@@ -66,7 +66,7 @@ bool encode_field(const Packet& p, CanFrame& out, EncodeError& error) noexcept {
   const auto value = p.*f.member;
   long raw = 0;
   if constexpr (std::is_floating_point_v<decltype(value)>) {
-    if (f.external_sensor && std::isnan(value)) {
+    if (f.no_sensor && std::isnan(value)) {
       raw = kNoSensorRaw;
     } else {
       // The in-range test inline, measured() only to word a refusal: returning its Result

@@ -151,6 +151,19 @@ bool CommandService::first_time(const std::string& key, const CommandSample& s) 
   return false;
 }
 
+// From the config alone (immutable, so any thread may read it): a device the config does
+// not name is taken to stream, the side on which the policy asks for more.
+DeviceUse CommandService::device_use(const CommandRequest& r) const {
+  for (const auto* w : workers_) {
+    const BusConfig& bus = w->config();
+    if (bus.name != r.bus) continue;
+    for (const auto& d : bus.devices)
+      if (d.address == r.address) return {d.mode == TelemetryMode::Streaming};
+    if (bus.discover) return {bus.discovered_defaults.mode == TelemetryMode::Streaming};
+  }
+  return {};
+}
+
 CommandService::Refusal CommandService::not_served(const CommandRequest& r) const {
   std::string served;
   for (auto* w : workers_) served += (served.empty() ? "" : ", ") + w->config().name;
@@ -158,7 +171,7 @@ CommandService::Refusal CommandService::not_served(const CommandRequest& r) cons
 }
 
 std::optional<CommandService::Refusal> CommandService::judge(const CommandRequest& r) const {
-  PolicyVerdict verdict = check_policy(r, policy_);
+  PolicyVerdict verdict = check_policy(r, policy_, device_use(r));
   if (verdict.allowed()) return std::nullopt;
   return Refusal{verdict.result, std::move(verdict.reason)};
 }

@@ -1,15 +1,20 @@
 #include "pmu/service/config.hpp"
 
+#include <sys/stat.h>
+#include <yaml-cpp/eventhandler.h>
 #include <yaml-cpp/yaml.h>
 
 #include <algorithm>
-#include <charconv>
 #include <cctype>
+#include <cerrno>
+#include <charconv>
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <cstring>
-#include <fstream>
 #include <initializer_list>
+#include <map>
+#include <memory>
 #include <set>
 #include <sstream>
 #include <utility>
@@ -17,12 +22,22 @@
 #include "pmu/codec/firmware.hpp"
 #include "pmu/codec/messages.hpp"
 #include "pmu/service/dds_statistics.hpp"
+#include "pmu/service/quoted.hpp"
 #include "pmu/service/vehicle.hpp"
 
 namespace pmu::service {
 namespace {
 
 constexpr std::size_t kMaxBusName = 15;  // the IDL key is string<15>; IFNAMSIZ - 1 too
+
+// -?(0|[1-9][0-9]*): the one spelling of an integer that YAML 1.1 and a reader agree on.
+bool is_plain_decimal(const std::string& s) {
+  const std::size_t start = !s.empty() && s[0] == '-' ? 1 : 0;
+  if (s.size() == start) return false;
+  if (s[start] == '0' && s.size() > start + 1) return false;
+  return std::all_of(s.begin() + static_cast<std::ptrdiff_t>(start), s.end(),
+                     [](unsigned char ch) { return ch >= '0' && ch <= '9'; });
+}
 
 struct Ctx {
   std::string source;
@@ -41,7 +56,7 @@ struct Ctx {
       if (std::none_of(keys.begin(), keys.end(), [&](const char* k) { return key == k; })) {
         std::string known;
         for (const char* k : keys) known += std::string(known.empty() ? "" : ", ") + k;
-        fail(kv.first, "unknown key '" + key + "' in " + where + " (known: " + known + ")");
+        fail(kv.first, "unknown key " + quoted(key) + " in " + where + " (known: " + known + ")");
       }
     }
   }
@@ -52,7 +67,7 @@ struct Ctx {
     try {
       return n.as<T>();
     } catch (const YAML::Exception&) {
-      fail(n, std::string(name) + " must be " + type + ", not '" + n.Scalar() + "'");
+      fail(n, std::string(name) + " must be " + type + ", not " + quoted(n.Scalar()) + "");
     }
   }
 
@@ -67,6 +82,11 @@ struct Ctx {
   }
 
   long integer(const YAML::Node& n, const char* name, long lo, long hi) const {
+    // yaml-cpp reads 010 as octal 8 and 0x10 as 16 (YAML 1.1), so an address written with
+    // a leading zero would silently name another device: only plain decimal is taken.
+    if (n.IsScalar() && !is_plain_decimal(n.Scalar()))
+      fail(n, std::string(name) + " must be a decimal integer (digits, optionally after '-'; no leading 0, '+', "
+                                  "0x, 0o, exponent or fraction), not " + quoted(n.Scalar()));
     const auto v = scalar<long>(n, name, "an integer");
     if (v < lo || v > hi)
       fail(n, std::string(name) + " " + n.Scalar() + " out of range " + std::to_string(lo) + ".." +
@@ -84,7 +104,7 @@ std::uint8_t parse_groups(const Ctx& c, const YAML::Node& n) {
     const auto name = c.scalar<std::string>(item, "packet", "a name");
     const auto bit = codec::bit_named(codec::kGroupNames, name);
     if (!bit)
-      c.fail(item, "unknown packet '" + name + "' (known: " + codec::names_of(codec::kGroupNames, 0xFF, ", ") + ")");
+      c.fail(item, "unknown packet " + quoted(name) + " (known: " + codec::names_of(codec::kGroupNames, 0xFF, ", ") + ")");
     mask = static_cast<std::uint8_t>(mask | *bit);
   }
   if (mask == 0) c.fail(n, "packets must name at least one packet");
@@ -114,7 +134,7 @@ void parse_device_settings(const Ctx& c, const YAML::Node& n, DeviceConfig& d) {
     else if (mode == "polling")
       d.mode = TelemetryMode::Polling;
     else
-      c.fail(m, "mode must be streaming or polling, not '" + mode + "'");
+      c.fail(m, "mode must be streaming or polling, not " + quoted(mode) + "");
   }
   if (const auto p = n["period"]) d.period = period_of(c, p, "period");
   if (const auto p = n["packets"]) d.groups = parse_groups(c, p);
@@ -180,12 +200,12 @@ BusConfig parse_bus(const Ctx& c, const YAML::Node& n) {
   if (!iface) c.fail(n, "bus needs an interface (a SocketCAN interface such as can0, or sim)");
   b.interface = c.scalar<std::string>(iface, "interface", "a name");
   if (b.interface.empty() || b.interface.size() > kMaxBusName || b.interface.find('/') != std::string::npos)
-    c.fail(iface, "interface '" + b.interface + "' is not a valid interface name (1..15 characters, no '/')");
+    c.fail(iface, "interface " + quoted(b.interface) + " is not a valid interface name (1..15 bytes, no '/')");
   b.name = b.interface;
   if (const auto name = n["name"]) {
     b.name = c.scalar<std::string>(name, "name", "a name");
     if (b.name.empty() || b.name.size() > kMaxBusName)
-      c.fail(name, "bus name '" + b.name + "' must be 1..15 characters (it is a DDS key)");
+      c.fail(name, "bus name " + quoted(b.name) + " must be 1..15 bytes (it is a DDS key, string<15>)");
   }
   if (const auto r = n["bitrate"]) {
     b.bitrate = static_cast<std::uint32_t>(c.integer(r, "bitrate", 1, 1000000));
@@ -240,9 +260,7 @@ void parse_policy(const Ctx& c, const YAML::Node& n, PolicyConfig& p) {
       const auto name = c.scalar<std::string>(item, "confirm rule", "a name");
       const auto rule = confirm_rule_from_name(name);
       if (!rule)
-        c.fail(item, "unknown confirm rule '" + name +
-                         "' (known: disable_avionics, reset, engine_start, set_can_address, thermal_shutdown, "
-                         "power_up_avionics_off)");
+        c.fail(item, "unknown confirm rule " + quoted(name) + " (known: " + confirm_rule_names() + ")");
       p.confirm[static_cast<std::size_t>(*rule)] = true;
     }
   }
@@ -251,7 +269,7 @@ void parse_policy(const Ctx& c, const YAML::Node& n, PolicyConfig& p) {
     for (const auto& item : v) {
       const auto name = c.scalar<std::string>(item, "command", "a name");
       const auto kind = command_kind_from_name(name);
-      if (!kind) c.fail(item, "unknown command '" + name + "' in deny");
+      if (!kind) c.fail(item, "unknown command " + quoted(name) + " in deny");
       if (*kind == CommandKind::EngineStop) c.fail(item, "engine_stop cannot be denied: it is the safety stop");
       p.deny[static_cast<std::size_t>(*kind)] = true;
     }
@@ -268,6 +286,12 @@ void parse_policy(const Ctx& c, const YAML::Node& n, PolicyConfig& p) {
       c.fail(n["max_command_lifetime"], "max_command_lifetime must be at least command_lifetime");
     lt.max_lifetime = lt.default_lifetime;  // only the default was raised: the cap follows it
   }
+}
+
+// "/etc/pmu-dds/" for "/etc/pmu-dds/pmu-service.yaml": what a relative path in it is relative to.
+std::string config_folder(const std::string& source) {
+  const auto slash = source.rfind('/');
+  return slash == std::string::npos ? std::string() : source.substr(0, slash + 1);
 }
 
 // `credential:NAME` in a security path: the file systemd's LoadCredential=NAME:... gave the
@@ -295,8 +319,7 @@ void parse_security(const Ctx& c, const YAML::Node& key, const YAML::Node& n, Se
   c.only_keys(n, "security", {"identity_ca", "identity_certificate", "private_key", "permissions_ca", "governance",
                               "permissions", "warn_days"});
   sec.source_line = c.line_of(key);
-  const auto slash = c.source.rfind('/');
-  const std::string base = slash == std::string::npos ? std::string() : c.source.substr(0, slash + 1);
+  const std::string base = config_folder(c.source);
   std::string missing;
   for (const auto& ref : dds::kSecurityFileKeys) {
     const auto v = n[ref.key];
@@ -334,10 +357,10 @@ std::vector<dds::Address> parse_address_list(const Ctx& c, const YAML::Node& n, 
     a.text = item.Scalar();
     a.where = c.line_of(item);
     const std::string why = what == "interface" ? dds::parse_interface(a.text, a) : dds::parse_address(a.text, a);
-    if (!why.empty()) c.fail(item, what + " '" + a.text + "': " + why);
+    if (!why.empty()) c.fail(item, what + " " + quoted(a.text) + ": " + why);
     std::string host = a.host;  // host names are case-insensitive
     std::transform(host.begin(), host.end(), host.begin(), [](unsigned char ch) { return std::tolower(ch); });
-    if (!seen.insert({host, a.port}).second) c.fail(item, what + " '" + a.text + "' appears twice in " + key);
+    if (!seen.insert({host, a.port}).second) c.fail(item, what + " " + quoted(a.text) + " appears twice in " + key);
     out.push_back(std::move(a));
   }
   return out;
@@ -364,7 +387,7 @@ void parse_discovery(const Ctx& c, const YAML::Node& key, const YAML::Node& n, d
     else if (m == "server")
       net.mode = dds::DiscoveryMode::Server;
     else if (m != "multicast")
-      c.fail(mode, "discovery mode '" + m + "' is not one of multicast, unicast, server");
+      c.fail(mode, "discovery mode " + quoted(m) + " is not one of multicast, unicast, server");
   }
   const std::string mode_name = dds::to_string(net.mode);
   const YAML::Node at = mode ? mode : key;
@@ -417,13 +440,60 @@ std::vector<std::string> parse_statistics(const Ctx& c, const YAML::Node& key, c
     if (!dds::is_statistics_topic(name)) {
       std::string list;
       for (const auto& k : known) list += (list.empty() ? "" : ", ") + k;
-      c.fail(item, "unknown statistics topic '" + name + "' (known: " + list + ")");
+      c.fail(item, "unknown statistics topic " + quoted(name) + " (known: " + list + ")");
     }
     if (std::find(topics.begin(), topics.end(), name) != topics.end())
-      c.fail(item, "statistics topic '" + name + "' appears twice in dds_statistics");
+      c.fail(item, "statistics topic " + quoted(name) + " appears twice in dds_statistics");
     topics.push_back(name);
   }
   return topics;
+}
+
+// Counts documents; nothing else of the stream is kept.
+class DocumentStarts : public YAML::EventHandler {
+ public:
+  std::vector<YAML::Mark> starts;
+  void OnDocumentStart(const YAML::Mark& mark) override { starts.push_back(mark); }
+  void OnDocumentEnd() override {}
+  void OnNull(const YAML::Mark&, YAML::anchor_t) override {}
+  void OnAlias(const YAML::Mark&, YAML::anchor_t) override {}
+  void OnScalar(const YAML::Mark&, const std::string&, YAML::anchor_t, const std::string&) override {}
+  void OnSequenceStart(const YAML::Mark&, const std::string&, YAML::anchor_t, YAML::EmitterStyle::value) override {}
+  void OnSequenceEnd() override {}
+  void OnMapStart(const YAML::Mark&, const std::string&, YAML::anchor_t, YAML::EmitterStyle::value) override {}
+  void OnMapEnd() override {}
+};
+
+// YAML::Load reads the first document and drops the rest: a second one (after `---`) would
+// be ignored whole. Throws YAML::ParserException for a syntax error.
+void refuse_second_document(const Ctx& c, const std::string& text) {
+  std::istringstream in(text);
+  YAML::Parser parser(in);
+  DocumentStarts docs;
+  while (docs.starts.size() < 2 && parser.HandleNextDocument(docs)) {
+  }
+  if (docs.starts.size() > 1)
+    throw ConfigError(c.source + ":" + std::to_string(docs.starts[1].line + 1) +
+                      ": a second YAML document ('---'): the config is one document; merge it into the first");
+}
+
+// Every mapping, at any depth: each key once, and a key is a name (a scalar).
+void refuse_duplicate_keys(const Ctx& c, const YAML::Node& n) {
+  if (n.IsSequence()) {
+    for (const auto& item : n) refuse_duplicate_keys(c, item);
+    return;
+  }
+  if (!n.IsMap()) return;
+  std::map<std::string, int> first_line;
+  for (const auto& kv : n) {
+    if (!kv.first.IsScalar()) c.fail(kv.first, "a key must be a name, not a list or mapping");
+    const int line = kv.first.Mark().line + 1;
+    const auto [it, fresh] = first_line.emplace(kv.first.Scalar(), line);
+    if (!fresh)
+      c.fail(kv.first, "key " + quoted(kv.first.Scalar()) + " appears twice in one mapping (first on line " +
+                           std::to_string(it->second) + "); give each key once");
+    refuse_duplicate_keys(c, kv.second);
+  }
 }
 
 const char* const kLogLevels[] = {"trace", "debug", "info", "warn", "error", "critical", "off"};
@@ -438,6 +508,7 @@ Config parse_config(const std::string& text, const std::string& source, const Co
   const Ctx c{source, env};
   YAML::Node root;
   try {
+    refuse_second_document(c, text);
     root = YAML::Load(text);
   } catch (const YAML::ParserException& e) {
     throw ConfigError(source + ":" + std::to_string(e.mark.line + 1) + ": YAML syntax error: " + e.msg);
@@ -445,6 +516,8 @@ Config parse_config(const std::string& text, const std::string& source, const Co
   Config cfg;
   cfg.source = source;
   if (root.IsNull()) throw ConfigError(source + ":1: the file is empty");
+  // Before any key is read: yaml-cpp keeps both of two equal keys, and n["key"] finds the first.
+  refuse_duplicate_keys(c, root);
   c.only_keys(root, "the top level", {"domain", "vehicle", "low_rate_period", "qos_file", "dds_transport", "log_level",
                                       "buses", "timeouts", "policy", "security", "discovery", "interfaces",
                                       "canopen_publish_period", "dds_statistics", "dds_type_objects"});
@@ -453,7 +526,7 @@ Config parse_config(const std::string& text, const std::string& source, const Co
     // `vehicle:` with nothing after it is YAML null: the unnamed vehicle, like no key.
     if (!v.IsNull()) cfg.vehicle = c.scalar<std::string>(v, "vehicle", "a name");
     if (const auto why = vehicle_name_problem(cfg.vehicle); !why.empty())
-      c.fail(v, "vehicle '" + cfg.vehicle + "' " + why);
+      c.fail(v, "vehicle " + quoted(cfg.vehicle) + " " + why);
   }
   if (const auto v = root["low_rate_period"]) {
     // 0 turns the low-rate topics off; below 0.1 s they would be no slower than a PMU streams.
@@ -465,7 +538,14 @@ Config parse_config(const std::string& text, const std::string& source, const Co
   if (const auto v = root["canopen_publish_period"])
     canopen_publish_period =
         std::chrono::milliseconds(std::lround(c.number(v, "canopen_publish_period", 0, 3600) * 1000));
-  if (const auto v = root["qos_file"]) cfg.qos_file = c.scalar<std::string>(v, "qos_file", "a path");
+  if (const auto v = root["qos_file"]) {
+    // Relative to the config file's folder, as the security files are: the service's working
+    // directory is not the config's (systemd runs it in /).
+    cfg.qos_file = c.scalar<std::string>(v, "qos_file", "a path");
+    if (cfg.qos_file.empty()) c.fail(v, "qos_file must be a path to a file, not empty");
+    if (cfg.qos_file.front() != '/') cfg.qos_file = config_folder(source) + cfg.qos_file;
+    cfg.qos_file_line = c.line_of(v);
+  }
   if (const auto v = root["dds_transport"]) {
     const auto t = c.scalar<std::string>(v, "dds_transport", "default, udp or shm");
     if (t == "udp")
@@ -473,19 +553,22 @@ Config parse_config(const std::string& text, const std::string& source, const Co
     else if (t == "shm")
       cfg.dds_transport = dds::Transport::ShmOnly;
     else if (t != "default")
-      c.fail(v, "dds_transport '" + t + "' is not one of default, udp, shm");
+      c.fail(v, "dds_transport " + quoted(t) + " is not one of default, udp, shm");
   }
   if (const auto v = root["dds_type_objects"]) cfg.dds_type_objects = c.scalar<bool>(v, "dds_type_objects", "true or false");
   if (const auto v = root["log_level"]) {
     cfg.log_level = c.scalar<std::string>(v, "log_level", "a level");
     if (!is_log_level(cfg.log_level))
-      c.fail(v, "log_level '" + cfg.log_level + "' is not one of trace, debug, info, warn, error, critical, off");
+      c.fail(v, "log_level " + quoted(cfg.log_level) + " is not one of trace, debug, info, warn, error, critical, off");
   }
   for (const auto& kv : root) {
     const auto key = kv.first.as<std::string>();
     if (key == "discovery") parse_discovery(c, kv.first, kv.second, cfg.dds_transport, cfg.network);
     if (key == "interfaces") parse_interfaces(c, kv.first, kv.second, cfg.dds_transport, cfg.network);
-    if (key == "dds_statistics") cfg.dds_statistics = parse_statistics(c, kv.first, kv.second);
+    if (key == "dds_statistics") {
+      cfg.dds_statistics = parse_statistics(c, kv.first, kv.second);
+      cfg.dds_statistics_line = c.line_of(kv.first);
+    }
   }
   if (const auto v = root["timeouts"]) parse_timeouts(c, v, cfg.timeouts);
   if (const auto v = root["policy"]) parse_policy(c, v, cfg.policy);
@@ -520,9 +603,9 @@ Config parse_config(const std::string& text, const std::string& source, const Co
                  " devices (PMUs, batteries and MPPTs) in one service (the capacity its DDS writers are sized for, "
                  "pmu::service::kMaxDevicesPerService); split them across services");
     devices += canopen;
-    if (!names.insert(b.name).second) c.fail(bn, "bus name '" + b.name + "' appears twice");
+    if (!names.insert(b.name).second) c.fail(bn, "bus name " + quoted(b.name) + " appears twice");
     if (b.interface != "sim" && !interfaces.insert(b.interface).second)
-      c.fail(bn, "interface '" + b.interface + "' is used by two buses (the service owns each bus alone)");
+      c.fail(bn, "interface " + quoted(b.interface) + " is used by two buses (the service owns each bus alone)");
     cfg.buses.push_back(std::move(b));
   }
   return cfg;
@@ -534,14 +617,22 @@ std::string SecurityConfig::line_of(const std::string& key) const {
 }
 
 Config load_config(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) throw ConfigError(path + ": cannot open the config file");
-  std::stringstream text;
-  text << in.rdbuf();
-  if (in.bad()) throw ConfigError(path + ": cannot read the config file");
+  const auto reason = [&](const char* what) {
+    return ConfigError(path + ": " + what + " the config file: " + std::strerror(errno));
+  };
+  // A directory opens and reads as nothing; it is not an empty file.
+  struct stat st {};
+  if (::stat(path.c_str(), &st) != 0) throw reason("cannot open");
+  if (S_ISDIR(st.st_mode)) throw ConfigError(path + ": is a directory, not a config file");
+  const std::unique_ptr<std::FILE, int (*)(std::FILE*)> f(std::fopen(path.c_str(), "rb"), &std::fclose);
+  if (!f) throw reason("cannot open");
+  std::string text;
+  char buf[4096];
+  for (std::size_t n; (n = std::fread(buf, 1, sizeof buf, f.get())) > 0;) text.append(buf, n);
+  if (std::ferror(f.get())) throw reason("cannot read");
   ConfigEnvironment env;
   if (const char* dir = std::getenv("CREDENTIALS_DIRECTORY"); dir != nullptr) env.credentials_directory = dir;
-  return parse_config(text.str(), path, env);
+  return parse_config(text, path, env);
 }
 
 Config default_sim_config() {
@@ -566,7 +657,7 @@ void override_bus(Config& config, const std::string& spec) {
   } else if (spec.rfind("socketcan:", 0) == 0) {
     iface = spec.substr(10);
     if (iface.empty() || iface.size() > kMaxBusName || iface == "sim")
-      throw ConfigError("--bus " + spec + ": '" + iface + "' is not a valid interface name");
+      throw ConfigError("--bus " + spec + ": " + quoted(iface) + " is not a valid interface name");
   } else if (spec.rfind("fd:", 0) == 0) {
     // An inherited fd carrying struct can_frame records (one end of a socketpair): how the
     // benchmarks drive the SocketCAN code path on a kernel without CAN.

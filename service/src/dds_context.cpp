@@ -9,6 +9,7 @@
 
 #include "pmu/service/dds_capacity.hpp"
 #include "pmu/service/dds_participant.hpp"
+#include "pmu/service/dds_qos_file.hpp"
 #include "pmu/service/dds_type_objects.hpp"
 #include "pmu/sysconf_dir.hpp"
 
@@ -18,18 +19,6 @@ namespace {
 using namespace eprosima::fastdds::dds;
 
 bool readable(const std::string& path) { return std::ifstream(path).good(); }
-
-// Fast DDS keeps loaded profiles in a process-wide registry: load each file once.
-void load_profiles_once(const std::string& file) {
-  static std::mutex mutex;
-  static std::map<std::string, bool> loaded;
-  std::lock_guard<std::mutex> lock(mutex);
-  if (loaded[file]) return;
-  if (!readable(file)) throw DdsError("QoS profile file " + file + " cannot be read");
-  if (DomainParticipantFactory::get_instance()->load_XML_profiles_file(file) != ReturnCode_t::RETCODE_OK)
-    throw DdsError("cannot load QoS profiles from " + file + " (see the Fast DDS XML error above)");
-  loaded[file] = true;
-}
 
 // Fast DDS 2.9.1 (Debian bookworm's) can hang forever deleting a reliable writer whose readers
 // have not acknowledged everything. Its destructor (RTPSWriter::deinit) returns the history's
@@ -70,6 +59,15 @@ std::string patterns_text(const std::vector<std::string>& patterns) {
 
 }  // namespace
 
+std::optional<std::string> statistics_topic_not_granted(const SecurityFiles& security,
+                                                        const std::vector<std::string>& topics) {
+  for (const auto& topic : topics)
+    if (const auto grant = topic_grant(security, topic, true); !grant || !grant->allowed ||
+                                                                partition_not_granted({}, grant->partitions))
+      return topic;
+  return std::nullopt;
+}
+
 std::string default_qos_file() {
   if (const char* env = std::getenv("PMU_QOS_FILE"); env && *env) return env;
   // Only installed places: a binary that also looked in its build tree would carry that
@@ -88,18 +86,16 @@ DdsContext::DdsContext(int domain, const std::string& qos_file, const std::strin
   const std::string file = qos_file.empty() ? default_qos_file() : qos_file;
   qos_file_ = file;
   if (file.empty()) throw DdsError("no QoS profile file: neither " PMU_SYSCONFDIR "/qos.xml nor " PMU_DATADIR "/qos.xml exists; install deploy/qos.xml, set PMU_QOS_FILE or set qos_file");
-  load_profiles_once(file);
+  load_qos_profiles(file);
   // Before any endpoint exists: Fast DDS copies a type's object into the endpoint's discovery
   // data when the endpoint is created, from what is registered then.
   if (type_objects_) register_type_objects();
   // Fast DDS creates statistics writers in the default partition when the participant is
   // enabled; a writer the permissions refuse is only logged, and the topic stays silent.
   if (secure_)
-    for (const auto& topic : statistics)
-      if (const auto grant = topic_grant(security_, topic, true); !grant || !grant->allowed ||
-                                                                   partition_not_granted({}, grant->partitions))
-        throw DdsError("dds_statistics: this identity's permissions do not allow publishing " + topic +
-                       " in the default partition (DDS-Security; docs/interface.md 4.5 says what to grant)");
+    if (const auto topic = statistics_topic_not_granted(security_, statistics))
+      throw DdsError("dds_statistics: this identity's permissions do not allow publishing " + *topic +
+                     " in the default partition (DDS-Security; docs/interface.md 4.5 says what to grant)");
   // Transports, discovery, interfaces, security and statistics: dds_participant.hpp says what each sets.
   DomainParticipantQos pqos;
   try {

@@ -31,6 +31,7 @@
 #include "pmu/service/dds_statistics.hpp"
 #include "pmu/service/receive_filters.hpp"
 #include "pmu/service/logging.hpp"
+#include "pmu/service/startup_check.hpp"
 #include "pmu/service/systemd.hpp"
 #include "pmu/service/vehicle.hpp"
 #include "pmu/sim/bus_runner.hpp"
@@ -231,27 +232,17 @@ int run(const service::Config& cfg, const pmu::dds::ResolvedNetwork& network) {
   return 0;
 }
 
-// The configured security files, checked before any participant or bus is opened. Errors
-// are printed as "FILE:LINE: PATH: what is wrong" (the config line naming the file);
-// warnings (expiry within warn_days, a key readable by others) are logged.
-bool security_files_ok(const service::Config& cfg) {
-  if (cfg.security.files.empty()) return true;
-  pmu::dds::SecurityCheckOptions options;
-  options.warn_days = cfg.security.warn_days;
-  options.domain = cfg.domain;
-  const auto issues = pmu::dds::check_security_files(cfg.security.files, options);
-  for (const auto& i : issues) {
-    const std::string where = cfg.security.line_of(i.key);
-    if (i.level == pmu::dds::SecurityIssue::Level::Error)
-      std::fprintf(stderr, "pmu-service: %s: %s\n", where.c_str(), i.message.c_str());
-    else
-      spdlog::warn("{}: {}", where, i.message);
-  }
-  if (pmu::dds::has_errors(issues)) {
-    std::fprintf(stderr, "pmu-service: DDS-Security files rejected: not starting (nothing was sent)\n");
-    return false;
-  }
-  return true;
+// check_startup's findings, printed: errors as "pmu-service: FILE:LINE: what is wrong",
+// warnings (expiry within warn_days, a key readable by others) logged. The start and
+// --check-config both come here, so they accept the same configurations. Sets the QoS file
+// to the one checked, so that is the one the participant loads.
+bool startup_ok(service::Config& cfg) {
+  const auto check = service::check_startup(cfg);
+  for (const auto& w : check.warnings) spdlog::warn("{}", w);
+  for (const auto& e : check.errors) std::fprintf(stderr, "pmu-service: %s\n", e.c_str());
+  if (!check.ok()) std::fprintf(stderr, "pmu-service: configuration rejected: not starting (nothing was sent)\n");
+  cfg.qos_file = check.qos_file;
+  return check.ok();
 }
 
 // discovery: and interfaces: with every name looked up (interfaces, host names), before any
@@ -311,12 +302,13 @@ int main(int argc, char** argv) {
     return 2;
   }
   service::setup_logging(level);
-  if (!security_files_ok(cfg)) return 2;
+  if (!startup_ok(cfg)) return 2;
   const auto network = resolved_network(cfg);
   if (!network) return 1;
   if (check_only) {
     std::printf("%s: configuration OK (%zu bus(es)%s)\n", cfg.source.c_str(), cfg.buses.size(),
                 cfg.security.files.empty() ? "" : ", DDS-Security files OK");
+    std::printf("%s: QoS profiles %s OK\n", cfg.source.c_str(), cfg.qos_file.c_str());
     std::printf("%s: DDS %s\n", cfg.source.c_str(), network->summary.c_str());
     return 0;
   }

@@ -9,7 +9,8 @@ namespace pmu::service {
 namespace {
 
 constexpr std::array<std::string_view, kConfirmRuleCount> kRuleNames{
-    "disable_avionics", "reset", "engine_start", "set_can_address", "thermal_shutdown", "power_up_avionics_off"};
+    "disable_avionics", "reset", "engine_start", "set_can_address", "thermal_shutdown", "power_up_avionics_off",
+    "stop_streaming"};
 
 // What each rule protects against, for the DENIED reason.
 constexpr std::array<std::string_view, kConfirmRuleCount> kRuleWhy{
@@ -19,11 +20,12 @@ constexpr std::array<std::string_view, kConfirmRuleCount> kRuleWhy{
     "moves the PMU to another CAN address",
     "sets the upper temperature limit to 0, which forces thermal shutdown",
     "leaves the avionics/servo output off at the next power-up or reset",
+    "sets packets_streamed to 0: the PMU stops the telemetry this service listens for, and goes OFFLINE",
 };
 
 // Judged on the typed request, whose values are already what the wire will carry: a
 // requested 0.0004 that rounds to 0 is 0 here.
-std::optional<ConfirmRule> rule_for(const CommandRequest& r) {
+std::optional<ConfirmRule> rule_for(const CommandRequest& r, const DeviceUse& device) {
   using codec::output_bit::AvionicsServo;
   if (const auto* off = std::get_if<action::DisableOutputs>(&r.action))
     return off->mask & AvionicsServo ? std::optional(ConfirmRule::DisableAvionics) : std::nullopt;
@@ -42,8 +44,9 @@ std::optional<ConfirmRule> rule_for(const CommandRequest& r) {
       case codec::Parameter::PayloadVoltage:
       case codec::Parameter::ServoVoltage:
       case codec::Parameter::BatteryVoltage:
-      case codec::Parameter::PacketPeriod:
       case codec::Parameter::PacketsStreamed:
+        return p->raw == 0 && device.streaming ? std::optional(ConfirmRule::StopStreaming) : std::nullopt;
+      case codec::Parameter::PacketPeriod:
       case codec::Parameter::TemperatureOffset:
       case codec::Parameter::CrankingTime: return std::nullopt;
     }
@@ -61,11 +64,17 @@ std::optional<ConfirmRule> confirm_rule_from_name(std::string_view name) noexcep
   return std::nullopt;
 }
 
-PolicyVerdict check_policy(const CommandRequest& r, const PolicyConfig& p) {
+std::string confirm_rule_names() {
+  std::string names;
+  for (const auto n : kRuleNames) names += (names.empty() ? "" : ", ") + std::string(n);
+  return names;
+}
+
+PolicyVerdict check_policy(const CommandRequest& r, const PolicyConfig& p, const DeviceUse& device) {
   if (r.kind() == CommandKind::EngineStop) return {};  // never refused by policy
   if (p.deny[static_cast<std::size_t>(r.kind())])
     return {CommandResult::Denied, std::string(to_string(r.kind())) + " is denied by the service's policy"};
-  if (const auto rule = rule_for(r); rule && p.confirm[static_cast<std::size_t>(*rule)] && !r.confirm) {
+  if (const auto rule = rule_for(r, device); rule && p.confirm[static_cast<std::size_t>(*rule)] && !r.confirm) {
     return {CommandResult::Denied, std::string(to_string(r.kind())) + " " +
                                        std::string(kRuleWhy[static_cast<std::size_t>(*rule)]) +
                                        ": it needs confirm (pmuctl --confirm); rule " + std::string(to_string(*rule))};

@@ -1,17 +1,21 @@
 #include "pmu/service/vehicle.hpp"
 
+#include "pmu/service/quoted.hpp"
+
 namespace pmu::service {
 
 std::string vehicle_name_problem(std::string_view name) {
+  // Bytes: the IDL bound counts them (every character a vehicle name may hold is one byte).
   if (name.size() > kMaxVehicleNameLength)
-    return "is " + std::to_string(name.size()) + " characters; a vehicle name has at most " +
-           std::to_string(kMaxVehicleNameLength) + " (it is a DDS key)";
-  for (const char ch : name) {
+    return "is " + std::to_string(name.size()) + " bytes; a vehicle name has at most " +
+           std::to_string(kMaxVehicleNameLength) + " (it is a DDS key, string<15>)";
+  for (std::size_t i = 0; i < name.size(); ++i) {
+    const char ch = name[i];
     const bool ok = (ch >= 'a' && ch <= 'z') || (ch >= 'A' && ch <= 'Z') || (ch >= '0' && ch <= '9') || ch == '_' ||
                     ch == '-' || ch == '.';
     if (!ok)
-      return "contains '" + std::string(1, ch) +
-             "'; a vehicle name is letters, digits, '_', '-' and '.' (it is also a DDS partition name, where "
+      return "contains " + character_at(name, i) +
+             "; a vehicle name is letters, digits, '_', '-' and '.' (it is also a DDS partition name, where "
              "other characters are patterns)";
   }
   return {};

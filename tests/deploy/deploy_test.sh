@@ -56,7 +56,7 @@ grep -q "^dds_transport: udp$" "$deploy/pmu-service.yaml" ||
 
 step "check-config with the commented examples switched on"
 full="$work/full.yaml"
-sed -e 's/^# qos_file:/qos_file:/' \
+sed -e "s|^# qos_file: .*|qos_file: $deploy/qos.xml|" \
     -e 's/^# dds_statistics:/dds_statistics:/' \
     -e 's/^# dds_type_objects:/dds_type_objects:/' \
     -e '/^ *discover: false$/d' \

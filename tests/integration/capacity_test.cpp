@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <fastdds/dds/subscriber/SampleInfo.hpp>
 #include <map>
@@ -130,9 +131,13 @@ TEST(QosCapacity, AMiseditedProfileIsAStartUpError) {
   const auto r = run(std::string("PMU_QOS_FILE=") + path + " " PMU_SERVICE_PATH " --bus sim --domain " +
                      std::to_string(exclusive_domain()) + " 2>&1");
   std::remove(path);
-  EXPECT_EQ(r.status, 1) << r.out;
-  EXPECT_NE(r.out.find(std::string(path) + ": <data_writer profile_name=\"state\"> (pmu/config): max_instances 10 < 256 "
-                       "(PMUs per service, pmu::service::kMaxDevicesPerService)"),
+  // A rejected configuration, found by the start-up check before anything is opened, at the
+  // profile's line.
+  EXPECT_EQ(r.status, 2) << r.out;
+  const std::string line = std::to_string(std::count(xml.begin(), xml.begin() + static_cast<std::ptrdiff_t>(at), '\n') + 1);
+  EXPECT_NE(r.out.find(std::string(path) + ":" + line +
+                       ": <data_writer profile_name=\"state\"> (the pmu/config, pmu/info and pmu/health writers): "
+                       "max_instances 10 < 256 (PMUs per service, pmu::service::kMaxDevicesPerService)"),
             std::string::npos)
       << r.out;
 }

@@ -94,7 +94,7 @@ TEST(PmuctlVehicles, ABadVehicleNameIsRefusedBeforeAnythingIsSent) {
   EXPECT_NE(r.out.find("pmuctl: --vehicle 'uav*' contains '*'"), std::string::npos) << r.out;
   r = sh("PMU_VEHICLE=a-name-longer-than-15 " + std::string(PMUCTL_PATH) + " list");
   EXPECT_EQ(r.status, 2);
-  EXPECT_NE(r.out.find("pmuctl: PMU_VEHICLE 'a-name-longer-than-15' is 21 characters"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("pmuctl: PMU_VEHICLE 'a-name-longer-than-15' is 21 bytes"), std::string::npos) << r.out;
 }
 
 }  // namespace

@@ -426,5 +426,21 @@ TEST(ServiceProgram, RefusesToStartWithBadSecurityFilesAndSaysWhere) {
   EXPECT_NE(r.out.find("DDS-Security files OK"), std::string::npos) << r.out;
 }
 
+// Fast DDS only logs a statistics writer the permissions refuse, and the participant refuses
+// to start with one; --check-config finds it too, at the config line (make_pki.sh grants no
+// identity the statistics topics).
+TEST(ServiceProgram, CheckConfigRefusesStatisticsThePermissionsDoNotGrant) {
+  const auto f = Pki::get().files("pmu-service");
+  const std::string cfg =
+      write_config("statistics", f, "dds_statistics: [_fastdds_statistics_history2history_latency]\n");
+  const auto r = sh(std::string(PMU_SERVICE_PATH) + " --config " + cfg + " --check-config");
+  EXPECT_EQ(r.status, 2) << r.out;
+  EXPECT_NE(r.out.find(cfg + ":15: dds_statistics: this identity's permissions (" + f.permissions +
+                       ") do not allow publishing _fastdds_statistics_history2history_latency in the default "
+                       "partition"),
+            std::string::npos)
+      << r.out;
+}
+
 }  // namespace
 }  // namespace pmu::security_test

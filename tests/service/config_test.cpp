@@ -1,5 +1,9 @@
 // pmu-service configuration: every bad value is refused with FILE:LINE and what is wrong.
 #include <gtest/gtest.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <cstdlib>
 
 #include "pmu/service/config.hpp"
 #include "pmu/service/dds_statistics.hpp"
@@ -110,13 +114,16 @@ const BadCase kBad[] = {
      "bad.yaml:2: vehicle 'uav*' contains '*'; a vehicle name is letters, digits, '_', '-' and '.' (it is also a DDS "
      "partition name, where other characters are patterns)"},
     {"vehicle: a-vehicle-name-16\nbuses: []\n",
-     "bad.yaml:1: vehicle 'a-vehicle-name-16' is 17 characters; a vehicle name has at most 15 (it is a DDS key)"},
+     "bad.yaml:1: vehicle 'a-vehicle-name-16' is 17 bytes; a vehicle name has at most 15 (it is a DDS key, "
+     "string<15>)"},
     {"vehicle: [uav1]\nbuses: []\n", "bad.yaml:1: vehicle must be a name"},
     {"low_rate_period: 0.05\nbuses: []\n",
      "bad.yaml:1: low_rate_period 0.05 is below 0.1 s (0 turns the low-rate topics off)"},
     {"low_rate_period: -1\nbuses: []\n", "bad.yaml:1: low_rate_period -1 out of range 0..3600"},
     {"domain: 300\nbuses: []\n", "bad.yaml:1: domain 300 out of range 0..232"},
-    {"domain: x\nbuses: []\n", "bad.yaml:1: domain must be an integer, not 'x'"},
+    {"domain: x\nbuses: []\n",
+     "bad.yaml:1: domain must be a decimal integer (digits, optionally after '-'; no leading 0, '+', 0x, 0o, exponent "
+     "or fraction), not 'x'"},
     {"buses: []\n", "bad.yaml:1: buses must be a non-empty list"},
     {"buses:\n  - name: a\n", "bad.yaml:2: bus needs an interface (a SocketCAN interface such as can0, or sim)"},
     {"buses:\n  - interface: can0\n",
@@ -158,7 +165,7 @@ const BadCase kBad[] = {
     {"buses:\n  - interface: can0\n    bitrate: 800000\n    discover: true\n",
      "bad.yaml:3: bitrate 800000 is not one the PMU supports (125000, 250000, 500000, 1000000)"},
     {"buses:\n  - interface: averyveryverylongname\n    discover: true\n",
-     "bad.yaml:2: interface 'averyveryverylongname' is not a valid interface name (1..15 characters, no '/')"},
+     "bad.yaml:2: interface 'averyveryverylongname' is not a valid interface name (1..15 bytes, no '/')"},
     {"buses:\n  - interface: can0\n    discover: true\n  - interface: can0\n    name: other\n    discover: true\n",
      "bad.yaml:4: interface 'can0' is used by two buses (the service owns each bus alone)"},
     {"buses:\n  - interface: can0\n    discover: true\n  - interface: can1\n    name: can0\n    discover: true\n",
@@ -500,13 +507,137 @@ TEST(Config, VehicleIsTheUnnamedOneUnlessNamed) {
             "UAV-7.b_2");
 }
 
-TEST(Config, MissingFileSaysSo) {
+// The system's reason, in words: a missing file and an unreadable one are fixed differently.
+TEST(ConfigFile, MissingFileSaysWhy) {
   try {
     (void)load_config("/nonexistent/pmu.yaml");
     ADD_FAILURE() << "accepted";
   } catch (const ConfigError& e) {
-    EXPECT_EQ(std::string(e.what()), "/nonexistent/pmu.yaml: cannot open the config file");
+    EXPECT_EQ(std::string(e.what()), "/nonexistent/pmu.yaml: cannot open the config file: No such file or directory");
   }
+}
+
+TEST(ConfigFile, UnreadableFileSaysWhy) {
+  if (::geteuid() == 0) GTEST_SKIP() << "root reads a file of mode 000: no EACCES to see";
+  char path[] = "/tmp/pmu-config-XXXXXX";
+  const int fd = ::mkstemp(path);
+  ASSERT_GE(fd, 0);
+  ::close(fd);
+  ASSERT_EQ(::chmod(path, 0), 0);
+  try {
+    (void)load_config(path);
+    ADD_FAILURE() << "accepted";
+  } catch (const ConfigError& e) {
+    EXPECT_EQ(std::string(e.what()), std::string(path) + ": cannot open the config file: Permission denied");
+  }
+  ::unlink(path);
+}
+
+TEST(ConfigFile, DirectoryIsNotAnEmptyFile) {
+  try {
+    (void)load_config("/tmp");
+    ADD_FAILURE() << "accepted";
+  } catch (const ConfigError& e) {
+    EXPECT_EQ(std::string(e.what()), "/tmp: is a directory, not a config file");
+  }
+}
+
+// A key given twice, at any depth, is refused at its second line (yaml-cpp keeps both and
+// n["key"] found the first, so the second was silently ignored); so is a second document.
+const BadCase kRepeated[] = {
+    {"buses:\n  - interface: can0\n    discover: true\nbuses:\n  - interface: can1\n    discover: true\n",
+     "bad.yaml:4: key 'buses' appears twice in one mapping (first on line 1); give each key once"},
+    {"domain: 1\nbuses:\n  - interface: can0\n    discover: true\ndomain: 2\n",
+     "bad.yaml:5: key 'domain' appears twice in one mapping (first on line 1); give each key once"},
+    {"vehicle: uav1\nvehicle: uav2\nbuses:\n  - interface: can0\n    discover: true\n",
+     "bad.yaml:2: key 'vehicle' appears twice in one mapping (first on line 1); give each key once"},
+    {"buses:\n  - interface: can0\n    interface: can1\n    discover: true\n",
+     "bad.yaml:3: key 'interface' appears twice in one mapping (first on line 2); give each key once"},
+    {"buses:\n  - interface: can0\n    devices:\n      - address: 1\n        address: 2\n",
+     "bad.yaml:5: key 'address' appears twice in one mapping (first on line 4); give each key once"},
+    {"timeouts:\n  reply: 0.3\n  reply: 0.5\nbuses:\n  - interface: can0\n    discover: true\n",
+     "bad.yaml:3: key 'reply' appears twice in one mapping (first on line 2); give each key once"},
+    {"discovery: {mode: unicast, peers: [10.0.0.1], mode: server}\nbuses:\n  - interface: can0\n    discover: true\n",
+     "bad.yaml:1: key 'mode' appears twice in one mapping (first on line 1); give each key once"},
+    {"? [a, b]\n: 1\nbuses:\n  - interface: can0\n    discover: true\n",
+     "bad.yaml:1: a key must be a name, not a list or mapping"},
+    {"buses:\n  - interface: can0\n    discover: true\n---\ndomain: 3\n",
+     "bad.yaml:4: a second YAML document ('---'): the config is one document; merge it into the first"},
+    {"buses:\n  - interface: can0\n    discover: true\n\n---\n",
+     "bad.yaml:5: a second YAML document ('---'): the config is one document; merge it into the first"},
+};
+
+TEST(Config, RepeatedKeysAndSecondDocumentsAreRefusedAtTheirLine) {
+  for (const auto& c : kRepeated) expect_refused(c.yaml, c.message);
+  // One document may still say where it starts.
+  EXPECT_EQ(parse_config("---\ndomain: 3\nbuses:\n  - interface: can0\n    discover: true\n", "a.yaml").domain, 3);
+}
+
+// Integers are plain decimal (interface.md 2): YAML 1.1 reads 010 as 8 and 0x10 as 16, so a
+// PMU written 010 was PMU 8. Each form is refused at its line, naming the key.
+TEST(Config, IntegersAreDecimalOnly) {
+  const std::string rule =
+      " must be a decimal integer (digits, optionally after '-'; no leading 0, '+', 0x, 0o, exponent or fraction), "
+      "not ";
+  for (const char* v : {"010", "0x10", "0o10", "1e1", "+5", "08", "1.0", "-05", "1_000", "00"}) {
+    SCOPED_TRACE(v);
+    expect_refused("buses:\n  - interface: can0\n    devices:\n      - address: " + std::string(v) + "\n",
+                   "bad.yaml:4: address" + rule + "'" + v + "'");
+  }
+  expect_refused("domain: 010\nbuses:\n  - interface: can0\n    discover: true\n", "bad.yaml:1: domain" + rule + "'010'");
+  expect_refused("buses:\n  - interface: can0\n    mppts:\n      - device: 0x1\n", "bad.yaml:4: device" + rule + "'0x1'");
+  expect_refused("buses:\n  - interface: can0\n    bitrate: 5e5\n    discover: true\n", "bad.yaml:3: bitrate" + rule + "'5e5'");
+  // Accepted: 0, and decimal as written (quoted too); a negative one is out of range, not misread.
+  for (const char* v : {"0", "8", "10", "65534", "\"10\""}) {
+    SCOPED_TRACE(v);
+    const Config c = parse_config("buses:\n  - interface: can0\n    devices:\n      - address: " + std::string(v) + "\n", "a.yaml");
+    EXPECT_EQ(c.buses[0].devices[0].address, std::stoi(std::string(v[0] == '"' ? v + 1 : v)));
+  }
+  expect_refused("buses:\n  - interface: can0\n    devices:\n      - address: -1\n",
+                 "bad.yaml:4: address -1 out of range 0..65534");
+  expect_refused("buses:\n  - interface: can0\n    devices:\n      - address: 99999999999999999999\n",
+                 "bad.yaml:4: address must be an integer, not '99999999999999999999'");
+}
+
+// Names are limited in bytes (the IDL's string<15>), shown whole when short, else as a
+// prefix cut at a character boundary with the length: never half a UTF-8 character, never a
+// megabyte in a message.
+TEST(Config, NameLimitsAreBytesAndLongValuesAreShownShort) {
+  expect_refused("buses:\n  - interface: can0\n    name: \xC3\xA9t\xC3\xA9-\xC3\xA9t\xC3\xA9-\xC3\xA9t\xC3\xA9\n    discover: true\n",
+                 "bad.yaml:3: bus name '\xC3\xA9t\xC3\xA9-\xC3\xA9t\xC3\xA9-\xC3\xA9t\xC3\xA9' must be 1..15 bytes (it is a "
+                 "DDS key, string<15>)");
+  // 1 + 13 x 3 bytes: the 24-byte prefix holds 'a' and 7 euro signs; the 8th would be cut.
+  std::string euros = "a";
+  for (int i = 0; i < 13; ++i) euros += "\xE2\x82\xAC";
+  std::string shown = "a";
+  for (int i = 0; i < 7; ++i) shown += "\xE2\x82\xAC";
+  expect_refused("buses:\n  - interface: can0\n    name: " + euros + "\n    discover: true\n",
+                 "bad.yaml:3: bus name '" + shown + "...' (40 bytes) must be 1..15 bytes (it is a DDS key, string<15>)");
+  const std::string huge(1000000, 'v');
+  expect_refused("vehicle: " + huge + "\nbuses:\n  - interface: can0\n    discover: true\n",
+                 "bad.yaml:1: vehicle '" + std::string(24, 'v') + "...' (1000000 bytes) is 1000000 bytes; a vehicle "
+                 "name has at most 15 (it is a DDS key, string<15>)");
+  expect_refused("log_level: " + huge + "\nbuses:\n  - interface: can0\n    discover: true\n",
+                 "bad.yaml:1: log_level '" + std::string(24, 'v') + "...' (1000000 bytes) is not one of trace, debug, "
+                 "info, warn, error, critical, off");
+  expect_refused("vehicle: uav\xC3\xA9\nbuses:\n  - interface: can0\n    discover: true\n",
+                 "bad.yaml:1: vehicle 'uav\xC3\xA9' contains '\xC3\xA9'; a vehicle name is letters, digits, '_', '-' and "
+                 "'.' (it is also a DDS partition name, where other characters are patterns)");
+  expect_refused("vehicle: \"uav\\t1\"\nbuses:\n  - interface: can0\n    discover: true\n",
+                 "bad.yaml:1: vehicle 'uav\\x091' contains byte 0x09; a vehicle name is letters, digits, '_', '-' and "
+                 "'.' (it is also a DDS partition name, where other characters are patterns)");
+}
+
+// qos_file: relative to the config file's folder, like the security files; its line is kept
+// for the start-up check's messages.
+TEST(Config, QosFileIsRelativeToTheConfigFolder) {
+  const std::string bus = "buses:\n  - interface: can0\n    discover: true\n";
+  const Config rel = parse_config("qos_file: site/qos.xml\n" + bus, "/etc/pmu-dds/pmu-service.yaml");
+  EXPECT_EQ(rel.qos_file, "/etc/pmu-dds/site/qos.xml");
+  EXPECT_EQ(rel.qos_file_line, "/etc/pmu-dds/pmu-service.yaml:1");
+  EXPECT_EQ(parse_config(bus + "qos_file: /opt/qos.xml\n", "a.yaml").qos_file, "/opt/qos.xml");
+  EXPECT_EQ(parse_config(bus, "a.yaml").qos_file, "") << "none: the installed one, found at start";
+  expect_refused(bus + "qos_file: ''\n", "bad.yaml:4: qos_file must be a path to a file, not empty");
 }
 
 // dds_type_objects (interface.md 4.4): off unless true.

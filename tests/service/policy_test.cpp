@@ -44,6 +44,12 @@ TEST(Policy, ConfirmRulesByDefault) {
       {"S0 with avionics", make(CommandKind::SetParameter, 0, "power_up_state", 0x21), false},
       {"S0 without avionics", make(CommandKind::SetParameter, 0, "power_up_state", 0x20), true},
       {"a voltage", make(CommandKind::SetParameter, 0, "avionics_voltage", 24), false},
+      // PS = 0 silences a streaming PMU (v1.9 table 13: PS selects the packets streamed).
+      {"PS 0", make(CommandKind::SetParameter, 0, "packets_streamed", 0), true},
+      {"PS 0.0004", make(CommandKind::SetParameter, 0, "packets_streamed", 0.0004), true},
+      {"PS voltages only", make(CommandKind::SetParameter, 0, "packets_streamed", 1), false},
+      {"PS every packet", make(CommandKind::SetParameter, 0, "packets_streamed", 0x1F), false},
+      {"PP 0.1 s", make(CommandKind::SetParameter, 0, "packet_period", 0.1), false},
       {"generation off", make(CommandKind::SetGeneration), false},
   };
   const PolicyConfig p;
@@ -58,6 +64,25 @@ TEST(Policy, ConfirmRulesByDefault) {
       EXPECT_TRUE(check_policy(confirmed, p).allowed());
     }
   }
+}
+
+// The service asks a polled device for its packets: PS = 0 takes nothing from it.
+TEST(Policy, StopStreamingOnlyForADeviceTheServiceListensTo) {
+  const PolicyConfig p;
+  const auto ps0 = make(CommandKind::SetParameter, 0, "packets_streamed", 0);
+  const auto streaming = check_policy(ps0, p, DeviceUse{true});
+  EXPECT_EQ(streaming.result, CommandResult::Denied);
+  EXPECT_EQ(streaming.reason,
+            "set_parameter sets packets_streamed to 0: the PMU stops the telemetry this service listens for, and "
+            "goes OFFLINE: it needs confirm (pmuctl --confirm); rule stop_streaming");
+  EXPECT_TRUE(check_policy(ps0, p, DeviceUse{false}).allowed());
+  PolicyConfig off;
+  off.confirm[static_cast<std::size_t>(ConfirmRule::StopStreaming)] = false;
+  EXPECT_TRUE(check_policy(ps0, off, DeviceUse{true}).allowed());
+  EXPECT_EQ(parse_config("policy:\n  confirm: [stop_streaming]\nbuses:\n  - interface: can0\n    discover: true\n",
+                         "p.yaml")
+                .policy.confirm,
+            (std::array<bool, kConfirmRuleCount>{false, false, false, false, false, false, true}));
 }
 
 TEST(Policy, RulesCanBeSwitchedOffAndKindsDenied) {

@@ -318,7 +318,7 @@ TEST(SimMeasurements, ClampedIntoFieldRange) {
   p.battery_b_voltage = -1.0;       // below 0
   p.output_28v_load = -20.0;        // table 3: -12.5..12.5
   p.avionics_load = 14.0;           // 0..10.0
-  p.internal_temperature = -200.0;  // table 5: -128..127
+  p.internal_temperature = -200.0;  // table 5: -127..127 and "no sensor"
   p.battery_a_temperature = -128.0; // a real -128 is not "no sensor": -127
   p.battery_b_temperature = 300.0;
   p.starter_temperature = -60.0;    // -49..127
@@ -334,7 +334,7 @@ TEST(SimMeasurements, ClampedIntoFieldRange) {
   EXPECT_DOUBLE_EQ(v->battery_b, 0.0);
   EXPECT_DOUBLE_EQ(a->output_28v, -12.5);
   EXPECT_DOUBLE_EQ(a->avionics, 10.0);
-  EXPECT_DOUBLE_EQ(t->internal, -128.0);
+  EXPECT_DOUBLE_EQ(t->internal, -127.0);
   EXPECT_DOUBLE_EQ(t->battery_a, -127.0);
   EXPECT_DOUBLE_EQ(t->battery_b, 127.0);
   EXPECT_DOUBLE_EQ(t->starter, -49.0);
@@ -389,14 +389,15 @@ TEST(SimMeasurements, ClampLimitsAreTheCodecTablesRanges) {
   }
 }
 
-TEST(SimMeasurements, NanWithoutNoSensorValueIsNotSent) {
+TEST(SimMeasurements, NanTemperatureIsSentAsNoSensor) {
   Harness h;
   Plant p;
-  p.internal_temperature = std::nan("");  // only the external sensors have "no sensor"
+  p.internal_temperature = std::nan("");  // every temperature has "no sensor" (-128)
   h.pmu.set_plant(p, h.now);
-  h.deliver(codec::encode_get(PacketId::Temperatures, 1));
-  EXPECT_TRUE(h.sent.empty());
-  EXPECT_EQ(h.pmu.counters().encode_errors, 1u);
+  const auto t = h.get<codec::Temperatures>(PacketId::Temperatures);
+  ASSERT_TRUE(t);
+  EXPECT_TRUE(std::isnan(t->internal));
+  EXPECT_EQ(h.pmu.counters().encode_errors, 0u);
 }
 
 }  // namespace

@@ -187,15 +187,60 @@ TEST(BatteryEnergy, SignedBigEndianExtremes) {
 }
 
 // ---- table 5: temperatures ---------------------------------------------------------------
-TEST(Temperatures, NoSensorIsNaNOnlyForExternalSensors) {
-  auto m = decode(pmu_frame(0x03, 1, {0x80, 0x80, 0x80, 0x80, 0xCF}));
-  ASSERT_TRUE(m.ok());
-  const auto& t = std::get<Temperatures>(m->payload);
-  EXPECT_EQ(t.internal, -128);  // internal sensor has no "no sensor" value
-  EXPECT_TRUE(std::isnan(t.battery_a));
-  EXPECT_TRUE(std::isnan(t.battery_b));
-  EXPECT_TRUE(std::isnan(t.generator));
-  EXPECT_EQ(t.starter, -49);
+// Table 5, one row per temperature: its byte, and the firmware from which it is reported
+// (the external sensors from 1.12, v1.9 6.1). -128 on any of them is "no sensor", NaN
+// (interface.md 1); the spec says so of the external sensors, and the internal and starter
+// sensors cannot read -128 degC either.
+struct TemperatureRow {
+  const char* field;
+  std::size_t byte;
+  double Temperatures::*member;
+  FirmwareVersion reported_from;
+};
+
+const TemperatureRow kTemperatureRows[] = {
+    {"internal", 0, &Temperatures::internal, {1, 0}},
+    {"battery_a", 1, &Temperatures::battery_a, {1, 12}},
+    {"battery_b", 2, &Temperatures::battery_b, {1, 12}},
+    {"generator", 3, &Temperatures::generator, {1, 12}},
+    {"starter", 4, &Temperatures::starter, {1, 0}},
+};
+
+TEST(Temperatures, MinusOneTwentyEightIsNoSensorOnEveryTemperature) {
+  for (const auto& row : kTemperatureRows) {
+    SCOPED_TRACE(row.field);
+    CanFrame frame = pmu_frame(0x03, 1, {20, 21, 22, 23, 24});
+    frame.data[row.byte] = 0x80;  // -128
+    const auto m = decode(frame, FirmwareVersion{1, 14});
+    ASSERT_TRUE(m.ok());
+    const auto& t = std::get<Temperatures>(m->payload);
+    EXPECT_TRUE(std::isnan(t.*row.member));
+    for (const auto& other : kTemperatureRows) {
+      if (other.member != row.member) {
+        EXPECT_EQ(t.*other.member, 20 + static_cast<double>(other.byte)) << other.field;
+      }
+    }
+    // The encoder sends "no sensor" for NaN, and refuses the -128 it could not tell from it.
+    Temperatures in{20, 21, 22, 23, 24};
+    in.*row.member = std::nan("");
+    const auto sent = encode_temperatures(in, 1);
+    ASSERT_TRUE(sent.ok());
+    EXPECT_EQ(sent->data[row.byte], 0x80);
+    in.*row.member = -128;
+    EXPECT_FALSE(encode_temperatures(in, 1).ok());
+  }
+}
+
+// One past "no sensor" is a reading, on every temperature that the firmware reports.
+TEST(Temperatures, MinusOneTwentySevenIsAReading) {
+  for (const auto& row : kTemperatureRows) {
+    SCOPED_TRACE(row.field);
+    CanFrame frame = pmu_frame(0x03, 1, {0, 0, 0, 0, 0});
+    frame.data[row.byte] = 0x81;  // -127
+    const auto m = decode(frame, row.reported_from);
+    ASSERT_TRUE(m.ok());
+    EXPECT_EQ(std::get<Temperatures>(m->payload).*row.member, -127);
+  }
 }
 
 TEST(Temperatures, SignedExtremes) {
@@ -223,11 +268,11 @@ TEST(Temperatures, ExternalSensorsAbsentBeforeFirmware112) {
 
 TEST(Temperatures, EncodeNoSensorAndRanges) {
   Temperatures t;
-  t.internal = -128;
+  t.internal = -127;
   t.starter = -49;
   auto fr = encode_temperatures(t, 1);
   ASSERT_TRUE(fr.ok());
-  EXPECT_EQ(fr->data[0], 0x80);
+  EXPECT_EQ(fr->data[0], 0x81);
   EXPECT_EQ(fr->data[1], 0x80);  // NaN -> "no sensor"
   EXPECT_EQ(fr->data[4], 0xCF);
   t.starter = -50;  // one past table 5's -49

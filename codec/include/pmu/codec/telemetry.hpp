@@ -29,7 +29,9 @@ constexpr std::uint8_t wire_size(WireType t) noexcept {
   return 2;
 }
 
-// An external sensor's "no sensor" on the wire (table 5).
+// "No sensor" on the wire (table 5): said of the external sensors, and taken to mean the
+// same for every temperature (interface.md 1), since a reading of -128 degC on the internal
+// or starter sensor is no reading either.
 inline constexpr std::int8_t kNoSensorRaw = -128;
 
 template <class Packet, class Value = double>
@@ -41,16 +43,17 @@ struct FieldSpec {
   std::int32_t raw_min, raw_max;  // what a reading can be (the spec's "Range"), raw units
   std::string_view unit;
   Value Packet::*member;
-  // A 1.12+ external sensor (v1.9 6.1): -128 on the wire is "no sensor" (NaN), so a reading
-  // stops at -127; before 1.12 the field is not reported at all.
+  // A 1.12+ external sensor (v1.9 6.1): before 1.12 the field is not reported at all.
   bool external_sensor = false;
+  // A temperature: kNoSensorRaw on the wire is "no sensor" (NaN), so a reading stops at -127.
+  bool no_sensor = false;
 
   constexpr double min() const noexcept { return static_cast<double>(raw_min) / divisor; }
   constexpr double max() const noexcept { return static_cast<double>(raw_max) / divisor; }
 };
 
 // A reading beyond what the field can carry, reported at the field's limit (what a unit
-// whose sensor reads past the range sends). NaN passes: for an external sensor it is "no
+// whose sensor reads past the range sends). NaN passes: for a temperature it is "no
 // sensor", elsewhere the encoder refuses it.
 template <class Packet, class Value>
 constexpr double clamp_to_field(const FieldSpec<Packet, Value>& f, double v) noexcept {
@@ -102,16 +105,17 @@ struct Telemetry<BatteryEnergy> {
   }};
 };
 
-// Protocol v1.9 table 5: signed whole degrees; the starter sensor reads -49..127.
+// Protocol v1.9 table 5: signed whole degrees; the starter sensor reads -49..127. The
+// internal sensor's -128..127 loses -128 to "no sensor", like the external ones.
 template <>
 struct Telemetry<Temperatures> {
   static constexpr PacketId packet = PacketId::Temperatures;
   static constexpr std::array<FieldSpec<Temperatures>, 5> fields{{
-      {"internal", 0, WireType::S8, 1, -128, 127, "degC", &Temperatures::internal},
-      {"battery_a", 1, WireType::S8, 1, -127, 127, "degC", &Temperatures::battery_a, true},
-      {"battery_b", 2, WireType::S8, 1, -127, 127, "degC", &Temperatures::battery_b, true},
-      {"generator", 3, WireType::S8, 1, -127, 127, "degC", &Temperatures::generator, true},
-      {"starter", 4, WireType::S8, 1, -49, 127, "degC", &Temperatures::starter},
+      {"internal", 0, WireType::S8, 1, -127, 127, "degC", &Temperatures::internal, false, true},
+      {"battery_a", 1, WireType::S8, 1, -127, 127, "degC", &Temperatures::battery_a, true, true},
+      {"battery_b", 2, WireType::S8, 1, -127, 127, "degC", &Temperatures::battery_b, true, true},
+      {"generator", 3, WireType::S8, 1, -127, 127, "degC", &Temperatures::generator, true, true},
+      {"starter", 4, WireType::S8, 1, -49, 127, "degC", &Temperatures::starter, false, true},
   }};
 };
 

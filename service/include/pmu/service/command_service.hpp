@@ -73,6 +73,7 @@ class CommandService {
   Refusal not_served(const CommandRequest& r) const;
   // The deny list and confirm rules (policy.hpp).
   std::optional<Refusal> judge(const CommandRequest& r) const;
+  DeviceUse device_use(const CommandRequest& r) const;
   // The per-device token bucket; never for engine stop.
   std::optional<Refusal> limit_rate(const CommandRequest& r);
   // ...and on the bus worker's thread:

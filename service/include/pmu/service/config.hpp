@@ -59,7 +59,7 @@ struct MpptConfig {
 };
 
 struct BusConfig {
-  std::string name;       // the DDS key `bus`; at most 15 characters
+  std::string name;       // the DDS key `bus`; at most 15 bytes
   std::string interface;  // SocketCAN interface, or "sim" for the built-in simulated PMU
   std::uint32_t bitrate = 1000000;  // what the link runs at (checked against the firmware)
   std::vector<DeviceConfig> devices;
@@ -107,7 +107,10 @@ struct Config {
   std::string vehicle;
   // pmu/low_rate/* get each device's telemetry at most once per this period (0: off).
   std::chrono::milliseconds low_rate_period{1000};
-  std::string qos_file;  // empty: the installed deploy/qos.xml, found by the service
+  // Empty: the installed deploy/qos.xml, found by the service. Relative in the file: to the
+  // config file's folder (made absolute here).
+  std::string qos_file;
+  std::string qos_file_line;  // "FILE:LINE" of qos_file, for the start-up check's messages
   // default: Fast DDS's builtin transports (shared memory between processes on one host,
   // UDPv4); udp: UDPv4 only, e.g. when readers run as other users (SHM segments are
   // owner-only in Fast DDS 2.9).
@@ -118,6 +121,7 @@ struct Config {
   // `dds_statistics`: the Fast DDS statistics topics the participant writes, for Fast DDS
   // Monitor (dds_statistics.hpp); empty (the default): none.
   std::vector<std::string> dds_statistics;
+  std::string dds_statistics_line;  // "FILE:LINE" of dds_statistics, for the start-up check
   // `dds_type_objects`: announce the contract's type objects in discovery, for eProsima's
   // dynamic-type tools (dds_type_objects.hpp). Off by default: they add about 10 kB of
   // discovery traffic per joining participant, which a lossy, narrow ground link pays for.
@@ -137,7 +141,9 @@ struct ConfigEnvironment {
 };
 
 // Parses `path` with this process's environment. Throws ConfigError("path:line: ...") for
-// every problem: unknown keys, wrong types, values out of range, duplicate names/addresses.
+// every problem: unknown or repeated keys (at any depth), a second YAML document, wrong
+// types, integers not in plain decimal, values out of range, duplicate names/addresses; and
+// "path: ..." with the system's reason when the file cannot be opened or read.
 Config load_config(const std::string& path);
 // Parses YAML text; `source` names it in messages.
 Config parse_config(const std::string& text, const std::string& source, const ConfigEnvironment& env = {});

@@ -23,6 +23,7 @@
 #include <fastdds/dds/topic/Topic.hpp>
 #include <fastdds/dds/topic/TypeSupport.hpp>
 #include <map>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -57,6 +58,13 @@ class PartitionNotGranted : public DdsError {
 // /usr/share/pmu-dds). Empty when none exists. Never the source tree: runs from a
 // build directory set PMU_QOS_FILE (scripts/run.sh and the tests do).
 std::string default_qos_file();
+
+// The first of the Fast DDS statistics topics `topics` that the permissions of `security`
+// do not let this identity publish in the default partition, where Fast DDS creates their
+// writers (and a refused one is only logged), or nullopt. DdsContext refuses to start with
+// one; pmu-service's start-up check (startup_check.hpp) says so first, at the config line.
+std::optional<std::string> statistics_topic_not_granted(const SecurityFiles& security,
+                                                        const std::vector<std::string>& topics);
 
 
 // The DDS partitions of the participant's one publisher and one subscriber (empty: the

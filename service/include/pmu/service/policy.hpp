@@ -10,6 +10,7 @@
 //   set_can_address        0x1B: the unit leaves the address the service knows it by
 //   thermal_shutdown       T_U = 0 forces thermal shutdown (charging stops)
 //   power_up_avionics_off  S0 without the avionics/servo bit: no avionics after a reset
+//   stop_streaming         PS = 0 for a device the service expects to stream: it goes silent
 // ENGINE_STOP is never refused by policy: not by deny, confirm, nor the rate limit.
 
 #include <array>
@@ -30,13 +31,16 @@ enum class ConfirmRule : std::uint8_t {
   SetCanAddress,
   ThermalShutdown,
   PowerUpAvionicsOff,
+  StopStreaming,
 };
-inline constexpr std::size_t kConfirmRuleCount = 6;
+inline constexpr std::size_t kConfirmRuleCount = 7;
 std::string_view to_string(ConfirmRule r) noexcept;
 std::optional<ConfirmRule> confirm_rule_from_name(std::string_view name) noexcept;
+// "disable_avionics, reset, ...": every rule's name, for messages.
+std::string confirm_rule_names();
 
 struct PolicyConfig {
-  std::array<bool, kConfirmRuleCount> confirm{true, true, true, true, true, true};
+  std::array<bool, kConfirmRuleCount> confirm{true, true, true, true, true, true, true};
   std::array<bool, kCommandKindCount> deny{};  // by CommandKind
   double rate_per_second = 20;                 // per device; 0 = no limit
   double burst = 40;                           // commands allowed at once
@@ -49,8 +53,15 @@ struct PolicyVerdict {
   bool allowed() const noexcept { return result == CommandResult::Completed; }
 };
 
-// Deny list and confirm rules. `outputs` is the device's current output mask if known.
-PolicyVerdict check_policy(const CommandRequest& r, const PolicyConfig& p);
+// What the service relies on from the device a request is for (its config).
+struct DeviceUse {
+  // The service listens for the packets the PMU streams (mode streaming), rather than
+  // asking for them: PS = 0 would leave it nothing to hear.
+  bool streaming = true;
+};
+
+// Deny list and confirm rules.
+PolicyVerdict check_policy(const CommandRequest& r, const PolicyConfig& p, const DeviceUse& device = {});
 
 // A token bucket per device. Not thread-safe: used under the command service's lock.
 class RateLimiter {

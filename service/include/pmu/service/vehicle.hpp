@@ -18,7 +18,7 @@ namespace pmu::service {
 
 inline constexpr std::size_t kMaxVehicleNameLength = 15;  // string<15> in the IDL
 
-// Why `name` cannot be a vehicle name, or "" when it can: 0..15 characters of letters,
+// Why `name` cannot be a vehicle name, or "" when it can: 0..15 bytes of letters,
 // digits, '_', '-' and '.'. Partition matching treats '*', '?', '[' and '\' as patterns, so
 // they are refused: a vehicle name must name one vehicle.
 std::string vehicle_name_problem(std::string_view name);

@@ -1,0 +1,137 @@
+// The start-up check (startup_check.hpp) that every start and --check-config run: the QoS
+// profile file, found, well-formed, loaded and holding the service's profiles, each problem
+// with FILE:LINE. Fast DDS keeps loaded profiles for the process, and each test here runs in
+// a process of its own (gtest_discover_tests), so each loads at most one file.
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <cstdlib>
+#include <fstream>
+#include <regex>
+#include <string>
+
+#include "pmu/service/config.hpp"
+#include "pmu/service/dds_context.hpp"
+#include "pmu/service/startup_check.hpp"
+#include "support/process.hpp"
+
+namespace pmu::service {
+namespace {
+
+const std::string kShippedQos = PMU_SOURCE_DIR "/deploy/qos.xml";
+const char* const kBus = "buses:\n  - interface: sim\n    discover: true\n";
+
+// A folder of its own for each test's files.
+std::string scratch(const std::string& name) {
+  const std::string dir = ::testing::TempDir() + "startup-check-" + name + "-" + std::to_string(::getpid());
+  (void)std::system(("rm -rf '" + dir + "' && mkdir -p '" + dir + "'").c_str());
+  return dir;
+}
+
+std::string write(const std::string& path, const std::string& text) {
+  std::ofstream(path) << text;
+  return path;
+}
+
+// The shipped file with one edit, so every other profile stays right.
+std::string edited_qos(const std::string& dir, const std::string& from, const std::string& to) {
+  std::ifstream in(kShippedQos);
+  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const auto at = text.find(from);
+  EXPECT_NE(at, std::string::npos) << from;
+  if (at != std::string::npos) text.replace(at, from.size(), to);
+  return write(dir + "/qos.xml", text);
+}
+
+StartupCheck check(const std::string& yaml, const std::string& source) {
+  return check_startup(parse_config(yaml, source));
+}
+
+TEST(StartupCheck, TheShippedQosFileHasEveryProfileTheServiceUses) {
+  const auto c = check("qos_file: " + kShippedQos + "\n" + kBus, "a.yaml");
+  EXPECT_TRUE(c.ok()) << (c.errors.empty() ? "" : c.errors.front());
+  EXPECT_EQ(c.qos_file, kShippedQos);
+}
+
+TEST(StartupCheck, MissingQosFileIsNamedAtTheConfigLine) {
+  const auto c = check(std::string(kBus) + "qos_file: /nonexistent/qos.xml\n", "/etc/pmu-dds/pmu-service.yaml");
+  ASSERT_EQ(c.errors.size(), 1u);
+  EXPECT_EQ(c.errors[0],
+            "/etc/pmu-dds/pmu-service.yaml:4: qos_file: /nonexistent/qos.xml: cannot open: No such file or directory");
+}
+
+TEST(StartupCheck, QosFileThatIsADirectory) {
+  const std::string dir = scratch("dir");
+  const auto c = check("qos_file: " + dir + "\n" + kBus, "a.yaml");
+  ASSERT_EQ(c.errors.size(), 1u);
+  EXPECT_EQ(c.errors[0], "a.yaml:1: qos_file: " + dir + ": is a directory, not a QoS profile file");
+}
+
+TEST(StartupCheck, MalformedQosFileIsNamedAtItsOwnLine) {
+  const std::string dir = scratch("malformed");
+  const std::string qos = write(dir + "/qos.xml", "<dds>\n  <profiles>\n    <data_writer profile_name=\"telemetry\">\n"
+                                                  "  </profiles>\n</dds>\n");
+  const auto c = check("qos_file: qos.xml\n" + std::string(kBus), dir + "/pmu-service.yaml");
+  ASSERT_EQ(c.errors.size(), 1u);
+  // tinyxml2 names the element left open, at its line.
+  EXPECT_EQ(c.errors[0].rfind(dir + "/pmu-service.yaml:1: qos_file: " + qos + ":3: not well-formed XML: ", 0), 0u)
+      << c.errors[0];
+  EXPECT_NE(c.errors[0].find("data_writer"), std::string::npos) << c.errors[0];
+}
+
+TEST(StartupCheck, AMissingProfileIsNamed) {
+  const std::string dir = scratch("profile");
+  const std::string qos = edited_qos(dir, "<data_reader profile_name=\"command\">", "<data_reader profile_name=\"commands\">");
+  const auto c = check("qos_file: " + qos + "\n" + kBus, "a.yaml");
+  ASSERT_EQ(c.errors.size(), 1u);
+  EXPECT_EQ(c.errors[0], "a.yaml:1: qos_file: " + qos +
+                             ": no <data_reader profile_name=\"command\">, needed for the pmu/command reader");
+}
+
+TEST(StartupCheck, AProfileShortOfTheCapacityIsNamedAtItsLine) {
+  const std::string dir = scratch("capacity");
+  const std::string qos = edited_qos(dir, "<max_instances>256</max_instances>", "<max_instances>10</max_instances>");
+  const auto c = check("qos_file: " + qos + "\n" + kBus, "a.yaml");
+  ASSERT_EQ(c.errors.size(), 1u);
+  EXPECT_EQ(c.errors[0], "a.yaml:1: qos_file: " + qos +
+                             ":29: <data_writer profile_name=\"telemetry\"> (the telemetry topics' writers): "
+                             "max_instances 10 < 256 (PMUs per service, pmu::service::kMaxDevicesPerService): raise "
+                             "its <resourceLimitsQos> (deploy/qos.xml says how each number is derived)");
+}
+
+TEST(StartupCheck, PmuQosFileIsNamedWhenItIsTheOneUsed) {
+  ::setenv("PMU_QOS_FILE", "/nonexistent/env-qos.xml", 1);
+  const auto c = check(kBus, "a.yaml");
+  ::unsetenv("PMU_QOS_FILE");
+  ASSERT_EQ(c.errors.size(), 1u);
+  EXPECT_EQ(c.errors[0], "$PMU_QOS_FILE: /nonexistent/env-qos.xml: cannot open: No such file or directory");
+}
+
+TEST(StartupCheck, NoQosFileAnywhere) {
+  ::unsetenv("PMU_QOS_FILE");
+  if (!dds::default_qos_file().empty()) GTEST_SKIP() << "this machine has an installed qos.xml";
+  const auto c = check(kBus, "a.yaml");
+  ASSERT_EQ(c.errors.size(), 1u);
+  EXPECT_EQ(c.errors[0].rfind("a.yaml:1: no QoS profile file: no qos_file here, $PMU_QOS_FILE unset, and neither ", 0),
+            0u)
+      << c.errors[0];
+}
+
+// The program: --check-config and the start say the same about the same file, because the
+// start runs the check first. (The start stops before any bus or participant is opened.)
+TEST(StartupCheck, CheckConfigAndTheStartRefuseTheSameQosFileTheSameWay) {
+  const std::string dir = scratch("program");
+  const std::string cfg = write(dir + "/pmu-service.yaml",
+                                "domain: 170\nqos_file: /nonexistent/qos.xml\n" + std::string(kBus));
+  const std::string expected = cfg + ":2: qos_file: /nonexistent/qos.xml: cannot open: No such file or directory";
+  for (const std::string extra : {" --check-config", ""}) {
+    SCOPED_TRACE(extra);
+    const auto r = pmu::test::run_capture("timeout 30 " PMU_SERVICE_PATH " --config " + cfg + extra + " 2>&1");
+    EXPECT_EQ(r.status, 2) << r.out;
+    EXPECT_NE(r.out.find(expected), std::string::npos) << r.out;
+    EXPECT_EQ(r.out.find("ready"), std::string::npos) << r.out;
+  }
+}
+
+}  // namespace
+}  // namespace pmu::service
