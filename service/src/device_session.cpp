@@ -137,6 +137,26 @@ void DeviceSession::absorb(const codec::PmuMessage& m) {
   if (changes.config) sink_.on_config(key_, reading_.config());
 }
 
+void DeviceSession::move_to(std::uint16_t address, MoveCause cause, SteadyTime now) {
+  now_ = now;
+  const DeviceKey old = key_;
+  HealthReport last = health_.report();
+  last.state = HealthState::Offline;
+  sink_.on_health(old, last);
+  sink_.on_gone(old);
+  key_.address = address;
+  alias_.reset();
+  reading_.set_address(address);
+  if (cause == MoveCause::ByItself) {
+    if (health_.offline()) health_.on_reconnect();
+    health_.on_frame(now);  // its serial answer, which the bus worker took as the evidence
+    start_reading(now);
+  }
+  if (reading_.info()) sink_.on_info(key_, *reading_.info());
+  sink_.on_config(key_, reading_.config());
+  update_health(now, true);
+}
+
 void DeviceSession::on_bus_state(transport::BusState state, SteadyTime now) {
   if (health_.on_bus_state(state)) update_health(now, true);
 }

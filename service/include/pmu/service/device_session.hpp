@@ -62,14 +62,24 @@ class DeviceSession {
   // Reads identity and every stored value again (after a reset).
   void reread(SteadyTime now) { start_reading(now); }
 
-  // During a CAN address change, frames from `alias` belong to this session too; readdress()
+  // During a CAN address change, frames from `alias` belong to this session too; move_to()
   // moves the session to its new address once the change is verified.
   void set_alias(std::optional<std::uint16_t> alias) noexcept { alias_ = alias; }
   std::optional<std::uint16_t> alias() const noexcept { return alias_; }
-  void readdress(std::uint16_t address) noexcept {
-    key_.address = address;
-    alias_.reset();
-  }
+
+  enum class MoveCause : std::uint8_t {
+    Commanded,  // our own set of CA (0x1B), read back at the new address
+    ByItself,   // its serial (0x30) answered at `address` while its old address is silent
+  };
+  // The unit answers at `address` now. The old key gets its health once more, OFFLINE,
+  // then is gone (StateSink::on_gone); the new key gets the identity and configuration
+  // carried over (CA = `address`) and the health, at once. ByItself also counts as a frame
+  // heard now and reads everything again: whoever changed the address may have changed more.
+  // The bus worker files the session under its new key at the end of its turn.
+  void move_to(std::uint16_t address, MoveCause cause, SteadyTime now);
+  // Where the session started (the config's address, or where discovery found it).
+  std::uint16_t first_address() const noexcept { return settings_.address; }
+  const DeviceConfig& settings() const noexcept { return settings_; }
 
   // The latest time any call brought: callbacks that queue follow-up work use it.
   SteadyTime now() const noexcept { return now_; }
