@@ -2,6 +2,8 @@
 
 #include <spdlog/spdlog.h>
 
+#include <algorithm>
+
 #include "pmu/codec/encode.hpp"
 
 namespace pmu::service {
@@ -143,7 +145,10 @@ void DeviceSession::move_to(std::uint16_t address, MoveCause cause, SteadyTime n
   HealthReport last = health_.report();
   last.state = HealthState::Offline;
   sink_.on_health(old, last);
-  sink_.on_gone(old);
+  gone_.push_back({old, now + kGoneDelay});
+  // Back at a key not yet disposed: it stays, with what follows published on it.
+  gone_.erase(std::remove_if(gone_.begin(), gone_.end(), [address](const Gone& g) { return g.key.address == address; }),
+              gone_.end());
   key_.address = address;
   alias_.reset();
   reading_.set_address(address);
@@ -163,6 +168,10 @@ void DeviceSession::on_bus_state(transport::BusState state, SteadyTime now) {
 
 void DeviceSession::tick(SteadyTime now) {
   now_ = now;
+  while (!gone_.empty() && now >= gone_.front().at) {
+    sink_.on_gone(gone_.front().key);
+    gone_.erase(gone_.begin());
+  }
   if (queue_.tick(now)) health_.on_timeout();
   if (reading_.retry_due(now)) start_reading(now);
   if (reading_.running() && settings_.mode == TelemetryMode::Polling && now >= next_poll_) poll(now);

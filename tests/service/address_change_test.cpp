@@ -92,7 +92,11 @@ TEST(AddressChange, CommandedMoveGivesTheOldKeyOneOfflineThenDisposesItAndTheNew
   ASSERT_EQ(reply.result, CommandResult::Completed) << reply.reason;
   EXPECT_NE(reply.reason.find("from address 1 to 7"), std::string::npos) << reply.reason;
 
-  // Published by the time the reply is: nothing waits for the next packet period.
+  // Published by the time the reply is: nothing waits for the next packet period. The old
+  // key is disposed a moment after its OFFLINE, so that readers take that sample first.
+  EXPECT_EQ(m.health_states(1, healths), (std::vector<HealthState>{HealthState::Offline}));
+  EXPECT_TRUE(m.h.sink.gone.empty());
+  m.h.run_for(DeviceSession::kGoneDelay + 20ms);
   ASSERT_EQ(m.h.sink.gone.size(), 1u);
   EXPECT_EQ(m.h.sink.gone[0], (DeviceKey{"sim0", 1, DeviceKind::Pmu}));
   EXPECT_EQ(m.health_states(1, healths), (std::vector<HealthState>{HealthState::Offline}));
@@ -160,6 +164,19 @@ TEST(AddressChange, MovingBackAndForthLeavesNoGhostAtEitherAddress) {
   EXPECT_EQ(m.h.sink.gone.size(), 4u);
   ASSERT_EQ(m.moved.size(), 4u);
   EXPECT_EQ(m.moved.back().first, 1) << "the session remembers where it started";
+}
+
+TEST(AddressChange, BackBeforeTheOldKeyIsDisposedKeepsThatKeyAlive) {
+  Moves m;
+  ASSERT_EQ(m.move(1, 7).result, CommandResult::Completed);
+  ASSERT_EQ(m.move(7, 1).result, CommandResult::Completed);
+  EXPECT_TRUE(m.h.sink.gone.empty()) << "both moves within the disposal delay";
+  m.h.run_for(2s);
+  ASSERT_EQ(m.h.sink.gone.size(), 1u);
+  EXPECT_EQ(m.h.sink.gone[0].address, 7);
+  EXPECT_EQ(m.h.sink.live_pmus(), (std::vector<std::uint16_t>{1}));
+  ASSERT_NE(m.h.sink.last_health(1), nullptr);
+  EXPECT_EQ(m.h.sink.last_health(1)->state, HealthState::Online);
 }
 
 TEST(AddressChange, SettingTheSameAddressMovesNothing) {

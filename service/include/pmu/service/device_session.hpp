@@ -28,6 +28,7 @@
 #include <cstdint>
 #include <functional>
 #include <optional>
+#include <vector>
 
 #include "pmu/codec/decode.hpp"
 #include "pmu/service/config.hpp"
@@ -72,8 +73,9 @@ class DeviceSession {
     ByItself,   // its serial (0x30) answered at `address` while its old address is silent
   };
   // The unit answers at `address` now. The old key gets its health once more, OFFLINE,
-  // then is gone (StateSink::on_gone); the new key gets the identity and configuration
-  // carried over (CA = `address`) and the health, at once. ByItself also counts as a frame
+  // and is gone (StateSink::on_gone) kGoneDelay later, unless the unit is back there by
+  // then; the new key gets the identity and configuration carried over (CA = `address`)
+  // and the health, at once. ByItself also counts as a frame
   // heard now and reads everything again: whoever changed the address may have changed more.
   // The bus worker files the session under its new key at the end of its turn.
   void move_to(std::uint16_t address, MoveCause cause, SteadyTime now);
@@ -89,6 +91,12 @@ class DeviceSession {
   const HealthReport& health() const noexcept { return health_.report(); }
   bool ready() const noexcept { return reading_.running(); }
   std::size_t queued() const noexcept { return queue_.size(); }
+
+ public:
+  // Between the old key's OFFLINE and its disposal: a state reader keeps one sample per
+  // instance, and a disposal that comes first replaces the OFFLINE it has not taken yet.
+  // Short, so that `list` shows the new key alone well within the usual packet periods.
+  static constexpr std::chrono::milliseconds kGoneDelay{250};
 
  private:
   static constexpr int kReadingTag = 1;
@@ -113,6 +121,11 @@ class DeviceSession {
   RequestQueue queue_;
 
   std::optional<std::uint16_t> alias_;
+  struct Gone {
+    DeviceKey key;
+    SteadyTime at;
+  };
+  std::vector<Gone> gone_;  // old keys to dispose, once due (tick)
   SteadyTime now_{};  // the latest time any call brought
   SteadyTime next_poll_{};
 };
