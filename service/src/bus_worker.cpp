@@ -202,6 +202,8 @@ DeviceSession* BusWorker::on_stranger(const codec::PmuId& id, const transport::R
       known->move_to(address, DeviceSession::MoveCause::ByItself, now);
       return nullptr;  // move_to took this answer as the frame heard
     }
+    // Another unit: asked again only at the search's pace, in case a silent one moves there later.
+    if (auto it = asked_.find(address); it != asked_.end()) it->second = now + kSearchInterval;
     if (config_.discover) {
       DeviceConfig d = config_.discovered_defaults;
       d.address = address;

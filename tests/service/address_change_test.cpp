@@ -21,8 +21,9 @@ std::uint32_t raw_of(const ConfigState& c, Parameter p) { return c.raw[static_ca
 // A harness whose PMU at address 1 (serial 4001) streams every second, plus a command service.
 class Moves {
  public:
-  explicit Moves(std::vector<DeviceConfig> devices = {device(1)}, std::vector<sim::DeviceConfig> pmus = {pmu(1)})
-      : h(sim_bus(std::move(devices)), std::move(pmus)),
+  explicit Moves(std::vector<DeviceConfig> devices = {device(1)}, std::vector<sim::DeviceConfig> pmus = {pmu(1)},
+                 bool discover = false)
+      : h(sim_bus(std::move(devices), discover), std::move(pmus)),
         service({&h.worker()}, PolicyConfig{}, Timeouts{}, h.clock(),
                 [this](const CommandReplyData& r) {
                   replies.push_back(r);
@@ -244,6 +245,26 @@ TEST(AddressChange, APolledUnitThatStreamsNothingIsFoundByTheBroadcastSerialRequ
   }));
 }
 
+TEST(AddressChange, ADiscoveredUnitMovedByAnotherToolIsFollowedNotDiscoveredAgain) {
+  Moves m({}, {pmu(1)}, true);
+  ASSERT_EQ(m.h.worker().addresses(), (std::vector<std::uint16_t>{1}));
+  set_address_by_other_tool(m, 1, 9);
+  m.h.run_for(30s);  // past the next discovery broadcasts: their answer comes from 9
+  EXPECT_EQ(m.h.worker().addresses(), (std::vector<std::uint16_t>{9}));
+  EXPECT_EQ(m.h.sink.live_pmus(), (std::vector<std::uint16_t>{9}));
+  ASSERT_EQ(m.moved.size(), 1u);
+  EXPECT_TRUE(m.moved[0].config_line.empty()) << "discovered: no config line to change";
+}
+
+TEST(AddressChange, AConfiguredDeviceKnowsItsConfigLine) {
+  Config cfg = parse_config("buses:\n  - interface: sim\n    devices:\n      - address: 1\n", "c.yaml");
+  Moves m(cfg.buses[0].devices);
+  ASSERT_EQ(m.move(1, 7).result, CommandResult::Completed);
+  m.h.run_for(100ms);
+  ASSERT_EQ(m.moved.size(), 1u);
+  EXPECT_EQ(m.moved[0].config_line, "c.yaml:4");
+}
+
 TEST(AddressChange, AnotherUnitAtANewAddressIsNotTakenForTheSilentOne) {
   // Unit 1 goes silent; a different unit (serial 4002) speaks at 2: not the same device.
   Moves m({device(1)}, {pmu(1), pmu(2)});
@@ -255,7 +276,15 @@ TEST(AddressChange, AnotherUnitAtANewAddressIsNotTakenForTheSilentOne) {
   m.h.run_for(20s);
   EXPECT_TRUE(m.h.sink.gone.empty());
   EXPECT_EQ(m.h.worker().addresses(), (std::vector<std::uint16_t>{1}));
+  ASSERT_NE(m.h.sink.last_health(1), nullptr);
   EXPECT_EQ(m.h.sink.last_health(1)->state, HealthState::Offline);
+  // Asked once it went silent, then again only at the search's pace: not once a second.
+  const auto sent = m.h.sent();
+  const auto asked = std::count_if(sent.begin(), sent.end(), [](const codec::PmuMessage& s) {
+    return s.packet == codec::PacketId::Serial && s.request && s.address == 2;
+  });
+  EXPECT_GE(asked, 1);
+  EXPECT_LE(asked, 3);
 }
 
 }  // namespace

@@ -21,7 +21,7 @@
 // serial read from a session whose address has gone silent (STALE or OFFLINE). A unit that
 // speaks at such an address (telemetry, or a serial or firmware answer: frames only a PMU
 // sends) while a session with a known serial is silent is asked its serial, at most once per
-// second per address. A serial that matches a session that still speaks is two units
+// second per address (every 10 s once it answered another serial). A serial that matches a session that still speaks is two units
 // claiming one serial: logged, nothing moves. While a session with a known serial is OFFLINE,
 // a broadcast serial request every 10 s finds a polled unit that streams nothing.
 //
