@@ -305,6 +305,10 @@ void DdsPublisher::on_gone(const DeviceKey& key) {
   std::lock_guard<std::mutex> lock(w_->mutex);
   if (!w_->admitted.erase(std::make_tuple(key.bus, key.kind, key.address))) return;  // never published
   // A writer that never wrote this key answers PRECONDITION_NOT_MET: nothing to dispose there.
+  // Unregistered, not only disposed: a reader's DEADLINE must stop watching the old key. Fast
+  // DDS 2.9 then logs "Could not set the next deadline in the history" once per writer with a
+  // DEADLINE (telemetry, low rate): it looks for the instance it has just let go; the
+  // unregistration itself returns OK (measured with `pmu-service --bus sim`).
   auto gone = [&](DataWriter* w, void* sample) {
     if (w == nullptr) return;
     const ReturnCode_t rc = w->unregister_instance(sample, HANDLE_NIL);
