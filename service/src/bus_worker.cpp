@@ -166,13 +166,13 @@ void BusWorker::on_event(const transport::BusEvent& event) {
 
 DeviceSession* BusWorker::session_with_serial(std::uint16_t serial) {
   for (auto& [a, s] : sessions_)
-    if (s->info() && s->info()->serial_number == serial && !s->alias()) return s.get();
+    if (s->serial() == serial && !s->alias()) return s.get();
   return nullptr;
 }
 
 bool BusWorker::any_silent_known(HealthState at_least) const {
   for (const auto& [a, s] : sessions_)
-    if (s->info() && silent(s->health().state, at_least)) return true;
+    if (s->serial() && silent(s->health().state, at_least)) return true;
   return false;
 }
 
@@ -264,10 +264,26 @@ void BusWorker::end_turn() {
   progress_.fetch_add(1, std::memory_order_relaxed);
 }
 
+void BusWorker::confirm_expected(DeviceSession& s) {
+  // A unit recorded as moved answered at its configured address after all: the record is over.
+  if (!s.expects_serial() || !s.info() || s.key().address != s.first_address()) return;
+  s.expect_serial(std::nullopt);
+  spdlog::info("{}/{}: the PMU answers at its configured address (serial {}): the record of a move is dropped",
+               config_.name, s.key().address, s.info()->serial_number);
+  if (!moved_) return;
+  Moved m;
+  m.bus = config_.name;
+  m.from = m.to = m.first = s.first_address();
+  m.serial = s.serial();
+  m.config_line = s.settings().source_line;
+  moved_(m);
+}
+
 void BusWorker::rekey_moved_sessions() {
   // A verified CAN address change moved a session: file it under its new address.
   for (auto it = sessions_.begin(); it != sessions_.end();) {
     if (it->second->key().address == it->first) {
+      confirm_expected(*it->second);
       ++it;
       continue;
     }
@@ -280,7 +296,7 @@ void BusWorker::rekey_moved_sessions() {
     m.from = from;
     m.to = address;
     m.first = moved->first_address();
-    if (moved->info()) m.serial = moved->info()->serial_number;
+    m.serial = moved->serial();
     m.config_line = moved->settings().source_line;
     // A move onto an address that had a session of its own leaves one session fewer.
     sessions_[address] = std::move(moved);

@@ -173,6 +173,10 @@ int run(const service::Config& cfg, const pmu::dds::ResolvedNetwork& network) {
     buses[i].worker->on_moved([&moved](const service::BusWorker::Moved& m) {
       if (!m.config_line.empty()) moved.record(m.bus, m.first, m.to, m.serial);
     });
+    // A unit recorded as moved is followed by its serial before it is heard at its old address.
+    for (const auto& m : moved.moves())
+      if (auto* s = m.bus == cfg.buses[i].name && m.serial ? buses[i].worker->session(m.configured) : nullptr)
+        s->expect_serial(*m.serial);
   }
   service::DdsCommandEndpoint command_topics(participant, &publisher, cfg.vehicle);
   std::vector<service::BusWorker*> workers;

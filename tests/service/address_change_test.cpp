@@ -265,6 +265,38 @@ TEST(AddressChange, AConfiguredDeviceKnowsItsConfigLine) {
   EXPECT_EQ(m.moved[0].config_line, "c.yaml:4");
 }
 
+TEST(AddressChange, AfterARestartTheRecordedSerialFollowsAUnitNeverHeardAtItsConfiguredAddress) {
+  // The config says 1; the unit (serial 4001) answers at 9 since before the service started.
+  auto unit = pmu(9);
+  unit.serial_number = 4001;
+  {
+    Moves m({device(1)}, {unit});
+    m.h.run_for(30s);
+    EXPECT_EQ(m.h.worker().addresses(), (std::vector<std::uint16_t>{1})) << "no serial known: not followed";
+  }
+  Moves m({device(1)}, {unit});
+  m.h.worker().session(1)->expect_serial(4001);
+  m.h.run_for(30s);
+  EXPECT_EQ(m.h.worker().addresses(), (std::vector<std::uint16_t>{9}));
+  EXPECT_EQ(m.h.sink.live_pmus(), (std::vector<std::uint16_t>{9}));
+  ASSERT_NE(m.last_info(9), nullptr);
+  EXPECT_EQ(m.last_info(9)->serial_number, 4001);
+  ASSERT_NE(m.h.sink.last_health(9), nullptr);
+  EXPECT_EQ(m.h.sink.last_health(9)->state, HealthState::Online);
+}
+
+TEST(AddressChange, AUnitRecordedAsMovedThatAnswersAtItsConfiguredAddressEndsTheRecord) {
+  Moves m({device(1)}, {pmu(1)});  // started (and read) before the expectation: read again
+  m.h.worker().session(1)->expect_serial(4001);
+  m.h.run_for(100ms);
+  ASSERT_EQ(m.moved.size(), 1u);
+  EXPECT_EQ(m.moved[0].from, 1);
+  EXPECT_EQ(m.moved[0].to, 1);
+  EXPECT_EQ(m.moved[0].first, 1);
+  EXPECT_FALSE(m.h.worker().session(1)->expects_serial());
+  EXPECT_TRUE(m.h.sink.gone.empty());
+}
+
 TEST(AddressChange, AnotherUnitAtANewAddressIsNotTakenForTheSilentOne) {
   // Unit 1 goes silent; a different unit (serial 4002) speaks at 2: not the same device.
   Moves m({device(1)}, {pmu(1), pmu(2)});

@@ -67,7 +67,9 @@ class BusWorker final : private transport::BusHandler {
   // Runs `fn` on the worker's thread at its next turn. Thread-safe.
   void post(std::function<void()> fn);
 
-  // A PMU session moved from one address to another (after the move; worker thread).
+  // A PMU session moved from one address to another (after the move; worker thread). Also,
+  // with from == to == first, a session expecting a recorded serial that read its unit at its
+  // configured address: the unit is where the config says.
   struct Moved {
     std::string bus;
     std::uint16_t from = 0, to = 0;
@@ -103,6 +105,7 @@ class BusWorker final : private transport::BusHandler {
   void on_canopen_frame(const transport::ReceivedFrame& frame);
   void discover();  // the broadcast firmware request (a loop timer, when config_.discover)
   void rekey_moved_sessions();
+  void confirm_expected(DeviceSession& s);
   // A PMU frame from an address no session serves: a moved unit found by its serial, a new
   // one found by discovery, or nothing. Returns the session the frame belongs to, if any.
   DeviceSession* on_stranger(const codec::PmuId& id, const transport::ReceivedFrame& rx);

@@ -79,6 +79,15 @@ class DeviceSession {
   // heard now and reads everything again: whoever changed the address may have changed more.
   // The bus worker files the session under its new key at the end of its turn.
   void move_to(std::uint16_t address, MoveCause cause, SteadyTime now);
+  // The serial this PMU has when none was read yet: what the service recorded before it
+  // restarted (moved_addresses.hpp), so a unit that moved is followed before it is heard.
+  void expect_serial(std::optional<std::uint16_t> serial) noexcept { expected_serial_ = serial; }
+  bool expects_serial() const noexcept { return expected_serial_.has_value(); }
+  // The serial read from the unit, else the one expected.
+  std::optional<std::uint16_t> serial() const noexcept {
+    if (reading_.info()) return reading_.info()->serial_number;
+    return expected_serial_;
+  }
   // Where the session started (the config's address, or where discovery found it).
   std::uint16_t first_address() const noexcept { return settings_.address; }
   const DeviceConfig& settings() const noexcept { return settings_; }
@@ -121,6 +130,7 @@ class DeviceSession {
   RequestQueue queue_;
 
   std::optional<std::uint16_t> alias_;
+  std::optional<std::uint16_t> expected_serial_;
   struct Gone {
     DeviceKey key;
     SteadyTime at;
