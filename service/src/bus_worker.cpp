@@ -186,6 +186,9 @@ DeviceSession* BusWorker::on_stranger(const codec::PmuId& id, const transport::R
   const auto now = clock_.steady_now();
   const std::uint16_t address = id.address;
   if (const auto* sn = std::get_if<codec::SerialNumber>(&m->payload)) {
+    // Unless it is a silent one's: asked again only at the search's pace, in case one moves
+    // there later.
+    if (auto it = asked_.find(address); it != asked_.end()) it->second = now + kSearchInterval;
     if (DeviceSession* known = session_with_serial(sn->serial_number)) {
       const auto was = known->key().address;
       if (!silent(known->health().state, HealthState::Stale)) {
@@ -202,8 +205,6 @@ DeviceSession* BusWorker::on_stranger(const codec::PmuId& id, const transport::R
       known->move_to(address, DeviceSession::MoveCause::ByItself, now);
       return nullptr;  // move_to took this answer as the frame heard
     }
-    // Another unit: asked again only at the search's pace, in case a silent one moves there later.
-    if (auto it = asked_.find(address); it != asked_.end()) it->second = now + kSearchInterval;
     if (config_.discover) {
       DeviceConfig d = config_.discovered_defaults;
       d.address = address;

@@ -75,10 +75,14 @@ class DeviceSession {
   // The unit answers at `address` now. The old key gets its health once more, OFFLINE,
   // and is gone (StateSink::on_gone) kGoneDelay later, unless the unit is back there by
   // then; the new key gets the identity and configuration carried over (CA = `address`)
-  // and the health, at once. ByItself also counts as a frame
-  // heard now and reads everything again: whoever changed the address may have changed more.
-  // The bus worker files the session under its new key at the end of its turn.
+  // and the health, at once. ByItself also counts as a frame heard now and reads
+  // everything again: whoever changed the address may have changed more. The bus worker
+  // files the session under its new key at the end of its turn.
   void move_to(std::uint16_t address, MoveCause cause, SteadyTime now);
+  // Between the old key's OFFLINE and its disposal: a state reader keeps one sample per
+  // instance, and a disposal that comes first replaces the OFFLINE it has not taken yet.
+  // Short, so that `list` shows the new key alone well within the usual packet periods.
+  static constexpr std::chrono::milliseconds kGoneDelay{250};
   // The serial this PMU has when none was read yet: what the service recorded before it
   // restarted (moved_addresses.hpp), so a unit that moved is followed before it is heard.
   void expect_serial(std::optional<std::uint16_t> serial) noexcept { expected_serial_ = serial; }
@@ -100,12 +104,6 @@ class DeviceSession {
   const HealthReport& health() const noexcept { return health_.report(); }
   bool ready() const noexcept { return reading_.running(); }
   std::size_t queued() const noexcept { return queue_.size(); }
-
- public:
-  // Between the old key's OFFLINE and its disposal: a state reader keeps one sample per
-  // instance, and a disposal that comes first replaces the OFFLINE it has not taken yet.
-  // Short, so that `list` shows the new key alone well within the usual packet periods.
-  static constexpr std::chrono::milliseconds kGoneDelay{250};
 
  private:
   static constexpr int kReadingTag = 1;
