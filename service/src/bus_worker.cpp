@@ -18,6 +18,30 @@ constexpr milliseconds kTick{20};  // session timers need no finer grain than th
 constexpr milliseconds kMaintainInterval{250};
 constexpr milliseconds kDiscoveryInterval{10000};
 constexpr milliseconds kHeardCanOpenPeriod{1000};  // listen_canopen: a device not in the config
+constexpr milliseconds kAskInterval{1000};        // serial gets to one unserved address
+constexpr milliseconds kSearchInterval{10000};    // broadcast serial requests while a known PMU is OFFLINE
+constexpr std::size_t kMaxAsked = 64;             // unserved addresses remembered
+
+bool silent(HealthState s, HealthState at_least) noexcept {
+  if (at_least == HealthState::Offline) return s == HealthState::Offline;
+  return s == HealthState::Stale || s == HealthState::Offline;
+}
+
+// What the operator does about a move: the config line to change, if any.
+void log_move(const BusWorker::Moved& m) {
+  const std::string serial = m.serial ? " (serial " + std::to_string(*m.serial) + ")" : std::string();
+  if (m.config_line.empty())
+    spdlog::info("{}: PMU{} moved from address {} to {}; it is not in a config file (discovered or built in): "
+                 "nothing to change",
+                 m.bus, serial, m.from, m.to);
+  else if (m.to == m.first)
+    spdlog::info("{}: PMU{} moved from address {} back to {}, its address in the config ({}): nothing to change",
+                 m.bus, serial, m.from, m.to, m.config_line);
+  else
+    spdlog::warn("{}: PMU{} moved from address {} to {}: the config is stale: {}: change `address: {}` to "
+                 "`address: {}`",
+                 m.bus, serial, m.from, m.to, m.config_line, m.first, m.to);
+}
 
 }  // namespace
 
@@ -41,6 +65,7 @@ BusWorker::BusWorker(BusConfig config, std::unique_ptr<transport::CanBus> bus, c
   if (config_.discover)
     loop_.add_timer(now, kDiscoveryInterval, [this](std::chrono::steady_clock::time_point) { discover(); });
   loop_.add_timer(now, kMaintainInterval, [this](std::chrono::steady_clock::time_point t) { bus_->maintain(t); });
+  loop_.add_timer(now + kSearchInterval, kSearchInterval, [this](std::chrono::steady_clock::time_point) { search(); });
 }
 
 BusWorker::~BusWorker() = default;
@@ -86,7 +111,11 @@ void BusWorker::on_canopen_frame(const transport::ReceivedFrame& rx) {
 
 DeviceSession* BusWorker::session(std::uint16_t address) {
   auto it = sessions_.find(address);
-  return it == sessions_.end() ? nullptr : it->second.get();
+  if (it != sessions_.end() && it->second->key().address == address) return it->second.get();
+  // Moved this turn and not yet filed under its new address (rekey_moved_sessions).
+  for (auto& [a, s] : sessions_)
+    if (s->key().address == address) return s.get();
+  return nullptr;
 }
 
 std::vector<std::uint16_t> BusWorker::addresses() const {
@@ -109,12 +138,7 @@ void BusWorker::on_frame(const transport::ReceivedFrame& rx) {
     for (auto& [a, candidate] : sessions_)
       if (candidate->alias() == address) s = candidate.get();
   }
-  if (!s && config_.discover && id.id->packet == codec::PacketId::Firmware && rx.frame.length == codec::data_length(codec::PacketId::Firmware)) {
-    DeviceConfig d = config_.discovered_defaults;
-    d.address = address;
-    s = &add_session(d);
-    spdlog::info("{}: discovered a PMU at address {}", config_.name, address);
-  }
+  if (!s) s = on_stranger(*id.id, rx);
   if (!s) return;  // a PMU the config does not serve
   s->on_frame(*id.id, rx.frame, now, rx.timestamp);  // the id is parsed here only
 }
@@ -138,6 +162,79 @@ void BusWorker::on_event(const transport::BusEvent& event) {
   const auto now = clock_.steady_now();
   for (auto& [a, s] : sessions_) s->on_bus_state(event.state, now);
   for (auto& [id, s] : canopen_) s->on_bus_state(event.state, now);
+}
+
+DeviceSession* BusWorker::session_with_serial(std::uint16_t serial) {
+  for (auto& [a, s] : sessions_)
+    if (s->serial() == serial && !s->alias()) return s.get();
+  return nullptr;
+}
+
+bool BusWorker::any_silent_known(HealthState at_least) const {
+  for (const auto& [a, s] : sessions_)
+    if (s->serial() && silent(s->health().state, at_least)) return true;
+  return false;
+}
+
+DeviceSession* BusWorker::on_stranger(const codec::PmuId& id, const transport::ReceivedFrame& rx) {
+  const auto m = codec::decode(rx.frame, id, std::nullopt);
+  // Only a PMU sends these with data; a set or a get from another tool looks like any other
+  // address's traffic and proves nothing.
+  if (!m || m->request) return nullptr;
+  const auto p = static_cast<std::uint8_t>(m->packet);
+  if (p > 0x04 && m->packet != codec::PacketId::Serial && m->packet != codec::PacketId::Firmware) return nullptr;
+  const auto now = clock_.steady_now();
+  const std::uint16_t address = id.address;
+  if (const auto* sn = std::get_if<codec::SerialNumber>(&m->payload)) {
+    // Unless it is a silent one's: asked again only at the search's pace, in case one moves
+    // there later.
+    if (auto it = asked_.find(address); it != asked_.end()) it->second = now + kSearchInterval;
+    if (DeviceSession* known = session_with_serial(sn->serial_number)) {
+      const auto was = known->key().address;
+      if (!silent(known->health().state, HealthState::Stale)) {
+        spdlog::warn("{}: serial {} answers at address {} while address {} with that serial still speaks: two "
+                     "units report one serial; address {} is not served",
+                     config_.name, sn->serial_number, address, was, address);
+        return nullptr;
+      }
+      spdlog::warn("{}: the PMU of serial {} (address {}, {} for {:.1f} s) answers at address {}: the same unit, "
+                   "moved; served as {}/{} from now on",
+                   config_.name, sn->serial_number, was, to_string(known->health().state),
+                   known->health().last_frame_age, address, config_.name, address);
+      asked_.erase(address);
+      known->move_to(address, DeviceSession::MoveCause::ByItself, now);
+      return nullptr;  // move_to took this answer as the frame heard
+    }
+    if (config_.discover) {
+      DeviceConfig d = config_.discovered_defaults;
+      d.address = address;
+      spdlog::info("{}: discovered a PMU at address {} (serial {})", config_.name, address, sn->serial_number);
+      return &add_session(d);
+    }
+    return nullptr;
+  }
+  if (any_silent_known(HealthState::Stale)) {
+    // Perhaps a silent session's unit, moved: its serial says.
+    auto it = asked_.find(address);
+    if (it == asked_.end() || now >= it->second) {
+      if (asked_.size() >= kMaxAsked) asked_.clear();
+      asked_[address] = now + kAskInterval;
+      (void)bus_->send(*codec::encode_get(codec::PacketId::Serial, address), timeouts_.send);
+    }
+    return nullptr;  // served once its serial is known (above)
+  }
+  if (config_.discover && m->packet == codec::PacketId::Firmware) {
+    DeviceConfig d = config_.discovered_defaults;
+    d.address = address;
+    spdlog::info("{}: discovered a PMU at address {}", config_.name, address);
+    return &add_session(d);
+  }
+  return nullptr;
+}
+
+void BusWorker::search() {
+  if (!any_silent_known(HealthState::Offline)) return;
+  (void)bus_->send(*codec::encode_get(codec::PacketId::Serial, codec::kBroadcastAddress), timeouts_.send);
 }
 
 void BusWorker::discover() {
@@ -168,19 +265,45 @@ void BusWorker::end_turn() {
   progress_.fetch_add(1, std::memory_order_relaxed);
 }
 
+void BusWorker::confirm_expected(DeviceSession& s) {
+  // A unit recorded as moved answered at its configured address after all: the record is over.
+  if (!s.expects_serial() || !s.info() || s.key().address != s.first_address()) return;
+  s.expect_serial(std::nullopt);
+  spdlog::info("{}/{}: the PMU answers at its configured address (serial {}): the record of a move is dropped",
+               config_.name, s.key().address, s.info()->serial_number);
+  if (!moved_) return;
+  Moved m;
+  m.bus = config_.name;
+  m.from = m.to = m.first = s.first_address();
+  m.serial = s.serial();
+  m.config_line = s.settings().source_line;
+  moved_(m);
+}
+
 void BusWorker::rekey_moved_sessions() {
   // A verified CAN address change moved a session: file it under its new address.
   for (auto it = sessions_.begin(); it != sessions_.end();) {
     if (it->second->key().address == it->first) {
+      confirm_expected(*it->second);
       ++it;
       continue;
     }
     auto moved = std::move(it->second);
+    const std::uint16_t from = it->first;
     it = sessions_.erase(it);
     const auto address = moved->key().address;
-    sessions_[address] = std::move(moved);
+    Moved m;
+    m.bus = config_.name;
+    m.from = from;
+    m.to = address;
+    m.first = moved->first_address();
+    m.serial = moved->serial();
+    m.config_line = moved->settings().source_line;
     // A move onto an address that had a session of its own leaves one session fewer.
+    sessions_[address] = std::move(moved);
     device_count_.store(sessions_.size(), std::memory_order_relaxed);
+    log_move(m);
+    if (moved_) moved_(m);
   }
 }
 

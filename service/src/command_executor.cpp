@@ -45,17 +45,24 @@ struct Table {
     CommandPlan p;
     p.frame = *codec::encode_parameter_reply(param, raw, a);
     p.read_back = CommandPlan::ReadBack{codec::spec_of(param).packet, a};
-    if (param == codec::Parameter::CanAddress) {
+    const bool moves = param == codec::Parameter::CanAddress && raw != a;
+    if (moves) {
       // The unit answers at its new address at once: read back there.
       const auto moved_to = static_cast<std::uint16_t>(raw);
       p.read_back->address = moved_to;
       p.alias = moved_to;
-      p.on_completed = [moved_to](DeviceSession& s) { s.readdress(moved_to); };
+      p.on_completed = [moved_to](DeviceSession& s) {
+        s.move_to(moved_to, DeviceSession::MoveCause::Commanded, s.now());
+      };
     }
-    p.check = [param, raw](const codec::PmuMessage* m) -> Verdict {
+    // The audit line and the reply say both addresses: the operator's next command uses the new one.
+    const std::string done = moves ? "moved from address " + std::to_string(a) + " to " + std::to_string(raw) +
+                                       ": address it as " + std::to_string(raw) + " from now on"
+                                 : std::string();
+    p.check = [param, raw, done](const codec::PmuMessage* m) -> Verdict {
       const auto* got = std::get_if<codec::ParameterValue>(&m->payload);
       const double want = codec::parameter_value(param, raw);
-      if (got && got->raw == raw) return {CommandResult::Completed, "", want, ""};
+      if (got && got->raw == raw) return {CommandResult::Completed, done, want, ""};
       char buf[128];
       std::snprintf(buf, sizeof buf, "device reports %g after the set, not %g", got ? got->value : -1.0, want);
       return {CommandResult::Failed, buf, got ? std::optional<double>(got->value) : std::nullopt, ""};

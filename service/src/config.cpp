@@ -148,6 +148,7 @@ DeviceConfig parse_device(const Ctx& c, const YAML::Node& n) {
   // 65535 is the broadcast address, never a device's (v1.9 section 4).
   if (!a) c.fail(n, "device needs an address (0.." + std::to_string(codec::kMaxDeviceAddress) + ")");
   d.address = static_cast<std::uint16_t>(c.integer(a, "address", 0, codec::kMaxDeviceAddress));
+  d.source_line = c.line_of(a);
   parse_device_settings(c, n, d);
   return d;
 }

@@ -301,6 +301,49 @@ void DdsPublisher::on_health(const DeviceKey& key, const HealthReport& h) {
   count(w_->health->write(&s), topics::kHealth, key, "write returned false");
 }
 
+void DdsPublisher::on_gone(const DeviceKey& key) {
+  std::lock_guard<std::mutex> lock(w_->mutex);
+  if (!w_->admitted.erase(std::make_tuple(key.bus, key.kind, key.address))) return;  // never published
+  // A writer that never wrote this key answers PRECONDITION_NOT_MET: nothing to dispose there.
+  // Unregistered, not only disposed: a reader's DEADLINE must stop watching the old key. Fast
+  // DDS 2.9 then logs "Could not set the next deadline in the history" once per writer with a
+  // DEADLINE (telemetry, low rate): it looks for the instance it has just let go; the
+  // unregistration itself returns OK (measured with `pmu-service --bus sim`).
+  auto gone = [&](DataWriter* w, void* sample) {
+    if (w == nullptr) return;
+    const ReturnCode_t rc = w->unregister_instance(sample, HANDLE_NIL);
+    if (rc != ReturnCode_t::RETCODE_PRECONDITION_NOT_MET)
+      count(rc == ReturnCode_t::RETCODE_OK, w->get_topic()->get_name().c_str(), key, why(rc));
+  };
+  pmu::Health h;
+  set_key(h, w_->vehicle, key);
+  h.kind(static_cast<pmu::DeviceKind>(static_cast<int>(key.kind)));
+  gone(w_->health, &h);
+  if (key.kind != DeviceKind::Pmu) return;  // batteries and MPPTs keep their node and device id
+  pmu::Voltages v;
+  set_key(v, w_->vehicle, key);
+  pmu::Currents c;
+  set_key(c, w_->vehicle, key);
+  pmu::BatteryEnergy e;
+  set_key(e, w_->vehicle, key);
+  pmu::Temperatures t;
+  set_key(t, w_->vehicle, key);
+  pmu::Status st;
+  set_key(st, w_->vehicle, key);
+  void* telemetry[LowRateGate::kPackets] = {&v, &c, &e, &t, &st};
+  DataWriter* live[LowRateGate::kPackets] = {w_->voltages, w_->currents, w_->energy, w_->temperatures, w_->status};
+  for (std::size_t i = 0; i < LowRateGate::kPackets; ++i) {
+    gone(live[i], telemetry[i]);
+    gone(w_->low[i], telemetry[i]);
+  }
+  pmu::Config cfg;
+  set_key(cfg, w_->vehicle, key);
+  gone(w_->config, &cfg);
+  pmu::DeviceInfo info;
+  set_key(info, w_->vehicle, key);
+  gone(w_->info, &info);
+}
+
 }  // namespace pmu::service
 
 namespace pmu::service {

@@ -2,6 +2,8 @@
 
 #include <spdlog/spdlog.h>
 
+#include <algorithm>
+
 #include "pmu/codec/encode.hpp"
 
 namespace pmu::service {
@@ -137,12 +139,39 @@ void DeviceSession::absorb(const codec::PmuMessage& m) {
   if (changes.config) sink_.on_config(key_, reading_.config());
 }
 
+void DeviceSession::move_to(std::uint16_t address, MoveCause cause, SteadyTime now) {
+  now_ = now;
+  const DeviceKey old = key_;
+  HealthReport last = health_.report();
+  last.state = HealthState::Offline;
+  sink_.on_health(old, last);
+  gone_.push_back({old, now + kGoneDelay});
+  // Back at a key not yet disposed: it stays, with what follows published on it.
+  gone_.erase(std::remove_if(gone_.begin(), gone_.end(), [address](const Gone& g) { return g.key.address == address; }),
+              gone_.end());
+  key_.address = address;
+  alias_.reset();
+  reading_.set_address(address);
+  if (cause == MoveCause::ByItself) {
+    if (health_.offline()) health_.on_reconnect();
+    health_.on_frame(now);  // its serial answer, which the bus worker took as the evidence
+    start_reading(now);
+  }
+  if (reading_.info()) sink_.on_info(key_, *reading_.info());
+  sink_.on_config(key_, reading_.config());
+  update_health(now, true);
+}
+
 void DeviceSession::on_bus_state(transport::BusState state, SteadyTime now) {
   if (health_.on_bus_state(state)) update_health(now, true);
 }
 
 void DeviceSession::tick(SteadyTime now) {
   now_ = now;
+  while (!gone_.empty() && now >= gone_.front().at) {
+    sink_.on_gone(gone_.front().key);
+    gone_.erase(gone_.begin());
+  }
   if (queue_.tick(now)) health_.on_timeout();
   if (reading_.retry_due(now)) start_reading(now);
   if (reading_.running() && settings_.mode == TelemetryMode::Polling && now >= next_poll_) poll(now);

@@ -12,6 +12,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
+#include <cstdlib>
 #include <fstream>
 #include <memory>
 #include <optional>
@@ -31,6 +32,7 @@
 #include "pmu/service/dds_statistics.hpp"
 #include "pmu/service/receive_filters.hpp"
 #include "pmu/service/logging.hpp"
+#include "pmu/service/moved_addresses.hpp"
 #include "pmu/service/startup_check.hpp"
 #include "pmu/service/systemd.hpp"
 #include "pmu/service/vehicle.hpp"
@@ -164,10 +166,19 @@ int run(const service::Config& cfg, const pmu::dds::ResolvedNetwork& network) {
   service::DdsPublisher publisher(participant, 3 * longest, cfg.vehicle, cfg.low_rate_period,
                                   canopen ? std::optional<milliseconds>(3 * canopen_longest) : std::nullopt);
 
+  service::MovedAddressStore moved(service::moved_addresses_path(std::getenv("STATE_DIRECTORY")), cfg);
   std::vector<BusRuntime> buses(cfg.buses.size());
   for (std::size_t i = 0; i < cfg.buses.size(); ++i) {
     auto bus = open_bus(cfg.buses[i], clock, buses[i]);
     buses[i].worker = std::make_unique<service::BusWorker>(cfg.buses[i], std::move(bus), clock, cfg.timeouts, publisher);
+    // Only a device from the config file has an `address:` that can go stale.
+    buses[i].worker->on_moved([&moved](const service::BusWorker::Moved& m) {
+      if (!m.config_line.empty()) moved.record(m.bus, m.first, m.to, m.serial);
+    });
+    // A unit recorded as moved is followed by its serial before it is heard at its old address.
+    for (const auto& m : moved.moves())
+      if (auto* s = m.bus == cfg.buses[i].name && m.serial ? buses[i].worker->session(m.configured) : nullptr)
+        s->expect_serial(*m.serial);
   }
   service::DdsCommandEndpoint command_topics(participant, &publisher, cfg.vehicle);
   std::vector<service::BusWorker*> workers;
@@ -258,6 +269,18 @@ std::optional<pmu::dds::ResolvedNetwork> resolved_network(const service::Config&
   }
 }
 
+// --check-config: the configured addresses that the running service found moved (its state
+// directory's record, moved_addresses.hpp). False, with FILE:LINE and the value to write, when
+// one is stale.
+bool addresses_current(const service::Config& cfg) {
+  const auto path = service::moved_addresses_path(std::getenv("STATE_DIRECTORY"));
+  const auto record = service::read_moved_addresses(path);
+  for (const auto& e : record.errors) std::fprintf(stderr, "pmu-service: warning: %s (line ignored)\n", e.c_str());
+  const auto stale = service::stale_addresses(cfg, record.moves);
+  for (const auto& s : stale) std::fprintf(stderr, "pmu-service: %s\n", s.c_str());
+  return stale.empty();
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -306,6 +329,7 @@ int main(int argc, char** argv) {
   const auto network = resolved_network(cfg);
   if (!network) return 1;
   if (check_only) {
+    if (!addresses_current(cfg)) return 2;
     std::printf("%s: configuration OK (%zu bus(es)%s)\n", cfg.source.c_str(), cfg.buses.size(),
                 cfg.security.files.empty() ? "" : ", DDS-Security files OK");
     std::printf("%s: QoS profiles %s OK\n", cfg.source.c_str(), cfg.qos_file.c_str());

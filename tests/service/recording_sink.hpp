@@ -2,6 +2,7 @@
 // A StateSink that keeps everything the service would have published.
 
 #include <chrono>
+#include <map>
 #include <vector>
 
 #include "pmu/service/device_state.hpp"
@@ -17,10 +18,24 @@ class RecordingSink final : public StateSink {
   };
   void on_telemetry(const DeviceKey& k, const codec::PmuMessage& m, std::chrono::system_clock::time_point t) override {
     telemetry.push_back({k, m, t});
+    events.push_back({k, false});
   }
-  void on_config(const DeviceKey& k, const ConfigState& c) override { configs.push_back({k, c}); }
-  void on_info(const DeviceKey& k, const InfoState& i) override { infos.push_back({k, i}); }
-  void on_health(const DeviceKey& k, const HealthReport& h) override { healths.push_back({k, h}); }
+  void on_config(const DeviceKey& k, const ConfigState& c) override {
+    configs.push_back({k, c});
+    events.push_back({k, false});
+  }
+  void on_info(const DeviceKey& k, const InfoState& i) override {
+    infos.push_back({k, i});
+    events.push_back({k, false});
+  }
+  void on_health(const DeviceKey& k, const HealthReport& h) override {
+    healths.push_back({k, h});
+    events.push_back({k, false});
+  }
+  void on_gone(const DeviceKey& k) override {
+    gone.push_back(k);
+    events.push_back({k, true});
+  }
   void on_battery(const DeviceKey& k, const BatteryState& b, std::chrono::system_clock::time_point t) override {
     batteries.push_back({k, b, t});
   }
@@ -46,6 +61,23 @@ class RecordingSink final : public StateSink {
   std::vector<std::pair<DeviceKey, ConfigState>> configs;
   std::vector<std::pair<DeviceKey, InfoState>> infos;
   std::vector<std::pair<DeviceKey, HealthReport>> healths;
+  std::vector<DeviceKey> gone;
+  // Every PMU publication and disposal in order: what a DDS reader would hold now.
+  struct Event {
+    DeviceKey key;
+    bool gone = false;
+  };
+  std::vector<Event> events;
+  // PMU addresses with an instance on DDS now: published, and not gone since.
+  std::vector<std::uint16_t> live_pmus() const {
+    std::map<std::uint16_t, bool> last;
+    for (const auto& e : events)
+      if (e.key.kind == DeviceKind::Pmu) last[e.key.address] = !e.gone;
+    std::vector<std::uint16_t> out;
+    for (const auto& [a, live] : last)
+      if (live) out.push_back(a);
+    return out;
+  }
   template <class State>
   struct Sample {
     DeviceKey key;

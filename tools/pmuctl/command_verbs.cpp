@@ -7,6 +7,7 @@
 #include <fastdds/dds/core/status/PublicationMatchedStatus.hpp>
 #include <fastdds/dds/core/status/SubscriptionMatchedStatus.hpp>
 #include <fastdds/dds/subscriber/SampleInfo.hpp>
+#include <map>
 #include <optional>
 #include <set>
 #include <thread>
@@ -62,16 +63,24 @@ std::optional<int> resolve_target(const GlobalOptions& o, const std::string& veh
                              qos_profiles::kState);
   std::set<std::pair<std::string, std::uint16_t>> seen;
   std::set<std::string> vehicles_seen;
+  std::map<InstanceHandle_t, std::pair<std::string, std::uint16_t>> handles;
   std::optional<Clock::time_point> settle;
   while (Clock::now() < deadline) {
     pmu::Health h;
     SampleInfo info;
     while (r.take_next_sample(&h, &info) == ReturnCode_t::RETCODE_OK) {
-      if (!info.valid_data) continue;
+      if (!info.valid_data) {
+        // Disposed: a PMU that moved to another address is not a second PMU.
+        if (auto it = handles.find(info.instance_handle); it != handles.end() && info.instance_state != ALIVE_INSTANCE_STATE)
+          seen.erase(it->second);
+        continue;
+      }
       vehicles_seen.insert(h.vehicle().to_string());
       if (h.kind() == pmu::KIND_PMU && h.vehicle().to_string() == vehicle &&
-          (o.bus.empty() || o.bus == h.bus().to_string()) && (!o.address || *o.address == h.address()))
+          (o.bus.empty() || o.bus == h.bus().to_string()) && (!o.address || *o.address == h.address())) {
         seen.insert({h.bus().to_string(), h.address()});
+        handles[info.instance_handle] = {h.bus().to_string(), h.address()};
+      }
     }
     if (!seen.empty() && !settle) settle = Clock::now() + std::chrono::milliseconds(300);
     if (settle && Clock::now() >= *settle) break;

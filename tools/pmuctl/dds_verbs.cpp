@@ -125,8 +125,14 @@ class StateCollector {
     T sample;
     SampleInfo info;
     while (reader_.take_next_sample(&sample, &info) == ReturnCode_t::RETCODE_OK) {
-      if (!info.valid_data || !selected(o, id_of(sample))) continue;
+      if (!info.valid_data) {
+        // Disposed (a PMU that moved to another address): that device is not there any more.
+        if (info.instance_state != ALIVE_INSTANCE_STATE) forget(info.instance_handle);
+        continue;
+      }
+      if (!selected(o, id_of(sample))) continue;
       latest_[id_of(sample)] = sample;
+      handles_[info.instance_handle] = id_of(sample);
     }
   }
   bool matched() {
@@ -137,8 +143,15 @@ class StateCollector {
   const std::map<DeviceId, T>& latest() const { return latest_; }
 
  private:
+  void forget(const InstanceHandle_t& h) {
+    auto it = handles_.find(h);
+    if (it == handles_.end()) return;
+    latest_.erase(it->second);
+    handles_.erase(it);
+  }
   DataReader& reader_;
   std::map<DeviceId, T> latest_;
+  std::map<InstanceHandle_t, DeviceId> handles_;
 };
 
 // Waits for the state of the selected devices: returns once samples arrived and a short

@@ -13,6 +13,18 @@
 // gets a session with the bus's discovery settings. New units plugged in later are found
 // by the same periodic broadcast.
 //
+// A PMU that moves to another CAN address stays one session, filed under its new address at
+// the end of the turn (DeviceSession::move_to says what is published). Our own verified set
+// of CA moves it; so does the unit itself, when another tool or its panel changed its
+// address: a unit is taken for the same one moved when, at an address no session serves,
+// its serial answer (0x30, the one value a unit keeps for life, v1.9 5.25) equals the
+// serial read from a session whose address has gone silent (STALE or OFFLINE). A unit that
+// speaks at such an address (telemetry, or a serial or firmware answer: frames only a PMU
+// sends) while a session with a known serial is silent is asked its serial, at most once per
+// second per address (every 10 s once it answered another serial). A serial that matches a session that still speaks is two units
+// claiming one serial: logged, nothing moves. While a session with a known serial is OFFLINE,
+// a broadcast serial request every 10 s finds a polled unit that streams nothing.
+//
 // Batteries and MPPTs (CANopen frames, read-only): each configured one has a CanOpenSession
 // from the start (so a silent one goes OFFLINE); with `listen_canopen`, one heard but not
 // configured gets a session at its first frame, with a period of 1 s.
@@ -22,6 +34,8 @@
 #include <functional>
 #include <map>
 #include <memory>
+#include <optional>
+#include <string>
 #include <vector>
 
 #include "pmu/service/canopen_session.hpp"
@@ -53,7 +67,21 @@ class BusWorker final : private transport::BusHandler {
   // Runs `fn` on the worker's thread at its next turn. Thread-safe.
   void post(std::function<void()> fn);
 
+  // A PMU session moved from one address to another (after the move; worker thread). Also,
+  // with from == to == first, a session expecting a recorded serial that read its unit at its
+  // configured address: the unit is where the config says.
+  struct Moved {
+    std::string bus;
+    std::uint16_t from = 0, to = 0;
+    std::uint16_t first = 0;                  // where it started: the config's address, or discovery's
+    std::optional<std::uint16_t> serial;
+    std::string config_line;                  // "FILE:LINE" of its `address:`; empty when not configured
+  };
+  // Called on the worker's thread after every move. Set before run().
+  void on_moved(std::function<void(const Moved&)> fn) { moved_ = std::move(fn); }
+
   // Worker thread only (or before run()):
+  // The session serving `address` now (a session that moved this turn included).
   DeviceSession* session(std::uint16_t address);
   std::vector<std::uint16_t> addresses() const;
   // The battery (node) or MPPT (device id) session, or null.
@@ -77,6 +105,13 @@ class BusWorker final : private transport::BusHandler {
   void on_canopen_frame(const transport::ReceivedFrame& frame);
   void discover();  // the broadcast firmware request (a loop timer, when config_.discover)
   void rekey_moved_sessions();
+  void confirm_expected(DeviceSession& s);
+  // A PMU frame from an address no session serves: a moved unit found by its serial, a new
+  // one found by discovery, or nothing. Returns the session the frame belongs to, if any.
+  DeviceSession* on_stranger(const codec::PmuId& id, const transport::ReceivedFrame& rx);
+  DeviceSession* session_with_serial(std::uint16_t serial);  // not one mid-way through our own move
+  bool any_silent_known(HealthState at_least) const;
+  void search();  // the broadcast serial request while a known session is OFFLINE (a loop timer)
   void end_turn();  // ticks every session; the watchdog's progress
 
   BusConfig config_;
@@ -86,6 +121,8 @@ class BusWorker final : private transport::BusHandler {
   StateSink& sink_;
   std::map<std::uint16_t, std::unique_ptr<DeviceSession>> sessions_;
   std::map<std::pair<DeviceKind, std::uint16_t>, std::unique_ptr<CanOpenSession>> canopen_;
+  std::map<std::uint16_t, std::chrono::steady_clock::time_point> asked_;  // stranger -> next serial get allowed
+  std::function<void(const Moved&)> moved_;
 
   transport::EventLoop loop_;
   std::size_t turn_frames_ = 0;  // frames drained in the run_once() turn in progress

@@ -41,6 +41,9 @@ struct DeviceConfig {
   // Streaming only: write PP and PS to the PMU when they differ from period/groups. Off by
   // default: they live in the PMU's non-volatile memory and belong to whoever set it up.
   bool configure_streaming = false;
+  // "FILE:LINE" of its `address:` in the config file, for the line to change when the unit
+  // moves; empty for a device not from a file (discovered, built in).
+  std::string source_line;
 };
 
 // A battery (MG BMS) on the bus, read-only (spec/solar-boat-canopen-battery-mppt.txt). The

@@ -39,6 +39,9 @@ class DdsPublisher final : public StateSink {
   void on_config(const DeviceKey& key, const ConfigState& config) override;
   void on_info(const DeviceKey& key, const InfoState& info) override;
   void on_health(const DeviceKey& key, const HealthReport& health) override;
+  // Unregisters (and so disposes: the writers autodispose) `key`'s instance on every topic
+  // it can have one on, and frees its place among the kMaxDevicesPerService admitted.
+  void on_gone(const DeviceKey& key) override;
   void on_battery(const DeviceKey& key, const BatteryState& battery,
                   std::chrono::system_clock::time_point newest) override;
   void on_battery_cells(const DeviceKey& key, const BatteryCellsState& cells,

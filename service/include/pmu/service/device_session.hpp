@@ -28,6 +28,7 @@
 #include <cstdint>
 #include <functional>
 #include <optional>
+#include <vector>
 
 #include "pmu/codec/decode.hpp"
 #include "pmu/service/config.hpp"
@@ -62,14 +63,38 @@ class DeviceSession {
   // Reads identity and every stored value again (after a reset).
   void reread(SteadyTime now) { start_reading(now); }
 
-  // During a CAN address change, frames from `alias` belong to this session too; readdress()
+  // During a CAN address change, frames from `alias` belong to this session too; move_to()
   // moves the session to its new address once the change is verified.
   void set_alias(std::optional<std::uint16_t> alias) noexcept { alias_ = alias; }
   std::optional<std::uint16_t> alias() const noexcept { return alias_; }
-  void readdress(std::uint16_t address) noexcept {
-    key_.address = address;
-    alias_.reset();
+
+  enum class MoveCause : std::uint8_t {
+    Commanded,  // our own set of CA (0x1B), read back at the new address
+    ByItself,   // its serial (0x30) answered at `address` while its old address is silent
+  };
+  // The unit answers at `address` now. The old key gets its health once more, OFFLINE,
+  // and is gone (StateSink::on_gone) kGoneDelay later, unless the unit is back there by
+  // then; the new key gets the identity and configuration carried over (CA = `address`)
+  // and the health, at once. ByItself also counts as a frame heard now and reads
+  // everything again: whoever changed the address may have changed more. The bus worker
+  // files the session under its new key at the end of its turn.
+  void move_to(std::uint16_t address, MoveCause cause, SteadyTime now);
+  // Between the old key's OFFLINE and its disposal: a state reader keeps one sample per
+  // instance, and a disposal that comes first replaces the OFFLINE it has not taken yet.
+  // Short, so that `list` shows the new key alone well within the usual packet periods.
+  static constexpr std::chrono::milliseconds kGoneDelay{250};
+  // The serial this PMU has when none was read yet: what the service recorded before it
+  // restarted (moved_addresses.hpp), so a unit that moved is followed before it is heard.
+  void expect_serial(std::optional<std::uint16_t> serial) noexcept { expected_serial_ = serial; }
+  bool expects_serial() const noexcept { return expected_serial_.has_value(); }
+  // The serial read from the unit, else the one expected.
+  std::optional<std::uint16_t> serial() const noexcept {
+    if (reading_.info()) return reading_.info()->serial_number;
+    return expected_serial_;
   }
+  // Where the session started (the config's address, or where discovery found it).
+  std::uint16_t first_address() const noexcept { return settings_.address; }
+  const DeviceConfig& settings() const noexcept { return settings_; }
 
   // The latest time any call brought: callbacks that queue follow-up work use it.
   SteadyTime now() const noexcept { return now_; }
@@ -103,6 +128,12 @@ class DeviceSession {
   RequestQueue queue_;
 
   std::optional<std::uint16_t> alias_;
+  std::optional<std::uint16_t> expected_serial_;
+  struct Gone {
+    DeviceKey key;
+    SteadyTime at;
+  };
+  std::vector<Gone> gone_;  // old keys to dispose, once due (tick)
   SteadyTime now_{};  // the latest time any call brought
   SteadyTime next_poll_{};
 };

@@ -82,6 +82,11 @@ class StateSink {
   virtual void on_config(const DeviceKey& key, const ConfigState& config) = 0;
   virtual void on_info(const DeviceKey& key, const InfoState& info) = 0;
   virtual void on_health(const DeviceKey& key, const HealthReport& health) = 0;
+  // No device is at `key` any more (a PMU that moved to another CAN address): every
+  // instance of every topic under it is unregistered and disposed, so neither a reader
+  // nor a late joiner keeps a device that is not there. The last health sent before is
+  // OFFLINE.
+  virtual void on_gone(const DeviceKey& key) = 0;
   // A battery's or MPPT's assembled values changed (canopen_session.hpp); `newest` is the
   // receive time of the newest frame that contributed.
   virtual void on_battery(const DeviceKey& key, const BatteryState& battery,

@@ -54,6 +54,12 @@ class ReadingMachine {
   };
   Changes absorb(const codec::PmuMessage& m);
 
+  // The unit answers at `address` now (a verified or observed CAN address change): its
+  // stored CA is that, whatever was last read.
+  void set_address(std::uint16_t address) noexcept {
+    config_.raw[static_cast<std::size_t>(codec::Parameter::CanAddress)] = address;
+  }
+
   const ConfigState& config() const noexcept { return config_; }
   const std::optional<InfoState>& info() const noexcept { return info_; }
   // Known once the firmware packet was read; until then decoding assumes nothing.
