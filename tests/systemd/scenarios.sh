@@ -387,8 +387,11 @@ scenario_purge() {
   dpkg-query -W -f='${Status}' pmu-dds 2>/dev/null | grep -q config-files || fail "pmu-dds is not in state config-files before purge: $(dpkg-query -W -f='${Status}' pmu-dds 2>&1)"
   dpkg -P pmu-dds </dev/null >"$WORK/$SCEN.out" 2>&1 || fail "dpkg -P pmu-dds failed: $(tail -n 3 "$WORK/$SCEN.out" | tr '\n' ' ')"
   [ ! -e /etc/pmu-dds ] || fail "/etc/pmu-dds still there after purge: $(ls -A /etc/pmu-dds | tr '\n' ' ')"
+  for d in /var/lib/pmu-dds /var/lib/private/pmu-dds; do
+    [ ! -e "$d" ] && [ ! -L "$d" ] || fail "$d (the service's state) still there after purge"
+  done
   st=$(systemctl is-enabled pmu-service 2>&1)
-  detail "/etc/pmu-dds deleted; is-enabled: $st"
+  detail "/etc/pmu-dds and the state directory deleted; is-enabled: $st"
 }
 
 # ---- driver ----------------------------------------------------------------------------
