@@ -15,7 +15,7 @@ usage() {
   exit 2
 }
 list=0
-set_name=test
+set_name="test"
 case "$#:${1:-}" in
   0:) ;;
   1:run | 1:test) set_name=$1 ;;

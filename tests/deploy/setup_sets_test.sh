@@ -75,5 +75,5 @@ done < <(sort -u "$work/run" "$work/test")
 apt-cache show --no-all-versions "${names[@]}" 2>/dev/null |
   awk '/^Package: / {p = $2} /^Architecture: / {print p; print p ":" $2}' | sort -u >"$work/found" || true
 missing=$(printf '%s\n' "${names[@]}" | sort -u | comm -23 - "$work/found")
-[ -z "$missing" ] || fail "not in this machine's Debian archive (apt-cache show): $(echo $missing)"
+[ -z "$missing" ] || fail "not in this machine's Debian archive (apt-cache show): $(tr '\n' ' ' <<<"$missing")"
 echo "ok: all ${#names[@]} packages exist in the archive"
