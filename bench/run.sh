@@ -28,7 +28,7 @@ done
 
 if [ "$build_it" = 1 ]; then
   "$root/scripts/setup.sh" >&2
-  cmake -S "$root" -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=Release -DPMU_BUILD_TESTS=OFF >/dev/null
+  cmake -S "$root" -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=Release -DPMU_BUILD_TESTS=OFF -DPMU_BUILD_BENCH=ON >/dev/null
   cmake --build "$build" -j"$(nproc)" --target pmu-service pmuctl pmu_bench codec_bench make_candump_log >&2
 fi
 for b in service/pmu-service tools/pmuctl bench/pmu_bench bench/codec_bench bench/make_candump_log; do

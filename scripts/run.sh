@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
-# Quick start: installs what is missing, builds, starts pmu-service on the built-in simulated
-# power system (a PMU, the battery's BMS and two MPPTs: deploy/examples/sim-power-system.yaml)
-# and shows its live telemetry with `pmuctl watch` (Ctrl-C stops both).
+# Quick start: installs what is missing (scripts/setup.sh run), builds, starts pmu-service on
+# the built-in simulated power system (a PMU, the battery's BMS and two MPPTs:
+# deploy/examples/sim-power-system.yaml) and shows its live telemetry with `pmuctl watch`
+# (Ctrl-C stops both).
 #   scripts/run.sh [--domain N] [extra pmuctl watch options, e.g. --json --count 20]
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
@@ -11,7 +12,9 @@ export PMU_QOS_FILE=${PMU_QOS_FILE:-$root/deploy/qos.xml}
 domain=0
 if [ "${1:-}" = "--domain" ]; then domain=$2; shift 2; fi
 
-"$root/scripts/setup.sh"
+# The run set is enough: a fresh tree has tests and benchmarks off (a tree that
+# scripts/test.sh configured keeps them on, and its packages are there).
+"$root/scripts/setup.sh" run
 cmake -S . -B build/release -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo >/dev/null
 cmake --build build/release -j"$(nproc)" --target pmu-service pmuctl
 

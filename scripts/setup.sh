@@ -1,18 +1,45 @@
 #!/usr/bin/env bash
-# Installs every Debian package that building, testing and running pmu-dds needs.
+# Installs the Debian packages of one set:
+#   run   what building and running pmu-dds need (a tree with PMU_BUILD_TESTS and
+#         PMU_BUILD_BENCH off, as a plain `cmake -S . -B build` configures it): scripts/run.sh
+#   test  everything: the run set, the tests' and benchmarks' libraries, the VMs, the Debian
+#         packaging and its arm64 cross build, ccache, Node.js for tests/mcap: scripts/test.sh
+#   scripts/setup.sh [run|test]        install the set (default: test)
+#   scripts/setup.sh --list run|test   print the set's Debian packages, one per line
 # Idempotent: packages already present are left alone, and apt is not touched at all
 # when nothing is missing (so repeated test runs stay fast and work offline).
 set -euo pipefail
 
-packages=(
+usage() {
+  echo "usage: scripts/setup.sh [run|test] | scripts/setup.sh --list run|test" >&2
+  exit 2
+}
+list=0
+set_name="test"
+case "$#:${1:-}" in
+  0:) ;;
+  1:run | 1:test) set_name=$1 ;;
+  2:--list)
+    case "$2" in run | test) list=1; set_name=$2 ;; *) echo "setup: unknown set '$2'" >&2; usage ;; esac ;;
+  *) echo "setup: bad arguments: $*" >&2; usage ;;
+esac
+
+# Debian's Build-Depends (debian/control) without the test ones: the CMake files find these
+# whatever the options.
+run_packages=(
   build-essential cmake ninja-build pkg-config
-  clang-14 libclang-rt-14-dev lld-14
-  libgtest-dev libgmock-dev libbenchmark-dev
-  libfastrtps-dev libfastcdr-dev fastddsgen fastdds-tools
+  libfastrtps-dev libfastcdr-dev fastddsgen
   libspdlog-dev libfmt-dev libsystemd-dev libcli11-dev libyaml-cpp-dev nlohmann-json3-dev
   # pmuctl serve: a WebSocket server (header-only) on standalone asio
   libwebsocketpp-dev libasio-dev
-  libssl-dev libtinyxml2-dev openssl
+  libssl-dev libtinyxml2-dev
+)
+test_only_packages=(
+  ccache
+  clang-14 libclang-rt-14-dev lld-14
+  libgtest-dev libgmock-dev libbenchmark-dev
+  # fastdds: the Discovery Server of the discovery tests; openssl: the DDS-Security PKI
+  fastdds-tools openssl
   cyclonedds-dev cyclonedds-tools
   can-utils iproute2 python3 python3-can
   # The VM of the system tests and the network lab (tests/lab: iproute2's ip and tc with
@@ -33,7 +60,17 @@ arm64_packages=(
   libsystemd-dev:arm64 libyaml-cpp0.7:arm64 libssl-dev:arm64 libtinyxml2-dev:arm64
   libgtest-dev:arm64 libgmock-dev:arm64 pkg-config:arm64 libwebsocketpp-dev:arm64
 )
-packages+=("${arm64_packages[@]}")
+# Node.js for the MCAP tests (tests/mcap), installed below only when node or npm is missing.
+node_packages=(nodejs npm)
+
+packages=("${run_packages[@]}")
+if [ "$set_name" = test ]; then packages+=("${test_only_packages[@]}" "${arm64_packages[@]}"); fi
+
+if [ "$list" = 1 ]; then
+  printf '%s\n' "${packages[@]}"
+  if [ "$set_name" = test ]; then printf '%s\n' "${node_packages[@]}"; fi
+  exit 0
+fi
 
 missing=()
 for p in "${packages[@]}"; do
@@ -43,7 +80,9 @@ for p in "${packages[@]}"; do
 done
 
 add_arm64=0
-dpkg --print-foreign-architectures | grep -qx arm64 || add_arm64=1
+if [ "$set_name" = test ]; then
+  dpkg --print-foreign-architectures | grep -qx arm64 || add_arm64=1
+fi
 
 SUDO=""
 if [ "$(id -u)" -ne 0 ]; then SUDO="sudo"; fi
@@ -52,7 +91,7 @@ need_root() {
 }
 
 if [ ${#missing[@]} -eq 0 ] && [ "$add_arm64" -eq 0 ]; then
-  echo "setup: all ${#packages[@]} packages present"
+  echo "setup: all ${#packages[@]} packages of the $set_name set present"
 else
   need_root "${missing[*]}"
   if [ "$add_arm64" -eq 1 ]; then
@@ -65,16 +104,18 @@ else
   $SUDO apt-get install -y -q --no-install-recommends "${missing[@]}"
 fi
 
+[ "$set_name" = test ] || exit 0
+
 # The MCAP tests (tests/mcap) read pmuctl's files with the ecosystem's own npm packages on
 # Node.js. Node.js may come from elsewhere (NodeSource bundles npm): Debian's nodejs and npm
 # are installed only when the commands are missing. The packages come from the lock file
 # (npm ci), and only when it changed since the last install.
 if ! command -v node >/dev/null || ! command -v npm >/dev/null; then
-  need_root nodejs npm
-  echo "setup: installing nodejs npm (Debian) for tests/mcap"
+  need_root "${node_packages[*]}"
+  echo "setup: installing ${node_packages[*]} (Debian) for tests/mcap"
   export DEBIAN_FRONTEND=noninteractive
   $SUDO apt-get update -q
-  $SUDO apt-get install -y -q --no-install-recommends nodejs npm
+  $SUDO apt-get install -y -q --no-install-recommends "${node_packages[@]}"
 fi
 mcap_dir="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)/tests/mcap"
 stamp="$mcap_dir/node_modules/.package-lock.json"

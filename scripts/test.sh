@@ -22,34 +22,34 @@ root=$(cd "$(dirname "$0")/.." && pwd)
 cd "$root"
 jobs=$(nproc)
 
-"$root/scripts/setup.sh"
+"$root/scripts/setup.sh" test
 
 step() { printf '\n=== %s ===\n' "$*"; }
 
 step "release build"
-cmake -S . -B build/release -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DPMU_WERROR=ON >/dev/null
-cmake --build build/release -j"$jobs"
+# Each build's flags are its preset in CMakePresets.json (folder build/<preset>).
+cmake --preset release >/dev/null
+cmake --build --preset release -j"$jobs"
 
 step "ASan+UBSan build"
-cmake -S . -B build/asan -G Ninja -DCMAKE_BUILD_TYPE=Debug -DPMU_SANITIZE=ON -DPMU_BUILD_BENCH=OFF >/dev/null
-cmake --build build/asan -j"$jobs"
+cmake --preset asan >/dev/null
+cmake --build --preset asan -j"$jobs"
 
 step "ThreadSanitizer build"
-# -O1: TSan's reports keep their stack frames, and the tests run about twice as fast as -O0.
-# Only the test programs that run under TSan (and what they start) are built.
-cmake -S . -B build/tsan -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo "-DCMAKE_CXX_FLAGS_RELWITHDEBINFO=-O1 -g -DNDEBUG" \
-  -DPMU_TSAN=ON -DPMU_BUILD_BENCH=OFF >/dev/null
-cmake --build build/tsan -j"$jobs" --target transport_tests sim_tests service_tests integration_tests
+# -O1 (the preset): TSan's reports keep their stack frames, and the tests run about twice as
+# fast as -O0. Only the test programs that run under TSan (and what they start) are built.
+cmake --preset tsan >/dev/null
+cmake --build --preset tsan -j"$jobs"
 
 step "libFuzzer build (clang-14)"
-CC=clang-14 CXX=clang++-14 cmake -S . -B build/fuzz -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo \
-  -DPMU_FUZZ=ON -DPMU_BUILD_BENCH=OFF >/dev/null
-# Only what the fuzz runs use: the rest is built and tested by the gcc builds above.
-cmake --build build/fuzz -j"$jobs" --target fuzz_decode_frame fuzz_candump_line fuzz_command_path
+cmake --preset fuzz >/dev/null
+# Only what the fuzz runs use (the preset's targets): the rest is built and tested by the gcc
+# builds above.
+cmake --build --preset fuzz -j"$jobs"
 
 step "sanitizer tests"
-ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
-  ctest --test-dir build/asan --output-on-failure -j"$jobs" -LE 'fuzz|bench|integration|deploy|system|lab|package'
+# ASAN_OPTIONS, UBSAN_OPTIONS and the labels left out are the preset's.
+ctest --preset asan -j"$jobs"
 
 step "ThreadSanitizer tests"
 # setarch -R: TSan's fixed memory layout fails under the high mmap randomisation of some
@@ -61,12 +61,11 @@ step "ThreadSanitizer tests"
 # same unsymbolised race (libfastrtps+0x294b87, pthread_mutex_timedlock against mmap of a
 # shared-memory segment) in their 2,000-command burst; the service's threads they exercise run
 # here through the integration tests. crossvendor: the Cyclone DDS client is not built here.
-TSAN_OPTIONS="suppressions=$root/tests/tsan.supp halt_on_error=1 second_deadlock_stack=1" \
-  setarch "$(uname -m)" -R ctest --test-dir build/tsan --output-on-failure -j"$jobs" \
-  -L '^(transport|sim|service|integration)$' -LE crossvendor -E '^(Scale\.|Boundary\.|GuardedType\.)'
+# TSAN_OPTIONS (tests/tsan.supp) and these exclusions are the preset's.
+setarch "$(uname -m)" -R ctest --preset tsan -j"$jobs"
 
 step "fuzz runs"
-ctest --test-dir build/fuzz --output-on-failure -L fuzz
+ctest --preset fuzz
 
 # These packages only feed the tests (systemd_vm, package_*): built without debug
 # information and without -dbgsym packages, which is most of a C++ link's time and output.
@@ -80,4 +79,4 @@ step "arm64 packages (tests under qemu-user)"
 env "${no_debug[@]}" DEB_BUILD_OPTIONS=noautodbgsym "$root/scripts/package.sh" --arch arm64
 
 step "release tests"
-ctest --test-dir build/release --output-on-failure -j"$jobs"
+ctest --preset release -j"$jobs"
