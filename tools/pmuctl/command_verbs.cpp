@@ -63,6 +63,7 @@ std::optional<int> resolve_target(const GlobalOptions& o, const std::string& veh
                              qos_profiles::kState);
   std::set<std::pair<std::string, std::uint16_t>> seen;
   std::set<std::string> vehicles_seen;
+  bool own_vehicle_seen = false;
   std::map<InstanceHandle_t, std::pair<std::string, std::uint16_t>> handles;
   std::optional<Clock::time_point> settle;
   while (Clock::now() < deadline) {
@@ -76,13 +77,18 @@ std::optional<int> resolve_target(const GlobalOptions& o, const std::string& veh
         continue;
       }
       vehicles_seen.insert(h.vehicle().to_string());
+      own_vehicle_seen = own_vehicle_seen || h.vehicle().to_string() == vehicle;
       if (h.kind() == pmu::KIND_PMU && h.vehicle().to_string() == vehicle &&
           (o.bus.empty() || o.bus == h.bus().to_string()) && (!o.address || *o.address == h.address())) {
         seen.insert({h.bus().to_string(), h.address()});
         handles[info.instance_handle] = {h.bus().to_string(), h.address()};
       }
     }
-    if (!seen.empty() && !settle) settle = Clock::now() + std::chrono::milliseconds(300);
+    // The service's health is TRANSIENT_LOCAL: all of it comes in one burst once matched, so
+    // the settle time starts with its first sample, of the wanted PMU or not. Other
+    // vehicles' samples do not start it: on a slow link their services are discovered one
+    // by one, and the one asked for may still come.
+    if ((!seen.empty() || own_vehicle_seen) && !settle) settle = Clock::now() + std::chrono::milliseconds(300);
     if (settle && Clock::now() >= *settle) break;
     std::this_thread::sleep_for(std::chrono::milliseconds(20));
   }

@@ -130,6 +130,7 @@ class StateCollector {
         if (info.instance_state != ALIVE_INSTANCE_STATE) forget(info.instance_handle);
         continue;
       }
+      ++received_;
       if (!selected(o, id_of(sample))) continue;
       latest_[id_of(sample)] = sample;
       handles_[info.instance_handle] = id_of(sample);
@@ -141,6 +142,8 @@ class StateCollector {
     return st.current_count > 0;
   }
   const std::map<DeviceId, T>& latest() const { return latest_; }
+  // Samples of any device, selected or not: the service's current state has arrived.
+  std::size_t received() const { return received_; }
 
  private:
   void forget(const InstanceHandle_t& h) {
@@ -150,6 +153,7 @@ class StateCollector {
     handles_.erase(it);
   }
   DataReader& reader_;
+  std::size_t received_ = 0;
   std::map<DeviceId, T> latest_;
   std::map<InstanceHandle_t, DeviceId> handles_;
 };
@@ -162,7 +166,10 @@ int collect(const GlobalOptions& o, const pmu::dds::DdsContext& dds, Collector& 
   std::optional<Clock::time_point> settle;
   while (Clock::now() < deadline && !g_interrupted) {
     c.poll(o);
-    if (!c.latest().empty() && !settle) settle = Clock::now() + std::chrono::milliseconds(300);
+    // A state topic is TRANSIENT_LOCAL: once any device's sample came, the rest of the
+    // service's current state comes in the same burst, so a device missing after the settle
+    // time is not there. Waiting to the deadline would only make "not seen" slow.
+    if ((!c.latest().empty() || c.received() > 0) && !settle) settle = Clock::now() + std::chrono::milliseconds(300);
     if (settle && Clock::now() >= *settle) break;
     std::this_thread::sleep_for(std::chrono::milliseconds(20));
   }
