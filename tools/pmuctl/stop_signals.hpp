@@ -2,7 +2,7 @@
 // SIGINT and SIGTERM for the long-running verbs (record, serve), taken by sigtimedwait in the
 // main thread instead of a handler: constructed before Fast DDS or a server starts its
 // threads, which inherit the blocked mask, so no handler ever runs inside them
-// (design.md: no signal handlers that call into the application).
+// (docs/design.md: signals are read, never handled).
 
 #include <signal.h>
 

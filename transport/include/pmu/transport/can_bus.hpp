@@ -13,7 +13,8 @@
 //     never re-registers anything.
 //   * fd() is level-triggered readable while frames or events are pending. Each wakeup the
 //     loop calls drain(), which delivers EVERY pending frame and event (a kernel wakeup costs
-//     far more than a frame: design.md measures ~28 us here), then returns.
+//     far more than a frame: docs/design.md, "Drain every pending frame per wakeup"), then
+//     returns.
 //   * The loop calls maintain(now) periodically (every few hundred ms is plenty) for the
 //     work no fd announces: reopening a vanished interface, noticing a link that came up.
 //   * One thread uses a bus at a time. (SimBus endpoints of one network may be used from

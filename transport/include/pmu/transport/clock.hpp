@@ -1,7 +1,7 @@
 #pragma once
 // The time source of transport/ (and of anything above it that wants the same one).
 // Injected so that send deadlines, reopen intervals and simulated receive timestamps can be
-// driven by a test without sleeping (the MAVSDK habit; see shared/design.md).
+// driven by a test without sleeping (docs/design.md: the clock is injected).
 
 #include <atomic>
 #include <chrono>

@@ -35,7 +35,8 @@
 //     (start-up). Nothing throws after that: watch()/unwatch() return an errno value
 //     (0 on success); a failed epoll_wait (EINTR) counts as a wait that found nothing
 //     ready. Exceptions thrown by callbacks propagate to the caller of run_once()/run();
-//     the callers here do not throw on their per-frame paths (design.md).
+//     the callers here do not throw on their per-frame paths (docs/design.md: exceptions
+//     only at start-up).
 //   * Safe re-entry into the registrations: a callback may watch, unwatch, post, add or
 //     remove timers and stop the loop. Once unwatch(fd) or remove_timer(id) has returned,
 //     that callback is never called again, even for an event already collected this turn.
