@@ -28,6 +28,15 @@
 // Batteries and MPPTs (CANopen frames, read-only): each configured one has a CanOpenSession
 // from the start (so a silent one goes OFFLINE); with `listen_canopen`, one heard but not
 // configured gets a session at its first frame, with a period of 1 s.
+//
+// Lifetime: `clock` and `sink` must outlive the worker, which keeps references to both
+// (main.cpp makes the SystemClock and the DdsPublisher before any worker and destroys the
+// workers first). The worker owns its bus and its sessions, whose send callback refers back
+// to it. The thread running run() must be stopped and joined before the worker is destroyed.
+// Threads: run(), run_once() and every callback they make (the sessions, on_moved's function,
+// the StateSink) on the worker's thread; post(), stop(), device_count() and progress() from
+// any thread; on_moved() before run(); session(), addresses(), canopen_session() and bus()
+// on the worker's thread or before run(); config() from any thread (it never changes).
 
 #include <atomic>
 #include <chrono>

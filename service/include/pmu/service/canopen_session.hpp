@@ -15,6 +15,11 @@
 // sample never mixes a replaced or restarted unit's values with the old one's.
 //
 // No I/O and no clock of its own: time comes in with every call.
+//
+// Lifetime: `sink` must outlive the session, which keeps a reference (the DdsPublisher in the
+// daemon: main.cpp makes it before the bus workers that own the sessions, and destroys it
+// after them).
+// Threads: no lock: every member on the thread of the bus worker that owns it.
 
 #include <chrono>
 #include <optional>

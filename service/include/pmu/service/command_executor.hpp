@@ -13,6 +13,12 @@
 //   reset       sent, then identity and every stored value are read again
 // Nothing reaches the bus for a request that fails the checks (REJECTED / UNSUPPORTED).
 // Each kind is a description in one table (command_plan.hpp), run by one generic runner.
+//
+// Lifetime: the steps of a command keep a reference to `session` and are held by its request
+// queue, so they never outlive it. `reply` must stay callable until it is called; it is not
+// called when the session is destroyed with the command still queued.
+// Threads: execute_command() on the thread of the bus worker that owns `session`; `reply` is
+// called on that thread.
 
 #include <functional>
 #include <optional>

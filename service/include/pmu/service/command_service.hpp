@@ -17,6 +17,16 @@
 // Memory: at most kRememberedRequests ids are kept (oldest forgotten first); no request
 // lives longer than policy.lifetimes.max_lifetime, so at any rate below
 // kRememberedRequests per max_lifetime no live request's id is ever forgotten.
+//
+// Lifetime: every BusWorker in `workers`, `clock`, and whatever `reply` refers to (main.cpp:
+// the DdsCommandEndpoint) must outlive the service; it keeps pointers and a reference. Work
+// it posts to a worker refers to the service, so the command source is stopped
+// (DdsCommandEndpoint::stop) and the worker threads joined before it is destroyed: main.cpp's
+// Shutdown does both.
+// Threads: submit(), counters() and remembered() from any thread (in the daemon, a Fast DDS
+// listener thread calls submit()); `mutex_` guards what they share. The stages after
+// BusWorker::post run on that worker's thread. `reply` is called from both, never under
+// `mutex_`.
 
 #include <chrono>
 #include <deque>

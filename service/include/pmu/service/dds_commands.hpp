@@ -4,6 +4,14 @@
 // between pmu::Command / pmu::CommandReply and the service's own command types: samples are
 // read field for field as they arrived (command_cdr.hpp) and parsed by CommandService, so
 // no payload a peer can send reaches Fast DDS's threads as an exception.
+//
+// Lifetime: `dds` and `failures` must outlive the endpoint, which keeps a reference and a
+// pointer; the service given to start() must outlive the stop() call (or the destructor,
+// which calls it). main.cpp destroys the endpoint after the CommandService whose ReplyFn
+// calls publish(), and stops it first.
+// Threads: start() and stop() on one thread (main.cpp's main thread); the reader's listener
+// runs on Fast DDS's threads and calls CommandService::submit() there; publish() from any
+// thread (a mutex serialises the writer); malformed() and not_ours() from any thread.
 
 #include <memory>
 #include <string>

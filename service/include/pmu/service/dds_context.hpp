@@ -14,6 +14,15 @@
 // builtin plugins (PKI-DH authentication, Access-Permissions, AES-GCM-GMAC crypto) with
 // those files. Check them first (check_security_files): Fast DDS only says that the
 // participant could not be created.
+//
+// Lifetime: the topics, writers and readers it returns belong to its participant and are
+// valid until the context is destroyed; every object that keeps one (DdsPublisher,
+// DdsCommandEndpoint) must be destroyed first. A listener given to
+// writer() or reader() must outlive the context (Fast DDS may call it until the participant
+// is deleted), or be removed from its endpoint first (set_listener(nullptr), as
+// DdsCommandEndpoint::stop() does).
+// Threads: the constructor, topic(), writer() and reader() on one thread at a time (start-up;
+// they share the topic map unlocked); remote_writers() from any thread (it locks).
 
 #include <fastdds/dds/domain/DomainParticipant.hpp>
 #include <fastdds/dds/publisher/DataWriter.hpp>

@@ -1,11 +1,19 @@
 #pragma once
 // DdsPublisher: the StateSink that puts the service's view of each PMU on the contract's
-// topics. The only place that converts codec values to the generated DDS types.
+// topics. With telemetry_samples.hpp (whose fill() it uses for the telemetry packets), the
+// only place that converts codec values to the generated DDS types.
 //
 // Nothing is dropped silently: a write Fast DDS refuses is counted (pmu/health's
 // publish_failures) and logged at most once every few seconds with the running count, and a
 // PMU beyond the capacity the writers are sized for (kMaxDevicesPerService, e.g. found by
 // discovery) is not published, said in the log the same way, and counted too.
+//
+// Lifetime: the DdsContext given to the constructor must outlive the publisher: the
+// publisher keeps the DataWriters the context's participant owns (main.cpp makes the context
+// first and destroys it last). The publisher must outlive every BusWorker and
+// DdsCommandEndpoint that writes through it.
+// Threads: the StateSink members from any bus worker thread at once (Writers::mutex
+// serialises the writes); count_failed_write() and the counters from any thread.
 
 #include <atomic>
 #include <chrono>

@@ -23,6 +23,14 @@
 //
 // No I/O and no clock of its own: frames go out through a send callback, time comes in
 // through every call, so tests drive it with a fake clock.
+//
+// Lifetime: `sink` must outlive the session, which keeps a reference (the DdsPublisher in the
+// daemon: main.cpp makes it before the bus workers that own the sessions, and destroys it
+// after them). `send` may refer to the session's owner, the BusWorker. The command runs
+// queued on the session keep a reference to it; they live in its request queue, so never
+// longer than the session.
+// Threads: no lock and no thread of its own: every member on the thread of the bus worker
+// that owns it; other threads reach it only through BusWorker::post().
 
 #include <chrono>
 #include <cstdint>

@@ -60,7 +60,9 @@ struct DeviceUse {
   bool streaming = true;
 };
 
-// Deny list and confirm rules.
+// Deny list and confirm rules for `r`. `device` matters only to stop_streaming: PS = 0 needs
+// confirm for a device the service expects to stream, not for a polled one. The rate limit is
+// RateLimiter's, not this function's.
 PolicyVerdict check_policy(const CommandRequest& r, const PolicyConfig& p, const DeviceUse& device = {});
 
 // A token bucket per device. Not thread-safe: used under the command service's lock.

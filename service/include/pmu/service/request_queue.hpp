@@ -13,6 +13,10 @@
 // requests: they are queued and sent by the loop already running, never recursively.
 //
 // No clock of its own: time comes in through every call, so tests drive it with a fake one.
+//
+// Lifetime: `send` and each request's `done` may refer to the queue's owner; the queue
+// calls neither once it is destroyed (a request still waiting is dropped unanswered).
+// Threads: no lock: every member on its owner's thread (a DeviceSession's bus worker).
 
 #include <chrono>
 #include <cstdint>
