@@ -8,6 +8,9 @@
 // nlohmann's own shortest-round-trip routine, non-finite numbers are null, and a string
 // needing more than plain ASCII (escapes, UTF-8, invalid bytes) is handed to nlohmann.
 // Keys are our own names and are written as given.
+//
+// Lifetime: `out` must outlive the JsonLine, which appends to it until it is destroyed.
+// Threads: one thread at a time, like the string.
 
 #include <cstddef>
 #include <cstdint>

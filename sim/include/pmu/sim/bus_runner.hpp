@@ -9,6 +9,10 @@
 // one-shot timer on it, re-armed before every wait, ends the wait at the models' earliest
 // next_deadline(), and no wait is longer than 50 ms (start()) or run_once's max_wait.
 //
+// Lifetime: `clock` must outlive the runner, which keeps a reference (main.cpp's SystemClock
+// outlives every BusRuntime). The runner owns its bus and its models, whose FrameSink refers
+// back to it; the destructor stops the thread first.
+//
 // Thread safety: start() turns in its own thread; with_model(), with_battery() and
 // with_mppt() run harness code (faults, plant changes) under the same lock, so a test can
 // change a running simulator. A change of a model's deadline made while the loop waits is

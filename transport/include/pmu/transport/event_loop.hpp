@@ -15,6 +15,10 @@
 //   until stop().
 //
 // Assumptions
+//   * The Clock passed in must outlive the loop, which keeps a reference. What a callback
+//     refers to must outlive its registration: until unwatch() or remove_timer() returns,
+//     or until the loop is destroyed. Work posted but not yet run when the loop is
+//     destroyed is destroyed with it, never run.
 //   * One thread runs the loop ("the loop thread"). post(), wake() and stop() may be
 //     called from any thread; everything else only on the loop thread, or before the loop
 //     thread starts. The loop is not re-entrant: callbacks must not call run_once()/run()

@@ -12,7 +12,10 @@
 //     an EventLoop inside the bus (event_loop.hpp) watching the socket, so its number
 //     survives a reopen. Events raised outside drain() wake that loop; drain() runs a turn
 //     of it only then, and reads the socket on every call without asking epoll first.
-//   * The Clock and SocketOps passed in outlive the bus.
+//   * The Clock and SocketOps passed in outlive the bus: it keeps references to both
+//     (main.cpp's SystemClock outlives every bus; system_socket_ops() lives for the program).
+//   * One thread at a time (can_bus.hpp): in pmu-service, the bus worker's; the nested loop
+//     runs inside drain(), send() and maintain() on that thread and has none of its own.
 //
 // Error handling (run time; construction throws std::system_error, see can_bus.hpp)
 //   * ENETDOWN (link set down): keep the socket, state DOWN. Back to UP when a frame

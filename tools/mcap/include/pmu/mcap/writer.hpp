@@ -13,6 +13,8 @@
 // and return false; error() is the errno. close() on a failed writer still tries to end the
 // data with a DataEnd and an empty Footer, so readers that need a footer accept the file.
 //
+// Lifetime: `sink` must outlive the writer, which keeps a reference (McapRecording declares
+// the OutputFile whose sink() it is before the writer, so it is destroyed after it).
 // Not thread-safe: the caller serialises calls.
 
 #include <cstdint>
