@@ -14,8 +14,8 @@
 //     of it only then, and reads the socket on every call without asking epoll first.
 //   * The Clock and SocketOps passed in outlive the bus: it keeps references to both
 //     (main.cpp's SystemClock outlives every bus; system_socket_ops() lives for the program).
-//   * One thread at a time (can_bus.hpp): in pmu-service, the bus worker's; the nested loop
-//     runs inside drain(), send() and maintain() on that thread and has none of its own.
+//   * One thread at a time (can_bus.hpp): in pmu-service, the bus worker's. The nested loop
+//     has no thread of its own: drain() turns it on the caller's thread.
 //
 // Error handling (run time; construction throws std::system_error, see can_bus.hpp)
 //   * ENETDOWN (link set down): keep the socket, state DOWN. Back to UP when a frame
