@@ -16,7 +16,8 @@
 
 namespace pmu::sim {
 
-// The model never reads a clock: every call is given `now` (docs/design.md: the clock is injected).
+// The model never reads a clock: every call is given `now` (docs/design.md: the clock is
+// injected).
 using Clock = std::chrono::steady_clock;
 using TimePoint = Clock::time_point;
 using Duration = Clock::duration;
