@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # The ground link's budget: bytes per second one PMU's telemetry costs a ground subscriber,
-# at full rate and on the low-rate topics (docs/interface.md 5.2), measured on the wire.
+# at full rate and on the low-rate topics (docs/interface.md 1.5), measured on the wire.
 #
 #   bench/ground_link.sh [--build-dir DIR] [--seconds S] [--period P] [--check] [--json FILE]
 #

@@ -3,7 +3,7 @@
 
 What a user would write without pmu-dds: python-can's candump -L log reader plus `struct`
 decoding of the Millswood 250W PMU packets (protocol v1.9), printing one JSON line per
-frame with the field names of `pmuctl decode --json` (/work/shared/interface.md).
+frame with the field names of `pmuctl decode --json` (docs/interface.md 3.2).
 
   python_can_decode.py LOG                        decode LOG to stdout
   python_can_decode.py --check PMUCTL_OUT LOG [--lines N]
@@ -48,7 +48,7 @@ CURRENT_FW = (1, 17)  # firmware assumed until a device's 0x31 reply is seen
 
 
 def temperature(raw):
-    return None if raw == NO_SENSOR else float(raw)  # every temperature (interface.md 1)
+    return None if raw == NO_SENSOR else float(raw)  # every temperature (interface.md 1.1)
 
 
 def decode_values(packet, data, fw):

@@ -14,7 +14,7 @@
 #   --vehicles LIST
 #                   confine pmu-service, ground-station and mission-computer to these
 #                   vehicles: LIST is comma separated vehicle names (config `vehicle`,
-#                   docs/interface.md 5: 0..15 letters, digits, '_', '-', '.'); an empty
+#                   docs/interface.md 7.1: 0..15 letters, digits, '_', '-', '.'); an empty
 #                   name (--vehicles '', --vehicles ,uav1) is the unnamed vehicle, i.e. the
 #                   default partition. Default: every vehicle (partition pattern "*")
 #   --ground-station NAME=LIST

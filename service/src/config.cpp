@@ -343,7 +343,7 @@ void parse_security(const Ctx& c, const YAML::Node& key, const YAML::Node& n, Se
   if (const auto v = n["warn_days"]) sec.warn_days = static_cast<int>(c.integer(v, "warn_days", 0, 3650));
 }
 
-// discovery: and interfaces: (interface.md 2.1). Each entry is read by dds::parse_address or
+// discovery: and interfaces: (interface.md 7.2). Each entry is read by dds::parse_address or
 // dds::parse_interface, which pmuctl uses too, so both say the same about the same text.
 // Names are only checked for form here; they are looked up at start (dds::resolve_network).
 std::vector<dds::Address> parse_address_list(const Ctx& c, const YAML::Node& n, const std::string& key,

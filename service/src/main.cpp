@@ -1,5 +1,5 @@
 // pmu-service: owns the CAN buses, speaks the PMU protocol, publishes on DDS
-// (interface.md section 2). Start-up errors (config, bus, DDS) end the process with a
+// (interface.md section 3.1). Start-up errors (config, bus, DDS) end the process with a
 // message and a non-zero status before anything is sent on a bus; after start-up nothing
 // throws, and SIGTERM stops it cleanly within a second.
 

@@ -1,7 +1,7 @@
-// `pmuctl decode` run as a user runs it (interface.md section 2), on the logs in tests/data:
+// `pmuctl decode` run as a user runs it (interface.md section 3.2), on the logs in tests/data:
 // every packet of the spec decodes to the contract's names and values; one output line per
 // input line; bad lines are reported by number and decoding goes on. `decode --mcap` onto
-// each kind of path (interface.md section 6, "Where the file goes") leaves everything it did
+// each kind of path (interface.md section 9.1, "Where the file goes") leaves everything it did
 // not create in place.
 #include <fcntl.h>
 #include <gtest/gtest.h>

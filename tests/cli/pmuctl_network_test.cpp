@@ -1,5 +1,5 @@
 // pmuctl's discovery and interface options and their environment variables (interface.md
-// section 2.1): every bad value is refused before any DDS participant exists, with exit
+// section 7.2): every bad value is refused before any DDS participant exists, with exit
 // status 2 and a message naming the option or the variable. (That options win over the
 // variables needs a participant: tests/integration/discovery_test.cpp, since Fast DDS 2.9.1
 // trips AddressSanitizer, under which this label runs too.)

@@ -1,5 +1,5 @@
 // pmuctl's tables read from a running pmu-service on its built-in simulated PMU: mask names
-// both ways, units, and health and age on every watch row (interface.md section 2).
+// both ways, units, and health and age on every watch row (interface.md section 3.2).
 #include <gtest/gtest.h>
 
 #include <chrono>

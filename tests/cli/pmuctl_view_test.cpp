@@ -73,7 +73,7 @@ pmu::Mppt mppt() {
   s.voltage_output_raw(1234), s.current_output_raw(-17), s.mppt_state(3), s.safety_enabled(true);
   s.temperature(41), s.duty_cycle_panel_1(45), s.channel_1_active(1);
   // voltage_output_raw, current_output_raw, mppt_state, safety_enabled, temperature,
-  // duty_cycle_panel_1, channel_1_active (interface.md 3.1's bit order)
+  // duty_cycle_panel_1, channel_1_active (interface.md 1.4's bit order)
   s.received((1u << 0) | (1u << 1) | (1u << 3) | (1u << 4) | (1u << 6) | (1u << 9) | (1u << 10));
   return s;
 }
@@ -95,7 +95,7 @@ struct UnitRow {
   const char* text;  // text_with_unit: value and unit as a table shows them
 };
 
-// Units: protocol v1.9 tables 2..6 and 8..18, the battery/MPPT document, interface.md 1 and 3.1.
+// Units: protocol v1.9 tables 2..6 and 8..18, the battery/MPPT document, interface.md 1.1 and 1.4.
 TEST(PmuctlView, EveryTableValueHasItsUnit) {
   const std::vector<UnitRow> rows = {
       {"table 2", fields_of(voltages()), "avionics", "12.3 V"},
@@ -344,7 +344,7 @@ TEST(PmuctlView, BatteryCellsAreOneShortRow) {
   EXPECT_EQ(fields_of(pmu::BatteryCells{})[0].text, "none received");
 }
 
-// The JSON keys are the contract's field names, in its order (interface.md sections 1, 3.1).
+// The JSON keys are the contract's field names, in its order (interface.md sections 1.3, 1.4).
 TEST(PmuctlView, JsonKeysAreTheContractsNames) {
   auto keys = [](const SampleFields& f) {
     const Json j = json_of(f);

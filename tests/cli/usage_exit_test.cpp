@@ -1,5 +1,5 @@
 // Bad usage of each program (an unknown option, a value out of range, a missing argument)
-// exits with status 2 and says what is wrong, as the man pages and interface.md 2.1 say; the
+// exits with status 2 and says what is wrong, as the man pages and interface.md 3.2 say; the
 // help exits 0. CLI11 alone would exit with its own codes (105 for a value out of range).
 #include <gtest/gtest.h>
 

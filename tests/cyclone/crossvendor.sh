@@ -61,7 +61,7 @@ kill "$service_pid" 2>/dev/null || true
 wait "$service_pid" 2>/dev/null || true
 service_pid=
 
-# Batteries and MPPTs (interface.md 3.1), through pmu-service's SocketCAN code on an fd bus.
+# Batteries and MPPTs (interface.md 1.4), through pmu-service's SocketCAN code on an fd bus.
 cat >"$work/canopen.yaml" <<'YAML'
 buses:
   - interface: can9

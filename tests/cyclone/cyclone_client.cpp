@@ -9,7 +9,7 @@
 // figures (tests/cyclone/measure_repair.sh reads them). Exit status: 0 nothing missed,
 // 1 something missed, 2 bad usage or no DDS.
 //
-// With --canopen-bus NAME it checks the batteries and MPPTs instead (interface.md 3.1):
+// With --canopen-bus NAME it checks the batteries and MPPTs instead (interface.md 1.4):
 // pmu/battery, pmu/battery_cells and pmu/mppt deliver the values tests/cyclone/canopen_feeder.py
 // puts on that bus (NaN and the `received` bits for what it never sends), and pmu/health
 // has the battery and the MPPT as instances of their own kind.

@@ -1,4 +1,4 @@
-// A CAN address change over real Fast DDS (docs/interface.md section 8): in one process, the
+// A CAN address change over real Fast DDS (docs/interface.md section 2.6): in one process, the
 // old key's health ends OFFLINE and its instance is disposed, and a late joiner sees the new
 // key alone; across processes, pmuctl on pmu-service's simulated bus moves the unit there and
 // back, every verb agrees, commands without --address find the one PMU, and

@@ -1,4 +1,4 @@
-// Batteries and MPPTs end to end over real Fast DDS (interface.md 3.1): the service's bus
+// Batteries and MPPTs end to end over real Fast DDS (interface.md 1.4): the service's bus
 // worker and publisher with a fake clock, frames built from the document's tables injected
 // on the in-process bus by a node of the test's own, and readers written against the
 // contract's types and QoS profiles (canopen_pmuctl_test.cpp: pmuctl reading the same).

@@ -1,5 +1,5 @@
 // pmuctl, a separate process, reading batteries and MPPTs that the service (in this process,
-// fake clock, frames from the document's tables: canopen_bus.hpp) publishes (interface.md 3.1).
+// fake clock, frames from the document's tables: canopen_bus.hpp) publishes (interface.md 1.4).
 #include <gtest/gtest.h>
 
 #include <map>

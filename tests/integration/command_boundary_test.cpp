@@ -418,7 +418,7 @@ TEST_F(Boundary, ALookAlikeTypeOrGarbageIsDroppedNeverFatal) {
 // Half-way through, peer 0 sends ENGINE_STOP: it goes ahead of the device's queue, so its
 // reply comes before the burst's last one. KEEP_LAST is no promise under load (a reply a slow
 // reader has not acknowledged when 4,096 newer ones are written is gone), so a client does
-// what the contract allows (interface.md 4.2): it resends, with the same id, a request that
+// what the contract allows (interface.md 2.4): it resends, with the same id, a request that
 // got no reply, and the service answers it again without executing it twice. Every id must
 // be answered, and the audit trail must show each executed exactly once.
 void burst(Service& service, std::vector<Peer*> peers, int per_peer) {

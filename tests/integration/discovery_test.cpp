@@ -1,4 +1,4 @@
-// Discovery and interfaces over real Fast DDS (interface.md section 2.1): unicast peers with
+// Discovery and interfaces over real Fast DDS (interface.md section 7.2): unicast peers with
 // multicast off, Fast DDS's Discovery Server (the `fastdds discovery` program, started here),
 // the interface allowlist, and pmu-service + pmuctl with those settings.
 //

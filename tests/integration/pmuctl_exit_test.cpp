@@ -1,4 +1,4 @@
-// pmuctl's exit statuses, verb by verb, as pmuctl(1) and interface.md section 2 give them:
+// pmuctl's exit statuses, verb by verb, as pmuctl(1) and interface.md section 3.2 give them:
 // 0 done, 1 answered but not done, 2 bad usage or no such target, 3 nothing answered; and
 // with --json exactly one JSON line per result, failures included. On the demo power system
 // (deploy/examples/sim-power-system.yaml: a PMU, a battery and two MPPTs on one bus), PMU

@@ -1,4 +1,4 @@
-// What eProsima's dynamic-type tools see of pmu-service (docs/interface.md 4.4, 4.5), with
+// What eProsima's dynamic-type tools see of pmu-service (docs/interface.md 9.4, 9.3), with
 // pmu-service as a separate process on its built-in simulated bus:
 //
 // - TypeObject: a participant with no generated code at all (this program links Fast DDS and
@@ -195,7 +195,7 @@ std::set<std::string> service_writer_topics(ToolParticipant& tool, const std::ve
   return found;
 }
 
-// The contract's fields of pmu::Voltages in order (interface.md 1): keys first.
+// The contract's fields of pmu::Voltages in order (interface.md 1.3): keys first.
 const std::vector<std::string> kVoltagesFields = {"vehicle",  "bus",       "address",   "avionics", "output_28v",
                                                   "payload",  "servo",     "battery_a", "battery_b", "generator"};
 

@@ -1,4 +1,4 @@
-// Several vehicles on one DDS domain (docs/interface.md section 5): three in-process services
+// Several vehicles on one DDS domain (docs/interface.md section 7.1): three in-process services
 // (the unnamed vehicle, uav1, uav2), each with a simulated PMU under the same keys sim0/1, and
 // ground stations that read every vehicle or address one.
 #include <gtest/gtest.h>

@@ -4,7 +4,7 @@
 // the replies by request id, the way a ground-station bridge would over a lossy radio link:
 //   - at most `window` requests in flight (pipelined), each with a unique id `<tag>-<n>`;
 //   - a request without a final reply `resend` s after it was last sent is written again
-//     with the SAME id and content (interface.md 4.2: answered again, never executed twice);
+//     with the SAME id and content (interface.md 2.4: answered again, never executed twice);
 //   - a request without a final reply `timeout` s after its first send is given up: a
 //     TIMEOUT at the client;
 //   - the batch stops at `deadline` s; what is still open then is listed as unanswered.
@@ -229,7 +229,7 @@ void Ground::on_reply(const pmu::CommandReply& r) {
       wake_.notify_all();
       return;
     case Request::State::Answered:
-      // The service answers every resend again (interface.md 4.2): expected, and counted.
+      // The service answers every resend again (interface.md 2.4): expected, and counted.
       ++duplicates_[q.tag];
       emit({{"event", "duplicate_reply"}, {"id", id}, {"result", result_name(r.result())}, {"t", boottime()}});
       return;

@@ -2,7 +2,7 @@
 # pmuctl record against pmu-service on the simulated power system: stopped by SIGINT the
 # file has a summary and @mcap/core reads it; killed with SIGKILL the stream reader still
 # reads its complete chunks; an unwritable path and a full disk are refused with what and
-# where; onto each kind of path (interface.md section 6, "Where the file goes") nothing
+# where; onto each kind of path (interface.md section 9.1, "Where the file goes") nothing
 # record did not create is removed, renamed over or truncated; `record -` pipes the file
 # into a reader.
 #   record_test.sh PMU-SERVICE PMUCTL SOURCE-DIR

@@ -25,7 +25,7 @@ const [url, mode, ...rest] = process.argv.slice(2);
 const problems = [];
 const problem = (p) => problems.push(p);
 
-// The topics `pmuctl record` records by default (docs/interface.md section 6), and so serve.
+// The topics `pmuctl record` records by default (docs/interface.md section 9.1), and so serve.
 const defaultTopics = {
   "pmu/voltages": "pmu::Voltages",
   "pmu/currents": "pmu::Currents",

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# pmuctl serve (docs/interface.md section 7) against pmu-service on the simulated bus.
+# pmuctl serve (docs/interface.md section 9.2) against pmu-service on the simulated bus.
 #   serve_test.sh PMU-SERVICE PMUCTL SOURCE-DIR foxglove|slow|cli
 # foxglove: Foxglove's own client (serve_client.mjs check) reads serverInfo, the channels and
 #           their schemas, and pmu/voltages, pmu/health, pmu/battery equal to `pmuctl watch

@@ -303,7 +303,7 @@ TEST(Permissions, EveryIdentityMayCreateExactlyTheWritersAndReadersTheContractAl
 // The governance document says what the issue asks.
 // ---- the right identities work ------------------------------------------------------------
 
-// Config dds_statistics under DDS-Security (interface.md 4.5): make_pki.sh grants no identity
+// Config dds_statistics under DDS-Security (interface.md 6): make_pki.sh grants no identity
 // the statistics topics, and Fast DDS would only log the refused writers, so the participant
 // is not created at all and the message says what the permissions lack.
 TEST(Permissions, StatisticsTopicsThePermissionsDoNotGrantAreRefusedAtStartUp) {
@@ -624,7 +624,7 @@ TEST(ServiceProgram, SecurePmuServiceWithPmuctlAndTheExampleClient) {
   EXPECT_EQ(r.status, 2) << "the example as mission-computer may not command: " << r.out;
 }
 
-// Unicast discovery (interface.md section 2.1) keeps DDS-Security: a secure pmuctl with
+// Unicast discovery (interface.md section 7.2) keeps DDS-Security: a secure pmuctl with
 // --peer gets telemetry, an unauthenticated one gets none. Discovery Server mode is refused
 // with security by both programs: Fast DDS 2.9.1 cannot serve secure participants through a
 // server (tried: they find nothing, and abort in SecurityManager::encode_rtps_message when
@@ -655,7 +655,7 @@ TEST(ServiceProgram, UnicastDiscoveryKeepsSecurityAndServerModeIsRefusedWithIt) 
       << r.out;
 }
 
-// ---- vehicles: permissions confine an identity to some vehicles (docs/interface.md 5) -------
+// ---- vehicles: permissions confine an identity to some vehicles (docs/interface.md 7.1) -------
 
 pmu::test::RunResult pmuctl(const std::string& pki, const std::string& args) {
   return sh(std::string(PMUCTL_PATH) + " --domain " + std::to_string(test_domain()) + " --security-dir " + pki + " " +

@@ -119,7 +119,7 @@ inline std::string write_config(const std::string& name, const SecurityFiles& f,
   return path;
 }
 
-// The contract's topics (interface.md sections 1, 3.1 and 5.2).
+// The contract's topics (interface.md sections 1.2, 1.4 and 1.5).
 inline const std::set<std::string> kTelemetryAndState = {
     "pmu/voltages",          "pmu/currents",          "pmu/battery_energy",          "pmu/temperatures",
     "pmu/status",            "pmu/low_rate/voltages", "pmu/low_rate/currents",       "pmu/low_rate/battery_energy",

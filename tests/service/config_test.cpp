@@ -201,7 +201,7 @@ TEST(Config, EveryBadValueIsRefusedWithItsLine) {
   for (const auto& c : kBad) expect_refused(c.yaml, c.message);
 }
 
-// discovery: and interfaces: (interface.md 2.1). Each case is appended to a valid bus
+// discovery: and interfaces: (interface.md 7.2). Each case is appended to a valid bus
 // section of three lines, so the first line of a case is line 4.
 const char* const kBus = "buses:\n  - interface: can0\n    discover: true\n";
 
@@ -573,7 +573,7 @@ TEST(Config, RepeatedKeysAndSecondDocumentsAreRefusedAtTheirLine) {
   EXPECT_EQ(parse_config("---\ndomain: 3\nbuses:\n  - interface: can0\n    discover: true\n", "a.yaml").domain, 3);
 }
 
-// Integers are plain decimal (interface.md 2): YAML 1.1 reads 010 as 8 and 0x10 as 16, so a
+// Integers are plain decimal (interface.md 4.1): YAML 1.1 reads 010 as 8 and 0x10 as 16, so a
 // PMU written 010 was PMU 8. Each form is refused at its line, naming the key.
 TEST(Config, IntegersAreDecimalOnly) {
   const std::string rule =
@@ -640,7 +640,7 @@ TEST(Config, QosFileIsRelativeToTheConfigFolder) {
   expect_refused(bus + "qos_file: ''\n", "bad.yaml:4: qos_file must be a path to a file, not empty");
 }
 
-// dds_type_objects (interface.md 4.4): off unless true.
+// dds_type_objects (interface.md 9.4): off unless true.
 TEST(ConfigTypeObjects, OffUnlessTrueAndRefusedAtItsLineWhenNotABoolean) {
   EXPECT_FALSE(parse_config(kBus, "s.yaml").dds_type_objects);
   EXPECT_TRUE(parse_config(std::string("dds_type_objects: true\n") + kBus, "s.yaml").dds_type_objects);
@@ -652,7 +652,7 @@ TEST(ConfigTypeObjects, OffUnlessTrueAndRefusedAtItsLineWhenNotABoolean) {
   for (const auto& c : bad) expect_refused(c.yaml + std::string(kBus), c.message);
 }
 
-// dds_statistics (interface.md 4.5): Fast DDS's statistics topic names, or all; Fast DDS
+// dds_statistics (interface.md 9.3): Fast DDS's statistics topic names, or all; Fast DDS
 // itself would only log a wrong name, so the config refuses it at its line.
 TEST(ConfigStatistics, OffUnlessNamedAllOrAList) {
   EXPECT_TRUE(parse_config(kBus, "s.yaml").dds_statistics.empty());

@@ -178,7 +178,7 @@ TEST(ParticipantQos, SecurityPluginsWithMulticastUnicastAndAnAllowlist) {
   }
 }
 
-// Config dds_statistics (interface.md 4.5): the property Fast DDS reads when it enables the
+// Config dds_statistics (interface.md 9.3): the property Fast DDS reads when it enables the
 // participant, and nothing without it.
 TEST(ParticipantQos, StatisticsTopicsBecomeTheFastddsStatisticsProperty) {
   const auto value = [](const DomainParticipantQos& q) -> std::optional<std::string> {

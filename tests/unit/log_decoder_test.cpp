@@ -1,4 +1,4 @@
-// `pmuctl decode` line handling (interface.md section 2): one line in, one line out, the
+// `pmuctl decode` line handling (interface.md section 3.2): one line in, one line out, the
 // contract's JSON keys, errors with line numbers, firmware learned from 0x31 replies.
 #include <gtest/gtest.h>
 

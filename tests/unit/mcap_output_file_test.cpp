@@ -1,5 +1,5 @@
 // pmu::mcap::OutputFile (tools/mcap/include/pmu/mcap/output_file.hpp), for each kind of path
-// docs/interface.md section 6 names: what is written where, and that nothing the output did
+// docs/interface.md section 9.1 names: what is written where, and that nothing the output did
 // not create is removed, renamed over or truncated, whether it commits, discards or is
 // dropped. Device nodes are made with mknod(2) in a temporary folder (root only: those rows
 // are skipped otherwise, with the reason).
@@ -121,7 +121,7 @@ struct Case {
 const std::string kOld = "the operator's own bytes";
 const std::string kNew = "\x89MCAP0\r\n and the rest";
 
-// docs/interface.md section 6, "Where the file goes": one row per kind of path.
+// docs/interface.md section 9.1, "Where the file goes": one row per kind of path.
 const Case kCases[] = {
     {"missing file", false, [](const std::string&, FifoReader&) {}, "out", Then::Replaced, "out", ""},
     {"regular file", false, [](const std::string& d, FifoReader&) { write_file(d + "/out", kOld); }, "out",

@@ -189,7 +189,7 @@ TEST(BatteryEnergy, SignedBigEndianExtremes) {
 // ---- table 5: temperatures ---------------------------------------------------------------
 // Table 5, one row per temperature: its byte, and the firmware from which it is reported
 // (the external sensors from 1.12, v1.9 6.1). -128 on any of them is "no sensor", NaN
-// (interface.md 1); the spec says so of the external sensors, and the internal and starter
+// (interface.md 1.1); the spec says so of the external sensors, and the internal and starter
 // sensors cannot read -128 degC either.
 struct TemperatureRow {
   const char* field;

@@ -1,5 +1,5 @@
 // pmu-sim IFACE [--address N] [--firmware X.Y] [--serial N] [--battery NODE] [--mppt DEVICE]:
-// a simulated Millswood 250W PMU on a SocketCAN interface (interface.md section 2), a bench
+// a simulated Millswood 250W PMU on a SocketCAN interface (interface.md section 3.3), a bench
 // stand-in for the real unit, optionally with the solar-boat battery (MG BMS) and MPPTs
 // beside it. Repeat --address, --battery, --mppt for several devices. Stops on SIGTERM/SIGINT.
 

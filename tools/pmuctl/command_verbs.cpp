@@ -212,7 +212,7 @@ int run_command(const GlobalOptions& o, const CommandSpec& spec) {
   if (!writer.write(&c))  // bool in Fast DDS 2.x
     return fail(o, ExitStatus::NotDone, "the command could not be written to DDS");
 
-  // A request that met no reply is sent again with the same id (interface.md 4.2: answered
+  // A request that met no reply is sent again with the same id (interface.md 2.4: answered
   // again, never executed twice): a reader that matched a moment too late, or a service that
   // had not yet seen this writer in discovery (section 5), answers the resend.
   constexpr auto kResendAfter = std::chrono::seconds(1);

@@ -1,5 +1,5 @@
 #pragma once
-// pmuctl's command verbs (interface.md section 2): one pmu::Command, exactly one final
+// pmuctl's command verbs (interface.md section 3.2): one pmu::Command, exactly one final
 // pmu::CommandReply. Exit status 0 only for COMPLETED (exit_status.hpp); the result and
 // reason go to stderr.
 

@@ -21,7 +21,7 @@ Json values_of(const pmu::Status& s);
 Json values_of(const pmu::Config& s);
 Json values_of(const pmu::DeviceInfo& s);
 Json values_of(const pmu::Health& s);
-// Batteries and MPPTs (interface.md 3.1): a value not received is null, for integer and
+// Batteries and MPPTs (interface.md 1.4): a value not received is null, for integer and
 // boolean fields too (their `received` bit), so no consumer mistakes "not yet" for 0.
 // Sentinels are null too (sample_fields.hpp).
 Json values_of(const pmu::Battery& s);

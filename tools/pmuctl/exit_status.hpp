@@ -1,5 +1,5 @@
 #pragma once
-// pmuctl's exit statuses, one table for every verb (pmuctl(1), interface.md section 2), and
+// pmuctl's exit statuses, one table for every verb (pmuctl(1), interface.md section 3.2), and
 // the one way a verb ends in failure: the message on stderr and, with --json, exactly one
 // JSON line on stdout, so that a script reading lines always gets one per result.
 //

@@ -1,4 +1,4 @@
-// pmuctl: the operator's command line (interface.md section 2): the DDS verbs that read
+// pmuctl: the operator's command line (interface.md section 3.2): the DDS verbs that read
 // what pmu-service publishes, and the offline decoder for candump logs.
 
 #include <sys/types.h>

@@ -1,5 +1,5 @@
 #pragma once
-// pmuctl's discovery and interface options (interface.md section 2.1): --peer,
+// pmuctl's discovery and interface options (interface.md section 7.2): --peer,
 // --discovery-server, --interface, or the environment variables PMU_DDS_PEERS,
 // PMU_DISCOVERY_SERVER and PMU_DDS_INTERFACES (comma separated) when the options are absent.
 // Entries are read by the same functions as pmu-service's config (dds_network.hpp), so the

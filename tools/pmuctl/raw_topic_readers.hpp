@@ -1,7 +1,7 @@
 #pragma once
 // Readers of contract topics that hand on each sample's serialized bytes unread, with its DDS
 // source timestamp: what `pmuctl record` writes into MCAP files and `pmuctl serve` forwards
-// to Foxglove clients (docs/interface.md sections 6 and 7). The same topics, types and QoS
+// to Foxglove clients (docs/interface.md sections 9.1 and 9.2). The same topics, types and QoS
 // profiles for both, so a live view and a recording show the same channels.
 //
 // The sink runs on Fast DDS's listener threads: it must not block (record takes a mutex held

@@ -1,6 +1,6 @@
 #pragma once
 // The values of each DDS sample as pmuctl shows them: one list per sample, in the contract's
-// order and with its names (interface.md sections 1 and 3.1), each value with its JSON form
+// order and with its names (interface.md sections 1.3 and 1.4), each value with its JSON form
 // and its table text. The JSON printer and every table read this one list, so a unit, a mask
 // name or a sentinel word is decided once. Units come from the codec's tables (telemetry.hpp,
 // parameters.hpp, the decode formatter frame_fields.hpp) and, for batteries and MPPTs, from
@@ -56,7 +56,7 @@ std::string text_with_unit(const SampleField& f, bool compact = false);
 // The shortest decimal that reads back as the same float: 12.3f -> "12.3".
 std::string shortest(float v);
 
-// Sentinel words (interface.md section 2).
+// Sentinel words (interface.md section 3.2).
 inline constexpr const char* kNoSensor = "no sensor";
 inline constexpr const char* kNoReading = "no reading";
 inline constexpr const char* kNotDischarging = "n/a (not discharging)";

@@ -1,5 +1,5 @@
 #pragma once
-// pmuctl's human tables as pure functions of the values shown (interface.md section 2), so
+// pmuctl's human tables as pure functions of the values shown (interface.md section 3.2), so
 // each layout is tested without DDS: watch's one row per device and topic, the aligned
 // columns of `list`, and the name/value blocks of info, health and config get.
 

@@ -30,7 +30,7 @@ constexpr std::uint8_t wire_size(WireType t) noexcept {
 }
 
 // "No sensor" on the wire (table 5): said of the external sensors, and taken to mean the
-// same for every temperature (interface.md 1), since a reading of -128 degC on the internal
+// same for every temperature (interface.md 1.1), since a reading of -128 degC on the internal
 // or starter sensor is no reading either.
 inline constexpr std::int8_t kNoSensorRaw = -128;
 

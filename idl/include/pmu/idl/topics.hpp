@@ -1,5 +1,5 @@
 #pragma once
-// Topic and QoS profile names of interface.md section 1, in one place for the service,
+// Topic and QoS profile names of interface.md sections 1.2 and 5.1, in one place for the service,
 // pmuctl and the tests.
 
 namespace pmu::topics {
@@ -13,13 +13,13 @@ inline constexpr const char* kConfig = "pmu/config";
 inline constexpr const char* kInfo = "pmu/info";
 inline constexpr const char* kHealth = "pmu/health";
 // The same telemetry at most once per configured period (config low_rate_period), for
-// subscribers on slow links: docs/interface.md 5.2.
+// subscribers on slow links: docs/interface.md 1.5.
 inline constexpr const char* kLowRateVoltages = "pmu/low_rate/voltages";
 inline constexpr const char* kLowRateCurrents = "pmu/low_rate/currents";
 inline constexpr const char* kLowRateBatteryEnergy = "pmu/low_rate/battery_energy";
 inline constexpr const char* kLowRateTemperatures = "pmu/low_rate/temperatures";
 inline constexpr const char* kLowRateStatus = "pmu/low_rate/status";
-// Batteries and MPPTs on the PMUs' buses (CANopen frames): docs/interface.md 3.1.
+// Batteries and MPPTs on the PMUs' buses (CANopen frames): docs/interface.md 1.4.
 inline constexpr const char* kBattery = "pmu/battery";
 inline constexpr const char* kBatteryCells = "pmu/battery_cells";
 inline constexpr const char* kMppt = "pmu/mppt";

@@ -3,7 +3,7 @@
 // each carry one value (spec/solar-boat-canopen-battery-mppt.txt, codec/canopen.hpp).
 //
 // Each device's values sit in a fixed table of slots in the contract's order (the order of
-// the IDL fields, interface.md section 3.1). A slot holds the value in the contract's unit,
+// the IDL fields, interface.md section 1.4). A slot holds the value in the contract's unit,
 // or NaN while it has not been received since the session started or since the device came
 // back after OFFLINE; "not received" is never 0. The DDS side turns NaN of an integer or
 // flag field into the `received` bit mask the contract defines.

@@ -1,7 +1,7 @@
 #pragma once
 // How a participant finds others and which network interfaces DDS may use: the config's
 // `discovery:` and `interfaces:` keys and pmuctl's --peer, --discovery-server and
-// --interface (interface.md section 2.1). No Fast DDS type here, so the configuration can
+// --interface (interface.md section 7.2). No Fast DDS type here, so the configuration can
 // name the choice; dds_participant.hpp turns a ResolvedNetwork into participant QoS.
 //
 // Purpose: one reading of an address or an interface for the config file and pmuctl alike,

@@ -1,5 +1,5 @@
 #pragma once
-// Fast DDS statistics topics (config `dds_statistics`, docs/interface.md 4.5): the topics
+// Fast DDS statistics topics (config `dds_statistics`, docs/interface.md 9.3): the topics
 // eProsima's Fast DDS Monitor reads to show latency, throughput and traffic per endpoint.
 // Debian's Fast DDS 2.9.1 is built with statistics (FASTDDS_STATISTICS); a participant
 // writes a statistics topic when its participant property `fastdds.statistics` names it

@@ -1,7 +1,7 @@
 #pragma once
 // The contract's types as XTypes type objects, so eProsima's dynamic-type tools (Fast DDS
 // Monitor, PlotJuggler's Fast DDS plugin, DDS Record & Replay) can decode topics without our
-// IDL (docs/interface.md 4.4).
+// IDL (docs/interface.md 9.4).
 //
 // register_type_objects(): puts the TypeObject and TypeIdentifier of every type of idl/
 // (fastddsgen -typeobject, idl/CMakeLists.txt) into Fast DDS's process-wide TypeObjectFactory.

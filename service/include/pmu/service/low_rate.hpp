@@ -1,6 +1,6 @@
 #pragma once
 // LowRateGate: which telemetry samples also go to the low-rate topics (pmu/low_rate/*,
-// docs/interface.md 5.2), at most one per device and packet per period.
+// docs/interface.md 1.5), at most one per device and packet per period.
 //
 // A ground station on a slow radio link reads those topics instead of the full-rate ones:
 // its readers match only the low-rate writers, so the full-rate samples never cross the

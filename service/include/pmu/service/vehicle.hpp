@@ -1,5 +1,5 @@
 #pragma once
-// Which vehicle a service belongs to, and how that shows on DDS (docs/interface.md 5.1).
+// Which vehicle a service belongs to, and how that shows on DDS (docs/interface.md 7.1).
 //
 // Every sample carries its vehicle as the first key, so a ground station that reads every
 // vehicle tells them apart, and two aircraft with the same bus names and CAN addresses are

@@ -1,6 +1,6 @@
 #pragma once
 // Where a recording's bytes go, given the path an operator typed, chosen so that nothing the
-// program did not create is removed, renamed over or truncated (docs/interface.md section 6):
+// program did not create is removed, renamed over or truncated (docs/interface.md section 9.1):
 //
 //   path                      written to                          commit()        discard()
 //   missing, regular file     NAME.partial-XXXXXX beside it       renamed to NAME removes it
