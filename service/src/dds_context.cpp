@@ -95,7 +95,7 @@ DdsContext::DdsContext(int domain, const std::string& qos_file, const std::strin
   if (secure_)
     if (const auto topic = statistics_topic_not_granted(security_, statistics))
       throw DdsError("dds_statistics: this identity's permissions do not allow publishing " + *topic +
-                     " in the default partition (DDS-Security; docs/interface.md 4.5 says what to grant)");
+                     " in the default partition (DDS-Security; docs/interface.md section 6 says what to grant)");
   // Transports, discovery, interfaces, security and statistics: dds_participant.hpp says what each sets.
   DomainParticipantQos pqos;
   try {

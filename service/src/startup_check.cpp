@@ -62,7 +62,7 @@ void check_statistics_grants(const Config& cfg, StartupCheck& out) {
   if (const auto topic = dds::statistics_topic_not_granted(cfg.security.files, cfg.dds_statistics))
     out.errors.push_back(cfg.dds_statistics_line + ": dds_statistics: this identity's permissions (" +
                          cfg.security.files.permissions + ") do not allow publishing " + *topic +
-                         " in the default partition (DDS-Security; docs/interface.md 4.5 says what to grant)");
+                         " in the default partition (DDS-Security; docs/interface.md section 6 says what to grant)");
 }
 
 StartupCheck check_startup(const Config& cfg) {

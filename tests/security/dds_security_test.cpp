@@ -315,7 +315,7 @@ TEST(Permissions, StatisticsTopicsThePermissionsDoNotGrantAreRefusedAtStartUp) {
     EXPECT_EQ(std::string(e.what()),
               "dds_statistics: this identity's permissions do not allow publishing "
               "_fastdds_statistics_history2history_latency in the default partition (DDS-Security; "
-              "docs/interface.md 4.5 says what to grant)");
+              "docs/interface.md section 6 says what to grant)");
   }
 }
 
