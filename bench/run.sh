@@ -6,7 +6,7 @@
 #   bench/run.sh [--quick] [--build-dir DIR] [--no-build]
 #     --quick      one short pass of everything (what the test command runs)
 #     --no-build   use the binaries already in the build folder
-# Takes about 11 minutes in full (the zero-loss search runs 30 s per rate tried, the realistic
+# Its time in full is in bench/README.md (the zero-loss search runs 30 s per rate tried, the realistic
 # rate 60 s for the service, the bare writer and the socketpair hop each; the scale
 # rows, 1-100 PMUs and 1-16 subscriber processes, about 3.5 minutes).
 set -euo pipefail

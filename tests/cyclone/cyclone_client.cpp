@@ -397,7 +397,7 @@ int main(int argc, char** argv) {
       for (auto& r : requests) send(r);
     }
     // A volatile Cyclone reader skips for good a reply that its first accepted heartbeat
-    // from the reply writer lists (README, "Capacity and repair times"): a request still
+    // from the reply writer lists (deploy/README.md, "QoS: capacity and repair times"): a request still
     // unanswered is sent again with the same id, which the service answers again and never
     // executes twice (interface.md).
     for (auto& r : requests)

@@ -5,7 +5,7 @@
 # limits on the client, and prints the time from matching to all of pmu/config, pmu/info
 # and pmu/health (median, slowest, runs over 1 s), the first replies lost (with how many a
 # resend of the same request id recovered) and the slowest reply.
-# The README's figures (--qos FILE for another qos.xml, e.g. git show REV:deploy/qos.xml):
+# The figures of deploy/README.md, "QoS: capacity and repair times" (--qos FILE for another qos.xml, e.g. git show REV:deploy/qos.xml):
 #   tests/cyclone/measure_repair.sh --runs 20 --resend-ms 0
 #   tests/cyclone/measure_repair.sh --runs 20 --resend-ms 0 --command-delay-ms 1500
 #   tests/cyclone/measure_repair.sh --runs 20

@@ -2,7 +2,7 @@
 # The demo of scripts/run.sh serves the whole power system: pmu-service on
 # deploy/examples/sim-power-system.yaml publishes the PMU, the battery (its cells too) and
 # both MPPTs with received values, `pmuctl list` shows every device ONLINE with its kind, and
-# the README's bench session runs on it as written.
+# the bench session of tools/README.md runs on it as written.
 #   power_system_demo.sh PMU-SERVICE PMUCTL SOURCE-DIR
 set -uo pipefail
 svc=$1 ctl=$2 src=$3
@@ -55,10 +55,10 @@ for want in '"kind":"pmu"' '"kind":"battery"' '"kind":"mppt"'; do
 done
 [ "$(grep -c '"kind":"mppt"' "$work/list")" -eq 2 ] || fail "pmuctl list: $(grep -c '"kind":"mppt"' "$work/list") MPPT lines, want 2"
 
-# The README's bench session, run as written against this demo: every line it shows after a
+# The bench session of tools/README.md, run as written against this demo: every line it shows after a
 # `$ pmuctl ...` prompt is printed by that command, in that order ("..." stands for lines
 # left out).
-python3 - "$src/README.md" "$ctl" "$domain" <<'PY' || failures=$((failures + 1))
+python3 - "$src/tools/README.md" "$ctl" "$domain" <<'PY' || failures=$((failures + 1))
 import re, subprocess, sys
 readme, ctl, domain = sys.argv[1:4]
 text = open(readme).read()

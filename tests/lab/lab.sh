@@ -267,7 +267,7 @@ scenario_topology() {
 
 # Both consumers receive every topic: mc2 over the LAN, gnd over the impaired ground link;
 # a late joiner in gnd gets the state topics (TRANSIENT_LOCAL) promptly.
-LATE_JOIN_BOUND=20   # s from starting `pmuctl config get` / `info` in gnd to its output (README: measured)
+LATE_JOIN_BOUND=20   # s from starting `pmuctl config get` / `info` in gnd to its output (tests/lab/README.md: measured)
 scenario_consumers() {
   start_service mc1
   t0=$(now)
@@ -387,7 +387,7 @@ scenario_commands() {
     fail "pmu/health frames_sent grew by $((f1 - f0)) during the batch; $BULK_COUNT sets executed once each send $((2 * BULK_COUNT))"
   detail "pmu/health frames_sent $f0 -> $f1: exactly 2 frames (set, read-back) per command"
   # The premise of "never executed twice": resends happened. With 10 % loss each way they are
-  # hundreds (the reliable, in-order streams hold replies behind every repair: README).
+  # hundreds (the reliable, in-order streams hold replies behind every repair: tests/lab/README.md).
   [ "$resends" -gt 0 ] || fail "premise: no request was resent, so nothing tested that a resend is not executed again"
 }
 
