@@ -6,7 +6,7 @@
 #
 # Two network namespaces joined by a veth pair make an aircraft (pmu-service on the simulated
 # bus, one PMU streaming its five packets every P s, default 0.1 s: the realistic rate of
-# issue 17) and a ground station. Phases of S seconds each (default 20), after a warm-up:
+# a flight) and a ground station. Phases of S seconds each (default 20), after a warm-up:
 #   idle   no ground subscriber: what discovery alone costs the link
 #   full   pmuctl watch (pmu/voltages ... pmu/status)
 #   low    pmuctl watch --low-rate (pmu/low_rate/*, the service's low_rate_period: 1 s)

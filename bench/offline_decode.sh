@@ -9,7 +9,7 @@
 # meaningless. Then times both (wall, user+sys; R alternating runs, default 3, the best
 # counts), checks one output line per input line each time, and prints one result row
 # (JSON, for bench/report.py) on stdout; progress on stderr.
-# Target (per-frame cost issue): >= 1,000,000 frames/s on the 1,000,000-frame log; the
+# Target (bench/README.md): >= 1,000,000 frames/s on the 1,000,000-frame log; the
 # python-can reference is there to show the figure is not the machine's alone.
 set -euo pipefail
 frames=1000000

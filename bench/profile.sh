@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # A profile of pmu-service at a saturated bus (7,634 frames/s over SHM), kept with the
-# benchmark so the next person starts from data (per-frame cost issue, item 4):
+# benchmark so the next person starts from data:
 #   sudo bench/profile.sh [--build-dir build/bench] [--out bench/profile] [--seconds 8]
 # Runs `pmu_bench run --latency-only` and, while the service's 7,634 frames/s stream runs,
 # records with perf (DWARF call graphs: Debian's Fast DDS has no frame pointers), counts

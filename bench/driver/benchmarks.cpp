@@ -155,7 +155,7 @@ std::string loss_note(const Stream& st) {
 
 // The service's frame takes the socketpair hop and then a DDS hop; the bare reference has
 // only the DDS hop. So each percentile is held against (bare DDS hop + socketpair hop) at
-// that percentile (per-frame cost issue: p50 <= 1.1x, p99 <= 1.5x, p99.9 <= 3x).
+// that percentile (targets, bench/README.md: p50 <= 1.1x, p99 <= 1.5x, p99.9 <= 3x).
 void latency_rows(Rows& rows, const std::string& what, const std::string& transport, const Stream& svc,
                   const Stream& ref, const Percentiles& hop) {
   const std::string ref_name = "bare Fast DDS writer -> reader + socketpair hop, " + transport;

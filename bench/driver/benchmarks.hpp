@@ -1,5 +1,5 @@
 #pragma once
-// The service benchmarks of issue 6, each beside its bare-Fast-DDS reference from the same
+// The service benchmarks, each beside its bare-Fast-DDS reference from the same
 // run. Each prints result rows (JSON lines, bench/report.py's format) on stdout and its
 // progress on stderr.
 

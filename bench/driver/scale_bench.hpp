@@ -1,5 +1,5 @@
 #pragma once
-// How the service's cost grows (issue 11): CPU and RSS of pmu-service with 1, 10 and 100
+// How the service's cost grows: CPU and RSS of pmu-service with 1, 10 and 100
 // PMUs streaming every packet at 10 Hz, and with 1, 4 and 16 subscriber processes, each
 // beside a bare Fast DDS writer process publishing the same samples/s of the same types
 // to the same readers, measured in the same run.

@@ -1,4 +1,4 @@
-// 100 PMUs on one pmu-service (issue 11): four built-in simulated buses of 25 units each,
+// 100 PMUs on one pmu-service: four built-in simulated buses of 25 units each,
 // the same addresses 1..25 on every bus, so only the (bus, address) key tells them apart.
 // Every unit must be listed, stream every packet to `pmuctl watch` and take commands; a
 // QoS resource limit that caps instances per reader or writer (Fast DDS's default is 10)

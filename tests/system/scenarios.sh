@@ -212,8 +212,8 @@ scenario_iface_recreate() {
 
 # The service started while its interface does not exist (a CAN controller probed late,
 # another interface named in the config): it starts and stays up, DOWN, without waiting
-# or exiting, and binds by name once the interface appears (issue 14: the unit has no
-# device ordering).
+# or exiting, and binds by name once the interface appears (the unit has no device
+# ordering).
 scenario_iface_absent_at_start() {
   ip link del "$IFACE" || fail "cannot delete $IFACE"
   start_service --bus "socketcan:$IFACE"
