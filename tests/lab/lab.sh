@@ -695,8 +695,46 @@ scenario_limit() {  # seconds a scenario may take in the (slow, emulated) VM
   esac
 }
 
-# A failed cut must not leave the link cut, nor a scenario without multicast the bridge so.
-after_scenario() { set_link_loss "$LINK_LOSS"; multicast_flood on; }
+# A failed cut must not leave the link cut, nor a scenario without multicast the bridge so;
+# and no scenario may inherit the previous one's traffic. netem's queue holds up to 1000
+# packets (its limit), about half a minute of the link at 250 kbit/s, and its delay line
+# another 300 ms of packets: a scenario that ends with a full queue (resends into a cut, a
+# burst of discovery) would hand that backlog to the next one, whose discovery and
+# commands would then wait behind it. `qdisc replace` keeps the queue, so each end's netem
+# is deleted and added again, which drops what it held.
+reset_link() {
+  for _end in "$(port_of gnd)" "eth0 in gnd"; do
+    case $_end in
+      "eth0 in gnd") _tc="on gnd /usr/sbin/tc"; _dev=eth0 ;;
+      *) _tc="tc"; _dev=$_end ;;
+    esac
+    $_tc qdisc del dev "$_dev" root 2>/dev/null
+    # shellcheck disable=SC2046 # netem_line is a word list
+    $_tc $(netem_line "$_dev" "$LINK_LOSS" | sed 's/^qdisc replace/qdisc add/') || return 1
+  done
+}
+# The packets queued at both ends of the ground link ("N N"), from netem's backlog counters.
+link_backlog() {
+  echo "$(tc -s qdisc show dev "$(port_of gnd)" | sed -n 's/.*backlog [^ ]* \([0-9]*\)p.*/\1/p' | head -n1)" \
+    "$(on gnd /usr/sbin/tc -s qdisc show dev eth0 | sed -n 's/.*backlog [^ ]* \([0-9]*\)p.*/\1/p' | head -n1)"
+}
+after_scenario() {
+  multicast_flood on
+  reset_link || echo "[$SCEN] could not reset the ground link's netem"
+}
+# Each scenario says that it starts on an empty link that nobody loads (every process of the
+# previous one has been killed), so a failure names its own cause: both netem queues empty,
+# and at most a few control packets (IGMP leaves of the killed sockets, IPv6 router
+# solicitations: ~100 bytes each) over 1 s, where one DDS participant alone sends more.
+IDLE_BYTES=2000
+before_scenario() {
+  _q=$(link_backlog); _b0=$(link_bytes); sleep 1; _b1=$(link_bytes)
+  _moved=$(echo "$_b0 $_b1" | awk '{ a = $3 - $1; b = $4 - $2; print (a > b ? a : b) }')
+  if [ "$_q" != "0 0" ] || [ "$_moved" -gt "$IDLE_BYTES" ]; then
+    fail "the ground link was not idle at the start: packets queued (toward gnd, toward the aircraft) $_q, up to $_moved bytes sent in 1 s"
+  fi
+  detail "started on an idle ground link (queues empty, $_moved bytes in 1 s)"
+}
 FAIL_LOGS="service*.log ground.out.err *.err ds.log"
 DOMAIN_BASE=40
 

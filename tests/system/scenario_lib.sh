@@ -5,6 +5,8 @@
 # A suite defines before sourcing: ALL_SCENARIOS, WORK, log(), diagnose(); and before running:
 #   scenario_limit NAME    seconds the scenario may take
 #   after_scenario         puts shared state back after each scenario (the bus, the link)
+#   before_scenario        (optional) checks that shared state is as a scenario expects, in the
+#                          scenario's own shell (it may call detail and fail)
 #   FAIL_LOGS              file globs under $WORK/NAME whose tails a failure prints
 #   DOMAIN_BASE            the scenarios' DDS domains are DOMAIN_BASE + their index
 
@@ -36,6 +38,8 @@ wait_until() {
   done
   return 0
 }
+
+before_scenario() { :; }   # a suite that needs it defines its own after sourcing this file
 
 track() { echo "$1" >>"$WORK/pids"; }
 alive() { [ -d "/proc/$1" ] && ! grep -q '^State:.*Z' "/proc/$1/status" 2>/dev/null; }
@@ -107,6 +111,7 @@ run_scenario() {
   SCEN=$1
   : "${DOMAIN:=$DOMAIN_BASE}"
   rm -f "$WORK/pids"
+  before_scenario
   "scenario_$SCEN"
   exit 0
 }
