@@ -24,7 +24,10 @@ jobs=$(nproc)
 
 "$root/scripts/setup.sh" test
 
-step() { printf '\n=== %s ===\n' "$*"; }
+# Each step's heading says how long the command has run so far, so a slow step shows in the
+# log (tests/README.md gives the measured times).
+started=$(date +%s)
+step() { printf '\n=== %s (at %d s) ===\n' "$*" "$(($(date +%s) - started))"; }
 
 step "release build"
 # Each build's flags are its preset in CMakePresets.json (folder build/<preset>).
@@ -80,3 +83,5 @@ env "${no_debug[@]}" DEB_BUILD_OPTIONS=noautodbgsym "$root/scripts/package.sh" -
 
 step "release tests"
 ctest --preset release -j"$jobs"
+
+step "done"
