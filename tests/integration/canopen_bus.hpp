@@ -1,48 +1,17 @@
 #pragma once
-// What the battery and MPPT tests over DDS share: a bus with a PMU, a battery and an MPPT
-// (fake clock, run in a thread of its own) and a node that repeats frames built from
-// spec/solar-boat-canopen-battery-mppt.txt's tables.
-#include <atomic>
+// What the battery and MPPT tests over DDS share: a bus with a PMU, a battery and an MPPT,
+// and frames built from spec/solar-boat-canopen-battery-mppt.txt's tables for a node that
+// repeats them (BusThread, bus_thread.hpp).
 #include <chrono>
-#include <thread>
 #include <vector>
 
 #include "../service/canopen_frames.hpp"
 #include "../service/harness.hpp"
+#include "bus_thread.hpp"
 
 namespace pmu::service::test {
 
 using namespace std::chrono_literals;
-
-// The bus side in a thread of its own (fake clock: 10 ms of bus time per 2 ms of real time),
-// with a CANopen node that sends `frames` again every 200 ms of bus time, as a BMS and an
-// MPPT repeat their values.
-class Bus {
- public:
-  Bus(Harness& h, std::vector<codec::CanFrame> frames)
-      : h_(h), node_(h.network().attach("bms-and-mppt")), frames_(std::move(frames)), t_([this] {
-          auto next = h_.clock().steady_now();
-          while (!stop_) {
-            if (h_.clock().steady_now() >= next) {
-              for (const auto& f : frames_) (void)node_->send(f, 0ms);
-              next += 200ms;
-            }
-            h_.run_for(10ms);
-            std::this_thread::sleep_for(2ms);
-          }
-        }) {}
-  ~Bus() {
-    stop_ = true;
-    t_.join();
-  }
-
- private:
-  Harness& h_;
-  std::unique_ptr<transport::SimBus> node_;
-  std::vector<codec::CanFrame> frames_;
-  std::atomic<bool> stop_{false};
-  std::thread t_;
-};
 
 inline BusConfig bus_with_battery_and_mppt() {
   BusConfig b = sim_bus({device(1)});

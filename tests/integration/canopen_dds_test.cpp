@@ -56,7 +56,7 @@ TEST(DdsCanOpen, BatteryCellsAndMpptArriveWithTheirValuesAndFrameTimes) {
       client.reader(client.topic(topics::kMppt, TypeSupport(new pmu::MpptPubSubType())), qos_profiles::kTelemetry);
 
   Harness h(bus_with_battery_and_mppt(), {pmu(1)}, Timeouts{}, &publisher);
-  Bus bus(h, document_frames());
+  BusThread bus(h, document_frames());
 
   SampleInfo si;
   pmu::Battery b;
@@ -112,7 +112,7 @@ TEST(DdsCanOpen, HealthHasAnInstancePerDeviceKind) {
   BusConfig config = bus_with_battery_and_mppt();
   config.mppts.push_back(MpptConfig{2, 1000ms});  // configured, never heard
   Harness h(config, {pmu(1)}, Timeouts{}, &publisher);
-  Bus bus(h, document_frames());
+  BusThread bus(h, document_frames());
 
   std::map<std::pair<int, int>, pmu::HealthState> seen;  // (kind, address) -> latest state
   pmu::Health s;

@@ -29,7 +29,7 @@ TEST(DdsCanOpen, PmuctlWatchListAndHealthShowBatteriesAndMppts) {
   dds::DdsContext service_side(domain, "", "pmu-service-canopen-pmuctl");
   DdsPublisher publisher(service_side, 3s);
   Harness h(bus_with_battery_and_mppt(), {pmu(1)}, Timeouts{}, &publisher);
-  Bus bus(h, document_frames());
+  BusThread bus(h, document_frames());
   const std::string pmuctl = std::string(PMUCTL_PATH) + " --domain " + std::to_string(domain);
 
   const auto watched = run_capture(pmuctl + " --json --timeout 20 watch --count 12");

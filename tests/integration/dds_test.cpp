@@ -20,6 +20,7 @@
 #include <thread>
 
 #include "../service/harness.hpp"
+#include "bus_thread.hpp"
 #include "pmu/idl/commandPubSubTypes.h"
 #include "pmu/idl/statePubSubTypes.h"
 #include "pmu/idl/telemetryPubSubTypes.h"
@@ -72,27 +73,6 @@ struct Readers {
   DataReader& config;
   DataReader& info;
   DataReader& health;
-};
-
-// Runs the bus side (fake clock) in a thread, 10 ms of bus time per 2 ms of real time.
-class BusThread {
- public:
-  explicit BusThread(Harness& h) : h_(h), t_([this] {
-      while (!stop_) {
-        h_.run_for(10ms);
-        // Meant: real time passes between steps of bus time (the DDS side runs in real time).
-        std::this_thread::sleep_for(2ms);
-      }
-    }) {}
-  ~BusThread() {
-    stop_ = true;
-    t_.join();
-  }
-
- private:
-  Harness& h_;
-  std::atomic<bool> stop_{false};
-  std::thread t_;
 };
 
 TEST(DdsTelemetry, EveryTopicArrivesWithTheSimulatorsValuesAndFrameTimestamps) {

@@ -21,7 +21,6 @@
 #include <fastdds/dds/core/status/PublicationMatchedStatus.hpp>
 #include <fastdds/dds/core/status/SubscriptionMatchedStatus.hpp>
 #include <fastdds/dds/subscriber/SampleInfo.hpp>
-#include <fastrtps/xmlparser/XMLProfileManager.h>
 #include <filesystem>
 #include <fstream>
 #include <set>
@@ -36,6 +35,7 @@
 #include "support/domain.hpp"
 #include "support/json_lines.hpp"
 #include "support/process.hpp"
+#include "support/udp_ports.hpp"
 #include "support/wait.hpp"
 
 namespace pmu::dds {
@@ -47,34 +47,6 @@ using namespace std::chrono_literals;
 constexpr const char* kDiscoveryServer = "/usr/bin/fast-discovery-server";  // fastdds-tools
 
 int test_domain() { return pmu::test::exclusive_dds_domain(); }
-
-// A free UDP port on loopback for the Discovery Server (bound, read back, released).
-std::uint16_t free_udp_port() {
-  const int s = ::socket(AF_INET, SOCK_DGRAM | SOCK_CLOEXEC, 0);
-  sockaddr_in a{};
-  a.sin_family = AF_INET;
-  a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-  socklen_t len = sizeof a;
-  if (s < 0 || ::bind(s, reinterpret_cast<sockaddr*>(&a), sizeof a) != 0 ||
-      ::getsockname(s, reinterpret_cast<sockaddr*>(&a), &len) != 0)
-    ADD_FAILURE() << "no free UDP port";
-  ::close(s);
-  return ntohs(a.sin_port);
-}
-
-// True when nothing listens on the domain's multicast discovery port (7400 + 250 * domain):
-// a participant with multicast discovery binds it (with SO_REUSEADDR, so a bind without it
-// fails while the participant lives).
-bool multicast_port_free(int domain) {
-  const int s = ::socket(AF_INET, SOCK_DGRAM | SOCK_CLOEXEC, 0);
-  sockaddr_in a{};
-  a.sin_family = AF_INET;
-  a.sin_port = htons(static_cast<std::uint16_t>(7400 + 250 * domain));
-  a.sin_addr.s_addr = htonl(INADDR_ANY);
-  const bool free = ::bind(s, reinterpret_cast<sockaddr*>(&a), sizeof a) == 0;
-  ::close(s);
-  return free;
-}
 
 ResolvedNetwork unicast_to_loopback() {
   ResolvedNetwork n;
@@ -142,7 +114,7 @@ TEST(UnicastDiscovery, PeersOnLoopbackFindEachOtherWithNoMulticastSocket) {
   client.reader();
   ASSERT_TRUE(exchange(service, client, 20s)) << "no sample over unicast discovery";
   // Both live and matched, and neither has the multicast discovery port open.
-  EXPECT_TRUE(multicast_port_free(test_domain()));
+  EXPECT_TRUE(pmu::test::dds_discovery_port_free(test_domain()));
 }
 
 TEST(UnicastDiscovery, WithoutAPeerAtTheirPortsTheyFindNobody) {
@@ -184,7 +156,7 @@ struct Server {
 TEST(DiscoveryServer, ClientsFindEachOtherOnlyThroughTheServerWithTheIdOfTheirPosition) {
   if (::access(kDiscoveryServer, X_OK) != 0)
     GTEST_SKIP() << kDiscoveryServer << " is missing: install Debian's fastdds-tools (scripts/setup.sh does)";
-  const std::uint16_t port = free_udp_port();
+  const std::uint16_t port = pmu::test::free_udp_port();
   Side service("ds-client-publisher", client_of(port));
   Side client("ds-client-subscriber", client_of(port));
   service.writer();
@@ -205,7 +177,7 @@ TEST(DiscoveryServer, ClientsFindEachOtherOnlyThroughTheServerWithTheIdOfTheirPo
 
   Server server(0, port);
   ASSERT_TRUE(exchange(service, client, 20s)) << "no sample through the Discovery Server";
-  EXPECT_TRUE(multicast_port_free(test_domain()));
+  EXPECT_TRUE(pmu::test::dds_discovery_port_free(test_domain()));
 }
 
 // ---- the interface allowlist ---------------------------------------------------------------
@@ -323,7 +295,7 @@ TEST(DiscoveryEndToEnd, ServiceWithUnicastPeersFeedsPmuctlWithPeer) {
   o.stderr_path = config.path + ".log";
   pmu::test::Child service({PMU_SERVICE_PATH, "--config", config.path, "--bus", "sim"}, o);
   expect_watch("", "--peer 127.0.0.1", domain);
-  EXPECT_TRUE(multicast_port_free(std::stoi(domain))) << "pmu-service or pmuctl opened the multicast port";
+  EXPECT_TRUE(pmu::test::dds_discovery_port_free(std::stoi(domain))) << "pmu-service or pmuctl opened the multicast port";
   service.stop(5s);
   std::ifstream log(o.stderr_path);
   const std::string text((std::istreambuf_iterator<char>(log)), std::istreambuf_iterator<char>());
@@ -335,7 +307,7 @@ TEST(DiscoveryEndToEnd, ServiceAndPmuctlAsClientsOfADiscoveryServer) {
   if (::access(kDiscoveryServer, X_OK) != 0)
     GTEST_SKIP() << kDiscoveryServer << " is missing: install Debian's fastdds-tools (scripts/setup.sh does)";
   const std::string domain = std::to_string(test_domain());
-  const std::string port = std::to_string(free_udp_port());
+  const std::string port = std::to_string(pmu::test::free_udp_port());
   Server server(0, static_cast<std::uint16_t>(std::stoi(port)));
   ConfigFile config("domain: " + domain + "\ndds_transport: udp\ndiscovery:\n  mode: server\n  servers: [\"127.0.0.1:" +
                     port + "\"]\n");
@@ -359,14 +331,3 @@ TEST(DiscoveryEndToEnd, PmuctlOptionsWinOverTheEnvironment) {
 
 }  // namespace
 }  // namespace pmu::dds
-
-int main(int argc, char** argv) {
-  ::testing::InitGoogleTest(&argc, argv);
-  // Everything between participants goes through UDP, none of it through Fast DDS's
-  // in-process shortcut: what is tested is what two hosts would exchange.
-  eprosima::fastrtps::LibrarySettingsAttributes library;
-  library.intraprocess_delivery = eprosima::fastrtps::INTRAPROCESS_OFF;
-  eprosima::fastrtps::xmlparser::XMLProfileManager::library_settings(library);
-  ::signal(SIGPIPE, SIG_IGN);
-  return RUN_ALL_TESTS();
-}

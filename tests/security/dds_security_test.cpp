@@ -26,8 +26,6 @@
 #include <fastdds/dds/core/status/PublicationMatchedStatus.hpp>
 #include <fastdds/dds/core/status/SubscriptionMatchedStatus.hpp>
 #include <fastdds/dds/subscriber/SampleInfo.hpp>
-#include <fastdds/dds/log/Log.hpp>
-#include <fastrtps/xmlparser/XMLProfileManager.h>
 #include <fstream>
 #include <functional>
 #include <map>
@@ -826,18 +824,3 @@ TEST(SecureVehicles, AConfinedIdentityCannotWriteToEveryVehicleNorToAnotherOne) 
 
 }  // namespace
 }  // namespace pmu::service
-
-int main(int argc, char** argv) {
-  ::testing::InitGoogleTest(&argc, argv);
-  // Everything between participants goes through the transport (UDP), none of it through
-  // Fast DDS's in-process shortcut: what the wire test looks at is what two hosts exchange.
-  eprosima::fastrtps::LibrarySettingsAttributes library;
-  library.intraprocess_delivery = eprosima::fastrtps::INTRAPROCESS_OFF;
-  eprosima::fastrtps::xmlparser::XMLProfileManager::library_settings(library);
-  ::signal(SIGPIPE, SIG_IGN);
-  // PMU_FASTDDS_WARNINGS=1 shows why Fast DDS rejected a participant (handshake failures
-  // are warnings).
-  if (std::getenv("PMU_FASTDDS_WARNINGS")) eprosima::fastdds::dds::Log::SetVerbosity(eprosima::fastdds::dds::Log::Warning);
-  return RUN_ALL_TESTS();
-}
-

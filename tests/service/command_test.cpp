@@ -12,21 +12,14 @@
 #include "harness.hpp"
 #include "pmu/codec/encode.hpp"
 #include "pmu/service/command_service.hpp"
+#include "support/pmu_frames.hpp"
 
 namespace pmu::service::test {
 namespace {
 
 using codec::CanFrame;
 
-CanFrame frame(std::uint8_t packet, std::uint16_t address, std::initializer_list<std::uint8_t> bytes) {
-  CanFrame f;
-  f.id = (0x1Eu << 24) | (std::uint32_t{packet} << 16) | address;
-  f.extended = true;
-  f.length = static_cast<std::uint8_t>(bytes.size());
-  std::size_t i = 0;
-  for (auto b : bytes) f.data[i++] = b;
-  return f;
-}
+using codec::test::pmu_frame;
 
 std::uint32_t wire(CommandKind k) { return static_cast<std::uint32_t>(k); }
 
@@ -107,7 +100,7 @@ TEST(Commands, EveryKindPutsTheSpecsFramesOnTheBusAndTheResultShowsUp) {
   const HappyCase cases[] = {
       {"set avionics_voltage 24.0",
        [](Commands& c) { return set_param(c, "avionics_voltage", 24.0); },
-       {frame(0x10, 1, {240}), frame(0x10, 1, {})},
+       {pmu_frame(0x10, 1, {240}), pmu_frame(0x10, 1, {})},
        [](Commands& c, const CommandReplyData& r) {
          EXPECT_DOUBLE_EQ(r.value, 24.0);
          EXPECT_EQ(sim_param(c, codec::Parameter::AvionicsVoltage), 240u);
@@ -115,7 +108,7 @@ TEST(Commands, EveryKindPutsTheSpecsFramesOnTheBusAndTheResultShowsUp) {
        }},
       {"set cranking_time 2.5",
        [](Commands& c) { return set_param(c, "cranking_time", 2.5); },
-       {frame(0x19, 1, {25}), frame(0x19, 1, {})},
+       {pmu_frame(0x19, 1, {25}), pmu_frame(0x19, 1, {})},
        [](Commands& c, const CommandReplyData&) { EXPECT_EQ(sim_param(c, codec::Parameter::CrankingTime), 25u); }},
       {"set outputs avionics+payload",
        [](Commands& c) {
@@ -123,7 +116,7 @@ TEST(Commands, EveryKindPutsTheSpecsFramesOnTheBusAndTheResultShowsUp) {
          r.outputs = 0x03;
          return r;
        },
-       {frame(0x20, 1, {0x03}), frame(0x20, 1, {})},
+       {pmu_frame(0x20, 1, {0x03}), pmu_frame(0x20, 1, {})},
        [](Commands& c, const CommandReplyData& r) {
          EXPECT_EQ(sim_outputs(c), 0x03);
          EXPECT_EQ(r.value, 3);
@@ -135,7 +128,7 @@ TEST(Commands, EveryKindPutsTheSpecsFramesOnTheBusAndTheResultShowsUp) {
          r.outputs = 0x02;
          return r;
        },
-       {frame(0x22, 1, {0x02}), frame(0x20, 1, {})},
+       {pmu_frame(0x22, 1, {0x02}), pmu_frame(0x20, 1, {})},
        [](Commands& c, const CommandReplyData&) { EXPECT_EQ(sim_outputs(c) & 0x02, 0); }},
       {"enable payload",
        [](Commands& c) {
@@ -143,7 +136,7 @@ TEST(Commands, EveryKindPutsTheSpecsFramesOnTheBusAndTheResultShowsUp) {
          r.outputs = 0x02;
          return r;
        },
-       {frame(0x21, 1, {0x02}), frame(0x20, 1, {})},
+       {pmu_frame(0x21, 1, {0x02}), pmu_frame(0x20, 1, {})},
        [](Commands& c, const CommandReplyData&) { EXPECT_EQ(sim_outputs(c) & 0x02, 0x02); }},
       {"generation off",
        [](Commands& c) {
@@ -151,7 +144,7 @@ TEST(Commands, EveryKindPutsTheSpecsFramesOnTheBusAndTheResultShowsUp) {
          r.enable = false;
          return r;
        },
-       {frame(0x23, 1, {0x00}), frame(0x23, 1, {})},
+       {pmu_frame(0x23, 1, {0x00}), pmu_frame(0x23, 1, {})},
        [](Commands& c, const CommandReplyData&) {
          bool on = true;
          c.h.pmus().with_model(1, [&](sim::PmuModel& m) { on = m.generation_enabled(); });
@@ -163,7 +156,7 @@ TEST(Commands, EveryKindPutsTheSpecsFramesOnTheBusAndTheResultShowsUp) {
          r.groups = 0x08;
          return r;
        },
-       {frame(0x0F, 1, {0x08})},
+       {pmu_frame(0x0F, 1, {0x08})},
        [](Commands& c, const CommandReplyData&) { EXPECT_GE(c.h.sink.count(codec::PacketId::Temperatures, 1), 1u); }},
       {"engine start (confirmed)",
        [](Commands& c) {
@@ -172,27 +165,27 @@ TEST(Commands, EveryKindPutsTheSpecsFramesOnTheBusAndTheResultShowsUp) {
          r.confirm = true;
          return r;
        },
-       {frame(0x24, 1, {})},
+       {pmu_frame(0x24, 1, {})},
        [](Commands& c, const CommandReplyData&) {
          sim::EngineState e{};
          c.h.pmus().with_model(1, [&](sim::PmuModel& m) { e = m.engine_state(); });
          EXPECT_NE(e, sim::EngineState::Stopped);
        }},
-      {"engine stop", [](Commands& c) { return c.req(CommandKind::EngineStop); }, {frame(0x25, 1, {})}, nullptr},
+      {"engine stop", [](Commands& c) { return c.req(CommandKind::EngineStop); }, {pmu_frame(0x25, 1, {})}, nullptr},
       {"get avionics_voltage",
        [](Commands& c) {
          auto r = c.req(CommandKind::Get);
          r.parameter = "avionics_voltage";
          return r;
        },
-       {frame(0x10, 1, {})},
+       {pmu_frame(0x10, 1, {})},
        [](Commands&, const CommandReplyData& r) {
          EXPECT_TRUE(r.has_value);
          EXPECT_DOUBLE_EQ(r.value, 12.0);
        }},
-      {"get serial", [](Commands& c) { return c.req(CommandKind::GetSerial); }, {frame(0x30, 1, {})},
+      {"get serial", [](Commands& c) { return c.req(CommandKind::GetSerial); }, {pmu_frame(0x30, 1, {})},
        [](Commands&, const CommandReplyData& r) { EXPECT_EQ(r.value, 4001); }},
-      {"get firmware", [](Commands& c) { return c.req(CommandKind::GetFirmware); }, {frame(0x31, 1, {})},
+      {"get firmware", [](Commands& c) { return c.req(CommandKind::GetFirmware); }, {pmu_frame(0x31, 1, {})},
        [](Commands&, const CommandReplyData& r) { EXPECT_EQ(r.value_text, "1.17 built 2023-06-15"); }},
   };
   for (const auto& hc : cases) {
@@ -215,7 +208,7 @@ TEST(Commands, ResetIsSentThenEverythingIsReadAgain) {
   EXPECT_EQ(c.run(r).result, CommandResult::Completed);
   c.h.run_for(300ms);
   ASSERT_GE(c.sent().size(), 16u);
-  EXPECT_EQ(c.sent()[0], hex(frame(0x26, 1, {})));
+  EXPECT_EQ(c.sent()[0], hex(pmu_frame(0x26, 1, {})));
   EXPECT_EQ(c.h.sink.infos.size(), infos + 1);
 }
 
@@ -225,7 +218,7 @@ TEST(Commands, CanAddressChangeIsVerifiedAtTheNewAddressAndTheSessionMoves) {
   r.confirm = true;
   const auto reply = c.run(r);
   EXPECT_EQ(reply.result, CommandResult::Completed) << reply.reason;
-  EXPECT_EQ(c.sent(), (std::vector<std::string>{hex(frame(0x1B, 1, {0x00, 0x05})), hex(frame(0x1B, 5, {}))}));
+  EXPECT_EQ(c.sent(), (std::vector<std::string>{hex(pmu_frame(0x1B, 1, {0x00, 0x05})), hex(pmu_frame(0x1B, 5, {}))}));
   c.h.run_for(50ms);
   EXPECT_EQ(c.h.worker().addresses(), (std::vector<std::uint16_t>{5}));
   EXPECT_EQ(c.run(c.req(CommandKind::GetSerial, 5)).result, CommandResult::Completed);
@@ -371,7 +364,7 @@ TEST(Commands, BroadcastStopWithoutABusGoesOutOnEveryBus) {
   const auto r = c.run(stop);
   EXPECT_EQ(r.result, CommandResult::Completed);
   EXPECT_EQ(r.reason, "stop sent to every PMU (broadcast) on sim0");
-  EXPECT_EQ(c.sent(), (std::vector<std::string>{hex(frame(0x25, 0xFFFF, {}))}));
+  EXPECT_EQ(c.sent(), (std::vector<std::string>{hex(pmu_frame(0x25, 0xFFFF, {}))}));
   c.h.clear_sent();
   auto get = c.req(CommandKind::GetSerial, codec::kBroadcastAddress);
   get.bus = "";
@@ -409,7 +402,7 @@ TEST(Commands, DuplicateRequestIdIsAnsweredAgainButExecutedOnce) {
     EXPECT_EQ(reply.request_id, r.request_id);
     EXPECT_EQ(reply.result, CommandResult::Completed);
   }
-  EXPECT_EQ(c.sent(), (std::vector<std::string>{hex(frame(0x11, 1, {200})), hex(frame(0x11, 1, {}))}));
+  EXPECT_EQ(c.sent(), (std::vector<std::string>{hex(pmu_frame(0x11, 1, {200})), hex(pmu_frame(0x11, 1, {}))}));
   EXPECT_EQ(c.service.counters().duplicates, 2u);
 }
 
@@ -473,14 +466,14 @@ TEST(Commands, OneDeviceIsSerialisedTwoDevicesProceedInParallel) {
   c.service.submit(c.req(CommandKind::GetSerial, 2));
   c.h.run_for(20ms);
   // Device 1 has one get in flight (its second waits); device 2 was asked at the same time.
-  EXPECT_EQ(c.sent(), (std::vector<std::string>{hex(frame(0x30, 1, {})), hex(frame(0x30, 2, {}))}));
+  EXPECT_EQ(c.sent(), (std::vector<std::string>{hex(pmu_frame(0x30, 1, {})), hex(pmu_frame(0x30, 2, {}))}));
   ASSERT_EQ(c.replies.size(), 1u);
   EXPECT_EQ(c.replies[0].address, 2);
   c.h.run_for(400ms);
   ASSERT_EQ(c.replies.size(), 3u);
   EXPECT_EQ(c.replies[1].kind, CommandKind::GetSerial);
   EXPECT_EQ(c.replies[2].kind, CommandKind::GetFirmware);
-  EXPECT_EQ(c.sent().back(), hex(frame(0x31, 1, {})));
+  EXPECT_EQ(c.sent().back(), hex(pmu_frame(0x31, 1, {})));
 }
 
 TEST(Commands, EngineStopJumpsTheQueue) {
@@ -496,7 +489,7 @@ TEST(Commands, EngineStopJumpsTheQueue) {
   c.h.run_for(150ms);
   const auto s = c.sent();
   ASSERT_GE(s.size(), 2u);
-  EXPECT_EQ(s[1], hex(frame(0x25, 1, {}))) << "sent right after the get already in flight";
+  EXPECT_EQ(s[1], hex(pmu_frame(0x25, 1, {}))) << "sent right after the get already in flight";
 }
 
 TEST(Commands, BurstOf1000MixedCommandsFromTwoSendersGetsExactly1000Replies) {

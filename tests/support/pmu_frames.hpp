@@ -1,6 +1,6 @@
 #pragma once
-// Frame builders for codec tests: a PMU frame from packet id, address and bytes, written the
-// way the spec's tables read.
+// A PMU frame from packet id, address and bytes, written the way the spec's tables read:
+// for the codec's tests and the service's (what a command puts on the bus).
 
 #include <cstdint>
 #include <initializer_list>

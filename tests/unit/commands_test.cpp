@@ -4,7 +4,7 @@
 
 #include "pmu/codec/decode.hpp"
 #include "pmu/codec/encode.hpp"
-#include "test_frames.hpp"
+#include "support/pmu_frames.hpp"
 
 namespace pmu::codec {
 namespace {

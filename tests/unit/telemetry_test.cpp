@@ -6,7 +6,7 @@
 
 #include "pmu/codec/decode.hpp"
 #include "pmu/codec/encode.hpp"
-#include "test_frames.hpp"
+#include "support/pmu_frames.hpp"
 
 namespace pmu::codec {
 namespace {
