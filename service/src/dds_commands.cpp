@@ -18,7 +18,7 @@
 #include "pmu/service/command_cdr.hpp"
 #include "pmu/service/command_service.hpp"
 #include "pmu/service/dds_publisher.hpp"
-#include "pmu/service/rate_limit.hpp"
+#include "pmu/service/log_throttle.hpp"
 #include "pmu/service/vehicle.hpp"
 
 namespace pmu::service {
@@ -54,7 +54,7 @@ struct DdsCommandEndpoint::Impl final : public DataReaderListener {
   std::string vehicle;
   std::atomic<std::uint64_t> not_ours{0};  // commands for another vehicle or from another partition
   // (the rate limit below is used under service_mutex)
-  RateLimit not_ours_reports{kMalformedLogInterval};
+  LogThrottle not_ours_reports{kMalformedLogInterval};
   DataWriter* writer = nullptr;
   DataReader* reader = nullptr;
   CommandSampleType* type = nullptr;  // owned by the TypeSupport registered with the participant
@@ -87,7 +87,7 @@ struct DdsCommandEndpoint::Impl final : public DataReaderListener {
       return true;
     }
     const auto total = not_ours.fetch_add(1, std::memory_order_relaxed) + 1;
-    if (const auto held = not_ours_reports.allow(RateLimit::Clock::now()))
+    if (const auto held = not_ours_reports.allow(LogThrottle::Clock::now()))
       spdlog::warn("audit: command {} from {} {}; this service is vehicle '{}': not executed, not answered "
                    "({} such command(s) since start{})",
                    printable(s.request_id), printable(s.sender), why, printable(vehicle), total,

@@ -23,7 +23,7 @@
 #include "pmu/idl/topics.hpp"
 #include "pmu/service/capacity.hpp"
 #include "pmu/service/low_rate.hpp"
-#include "pmu/service/rate_limit.hpp"
+#include "pmu/service/log_throttle.hpp"
 #include "pmu/service/telemetry_samples.hpp"
 
 namespace pmu::service {
@@ -113,8 +113,8 @@ struct DdsPublisher::Writers {
   // Bus workers run in threads of their own and share these writers and the rest below.
   std::mutex mutex;
   std::set<std::tuple<std::string, DeviceKind, std::uint16_t>> admitted;
-  RateLimit failure_reports{kReportInterval};
-  RateLimit refusal_reports{kReportInterval};
+  LogThrottle failure_reports{kReportInterval};
+  LogThrottle refusal_reports{kReportInterval};
 };
 
 DdsPublisher::DdsPublisher(dds::DdsContext& dds, std::chrono::milliseconds telemetry_deadline, std::string vehicle,
@@ -172,7 +172,7 @@ bool DdsPublisher::admit(const DeviceKey& key) {
   }
   const auto refused = refused_.fetch_add(1, std::memory_order_relaxed) + 1;
   failures_.fetch_add(1, std::memory_order_relaxed);
-  if (const auto held = w_->refusal_reports.allow(RateLimit::Clock::now()))
+  if (const auto held = w_->refusal_reports.allow(LogThrottle::Clock::now()))
     spdlog::error("{}/{}: not published on DDS: this service already publishes {} PMUs, the capacity its DDS "
                   "writers are sized for (kMaxDevicesPerService); {} sample(s) of PMUs over capacity not "
                   "published so far{}",
@@ -187,7 +187,7 @@ void DdsPublisher::count(bool ok, const char* topic, const DeviceKey& key, const
     return;
   }
   const auto total = failures_.fetch_add(1, std::memory_order_relaxed) + 1;
-  if (const auto held = w_->failure_reports.allow(RateLimit::Clock::now()))
+  if (const auto held = w_->failure_reports.allow(LogThrottle::Clock::now()))
     spdlog::warn("{}/{}: DDS write to {} failed ({}); {} sample(s) not published so far{}", key.bus, key.address,
                  topic, reason, total,
                  *held ? " (" + std::to_string(*held) + " failures not logged since the last message)" : std::string());

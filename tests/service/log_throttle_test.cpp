@@ -1,16 +1,16 @@
-// RateLimit: one report per interval, and the count of those held back in between.
+// LogThrottle: one report per interval, and the count of those held back in between.
 #include <gtest/gtest.h>
 
-#include "pmu/service/rate_limit.hpp"
+#include "pmu/service/log_throttle.hpp"
 
 namespace pmu::service {
 namespace {
 
 using namespace std::chrono_literals;
 
-TEST(RateLimit, OneReportPerIntervalWithTheCountHeldBack) {
-  RateLimit limit(5s);
-  const RateLimit::Clock::time_point t0{};
+TEST(LogThrottle, OneReportPerIntervalWithTheCountHeldBack) {
+  LogThrottle limit(5s);
+  const LogThrottle::Clock::time_point t0{};
   ASSERT_EQ(limit.allow(t0), 0u) << "the first event is reported";
   EXPECT_EQ(limit.allow(t0 + 1s), std::nullopt);
   EXPECT_EQ(limit.allow(t0 + 4999ms), std::nullopt);

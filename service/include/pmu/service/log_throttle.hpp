@@ -1,5 +1,5 @@
 #pragma once
-// RateLimit: lets one report of a repeating fault through per interval and counts the ones
+// LogThrottle: lets one report of a repeating fault through per interval and counts the ones
 // held back, so a fault that repeats thousands of times a second is still reported, with how
 // often, without flooding the journal. (The logger's duplicate filter only collapses
 // identical lines; these lines carry running counts.) Not thread-safe: callers hold a lock.
@@ -10,10 +10,10 @@
 
 namespace pmu::service {
 
-class RateLimit {
+class LogThrottle {
  public:
   using Clock = std::chrono::steady_clock;
-  explicit RateLimit(Clock::duration interval) : interval_(interval) {}
+  explicit LogThrottle(Clock::duration interval) : interval_(interval) {}
 
   // When this event may be reported: how many were held back since the last report.
   // Otherwise nullopt (the event is counted).
