@@ -16,13 +16,11 @@
 #include <fstream>
 #include <memory>
 #include <optional>
-#include <spdlog/fmt/ranges.h>
 #include <spdlog/spdlog.h>
 #include <string>
 #include <thread>
 #include <vector>
 
-#include "pmu/codec/encode.hpp"
 #include "pmu/service/bus_worker.hpp"
 #include "pmu/service/command_service.hpp"
 #include "pmu/service/config.hpp"
@@ -31,15 +29,14 @@
 #include "pmu/service/dds_publisher.hpp"
 #include "pmu/service/dds_statistics.hpp"
 #include "pmu/service/receive_filters.hpp"
+#include "pmu/service/simulated_bus.hpp"
 #include "pmu/service/logging.hpp"
 #include "pmu/service/moved_addresses.hpp"
 #include "pmu/service/startup_check.hpp"
 #include "pmu/service/systemd.hpp"
 #include "pmu/service/vehicle.hpp"
-#include "pmu/sim/bus_runner.hpp"
 #include "pmu/sysconf_dir.hpp"
 #include "pmu/version.hpp"
-#include "pmu/transport/sim_bus.hpp"
 #include "pmu/transport/socketcan_bus.hpp"
 
 namespace {
@@ -78,45 +75,10 @@ std::unique_ptr<transport::CanBus> open_bus(const service::BusConfig& bus, const
                  r.kernel_timestamps ? "kernel" : "user");
     return b;
   }
-  // The built-in simulated PMU: one simulated unit per configured address (address 1 when
-  // the bus only discovers), on an in-process bus shared with the service.
-  rt.network = std::make_unique<transport::SimulatedNetwork>(clock);
-  rt.simulator = std::make_unique<sim::BusRunner>(rt.network->attach("pmu-sim"), clock);
-  std::vector<service::DeviceConfig> devices = bus.devices;
-  if (devices.empty()) devices.push_back(bus.discovered_defaults);
-  std::vector<std::uint16_t> addresses;
-  for (const auto& dev : devices) {
-    sim::DeviceConfig d;
-    d.address = dev.address;
-    d.serial_number = static_cast<std::uint16_t>(1000 + dev.address);
-    // Stream what the service expects, so the demo shows every topic at the configured rate.
-    const auto pp = codec::to_raw(codec::Parameter::PacketPeriod,
-                                  codec::duration_value(codec::Parameter::PacketPeriod, dev.period));
-    if (pp) d.parameters.set_raw(codec::Parameter::PacketPeriod, *pp);  // the config checked it is a PP
-    d.parameters.set_raw(codec::Parameter::PacketsStreamed, dev.groups);
-    rt.simulator->add(d);
-    // An engine that is already running makes the generator figures come alive.
-    rt.simulator->with_model(dev.address, [&](sim::PmuModel& m) { m.set_engine_running(true, clock.steady_now()); });
-    addresses.push_back(dev.address);
-  }
-  spdlog::info("{}: built-in simulated PMU at address(es) {}", bus.name, fmt::join(addresses, ", "));
-  // The bus's batteries and MPPTs are simulated too, on one solar plant: sun on the panels
-  // charges the battery, the load discharges it (sim/README.md).
-  for (const auto& battery : bus.batteries) {
-    sim::BatterySimConfig c;
-    c.node = battery.node;
-    c.period = battery.period;
-    rt.simulator->add_battery(c);
-    spdlog::info("{}: built-in simulated battery (BMS) at node {}", bus.name, battery.node);
-  }
-  for (const auto& mppt : bus.mppts) {
-    sim::MpptSimConfig c;
-    c.device = mppt.device;
-    c.period = mppt.period;
-    rt.simulator->add_mppt(c);
-    spdlog::info("{}: built-in simulated MPPT, device {}", bus.name, mppt.device);
-  }
-  return rt.network->attach(bus.name);
+  auto simulated = service::make_simulated_bus(bus, clock);
+  rt.network = std::move(simulated.network);
+  rt.simulator = std::move(simulated.simulator);
+  return std::move(simulated.service_end);
 }
 
 // Called on the main thread while the workers run: only their thread-safe counters.
