@@ -20,12 +20,12 @@
 #include <thread>
 
 #include "../service/harness.hpp"
+#include "pmu/dds/dds_context.hpp"
+#include "pmu/dds/dds_publisher.hpp"
 #include "pmu/idl/commandPubSubTypes.h"
 #include "pmu/idl/statePubSubTypes.h"
 #include "pmu/idl/telemetryPubSubTypes.h"
 #include "pmu/idl/topics.hpp"
-#include "pmu/service/dds_context.hpp"
-#include "pmu/service/dds_publisher.hpp"
 #include "support/domain.hpp"
 #include "support/json_lines.hpp"
 #include "support/process.hpp"

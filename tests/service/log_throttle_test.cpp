@@ -1,7 +1,7 @@
 // LogThrottle: one report per interval, and the count of those held back in between.
 #include <gtest/gtest.h>
 
-#include "pmu/service/log_throttle.hpp"
+#include "pmu/session/log_throttle.hpp"
 
 namespace pmu::service {
 namespace {

@@ -15,14 +15,14 @@
 
 #include "pmu/codec/ids.hpp"
 #include "pmu/codec/messages.hpp"
-#include "pmu/idl/guarded_type.hpp"
+#include "pmu/command/command.hpp"
+#include "pmu/dds/dds_context.hpp"
 #include "pmu/idl/command.h"
 #include "pmu/idl/commandPubSubTypes.h"
+#include "pmu/idl/guarded_type.hpp"
 #include "pmu/idl/state.h"
 #include "pmu/idl/statePubSubTypes.h"
 #include "pmu/idl/topics.hpp"
-#include "pmu/service/command.hpp"
-#include "pmu/service/dds_context.hpp"
 #include "pmuctl/dds_json.hpp"
 #include "pmuctl/exit_status.hpp"
 #include "pmuctl/service_presence.hpp"
@@ -34,7 +34,7 @@ using namespace eprosima::fastdds::dds;
 using Clock = std::chrono::steady_clock;
 
 // The service's names for its results; pmu::CommandResult has the same order (static_assert
-// in service/src/dds_commands.cpp). The names are literals, so data() ends in NUL.
+// in dds/src/dds_commands.cpp). The names are literals, so data() ends in NUL.
 const char* result_name(pmu::CommandResult r) {
   return pmu::service::to_string(static_cast<pmu::service::CommandResult>(r)).data();
 }

@@ -7,9 +7,9 @@
 #include <optional>
 #include <string>
 
-#include "pmu/service/dds_context.hpp"
-#include "pmu/service/dds_network.hpp"
-#include "pmu/service/dds_security.hpp"
+#include "pmu/config/network_settings.hpp"
+#include "pmu/dds/dds_context.hpp"
+#include "pmu/security/security_files.hpp"
 
 namespace pmu::tools {
 

@@ -14,7 +14,7 @@
 #include "pmu/codec/candump.hpp"
 #include "pmu/codec/canopen.hpp"
 #include "pmu/codec/decode.hpp"
-#include "pmu/service/telemetry_samples.hpp"
+#include "pmu/dds/telemetry_samples.hpp"
 #include "pmuctl/mcap_recording.hpp"
 
 namespace pmu::tools {

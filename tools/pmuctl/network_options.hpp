@@ -2,7 +2,7 @@
 // pmuctl's discovery and interface options (interface.md section 7.2): --peer,
 // --discovery-server, --interface, or the environment variables PMU_DDS_PEERS,
 // PMU_DISCOVERY_SERVER and PMU_DDS_INTERFACES (comma separated) when the options are absent.
-// Entries are read by the same functions as pmu-service's config (dds_network.hpp), so the
+// Entries are read by the same functions as pmu-service's config (network_settings.hpp), so the
 // same text means the same thing in both.
 //
 //   --peer 10.0.0.7 --peer gcs.local:7412   -> unicast discovery to both (multicast off)
@@ -15,7 +15,7 @@
 #include <string>
 #include <vector>
 
-#include "pmu/service/dds_network.hpp"
+#include "pmu/config/network_settings.hpp"
 
 namespace pmu::tools {
 

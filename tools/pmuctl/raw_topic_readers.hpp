@@ -17,7 +17,7 @@
 #include <fastdds/dds/subscriber/DataReaderListener.hpp>
 #include <fastdds/dds/topic/TypeSupport.hpp>
 
-#include "pmu/service/dds_context.hpp"
+#include "pmu/dds/dds_context.hpp"
 #include "pmuctl/dds_verbs.hpp"
 #include "pmuctl/mcap_topics.hpp"
 #include "pmuctl/raw_sample_type.hpp"

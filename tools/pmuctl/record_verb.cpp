@@ -7,7 +7,7 @@
 #include <memory>
 #include <mutex>
 
-#include "pmu/service/dds_context.hpp"
+#include "pmu/dds/dds_context.hpp"
 #include "pmuctl/mcap_recording.hpp"
 #include "pmuctl/raw_topic_readers.hpp"
 #include "pmuctl/stop_signals.hpp"

@@ -9,7 +9,7 @@
 
 #include "pmu/codec/parameters.hpp"
 #include "pmu/codec/telemetry.hpp"
-#include "pmu/service/canopen_state.hpp"
+#include "pmu/session/canopen_state.hpp"
 #include "pmuctl/frame_fields.hpp"
 #include "pmuctl/mask_names.hpp"
 

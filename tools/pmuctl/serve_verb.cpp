@@ -5,8 +5,8 @@
 #include <cstdio>
 #include <string_view>
 
+#include "pmu/dds/dds_context.hpp"
 #include "pmu/idl/topics.hpp"
-#include "pmu/service/dds_context.hpp"
 #include "pmuctl/foxglove_server.hpp"
 #include "pmuctl/raw_topic_readers.hpp"
 #include "pmuctl/stop_signals.hpp"

@@ -9,7 +9,7 @@
 #include <set>
 #include <string>
 
-#include "pmu/service/dds_context.hpp"
+#include "pmu/dds/dds_context.hpp"
 #include "pmuctl/dds_verbs.hpp"
 
 namespace pmu::tools {

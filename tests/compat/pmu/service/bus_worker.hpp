@@ -1,0 +1,2 @@
+#pragma once
+#include "pmu/session/bus_worker.hpp"

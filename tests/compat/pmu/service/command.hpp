@@ -1,0 +1,2 @@
+#pragma once
+#include "pmu/command/command.hpp"

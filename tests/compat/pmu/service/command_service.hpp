@@ -1,0 +1,2 @@
+#pragma once
+#include "pmu/dispatch/command_service.hpp"

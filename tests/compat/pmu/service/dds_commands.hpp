@@ -1,0 +1,2 @@
+#pragma once
+#include "pmu/dds/dds_commands.hpp"

@@ -1,0 +1,2 @@
+#pragma once
+#include "pmu/security/security_files.hpp"

@@ -1,0 +1,2 @@
+#pragma once
+#include "pmu/config/vehicle.hpp"
