@@ -13,7 +13,7 @@
 #include <vector>
 
 #include "fake_pmu.hpp"
-#include "pmu/service/dds_context.hpp"
+#include "pmu/dds/dds_context.hpp"
 
 namespace pmu::bench {
 

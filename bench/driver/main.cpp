@@ -13,7 +13,7 @@
 #include "benchmarks.hpp"
 #include "peers.hpp"
 #include "scale_peers.hpp"
-#include "pmu/service/dds_context.hpp"
+#include "pmu/dds/dds_context.hpp"
 
 int main(int argc, char** argv) {
   using namespace pmu::bench;

@@ -14,12 +14,12 @@
 
 #include "dds_probes.hpp"
 #include "pacer.hpp"
+#include "pmu/dds/dds_context.hpp"
 #include "pmu/idl/command.h"
 #include "pmu/idl/commandPubSubTypes.h"
 #include "pmu/idl/telemetry.h"
 #include "pmu/idl/telemetryPubSubTypes.h"
 #include "pmu/idl/topics.hpp"
-#include "pmu/service/dds_context.hpp"
 
 namespace pmu::bench {
 

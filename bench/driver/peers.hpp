@@ -6,7 +6,7 @@
 
 #include <string>
 
-#include "pmu/service/dds_transport.hpp"
+#include "pmu/config/transport_choice.hpp"
 
 namespace pmu::bench {
 

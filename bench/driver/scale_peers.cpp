@@ -11,11 +11,11 @@
 #include <vector>
 
 #include "pacer.hpp"
+#include "pmu/dds/dds_context.hpp"
 #include "pmu/idl/statePubSubTypes.h"
 #include "pmu/idl/telemetry.h"
 #include "pmu/idl/telemetryPubSubTypes.h"
 #include "pmu/idl/topics.hpp"
-#include "pmu/service/dds_context.hpp"
 #include "telemetry_readers.hpp"
 
 namespace pmu::bench {

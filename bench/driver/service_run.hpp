@@ -9,7 +9,7 @@
 
 #include "child_process.hpp"
 #include "fake_pmu.hpp"
-#include "pmu/service/dds_transport.hpp"
+#include "pmu/config/transport_choice.hpp"
 
 namespace pmu::bench {
 

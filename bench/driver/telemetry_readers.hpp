@@ -11,7 +11,7 @@
 #include <memory>
 #include <vector>
 
-#include "pmu/service/dds_context.hpp"
+#include "pmu/dds/dds_context.hpp"
 
 namespace pmu::bench {
 

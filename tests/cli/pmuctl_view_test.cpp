@@ -1,4 +1,4 @@
-// What pmuctl's tables and --json show of each DDS sample (tools/pmuctl/sample_fields.hpp,
+// What pmuctl's tables and --json show of each DDS sample (tools/pmuctl/view/sample_fields.hpp,
 // table_text.hpp) and how `config set` reads a value (mask_names.hpp): units from the spec's
 // tables, every sentinel, every mask, and the health and age on watch rows.
 #include <gtest/gtest.h>
@@ -10,9 +10,9 @@
 #include <string>
 #include <vector>
 
-#include "pmuctl/mask_names.hpp"
-#include "pmuctl/sample_fields.hpp"
-#include "pmuctl/table_text.hpp"
+#include "pmuctl/view/mask_names.hpp"
+#include "pmuctl/view/sample_fields.hpp"
+#include "pmuctl/view/table_text.hpp"
 
 namespace pmu::tools {
 namespace {

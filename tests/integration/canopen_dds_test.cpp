@@ -16,11 +16,11 @@
 #include <thread>
 
 #include "canopen_bus.hpp"
+#include "pmu/dds/dds_context.hpp"
+#include "pmu/dds/dds_publisher.hpp"
 #include "pmu/idl/canopenPubSubTypes.h"
 #include "pmu/idl/statePubSubTypes.h"
 #include "pmu/idl/topics.hpp"
-#include "pmu/service/dds_context.hpp"
-#include "pmu/service/dds_publisher.hpp"
 #include "support/domain.hpp"
 #include "support/wait.hpp"
 

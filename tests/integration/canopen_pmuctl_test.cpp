@@ -8,8 +8,8 @@
 #include <string>
 
 #include "canopen_bus.hpp"
-#include "pmu/service/dds_context.hpp"
-#include "pmu/service/dds_publisher.hpp"
+#include "pmu/dds/dds_context.hpp"
+#include "pmu/dds/dds_publisher.hpp"
 #include "support/domain.hpp"
 #include "support/json_lines.hpp"
 #include "support/process.hpp"

@@ -16,11 +16,11 @@
 #include <string>
 #include <thread>
 
+#include "pmu/config/capacity.hpp"
+#include "pmu/dds/dds_context.hpp"
+#include "pmu/dds/dds_publisher.hpp"
 #include "pmu/idl/statePubSubTypes.h"
 #include "pmu/idl/topics.hpp"
-#include "pmu/service/capacity.hpp"
-#include "pmu/service/dds_context.hpp"
-#include "pmu/service/dds_publisher.hpp"
 #include "support/domain.hpp"
 #include "support/json_lines.hpp"
 #include "support/process.hpp"

@@ -21,12 +21,12 @@
 #include <sstream>
 #include <thread>
 
+#include "pmu/dds/command_cdr.hpp"
+#include "pmu/dds/dds_context.hpp"
 #include "pmu/idl/command.h"
 #include "pmu/idl/commandPubSubTypes.h"
 #include "pmu/idl/guarded_type.hpp"
 #include "pmu/idl/topics.hpp"
-#include "pmu/service/command_cdr.hpp"
-#include "pmu/service/dds_context.hpp"
 #include "support/domain.hpp"
 #include "support/process.hpp"
 #include "support/wait.hpp"

@@ -12,15 +12,15 @@
 #include <set>
 #include <thread>
 
+#include "pmu/dds/dds_commands.hpp"
+#include "pmu/dds/dds_context.hpp"
+#include "pmu/dds/dds_publisher.hpp"
+#include "pmu/dispatch/command_service.hpp"
 #include "pmu/idl/command.h"
 #include "pmu/idl/commandPubSubTypes.h"
 #include "pmu/idl/statePubSubTypes.h"
 #include "pmu/idl/topics.hpp"
-#include "pmu/service/bus_worker.hpp"
-#include "pmu/service/command_service.hpp"
-#include "pmu/service/dds_commands.hpp"
-#include "pmu/service/dds_context.hpp"
-#include "pmu/service/dds_publisher.hpp"
+#include "pmu/session/bus_worker.hpp"
 #include "pmu/sim/bus_runner.hpp"
 #include "pmu/transport/sim_bus.hpp"
 #include "support/domain.hpp"

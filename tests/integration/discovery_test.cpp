@@ -28,10 +28,10 @@
 #include <string>
 #include <thread>
 
+#include "pmu/config/network_settings.hpp"
+#include "pmu/dds/dds_context.hpp"
 #include "pmu/idl/telemetryPubSubTypes.h"
 #include "pmu/idl/topics.hpp"
-#include "pmu/service/dds_context.hpp"
-#include "pmu/service/dds_network.hpp"
 #include "support/domain.hpp"
 #include "support/json_lines.hpp"
 #include "support/process.hpp"

@@ -11,9 +11,9 @@
 #include <string>
 #include <thread>
 
+#include "pmu/dds/dds_context.hpp"
 #include "pmu/idl/commandPubSubTypes.h"
 #include "pmu/idl/topics.hpp"
-#include "pmu/service/dds_context.hpp"
 #include "support/domain.hpp"
 #include "support/json_lines.hpp"
 #include "support/process.hpp"

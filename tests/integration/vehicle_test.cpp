@@ -13,6 +13,8 @@
 #include <thread>
 #include <vector>
 
+#include "pmu/config/vehicle.hpp"
+#include "pmu/dds/dds_context.hpp"
 #include "pmu/idl/command.h"
 #include "pmu/idl/commandPubSubTypes.h"
 #include "pmu/idl/state.h"
@@ -20,8 +22,6 @@
 #include "pmu/idl/telemetry.h"
 #include "pmu/idl/telemetryPubSubTypes.h"
 #include "pmu/idl/topics.hpp"
-#include "pmu/service/dds_context.hpp"
-#include "pmu/service/vehicle.hpp"
 #include "support/domain.hpp"
 #include "support/in_process_service.hpp"
 #include "support/wait.hpp"

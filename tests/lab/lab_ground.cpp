@@ -54,12 +54,12 @@
 #include <thread>
 #include <vector>
 
+#include "pmu/command/command.hpp"
+#include "pmu/dds/dds_context.hpp"
 #include "pmu/idl/command.h"
 #include "pmu/idl/commandPubSubTypes.h"
 #include "pmu/idl/guarded_type.hpp"
 #include "pmu/idl/topics.hpp"
-#include "pmu/service/command.hpp"
-#include "pmu/service/dds_context.hpp"
 
 namespace {
 
@@ -77,7 +77,7 @@ double boottime() {
 double seconds_between(Clock::time_point a, Clock::time_point b) { return std::chrono::duration<double>(b - a).count(); }
 
 // The service's names for its results; pmu::CommandResult has the same order (static_assert
-// in service/src/dds_commands.cpp). The names are literals, so data() ends in NUL.
+// in dds/src/dds_commands.cpp). The names are literals, so data() ends in NUL.
 const char* result_name(pmu::CommandResult r) {
   return pmu::service::to_string(static_cast<pmu::service::CommandResult>(r)).data();
 }

@@ -18,7 +18,7 @@
 
 #include <gtest/gtest.h>
 
-#include "pmu/service/dds_security.hpp"
+#include "pmu/security/security_files.hpp"
 #include "support/domain.hpp"
 #include "support/process.hpp"
 

@@ -16,7 +16,7 @@
 #include <vector>
 
 #include "pki_fixture.hpp"
-#include "pmu/service/dds_security.hpp"
+#include "pmu/security/security_files.hpp"
 
 namespace pmu::security_test {
 namespace {

@@ -9,7 +9,7 @@
 
 #include "harness.hpp"
 #include "pmu/codec/encode.hpp"
-#include "pmu/service/command_service.hpp"
+#include "pmu/dispatch/command_service.hpp"
 
 namespace pmu::service::test {
 namespace {

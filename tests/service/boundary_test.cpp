@@ -8,7 +8,7 @@
 #include <limits>
 
 #include "command_sample.hpp"
-#include "pmu/service/command.hpp"
+#include "pmu/command/command.hpp"
 
 namespace pmu::service {
 namespace {

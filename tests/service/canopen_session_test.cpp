@@ -6,7 +6,7 @@
 #include <cmath>
 
 #include "canopen_frames.hpp"
-#include "pmu/service/canopen_session.hpp"
+#include "pmu/session/canopen_session.hpp"
 #include "recording_sink.hpp"
 
 namespace pmu::service::test {

@@ -6,7 +6,7 @@
 
 #include "canopen_frames.hpp"
 #include "harness.hpp"
-#include "pmu/service/receive_filters.hpp"
+#include "pmu/session/receive_filters.hpp"
 
 namespace pmu::service::test {
 namespace {

@@ -10,7 +10,7 @@
 #include "frame_text.hpp"
 #include "pmu/codec/decode.hpp"
 #include "pmu/codec/encode.hpp"
-#include "pmu/service/command_executor.hpp"
+#include "pmu/dispatch/command_executor.hpp"
 #include "recording_sink.hpp"
 
 namespace pmu::service {

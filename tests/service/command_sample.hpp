@@ -3,7 +3,7 @@
 // (parse_command) has looked at it; tests change the fields they are about.
 #include <cstdint>
 
-#include "pmu/service/command.hpp"
+#include "pmu/command/command.hpp"
 
 namespace pmu::service {
 

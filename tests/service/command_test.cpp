@@ -11,7 +11,7 @@
 #include "frame_text.hpp"
 #include "harness.hpp"
 #include "pmu/codec/encode.hpp"
-#include "pmu/service/command_service.hpp"
+#include "pmu/dispatch/command_service.hpp"
 #include "support/pmu_frames.hpp"
 
 namespace pmu::service::test {

@@ -5,8 +5,8 @@
 
 #include <cstdlib>
 
-#include "pmu/service/config.hpp"
-#include "pmu/service/dds_statistics.hpp"
+#include "pmu/config/config.hpp"
+#include "pmu/config/statistics_settings.hpp"
 
 namespace pmu::service {
 namespace {

@@ -9,7 +9,7 @@
 #include <vector>
 
 #include "pmu/codec/decode.hpp"
-#include "pmu/service/bus_worker.hpp"
+#include "pmu/session/bus_worker.hpp"
 #include "pmu/sim/bus_runner.hpp"
 #include "pmu/transport/sim_bus.hpp"
 #include "recording_sink.hpp"

@@ -2,7 +2,7 @@
 // never heard from, recovery, and when the report is due.
 #include <gtest/gtest.h>
 
-#include "pmu/service/health_tracker.hpp"
+#include "pmu/session/health_tracker.hpp"
 
 namespace pmu::service {
 namespace {

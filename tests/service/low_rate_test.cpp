@@ -1,7 +1,7 @@
 // LowRateGate: which samples also go to pmu/low_rate/* (one per device, packet and period).
 #include <gtest/gtest.h>
 
-#include "pmu/service/low_rate.hpp"
+#include "pmu/config/low_rate.hpp"
 
 namespace pmu::service {
 namespace {

@@ -1,6 +1,6 @@
 // The record of moved CAN addresses (moved_addresses.hpp): its lines, every bad line with
 // FILE:LINE, where it lives, and what --check-config says of a config it makes stale.
-#include "pmu/service/moved_addresses.hpp"
+#include "pmu/session/moved_addresses.hpp"
 
 #include <gtest/gtest.h>
 #include <unistd.h>

@@ -1,13 +1,13 @@
-// dds_network.hpp: addresses and interfaces as the config and pmuctl read them, and their
+// network_settings.hpp: addresses and interfaces as the config and pmuctl read them, and their
 // look-up at start through a fake NetworkLookup (no real interface or name server).
 #include <gtest/gtest.h>
 
-#include "pmu/service/dds_network.hpp"
+#include "pmu/config/network_settings.hpp"
 
 namespace pmu::dds {
 namespace {
 
-// The worked examples of dds_network.hpp.
+// The worked examples of network_settings.hpp.
 TEST(NetworkAddress, WorkedExamples) {
   Address a;
   EXPECT_EQ(parse_address("192.168.10.2", a), "");

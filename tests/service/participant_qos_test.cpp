@@ -13,7 +13,7 @@
 #include <map>
 #include <sstream>
 
-#include "pmu/service/dds_participant.hpp"
+#include "pmu/dds/dds_participant.hpp"
 
 namespace pmu::dds {
 namespace {
@@ -193,7 +193,7 @@ TEST(ParticipantQos, StatisticsTopicsBecomeTheFastddsStatisticsProperty) {
 }
 
 // Fast DDS 2.9.1 cannot serve secure participants through a Discovery Server
-// (dds_network.hpp, kServerWithSecurity): refused, never built.
+// (network_settings.hpp, kServerWithSecurity): refused, never built.
 TEST(ParticipantQos, DiscoveryServerWithSecurityIsRefused) {
   SecurityFiles f;
   f.identity_ca = "/pki/identity_ca.pem";

@@ -3,8 +3,8 @@
 #include <gtest/gtest.h>
 
 #include "command_sample.hpp"
-#include "pmu/service/config.hpp"
-#include "pmu/service/policy.hpp"
+#include "pmu/command/policy.hpp"
+#include "pmu/config/config.hpp"
 
 namespace pmu::service {
 namespace {

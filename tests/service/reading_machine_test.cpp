@@ -3,7 +3,7 @@
 #include <gtest/gtest.h>
 
 #include "pmu/codec/encode.hpp"
-#include "pmu/service/reading_machine.hpp"
+#include "pmu/session/reading_machine.hpp"
 
 namespace pmu::service {
 namespace {

@@ -5,7 +5,7 @@
 #include <map>
 #include <vector>
 
-#include "pmu/service/device_state.hpp"
+#include "pmu/session/device_state.hpp"
 
 namespace pmu::service::test {
 

@@ -6,7 +6,7 @@
 #include <vector>
 
 #include "pmu/codec/encode.hpp"
-#include "pmu/service/request_queue.hpp"
+#include "pmu/session/request_queue.hpp"
 
 namespace pmu::service {
 namespace {

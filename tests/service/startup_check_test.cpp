@@ -10,9 +10,9 @@
 #include <regex>
 #include <string>
 
-#include "pmu/service/config.hpp"
-#include "pmu/service/dds_context.hpp"
-#include "pmu/service/startup_check.hpp"
+#include "pmu/config/config.hpp"
+#include "pmu/dds/dds_context.hpp"
+#include "pmu/dds/startup_check.hpp"
 #include "support/process.hpp"
 
 namespace pmu::service {

@@ -7,11 +7,11 @@
 
 #include <fastdds/dds/topic/TypeSupport.hpp>
 
+#include "pmu/dds/dds_type_objects.hpp"
 #include "pmu/idl/canopenPubSubTypes.h"
 #include "pmu/idl/commandPubSubTypes.h"
 #include "pmu/idl/statePubSubTypes.h"
 #include "pmu/idl/telemetryPubSubTypes.h"
-#include "pmu/service/dds_type_objects.hpp"
 
 namespace pmu::dds {
 namespace {

@@ -11,7 +11,7 @@
 
 #include "harness.hpp"
 #include "support/wait.hpp"
-#include "pmu/service/command_service.hpp"
+#include "pmu/dispatch/command_service.hpp"
 
 namespace pmu::service::test {
 namespace {

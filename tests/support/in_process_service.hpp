@@ -1,5 +1,5 @@
 #pragma once
-// pmu-service assembled in the test process as service/src/main.cpp assembles it (participant
+// pmu-service assembled in the test process as service/app/src/main.cpp assembles it (participant
 // in its vehicle's partitions, publisher, one bus worker, command endpoint and service) on a
 // simulated bus of its own with one simulated PMU at address 1 streaming every packet every
 // 0.5 s. Header-only: a test target using it links pmu::dds and pmu::sim_runner.
@@ -12,12 +12,12 @@
 #include <string>
 #include <thread>
 
-#include "pmu/service/bus_worker.hpp"
-#include "pmu/service/command_service.hpp"
-#include "pmu/service/dds_commands.hpp"
-#include "pmu/service/dds_context.hpp"
-#include "pmu/service/dds_publisher.hpp"
-#include "pmu/service/vehicle.hpp"
+#include "pmu/config/vehicle.hpp"
+#include "pmu/dds/dds_commands.hpp"
+#include "pmu/dds/dds_context.hpp"
+#include "pmu/dds/dds_publisher.hpp"
+#include "pmu/dispatch/command_service.hpp"
+#include "pmu/session/bus_worker.hpp"
 #include "pmu/sim/bus_runner.hpp"
 #include "pmu/transport/sim_bus.hpp"
 

@@ -3,7 +3,7 @@
 // half the limit.
 #include <gtest/gtest.h>
 
-#include "pmuctl/client_backlog.hpp"
+#include "pmuctl/serve/client_backlog.hpp"
 
 namespace pmu::tools {
 namespace {

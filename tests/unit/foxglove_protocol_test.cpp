@@ -6,7 +6,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "pmuctl/foxglove_protocol.hpp"
+#include "pmuctl/serve/foxglove_protocol.hpp"
 
 namespace pmu::tools::foxglove {
 namespace {

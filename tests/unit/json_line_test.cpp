@@ -1,4 +1,4 @@
-// JsonLine (tools/pmuctl/json_line.hpp) writes the bytes nlohmann's dump wrote before it,
+// JsonLine (tools/pmuctl/decode/json_line.hpp) writes the bytes nlohmann's dump wrote before it,
 // because `pmuctl decode --json` output is compared by scripts: every kind of value, the
 // number formats at their edges, and strings that need escaping or are not valid UTF-8.
 #include <gtest/gtest.h>
@@ -8,7 +8,7 @@
 #include <nlohmann/json.hpp>
 #include <string>
 
-#include "pmuctl/json_line.hpp"
+#include "pmuctl/decode/json_line.hpp"
 
 namespace pmu::tools {
 namespace {

@@ -4,7 +4,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "pmuctl/log_decoder.hpp"
+#include "pmuctl/decode/log_decoder.hpp"
 
 namespace pmu::tools {
 namespace {

@@ -2,7 +2,7 @@
 // a value or a message naming the option.
 #include <gtest/gtest.h>
 
-#include "pmuctl/serve_options.hpp"
+#include "pmuctl/serve/serve_options.hpp"
 
 namespace pmu::tools {
 namespace {

@@ -1,0 +1,141 @@
+#pragma once
+// DdsContext: one Fast DDS participant with the contract's topics and named QoS profiles
+// (deploy/qos.xml), shared by pmu-service, pmuctl and the tests so every program creates
+// entities the same way.
+//
+// Start-up only throws (DdsError: "cannot load QoS profiles from X", "cannot create
+// participant on domain N"); afterwards calls return null or a ReturnCode like Fast DDS.
+//
+// Type objects: with `type_objects` the constructor registers the contract's type objects
+// (dds_type_objects.hpp) before anything else, and the context's endpoints announce them;
+// without (the default) no endpoint announces a type object or TypeInformation.
+//
+// Security: with SecurityFiles (security_files.hpp) the participant uses DDS-Security's
+// builtin plugins (PKI-DH authentication, Access-Permissions, AES-GCM-GMAC crypto) with
+// those files. Check them first (check_security_files): Fast DDS only says that the
+// participant could not be created.
+//
+// Lifetime: the topics, writers and readers it returns belong to its participant and are
+// valid until the context is destroyed; every object that keeps one (DdsPublisher,
+// DdsCommandEndpoint) must be destroyed first. A listener given to
+// writer() or reader() must outlive the context (Fast DDS may call it until the participant
+// is deleted), or be removed from its endpoint first (set_listener(nullptr), as
+// DdsCommandEndpoint::stop() does).
+// Threads: the constructor, topic(), writer() and reader() on one thread at a time (start-up;
+// they share the topic map unlocked); remote_writers() from any thread (it locks).
+
+#include <fastdds/dds/domain/DomainParticipant.hpp>
+#include <fastdds/dds/publisher/DataWriter.hpp>
+#include <fastdds/dds/publisher/Publisher.hpp>
+#include <fastdds/dds/subscriber/DataReader.hpp>
+#include <fastdds/dds/subscriber/Subscriber.hpp>
+#include <fastdds/dds/topic/Topic.hpp>
+#include <fastdds/dds/topic/TypeSupport.hpp>
+#include <map>
+#include <optional>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "pmu/config/network_settings.hpp"
+#include "pmu/config/transport_choice.hpp"
+#include "pmu/dds/dds_remote_writers.hpp"
+#include "pmu/security/security_files.hpp"
+
+namespace pmu::dds {
+
+class DdsError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+// Fast DDS refused a writer or reader, and the identity's permissions say why: they do not
+// grant `partition()` ("" is the default partition) for that topic. A program that maps
+// partitions to vehicles (pmuctl) can then say which vehicle the identity may not use.
+class PartitionNotGranted : public DdsError {
+ public:
+  PartitionNotGranted(const std::string& what, std::string partition)
+      : DdsError(what), partition_(std::move(partition)) {}
+  const std::string& partition() const noexcept { return partition_; }
+
+ private:
+  std::string partition_;
+};
+
+// The installed qos.xml: $PMU_QOS_FILE, else qos.xml in the configuration directory
+// (PMU_SYSCONFDIR, /etc/pmu-dds), else the read-only copy the client tools ship (PMU_DATADIR,
+// /usr/share/pmu-dds). Empty when none exists. Never the source tree: runs from a
+// build directory set PMU_QOS_FILE (scripts/run.sh and the tests do).
+std::string default_qos_file();
+
+// The first of the Fast DDS statistics topics `topics` that the permissions of `security`
+// do not let this identity publish in the default partition, where Fast DDS creates their
+// writers (and a refused one is only logged), or nullopt. DdsContext refuses to start with
+// one; pmu-service's start-up check (startup_check.hpp) says so first, at the config line.
+std::optional<std::string> statistics_topic_not_granted(const SecurityFiles& security,
+                                                        const std::vector<std::string>& topics);
+
+
+// The DDS partitions of the participant's one publisher and one subscriber (empty: the
+// default partition). vehicle.hpp says which a service and a client use.
+struct Partitions {
+  std::vector<std::string> publisher;
+  std::vector<std::string> subscriber;
+};
+
+class DdsContext {
+ public:
+  // `security` empty: no DDS-Security (as before). Relative paths are made absolute.
+  // `network`: discovery and interface allowlist (network_settings.hpp); default multicast, all.
+  // `statistics`: the Fast DDS statistics topics to write (statistics_settings.hpp), checked
+  // names; with DDS-Security the permissions must allow publishing each, or DdsError says so.
+  // `type_objects`: announce the self-contained types' type objects (see above).
+  DdsContext(int domain, const std::string& qos_file, const std::string& participant_name,
+             const SecurityFiles& security = {}, Transport transport = Transport::Default,
+             const ResolvedNetwork& network = {}, const Partitions& partitions = {},
+             const std::vector<std::string>& statistics = {}, bool type_objects = false);
+  ~DdsContext();
+  DdsContext(const DdsContext&) = delete;
+  DdsContext& operator=(const DdsContext&) = delete;
+
+  eprosima::fastdds::dds::DomainParticipant& participant() { return *participant_; }
+  int domain() const noexcept { return domain_; }
+  bool secure() const noexcept { return secure_; }
+  // Every remote writer discovery reported since the participant was created, with its
+  // partitions (dds_remote_writers.hpp).
+  const RemoteWriters& remote_writers() const noexcept { return remote_writers_; }
+
+  // Registers the type (once) and creates the topic (once). `type` is e.g.
+  // new pmu::VoltagesPubSubType(). Its endpoints announce its type object when the context
+  // was made with type_objects and the type is self-contained, never its TypeInformation
+  // (dds_type_objects.hpp says why). Throws
+  // DdsError at start-up when it fails.
+  eprosima::fastdds::dds::Topic& topic(const std::string& name, eprosima::fastdds::dds::TypeSupport type);
+
+  // A writer/reader with the named profile of qos.xml. Throws DdsError when it fails, and
+  // when the profile holds less than the declared capacity (capacity.hpp, dds_capacity.hpp).
+  // With DDS-Security the message says what the permissions do not allow (the topic, or
+  // which partition), and PartitionNotGranted is thrown when it is a partition.
+  eprosima::fastdds::dds::DataWriter& writer(eprosima::fastdds::dds::Topic& topic, const std::string& profile,
+                                             eprosima::fastdds::dds::DataWriterListener* listener = nullptr);
+  eprosima::fastdds::dds::DataReader& reader(eprosima::fastdds::dds::Topic& topic, const std::string& profile,
+                                             eprosima::fastdds::dds::DataReaderListener* listener = nullptr);
+
+ private:
+  // Throws the DdsError for an endpoint Fast DDS refused ("cannot create a writer for ...").
+  [[noreturn]] void refused(const std::string& topic, const std::string& profile, bool publish) const;
+
+  int domain_;
+  bool type_objects_;
+  std::string qos_file_;
+  bool secure_ = false;
+  SecurityFiles security_;
+  Partitions partitions_;
+  RemoteWriters remote_writers_;  // the participant's listener: outlives it
+  eprosima::fastdds::dds::DomainParticipant* participant_ = nullptr;
+  eprosima::fastdds::dds::Publisher* publisher_ = nullptr;
+  eprosima::fastdds::dds::Subscriber* subscriber_ = nullptr;
+  std::map<std::string, eprosima::fastdds::dds::Topic*> topics_;
+};
+
+}  // namespace pmu::dds

@@ -1,0 +1,49 @@
+#pragma once
+// participant_qos: the DomainParticipantQos of every participant the project creates
+// (pmu-service, pmuctl, the tests), from the transport choice, the discovery settings and
+// the DDS-Security files. A pure function (no look-up, no file read, no Fast DDS call), so
+// unit tests inspect exactly what a participant will be created with; DdsContext uses it.
+//
+// What each mode sets (Fast DDS 2.9, wire_protocol().builtin):
+//   multicast: nothing (Fast DDS's defaults: SPDP to 239.255.0.1:7400+250*domain and to the
+//              local well-known unicast ports).
+//   unicast:   discovery protocol SIMPLE; initialPeersList = the peers (port 0: Fast DDS
+//              tries the domain's well-known unicast discovery ports of participant ids
+//              0..3 on that host, 7410+250*domain+2*id); metatraffic multicast list empty
+//              and metatraffic unicast = one UDPv4 "any" locator with port 0, so Fast DDS
+//              neither opens the multicast discovery port nor sends to the group, and
+//              listens on the well-known unicast port of each (allowed) interface.
+//   server:    discovery protocol CLIENT; m_DiscoveryServers = the servers, server i with
+//              the GUID prefix of `fastdds discovery -i i` (44.53.<i>.5f.45.50.52.4f.53.49.4d.41)
+//              and its locators; metatraffic as in unicast (no multicast).
+// Interfaces (allowlist): the UDPv4 transport's interfaceWhiteList = the addresses
+// (127.0.0.1 always among them, see resolve_network), and the builtin transports are
+// replaced by explicit ones (use_builtin_transports = false): left on, Fast DDS would add
+// its own UDPv4 transport without the allowlist and use every interface anyway. Transport
+// Default keeps shared memory beside the restricted UDPv4 (same-host traffic, which never
+// reaches a network interface); UdpOnly has UDPv4 alone.
+// Security: the DDS-Security plugin properties when `security` is not empty, with multicast
+// and unicast discovery and with an allowlist.
+// Statistics: property `fastdds.statistics` = the topics joined by ';' when `statistics` is
+// not empty (statistics_settings.hpp); nothing otherwise.
+//
+// Throws NetworkError for a combination that cannot work (ShmOnly with unicast or server
+// discovery, or with an allowlist; server discovery with DDS-Security, kServerWithSecurity
+// says why); the config and pmuctl refuse these first, naming the line or the option.
+
+#include <fastdds/dds/domain/qos/DomainParticipantQos.hpp>
+#include <string>
+#include <vector>
+
+#include "pmu/config/network_settings.hpp"
+#include "pmu/config/transport_choice.hpp"
+#include "pmu/security/security_files.hpp"
+
+namespace pmu::dds {
+
+eprosima::fastdds::dds::DomainParticipantQos participant_qos(const std::string& name, Transport transport,
+                                                             const ResolvedNetwork& network,
+                                                             const SecurityFiles& security,
+                                                             const std::vector<std::string>& statistics = {});
+
+}  // namespace pmu::dds

@@ -1,0 +1,34 @@
+#pragma once
+// A PMU's telemetry packet as the contract's sample (idl/telemetry.idl), filled in one place
+// for the DDS publisher and for `pmuctl decode --mcap`, which writes the same samples' CDR
+// bytes into an MCAP file without a DDS participant.
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "pmu/codec/decode.hpp"
+#include "pmu/idl/telemetry.h"
+#include "pmu/session/device_state.hpp"
+
+namespace pmu::service {
+
+// Values only; the keys are the caller's.
+void fill(pmu::Voltages& s, const codec::Voltages& v);
+void fill(pmu::Currents& s, const codec::Currents& c);
+void fill(pmu::BatteryEnergy& s, const codec::BatteryEnergy& e);
+void fill(pmu::Temperatures& s, const codec::Temperatures& t);
+void fill(pmu::Status& s, const codec::Status& st);
+
+struct TelemetryCdr {
+  const char* topic = nullptr;  // topics::kVoltages, ...
+  // The serialized payload as a DataWriter sends it: the 4-byte encapsulation header
+  // (CDR little-endian) and the body, by the generated code.
+  std::vector<std::uint8_t> bytes;
+};
+
+// The sample of a telemetry packet (0x00..0x04) with its keys; false for any other packet
+// and for a zero-length request. Does not throw.
+bool telemetry_cdr(const std::string& vehicle, const DeviceKey& key, const codec::PmuMessage& m, TelemetryCdr& out);
+
+}  // namespace pmu::service

@@ -1,0 +1,193 @@
+#include "pmu/dds/dds_context.hpp"
+
+#include <fastdds/dds/domain/DomainParticipantFactory.hpp>
+
+#include <cstdlib>
+#include <fstream>
+#include <memory>
+#include <mutex>
+
+#include "pmu/dds/dds_capacity.hpp"
+#include "pmu/dds/dds_participant.hpp"
+#include "pmu/dds/dds_qos_file.hpp"
+#include "pmu/dds/dds_type_objects.hpp"
+#include "pmu/sysconf_dir.hpp"
+
+namespace pmu::dds {
+namespace {
+
+using namespace eprosima::fastdds::dds;
+
+bool readable(const std::string& path) { return std::ifstream(path).good(); }
+
+// Fast DDS 2.9.1 (Debian bookworm's) can hang forever deleting a reliable writer whose readers
+// have not acknowledged everything. Its destructor (RTPSWriter::deinit) returns the history's
+// samples to their pool one at a time, dropping the writer's lock between them, while the history
+// still lists them with their sequence numbers reset to 0, and the periodic heartbeat stays armed
+// until after that. A heartbeat that fires in between walks the history for holes
+// (StatefulWriter::add_gaps_for_holes_in_history_): from the first freed sample's 0 + 1 it counts
+// up to the next one's number, 0 again, i.e. through the whole 64-bit sequence space, holding
+// the lock the destructor waits for. The four-writer burst of command_boundary_test.cpp hung so
+// in a client's teardown. Fixed upstream in 2.13.0 (eProsima/Fast-DDS#4076; backported to 2.6.10,
+// 2.10.3, 2.11.3 and 2.12.2, never to 2.9).
+// The heartbeat needs a matched reader: with none it sends nothing and its timer is cancelled.
+// Moving the publisher to a partition nobody subscribes to unmatches every reader of its writers
+// at once (Fast DDS re-pairs a writer synchronously when its publisher's QoS changes), so the
+// deletion that follows has nobody to send a heartbeat to. Readers lose nothing they would have
+// kept: a deleted writer repairs nothing either. The partition starts with '#', which no vehicle
+// name can (vehicle.hpp), so even the every-vehicle readers' pattern does not match it.
+constexpr const char* kClosingPartition = "#pmu-dds-closing";
+
+void unmatch_writers_before_deleting_them(Publisher& publisher) {
+  PublisherQos qos = publisher.get_qos();
+  qos.partition().clear();
+  qos.partition().push_back(kClosingPartition);
+  (void)publisher.set_qos(qos);  // if refused, the deletion runs as before: nothing else to do
+}
+
+// `"uav1"`, or `the default partition` for "", in messages.
+std::string partition_text(const std::string& p) {
+  return p.empty() ? std::string("the default partition") : "partition \"" + p + "\"";
+}
+
+// `"", "uav1"`: the granted patterns, as the permissions spell them.
+std::string patterns_text(const std::vector<std::string>& patterns) {
+  std::string s;
+  for (const auto& p : patterns) s += (s.empty() ? "\"" : ", \"") + p + "\"";
+  return s;
+}
+
+}  // namespace
+
+std::optional<std::string> statistics_topic_not_granted(const SecurityFiles& security,
+                                                        const std::vector<std::string>& topics) {
+  for (const auto& topic : topics)
+    if (const auto grant = topic_grant(security, topic, true); !grant || !grant->allowed ||
+                                                                partition_not_granted({}, grant->partitions))
+      return topic;
+  return std::nullopt;
+}
+
+std::string default_qos_file() {
+  if (const char* env = std::getenv("PMU_QOS_FILE"); env && *env) return env;
+  // Only installed places: a binary that also looked in its build tree would carry that
+  // path into the package. Runs from a build directory set PMU_QOS_FILE.
+  if (const char* installed = PMU_SYSCONFDIR "/qos.xml"; readable(installed)) return installed;
+  // The client tools are packaged without the daemon's /etc/pmu-dds (pmu-dds-tools): their
+  // copy of the profiles is read-only data. The site's edited /etc file still wins.
+  if (const char* shipped = PMU_DATADIR "/qos.xml"; readable(shipped)) return shipped;
+  return {};
+}
+
+DdsContext::DdsContext(int domain, const std::string& qos_file, const std::string& participant_name,
+                       const SecurityFiles& security, Transport transport, const ResolvedNetwork& network,
+                       const Partitions& partitions, const std::vector<std::string>& statistics, bool type_objects)
+    : domain_(domain), type_objects_(type_objects), secure_(!security.empty()), security_(security), partitions_(partitions) {
+  const std::string file = qos_file.empty() ? default_qos_file() : qos_file;
+  qos_file_ = file;
+  if (file.empty()) throw DdsError("no QoS profile file: neither " PMU_SYSCONFDIR "/qos.xml nor " PMU_DATADIR "/qos.xml exists; install deploy/qos.xml, set PMU_QOS_FILE or set qos_file");
+  load_qos_profiles(file);
+  // Before any endpoint exists: Fast DDS copies a type's object into the endpoint's discovery
+  // data when the endpoint is created, from what is registered then.
+  if (type_objects_) register_type_objects();
+  // Fast DDS creates statistics writers in the default partition when the participant is
+  // enabled; a writer the permissions refuse is only logged, and the topic stays silent.
+  if (secure_)
+    if (const auto topic = statistics_topic_not_granted(security_, statistics))
+      throw DdsError("dds_statistics: this identity's permissions do not allow publishing " + *topic +
+                     " in the default partition (DDS-Security; docs/interface.md section 6 says what to grant)");
+  // Transports, discovery, interfaces, security and statistics: dds_participant.hpp says what each sets.
+  DomainParticipantQos pqos;
+  try {
+    pqos = participant_qos(participant_name, transport, network, security, statistics);
+  } catch (const NetworkError& e) {
+    throw DdsError(e.what());
+  }
+  // The listener from the start: discovery is not replayed to one set later.
+  participant_ = DomainParticipantFactory::get_instance()->create_participant(static_cast<DomainId_t>(domain), pqos,
+                                                                              &remote_writers_, StatusMask::none());
+  if (!participant_)
+    throw DdsError("cannot create a DDS participant on domain " + std::to_string(domain) +
+                   (secure_ ? " with DDS-Security (see the Fast DDS SECURITY error above)" : "") +
+                   (network.mode == DiscoveryMode::Multicast && network.interface_addresses.empty()
+                        ? ""
+                        : " (" + network.summary + ")"));
+  PublisherQos pub_qos = PUBLISHER_QOS_DEFAULT;
+  for (const auto& p : partitions.publisher) pub_qos.partition().push_back(p.c_str());
+  SubscriberQos sub_qos = SUBSCRIBER_QOS_DEFAULT;
+  for (const auto& p : partitions.subscriber) sub_qos.partition().push_back(p.c_str());
+  publisher_ = participant_->create_publisher(pub_qos);
+  subscriber_ = participant_->create_subscriber(sub_qos);
+  if (!publisher_ || !subscriber_) {
+    DomainParticipantFactory::get_instance()->delete_participant(participant_);
+    throw DdsError("cannot create a DDS publisher/subscriber on domain " + std::to_string(domain) +
+                   (secure_ ? " (DDS-Security: this identity's permissions may not allow its vehicle's partition)" : ""));
+  }
+}
+
+DdsContext::~DdsContext() {
+  if (!participant_) return;
+  unmatch_writers_before_deleting_them(*publisher_);
+  participant_->delete_contained_entities();
+  DomainParticipantFactory::get_instance()->delete_participant(participant_);
+}
+
+Topic& DdsContext::topic(const std::string& name, TypeSupport type) {
+  if (auto it = topics_.find(name); it != topics_.end()) return *it->second;
+  const std::string type_name = type.get_type_name();
+  announce_type_object(type, type_objects_);  // never TypeInformation; the type object when asked and self-contained
+  if (type.register_type(participant_) != ReturnCode_t::RETCODE_OK)
+    throw DdsError("cannot register DDS type " + type_name);
+  Topic* t = participant_->create_topic(name, type_name, TOPIC_QOS_DEFAULT);
+  if (!t) throw DdsError("cannot create DDS topic " + name);
+  topics_[name] = t;
+  return *t;
+}
+
+DataWriter& DdsContext::writer(Topic& topic, const std::string& profile, DataWriterListener* listener) {
+  DataWriter* w = publisher_->create_datawriter_with_profile(&topic, profile, listener);
+  if (!w) refused(topic.get_name(), profile, true);
+  const DataWriterQos q = w->get_qos();
+  if (const auto s = capacity_shortfall(profile, EndpointKind::Writer, q.resource_limits(), q.history()); !s.empty()) {
+    publisher_->delete_datawriter(w);
+    throw DdsError(qos_file_ + ": <data_writer profile_name=\"" + profile + "\"> (" + topic.get_name() + "): " + s +
+                   ": raise its <resourceLimitsQos> (deploy/qos.xml says how each number is derived)");
+  }
+  return *w;
+}
+
+DataReader& DdsContext::reader(Topic& topic, const std::string& profile, DataReaderListener* listener) {
+  DataReader* r = subscriber_->create_datareader_with_profile(&topic, profile, listener);
+  if (!r) refused(topic.get_name(), profile, false);
+  const DataReaderQos q = r->get_qos();
+  if (const auto s = capacity_shortfall(profile, EndpointKind::Reader, q.resource_limits(), q.history()); !s.empty()) {
+    subscriber_->delete_datareader(r);
+    throw DdsError(qos_file_ + ": <data_reader profile_name=\"" + profile + "\"> (" + topic.get_name() + "): " + s +
+                   ": raise its <resourceLimitsQos> (deploy/qos.xml says how each number is derived)");
+  }
+  return *r;
+}
+
+void DdsContext::refused(const std::string& topic, const std::string& profile, bool publish) const {
+  const std::string what = std::string("cannot create a ") + (publish ? "writer" : "reader") + " for " + topic +
+                           " with QoS profile '" + profile + "'";
+  if (!secure_) throw DdsError(what);
+  // Fast DDS says why only in its log (its Access-Permissions plugin's "... partition not
+  // found in rule"); the permissions document says it too, so the message can name it.
+  const std::string verb = publish ? "publishing" : "subscribing to";
+  const std::vector<std::string>& partitions = publish ? partitions_.publisher : partitions_.subscriber;
+  const auto grant = topic_grant(security_, topic, publish);
+  if (grant && !grant->allowed)
+    throw DdsError(what + " (DDS-Security: this identity's permissions do not allow " + verb + " it: grant '" +
+                   grant->grant + "' has no allow rule for " + topic + ")");
+  if (grant) {
+    if (const auto p = partition_not_granted(partitions, grant->partitions))
+      throw PartitionNotGranted(what + " (DDS-Security: this identity's permissions do not allow " + verb + " it in " +
+                                    partition_text(*p) + ": grant '" + grant->grant + "' allows it only in " +
+                                    patterns_text(grant->partitions) + ")",
+                                *p);
+  }
+  throw DdsError(what + " (DDS-Security: this identity's permissions may not allow " + verb + " it)");
+}
+
+}  // namespace pmu::dds

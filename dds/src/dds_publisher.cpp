@@ -1,0 +1,439 @@
+#include "pmu/dds/dds_publisher.hpp"
+
+#include <spdlog/spdlog.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <limits>
+#include <string_view>
+#include <mutex>
+#include <set>
+#include <tuple>
+#include <utility>
+
+#include "pmu/config/capacity.hpp"
+#include "pmu/config/low_rate.hpp"
+#include "pmu/dds/telemetry_samples.hpp"
+#include "pmu/idl/canopen.h"
+#include "pmu/idl/canopenPubSubTypes.h"
+#include "pmu/idl/command.h"
+#include "pmu/idl/commandPubSubTypes.h"
+#include "pmu/idl/state.h"
+#include "pmu/idl/statePubSubTypes.h"
+#include "pmu/idl/telemetry.h"
+#include "pmu/idl/telemetryPubSubTypes.h"
+#include "pmu/idl/topics.hpp"
+#include "pmu/session/log_throttle.hpp"
+
+namespace pmu::service {
+namespace {
+
+using namespace eprosima::fastdds::dds;
+using codec::Parameter;
+
+float f(double v) { return static_cast<float>(v); }
+
+eprosima::fastrtps::Time_t dds_time(std::chrono::system_clock::time_point t) {
+  const auto ns = std::chrono::duration_cast<std::chrono::nanoseconds>(t.time_since_epoch()).count();
+  eprosima::fastrtps::Time_t out;
+  out.seconds = static_cast<std::int32_t>(ns / 1000000000);
+  out.nanosec = static_cast<std::uint32_t>(ns % 1000000000);
+  return out;
+}
+
+constexpr auto kReportInterval = std::chrono::seconds(5);
+
+const char* why(ReturnCode_t rc) {
+  if (rc == ReturnCode_t::RETCODE_OUT_OF_RESOURCES) return "out of resources";
+  if (rc == ReturnCode_t::RETCODE_TIMEOUT) return "timeout";
+  if (rc == ReturnCode_t::RETCODE_NOT_ENABLED) return "writer not enabled";
+  if (rc == ReturnCode_t::RETCODE_BAD_PARAMETER) return "bad parameter";
+  if (rc == ReturnCode_t::RETCODE_PRECONDITION_NOT_MET) return "precondition not met";
+  return "error";
+}
+
+template <class T>
+void set_key(T& s, const std::string& vehicle, const DeviceKey& k) {
+  s.vehicle(vehicle);
+  s.bus(k.bus);
+  s.address(k.address);
+}
+
+// The battery's node or the MPPT's device id fits an octet (node 1..127, device 0..7).
+std::uint8_t octet_id(const DeviceKey& k) { return static_cast<std::uint8_t>(k.address & 0xFF); }
+
+// A CANopen state's value by its contract name: float fields carry NaN when not received,
+// integer and boolean fields 0 (the `received` mask tells them apart).
+template <std::size_t N>
+class Values {
+ public:
+  Values(const CanOpenValues<N>& state, const CanOpenValue (&table)[N]) : state_(state), table_(table) {}
+  float real(std::string_view name) const {
+    const auto i = slot(name);
+    return i < N ? f(state_.values[i]) : std::numeric_limits<float>::quiet_NaN();
+  }
+  std::uint32_t u32(std::string_view name) const {
+    const auto i = slot(name);
+    return i < N && state_.received(i) ? static_cast<std::uint32_t>(state_.values[i]) : 0;
+  }
+  std::uint8_t u8(std::string_view name) const { return static_cast<std::uint8_t>(u32(name) & 0xFF); }
+  bool flag(std::string_view name) const { return u32(name) != 0; }
+
+ private:
+  std::size_t slot(std::string_view name) const {
+    for (std::size_t i = 0; i < N; ++i)
+      if (table_[i].name == name) return i;
+    return N;
+  }
+  const CanOpenValues<N>& state_;
+  const CanOpenValue (&table_)[N];
+};
+
+}  // namespace
+
+struct DdsPublisher::Writers {
+  explicit Writers(std::chrono::milliseconds low_rate_period) : low_rate(low_rate_period) {}
+  std::string vehicle;
+  // pmu/low_rate/*, in packet order 0x00..0x04; null when the low-rate topics are off.
+  std::array<DataWriter*, LowRateGate::kPackets> low{};
+  LowRateGate low_rate;
+  DataWriter* voltages;
+  DataWriter* currents;
+  DataWriter* energy;
+  DataWriter* temperatures;
+  DataWriter* status;
+  DataWriter* config;
+  DataWriter* info;
+  DataWriter* health;
+  // Null when the service serves no battery or MPPT (not offered).
+  DataWriter* battery = nullptr;
+  DataWriter* battery_cells = nullptr;
+  DataWriter* mppt = nullptr;
+  // Bus workers run in threads of their own and share these writers and the rest below.
+  std::mutex mutex;
+  std::set<std::tuple<std::string, DeviceKind, std::uint16_t>> admitted;
+  LogThrottle failure_reports{kReportInterval};
+  LogThrottle refusal_reports{kReportInterval};
+};
+
+DdsPublisher::DdsPublisher(dds::DdsContext& dds, std::chrono::milliseconds telemetry_deadline, std::string vehicle,
+                           std::chrono::milliseconds low_rate_period,
+                           std::optional<std::chrono::milliseconds> canopen_deadline)
+    : w_(std::make_unique<Writers>(low_rate_period)) {
+  w_->vehicle = std::move(vehicle);
+  auto telemetry = [&](const char* name, TypeSupport type, std::chrono::milliseconds deadline) {
+    DataWriter& w = dds.writer(dds.topic(name, type), qos_profiles::kTelemetry);
+    DataWriterQos q = w.get_qos();
+    const auto ns = std::chrono::duration_cast<std::chrono::nanoseconds>(deadline).count();
+    q.deadline().period = eprosima::fastrtps::Duration_t(static_cast<std::int32_t>(ns / 1000000000),
+                                                         static_cast<std::uint32_t>(ns % 1000000000));
+    if (w.set_qos(q) != ReturnCode_t::RETCODE_OK)
+      throw dds::DdsError(std::string("cannot set the DEADLINE of ") + name);
+    return &w;
+  };
+  auto state = [&](const char* name, TypeSupport type) {
+    return &dds.writer(dds.topic(name, type), qos_profiles::kState);
+  };
+  const auto d = telemetry_deadline;
+  w_->voltages = telemetry(topics::kVoltages, TypeSupport(new pmu::VoltagesPubSubType()), d);
+  w_->currents = telemetry(topics::kCurrents, TypeSupport(new pmu::CurrentsPubSubType()), d);
+  w_->energy = telemetry(topics::kBatteryEnergy, TypeSupport(new pmu::BatteryEnergyPubSubType()), d);
+  w_->temperatures = telemetry(topics::kTemperatures, TypeSupport(new pmu::TemperaturesPubSubType()), d);
+  w_->status = telemetry(topics::kStatus, TypeSupport(new pmu::StatusPubSubType()), d);
+  if (w_->low_rate.enabled()) {
+    // The same types on topics of their own: a reader of one never matches the other's writer.
+    const auto low = std::max(telemetry_deadline, 3 * low_rate_period);
+    w_->low[0] = telemetry(topics::kLowRateVoltages, TypeSupport(new pmu::VoltagesPubSubType()), low);
+    w_->low[1] = telemetry(topics::kLowRateCurrents, TypeSupport(new pmu::CurrentsPubSubType()), low);
+    w_->low[2] = telemetry(topics::kLowRateBatteryEnergy, TypeSupport(new pmu::BatteryEnergyPubSubType()), low);
+    w_->low[3] = telemetry(topics::kLowRateTemperatures, TypeSupport(new pmu::TemperaturesPubSubType()), low);
+    w_->low[4] = telemetry(topics::kLowRateStatus, TypeSupport(new pmu::StatusPubSubType()), low);
+  }
+  if (canopen_deadline) {
+    const auto cd = *canopen_deadline;
+    w_->battery = telemetry(topics::kBattery, TypeSupport(new pmu::BatteryPubSubType()), cd);
+    w_->battery_cells = telemetry(topics::kBatteryCells, TypeSupport(new pmu::BatteryCellsPubSubType()), cd);
+    w_->mppt = telemetry(topics::kMppt, TypeSupport(new pmu::MpptPubSubType()), cd);
+  }
+  w_->config = state(topics::kConfig, TypeSupport(new pmu::ConfigPubSubType()));
+  w_->info = state(topics::kInfo, TypeSupport(new pmu::DeviceInfoPubSubType()));
+  w_->health = state(topics::kHealth, TypeSupport(new pmu::HealthPubSubType()));
+}
+
+DdsPublisher::~DdsPublisher() = default;
+
+bool DdsPublisher::admit(const DeviceKey& key) {
+  const auto id = std::make_tuple(key.bus, key.kind, key.address);
+  if (w_->admitted.count(id)) return true;
+  if (w_->admitted.size() < service::kMaxDevicesPerService) {
+    w_->admitted.insert(id);
+    return true;
+  }
+  const auto refused = refused_.fetch_add(1, std::memory_order_relaxed) + 1;
+  failures_.fetch_add(1, std::memory_order_relaxed);
+  if (const auto held = w_->refusal_reports.allow(LogThrottle::Clock::now()))
+    spdlog::error("{}/{}: not published on DDS: this service already publishes {} PMUs, the capacity its DDS "
+                  "writers are sized for (kMaxDevicesPerService); {} sample(s) of PMUs over capacity not "
+                  "published so far{}",
+                  key.bus, key.address, service::kMaxDevicesPerService, refused,
+                  *held ? " (" + std::to_string(*held) + " such messages held back)" : std::string());
+  return false;
+}
+
+void DdsPublisher::count(bool ok, const char* topic, const DeviceKey& key, const char* reason) {
+  if (ok) {
+    written_.fetch_add(1, std::memory_order_relaxed);
+    return;
+  }
+  const auto total = failures_.fetch_add(1, std::memory_order_relaxed) + 1;
+  if (const auto held = w_->failure_reports.allow(LogThrottle::Clock::now()))
+    spdlog::warn("{}/{}: DDS write to {} failed ({}); {} sample(s) not published so far{}", key.bus, key.address,
+                 topic, reason, total,
+                 *held ? " (" + std::to_string(*held) + " failures not logged since the last message)" : std::string());
+}
+
+void DdsPublisher::count_failed_write(const char* topic, const DeviceKey& key, const char* why) {
+  std::lock_guard<std::mutex> lock(w_->mutex);
+  count(false, topic, key, why);
+}
+
+void DdsPublisher::on_telemetry(const DeviceKey& key, const codec::PmuMessage& m,
+                                std::chrono::system_clock::time_point received) {
+  const auto ts = dds_time(received);
+  std::lock_guard<std::mutex> lock(w_->mutex);
+  if (!admit(key)) return;
+  auto write_one = [&](DataWriter* w, void* sample) {
+    const ReturnCode_t rc = w->write_w_timestamp(sample, HANDLE_NIL, ts);
+    count(rc == ReturnCode_t::RETCODE_OK, w->get_topic()->get_name().c_str(), key, why(rc));
+  };
+  // `packet`: 0x00..0x04, the index of the low-rate writer.
+  auto write = [&](DataWriter* w, void* sample, std::size_t packet) {
+    write_one(w, sample);
+    if (w_->low_rate.due(key.bus, key.address, packet, received)) write_one(w_->low[packet], sample);
+  };
+  if (const auto* v = std::get_if<codec::Voltages>(&m.payload)) {
+    pmu::Voltages s;
+    set_key(s, w_->vehicle, key);
+    fill(s, *v);
+    write(w_->voltages, &s, 0);
+  } else if (const auto* c = std::get_if<codec::Currents>(&m.payload)) {
+    pmu::Currents s;
+    set_key(s, w_->vehicle, key);
+    fill(s, *c);
+    write(w_->currents, &s, 1);
+  } else if (const auto* e = std::get_if<codec::BatteryEnergy>(&m.payload)) {
+    pmu::BatteryEnergy s;
+    set_key(s, w_->vehicle, key);
+    fill(s, *e);
+    write(w_->energy, &s, 2);
+  } else if (const auto* t = std::get_if<codec::Temperatures>(&m.payload)) {
+    pmu::Temperatures s;
+    set_key(s, w_->vehicle, key);
+    fill(s, *t);
+    write(w_->temperatures, &s, 3);
+  } else if (const auto* st = std::get_if<codec::Status>(&m.payload)) {
+    pmu::Status s;
+    set_key(s, w_->vehicle, key);
+    fill(s, *st);
+    write(w_->status, &s, 4);
+  }
+}
+
+void DdsPublisher::on_config(const DeviceKey& key, const ConfigState& c) {
+  pmu::Config s;
+  set_key(s, w_->vehicle, key);
+  auto raw8 = [&](Parameter p) {
+    return static_cast<std::uint8_t>(c.raw[static_cast<std::size_t>(p)].value_or(0) & 0xFF);
+  };
+  s.avionics_voltage(f(c.value(Parameter::AvionicsVoltage)));
+  s.payload_voltage(f(c.value(Parameter::PayloadVoltage)));
+  s.servo_voltage(f(c.value(Parameter::ServoVoltage)));
+  s.battery_voltage(f(c.value(Parameter::BatteryVoltage)));
+  s.packet_period(f(c.value(Parameter::PacketPeriod)));
+  s.packets_streamed(raw8(Parameter::PacketsStreamed));
+  s.temperature_offset(raw8(Parameter::TemperatureOffset));
+  s.upper_temperature_limit(raw8(Parameter::UpperTemperatureLimit));
+  s.power_up_state(raw8(Parameter::PowerUpState));
+  s.cranking_time(f(c.value(Parameter::CrankingTime)));
+  s.can_address(static_cast<std::uint16_t>(c.raw[static_cast<std::size_t>(Parameter::CanAddress)].value_or(key.address)));
+  s.outputs(c.outputs.value_or(0));
+  s.generation_enabled(c.generation_enabled.value_or(false));
+  std::lock_guard<std::mutex> lock(w_->mutex);
+  if (!admit(key)) return;
+  // DataWriter::write(void*) returns bool in Fast DDS 2.x, without a reason.
+  count(w_->config->write(&s), topics::kConfig, key, "write returned false");
+}
+
+void DdsPublisher::on_info(const DeviceKey& key, const InfoState& i) {
+  pmu::DeviceInfo s;
+  set_key(s, w_->vehicle, key);
+  s.serial_number(i.serial_number);
+  s.firmware_major(i.firmware.firmware_major);
+  s.firmware_minor(i.firmware.firmware_minor);
+  s.build_year(i.firmware.build_year);
+  s.build_month(i.firmware.build_month);
+  s.build_day(i.firmware.build_day);
+  for (const auto feature : codec::kAllFeatures)
+    if (codec::supports(i.firmware.version(), feature)) s.features().emplace_back(std::string(codec::feature_name(feature)));
+  std::lock_guard<std::mutex> lock(w_->mutex);
+  if (!admit(key)) return;
+  count(w_->info->write(&s), topics::kInfo, key, "write returned false");
+}
+
+void DdsPublisher::on_health(const DeviceKey& key, const HealthReport& h) {
+  pmu::Health s;
+  set_key(s, w_->vehicle, key);
+  s.kind(static_cast<pmu::DeviceKind>(static_cast<int>(key.kind)));
+  s.state(static_cast<pmu::HealthState>(static_cast<int>(h.state)));
+  s.bus_state(static_cast<pmu::BusState>(static_cast<int>(h.bus_state)));
+  s.last_frame_age(f(h.last_frame_age));
+  s.frames_received(h.frames_received);
+  s.frames_sent(h.frames_sent);
+  s.decode_errors(h.decode_errors);
+  s.bus_errors(h.bus_errors);
+  s.rx_dropped(h.rx_dropped);
+  s.timeouts(h.timeouts);
+  s.reconnects(h.reconnects);
+  std::lock_guard<std::mutex> lock(w_->mutex);
+  if (!admit(key)) return;
+  s.publish_failures(failures_.load(std::memory_order_relaxed));
+  count(w_->health->write(&s), topics::kHealth, key, "write returned false");
+}
+
+void DdsPublisher::on_gone(const DeviceKey& key) {
+  std::lock_guard<std::mutex> lock(w_->mutex);
+  if (!w_->admitted.erase(std::make_tuple(key.bus, key.kind, key.address))) return;  // never published
+  // A writer that never wrote this key answers PRECONDITION_NOT_MET: nothing to dispose there.
+  // Unregistered, not only disposed: a reader's DEADLINE must stop watching the old key. Fast
+  // DDS 2.9 then logs "Could not set the next deadline in the history" once per writer with a
+  // DEADLINE (telemetry, low rate): it looks for the instance it has just let go; the
+  // unregistration itself returns OK (measured with `pmu-service --bus sim`).
+  auto gone = [&](DataWriter* w, void* sample) {
+    if (w == nullptr) return;
+    const ReturnCode_t rc = w->unregister_instance(sample, HANDLE_NIL);
+    if (rc != ReturnCode_t::RETCODE_PRECONDITION_NOT_MET)
+      count(rc == ReturnCode_t::RETCODE_OK, w->get_topic()->get_name().c_str(), key, why(rc));
+  };
+  pmu::Health h;
+  set_key(h, w_->vehicle, key);
+  h.kind(static_cast<pmu::DeviceKind>(static_cast<int>(key.kind)));
+  gone(w_->health, &h);
+  if (key.kind != DeviceKind::Pmu) return;  // batteries and MPPTs keep their node and device id
+  pmu::Voltages v;
+  set_key(v, w_->vehicle, key);
+  pmu::Currents c;
+  set_key(c, w_->vehicle, key);
+  pmu::BatteryEnergy e;
+  set_key(e, w_->vehicle, key);
+  pmu::Temperatures t;
+  set_key(t, w_->vehicle, key);
+  pmu::Status st;
+  set_key(st, w_->vehicle, key);
+  void* telemetry[LowRateGate::kPackets] = {&v, &c, &e, &t, &st};
+  DataWriter* live[LowRateGate::kPackets] = {w_->voltages, w_->currents, w_->energy, w_->temperatures, w_->status};
+  for (std::size_t i = 0; i < LowRateGate::kPackets; ++i) {
+    gone(live[i], telemetry[i]);
+    gone(w_->low[i], telemetry[i]);
+  }
+  pmu::Config cfg;
+  set_key(cfg, w_->vehicle, key);
+  gone(w_->config, &cfg);
+  pmu::DeviceInfo info;
+  set_key(info, w_->vehicle, key);
+  gone(w_->info, &info);
+}
+
+}  // namespace pmu::service
+
+namespace pmu::service {
+
+void DdsPublisher::write_at(DataWriter* writer, void* sample, const DeviceKey& key,
+                            std::chrono::system_clock::time_point when) {
+  if (writer == nullptr) return;  // topics not offered: no session can produce these samples
+  const ReturnCode_t rc = writer->write_w_timestamp(sample, HANDLE_NIL, dds_time(when));
+  count(rc == ReturnCode_t::RETCODE_OK, writer->get_topic()->get_name().c_str(), key, why(rc));
+}
+
+void DdsPublisher::on_battery(const DeviceKey& key, const BatteryState& b, std::chrono::system_clock::time_point newest) {
+  pmu::Battery s;
+  s.vehicle(w_->vehicle);
+  s.bus(key.bus);
+  s.node(octet_id(key));
+  const Values<kBatteryValueCount> v(b, kBatteryValues);
+  s.voltage(v.real("voltage"));
+  s.current(v.real("current"));
+  s.current_discharge(v.real("current_discharge"));
+  s.current_charge(v.real("current_charge"));
+  s.state_of_charge(v.real("state_of_charge"));
+  s.time_to_go(v.real("time_to_go"));
+  s.cell_temperature_high(v.real("cell_temperature_high"));
+  s.cell_temperature_low(v.real("cell_temperature_low"));
+  s.cell_voltage_high(v.real("cell_voltage_high"));
+  s.cell_voltage_low(v.real("cell_voltage_low"));
+  s.bms_state(v.u32("bms_state"));
+  s.temperature_1(v.real("temperature_1"));
+  s.temperature_2(v.real("temperature_2"));
+  s.temperature_3(v.real("temperature_3"));
+  s.temperature_4(v.real("temperature_4"));
+  s.power_level(v.real("power_level"));
+  s.received(b.received_mask());
+  std::lock_guard<std::mutex> lock(w_->mutex);
+  if (!admit(key)) return;
+  write_at(w_->battery, &s, key, newest);
+}
+
+void DdsPublisher::on_battery_cells(const DeviceKey& key, const BatteryCellsState& c,
+                                    std::chrono::system_clock::time_point newest) {
+  pmu::BatteryCells s;
+  s.vehicle(w_->vehicle);
+  s.bus(key.bus);
+  s.node(octet_id(key));
+  for (std::size_t cell = 0; cell < c.volts.size(); ++cell) {
+    if (std::isnan(c.volts[cell])) continue;
+    pmu::BatteryCell one;
+    one.cell(static_cast<std::uint8_t>(cell));
+    one.cell_voltage(f(c.volts[cell]));
+    s.cells().push_back(one);
+  }
+  std::lock_guard<std::mutex> lock(w_->mutex);
+  if (!admit(key)) return;
+  write_at(w_->battery_cells, &s, key, newest);
+}
+
+void DdsPublisher::on_mppt(const DeviceKey& key, const MpptState& m, std::chrono::system_clock::time_point newest) {
+  pmu::Mppt s;
+  s.vehicle(w_->vehicle);
+  s.bus(key.bus);
+  s.device(octet_id(key));
+  const Values<kMpptValueCount> v(m, kMpptValues);
+  s.voltage_output_raw(v.real("voltage_output_raw"));
+  s.current_output_raw(v.real("current_output_raw"));
+  s.voltage_out_sw_raw(v.real("voltage_out_sw_raw"));
+  s.mppt_state(v.u8("mppt_state"));
+  s.safety_enabled(v.flag("safety_enabled"));
+  s.pwm_enabled(v.flag("pwm_enabled"));
+  s.temperature(v.real("temperature"));
+  s.voltage_panel_1_raw(v.real("voltage_panel_1_raw"));
+  s.current_panel_1_raw(v.real("current_panel_1_raw"));
+  s.duty_cycle_panel_1(v.real("duty_cycle_panel_1"));
+  s.channel_1_active(v.u8("channel_1_active"));
+  s.voltage_panel_2_raw(v.real("voltage_panel_2_raw"));
+  s.current_panel_2_raw(v.real("current_panel_2_raw"));
+  s.duty_cycle_panel_2(v.real("duty_cycle_panel_2"));
+  s.channel_2_active(v.u8("channel_2_active"));
+  s.voltage_panel_3_raw(v.real("voltage_panel_3_raw"));
+  s.current_panel_3_raw(v.real("current_panel_3_raw"));
+  s.duty_cycle_panel_3(v.real("duty_cycle_panel_3"));
+  s.channel_3_active(v.u8("channel_3_active"));
+  s.voltage_panel_4_raw(v.real("voltage_panel_4_raw"));
+  s.current_panel_4_raw(v.real("current_panel_4_raw"));
+  s.duty_cycle_panel_4(v.real("duty_cycle_panel_4"));
+  s.channel_4_active(v.u8("channel_4_active"));
+  s.received(m.received_mask());
+  std::lock_guard<std::mutex> lock(w_->mutex);
+  if (!admit(key)) return;
+  write_at(w_->mppt, &s, key, newest);
+}
+
+}  // namespace pmu::service

@@ -1,0 +1,106 @@
+#include "pmu/dds/telemetry_samples.hpp"
+
+#include <fastdds/rtps/common/SerializedPayload.h>
+
+#include "pmu/idl/telemetryPubSubTypes.h"
+#include "pmu/idl/topics.hpp"
+
+namespace pmu::service {
+namespace {
+
+float f(double v) { return static_cast<float>(v); }
+
+template <class T>
+void set_key(T& s, const std::string& vehicle, const DeviceKey& k) {
+  s.vehicle(vehicle);
+  s.bus(k.bus);
+  s.address(k.address);
+}
+
+template <class PubSub, class T>
+bool serialize(T& s, std::vector<std::uint8_t>& out) {
+  try {
+    PubSub type;
+    eprosima::fastrtps::rtps::SerializedPayload_t payload(type.getSerializedSizeProvider(&s)());
+    if (!type.serialize(&s, &payload)) return false;
+    out.assign(payload.data, payload.data + payload.length);
+    return true;
+  } catch (...) {  // Fast CDR reports a bound exceeded (a bus name over 15) by throwing
+    return false;
+  }
+}
+
+template <class T, class PubSub, class Codec>
+bool sample(const std::string& vehicle, const DeviceKey& key, const Codec& values, const char* topic,
+            TelemetryCdr& out) {
+  T s;
+  set_key(s, vehicle, key);
+  fill(s, values);
+  out.topic = topic;
+  return serialize<PubSub>(s, out.bytes);
+}
+
+}  // namespace
+
+void fill(pmu::Voltages& s, const codec::Voltages& v) {
+  s.avionics(f(v.avionics));
+  s.output_28v(f(v.output_28v));
+  s.payload(f(v.payload));
+  s.servo(f(v.servo));
+  s.battery_a(f(v.battery_a));
+  s.battery_b(f(v.battery_b));
+  s.generator(f(v.generator));
+}
+
+void fill(pmu::Currents& s, const codec::Currents& c) {
+  s.avionics(f(c.avionics));
+  s.output_28v(f(c.output_28v));
+  s.payload(f(c.payload));
+  s.servo(f(c.servo));
+  s.battery_a(f(c.battery_a));
+  s.battery_b(f(c.battery_b));
+}
+
+void fill(pmu::BatteryEnergy& s, const codec::BatteryEnergy& e) {
+  s.battery_a_mah(e.battery_a_mah);
+  s.battery_b_mah(e.battery_b_mah);
+}
+
+void fill(pmu::Temperatures& s, const codec::Temperatures& t) {
+  s.internal(f(t.internal));
+  s.battery_a(f(t.battery_a));  // NaN stays NaN: "no sensor"
+  s.battery_b(f(t.battery_b));
+  s.generator(f(t.generator));
+  s.starter(f(t.starter));
+}
+
+void fill(pmu::Status& s, const codec::Status& st) {
+  s.generator_rpm(st.generator_rpm);
+  s.generation_enabled(st.generation_enabled);
+  s.thermal_shutdown(st.thermal_shutdown);
+  s.soa_shutdown(st.soa_shutdown);
+  s.start_button(st.start_button);
+  s.payload_shed(st.payload_shed);
+  s.starter_ready(st.starter_ready);
+  s.avionics_servo_on(st.avionics_servo_on());
+  s.payload_on(st.payload_on());
+  s.charger_a_on(st.charger_a_on());
+  s.charger_b_on(st.charger_b_on());
+}
+
+bool telemetry_cdr(const std::string& vehicle, const DeviceKey& key, const codec::PmuMessage& m, TelemetryCdr& out) {
+  if (m.request) return false;
+  if (const auto* v = std::get_if<codec::Voltages>(&m.payload))
+    return sample<pmu::Voltages, pmu::VoltagesPubSubType>(vehicle, key, *v, topics::kVoltages, out);
+  if (const auto* c = std::get_if<codec::Currents>(&m.payload))
+    return sample<pmu::Currents, pmu::CurrentsPubSubType>(vehicle, key, *c, topics::kCurrents, out);
+  if (const auto* e = std::get_if<codec::BatteryEnergy>(&m.payload))
+    return sample<pmu::BatteryEnergy, pmu::BatteryEnergyPubSubType>(vehicle, key, *e, topics::kBatteryEnergy, out);
+  if (const auto* t = std::get_if<codec::Temperatures>(&m.payload))
+    return sample<pmu::Temperatures, pmu::TemperaturesPubSubType>(vehicle, key, *t, topics::kTemperatures, out);
+  if (const auto* st = std::get_if<codec::Status>(&m.payload))
+    return sample<pmu::Status, pmu::StatusPubSubType>(vehicle, key, *st, topics::kStatus, out);
+  return false;
+}
+
+}  // namespace pmu::service

@@ -1,0 +1,307 @@
+// pmu-service: owns the CAN buses, speaks the PMU protocol, publishes on DDS
+// (interface.md section 3.1). Start-up errors (config, bus, DDS) end the process with a
+// message and a non-zero status before anything is sent on a bus; after start-up nothing
+// throws, and SIGTERM stops it cleanly within a second.
+
+#include <signal.h>
+#include <sys/signalfd.h>
+#include <poll.h>
+#include <unistd.h>
+
+#include <CLI/CLI.hpp>
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <fstream>
+#include <memory>
+#include <optional>
+#include <spdlog/spdlog.h>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "pmu/app/logging.hpp"
+#include "pmu/app/simulated_bus.hpp"
+#include "pmu/app/systemd.hpp"
+#include "pmu/config/config.hpp"
+#include "pmu/config/statistics_settings.hpp"
+#include "pmu/config/vehicle.hpp"
+#include "pmu/dds/dds_commands.hpp"
+#include "pmu/dds/dds_context.hpp"
+#include "pmu/dds/dds_publisher.hpp"
+#include "pmu/dds/startup_check.hpp"
+#include "pmu/dispatch/command_service.hpp"
+#include "pmu/session/bus_worker.hpp"
+#include "pmu/session/moved_addresses.hpp"
+#include "pmu/session/receive_filters.hpp"
+#include "pmu/sysconf_dir.hpp"
+#include "pmu/transport/socketcan_bus.hpp"
+#include "pmu/version.hpp"
+
+namespace {
+
+using namespace pmu;
+using std::chrono::milliseconds;
+
+constexpr const char* kDefaultConfig = PMU_SYSCONFDIR "/pmu-service.yaml";
+
+// Everything one bus needs, torn down in reverse order.
+struct BusRuntime {
+  std::unique_ptr<transport::SimulatedNetwork> network;  // --bus sim only
+  std::unique_ptr<sim::BusRunner> simulator;             // --bus sim only
+  std::unique_ptr<service::BusWorker> worker;
+  std::thread thread;
+};
+
+std::unique_ptr<transport::CanBus> open_bus(const service::BusConfig& bus, const transport::Clock& clock,
+                                            BusRuntime& rt) {
+  if (bus.interface != "sim") {
+    transport::SocketCanOptions options;
+    options.filters = service::receive_filters(bus);
+    auto b = bus.interface.rfind("fd:", 0) == 0
+                 ? transport::SocketCanBus::adopt(transport::UniqueFd(std::stoi(bus.interface.substr(3))), bus.name,
+                                                  options, clock)
+                 : transport::SocketCanBus::open(bus.interface, options, clock);
+    if (!b->has_socket()) {
+      spdlog::warn("{}: interface {} does not exist yet: waiting for it (pmu/health bus_state DOWN), bound when it "
+                   "appears",
+                   bus.name, bus.interface);
+      return b;
+    }
+    const auto& r = b->report();
+    spdlog::info("{}: SocketCAN open, receive buffer {} bytes{}, kernel filters {}, timestamps {}", bus.name,
+                 r.receive_buffer_bytes, r.receive_buffer_forced ? " (forced)" : "", r.kernel_filters ? "on" : "off",
+                 r.kernel_timestamps ? "kernel" : "user");
+    return b;
+  }
+  auto simulated = service::make_simulated_bus(bus, clock);
+  rt.network = std::move(simulated.network);
+  rt.simulator = std::move(simulated.simulator);
+  return std::move(simulated.service_end);
+}
+
+// Called on the main thread while the workers run: only their thread-safe counters.
+std::string summary(const std::vector<BusRuntime>& buses) {
+  std::size_t devices = 0;
+  for (const auto& b : buses) devices += b.worker->device_count();
+  return "serving " + std::to_string(devices) + " PMU(s) on " + std::to_string(buses.size()) + " bus(es)";
+}
+
+int run(const service::Config& cfg, const pmu::dds::ResolvedNetwork& network) {
+  // Signals arrive through a signalfd read by this thread; block them before any thread
+  // starts so every thread inherits the mask.
+  sigset_t signals;
+  sigemptyset(&signals);
+  for (int s : {SIGTERM, SIGINT, SIGHUP}) sigaddset(&signals, s);
+  pthread_sigmask(SIG_BLOCK, &signals, nullptr);
+  transport::UniqueFd sigfd(::signalfd(-1, &signals, SFD_CLOEXEC));
+  if (!sigfd) throw std::runtime_error("signalfd failed");
+
+  transport::SystemClock clock;
+  service::SystemdNotifier systemd;
+
+  milliseconds longest{0};
+  for (const auto& b : cfg.buses)
+    for (const auto& d : b.devices) longest = std::max(longest, d.period);
+  if (longest == milliseconds{0}) longest = milliseconds(1000);
+  // Batteries and MPPTs send each value once per their period; a heard one is taken as 1 s.
+  milliseconds canopen_longest{1000};
+  bool canopen = false;
+  for (const auto& b : cfg.buses) {
+    canopen |= b.wants_canopen();
+    for (const auto& d : b.batteries) canopen_longest = std::max(canopen_longest, d.period);
+    for (const auto& d : b.mppts) canopen_longest = std::max(canopen_longest, d.period);
+    canopen_longest = std::max(canopen_longest, b.canopen_publish_period);
+  }
+
+  spdlog::info("DDS: {}", network.summary);
+  const auto partitions = service::vehicle_partitions(cfg.vehicle);
+  pmu::dds::DdsContext participant(cfg.domain, cfg.qos_file, "pmu-service", cfg.security.files, cfg.dds_transport,
+                                   network, {partitions, partitions}, cfg.dds_statistics, cfg.dds_type_objects);
+  if (cfg.dds_type_objects) spdlog::info("DDS: type objects announced (dds_type_objects)");
+  if (!cfg.dds_statistics.empty())
+    spdlog::info("DDS: Fast DDS statistics on: {}", pmu::dds::statistics_property(cfg.dds_statistics));
+  if (participant.secure())
+    spdlog::info("DDS-Security on: identity {}, permissions {}", cfg.security.files.identity_certificate,
+                 cfg.security.files.permissions);
+  service::DdsPublisher publisher(participant, 3 * longest, cfg.vehicle, cfg.low_rate_period,
+                                  canopen ? std::optional<milliseconds>(3 * canopen_longest) : std::nullopt);
+
+  service::MovedAddressStore moved(service::moved_addresses_path(std::getenv("STATE_DIRECTORY")), cfg);
+  std::vector<BusRuntime> buses(cfg.buses.size());
+  for (std::size_t i = 0; i < cfg.buses.size(); ++i) {
+    auto bus = open_bus(cfg.buses[i], clock, buses[i]);
+    buses[i].worker = std::make_unique<service::BusWorker>(cfg.buses[i], std::move(bus), clock, cfg.timeouts, publisher);
+    // Only a device from the config file has an `address:` that can go stale.
+    buses[i].worker->on_moved([&moved](const service::BusWorker::Moved& m) {
+      if (!m.config_line.empty()) moved.record(m.bus, m.first, m.to, m.serial);
+    });
+    // A unit recorded as moved is followed by its serial before it is heard at its old address.
+    for (const auto& m : moved.moves())
+      if (auto* s = m.bus == cfg.buses[i].name && m.serial ? buses[i].worker->session(m.configured) : nullptr)
+        s->expect_serial(*m.serial);
+  }
+  service::DdsCommandEndpoint command_topics(participant, &publisher, cfg.vehicle);
+  std::vector<service::BusWorker*> workers;
+  for (auto& b : buses) workers.push_back(b.worker.get());
+  service::CommandService commands(workers, cfg.policy, cfg.timeouts, clock,
+                                   [&](const service::CommandReplyData& r) { command_topics.publish(r); });
+  // Declared after everything the running threads use, so it is destroyed first, on every
+  // way out of this function: commands stop first (no new request reaches `commands`, and
+  // the bus workers are still there to finish the ones in flight), then the worker threads
+  // end (nothing runs posted command work or writes a reply any more), and only then are
+  // `commands`, the endpoint, the workers and the publisher destroyed.
+  struct Shutdown {
+    service::DdsCommandEndpoint& command_topics;
+    std::vector<BusRuntime>& buses;
+    ~Shutdown() {
+      command_topics.stop();
+      for (auto& b : buses) b.worker->stop();
+      for (auto& b : buses) {
+        if (b.thread.joinable()) b.thread.join();
+        if (b.simulator) b.simulator->stop();
+      }
+      spdlog::info("pmu-service stopped");
+    }
+  } shutdown{command_topics, buses};
+  for (auto& b : buses) {
+    if (b.simulator) b.simulator->start();
+    b.thread = std::thread([w = b.worker.get()] { w->run(); });
+  }
+  command_topics.start(commands);
+  spdlog::info("pmu-service ready on DDS domain {}: {}", cfg.domain, summary(buses));
+  systemd.ready(summary(buses));
+
+  // Feed the watchdog only while every bus loop keeps turning.
+  const milliseconds check = systemd.watchdog_enabled()
+                                 ? std::chrono::duration_cast<milliseconds>(systemd.watchdog_interval())
+                                 : milliseconds(1000);
+  std::vector<std::uint64_t> last(buses.size(), 0);
+  for (;;) {
+    pollfd p{sigfd.get(), POLLIN, 0};
+    const int n = ::poll(&p, 1, static_cast<int>(std::max(check, milliseconds(10)).count()));
+    if (n > 0) {
+      signalfd_siginfo si{};
+      if (::read(sigfd.get(), &si, sizeof si) == sizeof si) {
+        spdlog::info("signal {} received: stopping", si.ssi_signo);
+        break;
+      }
+    }
+    bool progressing = true;
+    for (std::size_t i = 0; i < buses.size(); ++i) {
+      const auto now = buses[i].worker->progress();
+      if (now == last[i]) {
+        progressing = false;
+        spdlog::warn("bus {}: event loop made no progress in {} ms", cfg.buses[i].name, check.count());
+      }
+      last[i] = now;
+    }
+    if (progressing) systemd.watchdog();
+    systemd.status(summary(buses) + ", " + std::to_string(publisher.samples_written()) + " samples published");
+  }
+
+  systemd.stopping();
+  return 0;
+}
+
+// check_startup's findings, printed: errors as "pmu-service: FILE:LINE: what is wrong",
+// warnings (expiry within warn_days, a key readable by others) logged. The start and
+// --check-config both come here, so they accept the same configurations. Sets the QoS file
+// to the one checked, so that is the one the participant loads.
+bool startup_ok(service::Config& cfg) {
+  const auto check = service::check_startup(cfg);
+  for (const auto& w : check.warnings) spdlog::warn("{}", w);
+  for (const auto& e : check.errors) std::fprintf(stderr, "pmu-service: %s\n", e.c_str());
+  if (!check.ok()) std::fprintf(stderr, "pmu-service: configuration rejected: not starting (nothing was sent)\n");
+  cfg.qos_file = check.qos_file;
+  return check.ok();
+}
+
+// discovery: and interfaces: with every name looked up (interfaces, host names), before any
+// participant or bus is opened; --check-config does it too. A failure ends the start with
+// exit status 1, like a bus that cannot be opened: the interface or the name server may be
+// there at a later start (systemd restarts the unit), unlike a config error (status 2).
+std::optional<pmu::dds::ResolvedNetwork> resolved_network(const service::Config& cfg) {
+  try {
+    return pmu::dds::resolve_network(cfg.network, pmu::dds::system_lookup());
+  } catch (const pmu::dds::NetworkError& e) {
+    std::fprintf(stderr, "pmu-service: %s\n", e.what());
+    return std::nullopt;
+  }
+}
+
+// --check-config: the configured addresses that the running service found moved (its state
+// directory's record, moved_addresses.hpp). False, with FILE:LINE and the value to write, when
+// one is stale.
+bool addresses_current(const service::Config& cfg) {
+  const auto path = service::moved_addresses_path(std::getenv("STATE_DIRECTORY"));
+  const auto record = service::read_moved_addresses(path);
+  for (const auto& e : record.errors) std::fprintf(stderr, "pmu-service: warning: %s (line ignored)\n", e.c_str());
+  const auto stale = service::stale_addresses(cfg, record.moves);
+  for (const auto& s : stale) std::fprintf(stderr, "pmu-service: %s\n", s.c_str());
+  return stale.empty();
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"pmu-service: Millswood 250W PMUs on CAN, served on DDS"};
+  app.set_version_flag("--version", "pmu-service " PMU_VERSION_TEXT);
+  std::string config_path, bus_spec, log_level;
+  std::optional<int> domain;
+  bool check_only = false;
+  app.add_option("--config", config_path, std::string("YAML config file (default ") + kDefaultConfig + ")");
+  app.add_option("--bus", bus_spec, "sim (built-in simulated PMU) or socketcan:IFACE; replaces the config's buses "
+                 "(fd:N: an inherited fd carrying struct can_frame records, for benchmarks)");
+  app.add_option("--domain", domain, "DDS domain id (0..232)")->check(CLI::Range(0, 232));
+  app.add_option("--log-level", log_level, "trace, debug, info, warn, error, critical or off");
+  app.add_flag("--check-config", check_only, "Validate the configuration and exit");
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    // app.exit prints the help or the reason; bad usage is exit status 2 (the man page),
+    // not CLI11's own codes (105 for a value out of range).
+    return app.exit(e) == 0 ? 0 : 2;
+  }
+
+  service::Config cfg;
+  try {
+    if (!config_path.empty()) {
+      cfg = service::load_config(config_path);
+    } else if (bus_spec.empty() || std::ifstream(kDefaultConfig).good()) {
+      cfg = service::load_config(kDefaultConfig);
+    } else {
+      cfg = service::default_sim_config();
+    }
+    if (!bus_spec.empty()) service::override_bus(cfg, bus_spec);
+    if (domain) cfg.domain = *domain;
+  } catch (const service::ConfigError& e) {
+    std::fprintf(stderr, "pmu-service: %s\n", e.what());
+    return 2;
+  }
+  const std::string level = service::choose_log_level(log_level, cfg.log_level);
+  if (!service::is_log_level(level)) {
+    std::fprintf(stderr, "pmu-service: log level '%s' is not one of trace, debug, info, warn, error, critical, off\n",
+                 level.c_str());
+    return 2;
+  }
+  service::setup_logging(level);
+  if (!startup_ok(cfg)) return 2;
+  const auto network = resolved_network(cfg);
+  if (!network) return 1;
+  if (check_only) {
+    if (!addresses_current(cfg)) return 2;
+    std::printf("%s: configuration OK (%zu bus(es)%s)\n", cfg.source.c_str(), cfg.buses.size(),
+                cfg.security.files.empty() ? "" : ", DDS-Security files OK");
+    std::printf("%s: QoS profiles %s OK\n", cfg.source.c_str(), cfg.qos_file.c_str());
+    std::printf("%s: DDS %s\n", cfg.source.c_str(), network->summary.c_str());
+    return 0;
+  }
+  try {
+    return run(cfg, *network);
+  } catch (const std::exception& e) {
+    spdlog::critical("cannot start: {}", e.what());
+    return 1;
+  }
+}

@@ -1,0 +1,94 @@
+#include "pmu/command/policy.hpp"
+
+#include <algorithm>
+#include <array>
+
+#include "pmu/codec/messages.hpp"
+
+namespace pmu::service {
+namespace {
+
+constexpr std::array<std::string_view, kConfirmRuleCount> kRuleNames{
+    "disable_avionics", "reset", "engine_start", "set_can_address", "thermal_shutdown", "power_up_avionics_off",
+    "stop_streaming"};
+
+// What each rule protects against, for the DENIED reason.
+constexpr std::array<std::string_view, kConfirmRuleCount> kRuleWhy{
+    "switches the avionics/servo output off",
+    "resets the PMU (outputs to their power-up state)",
+    "cranks the engine",
+    "moves the PMU to another CAN address",
+    "sets the upper temperature limit to 0, which forces thermal shutdown",
+    "leaves the avionics/servo output off at the next power-up or reset",
+    "sets packets_streamed to 0: the PMU stops the telemetry this service listens for, and goes OFFLINE",
+};
+
+// Judged on the typed request, whose values are already what the wire will carry: a
+// requested 0.0004 that rounds to 0 is 0 here.
+std::optional<ConfirmRule> rule_for(const CommandRequest& r, const DeviceUse& device) {
+  using codec::output_bit::AvionicsServo;
+  if (const auto* off = std::get_if<action::DisableOutputs>(&r.action))
+    return off->mask & AvionicsServo ? std::optional(ConfirmRule::DisableAvionics) : std::nullopt;
+  if (const auto* set = std::get_if<action::SetOutputs>(&r.action))
+    return set->mask & AvionicsServo ? std::nullopt : std::optional(ConfirmRule::DisableAvionics);
+  if (std::holds_alternative<action::Reset>(r.action)) return ConfirmRule::Reset;
+  if (std::holds_alternative<action::EngineStart>(r.action)) return ConfirmRule::EngineStart;
+  if (const auto* p = std::get_if<action::SetParameter>(&r.action)) {
+    switch (p->parameter) {
+      case codec::Parameter::CanAddress: return ConfirmRule::SetCanAddress;
+      case codec::Parameter::UpperTemperatureLimit:
+        return p->raw == 0 ? std::optional(ConfirmRule::ThermalShutdown) : std::nullopt;
+      case codec::Parameter::PowerUpState:
+        return p->raw & AvionicsServo ? std::nullopt : std::optional(ConfirmRule::PowerUpAvionicsOff);
+      case codec::Parameter::AvionicsVoltage:
+      case codec::Parameter::PayloadVoltage:
+      case codec::Parameter::ServoVoltage:
+      case codec::Parameter::BatteryVoltage:
+      case codec::Parameter::PacketsStreamed:
+        return p->raw == 0 && device.streaming ? std::optional(ConfirmRule::StopStreaming) : std::nullopt;
+      case codec::Parameter::PacketPeriod:
+      case codec::Parameter::TemperatureOffset:
+      case codec::Parameter::CrankingTime: return std::nullopt;
+    }
+  }
+  return std::nullopt;
+}
+
+}  // namespace
+
+std::string_view to_string(ConfirmRule r) noexcept { return kRuleNames[static_cast<std::size_t>(r)]; }
+
+std::optional<ConfirmRule> confirm_rule_from_name(std::string_view name) noexcept {
+  for (std::size_t i = 0; i < kRuleNames.size(); ++i)
+    if (kRuleNames[i] == name) return static_cast<ConfirmRule>(i);
+  return std::nullopt;
+}
+
+std::string confirm_rule_names() {
+  std::string names;
+  for (const auto n : kRuleNames) names += (names.empty() ? "" : ", ") + std::string(n);
+  return names;
+}
+
+PolicyVerdict check_policy(const CommandRequest& r, const PolicyConfig& p, const DeviceUse& device) {
+  if (r.kind() == CommandKind::EngineStop) return {};  // never refused by policy
+  if (p.deny[static_cast<std::size_t>(r.kind())])
+    return {CommandResult::Denied, std::string(to_string(r.kind())) + " is denied by the service's policy"};
+  if (const auto rule = rule_for(r, device); rule && p.confirm[static_cast<std::size_t>(*rule)] && !r.confirm) {
+    return {CommandResult::Denied, std::string(to_string(r.kind())) + " " +
+                                       std::string(kRuleWhy[static_cast<std::size_t>(*rule)]) +
+                                       ": it needs confirm (pmuctl --confirm); rule " + std::string(to_string(*rule))};
+  }
+  return {};
+}
+
+bool RateLimiter::allow(std::chrono::steady_clock::time_point now) {
+  if (rate_ <= 0) return true;
+  if (last_) tokens_ = std::min(burst_, tokens_ + std::chrono::duration<double>(now - *last_).count() * rate_);
+  last_ = now;
+  if (tokens_ < 1) return false;
+  tokens_ -= 1;
+  return true;
+}
+
+}  // namespace pmu::service

@@ -1,0 +1,164 @@
+#pragma once
+// pmu-service configuration: a YAML file (deploy/pmu-service.yaml documents every key)
+// with command-line overrides. Loading is start-up, so errors throw ConfigError whose
+// message is "FILE:LINE: what is wrong"; main prints it and exits non-zero before anything
+// is opened, so a bad config never sends a frame.
+
+#include <chrono>
+#include <cstdint>
+#include <map>
+#include <optional>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "pmu/codec/messages.hpp"
+#include "pmu/command/policy.hpp"
+#include "pmu/config/capacity.hpp"
+#include "pmu/config/network_settings.hpp"
+#include "pmu/config/transport_choice.hpp"
+#include "pmu/security/security_files.hpp"
+
+namespace pmu::service {
+
+class ConfigError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+enum class TelemetryMode : std::uint8_t {
+  Streaming,  // the PMU streams what its PS selects every PP; the service listens
+  Polling,    // the service asks: 0x0F from firmware 1.14, single gets before
+};
+
+struct DeviceConfig {
+  std::uint16_t address = 1;
+  TelemetryMode mode = TelemetryMode::Streaming;
+  // Polling: the poll period. Streaming: the packet period expected (PP); with
+  // `configure_streaming` it is written to the PMU when the PMU's own PP differs.
+  std::chrono::milliseconds period{1000};
+  std::uint8_t groups = codec::group_bit::All;  // measurement groups, codec::kGroupNames
+  // Streaming only: write PP and PS to the PMU when they differ from period/groups. Off by
+  // default: they live in the PMU's non-volatile memory and belong to whoever set it up.
+  bool configure_streaming = false;
+  // "FILE:LINE" of its `address:` in the config file, for the line to change when the unit
+  // moves; empty for a device not from a file (discovered, built in).
+  std::string source_line;
+};
+
+// A battery (MG BMS) on the bus, read-only (spec/solar-boat-canopen-battery-mppt.txt). The
+// document gives one set of COB-IDs (0x202, 0x302, 0x402, 0x482): node 2.
+struct BatteryConfig {
+  std::uint8_t node = 2;
+  // Seconds between a BMS's frames of one value: health goes STALE after stale_periods and
+  // OFFLINE after offline_periods of these without a frame.
+  std::chrono::milliseconds period{1000};
+};
+
+// An MPPT on the bus, read-only; `device` 0..7 selects COB-IDs 0x4E6 + 8 x device (and + 1).
+struct MpptConfig {
+  std::uint8_t device = 0;
+  std::chrono::milliseconds period{1000};  // as BatteryConfig::period
+};
+
+struct BusConfig {
+  std::string name;       // the DDS key `bus`; at most 15 bytes
+  std::string interface;  // SocketCAN interface, or "sim" for the built-in simulated PMU
+  std::uint32_t bitrate = 1000000;  // what the link runs at (checked against the firmware)
+  std::vector<DeviceConfig> devices;
+  bool discover = false;  // find PMUs by a broadcast firmware request at start
+  DeviceConfig discovered_defaults;  // settings for PMUs found by discovery
+  std::vector<BatteryConfig> batteries;
+  std::vector<MpptConfig> mppts;
+  // Also serve batteries and MPPTs heard on the bus but not listed (with a period of 1 s).
+  bool listen_canopen = false;
+  // True when the bus serves any battery or MPPT: its receive filters must pass CANopen ids.
+  // pmu/battery, pmu/battery_cells and pmu/mppt get at most one sample per device per this
+  // period (0: one per bus-loop turn that brought a value). The config's top-level
+  // canopen_publish_period, the same for every bus.
+  std::chrono::milliseconds canopen_publish_period{200};
+  bool wants_canopen() const noexcept { return listen_canopen || !batteries.empty() || !mppts.empty(); }
+  std::string source_line;           // "FILE:LINE" of the bus entry, for later messages
+};
+
+struct Timeouts {
+  std::chrono::milliseconds reply{250};     // wait for an answer to one get
+  unsigned retries = 2;                     // extra tries of an idempotent get
+  double stale_periods = 3;                 // no frame for this many periods -> STALE
+  double offline_periods = 10;              // -> OFFLINE (and re-read info/config on return)
+  std::chrono::milliseconds send{100};      // wait for room in the transmit queue
+};
+
+// DDS-Security (the `security:` section). All six files or none; relative paths are taken
+// relative to the config file's folder. Checked at start-up (dds::check_security_files)
+// before any participant or bus is opened.
+struct SecurityConfig {
+  dds::SecurityFiles files;  // empty: security off
+  int warn_days = 30;        // warn when a certificate or grant ends within this many days
+  std::string source_line;   // "FILE:LINE" of the section
+  // "FILE:LINE" of each file's key (identity_ca, ...), for the start-up check's messages.
+  std::map<std::string, std::string> key_lines;
+  // "FILE:LINE" for a file key (the section's line when the key is unknown).
+  std::string line_of(const std::string& key) const;
+};
+
+struct Config {
+  std::string source = "<defaults>";  // the file it came from
+  int domain = 0;
+  // The vehicle this service belongs to (vehicle.hpp): the first key of every sample and its
+  // DDS partition. "" (the default): the unnamed vehicle, in the default partition.
+  std::string vehicle;
+  // pmu/low_rate/* get each device's telemetry at most once per this period (0: off).
+  std::chrono::milliseconds low_rate_period{1000};
+  // Empty: the installed deploy/qos.xml, found by the service. Relative in the file: to the
+  // config file's folder (made absolute here).
+  std::string qos_file;
+  std::string qos_file_line;  // "FILE:LINE" of qos_file, for the start-up check's messages
+  // default: Fast DDS's builtin transports (shared memory between processes on one host,
+  // UDPv4); udp: UDPv4 only, e.g. when readers run as other users (SHM segments are
+  // owner-only in Fast DDS 2.9).
+  dds::Transport dds_transport = dds::Transport::Default;
+  // `discovery:` (multicast, unicast peers, Discovery Server clients) and `interfaces:` (the
+  // UDP allowlist); names are resolved at start (dds::resolve_network), not here.
+  dds::NetworkConfig network;
+  // `dds_statistics`: the Fast DDS statistics topics the participant writes, for Fast DDS
+  // Monitor (statistics_settings.hpp); empty (the default): none.
+  std::vector<std::string> dds_statistics;
+  std::string dds_statistics_line;  // "FILE:LINE" of dds_statistics, for the start-up check
+  // `dds_type_objects`: announce the contract's type objects in discovery, for eProsima's
+  // dynamic-type tools (dds_type_objects.hpp). Off by default: they add about 10 kB of
+  // discovery traffic per joining participant, which a lossy, narrow ground link pays for.
+  bool dds_type_objects = false;
+  std::string log_level = "info";
+  std::vector<BusConfig> buses;
+  Timeouts timeouts;
+  PolicyConfig policy;
+  SecurityConfig security;
+};
+
+// What a config may refer to outside its own text, read once at the edge (load_config).
+struct ConfigEnvironment {
+  // $CREDENTIALS_DIRECTORY: where systemd put the unit's LoadCredential= files. A security
+  // path `credential:NAME` is that directory's NAME; unset, such a path is refused.
+  std::optional<std::string> credentials_directory;
+};
+
+// Parses `path` with this process's environment. Throws ConfigError("path:line: ...") for
+// every problem: unknown or repeated keys (at any depth), a second YAML document, wrong
+// types, integers not in plain decimal, values out of range, duplicate names/addresses; and
+// "path: ..." with the system's reason when the file cannot be opened or read.
+Config load_config(const std::string& path);
+// Parses YAML text; `source` names it in messages.
+Config parse_config(const std::string& text, const std::string& source, const ConfigEnvironment& env = {});
+
+// What `pmu-service --bus sim` with no config runs: one simulated PMU at address 1 on a bus
+// named "sim0", streaming every packet every 0.5 s.
+Config default_sim_config();
+
+bool is_log_level(const std::string& level);
+
+// Applies `--bus sim|socketcan:IFACE`: replaces the buses with one bus on that interface
+// (keeping the devices of the first configured bus, if any). Throws ConfigError.
+void override_bus(Config& config, const std::string& spec);
+
+}  // namespace pmu::service

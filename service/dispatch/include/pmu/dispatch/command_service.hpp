@@ -1,0 +1,117 @@
+#pragma once
+// CommandService: the front door for commands, callable from any thread (the DDS listener).
+// It guarantees exactly one final reply per received sample:
+//   * every sample is parsed once (parse_command, command.hpp); one that does not parse is
+//     REJECTED with the reason, with nothing sent to a bus;
+//   * a request id is remembered per sender (ids are unique per sender, not globally): a
+//     resend with the same content is answered again with the first one's result, never
+//     executed twice (while the first still runs, the answer is owed and sent when it ends);
+//     the same id with other content is REJECTED, never answered with the other's reply;
+//   * expired, unroutable, denied or rate-limited requests are answered at once, with
+//     nothing sent to a bus;
+//   * valid ones run on their bus worker's thread (command_executor.hpp), serialised per
+//     device by the device session, in parallel across devices and buses.
+// Replies are handed to `reply` outside the service's lock. Every command and its result is
+// logged as an audit trail (who, what, result, reason), with network text made printable.
+//
+// Memory: at most kRememberedRequests ids are kept (oldest forgotten first); no request
+// lives longer than policy.lifetimes.max_lifetime, so at any rate below
+// kRememberedRequests per max_lifetime no live request's id is ever forgotten.
+//
+// Lifetime: every BusWorker in `workers`, `clock`, and whatever `reply` refers to (main.cpp:
+// the DdsCommandEndpoint) must outlive the service; it keeps pointers and a reference. Work
+// it posts to a worker refers to the service, so the command source is stopped
+// (DdsCommandEndpoint::stop) and the worker threads joined before it is destroyed: main.cpp's
+// Shutdown does both.
+// Threads: submit(), counters() and remembered() from any thread (in the daemon, a Fast DDS
+// listener thread calls submit()); `mutex_` guards what they share. The stages after
+// BusWorker::post run on that worker's thread. `reply` is called from both, never under
+// `mutex_`.
+
+#include <chrono>
+#include <deque>
+#include <map>
+#include <mutex>
+#include <string>
+#include <unordered_map>
+#include <vector>
+
+#include "pmu/command/command.hpp"
+#include "pmu/command/policy.hpp"
+#include "pmu/dispatch/command_executor.hpp"
+#include "pmu/session/bus_worker.hpp"
+
+namespace pmu::service {
+
+inline constexpr std::size_t kRememberedRequests = 16384;
+
+class CommandService {
+ public:
+  // `reply` publishes a reply; it is called from bus worker threads and the caller's thread.
+  CommandService(std::vector<BusWorker*> workers, PolicyConfig policy, Timeouts timeouts,
+                 const transport::Clock& clock, ReplyFn reply);
+
+  void submit(const CommandSample& sample);
+
+  struct Counters {
+    std::uint64_t received = 0, duplicates = 0, reused_ids = 0, completed = 0, refused = 0, failed = 0;
+  };
+  Counters counters() const;
+  // Request ids currently remembered for duplicate detection (at most kRememberedRequests).
+  std::size_t remembered() const;
+
+ private:
+  struct Entry {
+    std::uint64_t fingerprint = 0;
+    std::optional<CommandReplyData> final;
+    unsigned owed = 0;  // resends that arrived while it ran
+  };
+  enum class Seen { New, Resend, Reused };
+
+  // Why a stage stopped a command: its final reply.
+  struct Refusal {
+    CommandResult result = CommandResult::Rejected;
+    std::string reason;
+  };
+
+  // The stages of submit(), in order (each answers or lets the command on):
+  void reject_without_id(const CommandSample& s);
+  // Duplicate detection: false when `s` is a resend (answered again) or reuses an id.
+  bool first_time(const std::string& key, const CommandSample& s);
+  Seen remember(const std::string& key, const CommandSample& s, std::optional<CommandReplyData>& again);
+  // Routing: the bus is not one of this service's (when worker_for found none).
+  Refusal not_served(const CommandRequest& r) const;
+  // The deny list and confirm rules (policy.hpp).
+  std::optional<Refusal> judge(const CommandRequest& r) const;
+  DeviceUse device_use(const CommandRequest& r) const;
+  // The per-device token bucket; never for engine stop.
+  std::optional<Refusal> limit_rate(const CommandRequest& r);
+  // ...and on the bus worker's thread:
+  void run_on_worker(BusWorker& worker, const CommandRequest& r);
+  void broadcast(BusWorker& worker, const CommandRequest& r);
+  // An engine stop to the broadcast address with no bus named: sent on every bus served.
+  void broadcast_on_every_bus(const CommandRequest& r);
+  // Known, read (firmware known) and, for an address change, the new address free.
+  std::optional<Refusal> check_device(BusWorker& worker, const DeviceSession* session, const CommandRequest& r);
+
+  // Records the final reply under `key`, logs it and publishes it (and the owed copies).
+  void finish(const std::string& key, const std::string& sender, const std::string& what,
+              const CommandReplyData& reply);
+  void answer(const CommandRequest& r, CommandResult result, std::string reason);
+  void refuse(const CommandRequest& r, const Refusal& refusal);
+  BusWorker* worker_for(const std::string& bus) const;
+
+  std::vector<BusWorker*> workers_;
+  PolicyConfig policy_;
+  Timeouts timeouts_;
+  const transport::Clock& clock_;
+  ReplyFn reply_;
+
+  mutable std::mutex mutex_;
+  std::unordered_map<std::string, Entry> seen_;  // by sender_key(sender, request_id)
+  std::deque<std::string> order_;                // oldest first, to bound seen_
+  std::map<std::pair<std::string, std::uint16_t>, RateLimiter> limiters_;
+  Counters counters_;
+};
+
+}  // namespace pmu::service

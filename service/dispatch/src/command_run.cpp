@@ -1,0 +1,127 @@
+// The runner of command plans (command_plan.hpp): one Run per command, owned by the
+// callbacks of its pending step. Each step's callback holds a shared_ptr to the Run and
+// submits the next step, so the Run lives exactly as long as a step is outstanding and
+// nothing refers to itself.
+#include <memory>
+
+#include "pmu/codec/encode.hpp"
+#include "pmu/dispatch/command_plan.hpp"
+
+namespace pmu::service {
+namespace {
+
+class Run : public std::enable_shared_from_this<Run> {
+ public:
+  Run(DeviceSession& session, const CommandRequest& request, CommandPlan plan, const Timeouts& timeouts,
+      ReplyFn reply)
+      : session_(session), request_(request), plan_(std::move(plan)), retries_(timeouts.retries),
+        reply_(std::move(reply)) {}
+
+  // Step 0: the command's own frame.
+  void start(SteadyTime now) {
+    if (plan_.alias) session_.set_alias(plan_.alias);
+    Request r;
+    r.frame = plan_.frame;
+    r.reply = plan_.answer;
+    r.retries = plan_.idempotent ? retries_ : 0;
+    if (!plan_.urgent) r.expires = request_.expires;
+    r.done = [self = shared_from_this()](const RequestOutcome& o) { self->on_command(o); };
+    if (plan_.urgent)
+      session_.submit_front(std::move(r), now);
+    else
+      session_.submit(std::move(r), now);
+  }
+
+ private:
+  void on_command(const RequestOutcome& o) {
+    if (!succeeded(o, plan_.what)) return;
+    if (plan_.read_back) return read_back(false);
+    conclude(plan_.check(o.reply ? &*o.reply : nullptr));
+  }
+
+  // Steps 1 and 2: the verification get, ahead of anything queued since.
+  void read_back(bool last) {
+    Request r;
+    r.frame = *codec::encode_get(plan_.read_back->packet, plan_.read_back->address);
+    r.reply = plan_.read_back->packet;
+    r.retries = retries_;
+    r.done = [self = shared_from_this(), last](const RequestOutcome& o) { self->on_read_back(o, last); };
+    session_.submit_front(std::move(r), session_.now());
+  }
+
+  void on_read_back(const RequestOutcome& o, bool last) {
+    if (!succeeded(o, "read-back")) return;
+    Verdict v = plan_.check(&*o.reply);
+    if (v.result != CommandResult::Completed && !last) return read_back(true);
+    conclude(std::move(v));
+  }
+
+  // True when the step did its part; otherwise the run ends with the step's failure.
+  bool succeeded(const RequestOutcome& o, const std::string& what) {
+    switch (o.status) {
+      case RequestStatus::Answered:
+      case RequestStatus::Sent: return true;
+      case RequestStatus::Expired:
+        conclude({CommandResult::Rejected, "expired before it could be sent", {}, {}});
+        break;
+      case RequestStatus::SendFailed:
+        conclude({CommandResult::Failed,
+                  "bus refused the " + what + ": " + std::string(transport::to_string(o.send.status)),
+                  {},
+                  {}});
+        break;
+      case RequestStatus::Timeout:
+        conclude({CommandResult::Timeout,
+                  "device " + std::to_string(request_.address) + " did not answer the " + what + " after " +
+                      std::to_string(retries_ + 1) + " tries",
+                  {},
+                  {}});
+        break;
+    }
+    return false;
+  }
+
+  void conclude(Verdict v) {
+    if (replied_) return;  // exactly one reply, whichever path ends the run
+    replied_ = true;
+    if (v.result == CommandResult::Completed) {
+      if (plan_.on_completed) plan_.on_completed(session_);
+    } else if (plan_.alias) {
+      session_.set_alias(std::nullopt);
+    }
+    CommandReplyData d = make_reply(request_, v.result, std::move(v.reason));
+    if (v.value) {
+      d.has_value = true;
+      d.value = *v.value;
+    }
+    d.value_text = std::move(v.value_text);
+    reply_(d);
+  }
+
+  DeviceSession& session_;
+  CommandRequest request_;
+  CommandPlan plan_;
+  unsigned retries_;
+  ReplyFn reply_;
+  bool replied_ = false;
+};
+
+}  // namespace
+
+void run_plan(DeviceSession& session, const CommandRequest& r, CommandPlan plan, SteadyTime now,
+              const Timeouts& timeouts, ReplyFn reply) {
+  std::make_shared<Run>(session, r, std::move(plan), timeouts, std::move(reply))->start(now);
+}
+
+CommandReplyData make_reply(const CommandRequest& r, CommandResult result, std::string reason) {
+  CommandReplyData d;
+  d.request_id = r.request_id;
+  d.bus = r.bus;
+  d.address = r.address;
+  d.kind = r.kind();
+  d.result = result;
+  d.reason = std::move(reason);
+  return d;
+}
+
+}  // namespace pmu::service

@@ -1,0 +1,253 @@
+#include "pmu/dispatch/command_service.hpp"
+
+#include <spdlog/spdlog.h>
+
+#include <cstdio>
+#include <memory>
+
+#include "pmu/codec/encode.hpp"
+#include "pmu/codec/ids.hpp"
+
+namespace pmu::service {
+namespace {
+
+// Request ids are unique per sender: the key is both. Senders are DDS GUIDs (no NUL).
+std::string sender_key(const std::string& sender, const std::string& request_id) {
+  std::string key = sender;
+  key += '\0';
+  key += request_id;
+  return key;
+}
+
+}  // namespace
+
+CommandService::CommandService(std::vector<BusWorker*> workers, PolicyConfig policy, Timeouts timeouts,
+                               const transport::Clock& clock, ReplyFn reply)
+    : workers_(std::move(workers)), policy_(policy), timeouts_(timeouts), clock_(clock), reply_(std::move(reply)) {}
+
+BusWorker* CommandService::worker_for(const std::string& bus) const {
+  for (auto* w : workers_)
+    if (w->config().name == bus) return w;
+  return nullptr;
+}
+
+CommandService::Counters CommandService::counters() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return counters_;
+}
+
+std::size_t CommandService::remembered() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return seen_.size();
+}
+
+CommandService::Seen CommandService::remember(const std::string& key, const CommandSample& s,
+                                              std::optional<CommandReplyData>& again) {
+  const std::uint64_t fingerprint = content_fingerprint(s);
+  std::lock_guard<std::mutex> lock(mutex_);
+  ++counters_.received;
+  if (auto it = seen_.find(key); it != seen_.end()) {
+    if (it->second.fingerprint != fingerprint) {
+      ++counters_.reused_ids;
+      return Seen::Reused;
+    }
+    ++counters_.duplicates;
+    if (it->second.final)
+      again = it->second.final;
+    else
+      ++it->second.owed;
+    return Seen::Resend;
+  }
+  seen_.emplace(key, Entry{fingerprint, std::nullopt, 0});
+  order_.push_back(key);
+  while (order_.size() > kRememberedRequests) {
+    seen_.erase(order_.front());
+    order_.pop_front();
+  }
+  return Seen::New;
+}
+
+void CommandService::finish(const std::string& key, const std::string& sender, const std::string& what,
+                            const CommandReplyData& reply) {
+  unsigned copies = 1;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (auto it = seen_.find(key); it != seen_.end()) {
+      if (it->second.final) return;  // already answered: never a second final reply
+      it->second.final = reply;
+      copies += it->second.owed;
+      it->second.owed = 0;
+    }
+    if (reply.result == CommandResult::Completed)
+      ++counters_.completed;
+    else if (reply.result == CommandResult::Timeout || reply.result == CommandResult::Failed)
+      ++counters_.failed;
+    else
+      ++counters_.refused;
+  }
+  // Reasons quote network text only through printable(); ids and senders are escaped here.
+  spdlog::info("audit: command {} from {}: {} -> {}{}{}", printable(reply.request_id), printable(sender), what,
+               to_string(reply.result), reply.reason.empty() ? "" : ": ", reply.reason);
+  for (unsigned i = 0; i < copies; ++i) reply_(reply);
+}
+
+void CommandService::answer(const CommandRequest& r, CommandResult result, std::string reason) {
+  finish(sender_key(r.sender, r.request_id), r.sender, describe(r), make_reply(r, result, std::move(reason)));
+}
+
+void CommandService::refuse(const CommandRequest& r, const Refusal& refusal) {
+  answer(r, refusal.result, refusal.reason);
+}
+
+// The stages, in order. Each either lets the command on or says why not; every refusal is
+// one final reply, published outside the lock, with nothing sent to a bus.
+
+void CommandService::submit(const CommandSample& s) {
+  if (s.request_id.empty()) return reject_without_id(s);
+  const std::string key = sender_key(s.sender, s.request_id);
+  if (!first_time(key, s)) return;
+  // Values, ranges and the expiry: parse_command checks them all.
+  auto parsed = parse_command(s, Now{clock_.system_now(), clock_.steady_now()}, policy_.lifetimes);
+  if (!parsed) return finish(key, s.sender, describe(s), make_reply(s, CommandResult::Rejected, parsed.error()));
+  const CommandRequest& r = *parsed;
+  // parse_command lets only engine_stop through to the broadcast address; a stop is never
+  // judged nor held back by the rate limit.
+  if (r.bus.empty() && r.address == codec::kBroadcastAddress) return broadcast_on_every_bus(r);
+  BusWorker* worker = worker_for(r.bus);
+  if (!worker) return refuse(r, not_served(r));
+  if (auto no = judge(r)) return refuse(r, *no);
+  if (auto no = limit_rate(r)) return refuse(r, *no);
+  worker->post([this, worker, r] { run_on_worker(*worker, r); });
+}
+
+void CommandService::reject_without_id(const CommandSample& s) {
+  // Nothing to correlate a resend with: answered, not remembered.
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    ++counters_.received;
+    ++counters_.refused;
+  }
+  spdlog::warn("audit: command without request_id from {}: {} -> REJECTED", printable(s.sender), describe(s));
+  reply_(make_reply(s, CommandResult::Rejected, "request_id is empty"));
+}
+
+bool CommandService::first_time(const std::string& key, const CommandSample& s) {
+  std::optional<CommandReplyData> again;
+  switch (remember(key, s, again)) {
+    case Seen::New: return true;
+    case Seen::Resend:
+      spdlog::info("audit: duplicate command {} from {}: answered again, not executed", printable(s.request_id),
+                   printable(s.sender));
+      if (again) reply_(*again);  // else owed: sent with the first one's final reply
+      return false;
+    case Seen::Reused:
+      spdlog::warn("audit: command {} from {} reuses that id for another command: {} -> REJECTED",
+                   printable(s.request_id), printable(s.sender), describe(s));
+      reply_(make_reply(s, CommandResult::Rejected,
+                        "request id '" + printable(s.request_id) +
+                            "' was already used by this sender for another command; not executed (use a new id)"));
+      return false;
+  }
+  return false;
+}
+
+// From the config alone (immutable, so any thread may read it): a device the config does
+// not name is taken to stream, the side on which the policy asks for more.
+DeviceUse CommandService::device_use(const CommandRequest& r) const {
+  for (const auto* w : workers_) {
+    const BusConfig& bus = w->config();
+    if (bus.name != r.bus) continue;
+    for (const auto& d : bus.devices)
+      if (d.address == r.address) return {d.mode == TelemetryMode::Streaming};
+    if (bus.discover) return {bus.discovered_defaults.mode == TelemetryMode::Streaming};
+  }
+  return {};
+}
+
+CommandService::Refusal CommandService::not_served(const CommandRequest& r) const {
+  std::string served;
+  for (auto* w : workers_) served += (served.empty() ? "" : ", ") + w->config().name;
+  return {CommandResult::Rejected, "bus '" + printable(r.bus) + "' is not served here (buses: " + served + ")"};
+}
+
+std::optional<CommandService::Refusal> CommandService::judge(const CommandRequest& r) const {
+  PolicyVerdict verdict = check_policy(r, policy_, device_use(r));
+  if (verdict.allowed()) return std::nullopt;
+  return Refusal{verdict.result, std::move(verdict.reason)};
+}
+
+std::optional<CommandService::Refusal> CommandService::limit_rate(const CommandRequest& r) {
+  if (r.kind() == CommandKind::EngineStop) return std::nullopt;  // a stop is never held back
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    auto it = limiters_.try_emplace({r.bus, r.address}, policy_.rate_per_second, policy_.burst).first;
+    if (it->second.allow(clock_.steady_now())) return std::nullopt;
+  }
+  char buf[96];
+  std::snprintf(buf, sizeof buf, "rate limit: more than %g commands/s (burst %g) to this device",
+                policy_.rate_per_second, policy_.burst);
+  return Refusal{CommandResult::Rejected, buf};
+}
+
+void CommandService::run_on_worker(BusWorker& worker, const CommandRequest& r) {
+  if (r.address == codec::kBroadcastAddress) return broadcast(worker, r);
+  DeviceSession* session = worker.session(r.address);
+  if (auto no = check_device(worker, session, r)) return refuse(r, *no);
+  execute_command(*session, r, clock_.steady_now(), timeouts_,
+                  [this, key = sender_key(r.sender, r.request_id), sender = r.sender,
+                   what = describe(r)](const CommandReplyData& d) { finish(key, sender, what, d); });
+}
+
+void CommandService::broadcast(BusWorker& worker, const CommandRequest& r) {
+  // parse_command lets only engine_stop through to the broadcast address; no device answers.
+  const auto sent = worker.bus().send(*codec::encode_engine_stop(r.address), timeouts_.send);
+  if (sent.ok()) return answer(r, CommandResult::Completed, "stop sent to every PMU (broadcast)");
+  answer(r, CommandResult::Failed, "bus refused the engine stop: " + std::string(transport::to_string(sent.status)));
+}
+
+void CommandService::broadcast_on_every_bus(const CommandRequest& r) {
+  if (workers_.empty()) return answer(r, CommandResult::Failed, "this service serves no bus");
+  // Each bus is sent to on its own worker's thread; the last one to finish answers, so the
+  // request still gets exactly one final reply.
+  struct Round {
+    std::mutex mutex;
+    std::size_t left;
+    std::string sent, refused;
+  };
+  auto round = std::make_shared<Round>();
+  round->left = workers_.size();
+  for (auto* w : workers_)
+    w->post([this, w, r, round] {
+      const auto sent = w->bus().send(*codec::encode_engine_stop(codec::kBroadcastAddress), timeouts_.send);
+      std::string done, failed;
+      {
+        std::lock_guard<std::mutex> lock(round->mutex);
+        std::string& list = sent.ok() ? round->sent : round->refused;
+        list += (list.empty() ? "" : ", ") + w->config().name +
+                (sent.ok() ? std::string() : " (" + std::string(transport::to_string(sent.status)) + ")");
+        if (--round->left > 0) return;
+        done = round->sent;
+        failed = round->refused;
+      }
+      if (failed.empty()) return answer(r, CommandResult::Completed, "stop sent to every PMU (broadcast) on " + done);
+      answer(r, CommandResult::Failed,
+             "bus refused the engine stop: " + failed + (done.empty() ? std::string() : "; sent on " + done));
+    });
+}
+
+std::optional<CommandService::Refusal> CommandService::check_device(BusWorker& worker, const DeviceSession* session,
+                                                                  const CommandRequest& r) {
+  const std::string device = "device " + std::to_string(r.address);
+  if (!session) return Refusal{CommandResult::Rejected, device + " not seen on " + r.bus};
+  // Firmware decides what a command may do; a stop needs nothing read.
+  if (!session->info() && r.kind() != CommandKind::EngineStop)
+    return Refusal{CommandResult::Rejected,
+                   device + " on " + r.bus + " is not ready: its firmware and configuration have not been read yet"};
+  if (const auto* set = std::get_if<action::SetParameter>(&r.action);
+      set && set->parameter == codec::Parameter::CanAddress && set->raw != r.address &&
+      worker.session(static_cast<std::uint16_t>(set->raw)))
+    return Refusal{CommandResult::Rejected, "address " + std::to_string(set->raw) + " is already in use on " + r.bus};
+  return std::nullopt;
+}
+
+}  // namespace pmu::service

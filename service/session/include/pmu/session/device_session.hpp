@@ -1,0 +1,149 @@
+#pragma once
+// DeviceSession: the service's conversation with one PMU, composed of three parts:
+//   RequestQueue     request/response correlation: one request in flight, the rest queued
+//                    in order, answers matched by packet id, retries, timeouts, expiry
+//                    (request_queue.hpp);
+//   ReadingMachine   the device's identity and stored values and the rounds of gets that
+//                    read them (reading_machine.hpp);
+//   HealthTracker    ONLINE / STALE / OFFLINE from frame age, and the counters
+//                    (health_tracker.hpp).
+// The session wires them together and owns what spans them: publishing, polling, and the
+// streaming set-up.
+//
+// Life of a session: READING (serial, firmware, every stored parameter, outputs, generation)
+// -> publishes info and config -> RUNNING (streaming: listen; polling: ask every period,
+// with 0x0F from firmware 1.14 and single gets before). Health follows frame age:
+// ONLINE while a frame came within stale_periods x period, STALE until offline_periods x
+// period, then OFFLINE; a frame after OFFLINE re-reads info and config (the unit may have
+// been swapped or reset).
+//
+// Frames arrive with their id already parsed (the bus worker parses it once to route the
+// frame); the session decodes the payload with the firmware it knows, so firmware-
+// dependent packets are read right from the first frame after the firmware is known.
+//
+// No I/O and no clock of its own: frames go out through a send callback, time comes in
+// through every call, so tests drive it with a fake clock.
+//
+// Lifetime: `sink` must outlive the session, which keeps a reference (the DdsPublisher in the
+// daemon: main.cpp makes it before the bus workers that own the sessions, and destroys it
+// after them). `send` may refer to the session's owner, the BusWorker. The command runs
+// queued on the session keep a reference to it; they live in its request queue, so never
+// longer than the session.
+// Threads: no lock and no thread of its own: every member on the thread of the bus worker
+// that owns it; other threads reach it only through BusWorker::post().
+
+#include <chrono>
+#include <cstdint>
+#include <functional>
+#include <optional>
+#include <vector>
+
+#include "pmu/codec/decode.hpp"
+#include "pmu/config/config.hpp"
+#include "pmu/session/device_state.hpp"
+#include "pmu/session/health_tracker.hpp"
+#include "pmu/session/reading_machine.hpp"
+#include "pmu/session/request_queue.hpp"
+
+namespace pmu::service {
+
+class DeviceSession {
+ public:
+  using SendFn = std::function<transport::SendResult(const codec::CanFrame&)>;
+
+  DeviceSession(DeviceKey key, DeviceConfig device, const Timeouts& timeouts, StateSink& sink, SendFn send,
+                SteadyTime now);
+
+  const DeviceKey& key() const noexcept { return key_; }
+  // A frame from this device's address (or alias) whose id the caller parsed into `id`.
+  void on_frame(const codec::PmuId& id, const codec::CanFrame& frame, SteadyTime now, WallTime received);
+  // A frame from this address that did not decode.
+  void on_decode_error() noexcept { health_.on_decode_error(); }
+  void on_bus_state(transport::BusState state, SteadyTime now);
+  void on_bus_counters(const transport::BusCounters& counters) noexcept { health_.on_bus_counters(counters); }
+  // Timeouts, polling, health. Call at least every few tens of ms.
+  void tick(SteadyTime now);
+
+  // Queues a request behind those already waiting.
+  void submit(Request request, SteadyTime now);
+  // Queues a request ahead of everything waiting (ENGINE_STOP must not wait behind a queue).
+  void submit_front(Request request, SteadyTime now);
+  // Reads identity and every stored value again (after a reset).
+  void reread(SteadyTime now) { start_reading(now); }
+
+  // During a CAN address change, frames from `alias` belong to this session too; move_to()
+  // moves the session to its new address once the change is verified.
+  void set_alias(std::optional<std::uint16_t> alias) noexcept { alias_ = alias; }
+  std::optional<std::uint16_t> alias() const noexcept { return alias_; }
+
+  enum class MoveCause : std::uint8_t {
+    Commanded,  // our own set of CA (0x1B), read back at the new address
+    ByItself,   // its serial (0x30) answered at `address` while its old address is silent
+  };
+  // The unit answers at `address` now. The old key gets its health once more, OFFLINE,
+  // and is gone (StateSink::on_gone) kGoneDelay later, unless the unit is back there by
+  // then; the new key gets the identity and configuration carried over (CA = `address`)
+  // and the health, at once. ByItself also counts as a frame heard now and reads
+  // everything again: whoever changed the address may have changed more. The bus worker
+  // files the session under its new key at the end of its turn.
+  void move_to(std::uint16_t address, MoveCause cause, SteadyTime now);
+  // Between the old key's OFFLINE and its disposal: a state reader keeps one sample per
+  // instance, and a disposal that comes first replaces the OFFLINE it has not taken yet.
+  // Short, so that `list` shows the new key alone well within the usual packet periods.
+  static constexpr std::chrono::milliseconds kGoneDelay{250};
+  // The serial this PMU has when none was read yet: what the service recorded before it
+  // restarted (moved_addresses.hpp), so a unit that moved is followed before it is heard.
+  void expect_serial(std::optional<std::uint16_t> serial) noexcept { expected_serial_ = serial; }
+  bool expects_serial() const noexcept { return expected_serial_.has_value(); }
+  // The serial read from the unit, else the one expected.
+  std::optional<std::uint16_t> serial() const noexcept {
+    if (reading_.info()) return reading_.info()->serial_number;
+    return expected_serial_;
+  }
+  // Where the session started (the config's address, or where discovery found it).
+  std::uint16_t first_address() const noexcept { return settings_.address; }
+  const DeviceConfig& settings() const noexcept { return settings_; }
+
+  // The latest time any call brought: callbacks that queue follow-up work use it.
+  SteadyTime now() const noexcept { return now_; }
+  const ConfigState& config_state() const noexcept { return reading_.config(); }
+  const std::optional<InfoState>& info() const noexcept { return reading_.info(); }
+  std::optional<codec::FirmwareVersion> firmware() const noexcept { return reading_.firmware(); }
+  const HealthReport& health() const noexcept { return health_.report(); }
+  bool ready() const noexcept { return reading_.running(); }
+  std::size_t queued() const noexcept { return queue_.size(); }
+
+ private:
+  static constexpr int kReadingTag = 1;
+  static constexpr int kPollTag = 2;
+
+  void start_reading(SteadyTime now);
+  void on_reading_done(const RequestOutcome& outcome, std::uint64_t round);
+  void configure_streaming();
+  void poll(SteadyTime now);
+  void absorb(const codec::PmuMessage& m);
+  void update_health(SteadyTime now, bool force);
+  std::chrono::milliseconds period() const noexcept;
+
+  DeviceKey key_;
+  DeviceConfig settings_;  // the config file's settings for it; what the device stores: reading_.config()
+  Timeouts timeouts_;
+  StateSink& sink_;
+  SendFn send_;
+
+  HealthTracker health_;
+  ReadingMachine reading_;
+  RequestQueue queue_;
+
+  std::optional<std::uint16_t> alias_;
+  std::optional<std::uint16_t> expected_serial_;
+  struct Gone {
+    DeviceKey key;
+    SteadyTime at;
+  };
+  std::vector<Gone> gone_;  // old keys to dispose, once due (tick)
+  SteadyTime now_{};  // the latest time any call brought
+  SteadyTime next_poll_{};
+};
+
+}  // namespace pmu::service

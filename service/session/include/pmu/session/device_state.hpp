@@ -1,0 +1,99 @@
+#pragma once
+// What the service knows of one PMU (and, canopen_state.hpp, of batteries and MPPTs), in codec terms. Conversion to the DDS types of
+// interface.md happens in dds/ only; the rest of the service and its tests use these.
+
+#include <array>
+#include <chrono>
+#include <cstdint>
+#include <optional>
+#include <string>
+
+#include "pmu/codec/decode.hpp"
+#include "pmu/codec/parameters.hpp"
+#include "pmu/session/canopen_state.hpp"
+#include "pmu/transport/can_bus.hpp"
+
+namespace pmu::service {
+
+// What a device on a bus is. PMUs are addressed by CAN address; a battery by its CANopen
+// node, an MPPT by its device id (0..7): the three number ranges overlap, so the kind is part
+// of every device's key (pmu/health's `kind`).
+enum class DeviceKind : std::uint8_t { Pmu, Battery, Mppt };
+const char* to_string(DeviceKind k) noexcept;
+
+struct DeviceKey {
+  std::string bus;
+  std::uint16_t address = 0;  // PMU: CAN address; battery: CANopen node; MPPT: device id
+  DeviceKind kind = DeviceKind::Pmu;
+  friend bool operator==(const DeviceKey& a, const DeviceKey& b) {
+    return a.bus == b.bus && a.address == b.address && a.kind == b.kind;
+  }
+};
+
+// Stored parameters as last read from (or verified on) the device, raw wire values.
+struct ConfigState {
+  std::array<std::optional<std::uint32_t>, codec::kParameterCount> raw{};
+  std::optional<std::uint8_t> outputs;
+  std::optional<bool> generation_enabled;
+
+  bool complete() const noexcept {
+    for (const auto& r : raw)
+      if (!r) return false;
+    return outputs.has_value() && generation_enabled.has_value();
+  }
+  double value(codec::Parameter p) const noexcept {
+    const auto& r = raw[static_cast<std::size_t>(p)];
+    return r ? codec::parameter_value(p, *r) : 0.0;
+  }
+};
+
+struct InfoState {
+  std::uint16_t serial_number = 0;
+  codec::FirmwareInfo firmware;
+  // The serial reply comes first: until the firmware reply, `firmware` reads 0.0, which is
+  // no real version and would decode telemetry as pre-1.12 (no external temperatures).
+  bool firmware_known = false;
+};
+
+enum class HealthState : std::uint8_t { Unknown, Online, Stale, Offline };
+const char* to_string(HealthState s) noexcept;
+
+struct HealthReport {
+  HealthState state = HealthState::Unknown;
+  transport::BusState bus_state = transport::BusState::Up;
+  double last_frame_age = -1;  // s; -1 = no frame yet
+  std::uint64_t frames_received = 0;
+  std::uint64_t frames_sent = 0;
+  std::uint64_t decode_errors = 0;
+  std::uint64_t bus_errors = 0;
+  std::uint64_t rx_dropped = 0;
+  std::uint64_t timeouts = 0;
+  std::uint64_t reconnects = 0;
+};
+
+// Where the service's view of the devices goes: the DDS publisher in the daemon, a recorder
+// in tests. Called on the bus worker's thread.
+class StateSink {
+ public:
+  virtual ~StateSink() = default;
+  // A telemetry frame (packets 0x00..0x04) decoded; `received` is the frame's receive time.
+  virtual void on_telemetry(const DeviceKey& key, const codec::PmuMessage& message,
+                            std::chrono::system_clock::time_point received) = 0;
+  virtual void on_config(const DeviceKey& key, const ConfigState& config) = 0;
+  virtual void on_info(const DeviceKey& key, const InfoState& info) = 0;
+  virtual void on_health(const DeviceKey& key, const HealthReport& health) = 0;
+  // No device is at `key` any more (a PMU that moved to another CAN address): every
+  // instance of every topic under it is unregistered and disposed, so neither a reader
+  // nor a late joiner keeps a device that is not there. The last health sent before is
+  // OFFLINE.
+  virtual void on_gone(const DeviceKey& key) = 0;
+  // A battery's or MPPT's assembled values changed (canopen_session.hpp); `newest` is the
+  // receive time of the newest frame that contributed.
+  virtual void on_battery(const DeviceKey& key, const BatteryState& battery,
+                          std::chrono::system_clock::time_point newest) = 0;
+  virtual void on_battery_cells(const DeviceKey& key, const BatteryCellsState& cells,
+                                std::chrono::system_clock::time_point newest) = 0;
+  virtual void on_mppt(const DeviceKey& key, const MpptState& mppt, std::chrono::system_clock::time_point newest) = 0;
+};
+
+}  // namespace pmu::service

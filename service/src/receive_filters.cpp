@@ -1,9 +1,0 @@
-#include "pmu/service/receive_filters.hpp"
-
-namespace pmu::service {
-
-std::vector<transport::IdFilter> receive_filters(const BusConfig& bus) {
-  return transport::default_filters(bus.wants_canopen());
-}
-
-}  // namespace pmu::service

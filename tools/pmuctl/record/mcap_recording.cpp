@@ -1,0 +1,82 @@
+#include "pmuctl/record/mcap_recording.hpp"
+
+#include <cerrno>
+#include <cstdio>
+#include <cstring>
+#include <map>
+
+namespace pmu::tools {
+
+std::string human_bytes(std::uint64_t n) {
+  char buf[32];
+  if (n < 1000) std::snprintf(buf, sizeof buf, "%llu B", static_cast<unsigned long long>(n));
+  else if (n < 1000000) std::snprintf(buf, sizeof buf, "%.1f kB", static_cast<double>(n) / 1e3);
+  else std::snprintf(buf, sizeof buf, "%.1f MB", static_cast<double>(n) / 1e6);
+  return buf;
+}
+
+std::string McapRecording::open(const std::string& path, const std::vector<const RecordedTopic*>& topics) {
+  if (auto why = out_.open(path); !why.empty()) return why;
+  writer_ = std::make_unique<pmu::mcap::Writer>(out_.sink(), pmu::mcap::WriterOptions{"", "pmuctl (pmu-dds)", 256 * 1024});
+  if (!writer_->open()) return error();
+  std::map<std::string, std::uint16_t> schemas;  // by type name: topics of one type share it
+  for (const auto* t : topics) {
+    auto it = schemas.find(t->type_name);
+    if (it == schemas.end())
+      it = schemas.emplace(t->type_name, writer_->add_schema(t->type_name, "omgidl", std::string(t->idl))).first;
+    channels_.push_back(writer_->add_channel(it->second, t->topic, "cdr"));
+  }
+  topics_ = topics;
+  counts_.assign(topics.size(), 0);
+  // The schemas and channels reach the file at once: a recording stopped before its first
+  // chunk still says what it would have held.
+  return writer_->flush() ? std::string() : error();
+}
+
+bool McapRecording::write(std::size_t topic, std::uint64_t time_ns, const std::uint8_t* data, std::size_t size) {
+  if (!writer_ || topic >= channels_.size()) return false;
+  if (!writer_->write(channels_[topic], time_ns, time_ns, data, size)) return false;
+  ++counts_[topic];
+  return true;
+}
+
+bool McapRecording::flush() { return writer_ && writer_->flush(); }
+
+std::string McapRecording::close() {
+  if (!writer_) return {};
+  const bool was_failed = writer_->failed();
+  const bool ok = writer_->close();
+  std::string why = ok ? std::string() : error();
+  if (const int e = out_.close(); e != 0 && why.empty())
+    why = "closing " + out_.name() + ": " + std::strerror(e);
+  if (was_failed)
+    why += std::string(out_.streaming() ? " (it got" : " (the file holds") + " the chunks written before it, " +
+           human_bytes(writer_->bytes_written()) + ")";
+  return why;
+}
+
+std::string McapRecording::commit() { return out_.commit(); }
+
+void McapRecording::discard() { out_.discard(); }
+
+std::string McapRecording::error() const {
+  if (!writer_ || !writer_->failed()) return {};
+  const int e = writer_->error();
+  std::string s = "writing " + out_.name() + ": " + std::strerror(e);
+  if (e == ENOSPC) s += " (disk full)";
+  return s + " after " + human_bytes(writer_->bytes_written());
+}
+
+std::string McapRecording::progress() const {
+  std::string s = std::to_string(messages()) + " messages, " + human_bytes(writer_ ? writer_->bytes_written() : 0);
+  std::string per;
+  for (std::size_t i = 0; i < topics_.size(); ++i) {
+    if (counts_[i] == 0) continue;
+    std::string_view name = topics_[i]->topic;
+    if (name.substr(0, 4) == "pmu/") name.remove_prefix(4);
+    per += (per.empty() ? "" : ", ") + std::string(name) + " " + std::to_string(counts_[i]);
+  }
+  return per.empty() ? s : s + " (" + per + ")";
+}
+
+}  // namespace pmu::tools

@@ -1,0 +1,88 @@
+#include "pmuctl/record/record_verb.hpp"
+
+#include <unistd.h>
+
+#include <csignal>
+#include <cstdio>
+#include <memory>
+#include <mutex>
+
+#include "pmu/dds/dds_context.hpp"
+#include "pmuctl/record/mcap_recording.hpp"
+#include "pmuctl/record/raw_topic_readers.hpp"
+#include "pmuctl/verbs/stop_signals.hpp"
+
+namespace pmu::tools {
+namespace {
+
+// The recording, shared by the readers' listeners (Fast DDS threads) and the main thread.
+struct Shared {
+  std::mutex mutex;
+  McapRecording rec;
+  bool closed = false;
+};
+
+}  // namespace
+
+int run_record(const GlobalOptions& o, const std::string& path, const std::vector<std::string>& names) {
+  std::vector<const RecordedTopic*> topics;
+  if (!forwarded_topics(o, names, "record", topics)) return 2;
+
+  const StopSignals stop;
+  // A reader of a pipe or FIFO that goes away gives EPIPE, said and exit status 1, instead
+  // of a silent death by SIGPIPE.
+  std::signal(SIGPIPE, SIG_IGN);
+  auto shared = std::make_unique<Shared>();  // outlives the participant and its listeners
+  // Before any participant exists: a path that cannot be written is refused at once.
+  if (const auto why = shared->rec.open(path, topics); !why.empty()) {
+    std::fprintf(stderr, "pmuctl record: %s\n", why.c_str());
+    const bool created = shared->rec.created();
+    shared->rec.close();
+    shared->rec.discard();  // nothing recorded: no file that looks like a recording (only its own)
+    return created ? 1 : 2;
+  }
+  Shared& s = *shared;
+  RawTopicReaders readers([&s](const RawSampleInfo& info, RawSample& sample) {
+    std::lock_guard<std::mutex> lock(s.mutex);
+    if (s.closed || s.rec.failed()) return;
+    s.rec.write(info.topic, info.time_ns, sample.bytes.data(), sample.bytes.size());
+  });
+  {
+    pmu::dds::DdsContext dds(o.domain, o.qos_file, "pmuctl-record", o.security, pmu::dds::Transport::Default,
+                             o.network, partitions_for(o));
+    readers.open(dds, topics);
+    std::fprintf(stderr, "pmuctl record: recording %zu topics on domain %d into %s; Ctrl-C stops\n", topics.size(),
+                 o.domain, shared->rec.name().c_str());
+    const bool tty = ::isatty(STDERR_FILENO) == 1;
+    int ticks = 0;
+    for (;;) {
+      const bool signalled = stop.wait_one_second();
+      std::lock_guard<std::mutex> lock(shared->mutex);
+      if (signalled) break;
+      if (!shared->rec.flush() || shared->rec.failed()) break;
+      if (tty)
+        std::fprintf(stderr, "\r\033[Kpmuctl record: %s", shared->rec.progress().c_str());
+      else if (++ticks % 10 == 0)
+        std::fprintf(stderr, "pmuctl record: %s\n", shared->rec.progress().c_str());
+    }
+    std::lock_guard<std::mutex> lock(shared->mutex);
+    shared->closed = true;
+    if (tty) std::fprintf(stderr, "\n");
+  }  // the participant and its readers end here: no listener runs after
+  const std::string failure = shared->rec.error();
+  const std::string closing = shared->rec.close();
+  // Also after a write error: the file is ended and holds what was recorded before it.
+  const std::string committing = shared->rec.commit();
+  std::string why;
+  for (const std::string* part : {&failure, &closing, &committing})
+    if (!part->empty()) why += (why.empty() ? "" : "; ") + *part;
+  if (!why.empty()) {
+    std::fprintf(stderr, "pmuctl record: %s\n", why.c_str());
+    return 1;
+  }
+  std::fprintf(stderr, "pmuctl record: %s written to %s (%llu bytes)\n", shared->rec.progress().c_str(),
+               shared->rec.name().c_str(), static_cast<unsigned long long>(shared->rec.bytes()));
+  return 0;
+}
+
+}  // namespace pmu::tools

@@ -1,0 +1,68 @@
+#include "pmuctl/serve/serve_verb.hpp"
+
+#include <unistd.h>
+
+#include <cstdio>
+#include <string_view>
+
+#include "pmu/dds/dds_context.hpp"
+#include "pmu/idl/topics.hpp"
+#include "pmuctl/record/raw_topic_readers.hpp"
+#include "pmuctl/serve/foxglove_server.hpp"
+#include "pmuctl/verbs/stop_signals.hpp"
+
+namespace pmu::tools {
+namespace {
+
+std::string progress(const FoxgloveServer::Counters& c) {
+  return std::to_string(c.clients) + (c.clients == 1 ? " client, " : " clients, ") + std::to_string(c.forwarded) +
+         " messages forwarded, " + std::to_string(c.dropped) + " dropped";
+}
+
+}  // namespace
+
+int run_serve(const GlobalOptions& o, const ServeOptions& serve, const std::vector<std::string>& names) {
+  std::vector<const RecordedTopic*> topics;
+  if (!forwarded_topics(o, names, "serve", topics)) return 2;
+  // Channel id = index into `topics`, which is also the readers' topic index.
+  std::vector<foxglove::Channel> channels;
+  std::vector<bool> latched;
+  for (std::uint32_t i = 0; i < topics.size(); ++i) {
+    channels.push_back(foxglove::Channel{i, topics[i]->topic, topics[i]->type_name, topics[i]->idl});
+    latched.push_back(std::string_view(topics[i]->qos_profile) == pmu::qos_profiles::kState);
+  }
+
+  const StopSignals stop;  // before the server's and Fast DDS's threads
+  FoxgloveServer server(std::move(channels), std::move(latched), serve, "pmuctl serve (pmu-dds)");
+  if (const auto why = server.start(); !why.empty()) {
+    std::fprintf(stderr, "pmuctl serve: %s\n", why.c_str());
+    return 1;
+  }
+  // Declared after the server, so destroyed before it: no listener calls publish() on a
+  // server that is gone.
+  RawTopicReaders readers([&server](const RawSampleInfo& info, RawSample& sample) {
+    server.publish(static_cast<std::uint32_t>(info.topic), info.time_ns, info.instance, std::move(sample.bytes));
+  });
+  {
+    pmu::dds::DdsContext dds(o.domain, o.qos_file, "pmuctl-serve", o.security, pmu::dds::Transport::Default,
+                             o.network, partitions_for(o));
+    readers.open(dds, topics);
+    std::fprintf(stderr,
+                 "pmuctl serve: serving %zu topics of domain %d on ws://%s (Foxglove WebSocket, subprotocol %s); "
+                 "Ctrl-C stops\n",
+                 topics.size(), o.domain, endpoint_label(serve).c_str(), std::string(foxglove::kSubprotocol).c_str());
+    const bool tty = ::isatty(STDERR_FILENO) == 1;
+    for (int ticks = 1; !stop.wait_one_second(); ++ticks) {
+      if (tty)
+        std::fprintf(stderr, "\r\033[Kpmuctl serve: %s", progress(server.counters()).c_str());
+      else if (ticks % 10 == 0)
+        std::fprintf(stderr, "pmuctl serve: %s\n", progress(server.counters()).c_str());
+    }
+    if (tty) std::fprintf(stderr, "\n");
+  }  // the participant and its readers end here: nothing publishes after
+  server.stop();
+  std::fprintf(stderr, "pmuctl serve: stopped; %s\n", progress(server.counters()).c_str());
+  return 0;
+}
+
+}  // namespace pmu::tools

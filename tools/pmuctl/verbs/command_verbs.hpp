@@ -1,0 +1,34 @@
+#pragma once
+// pmuctl's command verbs (interface.md section 3.2): one pmu::Command, exactly one final
+// pmu::CommandReply. Exit status 0 only for COMPLETED (exit_status.hpp); the result and
+// reason go to stderr.
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "pmuctl/verbs/dds_verbs.hpp"
+
+namespace pmu::tools {
+
+struct CommandSpec {
+  int kind = 0;  // pmu::CommandKind
+  std::string parameter;
+  double value = 0;
+  std::uint8_t outputs = 0;
+  bool enable = false;
+  std::uint8_t groups = 0;
+  bool confirm = false;
+};
+
+int run_command(const GlobalOptions& o, const CommandSpec& spec);
+
+// Why --address 65535 may not go with this command kind, or "" when it may (engine stop alone,
+// or another address).
+std::string broadcast_refusal(const GlobalOptions& o, int kind);
+
+// "avionics_servo" -> bit 0 ... ; false (with a message on stderr) for an unknown name.
+bool output_mask(const std::vector<std::string>& names, std::uint8_t& mask);
+bool group_mask(const std::vector<std::string>& names, std::uint8_t& mask);
+
+}  // namespace pmu::tools

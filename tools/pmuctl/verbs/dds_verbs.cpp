@@ -1,0 +1,445 @@
+#include "pmuctl/verbs/dds_verbs.hpp"
+
+#include <unistd.h>
+
+#include <atomic>
+#include <chrono>
+#include <csignal>
+#include <ctime>
+#include <cstdio>
+#include <fastdds/dds/core/status/SubscriptionMatchedStatus.hpp>
+#include <fastdds/dds/subscriber/SampleInfo.hpp>
+#include <map>
+#include <thread>
+#include <tuple>
+#include <vector>
+
+#include "pmu/codec/parameters.hpp"
+#include "pmu/command/command.hpp"
+#include "pmu/config/vehicle.hpp"
+#include "pmu/dds/dds_context.hpp"
+#include "pmu/idl/canopenPubSubTypes.h"
+#include "pmu/idl/commandPubSubTypes.h"
+#include "pmu/idl/guarded_type.hpp"
+#include "pmu/idl/statePubSubTypes.h"
+#include "pmu/idl/telemetryPubSubTypes.h"
+#include "pmu/idl/topics.hpp"
+#include "pmuctl/verbs/exit_status.hpp"
+#include "pmuctl/verbs/service_presence.hpp"
+#include "pmuctl/view/dds_json.hpp"
+#include "pmuctl/view/sample_fields.hpp"
+#include "pmuctl/view/table_text.hpp"
+
+namespace pmu::tools {
+namespace {
+
+using namespace eprosima::fastdds::dds;
+using Clock = std::chrono::steady_clock;
+
+std::atomic<bool> g_interrupted{false};
+extern "C" void on_interrupt(int) { g_interrupted = true; }
+
+// The names `config get` takes: pmu::Config's fields.
+std::string config_names() {
+  std::string names;
+  for (const auto& spec : codec::parameter_table()) names += std::string(spec.name) + ", ";
+  return names + "outputs, generation_enabled";
+}
+
+double seconds_of(const eprosima::fastrtps::rtps::Time_t& t) { return t.seconds() + t.nanosec() / 1e9; }
+
+
+// `no_address`: the words for "every device" ("any device", "no device").
+std::string device_name(const GlobalOptions& o, const char* no_address = "any device") {
+  std::string d = o.address ? "device " + std::to_string(*o.address) : std::string(no_address);
+  d += o.bus.empty() ? std::string() : " on " + o.bus;
+  if (o.vehicle) d += o.vehicle->empty() ? " of the unnamed vehicle" : " of vehicle " + *o.vehicle;
+  return d;
+}
+
+// "PMU 9 not seen on bus can0 of vehicle uav1", "no device seen on bus nope".
+std::string not_seen(const GlobalOptions& o) {
+  std::string d = o.address ? "PMU " + std::to_string(*o.address) + " not seen" : std::string("no device seen");
+  d += o.bus.empty() ? std::string() : " on bus " + o.bus;
+  if (o.vehicle) d += o.vehicle->empty() ? " of the unnamed vehicle" : " of vehicle " + *o.vehicle;
+  return d;
+}
+
+// A device on DDS: the samples' keys. `address` is a PMU's CAN address, a battery's node or
+// an MPPT's device id, told apart by `kind`.
+struct DeviceId {
+  std::string vehicle;
+  std::string bus;
+  std::uint16_t address;
+  pmu::DeviceKind kind = pmu::KIND_PMU;
+  bool operator<(const DeviceId& o) const {
+    return std::tie(vehicle, bus, kind, address) < std::tie(o.vehicle, o.bus, o.kind, o.address);
+  }
+};
+
+template <class T>
+DeviceId id_of(const T& s) {
+  return {s.vehicle().to_string(), s.bus().to_string(), s.address()};
+}
+DeviceId id_of(const pmu::Health& s) {
+  return {s.vehicle().to_string(), s.bus().to_string(), s.address(), s.kind()};
+}
+DeviceId id_of(const pmu::Battery& s) {
+  return {s.vehicle().to_string(), s.bus().to_string(), s.node(), pmu::KIND_BATTERY};
+}
+DeviceId id_of(const pmu::BatteryCells& s) {
+  return {s.vehicle().to_string(), s.bus().to_string(), s.node(), pmu::KIND_BATTERY};
+}
+DeviceId id_of(const pmu::Mppt& s) {
+  return {s.vehicle().to_string(), s.bus().to_string(), s.device(), pmu::KIND_MPPT};
+}
+
+// --address names a PMU: batteries and MPPTs are selected by vehicle and bus alone, and
+// drop out when a PMU is named.
+bool selected(const GlobalOptions& o, const DeviceId& d) {
+  return (!o.vehicle || *o.vehicle == d.vehicle) && (o.bus.empty() || o.bus == d.bus) &&
+         (!o.address || (d.kind == pmu::KIND_PMU && *o.address == d.address));
+}
+
+// "can0/1" for a PMU, "can0/battery2" and "can0/mppt4" for the others.
+std::string label(const DeviceId& d) {
+  if (d.kind == pmu::KIND_PMU) return device_label(d.vehicle, d.bus, d.address);
+  return (d.vehicle.empty() ? std::string() : d.vehicle + "/") + d.bus + "/" + to_string(d.kind) +
+         std::to_string(d.address);
+}
+
+// The JSON key of a device's number: the contract's key name of its type.
+const char* number_key(pmu::DeviceKind k) {
+  return k == pmu::KIND_BATTERY ? "node" : k == pmu::KIND_MPPT ? "device" : "address";
+}
+
+// Reads every sample of one state topic (TRANSIENT_LOCAL: the service's current values
+// arrive at once) and keeps the latest per device.
+template <class T, class PubSub>
+class StateCollector {
+ public:
+  StateCollector(pmu::dds::DdsContext& dds, const char* topic)
+      : reader_(dds.reader(dds.topic(topic, TypeSupport(new idl::Guarded<PubSub>())), qos_profiles::kState)) {}
+
+  void poll(const GlobalOptions& o) {
+    T sample;
+    SampleInfo info;
+    while (reader_.take_next_sample(&sample, &info) == ReturnCode_t::RETCODE_OK) {
+      if (!info.valid_data) {
+        // Disposed (a PMU that moved to another address): that device is not there any more.
+        if (info.instance_state != ALIVE_INSTANCE_STATE) forget(info.instance_handle);
+        continue;
+      }
+      ++received_;
+      if (!selected(o, id_of(sample))) continue;
+      latest_[id_of(sample)] = sample;
+      handles_[info.instance_handle] = id_of(sample);
+    }
+  }
+  bool matched() {
+    SubscriptionMatchedStatus st;
+    reader_.get_subscription_matched_status(st);
+    return st.current_count > 0;
+  }
+  const std::map<DeviceId, T>& latest() const { return latest_; }
+  // Samples of any device, selected or not: the service's current state has arrived.
+  std::size_t received() const { return received_; }
+
+ private:
+  void forget(const InstanceHandle_t& h) {
+    auto it = handles_.find(h);
+    if (it == handles_.end()) return;
+    latest_.erase(it->second);
+    handles_.erase(it);
+  }
+  DataReader& reader_;
+  std::size_t received_ = 0;
+  std::map<DeviceId, T> latest_;
+  std::map<InstanceHandle_t, DeviceId> handles_;
+};
+
+// Waits for the state of the selected devices: returns once samples arrived and a short
+// settle time passed (other devices' samples come in the same burst), or at the timeout.
+template <class Collector>
+int collect(const GlobalOptions& o, const pmu::dds::DdsContext& dds, Collector& c, double default_timeout) {
+  const auto deadline = Clock::now() + std::chrono::duration<double>(o.timeout.value_or(default_timeout));
+  std::optional<Clock::time_point> settle;
+  while (Clock::now() < deadline && !g_interrupted) {
+    c.poll(o);
+    // A state topic is TRANSIENT_LOCAL: once any device's sample came, the rest of the
+    // service's current state comes in the same burst, so a device missing after the settle
+    // time is not there. Waiting to the deadline would only make "not seen" slow.
+    if ((!c.latest().empty() || c.received() > 0) && !settle) settle = Clock::now() + std::chrono::milliseconds(300);
+    if (settle && Clock::now() >= *settle) break;
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+  if (!c.latest().empty()) return 0;
+  if (!c.matched()) return no_service(o, dds);
+  return fail(o, ExitStatus::BadUsage, not_seen(o));
+}
+
+// `with_kind`: the lines of verbs that show every kind of device (list, health) say which.
+void print_json(const char* topic, const DeviceId& d, const Json& values, std::optional<double> time = std::nullopt,
+                bool with_kind = false) {
+  Json j;
+  j["topic"] = topic;
+  j["vehicle"] = d.vehicle;
+  j["bus"] = d.bus;
+  if (with_kind) j["kind"] = to_string(d.kind);
+  j[number_key(d.kind)] = d.address;
+  if (time) j["time"] = *time;
+  j["values"] = values;
+  std::printf("%s\n", j.dump().c_str());
+}
+
+// "23:05:08.507": the sample's source time (the CAN frame's receive time), local time.
+std::string clock_text(double t) {
+  const auto secs = static_cast<std::time_t>(t);
+  std::tm tm{};
+  localtime_r(&secs, &tm);
+  char buf[32];
+  const std::size_t n = std::strftime(buf, sizeof buf, "%H:%M:%S", &tm);
+  std::snprintf(buf + n, sizeof buf - n, ".%03d", static_cast<int>((t - static_cast<double>(secs)) * 1000));
+  return buf;
+}
+
+template <class Collector>
+int print_state(const GlobalOptions& o, const pmu::dds::DdsContext& dds, Collector& c, const char* topic,
+                bool with_kind = false) {
+  if (int rc = collect(o, dds, c, 3.0)) return rc;
+  for (const auto& [key, s] : c.latest()) {
+    if (o.json)
+      print_json(topic, key, values_of(s), std::nullopt, with_kind);
+    else
+      std::printf("%s", value_block(label(key), fields_of(s)).c_str());
+  }
+  return 0;
+}
+
+// ---- watch --------------------------------------------------------------------------------
+
+struct TelemetryLine {
+  std::string topic;
+  DeviceId device;
+  double time;  // the sample's source timestamp, s since the Unix epoch
+  SampleFields values;
+};
+
+class TelemetryReader {
+ public:
+  virtual ~TelemetryReader() = default;
+  virtual bool take(const GlobalOptions& o, TelemetryLine& out) = 0;
+  virtual bool matched() const = 0;
+  virtual const std::string& name() const = 0;  // the topic's last word(s): "voltages", "low_rate/voltages"
+};
+
+template <class T, class PubSub>
+class TypedTelemetryReader final : public TelemetryReader {
+ public:
+  TypedTelemetryReader(pmu::dds::DdsContext& dds, const char* topic)
+      : name_(std::string(topic).substr(4)),
+        reader_(dds.reader(dds.topic(topic, TypeSupport(new idl::Guarded<PubSub>())), qos_profiles::kTelemetry)) {}
+  bool take(const GlobalOptions& o, TelemetryLine& out) override {
+    T sample;
+    SampleInfo info;
+    while (reader_.take_next_sample(&sample, &info) == ReturnCode_t::RETCODE_OK) {
+      if (!info.valid_data || !selected(o, id_of(sample))) continue;
+      out = {name_, id_of(sample), seconds_of(info.source_timestamp), fields_of(sample)};
+      return true;
+    }
+    return false;
+  }
+  bool matched() const override {
+    SubscriptionMatchedStatus st;
+    reader_.get_subscription_matched_status(st);
+    return st.current_count > 0;
+  }
+  const std::string& name() const override { return name_; }
+
+ private:
+  std::string name_;
+  DataReader& reader_;
+};
+
+}  // namespace
+
+pmu::dds::Partitions partitions_for(const GlobalOptions& o) {
+  return {service::vehicle_partitions(o.vehicle.value_or(std::string())),
+          o.vehicle ? service::vehicle_partitions(*o.vehicle) : service::every_vehicle_partitions()};
+}
+
+std::string device_label(const std::string& vehicle, const std::string& bus, std::uint16_t address) {
+  return (vehicle.empty() ? std::string() : vehicle + "/") + bus + "/" + std::to_string(address);
+}
+
+int run_watch(const GlobalOptions& o, long count) {
+  std::signal(SIGINT, on_interrupt);
+  std::signal(SIGTERM, on_interrupt);
+  pmu::dds::DdsContext dds(o.domain, o.qos_file, "pmuctl", o.security, pmu::dds::Transport::Default, o.network,
+                           partitions_for(o));
+  std::vector<std::unique_ptr<TelemetryReader>> readers;
+  // --low-rate: only the low-rate topics' writers match, so only their samples cross the link.
+  const bool low = o.low_rate;
+  readers.push_back(std::make_unique<TypedTelemetryReader<pmu::Voltages, pmu::VoltagesPubSubType>>(
+      dds, low ? topics::kLowRateVoltages : topics::kVoltages));
+  readers.push_back(std::make_unique<TypedTelemetryReader<pmu::Currents, pmu::CurrentsPubSubType>>(
+      dds, low ? topics::kLowRateCurrents : topics::kCurrents));
+  readers.push_back(std::make_unique<TypedTelemetryReader<pmu::BatteryEnergy, pmu::BatteryEnergyPubSubType>>(
+      dds, low ? topics::kLowRateBatteryEnergy : topics::kBatteryEnergy));
+  readers.push_back(std::make_unique<TypedTelemetryReader<pmu::Temperatures, pmu::TemperaturesPubSubType>>(
+      dds, low ? topics::kLowRateTemperatures : topics::kTemperatures));
+  readers.push_back(std::make_unique<TypedTelemetryReader<pmu::Status, pmu::StatusPubSubType>>(
+      dds, low ? topics::kLowRateStatus : topics::kStatus));
+  // Batteries and MPPTs have no low-rate topics: their canopen_publish_period already holds
+  // them to a few samples a second.
+  // DDS-Security permissions made before these topics existed do not grant them: then watch
+  // shows the PMUs and says what it leaves out, rather than nothing at all.
+  if (!low) {
+    try {
+      readers.push_back(
+          std::make_unique<TypedTelemetryReader<pmu::Battery, pmu::BatteryPubSubType>>(dds, topics::kBattery));
+      readers.push_back(std::make_unique<TypedTelemetryReader<pmu::BatteryCells, pmu::BatteryCellsPubSubType>>(
+          dds, topics::kBatteryCells));
+      readers.push_back(std::make_unique<TypedTelemetryReader<pmu::Mppt, pmu::MpptPubSubType>>(dds, topics::kMppt));
+    } catch (const pmu::dds::DdsError& e) {
+      std::fprintf(stderr, "pmuctl: not showing batteries and MPPTs: %s\n", e.what());
+    }
+  }
+
+  // Every row says its device's health and its values' age: a device gone OFFLINE keeps
+  // its last row, which must not look live.
+  StateCollector<pmu::Health, pmu::HealthPubSubType> health(dds, topics::kHealth);
+  const auto health_of = [&health](const DeviceId& d) -> std::optional<pmu::HealthState> {
+    const auto it = health.latest().find(d);
+    if (it == health.latest().end()) return std::nullopt;
+    return it->second.state();
+  };
+  const auto now_s = [] {
+    return std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count();
+  };
+  const bool refresh = !o.json && isatty(STDOUT_FILENO);
+  const auto deadline = o.timeout ? Clock::now() + std::chrono::duration<double>(*o.timeout) : Clock::time_point::max();
+  std::map<std::pair<DeviceId, std::string>, TelemetryLine> latest;
+  long seen = 0;
+  auto next_draw = Clock::now();
+  while (!g_interrupted && Clock::now() < deadline && (count <= 0 || seen < count)) {
+    bool any = false;
+    health.poll(o);
+    TelemetryLine line;
+    for (auto& r : readers) {
+      while ((count <= 0 || seen < count) && r->take(o, line)) {
+        any = true;
+        ++seen;
+        if (o.json) {
+          print_json(line.topic.c_str(), line.device, json_of(line.values), line.time);
+        } else if (!refresh) {
+          std::printf("%s %s %s %s %s\n", clock_text(line.time).c_str(), label(line.device).c_str(),
+                      line.topic.c_str(), freshness(health_of(line.device), now_s() - line.time).c_str(),
+                      row_values(line.values).c_str());
+        }
+        latest[{line.device, line.topic}] = line;
+      }
+    }
+    if (any) std::fflush(stdout);
+    if (refresh && Clock::now() >= next_draw) {
+      next_draw = Clock::now() + std::chrono::milliseconds(500);
+      std::printf("\033[H\033[2J");  // home + clear: a refreshing table
+      std::printf("pmuctl watch — domain %d — %ld samples (Ctrl-C to stop)\n\n", o.domain, seen);
+      std::vector<WatchRow> rows;
+      const double now = now_s();
+      // Topics in the contract's order (the readers'), devices in order within each.
+      for (const auto& r : readers)
+        for (const auto& [key, l] : latest)
+          if (l.topic == r->name()) rows.push_back({label(l.device), l.topic, health_of(l.device), now - l.time, l.values});
+      for (const auto& r : watch_table(rows)) std::printf("%s\n", r.c_str());
+      std::fflush(stdout);
+    }
+    if (!any) std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+  if (seen == 0) {
+    bool matched = false;
+    for (auto& r : readers) matched = matched || r->matched();
+    if (!matched) return no_service(o, dds);
+    return fail(o, ExitStatus::NotDone,
+                "no telemetry received from " + device_name(o) + " on domain " + std::to_string(o.domain));
+  }
+  if (count > 0 && seen < count)
+    return fail(o, ExitStatus::NotDone,
+                std::to_string(seen) + " of " + std::to_string(count) + " samples received before the timeout");
+  return 0;
+}
+
+int run_list(const GlobalOptions& o) {
+  pmu::dds::DdsContext dds(o.domain, o.qos_file, "pmuctl", o.security, pmu::dds::Transport::Default, o.network,
+                           partitions_for(o));
+  StateCollector<pmu::Health, pmu::HealthPubSubType> health(dds, topics::kHealth);
+  StateCollector<pmu::DeviceInfo, pmu::DeviceInfoPubSubType> info(dds, topics::kInfo);
+  if (int rc = collect(o, dds, health, 3.0)) return rc;
+  info.poll(o);
+  std::vector<std::vector<std::string>> rows{
+      {"VEHICLE", "BUS", "DEVICE", "SERIAL", "FIRMWARE", "STATE", "BUS STATE", "LAST FRAME"}};
+  for (const auto& [key, h] : health.latest()) {
+    const auto it = info.latest().find(key);
+    std::string fw = "-", serial = "-";
+    if (it != info.latest().end()) {
+      fw = std::to_string(it->second.firmware_major()) + "." + std::to_string(it->second.firmware_minor());
+      serial = std::to_string(it->second.serial_number());
+    }
+    if (o.json) {
+      Json j = values_of(h);
+      j["serial_number"] = it != info.latest().end() ? Json(it->second.serial_number()) : Json(nullptr);
+      j["firmware"] = it != info.latest().end() ? Json(fw) : Json(nullptr);
+      print_json("list", key, j, std::nullopt, true);
+    } else {
+      const SampleField age = *find_field(fields_of(h), "last_frame_age");  // "never", or the age
+      // A battery or MPPT shows its kind with its number ("battery2"): it has no serial or firmware.
+      const std::string number =
+          key.kind == pmu::KIND_PMU ? std::to_string(key.address) : to_string(key.kind) + std::to_string(key.address);
+      rows.push_back({key.vehicle.empty() ? "-" : key.vehicle, key.bus, number, serial, fw, to_string(h.state()),
+                      to_string(h.bus_state()), age.json.is_null() ? age.text : age_text(age.json.get<double>()) + " ago"});
+    }
+  }
+  if (!o.json)
+    for (const auto& line : aligned_columns(rows)) std::printf("%s\n", line.c_str());
+  return 0;
+}
+
+int run_info(const GlobalOptions& o) {
+  pmu::dds::DdsContext dds(o.domain, o.qos_file, "pmuctl", o.security, pmu::dds::Transport::Default, o.network,
+                           partitions_for(o));
+  StateCollector<pmu::DeviceInfo, pmu::DeviceInfoPubSubType> c(dds, topics::kInfo);
+  return print_state(o, dds, c, "info");
+}
+
+int run_health(const GlobalOptions& o) {
+  pmu::dds::DdsContext dds(o.domain, o.qos_file, "pmuctl", o.security, pmu::dds::Transport::Default, o.network,
+                           partitions_for(o));
+  StateCollector<pmu::Health, pmu::HealthPubSubType> c(dds, topics::kHealth);
+  return print_state(o, dds, c, "health", true);
+}
+
+int run_config_get(const GlobalOptions& o, const std::string& parameter) {
+  if (!parameter.empty() && !codec::parameter_from_name(parameter) && parameter != "outputs" &&
+      parameter != "generation_enabled") {
+    return fail(o, ExitStatus::BadUsage,
+                "unknown parameter '" + service::printable(parameter) + "'" +
+                    " (parameters: " + config_names() + ")");
+  }
+  pmu::dds::DdsContext dds(o.domain, o.qos_file, "pmuctl", o.security, pmu::dds::Transport::Default, o.network,
+                           partitions_for(o));
+  StateCollector<pmu::Config, pmu::ConfigPubSubType> c(dds, topics::kConfig);
+  if (parameter.empty()) return print_state(o, dds, c, "config");
+  if (int rc = collect(o, dds, c, 3.0)) return rc;
+  for (const auto& [key, s] : c.latest()) {
+    const SampleFields fields = fields_of(s);
+    const SampleField* f = find_field(fields, parameter);
+    if (!f) continue;
+    if (o.json)
+      print_json("config", key, Json{{parameter, f->json}});
+    else
+      std::printf("%s %s = %s\n", label(key).c_str(), parameter.c_str(), text_with_unit(*f).c_str());
+  }
+  return 0;
+}
+
+}  // namespace pmu::tools

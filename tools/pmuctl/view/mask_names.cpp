@@ -1,0 +1,114 @@
+#include "pmuctl/view/mask_names.hpp"
+
+#include <array>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+
+namespace pmu::tools {
+namespace {
+
+// Protocol v1.9 table 16: bits 0..3 are the outputs of tables 19..21, named as they are.
+constexpr std::array<codec::NamedBit, 7> kPowerUpNames{{
+    {codec::power_up_bit::AvionicsServo, codec::kOutputNames[0].name},
+    {codec::power_up_bit::Payload, codec::kOutputNames[1].name},
+    {codec::power_up_bit::ChargerA, codec::kOutputNames[2].name},
+    {codec::power_up_bit::ChargerB, codec::kOutputNames[3].name},
+    {codec::power_up_bit::BatteryDisconnectDetect, "battery_disconnect_detect"},
+    {codec::power_up_bit::PayloadShedding, "payload_shedding"},
+    {codec::power_up_bit::SoaManagement, "soa_management"},
+}};
+static_assert(codec::kOutputNames[0].bit == codec::power_up_bit::AvionicsServo &&
+              codec::kOutputNames[3].bit == codec::power_up_bit::ChargerB);
+
+const MaskNames kMasks[] = {
+    {"outputs", codec::kOutputNames.data(), codec::kOutputNames.size()},
+    {codec::spec_of(codec::Parameter::PacketsStreamed).name, codec::kGroupNames.data(), codec::kGroupNames.size()},
+    {codec::spec_of(codec::Parameter::PowerUpState).name, kPowerUpNames.data(), kPowerUpNames.size()},
+};
+
+// The range said is the mask the names cover (0x1F for packets_streamed), never the byte's
+// 0..255: a number with other bits is refused by the codec with the firmware's own reason.
+std::string valid_names(const MaskNames& m) {
+  std::string s;
+  unsigned defined = 0;
+  for (std::size_t i = 0; i < m.count; ++i) {
+    s += std::string(m.bits[i].name) + ", ";
+    defined |= m.bits[i].bit;
+  }
+  char hex[8];
+  std::snprintf(hex, sizeof hex, "0x%02X", defined);
+  return s + "none, or a number 0.." + hex;
+}
+
+// The whole of `text` as a number; nullopt when anything is left over.
+std::optional<double> number(std::string_view text) {
+  const std::string s(text);
+  if (s.empty() || s.find_first_of(" \t") != std::string::npos) return std::nullopt;
+  char* end = nullptr;
+  const double v = std::strtod(s.c_str(), &end);
+  if (*end != '\0') return std::nullopt;
+  return v;
+}
+
+ConfigValue refused(std::string why) { return {std::nullopt, std::move(why)}; }
+
+ConfigValue parse_mask(const MaskNames& m, std::string_view text) {
+  const std::string field(m.field);
+  if (const auto v = number(text)) {
+    if (!(*v >= 0 && *v <= 255 && std::floor(*v) == *v))
+      return refused(field + ": '" + std::string(text) + "' is not a mask (" + valid_names(m) + ")");
+    return {*v, {}};
+  }
+  if (text == "none") return {0.0, {}};
+  std::uint8_t mask = 0;
+  std::size_t start = 0;
+  while (true) {
+    const std::size_t comma = text.find(',', start);
+    const std::string_view token = text.substr(start, comma == std::string_view::npos ? comma : comma - start);
+    const std::string where = " in '" + std::string(text) + "'";
+    if (token.empty()) return refused(field + ": empty name" + where + " (" + valid_names(m) + ")");
+    if (token == "none") return refused(field + ": 'none' cannot be combined with names" + where);
+    std::optional<std::uint8_t> bit;
+    for (std::size_t i = 0; i < m.count && !bit; ++i)
+      if (m.bits[i].name == token) bit = m.bits[i].bit;
+    if (!bit)
+      return refused(field + ": unknown name '" + std::string(token) + "'" + where + " (" + valid_names(m) + ")");
+    mask = static_cast<std::uint8_t>(mask | *bit);
+    if (comma == std::string_view::npos) break;
+    start = comma + 1;
+  }
+  return {static_cast<double>(mask), {}};
+}
+
+}  // namespace
+
+const MaskNames* mask_names(std::string_view field) noexcept {
+  for (const auto& m : kMasks)
+    if (m.field == field) return &m;
+  return nullptr;
+}
+
+std::string mask_text(const MaskNames& names, std::uint8_t mask) {
+  std::string s;
+  for (unsigned bit = 0; bit < 8; ++bit) {
+    const auto b = static_cast<std::uint8_t>(1u << bit);
+    if (!(mask & b)) continue;
+    std::string name = "bit" + std::to_string(bit);
+    for (std::size_t i = 0; i < names.count; ++i)
+      if (names.bits[i].bit == b) name = std::string(names.bits[i].name);
+    s += (s.empty() ? "" : ",") + name;
+  }
+  char hex[8];
+  std::snprintf(hex, sizeof hex, "0x%02X", mask);
+  return (s.empty() ? std::string("none") : s) + " (" + hex + ")";
+}
+
+ConfigValue parse_config_value(std::string_view parameter, std::string_view text) {
+  if (const auto* m = mask_names(parameter)) return parse_mask(*m, text);
+  const auto v = number(text);
+  if (!v || !std::isfinite(*v)) return refused(std::string(parameter) + ": '" + std::string(text) + "' is not a number");
+  return {*v, {}};
+}
+
+}  // namespace pmu::tools
