@@ -398,7 +398,7 @@ TEST(PmuctlView, StateVerbsShowOneValuePerLine) {
 namespace pmu::tools {
 namespace {
 
-// --json through dds_json.hpp: sentinels are null, raw counts integers; the rest as before.
+// --json through sample_json.hpp: sentinels are null, raw counts integers; the rest as before.
 TEST(PmuctlViewJson, SentinelsAreNullAndRawCountsIntegers) {
   pmu::Health h;
   h.last_frame_age(-1.0f);

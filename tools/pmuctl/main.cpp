@@ -24,7 +24,7 @@
 #include "pmuctl/record/record_verb.hpp"
 #include "pmuctl/serve/serve_verb.hpp"
 #include "pmuctl/verbs/command_verbs.hpp"
-#include "pmuctl/verbs/dds_verbs.hpp"
+#include "pmuctl/verbs/state_verbs.hpp"
 #include "pmuctl/view/mask_names.hpp"
 #include "pmu/command/command.hpp"
 #include "pmu/config/vehicle.hpp"

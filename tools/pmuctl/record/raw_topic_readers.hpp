@@ -20,7 +20,7 @@
 #include "pmu/dds/dds_context.hpp"
 #include "pmuctl/record/mcap_topics.hpp"
 #include "pmuctl/record/raw_sample_type.hpp"
-#include "pmuctl/verbs/dds_verbs.hpp"
+#include "pmuctl/verbs/state_verbs.hpp"
 
 namespace pmu::tools {
 

@@ -9,7 +9,7 @@
 #include <vector>
 
 #include "pmuctl/serve/serve_options.hpp"
-#include "pmuctl/verbs/dds_verbs.hpp"
+#include "pmuctl/verbs/state_verbs.hpp"
 
 namespace pmu::tools {
 

@@ -25,7 +25,7 @@
 #include "pmu/idl/topics.hpp"
 #include "pmuctl/verbs/exit_status.hpp"
 #include "pmuctl/verbs/service_presence.hpp"
-#include "pmuctl/view/dds_json.hpp"
+#include "pmuctl/view/sample_json.hpp"
 
 namespace pmu::tools {
 namespace {

@@ -7,7 +7,7 @@
 #include <string>
 #include <vector>
 
-#include "pmuctl/verbs/dds_verbs.hpp"
+#include "pmuctl/verbs/state_verbs.hpp"
 
 namespace pmu::tools {
 

@@ -4,7 +4,7 @@
 
 #include <cstdio>
 
-#include "pmuctl/verbs/dds_verbs.hpp"
+#include "pmuctl/verbs/state_verbs.hpp"
 
 namespace pmu::tools {
 

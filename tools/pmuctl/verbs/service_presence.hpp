@@ -10,7 +10,7 @@
 #include <string>
 
 #include "pmu/dds/dds_context.hpp"
-#include "pmuctl/verbs/dds_verbs.hpp"
+#include "pmuctl/verbs/state_verbs.hpp"
 
 namespace pmu::tools {
 

@@ -20,7 +20,7 @@
 #include <string_view>
 #include <vector>
 
-#include "pmuctl/view/dds_json.hpp"
+#include "pmuctl/view/sample_json.hpp"
 
 namespace pmu::tools {
 

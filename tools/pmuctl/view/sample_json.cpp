@@ -1,4 +1,4 @@
-#include "pmuctl/view/dds_json.hpp"
+#include "pmuctl/view/sample_json.hpp"
 
 #include "pmuctl/view/sample_fields.hpp"
 

@@ -1,5 +1,5 @@
 #pragma once
-// pmuctl's DDS verbs (interface.md section 3.2): watch, list, info, health, config get.
+// pmuctl's state verbs (interface.md section 3.2): watch, list, info, health, config get.
 // Each returns the process exit status; messages a person can act on go to stderr
 // ("no pmu-service on domain 0", "device 7 not seen on can0").
 

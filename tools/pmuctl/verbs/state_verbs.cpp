@@ -1,4 +1,4 @@
-#include "pmuctl/verbs/dds_verbs.hpp"
+#include "pmuctl/verbs/state_verbs.hpp"
 
 #include <unistd.h>
 
@@ -26,7 +26,7 @@
 #include "pmu/idl/topics.hpp"
 #include "pmuctl/verbs/exit_status.hpp"
 #include "pmuctl/verbs/service_presence.hpp"
-#include "pmuctl/view/dds_json.hpp"
+#include "pmuctl/view/sample_json.hpp"
 #include "pmuctl/view/sample_fields.hpp"
 #include "pmuctl/view/table_text.hpp"
 
