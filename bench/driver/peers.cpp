@@ -25,34 +25,28 @@ namespace pmu::bench {
 
 using namespace eprosima::fastdds::dds;
 
-sigset_t block_stop_signals() {
-  sigset_t set;
-  sigemptyset(&set);
-  sigaddset(&set, SIGTERM);
-  sigaddset(&set, SIGINT);
-  pthread_sigmask(SIG_BLOCK, &set, nullptr);
-  return set;
+StopFlag::StopFlag()
+    : waiter_([this] {
+        signals_.wait();
+        stop_ = true;
+      }) {}
+
+StopFlag::~StopFlag() {
+  // The run ended by itself: a SIGTERM to the waiter alone wakes it (it is pending for that
+  // thread, which its signalfd reads).
+  if (!stop_) pthread_kill(waiter_.native_handle(), SIGTERM);
+  waiter_.join();
+}
+
+void StopFlag::wait() const {
+  while (!stop_) std::this_thread::sleep_for(std::chrono::milliseconds(20));
 }
 
 int peer_writer(const PeerOptions& o) {
   // SIGTERM ends the run cleanly: a process killed with its participant alive leaves its
   // listener in Fast DDS's shared-memory ports, and every later participant opening those
   // ports then waits out a health check (333 ms each), which would skew the start-ups.
-  sigset_t set = block_stop_signals();
-  std::atomic<bool> stop{false};
-  std::thread waiter([&] {
-    int sig = 0;
-    sigwait(&set, &sig);
-    stop = true;
-  });
-  struct Joiner {
-    std::thread& t;
-    const std::atomic<bool>& stopped;
-    ~Joiner() {
-      if (!stopped) pthread_kill(t.native_handle(), SIGTERM);  // the run ended by itself: wake the waiter
-      t.join();
-    }
-  } joiner{waiter, stop};
+  StopFlag stop;
   pmu::dds::DdsContext dds(o.domain, o.qos_file, "bench-peer-writer", {}, o.transport);
   DataWriter& w = dds.writer(dds.topic(topics::kVoltages, TypeSupport(new pmu::VoltagesPubSubType())),
                              qos_profiles::kTelemetry);
@@ -74,7 +68,7 @@ int peer_writer(const PeerOptions& o) {
   v.battery_b(22.2f);
   v.generator(48.0f);
   const auto count = static_cast<std::uint64_t>(o.rate * o.seconds);
-  paced(o.rate, count, &stop, [&](std::uint64_t) {
+  paced(o.rate, count, &stop.flag(), [&](std::uint64_t) {
     const auto t = static_cast<std::uint64_t>(steady_ns());
     v.avionics(static_cast<float>(t >> 48 & 0xFFFF));
     v.output_28v(static_cast<float>(t >> 32 & 0xFFFF));
@@ -115,15 +109,14 @@ class Echo : public DataReaderListener {
 }  // namespace
 
 int peer_echo(const PeerOptions& o) {
-  sigset_t set = block_stop_signals();
+  transport::StopSignals stop;
   pmu::dds::DdsContext dds(o.domain, o.qos_file, "bench-peer-echo", {}, o.transport);
   DataWriter& replies = dds.writer(dds.topic(topics::kCommandReply, TypeSupport(new pmu::CommandReplyPubSubType())),
                                    qos_profiles::kCommand);
   Echo echo(replies);
   DataReader& requests = dds.reader(dds.topic(topics::kCommand, TypeSupport(new pmu::CommandPubSubType())),
                                     qos_profiles::kCommand, &echo);
-  int sig = 0;
-  sigwait(&set, &sig);
+  stop.wait();
   requests.set_listener(nullptr);
   return 0;
 }

@@ -2,11 +2,12 @@
 // The references: the same Fast DDS, types, QoS profiles and transports as pmu-service,
 // with nothing in between. Each runs as its own process (pmu_bench peer-writer|peer-echo).
 
-#include <signal.h>
-
+#include <atomic>
 #include <string>
+#include <thread>
 
 #include "pmu/config/transport_choice.hpp"
+#include "pmu/transport/stop_signals.hpp"
 
 namespace pmu::bench {
 
@@ -20,9 +21,24 @@ struct PeerOptions {
   double period = 0.1;  // peer-telemetry: seconds between one unit's rounds of five packets
 };
 
-// SIGTERM and SIGINT, blocked in this thread and so in every thread started after it (call
-// it before Fast DDS starts its threads), for sigwait().
-sigset_t block_stop_signals();
+// SIGTERM or SIGINT as a flag a run loop checks without a system call: a thread of its own
+// waits for the signal. Construct it before Fast DDS starts its threads
+// (pmu/transport/stop_signals.hpp says why), in the thread that also destroys it.
+class StopFlag {
+ public:
+  StopFlag();
+  ~StopFlag();
+  StopFlag(const StopFlag&) = delete;
+  StopFlag& operator=(const StopFlag&) = delete;
+  const std::atomic<bool>& flag() const noexcept { return stop_; }
+  explicit operator bool() const noexcept { return stop_; }
+  void wait() const;  // until the signal came
+
+ private:
+  transport::StopSignals signals_;
+  std::atomic<bool> stop_{false};
+  std::thread waiter_;  // last: started once the signals are blocked
+};
 
 // A participant with one pmu/voltages writer (telemetry profile) writing samples that carry
 // their write time (dds_probes.hpp) at `rate` for `seconds` once a reader is matched.

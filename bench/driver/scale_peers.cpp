@@ -24,29 +24,6 @@ using namespace eprosima::fastdds::dds;
 
 namespace {
 
-// Sets `stop` when SIGTERM or SIGINT arrives; the mask must be blocked first.
-class StopSignal {
- public:
-  explicit StopSignal(sigset_t set) : set_(set), waiter_([this] {
-      int sig = 0;
-      sigwait(&set_, &sig);
-      stop_ = true;
-    }) {}
-  ~StopSignal() {
-    if (!stop_) pthread_kill(waiter_.native_handle(), SIGTERM);  // ended by itself: wake the waiter
-    waiter_.join();
-  }
-  const std::atomic<bool>& flag() const noexcept { return stop_; }
-  void wait() const {
-    while (!stop_) std::this_thread::sleep_for(std::chrono::milliseconds(20));
-  }
-
- private:
-  sigset_t set_;
-  std::atomic<bool> stop_{false};
-  std::thread waiter_;
-};
-
 template <class T>
 void keyed(T& s, std::uint16_t address) {
   s.bus("fd3");  // the key (and so the size) of the service's samples in the benchmark
@@ -56,7 +33,7 @@ void keyed(T& s, std::uint16_t address) {
 }  // namespace
 
 int peer_telemetry(const PeerOptions& o) {
-  StopSignal stop(block_stop_signals());
+  StopFlag stop;
   pmu::dds::DdsContext dds(o.domain, o.qos_file, "bench-peer-telemetry", {}, o.transport);
   Publisher* publisher = dds.participant().create_publisher(PUBLISHER_QOS_DEFAULT);
   if (!publisher) throw std::runtime_error("cannot create a publisher");
@@ -113,7 +90,7 @@ int peer_telemetry(const PeerOptions& o) {
 }
 
 int peer_reader(const PeerOptions& o) {
-  StopSignal stop(block_stop_signals());
+  StopFlag stop;
   pmu::dds::DdsContext dds(o.domain, o.qos_file, "bench-peer-reader", {}, o.transport);
   TelemetryReaders readers(dds, 256);
   stop.wait();

@@ -4,7 +4,6 @@
 // beside it. Repeat --address, --battery, --mppt for several devices. Stops on SIGTERM/SIGINT.
 
 #include <signal.h>
-#include <sys/signalfd.h>
 #include <unistd.h>
 
 #include <CLI/CLI.hpp>
@@ -17,6 +16,7 @@
 #include "pmu/codec/ids.hpp"
 #include "pmu/sim/bus_runner.hpp"
 #include "pmu/transport/socketcan_bus.hpp"
+#include "pmu/transport/stop_signals.hpp"
 #include "pmu/version.hpp"
 
 int main(int argc, char** argv) {
@@ -71,11 +71,7 @@ int main(int argc, char** argv) {
     return 2;
   }
 
-  sigset_t signals;
-  sigemptyset(&signals);
-  sigaddset(&signals, SIGTERM);
-  sigaddset(&signals, SIGINT);
-  pthread_sigmask(SIG_BLOCK, &signals, nullptr);
+  pmu::transport::StopSignals stop;  // before the runner's thread, which inherits the mask
 
   try {
     pmu::transport::SystemClock clock;
@@ -116,8 +112,7 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "pmu-sim: %zu PMU(s), %zu battery(ies), %zu MPPT(s) on %s, firmware %s\n", addresses.size(),
                  batteries.size(), mppts.size(), iface.c_str(), firmware.c_str());
     runner.start();
-    int sig = 0;
-    sigwait(&signals, &sig);
+    stop.wait();
     runner.stop();
   } catch (const std::exception& e) {
     std::fprintf(stderr, "pmu-sim: %s\n", e.what());

@@ -4,8 +4,6 @@
 // throws, and SIGTERM stops it cleanly within a second.
 
 #include <signal.h>
-#include <sys/signalfd.h>
-#include <poll.h>
 #include <unistd.h>
 
 #include <CLI/CLI.hpp>
@@ -37,6 +35,7 @@
 #include "pmu/session/receive_filters.hpp"
 #include "pmu/sysconf_dir.hpp"
 #include "pmu/transport/socketcan_bus.hpp"
+#include "pmu/transport/stop_signals.hpp"
 #include "pmu/version.hpp"
 
 namespace {
@@ -89,14 +88,8 @@ std::string summary(const std::vector<BusRuntime>& buses) {
 }
 
 int run(const service::Config& cfg, const pmu::dds::ResolvedNetwork& network) {
-  // Signals arrive through a signalfd read by this thread; block them before any thread
-  // starts so every thread inherits the mask.
-  sigset_t signals;
-  sigemptyset(&signals);
-  for (int s : {SIGTERM, SIGINT, SIGHUP}) sigaddset(&signals, s);
-  pthread_sigmask(SIG_BLOCK, &signals, nullptr);
-  transport::UniqueFd sigfd(::signalfd(-1, &signals, SFD_CLOEXEC));
-  if (!sigfd) throw std::runtime_error("signalfd failed");
+  // Before any thread starts, so that every thread inherits the blocked mask.
+  transport::StopSignals stop({SIGHUP});
 
   transport::SystemClock clock;
   service::SystemdNotifier systemd;
@@ -179,14 +172,9 @@ int run(const service::Config& cfg, const pmu::dds::ResolvedNetwork& network) {
                                  : milliseconds(1000);
   std::vector<std::uint64_t> last(buses.size(), 0);
   for (;;) {
-    pollfd p{sigfd.get(), POLLIN, 0};
-    const int n = ::poll(&p, 1, static_cast<int>(std::max(check, milliseconds(10)).count()));
-    if (n > 0) {
-      signalfd_siginfo si{};
-      if (::read(sigfd.get(), &si, sizeof si) == sizeof si) {
-        spdlog::info("signal {} received: stopping", si.ssi_signo);
-        break;
-      }
+    if (const int sig = stop.wait_for(std::max(check, milliseconds(10)))) {
+      spdlog::info("signal {} received: stopping", sig);
+      break;
     }
     bool progressing = true;
     for (std::size_t i = 0; i < buses.size(); ++i) {

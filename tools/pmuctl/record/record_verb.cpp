@@ -10,7 +10,7 @@
 #include "pmu/dds/dds_context.hpp"
 #include "pmuctl/record/mcap_recording.hpp"
 #include "pmuctl/record/raw_topic_readers.hpp"
-#include "pmuctl/verbs/stop_signals.hpp"
+#include "pmu/transport/stop_signals.hpp"
 
 namespace pmu::tools {
 namespace {
@@ -28,7 +28,7 @@ int run_record(const GlobalOptions& o, const std::string& path, const std::vecto
   std::vector<const RecordedTopic*> topics;
   if (!forwarded_topics(o, names, "record", topics)) return 2;
 
-  const StopSignals stop;
+  pmu::transport::StopSignals stop;
   // A reader of a pipe or FIFO that goes away gives EPIPE, said and exit status 1, instead
   // of a silent death by SIGPIPE.
   std::signal(SIGPIPE, SIG_IGN);
@@ -56,7 +56,7 @@ int run_record(const GlobalOptions& o, const std::string& path, const std::vecto
     const bool tty = ::isatty(STDERR_FILENO) == 1;
     int ticks = 0;
     for (;;) {
-      const bool signalled = stop.wait_one_second();
+      const bool signalled = stop.wait_for(std::chrono::seconds(1)) != 0;
       std::lock_guard<std::mutex> lock(shared->mutex);
       if (signalled) break;
       if (!shared->rec.flush() || shared->rec.failed()) break;

@@ -9,7 +9,7 @@
 #include "pmu/idl/topics.hpp"
 #include "pmuctl/record/raw_topic_readers.hpp"
 #include "pmuctl/serve/foxglove_server.hpp"
-#include "pmuctl/verbs/stop_signals.hpp"
+#include "pmu/transport/stop_signals.hpp"
 
 namespace pmu::tools {
 namespace {
@@ -32,7 +32,7 @@ int run_serve(const GlobalOptions& o, const ServeOptions& serve, const std::vect
     latched.push_back(std::string_view(topics[i]->qos_profile) == pmu::qos_profiles::kState);
   }
 
-  const StopSignals stop;  // before the server's and Fast DDS's threads
+  pmu::transport::StopSignals stop;  // before the server's and Fast DDS's threads
   FoxgloveServer server(std::move(channels), std::move(latched), serve, "pmuctl serve (pmu-dds)");
   if (const auto why = server.start(); !why.empty()) {
     std::fprintf(stderr, "pmuctl serve: %s\n", why.c_str());
@@ -52,7 +52,7 @@ int run_serve(const GlobalOptions& o, const ServeOptions& serve, const std::vect
                  "Ctrl-C stops\n",
                  topics.size(), o.domain, endpoint_label(serve).c_str(), std::string(foxglove::kSubprotocol).c_str());
     const bool tty = ::isatty(STDERR_FILENO) == 1;
-    for (int ticks = 1; !stop.wait_one_second(); ++ticks) {
+    for (int ticks = 1; stop.wait_for(std::chrono::seconds(1)) == 0; ++ticks) {
       if (tty)
         std::fprintf(stderr, "\r\033[Kpmuctl serve: %s", progress(server.counters()).c_str());
       else if (ticks % 10 == 0)

@@ -2,9 +2,7 @@
 
 #include <unistd.h>
 
-#include <atomic>
 #include <chrono>
-#include <csignal>
 #include <ctime>
 #include <cstdio>
 #include <fastdds/dds/core/status/SubscriptionMatchedStatus.hpp>
@@ -24,10 +22,11 @@
 #include "pmu/idl/statePubSubTypes.h"
 #include "pmu/idl/telemetryPubSubTypes.h"
 #include "pmu/idl/topics.hpp"
+#include "pmu/transport/stop_signals.hpp"
 #include "pmuctl/verbs/exit_status.hpp"
 #include "pmuctl/verbs/service_presence.hpp"
-#include "pmuctl/view/sample_json.hpp"
 #include "pmuctl/view/sample_fields.hpp"
+#include "pmuctl/view/sample_json.hpp"
 #include "pmuctl/view/table_text.hpp"
 
 namespace pmu::tools {
@@ -36,8 +35,6 @@ namespace {
 using namespace eprosima::fastdds::dds;
 using Clock = std::chrono::steady_clock;
 
-std::atomic<bool> g_interrupted{false};
-extern "C" void on_interrupt(int) { g_interrupted = true; }
 
 // The names `config get` takes: pmu::Config's fields.
 std::string config_names() {
@@ -164,7 +161,7 @@ template <class Collector>
 int collect(const GlobalOptions& o, const pmu::dds::DdsContext& dds, Collector& c, double default_timeout) {
   const auto deadline = Clock::now() + std::chrono::duration<double>(o.timeout.value_or(default_timeout));
   std::optional<Clock::time_point> settle;
-  while (Clock::now() < deadline && !g_interrupted) {
+  while (Clock::now() < deadline) {
     c.poll(o);
     // A state topic is TRANSIENT_LOCAL: once any device's sample came, the rest of the
     // service's current state comes in the same burst, so a device missing after the settle
@@ -273,8 +270,9 @@ std::string device_label(const std::string& vehicle, const std::string& bus, std
 }
 
 int run_watch(const GlobalOptions& o, long count) {
-  std::signal(SIGINT, on_interrupt);
-  std::signal(SIGTERM, on_interrupt);
+  // Ctrl-C or SIGTERM ends the watch like its count or timeout does (the summary and the exit
+  // status follow), read before Fast DDS starts its threads.
+  pmu::transport::StopSignals stop;
   pmu::dds::DdsContext dds(o.domain, o.qos_file, "pmuctl", o.security, pmu::dds::Transport::Default, o.network,
                            partitions_for(o));
   std::vector<std::unique_ptr<TelemetryReader>> readers;
@@ -322,7 +320,7 @@ int run_watch(const GlobalOptions& o, long count) {
   std::map<std::pair<DeviceId, std::string>, TelemetryLine> latest;
   long seen = 0;
   auto next_draw = Clock::now();
-  while (!g_interrupted && Clock::now() < deadline && (count <= 0 || seen < count)) {
+  while (stop.received() == 0 && Clock::now() < deadline && (count <= 0 || seen < count)) {
     bool any = false;
     health.poll(o);
     TelemetryLine line;
