@@ -191,7 +191,17 @@ bool wait_command_link(Client& gs, std::chrono::milliseconds timeout) {
 // The good ground station commands: the reply comes, and the PMU did it.
 void expect_ground_station_commands(ServiceUnderTest& svc, Client& gs, const std::string& id,
                                     const std::string& vehicle = "") {
-  ASSERT_TRUE(wait_command_link(gs, 10s)) << "the ground station's command writer and reply reader never matched";
+  const bool linked = wait_command_link(gs, 10s);
+  PublicationMatchedStatus writer;
+  SubscriptionMatchedStatus reader;
+  gs.commands().get_publication_matched_status(writer);
+  gs.replies().get_subscription_matched_status(reader);
+  // Both 0: the two participants never completed secure discovery. Fast DDS 2.9.1 sometimes
+  // leaves a pair of secured participants unauthenticated for as long as both live (measured
+  // with this file's in-process participants on a loaded 2-core machine: about 3 runs in 100
+  // of the fleet test below); no bound would help, and a new participant would.
+  ASSERT_TRUE(linked) << "the ground station's command writer and reply reader never matched (writer matched "
+                      << writer.current_count << " readers, reply reader " << reader.current_count << " writers)";
   pmu::Command c = command(id, "sim0", vehicle);
   ASSERT_EQ(gs.commands().write(&c), true);
   const auto reply = wait_reply(gs.replies(), id, 10s);
@@ -325,7 +335,7 @@ TEST(SecureDds, GroundStationCommandsAndMissionComputerReadsTelemetry) {
   EXPECT_TRUE(wait_sample<pmu::Voltages>(gs.voltages(), 20s)) << "ground station: no telemetry";
   EXPECT_TRUE(wait_sample<pmu::Voltages>(mc.voltages(), 20s)) << "mission computer: no telemetry";
   EXPECT_TRUE(wait_sample<pmu::Config>(mc.config(), 10s)) << "mission computer: no pmu/config (state)";
-  expect_ground_station_commands(svc, gs, "gs-1");
+  ASSERT_NO_FATAL_FAILURE(expect_ground_station_commands(svc, gs, "gs-1"));
   EXPECT_EQ(svc.commands.counters().received, 1u);
 }
 
@@ -442,7 +452,7 @@ TEST(SecureDds, MissionComputerWithARelaxedGovernanceStillCannotCommand) {
   EXPECT_NE(svc.outputs() & kPayload, 0) << "the payload was switched off";
   EXPECT_EQ(svc.handled(), handled_before) << "the PMU handled a request meanwhile";
   // The ground station still commands.
-  expect_ground_station_commands(svc, good, "gs-after-tampering");
+  ASSERT_NO_FATAL_FAILURE(expect_ground_station_commands(svc, good, "gs-after-tampering"));
 }
 
 TEST(SecureDds, PermissionsSignedByTheParticipantItselfAreRejected) {
@@ -798,9 +808,9 @@ TEST(SecureVehicles, AConfinedIdentityCannotWriteToEveryVehicleNorToAnotherOne) 
 
   // The controls: the identity commands its own vehicle, and uav2 takes commands from the
   // unconfined ground station (its payload is then off).
-  expect_ground_station_commands(uav1, gs1, "ground-uav1-to-uav1", "uav1");
+  ASSERT_NO_FATAL_FAILURE(expect_ground_station_commands(uav1, gs1, "ground-uav1-to-uav1", "uav1"));
   Client gs(domain, dds::security_files_in(fleet, "ground-station"), "ground-station", {{"uav2"}, {"uav2"}});
-  expect_ground_station_commands(uav2, gs, "ground-station-to-uav2", "uav2");
+  ASSERT_NO_FATAL_FAILURE(expect_ground_station_commands(uav2, gs, "ground-station-to-uav2", "uav2"));
   const std::uint64_t received = uav2.commands.counters().received;
   const std::uint64_t handled = uav2.handled();
   const std::uint64_t uav1_refused = uav1.endpoint.not_ours();
