@@ -1,10 +1,10 @@
 #!/usr/bin/env bash
 # The one test command (README, .ci/run): installs what is missing, builds, runs every test.
 #   1. release build (-Werror): unit, CLI, transport, simulator, service, DDS integration and
-#      deploy tests, benchmark smoke runs, and the system tests: real SocketCAN on vcan in a
-#      qemu VM booting Debian's kernel (tests/system, about 3 minutes), and the network lab
-#      in the same VM: hosts in namespaces, a netem-impaired ground link (tests/lab, ctest
-#      lab_vm, labels lab and system, about 6 minutes)
+#      deploy tests, benchmark smoke runs, and the VM suites (label system): real SocketCAN on
+#      vcan in a qemu VM booting Debian's kernel (tests/system), the network lab in the same
+#      kind of VM (tests/lab: hosts in namespaces, a netem-impaired ground link) and the amd64
+#      packages under a real systemd (tests/systemd)
 #   2. ASan+UBSan build: unit, CLI, transport, simulator and service tests under the sanitizers
 #      (the DDS integration tests run in the release build: Fast DDS itself is not built with ASan)
 #   3. ThreadSanitizer build: transport, simulator, service and DDS integration tests (threads:
@@ -14,8 +14,12 @@
 #   5. Debian packages (scripts/package.sh, lintian-clean): amd64 without tests (step 1
 #      runs them all), arm64 cross-built with its unit, transport, sim and service tests
 #      under qemu-user; the release tests then run the arm64 pmu-service from its package
-#      against this build's pmuctl (label package), and the system tests install the amd64
+#      against this build's pmuctl (label package), and the VM suites install the amd64
 #      packages (build/packages/amd64)
+# The VM suites spend most of their time waiting (link delays, cuts, leases, timeouts) with the
+# VM's CPUs mostly idle, so they run while the sanitizer and fuzz builds compile, one suite at
+# a time (RUN_SERIAL); every other test runs after the builds, on a machine that only tests.
+# tests/README.md gives each step's measured time.
 # Set PMU_FUZZ_SECONDS to change the fuzz time per target (default 30).
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
@@ -25,17 +29,33 @@ jobs=$(nproc)
 "$root/scripts/setup.sh" test
 
 # Each step's heading says how long the command has run so far, so a slow step shows in the
-# log (tests/README.md gives the measured times).
+# log.
 started=$(date +%s)
 step() { printf '\n=== %s (at %d s) ===\n' "$*" "$(($(date +%s) - started))"; }
+
+# These packages only feed the tests (systemd_vm, package_*): built without debug
+# information and without -dbgsym packages, which is most of a C++ link's time and output.
+# What ships is built by scripts/package.sh alone, with both.
+no_debug=(DEB_CFLAGS_APPEND=-g0 DEB_CXXFLAGS_APPEND=-g0)
 
 step "release build"
 # Each build's flags are its preset in CMakePresets.json (folder build/<preset>).
 cmake --preset release >/dev/null
 cmake --build --preset release -j"$jobs"
 
+step "amd64 packages"
+env "${no_debug[@]}" DEB_BUILD_OPTIONS="nocheck noautodbgsym" "$root/scripts/package.sh" --arch amd64
+
+step "VM suites started (label system), beside the builds below"
+vm_log="$root/build/release/vm-suites.log"
+ctest --preset release -L '^system$' >"$vm_log" 2>&1 &
+vm_pid=$!
+# A failure below must not leave the VMs running.
+trap 'kill "$vm_pid" 2>/dev/null || true' EXIT
+
 step "ASan+UBSan build"
 cmake --preset asan >/dev/null
+# Only the programs the sanitizer tests run (the preset's targets).
 cmake --build --preset asan -j"$jobs"
 
 step "ThreadSanitizer build"
@@ -50,8 +70,14 @@ cmake --preset fuzz >/dev/null
 # builds above.
 cmake --build --preset fuzz -j"$jobs"
 
+step "waiting for the VM suites"
+vm_status=0
+wait "$vm_pid" || vm_status=$?
+trap - EXIT
+cat "$vm_log"
+
 step "sanitizer tests"
-# ASAN_OPTIONS, UBSAN_OPTIONS and the labels left out are the preset's.
+# ASAN_OPTIONS, UBSAN_OPTIONS and the labels run are the preset's.
 ctest --preset asan -j"$jobs"
 
 step "ThreadSanitizer tests"
@@ -70,18 +96,14 @@ setarch "$(uname -m)" -R ctest --preset tsan -j"$jobs"
 step "fuzz runs"
 ctest --preset fuzz
 
-# These packages only feed the tests (systemd_vm, package_*): built without debug
-# information and without -dbgsym packages, which is most of a C++ link's time and output.
-# What ships is built by scripts/package.sh alone, with both.
-no_debug=(DEB_CFLAGS_APPEND=-g0 DEB_CXXFLAGS_APPEND=-g0)
-
-step "amd64 packages"
-env "${no_debug[@]}" DEB_BUILD_OPTIONS="nocheck noautodbgsym" "$root/scripts/package.sh" --arch amd64
-
 step "arm64 packages (tests under qemu-user)"
 env "${no_debug[@]}" DEB_BUILD_OPTIONS=noautodbgsym "$root/scripts/package.sh" --arch arm64
 
-step "release tests"
-ctest --preset release -j"$jobs"
+step "release tests (all but the VM suites, which ran above)"
+ctest --preset release -LE '^system$' -j"$jobs"
 
+if [ "$vm_status" -ne 0 ]; then
+  echo "test.sh: the VM suites failed (their output is above, after 'waiting for the VM suites')" >&2
+  exit "$vm_status"
+fi
 step "done"
