@@ -30,7 +30,6 @@ namespace {
 using namespace eprosima::fastdds::dds;
 using namespace std::chrono_literals;
 
-int test_domain() { return pmu::test::exclusive_dds_domain(); }
 
 template <class T>
 bool wait_for(DataReader& r, T& out, SampleInfo& info, std::chrono::milliseconds timeout,
@@ -45,9 +44,9 @@ bool wait_for(DataReader& r, T& out, SampleInfo& info, std::chrono::milliseconds
 }
 
 TEST(DdsCanOpen, BatteryCellsAndMpptArriveWithTheirValuesAndFrameTimes) {
-  dds::DdsContext service_side(test_domain(), "", "pmu-service-canopen");
+  dds::DdsContext service_side(pmu::test::exclusive_dds_domain(), "", "pmu-service-canopen");
   DdsPublisher publisher(service_side, 3s, "uav1");  // the vehicle key only; partitions: vehicle_test.cpp
-  dds::DdsContext client(test_domain(), "", "reader-canopen");
+  dds::DdsContext client(pmu::test::exclusive_dds_domain(), "", "reader-canopen");
   auto& battery_reader =
       client.reader(client.topic(topics::kBattery, TypeSupport(new pmu::BatteryPubSubType())), qos_profiles::kTelemetry);
   auto& cells_reader = client.reader(client.topic(topics::kBatteryCells, TypeSupport(new pmu::BatteryCellsPubSubType())),
@@ -104,9 +103,9 @@ TEST(DdsCanOpen, BatteryCellsAndMpptArriveWithTheirValuesAndFrameTimes) {
 }
 
 TEST(DdsCanOpen, HealthHasAnInstancePerDeviceKind) {
-  dds::DdsContext service_side(test_domain(), "", "pmu-service-canopen-health");
+  dds::DdsContext service_side(pmu::test::exclusive_dds_domain(), "", "pmu-service-canopen-health");
   DdsPublisher publisher(service_side, 3s);
-  dds::DdsContext client(test_domain(), "", "reader-canopen-health");
+  dds::DdsContext client(pmu::test::exclusive_dds_domain(), "", "reader-canopen-health");
   auto& health = client.reader(client.topic(topics::kHealth, TypeSupport(new pmu::HealthPubSubType())),
                                qos_profiles::kState);
   BusConfig config = bus_with_battery_and_mppt();
@@ -142,9 +141,9 @@ namespace {
 // they existed still let it start): a reader of pmu/battery finds no writer, while the same
 // service's pmu/health writer is found.
 TEST(DdsCanOpen, AServiceWithoutBatteriesOrMpptsDoesNotOfferTheirTopics) {
-  dds::DdsContext service_side(test_domain(), "", "pmu-service-no-canopen");
+  dds::DdsContext service_side(pmu::test::exclusive_dds_domain(), "", "pmu-service-no-canopen");
   DdsPublisher publisher(service_side, 3s, "", {}, std::nullopt);
-  dds::DdsContext client(test_domain(), "", "reader-no-canopen");
+  dds::DdsContext client(pmu::test::exclusive_dds_domain(), "", "reader-no-canopen");
   auto& battery =
       client.reader(client.topic(topics::kBattery, TypeSupport(new pmu::BatteryPubSubType())), qos_profiles::kTelemetry);
   auto& mppt = client.reader(client.topic(topics::kMppt, TypeSupport(new pmu::MpptPubSubType())), qos_profiles::kTelemetry);

@@ -19,13 +19,12 @@ namespace {
 
 using pmu::test::run_capture;
 
-int test_domain() { return pmu::test::exclusive_dds_domain(); }
 
 // pmuctl (another process) reads what the in-process service publishes: watch --json has one
 // line per battery, cells and MPPT sample with the contract's field names, null for what was
 // never received; list and health show each device with its kind.
 TEST(DdsCanOpen, PmuctlWatchListAndHealthShowBatteriesAndMppts) {
-  const int domain = test_domain();
+  const int domain = pmu::test::exclusive_dds_domain();
   dds::DdsContext service_side(domain, "", "pmu-service-canopen-pmuctl");
   DdsPublisher publisher(service_side, 3s);
   Harness h(bus_with_battery_and_mppt(), {pmu(1)}, Timeouts{}, &publisher);

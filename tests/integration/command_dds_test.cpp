@@ -34,7 +34,6 @@ using namespace eprosima::fastdds::dds;
 using namespace std::chrono_literals;
 
 // Each test process holds a domain of its own (a lock file), so parallel runs never meet.
-int test_domain() { return pmu::test::exclusive_dds_domain(); }
 
 struct Sender {
   Sender(int domain, const std::string& name)
@@ -55,7 +54,7 @@ struct Sender {
 };
 
 TEST(CommandsOverDds, TwoSendersBurst1000CommandsAndGetExactly1000Replies) {
-  const int domain = test_domain();
+  const int domain = pmu::test::exclusive_dds_domain();
   transport::SystemClock clock;
   transport::SimulatedNetwork network(clock);
   sim::BusRunner pmus(network.attach("pmu-sim"), clock);
@@ -175,7 +174,7 @@ TEST(CommandsOverDds, TwoSendersBurst1000CommandsAndGetExactly1000Replies) {
 pmu::test::RunResult sh(const std::string& cmd) { return pmu::test::run_capture(cmd, true); }
 
 TEST(PmuctlCommands, ResultsMessagesAndExitStatus) {
-  const int domain = test_domain();
+  const int domain = pmu::test::exclusive_dds_domain();
   pmu::test::Child service(
       {PMU_SERVICE_PATH, "--bus", "sim", "--domain", std::to_string(domain), "--log-level", "warn"});
   const std::string p = std::string(PMUCTL_PATH) + " --domain " + std::to_string(domain) + " ";
@@ -209,7 +208,7 @@ TEST(PmuctlCommands, ResultsMessagesAndExitStatus) {
 
 TEST(PmuctlCommands, NoServiceIsSaid) {
   // This process's own domain: no service runs on it (this test starts none).
-  const std::string domain = std::to_string(test_domain());
+  const std::string domain = std::to_string(pmu::test::exclusive_dds_domain());
   const auto r = sh(std::string(PMUCTL_PATH) + " --domain " + domain + " --timeout 1 config set avionics_voltage 24");
   EXPECT_EQ(r.status, 3);  // nothing answered
   EXPECT_NE(r.out.find("no pmu-service on domain " + domain), std::string::npos) << r.out;

@@ -46,7 +46,6 @@ using namespace std::chrono_literals;
 
 constexpr const char* kDiscoveryServer = "/usr/bin/fast-discovery-server";  // fastdds-tools
 
-int test_domain() { return pmu::test::exclusive_dds_domain(); }
 
 ResolvedNetwork unicast_to_loopback() {
   ResolvedNetwork n;
@@ -66,7 +65,7 @@ ResolvedNetwork client_of(std::uint16_t port) {
 // stand-in), with the contract's telemetry profile.
 struct Side {
   Side(const std::string& name, const ResolvedNetwork& network, Transport transport = Transport::UdpOnly)
-      : dds(test_domain(), "", name, {}, transport, network),
+      : dds(pmu::test::exclusive_dds_domain(), "", name, {}, transport, network),
         topic(dds.topic(topics::kVoltages, TypeSupport(new pmu::VoltagesPubSubType()))) {}
   DataWriter& writer() { return w ? *w : *(w = &dds.writer(topic, qos_profiles::kTelemetry)); }
   DataReader& reader() { return r ? *r : *(r = &dds.reader(topic, qos_profiles::kTelemetry)); }
@@ -114,7 +113,7 @@ TEST(UnicastDiscovery, PeersOnLoopbackFindEachOtherWithNoMulticastSocket) {
   client.reader();
   ASSERT_TRUE(exchange(service, client, 20s)) << "no sample over unicast discovery";
   // Both live and matched, and neither has the multicast discovery port open.
-  EXPECT_TRUE(pmu::test::dds_discovery_port_free(test_domain()));
+  EXPECT_TRUE(pmu::test::dds_discovery_port_free(pmu::test::exclusive_dds_domain()));
 }
 
 TEST(UnicastDiscovery, WithoutAPeerAtTheirPortsTheyFindNobody) {
@@ -177,7 +176,7 @@ TEST(DiscoveryServer, ClientsFindEachOtherOnlyThroughTheServerWithTheIdOfTheirPo
 
   Server server(0, port);
   ASSERT_TRUE(exchange(service, client, 20s)) << "no sample through the Discovery Server";
-  EXPECT_TRUE(pmu::test::dds_discovery_port_free(test_domain()));
+  EXPECT_TRUE(pmu::test::dds_discovery_port_free(pmu::test::exclusive_dds_domain()));
 }
 
 // ---- the interface allowlist ---------------------------------------------------------------
@@ -289,7 +288,7 @@ void expect_watch(const std::string& env, const std::string& options, const std:
 }
 
 TEST(DiscoveryEndToEnd, ServiceWithUnicastPeersFeedsPmuctlWithPeer) {
-  const std::string domain = std::to_string(test_domain());
+  const std::string domain = std::to_string(pmu::test::exclusive_dds_domain());
   ConfigFile config("domain: " + domain + "\ndds_transport: udp\ndiscovery: {mode: unicast, peers: [127.0.0.1]}\n");
   pmu::test::ChildOptions o;
   o.stderr_path = config.path + ".log";
@@ -306,7 +305,7 @@ TEST(DiscoveryEndToEnd, ServiceWithUnicastPeersFeedsPmuctlWithPeer) {
 TEST(DiscoveryEndToEnd, ServiceAndPmuctlAsClientsOfADiscoveryServer) {
   if (::access(kDiscoveryServer, X_OK) != 0)
     GTEST_SKIP() << kDiscoveryServer << " is missing: install Debian's fastdds-tools (scripts/setup.sh does)";
-  const std::string domain = std::to_string(test_domain());
+  const std::string domain = std::to_string(pmu::test::exclusive_dds_domain());
   const std::string port = std::to_string(pmu::test::free_udp_port());
   Server server(0, static_cast<std::uint16_t>(std::stoi(port)));
   ConfigFile config("domain: " + domain + "\ndds_transport: udp\ndiscovery:\n  mode: server\n  servers: [\"127.0.0.1:" +
@@ -320,7 +319,7 @@ TEST(DiscoveryEndToEnd, ServiceAndPmuctlAsClientsOfADiscoveryServer) {
 TEST(DiscoveryEndToEnd, PmuctlOptionsWinOverTheEnvironment) {
   // A bad PMU_DDS_PEERS is not even read when --discovery-server is given, nor a bad
   // PMU_DDS_INTERFACES with --interface: pmuctl gets as far as looking for the service.
-  const std::string domain = std::to_string(test_domain());
+  const std::string domain = std::to_string(pmu::test::exclusive_dds_domain());
   const auto r = pmu::test::run_capture("env PMU_DDS_PEERS=bad_host PMU_DDS_INTERFACES=bad/if " +
                                         std::string(PMUCTL_PATH) + " --domain " + domain +
                                         " --discovery-server 127.0.0.1:1 --interface lo --timeout 0.5 list "

@@ -40,7 +40,6 @@ using namespace std::chrono_literals;
 using Clock = std::chrono::steady_clock;
 
 // Each test process holds a domain of its own (a lock file), so parallel runs never meet.
-int test_domain() { return pmu::test::exclusive_dds_domain(); }
 
 template <class T>
 bool wait_sample(DataReader& r, T& out, SampleInfo& info, std::chrono::milliseconds timeout) {
@@ -76,9 +75,9 @@ struct Readers {
 };
 
 TEST(DdsTelemetry, EveryTopicArrivesWithTheSimulatorsValuesAndFrameTimestamps) {
-  dds::DdsContext service_side(test_domain(), "", "pmu-service-test");
+  dds::DdsContext service_side(pmu::test::exclusive_dds_domain(), "", "pmu-service-test");
   DdsPublisher publisher(service_side, 3s);
-  dds::DdsContext client(test_domain(), "", "reader-test");
+  dds::DdsContext client(pmu::test::exclusive_dds_domain(), "", "reader-test");
   Readers r(client);
 
   auto unit = pmu(1, codec::kCurrentFirmware, 5);
@@ -135,7 +134,7 @@ TEST(DdsTelemetry, EveryTopicArrivesWithTheSimulatorsValuesAndFrameTimestamps) {
   // A late-joining reader gets config, info and health as soon as it has discovered the
   // writers (TRANSIENT_LOCAL). The wait is discovery's, which under ThreadSanitizer beside
   // other tests took more than 3 s once; wait_sample returns at the first sample.
-  dds::DdsContext late(test_domain(), "", "late-reader");
+  dds::DdsContext late(pmu::test::exclusive_dds_domain(), "", "late-reader");
   Readers lr(late);
   ASSERT_TRUE(wait_sample(lr.config, cfg, si, 10s));
   EXPECT_FLOAT_EQ(cfg.avionics_voltage(), 12.0f);
@@ -145,9 +144,9 @@ TEST(DdsTelemetry, EveryTopicArrivesWithTheSimulatorsValuesAndFrameTimestamps) {
 }
 
 TEST(DdsTelemetry, RateFollowsThePacketPeriod) {
-  dds::DdsContext service_side(test_domain(), "", "pmu-service-rate");
+  dds::DdsContext service_side(pmu::test::exclusive_dds_domain(), "", "pmu-service-rate");
   DdsPublisher publisher(service_side, 3s);
-  dds::DdsContext client(test_domain(), "", "reader-rate");
+  dds::DdsContext client(pmu::test::exclusive_dds_domain(), "", "reader-rate");
   Readers r(client);
   Harness h(sim_bus({device(1)}), {pmu(1, codec::kCurrentFirmware, 2)}, Timeouts{}, &publisher);  // PP 0.2 s
   pmu::Voltages v;
@@ -180,7 +179,7 @@ TEST(DdsTelemetry, RateFollowsThePacketPeriod) {
 using pmu::test::run_capture;
 
 TEST(CrossProcess, ServiceOnSimulatedBusFeedsPmuctl) {
-  const std::string domain = std::to_string(test_domain());
+  const std::string domain = std::to_string(pmu::test::exclusive_dds_domain());
   pmu::test::Child service({PMU_SERVICE_PATH, "--bus", "sim", "--domain", domain, "--log-level", "warn"});
   const auto watched = run_capture(std::string(PMUCTL_PATH) + " --domain " + domain + " watch --json --count 15 --timeout 20");
   const std::string& out = watched.out;
@@ -229,7 +228,7 @@ TEST(CrossProcess, ServiceOnSimulatedBusFeedsPmuctl) {
 // Without the workaround this hung in each of 13 runs. A hung destructor cannot be undone, so
 // the test ends the process with the failure instead of sitting out ctest's timeout.
 TEST(CrossProcess, AContextWhoseReaderNeverAcknowledgedIsDestroyedPromptly) {
-  const int domain = test_domain();
+  const int domain = pmu::test::exclusive_dds_domain();
   const std::string qos = "/tmp/pmu-unacked-" + std::to_string(::getpid()) + ".xml";
   std::ofstream(qos) << R"(<?xml version="1.0" encoding="UTF-8" ?>
 <dds xmlns="http://www.eprosima.com/XMLSchemas/fastRTPS_Profiles"><profiles>
@@ -284,7 +283,7 @@ TEST(CrossProcess, AContextWhoseReaderNeverAcknowledgedIsDestroyedPromptly) {
 
 TEST(CrossProcess, PmuctlSaysWhenNoServiceIsThere) {
   // This process's own domain: no service runs on it (this test starts none).
-  const std::string domain = std::to_string(test_domain());
+  const std::string domain = std::to_string(pmu::test::exclusive_dds_domain());
   const auto r = run_capture(std::string(PMUCTL_PATH) + " --domain " + domain + " list --timeout 1", true);
   const std::string& err = r.out;
   EXPECT_EQ(r.status, 3);  // nothing answered

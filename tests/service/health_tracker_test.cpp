@@ -4,7 +4,7 @@
 
 #include "pmu/session/health_tracker.hpp"
 
-namespace pmu::service {
+namespace pmu::service::health_tracker_test {
 namespace {
 
 using namespace std::chrono_literals;
@@ -100,4 +100,4 @@ TEST(HealthTracker, CountersAndBusStateTravelInTheReport) {
 }
 
 }  // namespace
-}  // namespace pmu::service
+}  // namespace pmu::service::health_tracker_test

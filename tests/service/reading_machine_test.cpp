@@ -5,7 +5,7 @@
 #include "pmu/codec/encode.hpp"
 #include "pmu/session/reading_machine.hpp"
 
-namespace pmu::service {
+namespace pmu::service::reading_machine_test {
 namespace {
 
 using namespace std::chrono_literals;
@@ -97,4 +97,4 @@ TEST(ReadingMachine, AbsorbingAFrameSaysWhatChanged) {
 }
 
 }  // namespace
-}  // namespace pmu::service
+}  // namespace pmu::service::reading_machine_test

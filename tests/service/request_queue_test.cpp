@@ -8,7 +8,7 @@
 #include "pmu/codec/encode.hpp"
 #include "pmu/session/request_queue.hpp"
 
-namespace pmu::service {
+namespace pmu::service::request_queue_test {
 namespace {
 
 using namespace std::chrono_literals;
@@ -207,4 +207,4 @@ TEST(RequestQueue, ARoundAppendedTogetherCanBeDroppedByItsFirstFailure) {
 }
 
 }  // namespace
-}  // namespace pmu::service
+}  // namespace pmu::service::request_queue_test

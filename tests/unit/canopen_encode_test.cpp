@@ -15,12 +15,12 @@
 
 #include "pmu/codec/canopen.hpp"
 
-namespace pmu::codec::canopen {
+namespace pmu::codec::canopen::encode_test {
 namespace {
 
 // One value of the document's tables: where it goes and what its type and resolution allow.
 struct Row {
-  std::string_view name;   // decode()'s name
+  std::string_view name;   // canopen::decode()'s name
   std::uint16_t offset;    // battery: COB-ID of node 2; MPPT: 0 base id, 1 base + 1
   std::uint16_t index;     // 0 where the document says "Don't Care"
   std::uint8_t subindex;
@@ -110,7 +110,7 @@ void expect_frame(const Encoded& e, std::uint16_t id, const Row& r, double value
   EXPECT_EQ(f.data[0], command_for(r.size));
   EXPECT_EQ(f.data[1] | (f.data[2] << 8), r.index);
   EXPECT_EQ(f.data[3], subindex);
-  const auto d = decode(f);
+  const auto d = canopen::decode(f);
   ASSERT_TRUE(d.ok()) << d.error().describe();
   const Field& last = d->fields[d->field_count - 1u];
   EXPECT_EQ(last.name, r.name);
@@ -158,7 +158,7 @@ TEST(CanOpenEncodeBattery, ValuesRoundToTheResolution) {
   EXPECT_EQ(v->data[4] | (v->data[5] << 8), 48123);
   const auto c = encode_battery(BatteryValue::Current, -1.006);
   ASSERT_TRUE(c.ok());
-  EXPECT_DOUBLE_EQ(decode(*c)->fields[0].value, -1.01);
+  EXPECT_DOUBLE_EQ(canopen::decode(*c)->fields[0].value, -1.01);
 }
 
 TEST(CanOpenEncodeBattery, CellVoltagesCarryTheCellNumberAsSubindex) {
@@ -168,7 +168,7 @@ TEST(CanOpenEncodeBattery, CellVoltagesCarryTheCellNumberAsSubindex) {
     SCOPED_TRACE(cell);
     const auto c = static_cast<std::uint8_t>(cell);
     check_row(r, 0x482, [c](double x) { return encode_cell_voltage(c, x); }, c);
-    const auto d = decode(*encode_cell_voltage(c, 3.7));
+    const auto d = canopen::decode(*encode_cell_voltage(c, 3.7));
     ASSERT_TRUE(d.ok());
     EXPECT_EQ(d->fields[0].name, "cell");
     EXPECT_DOUBLE_EQ(d->fields[0].value, cell);
@@ -182,7 +182,7 @@ TEST(CanOpenEncodeBattery, TemperatureCollectionIsFourUint8) {
   EXPECT_EQ(e->id, 0x402u);
   EXPECT_EQ(e->data[0], 0x43);
   EXPECT_EQ(e->data[3], 0x0F);
-  const auto d = decode(*e);
+  const auto d = canopen::decode(*e);
   ASSERT_TRUE(d.ok());
   ASSERT_EQ(d->field_count, 4);
   const double expected[4] = {20, 21, 0, 255};
@@ -227,7 +227,7 @@ TEST(CanOpenEncodeMppt, EveryValueOfEveryDeviceRoundTrips) {
       EXPECT_EQ(name_of(value), r.name);
       const auto id = static_cast<std::uint16_t>(mppt_base(device) + r.offset);
       check_row(r, id, [device, v = value](double x) { return encode_mppt(device, v, x); }, r.subindex);
-      const auto d = decode(*encode_mppt(device, value, r.sample));
+      const auto d = canopen::decode(*encode_mppt(device, value, r.sample));
       ASSERT_TRUE(d.ok());
       EXPECT_EQ(d->device, device);
       EXPECT_EQ(d->source, Source::Mppt);
@@ -240,7 +240,7 @@ TEST(CanOpenEncodeMppt, ChannelActiveMap) {
   ASSERT_TRUE(e.ok());
   EXPECT_EQ(e->id, mppt_base(3) + 1u);
   EXPECT_EQ(e->data[3], 0x05);
-  const auto d = decode(*e);
+  const auto d = canopen::decode(*e);
   ASSERT_TRUE(d.ok()) << d.error().describe();
   ASSERT_EQ(d->field_count, 4);
   const double expected[4] = {1, 0, 1, 1};
@@ -285,4 +285,4 @@ TEST(CanOpenEncode, HeaderExamples) {
 }
 
 }  // namespace
-}  // namespace pmu::codec::canopen
+}  // namespace pmu::codec::canopen::encode_test

@@ -13,7 +13,7 @@
 #include <string_view>
 #include <vector>
 
-namespace pmu::codec::canopen {
+namespace pmu::codec::canopen::decode_test {
 namespace {
 
 // ---- helpers -------------------------------------------------------------------------------
@@ -58,7 +58,7 @@ struct Row {
 std::ostream& operator<<(std::ostream& os, const Row& r) { return os << r.label; }
 
 void expect_row(const Row& row, const CanFrame& f) {
-  const auto r = decode(f);
+  const auto r = canopen::decode(f);
   ASSERT_TRUE(r.ok()) << r.error().describe();
   const CanOpenMessage& m = r.value();
   EXPECT_EQ(m.source, row.source);
@@ -242,7 +242,7 @@ TEST(CanOpenMppt, BaseIdFormulaGivesTheHexIdsOfTheDocument) {
   for (std::uint8_t d = 0; d < 8; ++d) {
     SCOPED_TRACE(static_cast<int>(d));
     for (std::uint16_t offset = 0; offset < 2; ++offset) {
-      const auto r = decode(frame11(static_cast<std::uint32_t>(mppt_base(d) + offset), payload(0, 0, 0x03, {0x07})));
+      const auto r = canopen::decode(frame11(static_cast<std::uint32_t>(mppt_base(d) + offset), payload(0, 0, 0x03, {0x07})));
       if (offset == 0) {
         ASSERT_TRUE(r.ok()) << r.error().describe();
         EXPECT_EQ(r->device, d);
@@ -285,7 +285,7 @@ TEST(CanOpenByteOrder, ValuesAreLittleEndian) {
   };
   for (const auto& c : cases) {
     SCOPED_TRACE(c.what);
-    const auto r = decode(frame11(c.id, c.data));
+    const auto r = canopen::decode(frame11(c.id, c.data));
     ASSERT_TRUE(r.ok()) << r.error().describe();
     const Field& last = r->fields[r->field_count - 1u];
     EXPECT_DOUBLE_EQ(last.value, c.little_endian);
@@ -295,11 +295,11 @@ TEST(CanOpenByteOrder, ValuesAreLittleEndian) {
 
 TEST(CanOpenByteOrder, IndexIsLowByteFirst) {
   // Data[1] "Index Low", Data[2] "Index High": 05 20 is index 0x2005.
-  const auto ok = decode(frame11(0x302, {0x00, 0x05, 0x20, 0x01, 0x00, 0x00}));
+  const auto ok = canopen::decode(frame11(0x302, {0x00, 0x05, 0x20, 0x01, 0x00, 0x00}));
   ASSERT_TRUE(ok.ok()) << ok.error().describe();
   EXPECT_EQ(ok->index, 0x2005);
   // Swapped, it is index 0x0520, which 0x302 does not have.
-  const auto swapped = decode(frame11(0x302, {0x00, 0x20, 0x05, 0x01, 0x00, 0x00}));
+  const auto swapped = canopen::decode(frame11(0x302, {0x00, 0x20, 0x05, 0x01, 0x00, 0x00}));
   ASSERT_FALSE(swapped.ok());
   EXPECT_EQ(swapped.error().kind, ErrorKind::UnknownIndex);
   EXPECT_EQ(swapped.error().index, 0x0520);
@@ -311,11 +311,11 @@ TEST(CanOpenCommandByte, EveryValueIsReportedAndIgnored) {
   for (unsigned c = 0; c <= 0xFF; ++c) {
     SCOPED_TRACE(c);
     const auto cmd = static_cast<std::uint8_t>(c);
-    const auto battery = decode(frame11(0x302, payload(cmd, 0x2005, 0x01, {0x39, 0x30})));
+    const auto battery = canopen::decode(frame11(0x302, payload(cmd, 0x2005, 0x01, {0x39, 0x30})));
     ASSERT_TRUE(battery.ok());
     EXPECT_EQ(battery->command_byte, cmd);
     EXPECT_DOUBLE_EQ(battery->fields[0].value, 12.345);
-    const auto mppt = decode(frame11(mppt_base(7), payload(cmd, 0, 0x06, {0xEC})));
+    const auto mppt = canopen::decode(frame11(mppt_base(7), payload(cmd, 0, 0x06, {0xEC})));
     ASSERT_TRUE(mppt.ok());
     EXPECT_EQ(mppt->command_byte, cmd);
     EXPECT_DOUBLE_EQ(mppt->fields[0].value, -20.0);
@@ -347,7 +347,7 @@ CanFrame extended(std::uint32_t id, const std::vector<std::uint8_t>& bytes) {
 
 void expect_error(const ErrorCase& c) {
   SCOPED_TRACE(c.what);
-  const auto r = decode(c.frame);
+  const auto r = canopen::decode(c.frame);
   ASSERT_FALSE(r.ok()) << "decoded a value";
   const Error& e = r.error();
   EXPECT_EQ(e.kind, c.kind) << e.describe();
@@ -472,12 +472,12 @@ TEST(CanOpenIds, EveryTableIdIsRecognised) {
 }
 
 TEST(CanOpenErrors, DescribeNamesTheFrame) {
-  const auto unknown = decode(frame11(0x402, payload(0, 0x2005, 0x0A, {0})));
+  const auto unknown = canopen::decode(frame11(0x402, payload(0, 0x2005, 0x0A, {0})));
   ASSERT_FALSE(unknown.ok());
   const std::string text = unknown.error().describe();
   EXPECT_NE(text.find("402"), std::string::npos) << text;
   EXPECT_NE(text.find("0x0A"), std::string::npos) << text;
-  const auto short_frame = decode(frame11(0x402, payload(0, 0x2005, 0x0E, {1, 2, 3})));
+  const auto short_frame = canopen::decode(frame11(0x402, payload(0, 0x2005, 0x0E, {1, 2, 3})));
   ASSERT_FALSE(short_frame.ok());
   const std::string s = short_frame.error().describe();
   EXPECT_NE(s.find("7"), std::string::npos) << s;
@@ -485,4 +485,4 @@ TEST(CanOpenErrors, DescribeNamesTheFrame) {
 }
 
 }  // namespace
-}  // namespace pmu::codec::canopen
+}  // namespace pmu::codec::canopen::decode_test
