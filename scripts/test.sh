@@ -17,8 +17,12 @@
 #      against this build's pmuctl (label package), and the VM suites install the amd64
 #      packages (build/packages/amd64)
 # The VM suites spend most of their time waiting (link delays, cuts, leases, timeouts) with the
-# VM's CPUs mostly idle, so they run while the sanitizer and fuzz builds compile, one suite at
-# a time (RUN_SERIAL); every other test runs after the builds, on a machine that only tests.
+# VM's CPUs mostly idle, so they run, one suite at a time (RUN_SERIAL), while the sanitizer and
+# fuzz builds compile and their tests run, and while the arm64 packages are built. The
+# sanitizer and fuzz builds are unity builds (their presets): they compile each target's files
+# in a few batches, which halves their compile time; the release build compiles every file on
+# its own, so a file that does not include what it uses still fails there. The release tests
+# run last, on a machine that only tests.
 # tests/README.md gives each step's measured time.
 # Set PMU_FUZZ_SECONDS to change the fuzz time per target (default 30).
 set -euo pipefail
@@ -43,42 +47,46 @@ step "release build"
 cmake --preset release >/dev/null
 cmake --build --preset release -j"$jobs"
 
-step "amd64 packages"
-env "${no_debug[@]}" DEB_BUILD_OPTIONS="nocheck noautodbgsym" "$root/scripts/package.sh" --arch amd64
-
-step "VM suites started (label system), beside the builds below"
+step "VM suites started (label system), beside the steps below"
+# system_vm and lab_vm need only the release build; systemd_vm installs the amd64 packages,
+# so it waits for them (the first step below).
 vm_log="$root/build/release/vm-suites.log"
-ctest --preset release -L '^system$' >"$vm_log" 2>&1 &
+packages_ready="$root/build/release/.amd64-packages-built"
+rm -f "$packages_ready"
+vm_suites() {
+  local child status=0
+  # wait, unlike a foreground command, returns at once when a trapped signal arrives.
+  trap 'kill "$child" 2>/dev/null; exit 143' TERM
+  ctest --preset release -L '^system$' -E '^systemd_vm$' & child=$!
+  wait "$child" || status=$?
+  until [ -e "$packages_ready" ]; do sleep 5 & child=$!; wait "$child"; done
+  ctest --preset release -R '^systemd_vm$' & child=$!
+  wait "$child" || status=$?
+  return "$status"
+}
+vm_suites >"$vm_log" 2>&1 &
 vm_pid=$!
 # A failure below must not leave the VMs running.
 trap 'kill "$vm_pid" 2>/dev/null || true' EXIT
+
+step "amd64 packages"
+env "${no_debug[@]}" DEB_BUILD_OPTIONS="nocheck noautodbgsym" "$root/scripts/package.sh" --arch amd64
+touch "$packages_ready"
 
 step "ASan+UBSan build"
 cmake --preset asan >/dev/null
 # Only the programs the sanitizer tests run (the preset's targets).
 cmake --build --preset asan -j"$jobs"
 
+step "sanitizer tests"
+# ASAN_OPTIONS, UBSAN_OPTIONS and the labels run are the preset's.
+ctest --preset asan -j"$jobs"
+
 step "ThreadSanitizer build"
 # -O1 (the preset): TSan's reports keep their stack frames, and the tests run about twice as
 # fast as -O0. Only the test programs that run under TSan (and what they start) are built.
 cmake --preset tsan >/dev/null
 cmake --build --preset tsan -j"$jobs"
-
-step "libFuzzer build (clang-14)"
-cmake --preset fuzz >/dev/null
-# Only what the fuzz runs use (the preset's targets): the rest is built and tested by the gcc
-# builds above.
-cmake --build --preset fuzz -j"$jobs"
-
-step "waiting for the VM suites"
-vm_status=0
-wait "$vm_pid" || vm_status=$?
-trap - EXIT
-cat "$vm_log"
-
-step "sanitizer tests"
-# ASAN_OPTIONS, UBSAN_OPTIONS and the labels run are the preset's.
-ctest --preset asan -j"$jobs"
 
 step "ThreadSanitizer tests"
 # setarch -R: TSan's fixed memory layout fails under the high mmap randomisation of some
@@ -93,11 +101,23 @@ step "ThreadSanitizer tests"
 # TSAN_OPTIONS (tests/tsan.supp) and these exclusions are the preset's.
 setarch "$(uname -m)" -R ctest --preset tsan -j"$jobs"
 
+step "libFuzzer build (clang-14)"
+cmake --preset fuzz >/dev/null
+# Only what the fuzz runs use (the preset's targets): the rest is built and tested by the gcc
+# builds above.
+cmake --build --preset fuzz -j"$jobs"
+
 step "fuzz runs"
 ctest --preset fuzz
 
 step "arm64 packages (tests under qemu-user)"
 env "${no_debug[@]}" DEB_BUILD_OPTIONS=noautodbgsym "$root/scripts/package.sh" --arch arm64
+
+step "waiting for the VM suites"
+vm_status=0
+wait "$vm_pid" || vm_status=$?
+trap - EXIT
+cat "$vm_log"
 
 step "release tests (all but the VM suites, which ran above)"
 ctest --preset release -LE '^system$' -j"$jobs"
