@@ -1,7 +1,7 @@
 #pragma once
 // A command as a description, not as code: the frame that carries it, the packet that
 // answers it or reads it back, and the check that turns that answer into the final reply.
-// plan_command() holds one description per kind (the table, command_executor.cpp);
+// plan_command() holds one description per kind (the table, command_plan.cpp);
 // run_plan() is the one runner that carries any description out on a device session
 // (command_run.cpp). A kind's behaviour is read off its description:
 //
