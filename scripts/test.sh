@@ -20,9 +20,9 @@
 # VM's CPUs mostly idle, so they run, one suite at a time (RUN_SERIAL), while the sanitizer and
 # fuzz builds compile and their tests run, and while the arm64 packages are built. The
 # sanitizer and fuzz builds are unity builds (their presets): they compile each target's files
-# in a few batches, which halves their compile time; the release build compiles every file on
-# its own, so a file that does not include what it uses still fails there. The release tests
-# run last, on a machine that only tests.
+# in a few batches, in about half the time; the release build compiles every file on its own,
+# so a file that does not include what it uses still fails there. The release tests run last,
+# on a machine that only tests.
 # tests/README.md gives each step's measured time.
 # Set PMU_FUZZ_SECONDS to change the fuzz time per target (default 30).
 set -euo pipefail

@@ -30,7 +30,6 @@ namespace {
 using namespace eprosima::fastdds::dds;
 using namespace std::chrono_literals;
 
-
 template <class T>
 bool wait_for(DataReader& r, T& out, SampleInfo& info, std::chrono::milliseconds timeout,
               const std::function<bool(const T&)>& wanted) {

@@ -19,7 +19,6 @@ namespace {
 
 using pmu::test::run_capture;
 
-
 // pmuctl (another process) reads what the in-process service publishes: watch --json has one
 // line per battery, cells and MPPT sample with the contract's field names, null for what was
 // never received; list and health show each device with its kind.

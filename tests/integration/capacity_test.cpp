@@ -34,9 +34,6 @@ using namespace std::chrono_literals;
 
 constexpr int kDevices = 50;
 
-// Each test process holds a domain of its own (a lock file), so parallel runs never meet.
-int exclusive_domain() { return pmu::test::exclusive_dds_domain(); }
-
 // stdout only: pmuctl's diagnostics go to stderr and would not parse as JSON.
 pmu::test::RunResult run(const std::string& cmd) { return pmu::test::run_capture(cmd); }
 
@@ -54,8 +51,8 @@ class ManyPmus : public ::testing::Test {
     yaml << "buses:\n  - interface: sim\n    name: sim0\n    devices:\n";
     for (int a = 1; a <= kDevices; ++a) yaml << "      - address: " << a << "\n        period: 0.5\n";
     yaml.close();
-    ASSERT_GE(exclusive_domain(), 0);
-    domain_ = std::to_string(exclusive_domain());
+    ASSERT_GE(pmu::test::exclusive_dds_domain(), 0);
+    domain_ = std::to_string(pmu::test::exclusive_dds_domain());
     service_ = pmu::test::Child({PMU_SERVICE_PATH, "--config", config_, "--domain", domain_, "--log-level", "warn"});
   }
   void TearDown() override {
@@ -127,9 +124,9 @@ TEST(QosCapacity, AMiseditedProfileIsAStartUpError) {
   ASSERT_GE(fd, 0);
   ASSERT_EQ(::write(fd, xml.data(), xml.size()), static_cast<ssize_t>(xml.size()));
   ::close(fd);
-  ASSERT_GE(exclusive_domain(), 0);
+  ASSERT_GE(pmu::test::exclusive_dds_domain(), 0);
   const auto r = run(std::string("PMU_QOS_FILE=") + path + " " PMU_SERVICE_PATH " --bus sim --domain " +
-                     std::to_string(exclusive_domain()) + " 2>&1");
+                     std::to_string(pmu::test::exclusive_dds_domain()) + " 2>&1");
   std::remove(path);
   // A rejected configuration, found by the start-up check before anything is opened, at the
   // profile's line.
@@ -145,10 +142,10 @@ TEST(QosCapacity, AMiseditedProfileIsAStartUpError) {
 // A PMU beyond the capacity (discovery can find one) is not published, and that is counted
 // and carried in pmu/health's publish_failures rather than lost without a trace.
 TEST(QosCapacity, PmusBeyondTheCapacityAreCountedInHealthNotDroppedSilently) {
-  ASSERT_GE(exclusive_domain(), 0);
-  dds::DdsContext service_side(exclusive_domain(), PMU_QOS_FILE, "capacity-publisher");
+  ASSERT_GE(pmu::test::exclusive_dds_domain(), 0);
+  dds::DdsContext service_side(pmu::test::exclusive_dds_domain(), PMU_QOS_FILE, "capacity-publisher");
   DdsPublisher publisher(service_side, 3s);
-  dds::DdsContext client(exclusive_domain(), PMU_QOS_FILE, "capacity-reader");
+  dds::DdsContext client(pmu::test::exclusive_dds_domain(), PMU_QOS_FILE, "capacity-reader");
   DataReader& health = client.reader(
       client.topic(topics::kHealth, TypeSupport(new pmu::HealthPubSubType())), qos_profiles::kState);
   HealthReport report;

@@ -33,8 +33,6 @@ namespace {
 using namespace eprosima::fastdds::dds;
 using namespace std::chrono_literals;
 
-// Each test process holds a domain of its own (a lock file), so parallel runs never meet.
-
 struct Sender {
   Sender(int domain, const std::string& name)
       : dds(domain, "", name),

@@ -46,7 +46,6 @@ using namespace std::chrono_literals;
 
 constexpr const char* kDiscoveryServer = "/usr/bin/fast-discovery-server";  // fastdds-tools
 
-
 ResolvedNetwork unicast_to_loopback() {
   ResolvedNetwork n;
   n.mode = DiscoveryMode::Unicast;

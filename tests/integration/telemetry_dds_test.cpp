@@ -39,8 +39,6 @@ using namespace eprosima::fastdds::dds;
 using namespace std::chrono_literals;
 using Clock = std::chrono::steady_clock;
 
-// Each test process holds a domain of its own (a lock file), so parallel runs never meet.
-
 template <class T>
 bool wait_sample(DataReader& r, T& out, SampleInfo& info, std::chrono::milliseconds timeout) {
   return pmu::test::wait_until(

@@ -63,7 +63,6 @@ using Clock = std::chrono::steady_clock;
 using dds::SecurityFiles;
 using security_test::Pki;
 using security_test::sh;
-using security_test::test_domain;
 using security_test::allowed;
 using security_test::write_config;
 
@@ -286,7 +285,7 @@ const TopicInfo kTopics[] = {
 
 TEST(Permissions, EveryIdentityMayCreateExactlyTheWritersAndReadersTheContractAllows) {
   for (const char* identity : {"pmu-service", "ground-station", "mission-computer"}) {
-    dds::DdsContext p(test_domain(), "", std::string("matrix-") + identity, Pki::get().files(identity),
+    dds::DdsContext p(pmu::test::exclusive_dds_domain(), "", std::string("matrix-") + identity, Pki::get().files(identity),
                       dds::Transport::UdpOnly);
     for (const auto& t : kTopics) {
       Topic& topic = p.topic(t.name, t.type());
@@ -316,7 +315,7 @@ TEST(Permissions, EveryIdentityMayCreateExactlyTheWritersAndReadersTheContractAl
 // is not created at all and the message says what the permissions lack.
 TEST(Permissions, StatisticsTopicsThePermissionsDoNotGrantAreRefusedAtStartUp) {
   try {
-    dds::DdsContext p(test_domain(), "", "statistics-not-granted", Pki::get().files("pmu-service"),
+    dds::DdsContext p(pmu::test::exclusive_dds_domain(), "", "statistics-not-granted", Pki::get().files("pmu-service"),
                       dds::Transport::UdpOnly, {}, {}, {"_fastdds_statistics_history2history_latency"});
     ADD_FAILURE() << "created";
   } catch (const dds::DdsError& e) {
@@ -328,7 +327,7 @@ TEST(Permissions, StatisticsTopicsThePermissionsDoNotGrantAreRefusedAtStartUp) {
 }
 
 TEST(SecureDds, GroundStationCommandsAndMissionComputerReadsTelemetry) {
-  const int domain = test_domain();
+  const int domain = pmu::test::exclusive_dds_domain();
   ServiceUnderTest svc(domain, Pki::get().files("pmu-service"));
   Client gs(domain, Pki::get().files("ground-station"), "ground-station");
   Client mc(domain, Pki::get().files("mission-computer"), "mission-computer");
@@ -342,7 +341,7 @@ TEST(SecureDds, GroundStationCommandsAndMissionComputerReadsTelemetry) {
 // ---- who is shut out ------------------------------------------------------------------------
 
 TEST(SecureDds, UnauthenticatedParticipantGetsNoTelemetryAndCannotCommand) {
-  const int domain = test_domain();
+  const int domain = pmu::test::exclusive_dds_domain();
   ServiceUnderTest svc(domain, Pki::get().files("pmu-service"));
   Client good(domain, Pki::get().files("mission-computer"), "mission-computer");
   Client intruder(domain, SecurityFiles{}, "unauthenticated");
@@ -350,7 +349,7 @@ TEST(SecureDds, UnauthenticatedParticipantGetsNoTelemetryAndCannotCommand) {
 }
 
 TEST(SecureDds, CertificateFromAForeignCaIsRejected) {
-  const int domain = test_domain();
+  const int domain = pmu::test::exclusive_dds_domain();
   // A complete PKI of its own: its own CAs, governance and permissions, and an identity
   // called ground-station.
   const std::string foreign = Pki::get().foreign();
@@ -361,7 +360,7 @@ TEST(SecureDds, CertificateFromAForeignCaIsRejected) {
 }
 
 TEST(SecureDds, ExpiredCertificateIsRejected) {
-  const int domain = test_domain();
+  const int domain = pmu::test::exclusive_dds_domain();
   // A ground-station certificate from the real Identity CA, valid for a few seconds: the
   // intruder's participant is created while it is valid (Fast DDS checks its own identity
   // only then), the service starts after it has expired. On a loaded machine making the
@@ -394,7 +393,7 @@ TEST(SecureDds, ExpiredCertificateIsRejected) {
 }
 
 TEST(SecureDds, MissionComputerCannotWriteCommands) {
-  const int domain = test_domain();
+  const int domain = pmu::test::exclusive_dds_domain();
   ServiceUnderTest svc(domain, Pki::get().files("pmu-service"));
   Client mc(domain, Pki::get().files("mission-computer"), "mission-computer");
   ASSERT_TRUE(wait_sample<pmu::Voltages>(mc.voltages(), 20s)) << "the mission computer should read telemetry";
@@ -424,7 +423,7 @@ TEST(SecureDds, MissionComputerCannotWriteCommands) {
 }
 
 TEST(SecureDds, MissionComputerWithARelaxedGovernanceStillCannotCommand) {
-  const int domain = test_domain();
+  const int domain = pmu::test::exclusive_dds_domain();
   // The mission computer's real identity and permissions, but a local governance (signed by
   // the real Permissions CA) that does not guard pmu/command, as a tampered or misconfigured
   // client might have: its own participant then creates the writer. The service must still
@@ -456,7 +455,7 @@ TEST(SecureDds, MissionComputerWithARelaxedGovernanceStillCannotCommand) {
 }
 
 TEST(SecureDds, PermissionsSignedByTheParticipantItselfAreRejected) {
-  const int domain = test_domain();
+  const int domain = pmu::test::exclusive_dds_domain();
   // CVE-2023-24010's shape: mission-computer gives itself the ground station's rights in a
   // permissions document signed with its own identity (which the Identity CA issued). Its
   // own participant accepts it (it trusts the Identity CA for documents); the service,
@@ -473,7 +472,7 @@ TEST(SecureDds, PermissionsSignedByTheParticipantItselfAreRejected) {
 // Fast DDS 2.9.1 takes the same self-signed permissions and the mission computer reads
 // telemetry and switches the payload off. Skipped, not failed, if a fixed Fast DDS refuses.
 TEST(SecureDds, Cve202324010WithOneCaTheSelfSignedPermissionsWouldBeAccepted) {
-  const int domain = test_domain();
+  const int domain = pmu::test::exclusive_dds_domain();
   const std::string single = Pki::get().single_ca();
   ServiceUnderTest svc(domain, dds::security_files_in(single + "/world", "pmu-service"));
   Client good(domain, dds::security_files_in(single + "/world", "ground-station"), "ground-station");
@@ -545,7 +544,7 @@ struct WireResult {
 // ground station reads telemetry and sends a command whose request id is the marker.
 WireResult run_on_the_wire(const SecurityFiles& service_files, const SecurityFiles& gs_files, const std::string& marker,
                            const std::string& bus_marker) {
-  const int domain = test_domain();
+  const int domain = pmu::test::exclusive_dds_domain();
   WireResult w;
   Capture capture;
   if (!capture.ok()) return w;
@@ -599,7 +598,7 @@ pmu::test::Child service_process(const std::string& config) {
 TEST(ServiceProgram, SecurePmuServiceWithPmuctlAndTheExampleClient) {
   const std::string cfg = write_config("good", Pki::get().files("pmu-service"));
   const auto service = service_process(cfg);
-  const std::string d = " --domain " + std::to_string(test_domain());
+  const std::string d = " --domain " + std::to_string(pmu::test::exclusive_dds_domain());
   const std::string sec = " --security-dir " + Pki::get().dir();
   const std::string pmuctl = PMUCTL_PATH;
 
@@ -642,7 +641,7 @@ TEST(ServiceProgram, UnicastDiscoveryKeepsSecurityAndServerModeIsRefusedWithIt) 
   const std::string cfg =
       write_config("unicast", files, "dds_transport: udp\ndiscovery: {mode: unicast, peers: [127.0.0.1]}\n");
   const auto service = service_process(cfg);
-  const std::string d = " --domain " + std::to_string(test_domain());
+  const std::string d = " --domain " + std::to_string(pmu::test::exclusive_dds_domain());
   const std::string sec = " --security-dir " + Pki::get().dir();
   const std::string pmuctl = std::string("env -u PMU_DDS_PEERS -u PMU_DISCOVERY_SERVER ") + PMUCTL_PATH;
 
@@ -666,7 +665,7 @@ TEST(ServiceProgram, UnicastDiscoveryKeepsSecurityAndServerModeIsRefusedWithIt) 
 // ---- vehicles: permissions confine an identity to some vehicles (docs/interface.md 7.1) -------
 
 pmu::test::RunResult pmuctl(const std::string& pki, const std::string& args) {
-  return sh(std::string(PMUCTL_PATH) + " --domain " + std::to_string(test_domain()) + " --security-dir " + pki + " " +
+  return sh(std::string(PMUCTL_PATH) + " --domain " + std::to_string(pmu::test::exclusive_dds_domain()) + " --security-dir " + pki + " " +
             args);
 }
 
@@ -751,7 +750,7 @@ TEST(SecureVehicles, VehiclesGrantTheDefaultPartitionOnlyWithAnEmptyName) {
     std::string where;
     for (const auto& p : c.partitions) where += "\"" + p + "\" ";
     SCOPED_TRACE(args + ", a pmu/command writer in " + (where.empty() ? "the default partition" : where));
-    Client gs(test_domain(), dds::security_files_in(dir, "ground-station"), "ground-station", {c.partitions, {}});
+    Client gs(pmu::test::exclusive_dds_domain(), dds::security_files_in(dir, "ground-station"), "ground-station", {c.partitions, {}});
     bool created = true;
     try {
       gs.commands();
@@ -778,7 +777,7 @@ DataWriter* writer_with_partitions_property(dds::DdsContext& dds, const std::str
 }
 
 TEST(SecureVehicles, AConfinedIdentityCannotWriteToEveryVehicleNorToAnotherOne) {
-  const int domain = test_domain();
+  const int domain = pmu::test::exclusive_dds_domain();
   const std::string fleet = Pki::get().made("fleet", "--ground-station ground-uav1=uav1");
   const auto service_files = dds::security_files_in(fleet, "pmu-service");
   const auto confined = dds::security_files_in(fleet, "ground-uav1");

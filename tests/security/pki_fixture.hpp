@@ -26,9 +26,6 @@ namespace pmu::security_test {
 
 using dds::SecurityFiles;
 
-// This test process's own DDS domain (a lock file held while it runs).
-inline int test_domain() { return pmu::test::exclusive_dds_domain(); }
-
 // stdout and stderr of a shell command, and its exit status.
 inline pmu::test::RunResult sh(const std::string& cmd) { return pmu::test::run_capture(cmd, true); }
 
@@ -78,7 +75,7 @@ class Pki {
     const std::string out = root_ + "/" + name;
     if (made_.insert(name).second) {
       const auto r = sh(std::string("bash ") + PMU_SOURCE_DIR + "/deploy/security/make_pki.sh " + out + " --domain " +
-                        std::to_string(test_domain()) + " " + args);
+                        std::to_string(pmu::test::exclusive_dds_domain()) + " " + args);
       if (r.status != 0) ADD_FAILURE() << "make_pki.sh " << args << ": " << r.out;
     }
     return out;
@@ -95,7 +92,7 @@ class Pki {
     root_ = tmpl;
     dir_ = root_ + "/pki";
     const auto r = sh(std::string("bash ") + PMU_SOURCE_DIR + "/deploy/security/make_pki.sh " + dir_ + " --domain " +
-                      std::to_string(test_domain()));
+                      std::to_string(pmu::test::exclusive_dds_domain()));
     if (r.status != 0) throw std::runtime_error("make_pki.sh failed: " + r.out);
   }
   std::string root_, dir_;
@@ -109,7 +106,7 @@ inline std::string write_config(const std::string& name, const SecurityFiles& f,
                                 const std::string& vehicle = "") {
   const std::string path = Pki::get().root() + "/" + name + ".yaml";
   std::ofstream out(path);
-  out << "domain: " << test_domain() << "\n" << (vehicle.empty() ? "" : "vehicle: " + vehicle + "\n")
+  out << "domain: " << pmu::test::exclusive_dds_domain() << "\n" << (vehicle.empty() ? "" : "vehicle: " + vehicle + "\n")
       << "buses:\n  - interface: sim\n    name: sim0\n    devices:\n"
       << "      - address: 1\n        period: 0.5\nsecurity:\n"
       << "  identity_ca: " << f.identity_ca << "\n  identity_certificate: " << f.identity_certificate

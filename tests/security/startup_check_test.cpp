@@ -54,7 +54,7 @@ TEST(Governance, NoUnauthenticatedParticipantsJoinControlEverythingProtected) {
   EXPECT_TRUE(seen.count("pmu/command") && seen.count("pmu/command_reply") && seen.count("*"));
   // And the signed copy is what the start-up check accepts for this domain.
   dds::SecurityCheckOptions o;
-  o.domain = test_domain();
+  o.domain = pmu::test::exclusive_dds_domain();
   const auto issues = dds::check_security_files(Pki::get().files("pmu-service"), o);
   for (const auto& i : issues) ADD_FAILURE() << i.key << ": " << i.message;
 }
@@ -100,7 +100,7 @@ TEST(PermissionsDocuments, DefaultDenyAndExactlyTheContractsTopics) {
 std::vector<dds::SecurityIssue> check(const SecurityFiles& f, int warn_days = 30) {
   dds::SecurityCheckOptions o;
   o.warn_days = warn_days;
-  o.domain = test_domain();
+  o.domain = pmu::test::exclusive_dds_domain();
   return dds::check_security_files(f, o);
 }
 
@@ -228,9 +228,9 @@ TEST(StartupCheck, OneCaForBothRolesOrSelfSignedPermissionsAreRefused) {
 
 TEST(StartupCheck, DomainOutsideGovernanceAndPermissions) {
   dds::SecurityCheckOptions o;
-  o.domain = test_domain() + 1;
+  o.domain = pmu::test::exclusive_dds_domain() + 1;
   const auto issues = dds::check_security_files(Pki::get().files("pmu-service"), o);
-  expect_error(issues, "governance", "has no domain_rule for DDS domain " + std::to_string(test_domain() + 1));
+  expect_error(issues, "governance", "has no domain_rule for DDS domain " + std::to_string(pmu::test::exclusive_dds_domain() + 1));
   expect_error(issues, "permissions", "allows nothing on DDS domain");
 }
 
