@@ -8,6 +8,7 @@
 #include <fastdds/dds/core/status/SubscriptionMatchedStatus.hpp>
 #include <fastdds/dds/subscriber/SampleInfo.hpp>
 #include <map>
+#include <set>
 #include <thread>
 #include <tuple>
 #include <vector>
@@ -25,6 +26,7 @@
 #include "pmu/transport/stop_signals.hpp"
 #include "pmuctl/verbs/exit_status.hpp"
 #include "pmuctl/verbs/service_presence.hpp"
+#include "pmuctl/verbs/state_settle.hpp"
 #include "pmuctl/view/sample_fields.hpp"
 #include "pmuctl/view/sample_json.hpp"
 #include "pmuctl/view/table_text.hpp"
@@ -122,6 +124,7 @@ class StateCollector {
     T sample;
     SampleInfo info;
     while (reader_.take_next_sample(&sample, &info) == ReturnCode_t::RETCODE_OK) {
+      writers_heard_.insert(info.publication_handle);
       if (!info.valid_data) {
         // Disposed (a PMU that moved to another address): that device is not there any more.
         if (info.instance_state != ALIVE_INSTANCE_STATE) forget(info.instance_handle);
@@ -133,11 +136,14 @@ class StateCollector {
       handles_[info.instance_handle] = id_of(sample);
     }
   }
-  bool matched() {
+  bool matched() { return matched_writers() > 0; }
+  std::size_t matched_writers() {
     SubscriptionMatchedStatus st;
     reader_.get_subscription_matched_status(st);
-    return st.current_count > 0;
+    return st.current_count > 0 ? static_cast<std::size_t>(st.current_count) : 0;
   }
+  // Writers (services) whose samples have arrived, valid or not.
+  std::size_t writers_heard() const { return writers_heard_.size(); }
   const std::map<DeviceId, T>& latest() const { return latest_; }
   // Samples of any device, selected or not: the service's current state has arrived.
   std::size_t received() const { return received_; }
@@ -153,21 +159,19 @@ class StateCollector {
   std::size_t received_ = 0;
   std::map<DeviceId, T> latest_;
   std::map<InstanceHandle_t, DeviceId> handles_;
+  std::set<InstanceHandle_t> writers_heard_;
 };
 
-// Waits for the state of the selected devices: returns once samples arrived and a short
-// settle time passed (other devices' samples come in the same burst), or at the timeout.
+// Waits for the state of the selected devices: returns once every matched service has sent
+// its state and nothing new came for a short quiet time (state_settle.hpp), or at the timeout.
 template <class Collector>
 int collect(const GlobalOptions& o, const pmu::dds::DdsContext& dds, Collector& c, double default_timeout) {
   const auto deadline = Clock::now() + std::chrono::duration<double>(o.timeout.value_or(default_timeout));
-  std::optional<Clock::time_point> settle;
+  StateSettle settle(std::chrono::milliseconds(300));
   while (Clock::now() < deadline) {
     c.poll(o);
-    // A state topic is TRANSIENT_LOCAL: once any device's sample came, the rest of the
-    // service's current state comes in the same burst, so a device missing after the settle
-    // time is not there. Waiting to the deadline would only make "not seen" slow.
-    if ((!c.latest().empty() || c.received() > 0) && !settle) settle = Clock::now() + std::chrono::milliseconds(300);
-    if (settle && Clock::now() >= *settle) break;
+    settle.observe(Clock::now(), c.matched_writers(), c.writers_heard());
+    if (settle.settled(Clock::now())) break;
     std::this_thread::sleep_for(std::chrono::milliseconds(20));
   }
   if (!c.latest().empty()) return 0;
