@@ -7,9 +7,10 @@
 namespace pmu::dds {
 namespace {
 
-std::string text_of(const eprosima::fastrtps::rtps::GUID_t& guid) {
+template <class Id>
+std::string text_of(const Id& id) {
   std::ostringstream out;
-  out << guid;
+  out << id;
   return out.str();
 }
 
@@ -23,7 +24,37 @@ void RemoteWriters::on_publisher_discovery(eprosima::fastdds::dds::DomainPartici
   if (info.status == Status::REMOVED_WRITER)
     writers_.erase(guid);
   else
-    writers_[guid] = Writer{info.info.m_qos.m_partition.names(), info.info.topicName().to_string()};
+    writers_[guid] = Writer{info.info.m_qos.m_partition.names(), info.info.topicName().to_string(),
+                            text_of(info.info.guid().guidPrefix)};
+}
+
+void RemoteWriters::on_participant_discovery(eprosima::fastdds::dds::DomainParticipant*,
+                                             eprosima::fastrtps::rtps::ParticipantDiscoveryInfo&& info) {
+  using Status = eprosima::fastrtps::rtps::ParticipantDiscoveryInfo::DISCOVERY_STATUS;
+  const auto prefix = text_of(info.info.m_guid.guidPrefix);
+  std::lock_guard<std::mutex> lock(mutex_);
+  switch (info.status) {
+    case Status::DISCOVERED_PARTICIPANT:
+    case Status::CHANGED_QOS_PARTICIPANT:
+      participants_[prefix] = info.info.m_participantName.to_string();
+      break;
+    case Status::REMOVED_PARTICIPANT:
+    case Status::DROPPED_PARTICIPANT:
+      participants_.erase(prefix);
+      break;
+  }
+}
+
+std::size_t RemoteWriters::participants_without_writer(const std::string& name, const std::string& topic) const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  std::size_t n = 0;
+  for (const auto& [prefix, participant_name] : participants_) {
+    if (participant_name != name) continue;
+    bool writes = false;
+    for (const auto& [guid, w] : writers_) writes = writes || (w.topic == topic && w.participant == prefix);
+    if (!writes) ++n;
+  }
+  return n;
 }
 
 std::optional<std::vector<std::string>> RemoteWriters::partitions_of(

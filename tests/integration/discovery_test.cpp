@@ -103,6 +103,30 @@ bool exchange(Side& pub, Side& sub, std::chrono::seconds timeout) {
       timeout, 50ms);
 }
 
+// ---- services whose endpoints are still coming -------------------------------------------------
+
+// A client learns that a pmu-service is there from its participant announcement, before that
+// service's writers are discovered (seconds later over a slow link): pmuctl's state verbs
+// wait for such a service. Participants of other names are not waited for.
+TEST(RemoteParticipants, AServiceIsComingUntilItsWriterOfTheTopicIsDiscovered) {
+  Side client("pmuctl", unicast_to_loopback());
+  Side service(kServiceParticipantName, unicast_to_loopback());
+  Side other("ground-station", unicast_to_loopback());
+  client.reader();
+  other.writer();  // a writer of the topic, of a participant that is not a service
+  const auto coming = [&] {
+    return client.dds.remote_writers().participants_without_writer(kServiceParticipantName, topics::kVoltages);
+  };
+  ASSERT_TRUE(pmu::test::wait_until([&] { return coming() == 1; }, 20s))
+      << "the service's participant was not seen as coming: " << coming();
+  // The other participant's writer is discovered and matched; it never counts as a service.
+  ASSERT_TRUE(pmu::test::wait_until([&] { return client.matched(); }, 20s));
+  EXPECT_EQ(coming(), 1u);
+  service.writer();
+  EXPECT_TRUE(pmu::test::wait_until([&] { return coming() == 0; }, 20s))
+      << "the service's writer was discovered but it still counts as coming: " << coming();
+}
+
 // ---- unicast peers -------------------------------------------------------------------------
 
 TEST(UnicastDiscovery, PeersOnLoopbackFindEachOtherWithNoMulticastSocket) {

@@ -1,5 +1,6 @@
-// pmuctl's state verbs settle only when every matched service has sent its state and the
-// quiet time passed: a fleet's second service, matched late over a slow link, is waited for.
+// pmuctl's state verbs settle only when every expected service (matched, or discovered and its
+// endpoints still coming) has sent its state and the quiet time passed: a fleet's second
+// service, found late over a slow link, is waited for.
 #include <gtest/gtest.h>
 
 #include <chrono>
@@ -14,7 +15,7 @@ using Clock = StateSettle::Clock;
 
 struct Step {
   int at_ms;
-  std::size_t matched;
+  std::size_t expected;  // writers matched + services whose writer is still being discovered
   std::size_t heard;
   bool settled;  // settled() right after this observation
 };
@@ -30,12 +31,12 @@ const Case kCases[] = {
     {"two services, the second heard 700 ms after the first: not settled in between",
      {{0, 2, 0, false}, {50, 2, 1, false}, {350, 2, 1, false}, {700, 2, 1, false}, {750, 2, 2, false},
       {1050, 2, 2, true}}},
-    {"the second service matched after the first was heard: the quiet time starts again",
+    {"a second service discovered after the first was heard: the quiet time starts again",
      {{0, 1, 1, false}, {250, 2, 1, false}, {560, 2, 1, false}, {600, 2, 2, false}, {900, 2, 2, true}}},
-    {"matched but silent (no state yet): never settled",
+    {"expected but silent (no state yet): never settled",
      {{0, 1, 0, false}, {1000, 1, 0, false}, {5000, 1, 0, false}}},
-    {"nothing matched: never settled", {{0, 0, 0, false}, {5000, 0, 0, false}}},
-    {"a heard service left (unmatched): the rest suffices",
+    {"nothing expected: never settled", {{0, 0, 0, false}, {5000, 0, 0, false}}},
+    {"a heard service left: the rest suffices",
      {{0, 2, 2, false}, {300, 2, 2, true}, {400, 1, 2, false}, {700, 1, 2, true}}},
 };
 
@@ -46,8 +47,8 @@ TEST(StateSettle, WaitsForEveryMatchedServiceAndAQuietTime) {
     const auto t0 = Clock::time_point{} + 1h;
     for (const auto& st : c.steps) {
       const auto t = t0 + std::chrono::milliseconds(st.at_ms);
-      s.observe(t, st.matched, st.heard);
-      EXPECT_EQ(s.settled(t), st.settled) << "at " << st.at_ms << " ms, matched " << st.matched << ", heard "
+      s.observe(t, st.expected, st.heard);
+      EXPECT_EQ(s.settled(t), st.settled) << "at " << st.at_ms << " ms, expected " << st.expected << ", heard "
                                           << st.heard;
     }
   }

@@ -110,7 +110,7 @@ int run(const service::Config& cfg, const pmu::dds::ResolvedNetwork& network) {
 
   spdlog::info("DDS: {}", network.summary);
   const auto partitions = service::vehicle_partitions(cfg.vehicle);
-  pmu::dds::DdsContext participant(cfg.domain, cfg.qos_file, "pmu-service", cfg.security.files, cfg.dds_transport,
+  pmu::dds::DdsContext participant(cfg.domain, cfg.qos_file, pmu::dds::kServiceParticipantName, cfg.security.files, cfg.dds_transport,
                                    network, {partitions, partitions}, cfg.dds_statistics, cfg.dds_type_objects);
   if (cfg.dds_type_objects) spdlog::info("DDS: type objects announced (dds_type_objects)");
   if (!cfg.dds_statistics.empty())

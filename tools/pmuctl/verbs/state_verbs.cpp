@@ -118,7 +118,7 @@ template <class T, class PubSub>
 class StateCollector {
  public:
   StateCollector(pmu::dds::DdsContext& dds, const char* topic)
-      : reader_(dds.reader(dds.topic(topic, TypeSupport(new idl::Guarded<PubSub>())), qos_profiles::kState)) {}
+      : topic_(topic), reader_(dds.reader(dds.topic(topic, TypeSupport(new idl::Guarded<PubSub>())), qos_profiles::kState)) {}
 
   void poll(const GlobalOptions& o) {
     T sample;
@@ -144,6 +144,7 @@ class StateCollector {
   }
   // Writers (services) whose samples have arrived, valid or not.
   std::size_t writers_heard() const { return writers_heard_.size(); }
+  const std::string& topic() const { return topic_; }
   const std::map<DeviceId, T>& latest() const { return latest_; }
   // Samples of any device, selected or not: the service's current state has arrived.
   std::size_t received() const { return received_; }
@@ -155,6 +156,7 @@ class StateCollector {
     latest_.erase(it->second);
     handles_.erase(it);
   }
+  std::string topic_;
   DataReader& reader_;
   std::size_t received_ = 0;
   std::map<DeviceId, T> latest_;
@@ -162,7 +164,7 @@ class StateCollector {
   std::set<InstanceHandle_t> writers_heard_;
 };
 
-// Waits for the state of the selected devices: returns once every matched service has sent
+// Waits for the state of the selected devices: returns once every service discovered has sent
 // its state and nothing new came for a short quiet time (state_settle.hpp), or at the timeout.
 template <class Collector>
 int collect(const GlobalOptions& o, const pmu::dds::DdsContext& dds, Collector& c, double default_timeout) {
@@ -170,7 +172,10 @@ int collect(const GlobalOptions& o, const pmu::dds::DdsContext& dds, Collector& 
   StateSettle settle(std::chrono::milliseconds(300));
   while (Clock::now() < deadline) {
     c.poll(o);
-    settle.observe(Clock::now(), c.matched_writers(), c.writers_heard());
+    // Services whose writer is still being discovered will match (or prove to be another
+    // vehicle's) in a moment: they are waited for as matched ones are.
+    const auto coming = dds.remote_writers().participants_without_writer(pmu::dds::kServiceParticipantName, c.topic());
+    settle.observe(Clock::now(), c.matched_writers() + coming, c.writers_heard());
     if (settle.settled(Clock::now())) break;
     std::this_thread::sleep_for(std::chrono::milliseconds(20));
   }

@@ -76,6 +76,10 @@ std::optional<std::string> statistics_topic_not_granted(const SecurityFiles& sec
                                                         const std::vector<std::string>& topics);
 
 
+// The participant name of every pmu-service: a client that sees a participant of this name
+// knows a service's endpoints are on their way (interface.md section 7).
+inline constexpr const char* kServiceParticipantName = "pmu-service";
+
 // The DDS partitions of the participant's one publisher and one subscriber (empty: the
 // default partition). vehicle.hpp says which a service and a client use.
 struct Partitions {

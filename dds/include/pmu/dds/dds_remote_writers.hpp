@@ -1,6 +1,6 @@
 #pragma once
 // RemoteWriters: the partitions every remote DataWriter announced in discovery, by the
-// writer's GUID. DdsContext installs it when it creates the participant, so no writer is
+// writer's GUID, and the remote participants by name. DdsContext installs it when it creates the participant, so no writer is
 // missed: Fast DDS does not replay discovery to a listener set later, and a writer found in
 // the moment between the participant's creation and such a listener would stay unknown.
 // Fast DDS reports a writer (PDP::addWriterProxyData) before it pairs it with local readers,
@@ -30,14 +30,24 @@ class RemoteWriters final : public eprosima::fastdds::dds::DomainParticipantList
   // client reading one vehicle still learns which vehicles' services are there.
   std::vector<std::vector<std::string>> partitions_writing(const std::string& topic) const;
 
+  void on_participant_discovery(eprosima::fastdds::dds::DomainParticipant*,
+                                eprosima::fastrtps::rtps::ParticipantDiscoveryInfo&& info) override;
+
+  // Remote participants named `name` (alive) none of whose writers of `topic` discovery has
+  // reported yet: a participant's announcement is small and comes first, its endpoints'
+  // follow, seconds later over a slow link.
+  std::size_t participants_without_writer(const std::string& name, const std::string& topic) const;
+
  private:
   struct Writer {
     std::vector<std::string> partitions;
     std::string topic;
+    std::string participant;  // its GUID prefix as text
   };
   // Called from Fast DDS's discovery thread; read from any thread.
   mutable std::mutex mutex_;
   std::map<std::string, Writer> writers_;  // GUID text -> what it announced
+  std::map<std::string, std::string> participants_;  // GUID prefix text -> participant name
 };
 
 }  // namespace pmu::dds
