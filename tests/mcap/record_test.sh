@@ -20,11 +20,32 @@ trap '[ -n "$pid" ] && kill "$pid" 2>/dev/null; wait 2>/dev/null; umount "$work/
 pid=$!
 failures=0
 fail() { echo "FAIL: $*" >&2; failures=$((failures + 1)); }
+# A recorder is stopped once its output holds what is checked, not after a fixed time: when its
+# first samples come is up to DDS discovery. Fast DDS 2.9 (RTPSParticipantImpl::enable) sends a
+# new participant's first announcement before it listens, so the service's immediate reply can
+# be dropped; the recorder then finds the service at the service's next periodic announcement,
+# up to 3 s later. The bound only turns "never" into a FAIL line.
+#   within SECONDS COMMAND...: COMMAND succeeded before SECONDS passed
+within() {
+  local end=$((SECONDS + $1))
+  shift
+  until "$@"; do
+    ((SECONDS < end)) || return 1
+    sleep 0.5
+  done
+}
+# holds_recording FILE: the complete chunks of FILE (a recorder's temporary file, which it
+# flushes every second) hold what check_recording.mjs looks for
+holds_recording() {
+  local f
+  f=$(ls "$1".partial-* 2>/dev/null) && [ -n "$f" ] && read_mcap --stream "$f" >"$work/poll.jsonl" 2>/dev/null &&
+    node "$MCAP_TESTS_DIR/check_recording.mjs" "$work/poll.jsonl" --crashed >/dev/null 2>&1
+}
 
 # 1. SIGINT: a complete file.
 "$ctl" --domain "$domain" record "$work/rec.mcap" 2>"$work/rec.err" &
 rec=$!
-sleep 5
+within 30 holds_recording "$work/rec.mcap" || fail "after 30 s the recording holds no voltages, battery, mppt and health"
 kill -INT "$rec"
 wait "$rec"; status=$?
 [ $status -eq 0 ] || fail "record exited $status: $(cat "$work/rec.err")"
@@ -43,7 +64,7 @@ fi
 echo "an earlier recording" >"$work/crash.mcap"
 "$ctl" --domain "$domain" record --topic voltages --topic battery --topic pmu/mppt --topic health "$work/crash.mcap" 2>/dev/null &
 rec=$!
-sleep 4.5
+within 30 holds_recording "$work/crash.mcap" || fail "after 30 s the recording holds no voltages, battery, mppt and health"
 kill -KILL "$rec"
 wait "$rec" 2>/dev/null
 [ "$(cat "$work/crash.mcap")" = "an earlier recording" ] || fail "a killed recorder changed the file it was to replace"
@@ -129,11 +150,16 @@ wait "$reader" || fail "the FIFO's reader refused what it got"
 [ -p "$paths/fifo" ] || fail "the FIFO is gone: $(ls -l "$paths")"
 
 # 5. `record -`: the file on standard output, piped into @mcap/core's stream reader; status
-# lines on stderr. No file named "-".
+# lines on stderr. No file named "-". tee keeps a copy, which tells when voltages have come.
 ( cd "$work" && { "$ctl" --domain "$domain" record --topic voltages - 2>"$work/dash.err" & echo $! >"$work/dash.pid"; wait $!; echo $? >"$work/dash.status"; } ) |
-  read_mcap --stream - >"$work/dash.jsonl" &
+  tee "$work/dash.copy" | read_mcap --stream - >"$work/dash.jsonl" &
 pipeline=$!
-sleep 3
+streamed_voltages() {
+  [ -s "$work/dash.pid" ] || return 1
+  read_mcap --stream "$work/dash.copy" >"$work/poll.jsonl" 2>/dev/null
+  grep -q '"topic":"pmu/voltages"' "$work/poll.jsonl"
+}
+within 30 streamed_voltages || fail "record -: no voltages after 30 s"
 kill -INT "$(cat "$work/dash.pid")"
 wait "$pipeline" || fail "the stream reader refused record's standard output: $(cat "$work/dash.err")"
 [ "$(cat "$work/dash.status")" = 0 ] || fail "record - exited $(cat "$work/dash.status"): $(cat "$work/dash.err")"
