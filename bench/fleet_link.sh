@@ -12,7 +12,7 @@
 #   idle     10 s with no ground participant: discovery announcements alone
 #   list     one `pmuctl --json list`: bytes over the link, seconds, vehicles listed of N
 #   command  one `pmuctl --vehicle uavN config set payload_voltage 13.0`: bytes, seconds, result
-#   low      10 s of `pmuctl watch --low-rate` (started 5 s before): the steady cost of watching
+#   low      10 s of `pmuctl watch --low-rate` (started 15 s before): the steady cost of watching
 # Bytes are the ground interface's received + sent IP bytes; drops are the tbf queues'.
 # --qos and --pmuctl measure another qos.xml or pmuctl against the same services (a before
 # and after in one run). --discovery-server: Fast DDS's Discovery Server (fast-discovery-server)
@@ -140,7 +140,7 @@ EOF
 
   pmuctl_gnd watch --low-rate >"$work/low.out" 2>/dev/null &
   watcher=$!
-  sleep 5
+  sleep 15  # the watcher's own discovery and the state it gets first are not the steady cost
   b0=$(link_bytes); l0=$(wc -l <"$work/low.out"); sleep 10; b1=$(link_bytes); l1=$(wc -l <"$work/low.out")
   kill "$watcher" 2>/dev/null || true; wait "$watcher" 2>/dev/null || true
   low=$(( (b1 - b0) / 10 )); low_samples=$(python3 -c "print(round(($l1 - $l0) / 10, 1))")
