@@ -124,7 +124,14 @@ class Vehicles : public ::testing::Test {
             if (i.valid_data) configured.insert(c.vehicle().to_string());
           return configured.size() == services_.size();
         },
-        30s));
+        30s))
+        << "the watcher got pmu/config from " << configured.size() << " of " << services_.size()
+        << " vehicles: " << seen_text(configured);
+  }
+  static std::string seen_text(const std::set<std::string>& vehicles) {
+    std::string out;
+    for (const auto& v : vehicles) out += (out.empty() ? "" : ", ") + (v.empty() ? std::string("(unnamed)") : v);
+    return out.empty() ? "none" : out;
   }
   int domain_ = 0;
   std::map<std::string, std::unique_ptr<VehicleService>> services_;
