@@ -130,7 +130,6 @@ class StateCollector {
         if (info.instance_state != ALIVE_INSTANCE_STATE) forget(info.instance_handle);
         continue;
       }
-      ++received_;
       if (!selected(o, id_of(sample))) continue;
       latest_[id_of(sample)] = sample;
       handles_[info.instance_handle] = id_of(sample);
@@ -146,8 +145,6 @@ class StateCollector {
   std::size_t writers_heard() const { return writers_heard_.size(); }
   const std::string& topic() const { return topic_; }
   const std::map<DeviceId, T>& latest() const { return latest_; }
-  // Samples of any device, selected or not: the service's current state has arrived.
-  std::size_t received() const { return received_; }
 
  private:
   void forget(const InstanceHandle_t& h) {
@@ -158,7 +155,6 @@ class StateCollector {
   }
   std::string topic_;
   DataReader& reader_;
-  std::size_t received_ = 0;
   std::map<DeviceId, T> latest_;
   std::map<InstanceHandle_t, DeviceId> handles_;
   std::set<InstanceHandle_t> writers_heard_;
