@@ -42,6 +42,8 @@ test_only_packages=(
   fastdds-tools openssl
   cyclonedds-dev cyclonedds-tools
   can-utils iproute2 python3 python3-can
+  # tests/contract: the IDL 4.2 grammar (lark) the IDL layout guard parses idl/ with
+  python3-rosidl
   # The VM of the system tests and the network lab (tests/lab: iproute2's ip and tc with
   # netem's distribution tables go into it; its kernel is downloaded, not installed)
   qemu-system-x86 busybox-static cpio kmod

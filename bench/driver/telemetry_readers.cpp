@@ -56,13 +56,13 @@ TelemetryReaders::TelemetryReaders(pmu::dds::DdsContext& dds, int max_units) : d
     listeners_.push_back(std::move(listener));
     readers_.push_back(r);
   };
-  add(topics::kVoltages, TypeSupport(new pmu::VoltagesPubSubType()), std::make_unique<Counter<pmu::Voltages>>(shared, true));
-  add(topics::kCurrents, TypeSupport(new pmu::CurrentsPubSubType()), std::make_unique<Counter<pmu::Currents>>(shared, false));
-  add(topics::kBatteryEnergy, TypeSupport(new pmu::BatteryEnergyPubSubType()),
-      std::make_unique<Counter<pmu::BatteryEnergy>>(shared, false));
-  add(topics::kTemperatures, TypeSupport(new pmu::TemperaturesPubSubType()),
-      std::make_unique<Counter<pmu::Temperatures>>(shared, false));
-  add(topics::kStatus, TypeSupport(new pmu::StatusPubSubType()), std::make_unique<Counter<pmu::Status>>(shared, false));
+  add(topics::kVoltages, TypeSupport(new pmu::v4::VoltagesPubSubType()), std::make_unique<Counter<pmu::v4::Voltages>>(shared, true));
+  add(topics::kCurrents, TypeSupport(new pmu::v4::CurrentsPubSubType()), std::make_unique<Counter<pmu::v4::Currents>>(shared, false));
+  add(topics::kBatteryEnergy, TypeSupport(new pmu::v4::BatteryEnergyPubSubType()),
+      std::make_unique<Counter<pmu::v4::BatteryEnergy>>(shared, false));
+  add(topics::kTemperatures, TypeSupport(new pmu::v4::TemperaturesPubSubType()),
+      std::make_unique<Counter<pmu::v4::Temperatures>>(shared, false));
+  add(topics::kStatus, TypeSupport(new pmu::v4::StatusPubSubType()), std::make_unique<Counter<pmu::v4::Status>>(shared, false));
 }
 
 TelemetryReaders::~TelemetryReaders() {

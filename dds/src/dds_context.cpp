@@ -81,8 +81,9 @@ std::string default_qos_file() {
 
 DdsContext::DdsContext(int domain, const std::string& qos_file, const std::string& participant_name,
                        const SecurityFiles& security, Transport transport, const ResolvedNetwork& network,
-                       const Partitions& partitions, const std::vector<std::string>& statistics, bool type_objects)
-    : domain_(domain), type_objects_(type_objects), secure_(!security.empty()), security_(security), partitions_(partitions) {
+                       const Partitions& partitions, const std::vector<std::string>& statistics, bool type_objects,
+                       int contract)
+    : domain_(domain), contract_(contract), type_objects_(type_objects && contract == contract_major()), secure_(!security.empty()), security_(security), partitions_(partitions) {
   const std::string file = qos_file.empty() ? default_qos_file() : qos_file;
   qos_file_ = file;
   if (file.empty()) throw DdsError("no QoS profile file: neither " PMU_SYSCONFDIR "/qos.xml nor " PMU_DATADIR "/qos.xml exists; install deploy/qos.xml, set PMU_QOS_FILE or set qos_file");
@@ -103,6 +104,9 @@ DdsContext::DdsContext(int domain, const std::string& qos_file, const std::strin
   } catch (const NetworkError& e) {
     throw DdsError(e.what());
   }
+  // Sent in discovery, so a client tells which contract a participant serves before its
+  // endpoints are announced (seconds later over a slow link).
+  pqos.properties().properties().emplace_back(kContractProperty, std::to_string(contract), true);
   // The listener from the start: discovery is not replayed to one set later.
   participant_ = DomainParticipantFactory::get_instance()->create_participant(static_cast<DomainId_t>(domain), pqos,
                                                                               &remote_writers_, StatusMask::none());
@@ -134,6 +138,7 @@ DdsContext::~DdsContext() {
 
 Topic& DdsContext::topic(const std::string& name, TypeSupport type) {
   if (auto it = topics_.find(name); it != topics_.end()) return *it->second;
+  if (contract_ != contract_major()) type->setName(type_name_in_contract(type.get_type_name(), contract_).c_str());
   const std::string type_name = type.get_type_name();
   announce_type_object(type, type_objects_);  // never TypeInformation; the type object when asked and self-contained
   if (type.register_type(participant_) != ReturnCode_t::RETCODE_OK)

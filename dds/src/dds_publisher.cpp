@@ -136,29 +136,29 @@ DdsPublisher::DdsPublisher(dds::DdsContext& dds, std::chrono::milliseconds telem
     return &dds.writer(dds.topic(name, type), qos_profiles::kState);
   };
   const auto d = telemetry_deadline;
-  w_->voltages = telemetry(topics::kVoltages, TypeSupport(new pmu::VoltagesPubSubType()), d);
-  w_->currents = telemetry(topics::kCurrents, TypeSupport(new pmu::CurrentsPubSubType()), d);
-  w_->energy = telemetry(topics::kBatteryEnergy, TypeSupport(new pmu::BatteryEnergyPubSubType()), d);
-  w_->temperatures = telemetry(topics::kTemperatures, TypeSupport(new pmu::TemperaturesPubSubType()), d);
-  w_->status = telemetry(topics::kStatus, TypeSupport(new pmu::StatusPubSubType()), d);
+  w_->voltages = telemetry(topics::kVoltages, TypeSupport(new pmu::v4::VoltagesPubSubType()), d);
+  w_->currents = telemetry(topics::kCurrents, TypeSupport(new pmu::v4::CurrentsPubSubType()), d);
+  w_->energy = telemetry(topics::kBatteryEnergy, TypeSupport(new pmu::v4::BatteryEnergyPubSubType()), d);
+  w_->temperatures = telemetry(topics::kTemperatures, TypeSupport(new pmu::v4::TemperaturesPubSubType()), d);
+  w_->status = telemetry(topics::kStatus, TypeSupport(new pmu::v4::StatusPubSubType()), d);
   if (w_->low_rate.enabled()) {
     // The same types on topics of their own: a reader of one never matches the other's writer.
     const auto low = std::max(telemetry_deadline, 3 * low_rate_period);
-    w_->low[0] = telemetry(topics::kLowRateVoltages, TypeSupport(new pmu::VoltagesPubSubType()), low);
-    w_->low[1] = telemetry(topics::kLowRateCurrents, TypeSupport(new pmu::CurrentsPubSubType()), low);
-    w_->low[2] = telemetry(topics::kLowRateBatteryEnergy, TypeSupport(new pmu::BatteryEnergyPubSubType()), low);
-    w_->low[3] = telemetry(topics::kLowRateTemperatures, TypeSupport(new pmu::TemperaturesPubSubType()), low);
-    w_->low[4] = telemetry(topics::kLowRateStatus, TypeSupport(new pmu::StatusPubSubType()), low);
+    w_->low[0] = telemetry(topics::kLowRateVoltages, TypeSupport(new pmu::v4::VoltagesPubSubType()), low);
+    w_->low[1] = telemetry(topics::kLowRateCurrents, TypeSupport(new pmu::v4::CurrentsPubSubType()), low);
+    w_->low[2] = telemetry(topics::kLowRateBatteryEnergy, TypeSupport(new pmu::v4::BatteryEnergyPubSubType()), low);
+    w_->low[3] = telemetry(topics::kLowRateTemperatures, TypeSupport(new pmu::v4::TemperaturesPubSubType()), low);
+    w_->low[4] = telemetry(topics::kLowRateStatus, TypeSupport(new pmu::v4::StatusPubSubType()), low);
   }
   if (canopen_deadline) {
     const auto cd = *canopen_deadline;
-    w_->battery = telemetry(topics::kBattery, TypeSupport(new pmu::BatteryPubSubType()), cd);
-    w_->battery_cells = telemetry(topics::kBatteryCells, TypeSupport(new pmu::BatteryCellsPubSubType()), cd);
-    w_->mppt = telemetry(topics::kMppt, TypeSupport(new pmu::MpptPubSubType()), cd);
+    w_->battery = telemetry(topics::kBattery, TypeSupport(new pmu::v4::BatteryPubSubType()), cd);
+    w_->battery_cells = telemetry(topics::kBatteryCells, TypeSupport(new pmu::v4::BatteryCellsPubSubType()), cd);
+    w_->mppt = telemetry(topics::kMppt, TypeSupport(new pmu::v4::MpptPubSubType()), cd);
   }
-  w_->config = state(topics::kConfig, TypeSupport(new pmu::ConfigPubSubType()));
-  w_->info = state(topics::kInfo, TypeSupport(new pmu::DeviceInfoPubSubType()));
-  w_->health = state(topics::kHealth, TypeSupport(new pmu::HealthPubSubType()));
+  w_->config = state(topics::kConfig, TypeSupport(new pmu::v4::ConfigPubSubType()));
+  w_->info = state(topics::kInfo, TypeSupport(new pmu::v4::DeviceInfoPubSubType()));
+  w_->health = state(topics::kHealth, TypeSupport(new pmu::v4::HealthPubSubType()));
 }
 
 DdsPublisher::~DdsPublisher() = default;
@@ -213,27 +213,27 @@ void DdsPublisher::on_telemetry(const DeviceKey& key, const codec::PmuMessage& m
     if (w_->low_rate.due(key.bus, key.address, packet, received)) write_one(w_->low[packet], sample);
   };
   if (const auto* v = std::get_if<codec::Voltages>(&m.payload)) {
-    pmu::Voltages s;
+    pmu::v4::Voltages s;
     set_key(s, w_->vehicle, key);
     fill(s, *v);
     write(w_->voltages, &s, 0);
   } else if (const auto* c = std::get_if<codec::Currents>(&m.payload)) {
-    pmu::Currents s;
+    pmu::v4::Currents s;
     set_key(s, w_->vehicle, key);
     fill(s, *c);
     write(w_->currents, &s, 1);
   } else if (const auto* e = std::get_if<codec::BatteryEnergy>(&m.payload)) {
-    pmu::BatteryEnergy s;
+    pmu::v4::BatteryEnergy s;
     set_key(s, w_->vehicle, key);
     fill(s, *e);
     write(w_->energy, &s, 2);
   } else if (const auto* t = std::get_if<codec::Temperatures>(&m.payload)) {
-    pmu::Temperatures s;
+    pmu::v4::Temperatures s;
     set_key(s, w_->vehicle, key);
     fill(s, *t);
     write(w_->temperatures, &s, 3);
   } else if (const auto* st = std::get_if<codec::Status>(&m.payload)) {
-    pmu::Status s;
+    pmu::v4::Status s;
     set_key(s, w_->vehicle, key);
     fill(s, *st);
     write(w_->status, &s, 4);
@@ -241,7 +241,7 @@ void DdsPublisher::on_telemetry(const DeviceKey& key, const codec::PmuMessage& m
 }
 
 void DdsPublisher::on_config(const DeviceKey& key, const ConfigState& c) {
-  pmu::Config s;
+  pmu::v4::Config s;
   set_key(s, w_->vehicle, key);
   auto raw8 = [&](Parameter p) {
     return static_cast<std::uint8_t>(c.raw[static_cast<std::size_t>(p)].value_or(0) & 0xFF);
@@ -266,7 +266,7 @@ void DdsPublisher::on_config(const DeviceKey& key, const ConfigState& c) {
 }
 
 void DdsPublisher::on_info(const DeviceKey& key, const InfoState& i) {
-  pmu::DeviceInfo s;
+  pmu::v4::DeviceInfo s;
   set_key(s, w_->vehicle, key);
   s.serial_number(i.serial_number);
   s.firmware_major(i.firmware.firmware_major);
@@ -282,11 +282,11 @@ void DdsPublisher::on_info(const DeviceKey& key, const InfoState& i) {
 }
 
 void DdsPublisher::on_health(const DeviceKey& key, const HealthReport& h) {
-  pmu::Health s;
+  pmu::v4::Health s;
   set_key(s, w_->vehicle, key);
-  s.kind(static_cast<pmu::DeviceKind>(static_cast<int>(key.kind)));
-  s.state(static_cast<pmu::HealthState>(static_cast<int>(h.state)));
-  s.bus_state(static_cast<pmu::BusState>(static_cast<int>(h.bus_state)));
+  s.kind(static_cast<pmu::v4::DeviceKind>(static_cast<int>(key.kind)));
+  s.state(static_cast<pmu::v4::HealthState>(static_cast<int>(h.state)));
+  s.bus_state(static_cast<pmu::v4::BusState>(static_cast<int>(h.bus_state)));
   s.last_frame_age(f(h.last_frame_age));
   s.frames_received(h.frames_received);
   s.frames_sent(h.frames_sent);
@@ -315,20 +315,20 @@ void DdsPublisher::on_gone(const DeviceKey& key) {
     if (rc != ReturnCode_t::RETCODE_PRECONDITION_NOT_MET)
       count(rc == ReturnCode_t::RETCODE_OK, w->get_topic()->get_name().c_str(), key, why(rc));
   };
-  pmu::Health h;
+  pmu::v4::Health h;
   set_key(h, w_->vehicle, key);
-  h.kind(static_cast<pmu::DeviceKind>(static_cast<int>(key.kind)));
+  h.kind(static_cast<pmu::v4::DeviceKind>(static_cast<int>(key.kind)));
   gone(w_->health, &h);
   if (key.kind != DeviceKind::Pmu) return;  // batteries and MPPTs keep their node and device id
-  pmu::Voltages v;
+  pmu::v4::Voltages v;
   set_key(v, w_->vehicle, key);
-  pmu::Currents c;
+  pmu::v4::Currents c;
   set_key(c, w_->vehicle, key);
-  pmu::BatteryEnergy e;
+  pmu::v4::BatteryEnergy e;
   set_key(e, w_->vehicle, key);
-  pmu::Temperatures t;
+  pmu::v4::Temperatures t;
   set_key(t, w_->vehicle, key);
-  pmu::Status st;
+  pmu::v4::Status st;
   set_key(st, w_->vehicle, key);
   void* telemetry[LowRateGate::kPackets] = {&v, &c, &e, &t, &st};
   DataWriter* live[LowRateGate::kPackets] = {w_->voltages, w_->currents, w_->energy, w_->temperatures, w_->status};
@@ -336,10 +336,10 @@ void DdsPublisher::on_gone(const DeviceKey& key) {
     gone(live[i], telemetry[i]);
     gone(w_->low[i], telemetry[i]);
   }
-  pmu::Config cfg;
+  pmu::v4::Config cfg;
   set_key(cfg, w_->vehicle, key);
   gone(w_->config, &cfg);
-  pmu::DeviceInfo info;
+  pmu::v4::DeviceInfo info;
   set_key(info, w_->vehicle, key);
   gone(w_->info, &info);
 }
@@ -356,7 +356,7 @@ void DdsPublisher::write_at(DataWriter* writer, void* sample, const DeviceKey& k
 }
 
 void DdsPublisher::on_battery(const DeviceKey& key, const BatteryState& b, std::chrono::system_clock::time_point newest) {
-  pmu::Battery s;
+  pmu::v4::Battery s;
   s.vehicle(w_->vehicle);
   s.bus(key.bus);
   s.node(octet_id(key));
@@ -385,13 +385,13 @@ void DdsPublisher::on_battery(const DeviceKey& key, const BatteryState& b, std::
 
 void DdsPublisher::on_battery_cells(const DeviceKey& key, const BatteryCellsState& c,
                                     std::chrono::system_clock::time_point newest) {
-  pmu::BatteryCells s;
+  pmu::v4::BatteryCells s;
   s.vehicle(w_->vehicle);
   s.bus(key.bus);
   s.node(octet_id(key));
   for (std::size_t cell = 0; cell < c.volts.size(); ++cell) {
     if (std::isnan(c.volts[cell])) continue;
-    pmu::BatteryCell one;
+    pmu::v4::BatteryCell one;
     one.cell(static_cast<std::uint8_t>(cell));
     one.cell_voltage(f(c.volts[cell]));
     s.cells().push_back(one);
@@ -402,7 +402,7 @@ void DdsPublisher::on_battery_cells(const DeviceKey& key, const BatteryCellsStat
 }
 
 void DdsPublisher::on_mppt(const DeviceKey& key, const MpptState& m, std::chrono::system_clock::time_point newest) {
-  pmu::Mppt s;
+  pmu::v4::Mppt s;
   s.vehicle(w_->vehicle);
   s.bus(key.bus);
   s.device(octet_id(key));

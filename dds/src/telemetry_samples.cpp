@@ -42,7 +42,7 @@ bool sample(const std::string& vehicle, const DeviceKey& key, const Codec& value
 
 }  // namespace
 
-void fill(pmu::Voltages& s, const codec::Voltages& v) {
+void fill(pmu::v4::Voltages& s, const codec::Voltages& v) {
   s.avionics(f(v.avionics));
   s.output_28v(f(v.output_28v));
   s.payload(f(v.payload));
@@ -52,7 +52,7 @@ void fill(pmu::Voltages& s, const codec::Voltages& v) {
   s.generator(f(v.generator));
 }
 
-void fill(pmu::Currents& s, const codec::Currents& c) {
+void fill(pmu::v4::Currents& s, const codec::Currents& c) {
   s.avionics(f(c.avionics));
   s.output_28v(f(c.output_28v));
   s.payload(f(c.payload));
@@ -61,12 +61,12 @@ void fill(pmu::Currents& s, const codec::Currents& c) {
   s.battery_b(f(c.battery_b));
 }
 
-void fill(pmu::BatteryEnergy& s, const codec::BatteryEnergy& e) {
+void fill(pmu::v4::BatteryEnergy& s, const codec::BatteryEnergy& e) {
   s.battery_a_mah(e.battery_a_mah);
   s.battery_b_mah(e.battery_b_mah);
 }
 
-void fill(pmu::Temperatures& s, const codec::Temperatures& t) {
+void fill(pmu::v4::Temperatures& s, const codec::Temperatures& t) {
   s.internal(f(t.internal));
   s.battery_a(f(t.battery_a));  // NaN stays NaN: "no sensor"
   s.battery_b(f(t.battery_b));
@@ -74,7 +74,7 @@ void fill(pmu::Temperatures& s, const codec::Temperatures& t) {
   s.starter(f(t.starter));
 }
 
-void fill(pmu::Status& s, const codec::Status& st) {
+void fill(pmu::v4::Status& s, const codec::Status& st) {
   s.generator_rpm(st.generator_rpm);
   s.generation_enabled(st.generation_enabled);
   s.thermal_shutdown(st.thermal_shutdown);
@@ -91,15 +91,15 @@ void fill(pmu::Status& s, const codec::Status& st) {
 bool telemetry_cdr(const std::string& vehicle, const DeviceKey& key, const codec::PmuMessage& m, TelemetryCdr& out) {
   if (m.request) return false;
   if (const auto* v = std::get_if<codec::Voltages>(&m.payload))
-    return sample<pmu::Voltages, pmu::VoltagesPubSubType>(vehicle, key, *v, topics::kVoltages, out);
+    return sample<pmu::v4::Voltages, pmu::v4::VoltagesPubSubType>(vehicle, key, *v, topics::kVoltages, out);
   if (const auto* c = std::get_if<codec::Currents>(&m.payload))
-    return sample<pmu::Currents, pmu::CurrentsPubSubType>(vehicle, key, *c, topics::kCurrents, out);
+    return sample<pmu::v4::Currents, pmu::v4::CurrentsPubSubType>(vehicle, key, *c, topics::kCurrents, out);
   if (const auto* e = std::get_if<codec::BatteryEnergy>(&m.payload))
-    return sample<pmu::BatteryEnergy, pmu::BatteryEnergyPubSubType>(vehicle, key, *e, topics::kBatteryEnergy, out);
+    return sample<pmu::v4::BatteryEnergy, pmu::v4::BatteryEnergyPubSubType>(vehicle, key, *e, topics::kBatteryEnergy, out);
   if (const auto* t = std::get_if<codec::Temperatures>(&m.payload))
-    return sample<pmu::Temperatures, pmu::TemperaturesPubSubType>(vehicle, key, *t, topics::kTemperatures, out);
+    return sample<pmu::v4::Temperatures, pmu::v4::TemperaturesPubSubType>(vehicle, key, *t, topics::kTemperatures, out);
   if (const auto* st = std::get_if<codec::Status>(&m.payload))
-    return sample<pmu::Status, pmu::StatusPubSubType>(vehicle, key, *st, topics::kStatus, out);
+    return sample<pmu::v4::Status, pmu::v4::StatusPubSubType>(vehicle, key, *st, topics::kStatus, out);
   return false;
 }
 

@@ -36,8 +36,8 @@ using namespace std::chrono_literals;
 struct Sender {
   Sender(int domain, const std::string& name)
       : dds(domain, "", name),
-        writer(dds.writer(dds.topic(topics::kCommand, TypeSupport(new pmu::CommandPubSubType())), qos_profiles::kCommand)),
-        replies(dds.reader(dds.topic(topics::kCommandReply, TypeSupport(new pmu::CommandReplyPubSubType())),
+        writer(dds.writer(dds.topic(topics::kCommand, TypeSupport(new pmu::v4::CommandPubSubType())), qos_profiles::kCommand)),
+        replies(dds.reader(dds.topic(topics::kCommandReply, TypeSupport(new pmu::v4::CommandReplyPubSubType())),
                            qos_profiles::kCommand)) {}
   bool matched() {
     PublicationMatchedStatus p;
@@ -86,11 +86,11 @@ TEST(CommandsOverDds, TwoSendersBurst1000CommandsAndGetExactly1000Replies) {
   // The devices' start-up reading: over when each has published its configuration (a
   // session publishes pmu/config as it enters its running phase).
   DataReader& configs =
-      a.dds.reader(a.dds.topic(topics::kConfig, TypeSupport(new pmu::ConfigPubSubType())), qos_profiles::kState);
+      a.dds.reader(a.dds.topic(topics::kConfig, TypeSupport(new pmu::v4::ConfigPubSubType())), qos_profiles::kState);
   std::set<unsigned> configured;
   ASSERT_TRUE(pmu::test::wait_until(
       [&] {
-        pmu::Config c;
+        pmu::v4::Config c;
         SampleInfo i;
         while (configs.take_next_sample(&c, &i) == ReturnCode_t::RETCODE_OK)
           if (i.valid_data) configured.insert(c.address());
@@ -102,30 +102,30 @@ TEST(CommandsOverDds, TwoSendersBurst1000CommandsAndGetExactly1000Replies) {
   std::map<std::string, int> replies_a, replies_b;
   std::atomic<bool> done{false};
   auto collect = [&](Sender& s, std::map<std::string, int>& out, const std::string& prefix) {
-    pmu::CommandReply r;
+    pmu::v4::CommandReply r;
     SampleInfo info;
     while (s.replies.take_next_sample(&r, &info) == ReturnCode_t::RETCODE_OK)
       if (info.valid_data && r.request_id().to_string().rfind(prefix, 0) == 0) ++out[r.request_id().to_string()];
   };
   auto send = [&](Sender& s, const std::string& prefix) {
     for (int i = 0; i < 500; ++i) {
-      pmu::Command c;
+      pmu::v4::Command c;
       c.request_id(prefix + std::to_string(i));
       c.bus("sim0");
       c.address(static_cast<unsigned short>(1 + i % 2));
       switch (i % 4) {
         case 0:
-          c.kind(pmu::SET_PARAMETER);
+          c.kind(pmu::v4::SET_PARAMETER);
           c.parameter("payload_voltage");
           c.value(i % 8 == 0 ? 30.0 : 12.0 + (i % 100) / 10.0);  // some out of range
           break;
-        case 1: c.kind(pmu::GET_SERIAL); break;
+        case 1: c.kind(pmu::v4::GET_SERIAL); break;
         case 2:
-          c.kind(pmu::ENABLE_OUTPUTS);
+          c.kind(pmu::v4::ENABLE_OUTPUTS);
           c.outputs(0x02);
           break;
         default:
-          c.kind(pmu::GET);
+          c.kind(pmu::v4::GET);
           c.parameter("outputs");
       }
       s.writer.write(&c);

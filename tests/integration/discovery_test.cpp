@@ -65,7 +65,7 @@ ResolvedNetwork client_of(std::uint16_t port) {
 struct Side {
   Side(const std::string& name, const ResolvedNetwork& network, Transport transport = Transport::UdpOnly)
       : dds(pmu::test::exclusive_dds_domain(), "", name, {}, transport, network),
-        topic(dds.topic(topics::kVoltages, TypeSupport(new pmu::VoltagesPubSubType()))) {}
+        topic(dds.topic(topics::kVoltages, TypeSupport(new pmu::v4::VoltagesPubSubType()))) {}
   DataWriter& writer() { return w ? *w : *(w = &dds.writer(topic, qos_profiles::kTelemetry)); }
   DataReader& reader() { return r ? *r : *(r = &dds.reader(topic, qos_profiles::kTelemetry)); }
   bool matched() {
@@ -87,14 +87,14 @@ struct Side {
 // Writes a sample every 50 ms until the reader has one (best effort: a sample written
 // before matching is lost, so keep writing).
 bool exchange(Side& pub, Side& sub, std::chrono::seconds timeout) {
-  pmu::Voltages v;
+  pmu::v4::Voltages v;
   v.bus("sim0");
   v.address(1);
   v.avionics(12.5f);
   return pmu::test::wait_until(
       [&] {
         pub.writer().write(&v);
-        pmu::Voltages got;
+        pmu::v4::Voltages got;
         SampleInfo info;
         while (sub.reader().take_next_sample(&got, &info) == ReturnCode_t::RETCODE_OK)
           if (info.valid_data && got.avionics() == 12.5f) return true;

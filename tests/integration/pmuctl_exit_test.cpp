@@ -155,9 +155,9 @@ TEST(PmuctlExit, NoReplyIsExitThreeWithOneJsonLine) {
   using namespace eprosima::fastdds::dds;
   const int domain = pmu::test::exclusive_dds_domain();
   pmu::dds::DdsContext silent(domain, PMU_QOS_FILE, "silent-service");
-  (void)silent.reader(silent.topic(pmu::topics::kCommand, TypeSupport(new pmu::CommandPubSubType())),
+  (void)silent.reader(silent.topic(pmu::topics::kCommand, TypeSupport(new pmu::v4::CommandPubSubType())),
                       pmu::qos_profiles::kCommand);
-  (void)silent.writer(silent.topic(pmu::topics::kCommandReply, TypeSupport(new pmu::CommandReplyPubSubType())),
+  (void)silent.writer(silent.topic(pmu::topics::kCommandReply, TypeSupport(new pmu::v4::CommandReplyPubSubType())),
                       pmu::qos_profiles::kCommand);
   // The timeout bounds the match with the silent service too: long enough for a loaded machine.
   const auto r = pmu::test::run_capture(pmuctl(domain) + "--timeout 8 --json --bus can0 --address 1 outputs get");

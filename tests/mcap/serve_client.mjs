@@ -27,17 +27,17 @@ const problem = (p) => problems.push(p);
 
 // The topics `pmuctl record` records by default (docs/interface.md section 9.1), and so serve.
 const defaultTopics = {
-  "pmu/voltages": "pmu::Voltages",
-  "pmu/currents": "pmu::Currents",
-  "pmu/battery_energy": "pmu::BatteryEnergy",
-  "pmu/temperatures": "pmu::Temperatures",
-  "pmu/status": "pmu::Status",
-  "pmu/config": "pmu::Config",
-  "pmu/info": "pmu::DeviceInfo",
-  "pmu/health": "pmu::Health",
-  "pmu/battery": "pmu::Battery",
-  "pmu/battery_cells": "pmu::BatteryCells",
-  "pmu/mppt": "pmu::Mppt",
+  "pmu/voltages": "pmu::v4::Voltages",
+  "pmu/currents": "pmu::v4::Currents",
+  "pmu/battery_energy": "pmu::v4::BatteryEnergy",
+  "pmu/temperatures": "pmu::v4::Temperatures",
+  "pmu/status": "pmu::v4::Status",
+  "pmu/config": "pmu::v4::Config",
+  "pmu/info": "pmu::v4::DeviceInfo",
+  "pmu/health": "pmu::v4::Health",
+  "pmu/battery": "pmu::v4::Battery",
+  "pmu/battery_cells": "pmu::v4::BatteryCells",
+  "pmu/mppt": "pmu::v4::Mppt",
 };
 
 // float32 on the wire: the shortest decimal that is the same float32, as pmuctl prints it.

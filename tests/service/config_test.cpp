@@ -109,7 +109,7 @@ const BadCase kBad[] = {
     {"domain: 0\n", "bad.yaml:1: no buses: the service needs at least one bus"},
     {"domian: 0\nbuses: []\n",
      "bad.yaml:1: unknown key 'domian' in the top level (known: domain, vehicle, low_rate_period, qos_file, dds_transport, log_level, "
-     "buses, timeouts, policy, security, discovery, interfaces, canopen_publish_period, dds_statistics, dds_type_objects)"},
+     "buses, timeouts, policy, security, discovery, interfaces, canopen_publish_period, dds_statistics, dds_type_objects, also_serve_contract)"},
     {"domain: 0\nvehicle: uav*\nbuses: []\n",
      "bad.yaml:2: vehicle 'uav*' contains '*'; a vehicle name is letters, digits, '_', '-' and '.' (it is also a DDS "
      "partition name, where other characters are patterns)"},
@@ -648,6 +648,25 @@ TEST(ConfigTypeObjects, OffUnlessTrueAndRefusedAtItsLineWhenNotABoolean) {
   const BadCase bad[] = {
       {"domain: 3\ndds_type_objects: all\n", "bad.yaml:2: dds_type_objects must be true or false, not 'all'"},
       {"dds_type_objects: [true]\n", "bad.yaml:1: dds_type_objects must be true or false"},
+  };
+  for (const auto& c : bad) expect_refused(c.yaml + std::string(kBus), c.message);
+}
+
+// also_serve_contract (interface.md 10.3): unset by default; only the contract before this
+// build's, since the second participant writes this build's layouts under its names.
+TEST(ConfigAlsoServeContract, UnsetByDefaultAndOnlyThePreviousMajorVersion) {
+  EXPECT_FALSE(parse_config(kBus, "s.yaml").also_serve_contract);
+  EXPECT_EQ(parse_config(std::string("also_serve_contract: 3\n") + kBus, "s.yaml").also_serve_contract, 3);
+  const BadCase bad[] = {
+      {"domain: 3\nalso_serve_contract: 2\n",
+       "bad.yaml:2: also_serve_contract 2 is not served: this service serves contract 4 and can also serve 3 only "
+       "(docs/interface.md section 10)"},
+      {"also_serve_contract: 4\n",
+       "bad.yaml:1: also_serve_contract 4 is not served: this service serves contract 4 and can also serve 3 only "
+       "(docs/interface.md section 10)"},
+      {"also_serve_contract: v3\n",
+       "bad.yaml:1: also_serve_contract must be a decimal integer (digits, optionally after '-'; no leading 0, '+', 0x, "
+       "0o, exponent or fraction), not 'v3'"},
   };
   for (const auto& c : bad) expect_refused(c.yaml + std::string(kBus), c.message);
 }

@@ -21,19 +21,19 @@ using eprosima::fastdds::dds::TypeSupport;
 TEST(TypeObjects, SelfContainedAreExactlyTheTypesWithoutMembersNamedByHash) {
   register_type_objects();
   register_type_objects();  // idempotent
-  for (const char* t : {"pmu::Voltages", "pmu::Currents", "pmu::BatteryEnergy", "pmu::Temperatures", "pmu::Status",
-                        "pmu::Config", "pmu::DeviceInfo", "pmu::Battery", "pmu::Mppt", "pmu::BatteryCell"})
+  for (const char* t : {"pmu::v4::Voltages", "pmu::v4::Currents", "pmu::v4::BatteryEnergy", "pmu::v4::Temperatures", "pmu::v4::Status",
+                        "pmu::v4::Config", "pmu::v4::DeviceInfo", "pmu::v4::Battery", "pmu::v4::Mppt", "pmu::v4::BatteryCell"})
     EXPECT_TRUE(type_object_is_self_contained(t)) << t;
-  for (const char* t : {"pmu::Health", "pmu::BatteryCells", "pmu::Command", "pmu::CommandReply",
-                        "pmu::DeviceKind", "pmu::NoSuchType"})
+  for (const char* t : {"pmu::v4::Health", "pmu::v4::BatteryCells", "pmu::v4::Command", "pmu::v4::CommandReply",
+                        "pmu::v4::DeviceKind", "pmu::NoSuchType"})
     EXPECT_FALSE(type_object_is_self_contained(t)) << t;
 }
 
 TEST(TypeObjects, NeverTypeInformationAndTheObjectOnlyWhenSelfContained) {
   register_type_objects();
-  TypeSupport voltages(new pmu::VoltagesPubSubType());
-  TypeSupport cells(new pmu::BatteryCellsPubSubType());
-  TypeSupport health(new pmu::HealthPubSubType());
+  TypeSupport voltages(new pmu::v4::VoltagesPubSubType());
+  TypeSupport cells(new pmu::v4::BatteryCellsPubSubType());
+  TypeSupport health(new pmu::v4::HealthPubSubType());
   for (TypeSupport* t : {&voltages, &cells, &health}) {
     ASSERT_TRUE((*t)->auto_fill_type_information()) << "Fast DDS 2.9.1's default, which this changes";
     announce_type_object(*t, true);
@@ -47,7 +47,7 @@ TEST(TypeObjects, NeverTypeInformationAndTheObjectOnlyWhenSelfContained) {
 // Off (dds_type_objects absent): nothing, though the objects are registered in this process.
 TEST(TypeObjects, NothingAnnouncedWhenNotEnabled) {
   register_type_objects();
-  TypeSupport voltages(new pmu::VoltagesPubSubType());
+  TypeSupport voltages(new pmu::v4::VoltagesPubSubType());
   ASSERT_TRUE(voltages->auto_fill_type_object()) << "Fast DDS 2.9.1's default, which this changes";
   announce_type_object(voltages, false);
   EXPECT_FALSE(voltages->auto_fill_type_object());

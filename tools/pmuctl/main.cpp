@@ -314,12 +314,12 @@ int main(int argc, char** argv) {
     return run_decode(path, options);
   }
   {
-    const int kind = !*engine ? -1 : start_stop == "start" ? int{pmu::ENGINE_START} : int{pmu::ENGINE_STOP};
+    const int kind = !*engine ? -1 : start_stop == "start" ? int{pmu::v4::ENGINE_START} : int{pmu::v4::ENGINE_STOP};
     if (const auto why = pmu::tools::broadcast_refusal(g, kind); !why.empty())
       return pmu::tools::fail(g, pmu::tools::ExitStatus::BadUsage, why);
   }
   if (*config_set && !pmu::codec::parameter_from_name(set_param)) {
-    // The two fields of pmu::Config that are not stored parameters have verbs of their own.
+    // The two fields of pmu::v4::Config that are not stored parameters have verbs of their own.
     if (set_param == "outputs")
       return pmu::tools::fail(g, pmu::tools::ExitStatus::BadUsage,
                               "outputs are not a stored parameter: switch them with `pmuctl outputs set|enable|disable "
@@ -357,36 +357,36 @@ int main(int argc, char** argv) {
       const auto parsed = pmu::tools::parse_config_value(set_param, set_value);
       if (!parsed.value) return pmu::tools::fail(g, pmu::tools::ExitStatus::BadUsage, parsed.error);
       spec.value = *parsed.value;
-      spec.kind = pmu::SET_PARAMETER;
+      spec.kind = pmu::v4::SET_PARAMETER;
       spec.parameter = set_param;
       return pmu::tools::run_command(g, spec);
     }
     if (*outputs_get) {
-      spec.kind = pmu::GET;
+      spec.kind = pmu::v4::GET;
       spec.parameter = "outputs";
       return pmu::tools::run_command(g, spec);
     }
     if (*outputs_set || *outputs_enable || *outputs_disable) {
       if (!pmu::tools::output_mask(output_names, spec.outputs)) return 2;
-      spec.kind = *outputs_set ? pmu::SET_OUTPUTS : *outputs_enable ? pmu::ENABLE_OUTPUTS : pmu::DISABLE_OUTPUTS;
+      spec.kind = *outputs_set ? pmu::v4::SET_OUTPUTS : *outputs_enable ? pmu::v4::ENABLE_OUTPUTS : pmu::v4::DISABLE_OUTPUTS;
       return pmu::tools::run_command(g, spec);
     }
     if (*generation) {
-      spec.kind = pmu::SET_GENERATION;
+      spec.kind = pmu::v4::SET_GENERATION;
       spec.enable = on_off == "on";
       return pmu::tools::run_command(g, spec);
     }
     if (*engine) {
-      spec.kind = start_stop == "start" ? pmu::ENGINE_START : pmu::ENGINE_STOP;
+      spec.kind = start_stop == "start" ? pmu::v4::ENGINE_START : pmu::v4::ENGINE_STOP;
       return pmu::tools::run_command(g, spec);
     }
     if (*reset) {
-      spec.kind = pmu::RESET;
+      spec.kind = pmu::v4::RESET;
       return pmu::tools::run_command(g, spec);
     }
     if (*measure) {
       if (!pmu::tools::group_mask(groups, spec.groups)) return 2;
-      spec.kind = pmu::REQUEST_MEASUREMENTS;
+      spec.kind = pmu::v4::REQUEST_MEASUREMENTS;
       return pmu::tools::run_command(g, spec);
     }
   } catch (const pmu::dds::PartitionNotGranted& e) {

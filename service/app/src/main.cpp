@@ -20,6 +20,7 @@
 #include <vector>
 
 #include "pmu/app/logging.hpp"
+#include "pmu/app/state_fanout.hpp"
 #include "pmu/app/simulated_bus.hpp"
 #include "pmu/app/systemd.hpp"
 #include "pmu/config/config.hpp"
@@ -120,12 +121,30 @@ int run(const service::Config& cfg, const pmu::dds::ResolvedNetwork& network) {
                  cfg.security.files.permissions);
   service::DdsPublisher publisher(participant, 3 * longest, cfg.vehicle, cfg.low_rate_period,
                                   canopen ? std::optional<milliseconds>(3 * canopen_longest) : std::nullopt);
+  // also_serve_contract: the previous contract's names on a participant of their own (one
+  // participant cannot have two topics of one name), with the same values and commands.
+  // Declared after the service's own, so destroyed before it.
+  std::unique_ptr<pmu::dds::DdsContext> previous_participant;
+  std::unique_ptr<service::DdsPublisher> previous_publisher;
+  if (cfg.also_serve_contract) {
+    previous_participant = std::make_unique<pmu::dds::DdsContext>(
+        cfg.domain, cfg.qos_file, pmu::dds::kServiceParticipantName, cfg.security.files, cfg.dds_transport, network,
+        pmu::dds::Partitions{partitions, partitions}, std::vector<std::string>{}, false, *cfg.also_serve_contract);
+    previous_publisher = std::make_unique<service::DdsPublisher>(
+        *previous_participant, 3 * longest, cfg.vehicle, cfg.low_rate_period,
+        canopen ? std::optional<milliseconds>(3 * canopen_longest) : std::nullopt);
+    spdlog::info("DDS: also serving contract v{} on a second participant (also_serve_contract)",
+                 *cfg.also_serve_contract);
+  }
+  std::vector<service::StateSink*> sinks{&publisher};
+  if (previous_publisher) sinks.push_back(previous_publisher.get());
+  service::StateFanout state_sink(sinks);
 
   service::MovedAddressStore moved(service::moved_addresses_path(std::getenv("STATE_DIRECTORY")), cfg);
   std::vector<BusRuntime> buses(cfg.buses.size());
   for (std::size_t i = 0; i < cfg.buses.size(); ++i) {
     auto bus = open_bus(cfg.buses[i], clock, buses[i]);
-    buses[i].worker = std::make_unique<service::BusWorker>(cfg.buses[i], std::move(bus), clock, cfg.timeouts, publisher);
+    buses[i].worker = std::make_unique<service::BusWorker>(cfg.buses[i], std::move(bus), clock, cfg.timeouts, state_sink);
     // Only a device from the config file has an `address:` that can go stale.
     buses[i].worker->on_moved([&moved](const service::BusWorker::Moved& m) {
       if (!m.config_line.empty()) moved.record(m.bus, m.first, m.to, m.serial);
@@ -136,10 +155,18 @@ int run(const service::Config& cfg, const pmu::dds::ResolvedNetwork& network) {
         s->expect_serial(*m.serial);
   }
   service::DdsCommandEndpoint command_topics(participant, &publisher, cfg.vehicle);
+  std::unique_ptr<service::DdsCommandEndpoint> previous_command_topics;
+  if (previous_participant)
+    previous_command_topics =
+        std::make_unique<service::DdsCommandEndpoint>(*previous_participant, previous_publisher.get(), cfg.vehicle);
   std::vector<service::BusWorker*> workers;
   for (auto& b : buses) workers.push_back(b.worker.get());
-  service::CommandService commands(workers, cfg.policy, cfg.timeouts, clock,
-                                   [&](const service::CommandReplyData& r) { command_topics.publish(r); });
+  // A reply goes out in both contracts: a ground station takes the replies to its own
+  // request ids, whichever contract the others' commands came in.
+  service::CommandService commands(workers, cfg.policy, cfg.timeouts, clock, [&](const service::CommandReplyData& r) {
+    command_topics.publish(r);
+    if (previous_command_topics) previous_command_topics->publish(r);
+  });
   // Declared after everything the running threads use, so it is destroyed first, on every
   // way out of this function: commands stop first (no new request reaches `commands`, and
   // the bus workers are still there to finish the ones in flight), then the worker threads
@@ -147,9 +174,11 @@ int run(const service::Config& cfg, const pmu::dds::ResolvedNetwork& network) {
   // `commands`, the endpoint, the workers and the publisher destroyed.
   struct Shutdown {
     service::DdsCommandEndpoint& command_topics;
+    service::DdsCommandEndpoint* previous_command_topics;
     std::vector<BusRuntime>& buses;
     ~Shutdown() {
       command_topics.stop();
+      if (previous_command_topics) previous_command_topics->stop();
       for (auto& b : buses) b.worker->stop();
       for (auto& b : buses) {
         if (b.thread.joinable()) b.thread.join();
@@ -157,12 +186,13 @@ int run(const service::Config& cfg, const pmu::dds::ResolvedNetwork& network) {
       }
       spdlog::info("pmu-service stopped");
     }
-  } shutdown{command_topics, buses};
+  } shutdown{command_topics, previous_command_topics.get(), buses};
   for (auto& b : buses) {
     if (b.simulator) b.simulator->start();
     b.thread = std::thread([w = b.worker.get()] { w->run(); });
   }
   command_topics.start(commands);
+  if (previous_command_topics) previous_command_topics->start(commands);
   spdlog::info("pmu-service ready on DDS domain {}: {}", cfg.domain, summary(buses));
   systemd.ready(summary(buses));
 

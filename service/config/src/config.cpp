@@ -24,6 +24,7 @@
 #include "pmu/config/quoted.hpp"
 #include "pmu/config/statistics_settings.hpp"
 #include "pmu/config/vehicle.hpp"
+#include "pmu/version.hpp"
 
 namespace pmu::service {
 namespace {
@@ -521,7 +522,8 @@ Config parse_config(const std::string& text, const std::string& source, const Co
   refuse_duplicate_keys(c, root);
   c.only_keys(root, "the top level", {"domain", "vehicle", "low_rate_period", "qos_file", "dds_transport", "log_level",
                                       "buses", "timeouts", "policy", "security", "discovery", "interfaces",
-                                      "canopen_publish_period", "dds_statistics", "dds_type_objects"});
+                                      "canopen_publish_period", "dds_statistics", "dds_type_objects",
+                                      "also_serve_contract"});
   if (const auto v = root["domain"]) cfg.domain = static_cast<int>(c.integer(v, "domain", 0, 232));
   if (const auto v = root["vehicle"]) {
     // `vehicle:` with nothing after it is YAML null: the unnamed vehicle, like no key.
@@ -557,6 +559,17 @@ Config parse_config(const std::string& text, const std::string& source, const Co
       c.fail(v, "dds_transport " + quoted(t) + " is not one of default, udp, shm");
   }
   if (const auto v = root["dds_type_objects"]) cfg.dds_type_objects = c.scalar<bool>(v, "dds_type_objects", "true or false");
+  if (const auto v = root["also_serve_contract"]) {
+    // One step back only: the service writes this build's types under the older names, which
+    // is right only for the contract whose layouts tests/contract keeps equal to this one's.
+    const int previous = PMU_CONTRACT_MAJOR - 1;
+    const auto n = c.integer(v, "also_serve_contract", 0, 1000);
+    if (n != previous)
+      c.fail(v, "also_serve_contract " + v.Scalar() + " is not served: this service serves contract " +
+                    std::to_string(PMU_CONTRACT_MAJOR) + " and can also serve " + std::to_string(previous) +
+                    " only (docs/interface.md section 10)");
+    cfg.also_serve_contract = static_cast<int>(n);
+  }
   if (const auto v = root["log_level"]) {
     cfg.log_level = c.scalar<std::string>(v, "log_level", "a level");
     if (!is_log_level(cfg.log_level))

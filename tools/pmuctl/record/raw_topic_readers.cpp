@@ -40,19 +40,19 @@ class TopicListener final : public DataReaderListener {
 }  // namespace
 
 TypeSupport raw_type_support(const std::string& type_name) {
-  if (type_name == "pmu::Voltages") return TypeSupport(new RawSampleType<pmu::VoltagesPubSubType>());
-  if (type_name == "pmu::Currents") return TypeSupport(new RawSampleType<pmu::CurrentsPubSubType>());
-  if (type_name == "pmu::BatteryEnergy") return TypeSupport(new RawSampleType<pmu::BatteryEnergyPubSubType>());
-  if (type_name == "pmu::Temperatures") return TypeSupport(new RawSampleType<pmu::TemperaturesPubSubType>());
-  if (type_name == "pmu::Status") return TypeSupport(new RawSampleType<pmu::StatusPubSubType>());
-  if (type_name == "pmu::Config") return TypeSupport(new RawSampleType<pmu::ConfigPubSubType>());
-  if (type_name == "pmu::DeviceInfo") return TypeSupport(new RawSampleType<pmu::DeviceInfoPubSubType>());
-  if (type_name == "pmu::Health") return TypeSupport(new RawSampleType<pmu::HealthPubSubType>());
-  if (type_name == "pmu::Battery") return TypeSupport(new RawSampleType<pmu::BatteryPubSubType>());
-  if (type_name == "pmu::BatteryCells") return TypeSupport(new RawSampleType<pmu::BatteryCellsPubSubType>());
-  if (type_name == "pmu::Mppt") return TypeSupport(new RawSampleType<pmu::MpptPubSubType>());
-  if (type_name == "pmu::Command") return TypeSupport(new RawSampleType<pmu::CommandPubSubType>());
-  return TypeSupport(new RawSampleType<pmu::CommandReplyPubSubType>());
+  if (type_name == "pmu::v4::Voltages") return TypeSupport(new RawSampleType<pmu::v4::VoltagesPubSubType>());
+  if (type_name == "pmu::v4::Currents") return TypeSupport(new RawSampleType<pmu::v4::CurrentsPubSubType>());
+  if (type_name == "pmu::v4::BatteryEnergy") return TypeSupport(new RawSampleType<pmu::v4::BatteryEnergyPubSubType>());
+  if (type_name == "pmu::v4::Temperatures") return TypeSupport(new RawSampleType<pmu::v4::TemperaturesPubSubType>());
+  if (type_name == "pmu::v4::Status") return TypeSupport(new RawSampleType<pmu::v4::StatusPubSubType>());
+  if (type_name == "pmu::v4::Config") return TypeSupport(new RawSampleType<pmu::v4::ConfigPubSubType>());
+  if (type_name == "pmu::v4::DeviceInfo") return TypeSupport(new RawSampleType<pmu::v4::DeviceInfoPubSubType>());
+  if (type_name == "pmu::v4::Health") return TypeSupport(new RawSampleType<pmu::v4::HealthPubSubType>());
+  if (type_name == "pmu::v4::Battery") return TypeSupport(new RawSampleType<pmu::v4::BatteryPubSubType>());
+  if (type_name == "pmu::v4::BatteryCells") return TypeSupport(new RawSampleType<pmu::v4::BatteryCellsPubSubType>());
+  if (type_name == "pmu::v4::Mppt") return TypeSupport(new RawSampleType<pmu::v4::MpptPubSubType>());
+  if (type_name == "pmu::v4::Command") return TypeSupport(new RawSampleType<pmu::v4::CommandPubSubType>());
+  return TypeSupport(new RawSampleType<pmu::v4::CommandReplyPubSubType>());
 }
 
 void RawTopicReaders::open(pmu::dds::DdsContext& dds, const std::vector<const RecordedTopic*>& topics) {

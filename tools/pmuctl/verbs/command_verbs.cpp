@@ -33,9 +33,9 @@ namespace {
 using namespace eprosima::fastdds::dds;
 using Clock = std::chrono::steady_clock;
 
-// The service's names for its results; pmu::CommandResult has the same order (static_assert
+// The service's names for its results; pmu::v4::CommandResult has the same order (static_assert
 // in dds/src/dds_commands.cpp). The names are literals, so data() ends in NUL.
-const char* result_name(pmu::CommandResult r) {
+const char* result_name(pmu::v4::CommandResult r) {
   return pmu::service::to_string(static_cast<pmu::service::CommandResult>(r)).data();
 }
 
@@ -59,7 +59,7 @@ std::optional<int> resolve_target(const GlobalOptions& o, const std::string& veh
     address = *o.address;
     return std::nullopt;
   }
-  DataReader& r = dds.reader(dds.topic(topics::kHealth, TypeSupport(new idl::Guarded<pmu::HealthPubSubType>())),
+  DataReader& r = dds.reader(dds.topic(topics::kHealth, TypeSupport(new idl::Guarded<pmu::v4::HealthPubSubType>())),
                              qos_profiles::kState);
   std::set<std::pair<std::string, std::uint16_t>> seen;
   std::set<std::string> vehicles_seen;
@@ -67,7 +67,7 @@ std::optional<int> resolve_target(const GlobalOptions& o, const std::string& veh
   std::map<InstanceHandle_t, std::pair<std::string, std::uint16_t>> handles;
   std::optional<Clock::time_point> settle;
   while (Clock::now() < deadline) {
-    pmu::Health h;
+    pmu::v4::Health h;
     SampleInfo info;
     while (r.take_next_sample(&h, &info) == ReturnCode_t::RETCODE_OK) {
       if (!info.valid_data) {
@@ -78,7 +78,7 @@ std::optional<int> resolve_target(const GlobalOptions& o, const std::string& veh
       }
       vehicles_seen.insert(h.vehicle().to_string());
       own_vehicle_seen = own_vehicle_seen || h.vehicle().to_string() == vehicle;
-      if (h.kind() == pmu::KIND_PMU && h.vehicle().to_string() == vehicle &&
+      if (h.kind() == pmu::v4::KIND_PMU && h.vehicle().to_string() == vehicle &&
           (o.bus.empty() || o.bus == h.bus().to_string()) && (!o.address || *o.address == h.address())) {
         seen.insert({h.bus().to_string(), h.address()});
         handles[info.instance_handle] = {h.bus().to_string(), h.address()};
@@ -150,7 +150,7 @@ bool group_mask(const std::vector<std::string>& names, std::uint8_t& mask) {
 }
 
 std::string broadcast_refusal(const GlobalOptions& o, int kind) {
-  if (!o.address || *o.address != codec::kBroadcastAddress || kind == pmu::ENGINE_STOP) return {};
+  if (!o.address || *o.address != codec::kBroadcastAddress || kind == pmu::v4::ENGINE_STOP) return {};
   return "--address 65535 (broadcast) is only for `engine stop`: every other command names one PMU";
 }
 
@@ -161,15 +161,15 @@ int run_command(const GlobalOptions& o, const CommandSpec& spec) {
   // Reading every vehicle's health (without --vehicle) lets a failure name the vehicles there are.
   pmu::dds::DdsContext dds(o.domain, o.qos_file, "pmuctl", o.security, pmu::dds::Transport::Default, o.network,
                            partitions_for(o));
-  DataReader& replies = dds.reader(dds.topic(topics::kCommandReply, TypeSupport(new idl::Guarded<pmu::CommandReplyPubSubType>())),
+  DataReader& replies = dds.reader(dds.topic(topics::kCommandReply, TypeSupport(new idl::Guarded<pmu::v4::CommandReplyPubSubType>())),
                                    qos_profiles::kCommand);
   DataWriter& writer =
-      dds.writer(dds.topic(topics::kCommand, TypeSupport(new pmu::CommandPubSubType())), qos_profiles::kCommand);
+      dds.writer(dds.topic(topics::kCommand, TypeSupport(new pmu::v4::CommandPubSubType())), qos_profiles::kCommand);
 
   // A stop to the broadcast address needs no PMU seen: with --bus it goes to that bus, without
   // to every bus of the service (bus ""), so an engine can be stopped whatever the service
   // has read so far.
-  const bool broadcast = spec.kind == pmu::ENGINE_STOP && o.address && *o.address == codec::kBroadcastAddress;
+  const bool broadcast = spec.kind == pmu::v4::ENGINE_STOP && o.address && *o.address == codec::kBroadcastAddress;
   std::string bus = broadcast ? o.bus : std::string();
   std::uint16_t address = broadcast ? codec::kBroadcastAddress : 0;
   if (!broadcast)
@@ -192,13 +192,13 @@ int run_command(const GlobalOptions& o, const CommandSpec& spec) {
     std::this_thread::sleep_for(std::chrono::milliseconds(10));
   }
 
-  pmu::Command c;
+  pmu::v4::Command c;
   const std::string id = request_id();
   c.request_id(id);
   c.vehicle(vehicle);
   c.bus(bus);
   c.address(address);
-  c.kind(static_cast<pmu::CommandKind>(spec.kind));
+  c.kind(static_cast<pmu::v4::CommandKind>(spec.kind));
   c.parameter(spec.parameter);
   c.value(spec.value);
   c.outputs(spec.outputs);
@@ -223,12 +223,12 @@ int run_command(const GlobalOptions& o, const CommandSpec& spec) {
       (void)writer.write(&c);
       next_resend = Clock::now() + kResendAfter;
     }
-    pmu::CommandReply r;
+    pmu::v4::CommandReply r;
     SampleInfo info;
     while (replies.take_next_sample(&r, &info) == ReturnCode_t::RETCODE_OK) {
       if (!info.valid_data || r.request_id().to_string() != id || r.vehicle().to_string() != vehicle) continue;
       heard = true;
-      if (r.result() == pmu::IN_PROGRESS) {
+      if (r.result() == pmu::v4::IN_PROGRESS) {
         std::fprintf(stderr, "IN_PROGRESS: %s\n", r.reason().c_str());
         continue;
       }
@@ -249,7 +249,7 @@ int run_command(const GlobalOptions& o, const CommandSpec& spec) {
           std::printf("%g\n", r.value());
       }
       std::fprintf(stderr, "%s%s%s\n", result_name(r.result()), (r.reason().size() == 0) ? "" : ": ", r.reason().c_str());
-      return static_cast<int>(r.result() == pmu::COMPLETED ? ExitStatus::Ok : ExitStatus::NotDone);
+      return static_cast<int>(r.result() == pmu::v4::COMPLETED ? ExitStatus::Ok : ExitStatus::NotDone);
     }
     std::this_thread::sleep_for(std::chrono::milliseconds(5));
   }

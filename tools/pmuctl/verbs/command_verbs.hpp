@@ -1,6 +1,6 @@
 #pragma once
-// pmuctl's command verbs (interface.md section 3.2): one pmu::Command, exactly one final
-// pmu::CommandReply. Exit status 0 only for COMPLETED (exit_status.hpp); the result and
+// pmuctl's command verbs (interface.md section 3.2): one pmu::v4::Command, exactly one final
+// pmu::v4::CommandReply. Exit status 0 only for COMPLETED (exit_status.hpp); the result and
 // reason go to stderr.
 
 #include <cstdint>
@@ -12,7 +12,7 @@
 namespace pmu::tools {
 
 struct CommandSpec {
-  int kind = 0;  // pmu::CommandKind
+  int kind = 0;  // pmu::v4::CommandKind
   std::string parameter;
   double value = 0;
   std::uint8_t outputs = 0;

@@ -4,8 +4,13 @@
 // vehicles there are). A participant in one vehicle's partitions never matches another
 // vehicle's writers, so the answer comes from discovery (DdsContext::remote_writers).
 //
+// A service of another contract (contract_names.hpp) is never matched either: its type names
+// differ. Discovery still reports its writers, so the verb says which contract it found
+// instead of "no pmu-service".
+//
 // Call from the verb's thread, with the DdsContext the verb used (it must still be open).
 
+#include <map>
 #include <set>
 #include <string>
 
@@ -14,8 +19,16 @@
 
 namespace pmu::tools {
 
-// The vehicles whose pmu-service announced a health writer ("" is the unnamed vehicle).
+// The vehicles whose pmu-service announced a health writer of this pmuctl's contract ("" is
+// the unnamed vehicle).
 std::set<std::string> vehicles_on_domain(const pmu::dds::DdsContext& dds);
+
+// The services of other contracts discovery reported: contract -> their vehicles.
+std::map<int, std::set<std::string>> other_contracts_on_domain(const pmu::dds::DdsContext& dds);
+
+// "pmu-service of contract v3 (or older) (vehicles: (unnamed), uav2); this pmuctl reads
+// contract v4 (docs/interface.md section 10)", or "" for none.
+std::string other_contracts_text(const std::map<int, std::set<std::string>>& others);
 
 // "; vehicles seen: (unnamed), uav1 (choose one with --vehicle)", or "" for none.
 std::string vehicles_seen_text(const std::set<std::string>& vehicles);
@@ -23,8 +36,9 @@ std::string vehicles_seen_text(const std::set<std::string>& vehicles);
 // "the unnamed vehicle" / "vehicle uav1".
 std::string vehicle_text(const std::string& vehicle);
 
-// Ends a verb whose readers matched no pmu-service: exit 3 when discovery found none on the
-// domain, 2 when services of other vehicles than the one asked for are there.
+// Ends a verb whose readers matched no pmu-service: exit 3 when discovery found none of this
+// contract on the domain (saying which other contracts' services it found), 2 when services
+// of other vehicles than the one asked for are there.
 int no_service(const GlobalOptions& o, const pmu::dds::DdsContext& dds);
 
 }  // namespace pmu::tools

@@ -38,7 +38,7 @@ using namespace eprosima::fastdds::dds;
 using Clock = std::chrono::steady_clock;
 
 
-// The names `config get` takes: pmu::Config's fields.
+// The names `config get` takes: pmu::v4::Config's fields.
 std::string config_names() {
   std::string names;
   for (const auto& spec : codec::parameter_table()) names += std::string(spec.name) + ", ";
@@ -70,7 +70,7 @@ struct DeviceId {
   std::string vehicle;
   std::string bus;
   std::uint16_t address;
-  pmu::DeviceKind kind = pmu::KIND_PMU;
+  pmu::v4::DeviceKind kind = pmu::v4::KIND_PMU;
   bool operator<(const DeviceId& o) const {
     return std::tie(vehicle, bus, kind, address) < std::tie(o.vehicle, o.bus, o.kind, o.address);
   }
@@ -80,36 +80,36 @@ template <class T>
 DeviceId id_of(const T& s) {
   return {s.vehicle().to_string(), s.bus().to_string(), s.address()};
 }
-DeviceId id_of(const pmu::Health& s) {
+DeviceId id_of(const pmu::v4::Health& s) {
   return {s.vehicle().to_string(), s.bus().to_string(), s.address(), s.kind()};
 }
-DeviceId id_of(const pmu::Battery& s) {
-  return {s.vehicle().to_string(), s.bus().to_string(), s.node(), pmu::KIND_BATTERY};
+DeviceId id_of(const pmu::v4::Battery& s) {
+  return {s.vehicle().to_string(), s.bus().to_string(), s.node(), pmu::v4::KIND_BATTERY};
 }
-DeviceId id_of(const pmu::BatteryCells& s) {
-  return {s.vehicle().to_string(), s.bus().to_string(), s.node(), pmu::KIND_BATTERY};
+DeviceId id_of(const pmu::v4::BatteryCells& s) {
+  return {s.vehicle().to_string(), s.bus().to_string(), s.node(), pmu::v4::KIND_BATTERY};
 }
-DeviceId id_of(const pmu::Mppt& s) {
-  return {s.vehicle().to_string(), s.bus().to_string(), s.device(), pmu::KIND_MPPT};
+DeviceId id_of(const pmu::v4::Mppt& s) {
+  return {s.vehicle().to_string(), s.bus().to_string(), s.device(), pmu::v4::KIND_MPPT};
 }
 
 // --address names a PMU: batteries and MPPTs are selected by vehicle and bus alone, and
 // drop out when a PMU is named.
 bool selected(const GlobalOptions& o, const DeviceId& d) {
   return (!o.vehicle || *o.vehicle == d.vehicle) && (o.bus.empty() || o.bus == d.bus) &&
-         (!o.address || (d.kind == pmu::KIND_PMU && *o.address == d.address));
+         (!o.address || (d.kind == pmu::v4::KIND_PMU && *o.address == d.address));
 }
 
 // "can0/1" for a PMU, "can0/battery2" and "can0/mppt4" for the others.
 std::string label(const DeviceId& d) {
-  if (d.kind == pmu::KIND_PMU) return device_label(d.vehicle, d.bus, d.address);
+  if (d.kind == pmu::v4::KIND_PMU) return device_label(d.vehicle, d.bus, d.address);
   return (d.vehicle.empty() ? std::string() : d.vehicle + "/") + d.bus + "/" + to_string(d.kind) +
          std::to_string(d.address);
 }
 
 // The JSON key of a device's number: the contract's key name of its type.
-const char* number_key(pmu::DeviceKind k) {
-  return k == pmu::KIND_BATTERY ? "node" : k == pmu::KIND_MPPT ? "device" : "address";
+const char* number_key(pmu::v4::DeviceKind k) {
+  return k == pmu::v4::KIND_BATTERY ? "node" : k == pmu::v4::KIND_MPPT ? "device" : "address";
 }
 
 // Reads every sample of one state topic (TRANSIENT_LOCAL: the service's current values
@@ -185,6 +185,7 @@ void print_json(const char* topic, const DeviceId& d, const Json& values, std::o
                 bool with_kind = false) {
   Json j;
   j["topic"] = topic;
+  j["contract"] = pmu::dds::contract_major();  // the contract the values were read as
   j["vehicle"] = d.vehicle;
   j["bus"] = d.bus;
   if (with_kind) j["kind"] = to_string(d.kind);
@@ -283,15 +284,15 @@ int run_watch(const GlobalOptions& o, long count) {
   std::vector<std::unique_ptr<TelemetryReader>> readers;
   // --low-rate: only the low-rate topics' writers match, so only their samples cross the link.
   const bool low = o.low_rate;
-  readers.push_back(std::make_unique<TypedTelemetryReader<pmu::Voltages, pmu::VoltagesPubSubType>>(
+  readers.push_back(std::make_unique<TypedTelemetryReader<pmu::v4::Voltages, pmu::v4::VoltagesPubSubType>>(
       dds, low ? topics::kLowRateVoltages : topics::kVoltages));
-  readers.push_back(std::make_unique<TypedTelemetryReader<pmu::Currents, pmu::CurrentsPubSubType>>(
+  readers.push_back(std::make_unique<TypedTelemetryReader<pmu::v4::Currents, pmu::v4::CurrentsPubSubType>>(
       dds, low ? topics::kLowRateCurrents : topics::kCurrents));
-  readers.push_back(std::make_unique<TypedTelemetryReader<pmu::BatteryEnergy, pmu::BatteryEnergyPubSubType>>(
+  readers.push_back(std::make_unique<TypedTelemetryReader<pmu::v4::BatteryEnergy, pmu::v4::BatteryEnergyPubSubType>>(
       dds, low ? topics::kLowRateBatteryEnergy : topics::kBatteryEnergy));
-  readers.push_back(std::make_unique<TypedTelemetryReader<pmu::Temperatures, pmu::TemperaturesPubSubType>>(
+  readers.push_back(std::make_unique<TypedTelemetryReader<pmu::v4::Temperatures, pmu::v4::TemperaturesPubSubType>>(
       dds, low ? topics::kLowRateTemperatures : topics::kTemperatures));
-  readers.push_back(std::make_unique<TypedTelemetryReader<pmu::Status, pmu::StatusPubSubType>>(
+  readers.push_back(std::make_unique<TypedTelemetryReader<pmu::v4::Status, pmu::v4::StatusPubSubType>>(
       dds, low ? topics::kLowRateStatus : topics::kStatus));
   // Batteries and MPPTs have no low-rate topics: their canopen_publish_period already holds
   // them to a few samples a second.
@@ -300,10 +301,10 @@ int run_watch(const GlobalOptions& o, long count) {
   if (!low) {
     try {
       readers.push_back(
-          std::make_unique<TypedTelemetryReader<pmu::Battery, pmu::BatteryPubSubType>>(dds, topics::kBattery));
-      readers.push_back(std::make_unique<TypedTelemetryReader<pmu::BatteryCells, pmu::BatteryCellsPubSubType>>(
+          std::make_unique<TypedTelemetryReader<pmu::v4::Battery, pmu::v4::BatteryPubSubType>>(dds, topics::kBattery));
+      readers.push_back(std::make_unique<TypedTelemetryReader<pmu::v4::BatteryCells, pmu::v4::BatteryCellsPubSubType>>(
           dds, topics::kBatteryCells));
-      readers.push_back(std::make_unique<TypedTelemetryReader<pmu::Mppt, pmu::MpptPubSubType>>(dds, topics::kMppt));
+      readers.push_back(std::make_unique<TypedTelemetryReader<pmu::v4::Mppt, pmu::v4::MpptPubSubType>>(dds, topics::kMppt));
     } catch (const pmu::dds::DdsError& e) {
       std::fprintf(stderr, "pmuctl: not showing batteries and MPPTs: %s\n", e.what());
     }
@@ -311,8 +312,8 @@ int run_watch(const GlobalOptions& o, long count) {
 
   // Every row says its device's health and its values' age: a device gone OFFLINE keeps
   // its last row, which must not look live.
-  StateCollector<pmu::Health, pmu::HealthPubSubType> health(dds, topics::kHealth);
-  const auto health_of = [&health](const DeviceId& d) -> std::optional<pmu::HealthState> {
+  StateCollector<pmu::v4::Health, pmu::v4::HealthPubSubType> health(dds, topics::kHealth);
+  const auto health_of = [&health](const DeviceId& d) -> std::optional<pmu::v4::HealthState> {
     const auto it = health.latest().find(d);
     if (it == health.latest().end()) return std::nullopt;
     return it->second.state();
@@ -372,52 +373,89 @@ int run_watch(const GlobalOptions& o, long count) {
   return 0;
 }
 
+// "v4", or "v4, v3" for a vehicle whose service also serves contract 3's consumers.
+std::string contracts_cell(const std::set<int>& contracts) {
+  std::string cell;
+  for (auto it = contracts.rbegin(); it != contracts.rend(); ++it) cell += (cell.empty() ? "v" : ", v") + std::to_string(*it);
+  return cell;
+}
+
 int run_list(const GlobalOptions& o) {
   pmu::dds::DdsContext dds(o.domain, o.qos_file, "pmuctl", o.security, pmu::dds::Transport::Default, o.network,
                            partitions_for(o));
-  StateCollector<pmu::Health, pmu::HealthPubSubType> health(dds, topics::kHealth);
-  StateCollector<pmu::DeviceInfo, pmu::DeviceInfoPubSubType> info(dds, topics::kInfo);
+  StateCollector<pmu::v4::Health, pmu::v4::HealthPubSubType> health(dds, topics::kHealth);
+  StateCollector<pmu::v4::DeviceInfo, pmu::v4::DeviceInfoPubSubType> info(dds, topics::kInfo);
   if (int rc = collect(o, dds, health, 3.0)) return rc;
   info.poll(o);
+  // Every contract each vehicle's services serve; those of other contracts only discovery sees.
+  std::map<std::string, std::set<int>> contracts;
+  for (const auto& v : vehicles_on_domain(dds)) contracts[v].insert(pmu::dds::contract_major());
+  for (const auto& [contract, vehicles] : other_contracts_on_domain(dds))
+    for (const auto& v : vehicles)
+      if (!o.vehicle || *o.vehicle == v) contracts[v].insert(contract);
   std::vector<std::vector<std::string>> rows{
-      {"VEHICLE", "BUS", "DEVICE", "SERIAL", "FIRMWARE", "STATE", "BUS STATE", "LAST FRAME"}};
+      {"VEHICLE", "BUS", "DEVICE", "SERIAL", "FIRMWARE", "STATE", "BUS STATE", "LAST FRAME", "CONTRACT"}};
+  std::set<std::string> listed;
   for (const auto& [key, h] : health.latest()) {
+    listed.insert(key.vehicle);
     const auto it = info.latest().find(key);
     std::string fw = "-", serial = "-";
     if (it != info.latest().end()) {
       fw = std::to_string(it->second.firmware_major()) + "." + std::to_string(it->second.firmware_minor());
       serial = std::to_string(it->second.serial_number());
     }
+    auto& served = contracts[key.vehicle];
+    served.insert(pmu::dds::contract_major());  // read, so served, whatever discovery has said yet
     if (o.json) {
       Json j = values_of(h);
       j["serial_number"] = it != info.latest().end() ? Json(it->second.serial_number()) : Json(nullptr);
       j["firmware"] = it != info.latest().end() ? Json(fw) : Json(nullptr);
+      j["contracts"] = Json(std::vector<int>(served.rbegin(), served.rend()));
       print_json("list", key, j, std::nullopt, true);
     } else {
       const SampleField age = *find_field(fields_of(h), "last_frame_age");  // "never", or the age
       // A battery or MPPT shows its kind with its number ("battery2"): it has no serial or firmware.
       const std::string number =
-          key.kind == pmu::KIND_PMU ? std::to_string(key.address) : to_string(key.kind) + std::to_string(key.address);
+          key.kind == pmu::v4::KIND_PMU ? std::to_string(key.address) : to_string(key.kind) + std::to_string(key.address);
       rows.push_back({key.vehicle.empty() ? "-" : key.vehicle, key.bus, number, serial, fw, to_string(h.state()),
-                      to_string(h.bus_state()), age.json.is_null() ? age.text : age_text(age.json.get<double>()) + " ago"});
+                      to_string(h.bus_state()), age.json.is_null() ? age.text : age_text(age.json.get<double>()) + " ago",
+                      contracts_cell(served)});
     }
   }
-  if (!o.json)
-    for (const auto& line : aligned_columns(rows)) std::printf("%s\n", line.c_str());
+  // Services this pmuctl cannot read: a row each, so the fleet's view shows them, with the
+  // contract that keeps them out of the table.
+  std::map<int, std::set<std::string>> unreadable;
+  for (const auto& [vehicle, served] : contracts) {
+    if (listed.count(vehicle) || served.count(pmu::dds::contract_major())) continue;
+    for (const int c : served) unreadable[c].insert(vehicle);
+    if (o.json) {
+      Json j;
+      j["topic"] = "list";
+      j["contract"] = pmu::dds::contract_major();
+      j["vehicle"] = vehicle;
+      j["values"] = Json{{"contracts", std::vector<int>(served.rbegin(), served.rend())}};
+      j["error"] = "serves " + pmu::dds::contract_text(*served.rbegin()) + ", which this pmuctl cannot read";
+      std::printf("%s\n", j.dump().c_str());
+    } else {
+      rows.push_back({vehicle.empty() ? "-" : vehicle, "?", "?", "-", "-", "UNREADABLE", "-", "-", contracts_cell(served)});
+    }
+  }
+  if (!o.json) for (const auto& line : aligned_columns(rows)) std::printf("%s\n", line.c_str());
+  if (!unreadable.empty()) std::fprintf(stderr, "pmuctl: UNREADABLE: %s\n", other_contracts_text(unreadable).c_str());
   return 0;
 }
 
 int run_info(const GlobalOptions& o) {
   pmu::dds::DdsContext dds(o.domain, o.qos_file, "pmuctl", o.security, pmu::dds::Transport::Default, o.network,
                            partitions_for(o));
-  StateCollector<pmu::DeviceInfo, pmu::DeviceInfoPubSubType> c(dds, topics::kInfo);
+  StateCollector<pmu::v4::DeviceInfo, pmu::v4::DeviceInfoPubSubType> c(dds, topics::kInfo);
   return print_state(o, dds, c, "info");
 }
 
 int run_health(const GlobalOptions& o) {
   pmu::dds::DdsContext dds(o.domain, o.qos_file, "pmuctl", o.security, pmu::dds::Transport::Default, o.network,
                            partitions_for(o));
-  StateCollector<pmu::Health, pmu::HealthPubSubType> c(dds, topics::kHealth);
+  StateCollector<pmu::v4::Health, pmu::v4::HealthPubSubType> c(dds, topics::kHealth);
   return print_state(o, dds, c, "health", true);
 }
 
@@ -430,7 +468,7 @@ int run_config_get(const GlobalOptions& o, const std::string& parameter) {
   }
   pmu::dds::DdsContext dds(o.domain, o.qos_file, "pmuctl", o.security, pmu::dds::Transport::Default, o.network,
                            partitions_for(o));
-  StateCollector<pmu::Config, pmu::ConfigPubSubType> c(dds, topics::kConfig);
+  StateCollector<pmu::v4::Config, pmu::v4::ConfigPubSubType> c(dds, topics::kConfig);
   if (parameter.empty()) return print_state(o, dds, c, "config");
   if (int rc = collect(o, dds, c, 3.0)) return rc;
   for (const auto& [key, s] : c.latest()) {

@@ -4,44 +4,44 @@
 
 namespace pmu::tools {
 
-Json values_of(const pmu::Voltages& s) { return json_of(fields_of(s)); }
-Json values_of(const pmu::Currents& s) { return json_of(fields_of(s)); }
-Json values_of(const pmu::BatteryEnergy& s) { return json_of(fields_of(s)); }
-Json values_of(const pmu::Temperatures& s) { return json_of(fields_of(s)); }
-Json values_of(const pmu::Status& s) { return json_of(fields_of(s)); }
-Json values_of(const pmu::Config& s) { return json_of(fields_of(s)); }
-Json values_of(const pmu::DeviceInfo& s) { return json_of(fields_of(s)); }
-Json values_of(const pmu::Health& s) { return json_of(fields_of(s)); }
-Json values_of(const pmu::Battery& s) { return json_of(fields_of(s)); }
-Json values_of(const pmu::BatteryCells& s) { return json_of(fields_of(s)); }
-Json values_of(const pmu::Mppt& s) { return json_of(fields_of(s)); }
+Json values_of(const pmu::v4::Voltages& s) { return json_of(fields_of(s)); }
+Json values_of(const pmu::v4::Currents& s) { return json_of(fields_of(s)); }
+Json values_of(const pmu::v4::BatteryEnergy& s) { return json_of(fields_of(s)); }
+Json values_of(const pmu::v4::Temperatures& s) { return json_of(fields_of(s)); }
+Json values_of(const pmu::v4::Status& s) { return json_of(fields_of(s)); }
+Json values_of(const pmu::v4::Config& s) { return json_of(fields_of(s)); }
+Json values_of(const pmu::v4::DeviceInfo& s) { return json_of(fields_of(s)); }
+Json values_of(const pmu::v4::Health& s) { return json_of(fields_of(s)); }
+Json values_of(const pmu::v4::Battery& s) { return json_of(fields_of(s)); }
+Json values_of(const pmu::v4::BatteryCells& s) { return json_of(fields_of(s)); }
+Json values_of(const pmu::v4::Mppt& s) { return json_of(fields_of(s)); }
 
-const char* to_string(pmu::HealthState s) {
+const char* to_string(pmu::v4::HealthState s) {
   switch (s) {
-    case pmu::UNKNOWN: return "UNKNOWN";
-    case pmu::ONLINE: return "ONLINE";
-    case pmu::STALE: return "STALE";
-    case pmu::OFFLINE: return "OFFLINE";
+    case pmu::v4::UNKNOWN: return "UNKNOWN";
+    case pmu::v4::ONLINE: return "ONLINE";
+    case pmu::v4::STALE: return "STALE";
+    case pmu::v4::OFFLINE: return "OFFLINE";
   }
   return "UNKNOWN";
 }
 
-const char* to_string(pmu::BusState s) {
+const char* to_string(pmu::v4::BusState s) {
   switch (s) {
-    case pmu::UP: return "UP";
-    case pmu::ERROR_WARNING: return "ERROR_WARNING";
-    case pmu::ERROR_PASSIVE: return "ERROR_PASSIVE";
-    case pmu::BUS_OFF: return "BUS_OFF";
-    case pmu::DOWN: return "DOWN";
+    case pmu::v4::UP: return "UP";
+    case pmu::v4::ERROR_WARNING: return "ERROR_WARNING";
+    case pmu::v4::ERROR_PASSIVE: return "ERROR_PASSIVE";
+    case pmu::v4::BUS_OFF: return "BUS_OFF";
+    case pmu::v4::DOWN: return "DOWN";
   }
   return "DOWN";
 }
 
-const char* to_string(pmu::DeviceKind k) {
+const char* to_string(pmu::v4::DeviceKind k) {
   switch (k) {
-    case pmu::KIND_PMU: return "pmu";
-    case pmu::KIND_BATTERY: return "battery";
-    case pmu::KIND_MPPT: return "mppt";
+    case pmu::v4::KIND_PMU: return "pmu";
+    case pmu::v4::KIND_BATTERY: return "battery";
+    case pmu::v4::KIND_MPPT: return "mppt";
   }
   return "pmu";
 }

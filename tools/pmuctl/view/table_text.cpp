@@ -19,8 +19,8 @@ std::string age_text(double seconds) {
   return buf;
 }
 
-std::string freshness(std::optional<pmu::HealthState> state, double age_seconds) {
-  return std::string(to_string(state.value_or(pmu::UNKNOWN))) + " " + age_text(age_seconds);
+std::string freshness(std::optional<pmu::v4::HealthState> state, double age_seconds) {
+  return std::string(to_string(state.value_or(pmu::v4::UNKNOWN))) + " " + age_text(age_seconds);
 }
 
 std::string row_values(const SampleFields& fields) {
@@ -56,7 +56,7 @@ std::vector<std::string> watch_table(const std::vector<WatchRow>& rows) {
     std::vector<std::vector<std::string>> cells;
     for (const auto& r : rows)
       if (r.topic == t)
-        cells.push_back({r.label, to_string(r.state.value_or(pmu::UNKNOWN)), age_text(r.age), row_values(r.values)});
+        cells.push_back({r.label, to_string(r.state.value_or(pmu::v4::UNKNOWN)), age_text(r.age), row_values(r.values)});
     lines.push_back(t + ":");
     for (auto& l : aligned_columns(cells)) lines.push_back(std::move(l));
   }

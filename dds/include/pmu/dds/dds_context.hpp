@@ -39,6 +39,7 @@
 
 #include "pmu/config/network_settings.hpp"
 #include "pmu/config/transport_choice.hpp"
+#include "pmu/dds/contract_names.hpp"
 #include "pmu/dds/dds_remote_writers.hpp"
 #include "pmu/security/security_files.hpp"
 
@@ -94,23 +95,30 @@ class DdsContext {
   // `statistics`: the Fast DDS statistics topics to write (statistics_settings.hpp), checked
   // names; with DDS-Security the permissions must allow publishing each, or DdsError says so.
   // `type_objects`: announce the self-contained types' type objects (see above).
+  // `contract`: the major version whose type names the context's topics use
+  // (contract_names.hpp): another than this build's makes a participant that serves an older
+  // contract's consumers with this build's types under that contract's names, which is right
+  // only while their layouts are the same (tests/contract checks it). Announced as the
+  // participant property kContractProperty. An older contract never has type objects.
   DdsContext(int domain, const std::string& qos_file, const std::string& participant_name,
              const SecurityFiles& security = {}, Transport transport = Transport::Default,
              const ResolvedNetwork& network = {}, const Partitions& partitions = {},
-             const std::vector<std::string>& statistics = {}, bool type_objects = false);
+             const std::vector<std::string>& statistics = {}, bool type_objects = false,
+             int contract = contract_major());
   ~DdsContext();
   DdsContext(const DdsContext&) = delete;
   DdsContext& operator=(const DdsContext&) = delete;
 
   eprosima::fastdds::dds::DomainParticipant& participant() { return *participant_; }
   int domain() const noexcept { return domain_; }
+  int contract() const noexcept { return contract_; }
   bool secure() const noexcept { return secure_; }
   // Every remote writer discovery reported since the participant was created, with its
   // partitions (dds_remote_writers.hpp).
   const RemoteWriters& remote_writers() const noexcept { return remote_writers_; }
 
   // Registers the type (once) and creates the topic (once). `type` is e.g.
-  // new pmu::VoltagesPubSubType(). Its endpoints announce its type object when the context
+  // new pmu::v4::VoltagesPubSubType(); it is registered under contract()'s name for it. Its endpoints announce its type object when the context
   // was made with type_objects and the type is self-contained, never its TypeInformation
   // (dds_type_objects.hpp says why). Throws
   // DdsError at start-up when it fails.
@@ -130,6 +138,7 @@ class DdsContext {
   [[noreturn]] void refused(const std::string& topic, const std::string& profile, bool publish) const;
 
   int domain_;
+  int contract_;
   bool type_objects_;
   std::string qos_file_;
   bool secure_ = false;

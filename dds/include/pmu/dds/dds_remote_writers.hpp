@@ -1,6 +1,7 @@
 #pragma once
-// RemoteWriters: the partitions every remote DataWriter announced in discovery, by the
-// writer's GUID, and the remote participants by name. DdsContext installs it when it creates the participant, so no writer is
+// RemoteWriters: the partitions and type name every remote DataWriter announced in
+// discovery, by the writer's GUID, and the remote participants by name and the contract they
+// announce (contract_names.hpp). DdsContext installs it when it creates the participant, so no writer is
 // missed: Fast DDS does not replay discovery to a listener set later, and a writer found in
 // the moment between the participant's creation and such a listener would stay unknown.
 // Fast DDS reports a writer (PDP::addWriterProxyData) before it pairs it with local readers,
@@ -26,9 +27,15 @@ class RemoteWriters final : public eprosima::fastdds::dds::DomainParticipantList
   // writer may choose); nullopt when discovery never reported that writer.
   std::optional<std::vector<std::string>> partitions_of(const eprosima::fastdds::dds::SampleInfo& info) const;
 
-  // The partitions of every remote writer of `topic` discovery reported, matched or not: a
-  // client reading one vehicle still learns which vehicles' services are there.
-  std::vector<std::vector<std::string>> partitions_writing(const std::string& topic) const;
+  struct Seen {
+    std::vector<std::string> partitions;
+    std::string type_name;  // as the writer announced it: its contract's name for the type
+    std::optional<int> participant_contract;  // its participant's kContractProperty, if any
+  };
+  // Every remote writer of `topic` discovery reported, matched or not: a client reading one
+  // vehicle still learns which vehicles' services are there, and one of another contract
+  // (which it can never match) learns that they are there.
+  std::vector<Seen> writers_of(const std::string& topic) const;
 
   void on_participant_discovery(eprosima::fastdds::dds::DomainParticipant*,
                                 eprosima::fastrtps::rtps::ParticipantDiscoveryInfo&& info) override;
@@ -42,12 +49,17 @@ class RemoteWriters final : public eprosima::fastdds::dds::DomainParticipantList
   struct Writer {
     std::vector<std::string> partitions;
     std::string topic;
+    std::string type_name;
     std::string participant;  // its GUID prefix as text
+  };
+  struct Participant {
+    std::string name;
+    std::optional<int> contract;
   };
   // Called from Fast DDS's discovery thread; read from any thread.
   mutable std::mutex mutex_;
   std::map<std::string, Writer> writers_;  // GUID text -> what it announced
-  std::map<std::string, std::string> participants_;  // GUID prefix text -> participant name
+  std::map<std::string, Participant> participants_;  // GUID prefix text -> what it announced
 };
 
 }  // namespace pmu::dds

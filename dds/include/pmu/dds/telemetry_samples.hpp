@@ -14,11 +14,11 @@
 namespace pmu::service {
 
 // Values only; the keys are the caller's.
-void fill(pmu::Voltages& s, const codec::Voltages& v);
-void fill(pmu::Currents& s, const codec::Currents& c);
-void fill(pmu::BatteryEnergy& s, const codec::BatteryEnergy& e);
-void fill(pmu::Temperatures& s, const codec::Temperatures& t);
-void fill(pmu::Status& s, const codec::Status& st);
+void fill(pmu::v4::Voltages& s, const codec::Voltages& v);
+void fill(pmu::v4::Currents& s, const codec::Currents& c);
+void fill(pmu::v4::BatteryEnergy& s, const codec::BatteryEnergy& e);
+void fill(pmu::v4::Temperatures& s, const codec::Temperatures& t);
+void fill(pmu::v4::Status& s, const codec::Status& st);
 
 struct TelemetryCdr {
   const char* topic = nullptr;  // topics::kVoltages, ...

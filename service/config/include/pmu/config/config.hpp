@@ -129,6 +129,11 @@ struct Config {
   // dynamic-type tools (dds_type_objects.hpp). Off by default: they add about 10 kB of
   // discovery traffic per joining participant, which a lossy, narrow ground link pays for.
   bool dds_type_objects = false;
+  // `also_serve_contract`: the previous major version of the contract, served as well on a
+  // second participant for consumers not yet upgraded (docs/interface.md section 10); the
+  // only value accepted is the one before this build's. Unset (the default): only this
+  // build's contract.
+  std::optional<int> also_serve_contract;
   std::string log_level = "info";
   std::vector<BusConfig> buses;
   Timeouts timeouts;
