@@ -1,0 +1,345 @@
+// Clients built from older contracts' IDL (old_consumer_v2, old_consumer_v3) against
+// pmu-service on its simulated PMU, with pmuctl (contract v4) as the reference reader:
+// - a service that serves v4 only: neither old client matches anything (v4's type names),
+//   while pmuctl reads it;
+// - with `also_serve_contract: 3`: the v3 client reads every field as pmuctl does and gets
+//   one reply to its command; the v2 client's pmu/health matches (v2 and v3 share the name
+//   pmu::Health) and is misread: the limit docs/interface.md section 10.3 states;
+// - pmuctl against a v3 service names the contract instead of reporting no service.
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <fstream>
+#include <iterator>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "support/domain.hpp"
+#include "support/json_lines.hpp"
+#include "support/process.hpp"
+#include "support/wait.hpp"
+
+namespace {
+
+using namespace std::chrono_literals;
+using Json = nlohmann::json;
+
+// pmu-service on one simulated PMU (sim0, address 1), from a config file of its own.
+class Service {
+ public:
+  Service(int domain, bool also_v3) {
+    char dir[] = "/tmp/pmu-old-contract-XXXXXX";
+    if (::mkdtemp(dir)) dir_ = dir;
+    config_ = dir_ + "/pmu-service.yaml";
+    log_ = dir_ + "/service.log";
+    std::ofstream(config_) << "domain: " << domain << (also_v3 ? "\nalso_serve_contract: 3" : "")
+                           << "\nlog_level: info\nbuses:\n  - interface: sim\n    name: sim0\n    devices:\n"
+                              "      - address: 1\n        period: 0.5\n";
+    pmu::test::ChildOptions o;
+    o.stdout_path = o.stderr_path = log_;
+    process_ = pmu::test::Child({PMU_SERVICE_PATH, "--config", config_}, o);
+  }
+  ~Service() {
+    (void)process_.stop(10s);
+    ::unlink(config_.c_str());
+    ::unlink(log_.c_str());
+    ::rmdir(dir_.c_str());
+  }
+  std::string describe() {
+    std::ifstream in(log_);
+    return std::string(process_.running() ? "service running" : "service exited") + ", log:\n" +
+           std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+  }
+
+ private:
+  std::string dir_, config_, log_;
+  pmu::test::Child process_;
+};
+
+std::string pmuctl(int domain) { return std::string(PMUCTL_PATH) + " --domain " + std::to_string(domain) + " "; }
+
+// pmuctl's JSON line of the simulated PMU (unnamed vehicle, sim0/1), or null.
+Json pmu_line(const std::string& out, const char* topic) {
+  for (const auto& j : pmu::test::json_lines(out))
+    if (j.is_object() && j.value("topic", "") == topic && j.value("vehicle", "?").empty() &&
+        j.value("bus", "") == "sim0" && j.value("address", 0) == 1)
+      return j;
+  return nullptr;
+}
+
+Json v4_state(int domain, const std::string& verb, const char* topic) {
+  return pmu_line(pmu::test::run_capture(pmuctl(domain) + "--timeout 20 --json " + verb + " 2>/dev/null").out, topic);
+}
+
+// pmuctl reads the PMU's health as ONLINE: the service is up and discoverable.
+Json wait_v4_online(int domain) {
+  Json h;
+  (void)pmu::test::wait_until(
+      [&] {
+        h = v4_state(domain, "health", "health");
+        return h.is_object() && h["values"].value("state", "") == "ONLINE";
+      },
+      120s, 200ms);
+  return h;
+}
+
+struct ConsumerRun {
+  std::string out;
+  std::vector<Json> samples;  // every line but the final one
+  Json final;
+  // The newest decoded sample of `topic`, or null.
+  Json last(const std::string& topic) const {
+    Json j;
+    for (const auto& s : samples)
+      if (s.is_object() && s.value("topic", "") == topic) j = s;
+    return j;
+  }
+  std::size_t count(const std::string& topic) const {
+    std::size_t n = 0;
+    for (const auto& s : samples) n += s.is_object() && s.value("topic", "") == topic;
+    return n;
+  }
+};
+
+ConsumerRun run_consumer(const char* path, int domain, const std::string& args) {
+  ConsumerRun r;
+  r.out = pmu::test::run_capture(std::string(path) + " --domain " + std::to_string(domain) + " " + args).out;
+  for (auto& j : pmu::test::json_lines(r.out)) {
+    if (j.is_object() && j.value("final", false))
+      r.final = j;
+    else
+      r.samples.push_back(j);
+  }
+  return r;
+}
+
+// The contracts a `pmuctl --json list` line says its vehicle's services serve.
+Json contracts_of(const Json& line) {
+  return line.is_object() && line.contains("values") && line["values"].contains("contracts")
+             ? line["values"]["contracts"]
+             : Json();
+}
+
+bool has(const Json& list, const std::string& v) {
+  if (!list.is_array()) return false;
+  for (const auto& e : list)
+    if (e == v) return true;
+  return false;
+}
+
+// A health counter of the v3 client's newest sample lies between pmuctl's reads before and
+// after the client ran (they only grow): a misread number falls outside.
+void expect_between(const Json& before, const Json& v3, const Json& after, const char* counter) {
+  const auto lo = before["values"].value(counter, ~0ull), hi = after["values"].value(counter, 0ull);
+  const auto got = v3.value(counter, ~0ull);
+  EXPECT_TRUE(lo <= got && got <= hi) << counter << ": v3 read " << got << ", pmuctl " << lo << " before and " << hi
+                                      << " after";
+}
+
+TEST(OldContractConsumers, MatchNothingOfAServiceOfV4AloneWhichV4Reads) {
+  const int domain = pmu::test::exclusive_dds_domain();
+  Service service(domain, false);
+  ASSERT_TRUE(wait_v4_online(domain).is_object()) << service.describe();
+
+  for (const char* path : {OLD_CONSUMER_V3_PATH, OLD_CONSUMER_V2_PATH}) {
+    SCOPED_TRACE(path);
+    const bool v3 = std::string(path) == OLD_CONSUMER_V3_PATH;
+    const auto run = run_consumer(path, domain, std::string("--seconds 90 --until discovered --linger 2") +
+                                                    (v3 ? " --command GET_SERIAL" : ""));
+    ASSERT_TRUE(run.final.is_object()) << run.out;
+    // Discovery reported the service's endpoints under v4's names, so "matched nothing" is
+    // the verdict on them, not a run that ended too early.
+    std::vector<std::pair<std::string, std::string>> endpoints{
+        {"pmu/health", "Health"}, {"pmu/config", "Config"}, {"pmu/voltages", "Voltages"}};
+    if (v3) endpoints.insert(endpoints.end(), {{"pmu/command_reply", "CommandReply"}, {"reader:pmu/command", "Command"}});
+    for (const auto& [topic, type] : endpoints)
+      EXPECT_TRUE(has(run.final["discovered"].value(topic, Json()), "pmu::v4::" + type)) << topic << ": " << run.out;
+    EXPECT_EQ(run.final["matched"].size(), v3 ? 5u : 3u) << run.out;
+    for (const auto& [topic, n] : run.final["matched"].items()) EXPECT_EQ(n, 0) << topic << ": " << run.out;
+    EXPECT_TRUE(run.samples.empty()) << run.out;
+    EXPECT_EQ(run.final.value("command_sent", true), false) << run.out;
+  }
+  EXPECT_TRUE(wait_v4_online(domain).is_object()) << "pmuctl no longer reads the service: " << service.describe();
+}
+
+TEST(OldContractConsumers, V3ConsumerReadsEveryFieldOfAServiceThatAlsoServesV3) {
+  const int domain = pmu::test::exclusive_dds_domain();
+  Service service(domain, true);
+  const Json before = wait_v4_online(domain);
+  ASSERT_TRUE(before.is_object()) << service.describe();
+  // pmuctl sees the v3 participant once discovery has reported it.
+  Json listed;
+  EXPECT_TRUE(pmu::test::wait_until(
+      [&] {
+        listed = v4_state(domain, "list", "list");
+        return listed.is_object() && contracts_of(listed) == Json::array({4, 3});
+      },
+      60s, 200ms))
+      << listed.dump();
+  const Json config = v4_state(domain, "config get", "config");
+  const Json info = v4_state(domain, "info", "info");
+  ASSERT_TRUE(config.is_object() && info.is_object()) << config.dump() << "\n" << info.dump();
+  Json voltages;
+  for (const auto& j :
+       pmu::test::json_lines(pmu::test::run_capture(pmuctl(domain) + "--timeout 20 --json watch --count 20").out))
+    if (j.is_object() && j.value("topic", "") == "voltages") voltages = j;
+  ASSERT_TRUE(voltages.is_object()) << "pmuctl watch printed no voltages";
+
+  const auto run = run_consumer(OLD_CONSUMER_V3_PATH, domain, "--seconds 90 --until decoded --linger 2 --command GET_SERIAL");
+  const Json after = v4_state(domain, "health", "health");
+  ASSERT_TRUE(run.final.is_object() && after.is_object()) << run.out << "\n" << service.describe();
+  for (const char* topic : {"pmu/health", "pmu/config", "pmu/voltages", "pmu/command", "pmu/command_reply"})
+    EXPECT_EQ(run.final["matched"].value(topic, -1), 1) << topic << ": the v3 participant's alone; " << run.out;
+
+  const Json h = run.last("pmu/health");
+  ASSERT_TRUE(h.is_object()) << run.out;
+  EXPECT_EQ(h["vehicle"], "");
+  EXPECT_EQ(h["bus"], "sim0");
+  EXPECT_EQ(h["address"], before["address"]);
+  EXPECT_EQ(h["kind"], "KIND_PMU");
+  EXPECT_EQ(h["state"], "ONLINE");
+  EXPECT_EQ(h["bus_state"], "UP");
+  EXPECT_GE(h.value("last_frame_age", -1.0), 0.0) << h.dump();
+  EXPECT_LT(h.value("last_frame_age", 99.0), 5.0) << h.dump();
+  for (const char* c : {"frames_received", "frames_sent", "decode_errors", "bus_errors", "rx_dropped", "timeouts",
+                        "reconnects", "publish_failures"})
+    expect_between(before, h, after, c);
+
+  // Stored parameters do not change by themselves: every field as pmuctl read it.
+  const Json c = run.last("pmu/config");
+  ASSERT_TRUE(c.is_object()) << run.out;
+  EXPECT_EQ(c["bus"], "sim0");
+  EXPECT_EQ(c["address"], 1);
+  for (const auto& [field, value] : config["values"].items()) {
+    ASSERT_TRUE(c.contains(field)) << field << " missing from " << c.dump();
+    if (value.is_number_float()) {
+      EXPECT_NEAR(c[field].get<double>(), value.get<double>(), 1e-3) << field;
+    } else {
+      EXPECT_EQ(c[field], value) << field;
+    }
+  }
+  EXPECT_EQ(config["values"].size(), c.size() - 4) << "fields besides topic and keys: " << c.dump();
+
+  // Set points read exactly; battery voltages drift with the simulated plant.
+  const Json v = run.last("pmu/voltages");
+  ASSERT_TRUE(v.is_object()) << run.out;
+  for (const auto& [field, value] : voltages["values"].items()) {
+    ASSERT_TRUE(v.contains(field)) << field << " missing from " << v.dump();
+    if (value.is_number()) {
+      EXPECT_NEAR(v[field].get<double>(), value.get<double>(), 0.5) << field << ": " << v.dump();
+    }
+  }
+
+  ASSERT_EQ(run.count("pmu/command_reply"), 1u) << run.out;
+  const Json reply = run.last("pmu/command_reply");
+  EXPECT_EQ(reply["request_id"], run.final["request_id"]);
+  EXPECT_EQ(reply["kind"], "GET_SERIAL");
+  EXPECT_EQ(reply["result"], "COMPLETED") << reply.dump();
+  EXPECT_EQ(reply["has_value"], true);
+  EXPECT_EQ(reply.value("value", -1.0), info["values"].value("serial_number", -2.0)) << reply.dump() << info.dump();
+  EXPECT_EQ(run.final["replies"], 1);
+}
+
+TEST(OldContractConsumers, V2ConsumerOfAServiceThatAlsoServesV3MisreadsHealth) {
+  const int domain = pmu::test::exclusive_dds_domain();
+  Service service(domain, true);
+  const Json before = wait_v4_online(domain);
+  ASSERT_TRUE(before.is_object()) << service.describe();
+  const auto run = run_consumer(OLD_CONSUMER_V2_PATH, domain, "--seconds 90 --until decoded --linger 1");
+  const Json after = v4_state(domain, "health", "health");
+  ASSERT_TRUE(run.final.is_object() && after.is_object()) << run.out;
+
+  // The documented limit: v2 and v3 both name it pmu::Health, so they match ...
+  EXPECT_EQ(run.final["matched"].value("pmu/health", -1), 1) << run.out;
+  const Json h = run.last("pmu/health");
+  ASSERT_TRUE(h.is_object()) << run.out;
+  // ... and v3's `kind` key is read as v2's `state`, every later field one place off.
+  const auto frames = h.value("frames_received", ~0ull);
+  const bool frames_right = before["values"].value("frames_received", ~0ull) <= frames &&
+                            frames <= after["values"].value("frames_received", 0ull);
+  EXPECT_FALSE(h["state"] == "ONLINE" && h["bus_state"] == "UP" && frames_right)
+      << "a v2 client read v3's pmu/health right; docs/interface.md section 10.3 says it cannot: " << h.dump();
+  // The types v3 left as they were still read right.
+  const Json c = run.last("pmu/config");
+  ASSERT_TRUE(c.is_object()) << run.out;
+  const Json config = v4_state(domain, "config get", "config");
+  ASSERT_TRUE(config.is_object());
+  EXPECT_NEAR(c.value("avionics_voltage", 0.0), config["values"].value("avionics_voltage", -1.0), 1e-3) << c.dump();
+  EXPECT_EQ(c["can_address"], 1) << c.dump();
+}
+
+// A stand-in for a v3 pmu-service: participant "pmu-service", pmu/health as pmu::Health.
+pmu::test::Child fake_v3_service(int domain, const std::string& vehicle) {
+  pmu::test::ChildOptions o;
+  o.stdout_path = o.stderr_path = "/dev/null";
+  return pmu::test::Child({OLD_CONSUMER_V3_PATH, "--domain", std::to_string(domain), "--serve-health", "--vehicle",
+                           vehicle, "--seconds", "600"},
+                          o);
+}
+
+TEST(OldContractConsumers, PmuctlNamesTheContractOfTheOnlyServiceThere) {
+  const int domain = pmu::test::exclusive_dds_domain();
+  auto fake = fake_v3_service(domain, "");
+  // With nothing of v4 to read, pmuctl waits out its timeout: 15 s covers discovery.
+  const auto r = pmu::test::run_capture(pmuctl(domain) + "--timeout 15 list", true);
+  EXPECT_EQ(r.status, 3) << r.out;
+  EXPECT_NE(r.out.find("no pmu-service of contract v4 on domain " + std::to_string(domain) +
+                       "; found pmu-service of contract v3 (or older) (vehicles: (unnamed)); this pmuctl reads "
+                       "contract v4 only (docs/interface.md section 10"),
+            std::string::npos)
+      << r.out;
+  const auto j = pmu::test::run_capture(pmuctl(domain) + "--timeout 15 --json list 2>/dev/null");
+  EXPECT_EQ(j.status, 3) << j.out;
+  const auto lines = pmu::test::json_lines(j.out);
+  ASSERT_EQ(lines.size(), 1u) << j.out;
+  ASSERT_TRUE(lines[0].is_object()) << j.out;
+  EXPECT_EQ(lines[0].value("exit_status", -1), 3) << j.out;
+  const auto error = lines[0].value("error", "");
+  EXPECT_NE(error.find("contract v3"), std::string::npos) << j.out;
+  EXPECT_NE(error.find("this pmuctl reads contract v4"), std::string::npos) << j.out;
+  EXPECT_TRUE(fake.running()) << "the fake v3 service exited early";
+}
+
+TEST(OldContractConsumers, PmuctlListsAnotherVehiclesV3ServiceAsUnreadable) {
+  const int domain = pmu::test::exclusive_dds_domain();
+  Service service(domain, false);
+  auto fake = fake_v3_service(domain, "uav2");
+  ASSERT_TRUE(wait_v4_online(domain).is_object()) << service.describe();
+
+  // list settles on the v4 state it reads; uav2 is there once discovery has reported it.
+  Json uav2, own;
+  EXPECT_TRUE(pmu::test::wait_until(
+      [&] {
+        const auto r = pmu::test::run_capture(pmuctl(domain) + "--timeout 20 --json list 2>/dev/null");
+        own = pmu_line(r.out, "list");
+        for (const auto& l : pmu::test::json_lines(r.out))
+          if (l.is_object() && l.value("vehicle", "") == "uav2") uav2 = l;
+        return r.status == 0 && uav2.is_object();
+      },
+      60s, 200ms))
+      << uav2.dump();
+  EXPECT_EQ(contracts_of(uav2), Json::array({3})) << uav2.dump();
+  EXPECT_EQ(uav2["contract"], 4) << uav2.dump();
+  EXPECT_EQ(uav2.value("error", ""), "serves contract v3 (or older), which this pmuctl cannot read") << uav2.dump();
+  EXPECT_EQ(contracts_of(own), Json::array({4})) << own.dump();
+
+  pmu::test::RunResult text;
+  EXPECT_TRUE(pmu::test::wait_until(
+      [&] {
+        text = pmu::test::run_capture(pmuctl(domain) + "--timeout 20 list", true);
+        return text.out.find("UNREADABLE") != std::string::npos;
+      },
+      60s, 200ms))
+      << text.out;
+  EXPECT_EQ(text.status, 0) << text.out;
+  EXPECT_NE(text.out.find("\nuav2 "), std::string::npos) << text.out;
+  EXPECT_NE(text.out.find("pmuctl: UNREADABLE: pmu-service of contract v3 (or older) (vehicles: uav2); this pmuctl "
+                          "reads contract v4 only"),
+            std::string::npos)
+      << text.out;
+}
+
+}  // namespace
