@@ -38,9 +38,10 @@ started=$(date +%s)
 step() { printf '\n=== %s (at %d s) ===\n' "$*" "$(($(date +%s) - started))"; }
 
 # These packages only feed the tests (systemd_vm, package_*): built without debug
-# information and without -dbgsym packages, which is most of a C++ link's time and output.
-# What ships is built by scripts/package.sh alone, with both.
-no_debug=(DEB_CFLAGS_APPEND=-g0 DEB_CXXFLAGS_APPEND=-g0)
+# information and without -dbgsym packages, which is most of a C++ link's time and output,
+# and as unity builds (debian/rules), like the sanitizer trees. What ships is built by
+# scripts/package.sh alone, with debug information and file by file.
+no_debug=(DEB_CFLAGS_APPEND=-g0 DEB_CXXFLAGS_APPEND=-g0 PMU_UNITY_BUILD=1)
 
 step "release build"
 # Each build's flags are its preset in CMakePresets.json (folder build/<preset>).

@@ -32,8 +32,6 @@ namespace {
 using namespace eprosima::fastdds::dds;
 using codec::Parameter;
 
-float f(double v) { return static_cast<float>(v); }
-
 eprosima::fastrtps::Time_t dds_time(std::chrono::system_clock::time_point t) {
   const auto ns = std::chrono::duration_cast<std::chrono::nanoseconds>(t.time_since_epoch()).count();
   eprosima::fastrtps::Time_t out;
@@ -53,12 +51,6 @@ const char* why(ReturnCode_t rc) {
   return "error";
 }
 
-template <class T>
-void set_key(T& s, const std::string& vehicle, const DeviceKey& k) {
-  s.vehicle(vehicle);
-  s.bus(k.bus);
-  s.address(k.address);
-}
 
 // The battery's node or the MPPT's device id fits an octet (node 1..127, device 0..7).
 std::uint8_t octet_id(const DeviceKey& k) { return static_cast<std::uint8_t>(k.address & 0xFF); }
@@ -71,7 +63,7 @@ class Values {
   Values(const CanOpenValues<N>& state, const CanOpenValue (&table)[N]) : state_(state), table_(table) {}
   float real(std::string_view name) const {
     const auto i = slot(name);
-    return i < N ? f(state_.values[i]) : std::numeric_limits<float>::quiet_NaN();
+    return i < N ? idl_float(state_.values[i]) : std::numeric_limits<float>::quiet_NaN();
   }
   std::uint32_t u32(std::string_view name) const {
     const auto i = slot(name);
@@ -246,16 +238,16 @@ void DdsPublisher::on_config(const DeviceKey& key, const ConfigState& c) {
   auto raw8 = [&](Parameter p) {
     return static_cast<std::uint8_t>(c.raw[static_cast<std::size_t>(p)].value_or(0) & 0xFF);
   };
-  s.avionics_voltage(f(c.value(Parameter::AvionicsVoltage)));
-  s.payload_voltage(f(c.value(Parameter::PayloadVoltage)));
-  s.servo_voltage(f(c.value(Parameter::ServoVoltage)));
-  s.battery_voltage(f(c.value(Parameter::BatteryVoltage)));
-  s.packet_period(f(c.value(Parameter::PacketPeriod)));
+  s.avionics_voltage(idl_float(c.value(Parameter::AvionicsVoltage)));
+  s.payload_voltage(idl_float(c.value(Parameter::PayloadVoltage)));
+  s.servo_voltage(idl_float(c.value(Parameter::ServoVoltage)));
+  s.battery_voltage(idl_float(c.value(Parameter::BatteryVoltage)));
+  s.packet_period(idl_float(c.value(Parameter::PacketPeriod)));
   s.packets_streamed(raw8(Parameter::PacketsStreamed));
   s.temperature_offset(raw8(Parameter::TemperatureOffset));
   s.upper_temperature_limit(raw8(Parameter::UpperTemperatureLimit));
   s.power_up_state(raw8(Parameter::PowerUpState));
-  s.cranking_time(f(c.value(Parameter::CrankingTime)));
+  s.cranking_time(idl_float(c.value(Parameter::CrankingTime)));
   s.can_address(static_cast<std::uint16_t>(c.raw[static_cast<std::size_t>(Parameter::CanAddress)].value_or(key.address)));
   s.outputs(c.outputs.value_or(0));
   s.generation_enabled(c.generation_enabled.value_or(false));
@@ -287,7 +279,7 @@ void DdsPublisher::on_health(const DeviceKey& key, const HealthReport& h) {
   s.kind(static_cast<pmu::v4::DeviceKind>(static_cast<int>(key.kind)));
   s.state(static_cast<pmu::v4::HealthState>(static_cast<int>(h.state)));
   s.bus_state(static_cast<pmu::v4::BusState>(static_cast<int>(h.bus_state)));
-  s.last_frame_age(f(h.last_frame_age));
+  s.last_frame_age(idl_float(h.last_frame_age));
   s.frames_received(h.frames_received);
   s.frames_sent(h.frames_sent);
   s.decode_errors(h.decode_errors);
@@ -393,7 +385,7 @@ void DdsPublisher::on_battery_cells(const DeviceKey& key, const BatteryCellsStat
     if (std::isnan(c.volts[cell])) continue;
     pmu::v4::BatteryCell one;
     one.cell(static_cast<std::uint8_t>(cell));
-    one.cell_voltage(f(c.volts[cell]));
+    one.cell_voltage(idl_float(c.volts[cell]));
     s.cells().push_back(one);
   }
   std::lock_guard<std::mutex> lock(w_->mutex);

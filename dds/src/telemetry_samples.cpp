@@ -8,14 +8,6 @@
 namespace pmu::service {
 namespace {
 
-float f(double v) { return static_cast<float>(v); }
-
-template <class T>
-void set_key(T& s, const std::string& vehicle, const DeviceKey& k) {
-  s.vehicle(vehicle);
-  s.bus(k.bus);
-  s.address(k.address);
-}
 
 template <class PubSub, class T>
 bool serialize(T& s, std::vector<std::uint8_t>& out) {
@@ -43,22 +35,22 @@ bool sample(const std::string& vehicle, const DeviceKey& key, const Codec& value
 }  // namespace
 
 void fill(pmu::v4::Voltages& s, const codec::Voltages& v) {
-  s.avionics(f(v.avionics));
-  s.output_28v(f(v.output_28v));
-  s.payload(f(v.payload));
-  s.servo(f(v.servo));
-  s.battery_a(f(v.battery_a));
-  s.battery_b(f(v.battery_b));
-  s.generator(f(v.generator));
+  s.avionics(idl_float(v.avionics));
+  s.output_28v(idl_float(v.output_28v));
+  s.payload(idl_float(v.payload));
+  s.servo(idl_float(v.servo));
+  s.battery_a(idl_float(v.battery_a));
+  s.battery_b(idl_float(v.battery_b));
+  s.generator(idl_float(v.generator));
 }
 
 void fill(pmu::v4::Currents& s, const codec::Currents& c) {
-  s.avionics(f(c.avionics));
-  s.output_28v(f(c.output_28v));
-  s.payload(f(c.payload));
-  s.servo(f(c.servo));
-  s.battery_a(f(c.battery_a));
-  s.battery_b(f(c.battery_b));
+  s.avionics(idl_float(c.avionics));
+  s.output_28v(idl_float(c.output_28v));
+  s.payload(idl_float(c.payload));
+  s.servo(idl_float(c.servo));
+  s.battery_a(idl_float(c.battery_a));
+  s.battery_b(idl_float(c.battery_b));
 }
 
 void fill(pmu::v4::BatteryEnergy& s, const codec::BatteryEnergy& e) {
@@ -67,11 +59,11 @@ void fill(pmu::v4::BatteryEnergy& s, const codec::BatteryEnergy& e) {
 }
 
 void fill(pmu::v4::Temperatures& s, const codec::Temperatures& t) {
-  s.internal(f(t.internal));
-  s.battery_a(f(t.battery_a));  // NaN stays NaN: "no sensor"
-  s.battery_b(f(t.battery_b));
-  s.generator(f(t.generator));
-  s.starter(f(t.starter));
+  s.internal(idl_float(t.internal));
+  s.battery_a(idl_float(t.battery_a));  // NaN stays NaN: "no sensor"
+  s.battery_b(idl_float(t.battery_b));
+  s.generator(idl_float(t.generator));
+  s.starter(idl_float(t.starter));
 }
 
 void fill(pmu::v4::Status& s, const codec::Status& st) {

@@ -13,6 +13,17 @@
 
 namespace pmu::service {
 
+// The keys every sample of a device starts with (telemetry, state and battery/MPPT types).
+template <class T>
+void set_key(T& s, const std::string& vehicle, const DeviceKey& k) {
+  s.vehicle(vehicle);
+  s.bus(k.bus);
+  s.address(k.address);
+}
+
+// A codec value as the IDL's float.
+inline float idl_float(double v) { return static_cast<float>(v); }
+
 // Values only; the keys are the caller's.
 void fill(pmu::v4::Voltages& s, const codec::Voltages& v);
 void fill(pmu::v4::Currents& s, const codec::Currents& c);
