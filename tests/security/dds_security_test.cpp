@@ -631,6 +631,23 @@ TEST(ServiceProgram, SecurePmuServiceWithPmuctlAndTheExampleClient) {
   EXPECT_EQ(r.status, 2) << "the example as mission-computer may not command: " << r.out;
 }
 
+// also_serve_contract (interface.md section 10.3) under DDS-Security: the second participant
+// takes the service's identity and permissions, which name topics, not types, so the same
+// files serve both contracts, and a secure ground station sees both.
+TEST(ServiceProgram, ASecureServiceAlsoServesThePreviousContractWithTheSameFiles) {
+  const std::string cfg = write_config("both", Pki::get().files("pmu-service"), "also_serve_contract: 3\n");
+  const auto service = service_process(cfg);
+  const std::string d = " --domain " + std::to_string(pmu::test::exclusive_dds_domain());
+  const std::string sec = " --security-dir " + Pki::get().dir();
+  const std::string pmuctl = PMUCTL_PATH;
+  auto r = sh(pmuctl + d + sec + " --identity mission-computer --timeout 10 list --json");
+  EXPECT_EQ(r.status, 0) << r.out;
+  EXPECT_NE(r.out.find("\"contracts\":[4,3]"), std::string::npos) << r.out;
+  r = sh(pmuctl + d + sec + " --identity ground-station --timeout 10 config set avionics_voltage 24");
+  EXPECT_EQ(r.status, 0) << r.out;
+  EXPECT_NE(r.out.find("COMPLETED"), std::string::npos) << r.out;
+}
+
 // Unicast discovery (interface.md section 7.2) keeps DDS-Security: a secure pmuctl with
 // --peer gets telemetry, an unauthenticated one gets none. Discovery Server mode is refused
 // with security by both programs: Fast DDS 2.9.1 cannot serve secure participants through a
