@@ -10,6 +10,7 @@
 #include <set>
 #include <string>
 
+#include "support/configured_service.hpp"
 #include "support/domain.hpp"
 #include "support/json_lines.hpp"
 #include "support/process.hpp"
@@ -20,38 +21,16 @@ using namespace std::chrono_literals;
 
 pmu::test::RunResult sh(const std::string& cmd) { return pmu::test::run_capture(cmd, true); }
 
-// pmu-service for one vehicle on a config file of its own, stopped with SIGTERM.
-class VehicleProcess {
+// pmu-service for one vehicle on a config file of its own, stopped with SIGTERM. (Once, in a
+// full run under ThreadSanitizer, list saw uav1 only for 80 s while uav2 printed nothing at
+// warn: describe() shows what each logged.)
+class VehicleProcess : public pmu::test::ConfiguredService {
  public:
-  VehicleProcess(int domain, const std::string& vehicle) {
-    char dir[] = "/tmp/pmu-vehicle-XXXXXX";
-    if (::mkdtemp(dir)) dir_ = dir;
-    config_ = dir_ + "/pmu-service.yaml";
-    std::ofstream(config_) << "domain: " << domain << "\nvehicle: " << vehicle << "\nqos_file: " << PMU_QOS_FILE
-                           << "\nlog_level: info\nbuses:\n  - interface: sim\n    name: can0\n    devices:\n"
-                              "      - address: 1\n        period: 0.5\n";
-    log_ = dir_ + "/service.log";
-    pmu::test::ChildOptions o;
-    o.stdout_path = o.stderr_path = log_;
-    process_ = pmu::test::Child({PMU_SERVICE_PATH, "--config", config_}, o);
-  }
-  ~VehicleProcess() {
-    (void)process_.stop(10s);
-    ::unlink(config_.c_str());
-    ::unlink(log_.c_str());
-    ::rmdir(dir_.c_str());
-  }
-  // For a failure message: whether it still runs and what it logged. (Once, in a full run
-  // under ThreadSanitizer, list saw uav1 only for 80 s while uav2 printed nothing at warn.)
-  std::string describe() {
-    std::ifstream in(log_);
-    std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-    return std::string(process_.running() ? "running" : "exited") + ", log:\n" + text;
-  }
-
- private:
-  std::string dir_, config_, log_;
-  pmu::test::Child process_;
+  VehicleProcess(int domain, const std::string& vehicle)
+      : ConfiguredService(PMU_SERVICE_PATH, "domain: " + std::to_string(domain) + "\nvehicle: " + vehicle +
+                                                "\nqos_file: " + PMU_QOS_FILE +
+                                                "\nlog_level: info\nbuses:\n  - interface: sim\n    name: can0\n"
+                                                "    devices:\n      - address: 1\n        period: 0.5\n") {}
 };
 
 TEST(PmuctlVehicles, ListShowsEveryVehicleAndVehicleSelectsTheOneToCommand) {

@@ -17,6 +17,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "support/configured_service.hpp"
 #include "support/domain.hpp"
 #include "support/json_lines.hpp"
 #include "support/process.hpp"
@@ -28,35 +29,13 @@ using namespace std::chrono_literals;
 using Json = nlohmann::json;
 
 // pmu-service on one simulated PMU (sim0, address 1), from a config file of its own.
-class Service {
+class Service : public pmu::test::ConfiguredService {
  public:
-  Service(int domain, bool also_v3) {
-    char dir[] = "/tmp/pmu-old-contract-XXXXXX";
-    if (::mkdtemp(dir)) dir_ = dir;
-    config_ = dir_ + "/pmu-service.yaml";
-    log_ = dir_ + "/service.log";
-    std::ofstream(config_) << "domain: " << domain << (also_v3 ? "\nalso_serve_contract: 3" : "")
-                           << "\nlog_level: info\nbuses:\n  - interface: sim\n    name: sim0\n    devices:\n"
-                              "      - address: 1\n        period: 0.5\n";
-    pmu::test::ChildOptions o;
-    o.stdout_path = o.stderr_path = log_;
-    process_ = pmu::test::Child({PMU_SERVICE_PATH, "--config", config_}, o);
-  }
-  ~Service() {
-    (void)process_.stop(10s);
-    ::unlink(config_.c_str());
-    ::unlink(log_.c_str());
-    ::rmdir(dir_.c_str());
-  }
-  std::string describe() {
-    std::ifstream in(log_);
-    return std::string(process_.running() ? "service running" : "service exited") + ", log:\n" +
-           std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
-  }
-
- private:
-  std::string dir_, config_, log_;
-  pmu::test::Child process_;
+  Service(int domain, bool also_v3)
+      : ConfiguredService(PMU_SERVICE_PATH,
+                          "domain: " + std::to_string(domain) + (also_v3 ? "\nalso_serve_contract: 3" : "") +
+                              "\nlog_level: info\nbuses:\n  - interface: sim\n    name: sim0\n    devices:\n"
+                              "      - address: 1\n        period: 0.5\n") {}
 };
 
 std::string pmuctl(int domain) { return std::string(PMUCTL_PATH) + " --domain " + std::to_string(domain) + " "; }
