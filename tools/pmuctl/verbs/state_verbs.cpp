@@ -185,13 +185,15 @@ void print_json(const char* topic, const DeviceId& d, const Json& values, std::o
                 bool with_kind = false) {
   Json j;
   j["topic"] = topic;
-  j["contract"] = pmu::dds::contract_major();  // the contract the values were read as
   j["vehicle"] = d.vehicle;
   j["bus"] = d.bus;
   if (with_kind) j["kind"] = to_string(d.kind);
   j[number_key(d.kind)] = d.address;
   if (time) j["time"] = *time;
   j["values"] = values;
+  // Last, so scripts that match the keys before it in their order (as the VM suites do) are
+  // not disturbed by it: the contract the values were read as.
+  j["contract"] = pmu::dds::contract_major();
   std::printf("%s\n", j.dump().c_str());
 }
 
@@ -431,9 +433,9 @@ int run_list(const GlobalOptions& o) {
     if (o.json) {
       Json j;
       j["topic"] = "list";
-      j["contract"] = pmu::dds::contract_major();
       j["vehicle"] = vehicle;
       j["values"] = Json{{"contracts", std::vector<int>(served.rbegin(), served.rend())}};
+      j["contract"] = pmu::dds::contract_major();
       j["error"] = "serves " + pmu::dds::contract_text(*served.rbegin()) + ", which this pmuctl cannot read";
       std::printf("%s\n", j.dump().c_str());
     } else {
