@@ -319,6 +319,15 @@ TEST(OldContractConsumers, PmuctlListsAnotherVehiclesV3ServiceAsUnreadable) {
                           "reads contract v4 only"),
             std::string::npos)
       << text.out;
+
+  // Asked for uav2 alone, while a v4 service serves another vehicle: the message names uav2's
+  // contract, not the v4 vehicles, and nothing answered (3).
+  const auto one = pmu::test::run_capture(pmuctl(domain) + "--vehicle uav2 --timeout 5 health", true);
+  EXPECT_EQ(one.status, 3) << one.out;
+  EXPECT_NE(one.out.find("no pmu-service of contract v4 for vehicle uav2 on domain " + std::to_string(domain) +
+                         "; found pmu-service of contract v3 (or older) (vehicles: uav2)"),
+            std::string::npos)
+      << one.out;
 }
 
 }  // namespace

@@ -60,19 +60,19 @@ std::string vehicle_text(const std::string& vehicle) {
 int no_service(const GlobalOptions& o, const pmu::dds::DdsContext& dds) {
   const auto vehicles = vehicles_on_domain(dds);
   const std::string domain = " on domain " + std::to_string(o.domain);
-  if (!o.vehicle || vehicles.empty()) {
-    auto others = other_contracts_on_domain(dds);
-    if (o.vehicle)
-      for (auto it = others.begin(); it != others.end();)
-        it = it->second.count(*o.vehicle) ? std::next(it) : others.erase(it);
-    const std::string found = other_contracts_text(others);
-    if (!found.empty())
-      return fail(o, ExitStatus::NoAnswer,
-                  "no pmu-service of " + pmu::dds::contract_text(pmu::dds::contract_major()) +
-                      (o.vehicle ? " for " + vehicle_text(*o.vehicle) : std::string()) + domain + "; found " + found);
+  // The vehicle asked for (or any, without --vehicle) served only in another contract: that
+  // is why nothing matched, whatever this contract's services serve other vehicles.
+  auto others = other_contracts_on_domain(dds);
+  if (o.vehicle)
+    for (auto it = others.begin(); it != others.end();)
+      it = it->second.count(*o.vehicle) ? std::next(it) : others.erase(it);
+  if (const std::string found = other_contracts_text(others); !found.empty())
+    return fail(o, ExitStatus::NoAnswer,
+                "no pmu-service of " + pmu::dds::contract_text(pmu::dds::contract_major()) +
+                    (o.vehicle ? " for " + vehicle_text(*o.vehicle) : std::string()) + domain + "; found " + found);
+  if (!o.vehicle || vehicles.empty())
     return fail(o, ExitStatus::NoAnswer,
                 "no pmu-service" + (o.vehicle ? " of " + vehicle_text(*o.vehicle) : std::string()) + domain);
-  }
   return fail(o, ExitStatus::BadUsage,
               "no pmu-service of " + vehicle_text(*o.vehicle) + domain + vehicles_seen_text(vehicles));
 }
