@@ -4,8 +4,6 @@
 
 #include <sstream>
 
-#include "pmu/dds/contract_names.hpp"
-
 namespace pmu::dds {
 namespace {
 
@@ -14,19 +12,6 @@ std::string text_of(const Id& id) {
   std::ostringstream out;
   out << id;
   return out.str();
-}
-
-// The participant's contract property: a number, or nothing (a client, another vendor's
-// participant, a service of a contract before the property existed, or a value that is not one).
-std::optional<int> contract_property(const eprosima::fastrtps::rtps::ParticipantProxyData& data) {
-  for (const auto& p : data.m_properties) {
-    if (p.first() != kContractProperty) continue;
-    const std::string value = p.second();
-    if (value.empty() || value.size() > 4 || value.find_first_not_of("0123456789") != std::string::npos)
-      return std::nullopt;
-    return std::stoi(value);
-  }
-  return std::nullopt;
 }
 
 }  // namespace
@@ -51,7 +36,7 @@ void RemoteWriters::on_participant_discovery(eprosima::fastdds::dds::DomainParti
   switch (info.status) {
     case Status::DISCOVERED_PARTICIPANT:
     case Status::CHANGED_QOS_PARTICIPANT:
-      participants_[prefix] = Participant{info.info.m_participantName.to_string(), contract_property(info.info)};
+      participants_[prefix] = info.info.m_participantName.to_string();
       break;
     case Status::REMOVED_PARTICIPANT:
     case Status::DROPPED_PARTICIPANT:
@@ -63,8 +48,8 @@ void RemoteWriters::on_participant_discovery(eprosima::fastdds::dds::DomainParti
 std::size_t RemoteWriters::participants_without_writer(const std::string& name, const std::string& topic) const {
   std::lock_guard<std::mutex> lock(mutex_);
   std::size_t n = 0;
-  for (const auto& [prefix, participant] : participants_) {
-    if (participant.name != name) continue;
+  for (const auto& [prefix, participant_name] : participants_) {
+    if (participant_name != name) continue;
     bool writes = false;
     for (const auto& [guid, w] : writers_) writes = writes || (w.topic == topic && w.participant == prefix);
     if (!writes) ++n;
@@ -84,11 +69,8 @@ std::optional<std::vector<std::string>> RemoteWriters::partitions_of(
 std::vector<RemoteWriters::Seen> RemoteWriters::writers_of(const std::string& topic) const {
   std::vector<Seen> out;
   std::lock_guard<std::mutex> lock(mutex_);
-  for (const auto& [guid, w] : writers_) {
-    if (w.topic != topic) continue;
-    const auto p = participants_.find(w.participant);
-    out.push_back(Seen{w.partitions, w.type_name, p == participants_.end() ? std::nullopt : p->second.contract});
-  }
+  for (const auto& [guid, w] : writers_)
+    if (w.topic == topic) out.push_back(Seen{w.partitions, w.type_name});
   return out;
 }
 

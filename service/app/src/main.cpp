@@ -119,8 +119,8 @@ int run(const service::Config& cfg, const pmu::dds::ResolvedNetwork& network) {
   if (participant.secure())
     spdlog::info("DDS-Security on: identity {}, permissions {}", cfg.security.files.identity_certificate,
                  cfg.security.files.permissions);
-  service::DdsPublisher publisher(participant, 3 * longest, cfg.vehicle, cfg.low_rate_period,
-                                  canopen ? std::optional<milliseconds>(3 * canopen_longest) : std::nullopt);
+  const auto canopen_deadline = canopen ? std::optional<milliseconds>(3 * canopen_longest) : std::nullopt;
+  service::DdsPublisher publisher(participant, 3 * longest, cfg.vehicle, cfg.low_rate_period, canopen_deadline);
   // also_serve_contract: the previous contract's names on a participant of their own (one
   // participant cannot have two topics of one name), with the same values and commands.
   // Declared after the service's own, so destroyed before it.
@@ -130,9 +130,8 @@ int run(const service::Config& cfg, const pmu::dds::ResolvedNetwork& network) {
     previous_participant = std::make_unique<pmu::dds::DdsContext>(
         cfg.domain, cfg.qos_file, pmu::dds::kServiceParticipantName, cfg.security.files, cfg.dds_transport, network,
         pmu::dds::Partitions{partitions, partitions}, std::vector<std::string>{}, false, *cfg.also_serve_contract);
-    previous_publisher = std::make_unique<service::DdsPublisher>(
-        *previous_participant, 3 * longest, cfg.vehicle, cfg.low_rate_period,
-        canopen ? std::optional<milliseconds>(3 * canopen_longest) : std::nullopt);
+    previous_publisher = std::make_unique<service::DdsPublisher>(*previous_participant, 3 * longest, cfg.vehicle,
+                                                                 cfg.low_rate_period, canopen_deadline);
     spdlog::info("DDS: also serving contract v{} on a second participant (also_serve_contract)",
                  *cfg.also_serve_contract);
   }

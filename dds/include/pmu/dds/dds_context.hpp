@@ -111,7 +111,6 @@ class DdsContext {
 
   eprosima::fastdds::dds::DomainParticipant& participant() { return *participant_; }
   int domain() const noexcept { return domain_; }
-  int contract() const noexcept { return contract_; }
   bool secure() const noexcept { return secure_; }
   // Every remote writer discovery reported since the participant was created, with its
   // partitions (dds_remote_writers.hpp).

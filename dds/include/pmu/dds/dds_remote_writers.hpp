@@ -1,7 +1,6 @@
 #pragma once
 // RemoteWriters: the partitions and type name every remote DataWriter announced in
-// discovery, by the writer's GUID, and the remote participants by name and the contract they
-// announce (contract_names.hpp). DdsContext installs it when it creates the participant, so no writer is
+// discovery, by the writer's GUID, and the remote participants by name. DdsContext installs it when it creates the participant, so no writer is
 // missed: Fast DDS does not replay discovery to a listener set later, and a writer found in
 // the moment between the participant's creation and such a listener would stay unknown.
 // Fast DDS reports a writer (PDP::addWriterProxyData) before it pairs it with local readers,
@@ -30,7 +29,6 @@ class RemoteWriters final : public eprosima::fastdds::dds::DomainParticipantList
   struct Seen {
     std::vector<std::string> partitions;
     std::string type_name;  // as the writer announced it: its contract's name for the type
-    std::optional<int> participant_contract;  // its participant's kContractProperty, if any
   };
   // Every remote writer of `topic` discovery reported, matched or not: a client reading one
   // vehicle still learns which vehicles' services are there, and one of another contract
@@ -52,14 +50,10 @@ class RemoteWriters final : public eprosima::fastdds::dds::DomainParticipantList
     std::string type_name;
     std::string participant;  // its GUID prefix as text
   };
-  struct Participant {
-    std::string name;
-    std::optional<int> contract;
-  };
   // Called from Fast DDS's discovery thread; read from any thread.
   mutable std::mutex mutex_;
   std::map<std::string, Writer> writers_;  // GUID text -> what it announced
-  std::map<std::string, Participant> participants_;  // GUID prefix text -> what it announced
+  std::map<std::string, std::string> participants_;  // GUID prefix text -> participant name
 };
 
 }  // namespace pmu::dds
