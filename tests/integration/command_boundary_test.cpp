@@ -27,6 +27,7 @@
 #include "pmu/idl/commandPubSubTypes.h"
 #include "pmu/idl/guarded_type.hpp"
 #include "pmu/idl/topics.hpp"
+#include "support/answered.hpp"
 #include "support/domain.hpp"
 #include "support/process.hpp"
 #include "support/wait.hpp"
@@ -84,6 +85,15 @@ class Service {
   std::string config_path_, log_path_;
 };
 
+CommandSample command(const std::string& id, CommandKind kind, std::uint16_t address = 1) {
+  CommandSample s;
+  s.request_id = id;
+  s.bus = "sim0";
+  s.address = address;
+  s.kind = wire(kind);
+  return s;
+}
+
 // A peer that writes CommandSamples as they are, booleans and all, and reads every reply.
 class Peer {
  public:
@@ -109,6 +119,12 @@ class Peer {
     ASSERT_TRUE(writer_.write(&r));
   }
   void settle() { writer_.wait_for_acknowledgments(eprosima::fastrtps::Duration_t(10, 0)); }
+  // Matched on both sides: until the service has answered a probe (support/answered.hpp),
+  // whatever its result.
+  bool wait_answered(const std::string& probe_id) {
+    return wait_matched() && pmu::test::until_answered([&] { send(command(probe_id, CommandKind::GetSerial)); },
+                                                       [&] { return !replies(probe_id, 1, 0s).empty(); }, 30s);
+  }
   // Replies received so far (a mark for replies()).
   std::size_t received() {
     (void)replies("", 0, 0s);
@@ -146,15 +162,6 @@ class Peer {
   DataReader& replies_;
   std::vector<pmu::v4::CommandReply> all_, mine_;
 };
-
-CommandSample command(const std::string& id, CommandKind kind, std::uint16_t address = 1) {
-  CommandSample s;
-  s.request_id = id;
-  s.bus = "sim0";
-  s.address = address;
-  s.kind = wire(kind);
-  return s;
-}
 
 CommandSample set(const std::string& id, const char* parameter, double value) {
   auto s = command(id, CommandKind::SetParameter);
@@ -334,7 +341,7 @@ TEST_F(Boundary, DuplicatesAreKnownPerSenderAndAReusedIdIsRejected) {
       << reused.reason().to_string();
   // The same id from another sender: its own command, executed.
   Peer other(domain_, "other-ground-station");
-  ASSERT_TRUE(other.wait_matched());
+  ASSERT_TRUE(other.wait_answered("probe-other"));
   other.send(set("dup-1", "avionics_voltage", 16.5));
   const auto theirs = other.replies("dup-1", 1);
   ASSERT_EQ(theirs.size(), 1u);
@@ -483,7 +490,7 @@ TEST_F(Boundary, ABurstOf2000FromOneWriterIsAnsweredInFull) { burst(service_, {&
 
 TEST_F(Boundary, BurstsOf2000FromFourWritersAtOnceAreAnsweredInFull) {
   Peer b(domain_, "ground-b"), c(domain_, "ground-c"), d(domain_, "ground-d");
-  for (auto* p : {&b, &c, &d}) ASSERT_TRUE(p->wait_matched());
+  for (auto* p : {&b, &c, &d}) ASSERT_TRUE(p->wait_answered("probe"));
   burst(service_, {&peer_, &b, &c, &d}, 2000);
 }
 

@@ -22,6 +22,7 @@
 #include "pmu/idl/telemetry.h"
 #include "pmu/idl/telemetryPubSubTypes.h"
 #include "pmu/idl/topics.hpp"
+#include "support/answered.hpp"
 #include "support/domain.hpp"
 #include "support/in_process_service.hpp"
 #include "support/wait.hpp"
@@ -68,15 +69,41 @@ struct Ground {
     EXPECT_TRUE(writer.write(&c));
     return id;
   }
-  // Replies so far, by request id.
+  // Replies so far, by request id, but those to probes.
   std::vector<pmu::v4::CommandReply> take_replies() {
     std::vector<pmu::v4::CommandReply> out;
     pmu::v4::CommandReply r;
     SampleInfo info;
     while (replies.take_next_sample(&r, &info) == ReturnCode_t::RETCODE_OK)
-      if (info.valid_data) out.push_back(r);
+      if (info.valid_data) {
+        if (r.request_id().to_string().rfind(kProbe, 0) == 0)
+          probes_answered = true;
+        else
+          out.push_back(r);
+      }
     return out;
   }
+  // Until `vehicle`'s service has answered this station (support/answered.hpp says why
+  // matching on this side is not enough); what the probe reads changes nothing.
+  bool answered_by(const std::string& vehicle) {
+    pmu::v4::Command c;
+    c.request_id(std::string(kProbe) + vehicle);
+    c.vehicle(vehicle);
+    c.bus("sim0");
+    c.address(1);
+    c.kind(pmu::v4::GET_SERIAL);
+    std::vector<pmu::v4::CommandReply> others;
+    const bool ok = pmu::test::until_answered([&] { writer.write(&c); },
+                                              [&] {
+                                                for (auto& r : take_replies()) others.push_back(r);
+                                                return probes_answered;
+                                              },
+                                              30s);
+    EXPECT_TRUE(others.empty()) << "replies to more than the probe";
+    return ok;
+  }
+  static constexpr const char* kProbe = "probe-";
+  bool probes_answered = false;
 
   // Replies as soon as at least one came, or none after `timeout`.
   std::vector<pmu::v4::CommandReply> first_replies(std::chrono::seconds timeout) {
@@ -171,6 +198,7 @@ TEST_F(Vehicles, AGroundStationWithDefaultSettingsSeesEveryVehicleAndWhichSample
 TEST_F(Vehicles, ACommandReachesOnlyItsVehicleWhichGivesTheOneReply) {
   Ground g(domain_, "ground-uav1", only("uav1"));
   ready(g, 1);  // its partition holds uav1's command reader alone
+  ASSERT_TRUE(g.answered_by("uav1"));
   const auto before_unnamed = services_[""]->parameter(codec::Parameter::PayloadVoltage);
   const auto before_uav1 = services_["uav1"]->parameter(codec::Parameter::PayloadVoltage);
   const auto before_uav2 = services_["uav2"]->parameter(codec::Parameter::PayloadVoltage);
@@ -192,6 +220,7 @@ TEST_F(Vehicles, ACommandReachesOnlyItsVehicleWhichGivesTheOneReply) {
 TEST_F(Vehicles, TheUnnamedVehicleIsCommandedAsBeforeVehiclesExisted) {
   Ground g(domain_, "ground-unnamed", only(""));
   ready(g, 1);
+  ASSERT_TRUE(g.answered_by(""));
   const auto before = services_[""]->parameter(codec::Parameter::PayloadVoltage);
   g.send("to-unnamed", "", kNewPayloadVoltage);
   auto replies = g.first_replies(20s);

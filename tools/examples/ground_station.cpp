@@ -78,9 +78,18 @@ bool command(Link& l, pmu::v4::CommandKind kind, const char* what, const char* p
   const auto expires = std::chrono::system_clock::now() + 5s;
   c.expires_at(static_cast<unsigned long long>(
       std::chrono::duration_cast<std::chrono::nanoseconds>(expires.time_since_epoch()).count()));
-  l.commands->write(&c);
-  const auto deadline = std::chrono::steady_clock::now() + 6s;
+  // Sent again with the same id while no reply came, once a second: the service answers a
+  // resend and never executes it twice (interface.md 2.4). The first one can go unanswered:
+  // this writer and reader having matched the service's says nothing of whether the service's
+  // reply writer has matched this reader yet, and it sends no reader what it wrote before.
+  const auto resend_until = std::chrono::steady_clock::now() + 5s;  // the request's expiry
+  const auto deadline = resend_until + 1s;
+  auto next_send = std::chrono::steady_clock::now();
   while (std::chrono::steady_clock::now() < deadline) {
+    if (std::chrono::steady_clock::now() >= next_send && std::chrono::steady_clock::now() < resend_until) {
+      l.commands->write(&c);
+      next_send = std::chrono::steady_clock::now() + 1s;
+    }
     pmu::v4::CommandReply r;
     SampleInfo info;
     while (l.replies->take_next_sample(&r, &info) == ReturnCode_t::RETCODE_OK) {
