@@ -140,6 +140,8 @@ TEST(OldContractConsumers, MatchNothingOfAServiceOfV4AloneWhichV4Reads) {
     for (const auto& [topic, n] : run.final["matched"].items()) EXPECT_EQ(n, 0) << topic << ": " << run.out;
     EXPECT_TRUE(run.samples.empty()) << run.out;
     EXPECT_EQ(run.final.value("command_sent", true), false) << run.out;
+    // What a tool of any contract can read without matching: the participant's property.
+    EXPECT_EQ(run.final["service_contracts"], Json::array({"4"})) << run.out;
   }
   EXPECT_TRUE(wait_v4_online(domain).is_object()) << "pmuctl no longer reads the service: " << service.describe();
 }
@@ -172,6 +174,8 @@ TEST(OldContractConsumers, V3ConsumerReadsEveryFieldOfAServiceThatAlsoServesV3) 
   ASSERT_TRUE(run.final.is_object() && after.is_object()) << run.out << "\n" << service.describe();
   for (const char* topic : {"pmu/health", "pmu/config", "pmu/voltages", "pmu/command", "pmu/command_reply"})
     EXPECT_EQ(run.final["matched"].value(topic, -1), 1) << topic << ": the v3 participant's alone; " << run.out;
+  // Two participants named pmu-service, each announcing the contract it serves.
+  EXPECT_EQ(run.final["service_contracts"], Json::array({"3", "4"})) << run.out;
 
   const Json h = run.last("pmu/health");
   ASSERT_TRUE(h.is_object()) << run.out;

@@ -4,11 +4,12 @@
 //
 //   old_consumer_v3 --domain N [--seconds T] [--until decoded|discovered] [--linger S]
 //                   [--command GET_SERIAL|GET [--parameter NAME]] [--bus sim0] [--address 1]
-//     Reads pmu/health, pmu/voltages and pmu/config (and sends one command, waiting for its
+//     Reads pmu/health, pmu/voltages and pmu/config (and, once a probe is answered, sends one command, waiting for its
 //     replies on pmu/command_reply); one JSON line per decoded sample, with every field, then
 //     {"final":true,...}: the remote endpoints each endpoint matched and the type names of
 //     those discovery reported per topic (whatever their type, so "matched none" can be told
-//     from "not discovered yet"). Stops at T, or once the --until condition holds plus S seconds
+//     from "not discovered yet"), and the `pmu-dds.contract` property of every participant
+//     named pmu-service. Stops at T, or once the --until condition holds plus S seconds
 //     (to see a late match or a duplicate reply).
 //   old_consumer_v3 --domain N --serve-health [--vehicle NAME] [--seconds T]
 //     A stand-in for a vN pmu-service: participant "pmu-service", pmu/health of one ONLINE PMU
@@ -147,9 +148,25 @@ class Discovery : public DomainParticipantListener {
     if (info.status == eprosima::fastrtps::rtps::ReaderDiscoveryInfo::DISCOVERED_READER)
       add("reader:" + info.info.topicName().to_string(), info.info.typeName().to_string());
   }
+  // The participant property a pmu-service announces its contract in: what a tool of any
+  // contract can read before it matches anything (the participant's own announcement).
+  void on_participant_discovery(DomainParticipant*, eprosima::fastrtps::rtps::ParticipantDiscoveryInfo&& info) override {
+    if (info.status != eprosima::fastrtps::rtps::ParticipantDiscoveryInfo::DISCOVERED_PARTICIPANT ||
+        info.info.m_participantName.to_string() != "pmu-service")
+      return;
+    std::string contract = "(none)";
+    for (const auto& property : info.info.m_properties)
+      if (property.first() == "pmu-dds.contract") contract = property.second();
+    std::lock_guard<std::mutex> lock(mutex_);
+    service_contracts_.insert(contract);
+  }
   std::map<std::string, std::set<std::string>> types() const {
     std::lock_guard<std::mutex> lock(mutex_);
     return types_;
+  }
+  std::set<std::string> service_contracts() const {
+    std::lock_guard<std::mutex> lock(mutex_);
+    return service_contracts_;
   }
 
  private:
@@ -159,6 +176,7 @@ class Discovery : public DomainParticipantListener {
   }
   mutable std::mutex mutex_;
   std::map<std::string, std::set<std::string>> types_;
+  std::set<std::string> service_contracts_;  // pmu-dds.contract of each pmu-service participant
 };
 
 struct Options {
@@ -236,6 +254,13 @@ int consume(DomainParticipant* p, const Options& o, const Discovery& discovery) 
   const std::string request_id = "old-consumer-v" + std::to_string(PMU_OLD_CONTRACT) + "-" + std::to_string(getpid());
   bool sent = false;
   int replies = 0;  // final replies to our request
+  // A probe, resent once a second until answered, before the request: the service's reply
+  // writer may not have matched this reader yet when this side has matched it, and it would
+  // not send what it wrote before (interface.md 2.4). After an answer, the request is sent
+  // once and its replies are counted exactly.
+  const std::string probe_id = request_id + "-probe";
+  bool probe_answered = false;
+  auto next_probe = Clock::now();
   std::map<std::string, int> samples;
   const auto end = Clock::now() + std::chrono::duration<double>(o.seconds);
   auto stop_at = end;
@@ -247,17 +272,25 @@ int consume(DomainParticipant* p, const Options& o, const Discovery& discovery) 
       pmu::CommandReply r;
       SampleInfo info;
       while (readers["pmu/command_reply"]->take_next_sample(&r, &info) == ReturnCode_t::RETCODE_OK) {
+        if (info.valid_data && r.request_id().to_string() == probe_id) probe_answered = true;
         if (!info.valid_data || r.request_id().to_string() != request_id) continue;
         print(to_json(r));
         if (r.result() != pmu::IN_PROGRESS) ++replies;
       }
-      // Sent once both of the service's command endpoints are matched: a reliable volatile
-      // writer drops what it wrote before the reader matched.
       PublicationMatchedStatus pm;
       SubscriptionMatchedStatus sm;
       commands->get_publication_matched_status(pm);
       readers["pmu/command_reply"]->get_subscription_matched_status(sm);
-      if (!sent && pm.current_count > 0 && sm.current_count > 0) {
+      if (!probe_answered && pm.current_count > 0 && sm.current_count > 0 && Clock::now() >= next_probe) {
+        pmu::Command probe;
+        probe.request_id(probe_id);
+        probe.bus(o.bus);
+        probe.address(o.address);
+        probe.kind(pmu::GET_SERIAL);
+        (void)commands->write(&probe);
+        next_probe = Clock::now() + std::chrono::seconds(1);
+      }
+      if (!sent && probe_answered) {
         pmu::Command c;
         c.request_id(request_id);
         c.bus(o.bus);
@@ -296,7 +329,7 @@ int consume(DomainParticipant* p, const Options& o, const Discovery& discovery) 
   }
   for (const auto& [name, types] : discovery.types()) discovered[name] = types;
   print({{"final", true}, {"contract", PMU_OLD_CONTRACT}, {"matched", matched}, {"discovered", discovered},
-         {"samples", samples}, {"command_sent", sent}, {"replies", replies}, {"request_id", request_id}});
+         {"service_contracts", discovery.service_contracts()}, {"samples", samples}, {"command_sent", sent}, {"replies", replies}, {"request_id", request_id}});
   return 0;
 }
 
