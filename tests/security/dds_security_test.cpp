@@ -50,6 +50,7 @@
 #include "pmu/session/bus_worker.hpp"
 #include "pmu/sim/bus_runner.hpp"
 #include "pmu/transport/sim_bus.hpp"
+#include "support/answered.hpp"
 #include "support/in_process_service.hpp"
 #include "support/process.hpp"
 #include "support/wait.hpp"
@@ -174,6 +175,16 @@ std::optional<pmu::v4::CommandReply> wait_reply(DataReader& r, const std::string
   return found;
 }
 
+// Sends `c`, and again with the same id once a second while no final reply came, as pmuctl
+// does (support/answered.hpp says why this side's match is not enough): its final reply.
+std::optional<pmu::v4::CommandReply> send_until_answered(Client& gs, pmu::v4::Command c, std::chrono::seconds within) {
+  std::optional<pmu::v4::CommandReply> reply;
+  const std::string id = c.request_id().to_string();
+  (void)pmu::test::until_answered([&] { EXPECT_TRUE(gs.commands().write(&c)); },
+                                  [&] { return (reply = wait_reply(gs.replies(), id, 0ms)).has_value(); }, within);
+  return reply;
+}
+
 // Like pmuctl: wait until the service's command reader and reply writer are matched.
 bool wait_command_link(Client& gs, std::chrono::milliseconds timeout) {
   return pmu::test::wait_until(
@@ -201,9 +212,7 @@ void expect_ground_station_commands(ServiceUnderTest& svc, Client& gs, const std
   // and still after 30 s in every such run, so a longer bound would not help.
   ASSERT_TRUE(linked) << "the ground station's command writer and reply reader never matched (writer matched "
                       << writer.current_count << " readers, reply reader " << reader.current_count << " writers)";
-  pmu::v4::Command c = command(id, "sim0", vehicle);
-  ASSERT_EQ(gs.commands().write(&c), true);
-  const auto reply = wait_reply(gs.replies(), id, 10s);
+  const auto reply = send_until_answered(gs, command(id, "sim0", vehicle), 10s);
   ASSERT_TRUE(reply.has_value()) << "no reply to " << id;
   EXPECT_EQ(reply->result(), pmu::v4::COMPLETED) << reply->reason();
   EXPECT_EQ(svc.outputs() & kPayload, 0) << "the payload output is still on";
@@ -553,9 +562,7 @@ WireResult run_on_the_wire(const SecurityFiles& service_files, const SecurityFil
     Client gs(domain, gs_files, "ground-station");
     EXPECT_TRUE(wait_sample<pmu::v4::Voltages>(gs.voltages(), 20s));
     EXPECT_TRUE(wait_command_link(gs, 10s));
-    pmu::v4::Command c = command(marker, bus_marker);
-    EXPECT_TRUE(gs.commands().write(&c));
-    const auto reply = wait_reply(gs.replies(), marker, 10s);
+    const auto reply = send_until_answered(gs, command(marker, bus_marker), 10s);
     EXPECT_TRUE(reply.has_value() && reply->result() == pmu::v4::COMPLETED) << "the command did not complete";
     // Meant to let time pass: a second more of telemetry on the wire. With security the
     // marker must NOT show up, so there is no condition to wait for.
