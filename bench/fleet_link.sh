@@ -3,7 +3,8 @@
 # ground station still sees and commands them all.
 #
 #   bench/fleet_link.sh [--aircraft "1 4 8"] [--rate 250kbit] [--build-dir DIR] [--qos FILE]
-#                       [--pmuctl BIN] [--discovery-server] [--json FILE]
+#                       [--pmuctl BIN] [--service BIN] [--discovery-server [--server-xml FILE|none]]
+#                       [--json FILE]
 #
 # Two network namespaces joined by one veth pair, shaped by tbf to RATE each way (a radio
 # modem's queue of about 2 s; no delay or loss: the VM lab adds those): in `air`, N pmu-service
@@ -14,9 +15,10 @@
 #   command  one `pmuctl --vehicle uavN config set payload_voltage 13.0`: bytes, seconds, result
 #   low      10 s of `pmuctl watch --low-rate` (started 15 s before): the steady cost of watching
 # Bytes are the ground interface's received + sent IP bytes; drops are the tbf queues'.
-# --qos and --pmuctl measure another qos.xml or pmuctl against the same services (a before
-# and after in one run). --discovery-server: Fast DDS's Discovery Server (fast-discovery-server)
-# runs on the ground host, and the services and pmuctl are its clients. Needs root (ip netns); exit status 77 when namespaces cannot be made.
+# --qos, --pmuctl and --service measure another qos.xml, pmuctl or pmu-service (a before and
+# after, one run each). --discovery-server: Fast DDS's Discovery Server (fast-discovery-server)
+# runs on the ground host with the shipped deploy/discovery-server.xml (--server-xml: another
+# file, or none for the program's own defaults), and the services and pmuctl are its clients. Needs root (ip netns); exit status 77 when namespaces cannot be made.
 set -euo pipefail
 
 root=$(cd "$(dirname "$0")/.." && pwd)
@@ -27,6 +29,8 @@ qos="$root/deploy/qos.xml"
 ctl=""
 json_out=""
 ds=0
+svc=""
+server_xml="$root/deploy/discovery-server.xml"
 while [ $# -gt 0 ]; do
   case "$1" in
     --aircraft) aircraft=$2; shift 2 ;;
@@ -35,12 +39,14 @@ while [ $# -gt 0 ]; do
     --qos) qos=$(realpath "$2"); shift 2 ;;
     --pmuctl) ctl=$(realpath "$2"); shift 2 ;;
     --json) json_out=$2; shift 2 ;;
+    --service) svc=$(realpath "$2"); shift 2 ;;
     --discovery-server) ds=1; shift ;;
+    --server-xml) server_xml=$2; [ "$2" = none ] || server_xml=$(realpath "$2"); shift 2 ;;
     -h|--help) sed -n '2,21p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
     *) echo "fleet_link.sh: unknown argument '$1'" >&2; exit 2 ;;
   esac
 done
-svc=$(find "$build_dir" -type f -name pmu-service -perm -u+x | head -n1)
+[ -n "$svc" ] || svc=$(find "$build_dir" -type f -name pmu-service -perm -u+x | head -n1)
 [ -n "$ctl" ] || ctl=$(find "$build_dir" -type f -name pmuctl -perm -u+x | head -n1)
 [ -x "$svc" ] && [ -x "$ctl" ] || { echo "fleet_link.sh: build pmu-service and pmuctl in $build_dir first" >&2; exit 2; }
 [ -r "$qos" ] || { echo "fleet_link.sh: cannot read $qos" >&2; exit 2; }
@@ -98,7 +104,9 @@ for n in $aircraft; do
   ds_yaml=""
   if [ "$ds" = 1 ]; then
     command -v fast-discovery-server >/dev/null || { echo "fleet_link.sh: fast-discovery-server not found (fastdds-tools)" >&2; exit 2; }
-    ip netns exec "$gnd" fast-discovery-server -i 0 -l 10.79.0.2 -p 11811 >"$work/server.log" 2>&1 &
+    xml_option=()
+    [ "$server_xml" = none ] || xml_option=(-x "$server_xml")
+    ip netns exec "$gnd" fast-discovery-server -i 0 -l 10.79.0.2 -p 11811 "${xml_option[@]}" >"$work/server.log" 2>&1 &
     ds_yaml="discovery: {mode: server, servers: [10.79.0.2]}"
   fi
   for i in $(seq 1 "$n"); do
@@ -151,13 +159,13 @@ EOF
   wait 2>/dev/null || true
 done
 
-ROWS=$(printf '%s\n' "${rows[@]}") python3 - "$rate" "$json_out" "$qos" "$ctl" "$ds" <<'PY'
+ROWS=$(printf '%s\n' "${rows[@]}") python3 - "$rate" "$json_out" "$qos" "$ctl" "$ds" "$svc" "$server_xml" <<'PY'
 import json, os, re, sys
-rate, json_out, qos, ctl, ds = sys.argv[1:6]
+rate, json_out, qos, ctl, ds, svc, server_xml = sys.argv[1:8]
 m = re.match(r"(\d+)kbit", rate)
 cap = int(m.group(1)) * 1000 / 8 if m else None
 out = []
-print(f"fleet over a {rate} link (tbf each way){', Discovery Server on the ground' if ds == '1' else ''}; qos {qos}; pmuctl {ctl}")
+print(f"fleet over a {rate} link (tbf each way){', Discovery Server on the ground (' + server_xml + ')' if ds == '1' else ''}; qos {qos}; pmuctl {ctl}; pmu-service {svc}")
 print("| aircraft | idle B/s | list: bytes, s, listed | command: bytes, s, result | watch --low-rate B/s (samples/s) | low-rate watch / one way's capacity | queue drops |")
 print("|---|---|---|---|---|---|---|")
 for line in os.environ["ROWS"].splitlines():
@@ -172,5 +180,6 @@ for line in os.environ["ROWS"].splitlines():
                     low_rate_bytes_per_s=low, low_rate_samples_per_s=low_samples, drops=drops))
 if json_out:
     with open(json_out, "w") as fh:
-        json.dump({"rate": rate, "qos": qos, "pmuctl": ctl, "discovery_server": ds == "1", "rows": out}, fh, indent=1)
+        json.dump({"rate": rate, "qos": qos, "pmuctl": ctl, "pmu_service": svc, "discovery_server": ds == "1",
+                   "server_xml": server_xml if ds == "1" else None, "rows": out}, fh, indent=1)
 PY

@@ -25,6 +25,8 @@
 #                                                    (runs Debian's fast-discovery-server)
 #   /etc/pmu-dds/discovery-server.env                its id and address, only if absent; the
 #   /etc/pmu-dds/discovery-server.env.example          example itself is always refreshed
+#   /etc/pmu-dds/discovery-server.xml                its announcement period and lease, only
+#   /etc/pmu-dds/discovery-server.xml.example          if absent; the example always refreshed
 #   /etc/systemd/network/80-can0.network             CAN link setup, only if absent
 #   PREFIX/share/doc/pmu-dds/README.md               deploy/README.md
 #   PREFIX/share/doc/pmu-dds/security.md             deploy/security/README.md
@@ -87,7 +89,7 @@ pmuctl_bin=$(find_binary pmuctl tools) || pmuctl_bin=
 sim_bin=$(find_binary pmu-sim tools) || sim_bin=
 
 for f in qos.xml pmu-service.yaml systemd/pmu-service.service systemd/80-can0.network README.md \
-         security/make_pki.sh security/README.md systemd/pmu-discovery-server.service discovery-server.env; do
+         security/make_pki.sh security/README.md systemd/pmu-discovery-server.service discovery-server.env discovery-server.xml; do
   [ -f "$script_dir/$f" ] || die "missing deploy/$f in $script_dir"
 done
 
@@ -188,6 +190,8 @@ put 0644 "$ds_unit_src" "$unitdir/pmu-discovery-server.service" "$script_dir/sys
 if [ "$last_changed" -eq 1 ]; then unit_changed=1; fi
 put_keep 0644 "$script_dir/discovery-server.env" "$confdir/discovery-server.env"
 put 0644 "$script_dir/discovery-server.env" "$confdir/discovery-server.env.example"
+put_keep 0644 "$script_dir/discovery-server.xml" "$confdir/discovery-server.xml"
+put 0644 "$script_dir/discovery-server.xml" "$confdir/discovery-server.xml.example"
 put_keep 0644 "$script_dir/systemd/80-can0.network" "$networkdir/80-can0.network"
 put 0644 "$script_dir/README.md" "$docdir/README.md"
 

@@ -15,7 +15,8 @@
 #      /usr/bin/pmu-service is not installed here) and its offline security exposure is
 #      at most 1.5 (measured 1.3 with systemd 252), when systemd-analyze exists; the same
 #      for pmu-discovery-server.service (measured 1.1), whose ExecStart= uses exactly the
-#      variables discovery-server.env sets, and whose program takes those arguments.
+#      variables discovery-server.env sets, and whose program takes those arguments and
+#      discovery-server.xml (a SERVER on the command line's address and port).
 # Exits non-zero on the first failure.
 
 set -euo pipefail
@@ -38,7 +39,7 @@ fail() { echo "FAIL: $*" >&2; exit 1; }
 
 [ -x "$service_bin" ] || fail "$service_bin is not an executable"
 for f in pmu-service.yaml qos.xml install.sh README.md systemd/pmu-service.service systemd/80-can0.network \
-         systemd/pmu-discovery-server.service discovery-server.env; do
+         systemd/pmu-discovery-server.service discovery-server.env discovery-server.xml; do
   [ -f "$deploy/$f" ] || fail "deploy/$f is missing"
 done
 [ -x "$install_sh" ] || fail "deploy/install.sh is not executable"
@@ -155,7 +156,11 @@ expect 644 /etc/pmu-dds/discovery-server.env
 expect 644 /etc/pmu-dds/discovery-server.env.example
 cmp -s "$deploy/discovery-server.env" "$dest/etc/pmu-dds/discovery-server.env" ||
   fail "installed discovery-server.env differs from deploy/discovery-server.env"
-grep -qx "ExecStart=/usr/bin/fast-discovery-server -i \${PMU_DISCOVERY_SERVER_ID} -l \${PMU_DISCOVERY_SERVER_ADDRESS} -p \${PMU_DISCOVERY_SERVER_PORT}" \
+expect 644 /etc/pmu-dds/discovery-server.xml
+expect 644 /etc/pmu-dds/discovery-server.xml.example
+cmp -s "$deploy/discovery-server.xml" "$dest/etc/pmu-dds/discovery-server.xml" ||
+  fail "installed discovery-server.xml differs from deploy/discovery-server.xml"
+grep -qx "ExecStart=/usr/bin/fast-discovery-server -i \${PMU_DISCOVERY_SERVER_ID} -l \${PMU_DISCOVERY_SERVER_ADDRESS} -p \${PMU_DISCOVERY_SERVER_PORT} -x /etc/pmu-dds/discovery-server.xml" \
   "$dest/usr/lib/systemd/system/pmu-discovery-server.service" || fail "installed discovery server unit has an unexpected ExecStart="
 expect 644 /etc/systemd/network/80-can0.network
 expect 644 /usr/share/doc/pmu-dds/README.md
@@ -246,13 +251,18 @@ if [ -x /usr/bin/fast-discovery-server ]; then
   # SIGINT is how the unit stops it (KillSignal=).
   ( set -a; . "$deploy/discovery-server.env"; set +a
     port=$(python3 -c 'import socket; s=socket.socket(socket.AF_INET, socket.SOCK_DGRAM); s.bind(("127.0.0.1", 0)); print(s.getsockname()[1])')
-    /usr/bin/fast-discovery-server -i "$PMU_DISCOVERY_SERVER_ID" -l 127.0.0.1 -p "$port" > "$work/ds.out" 2>&1 &
+    /usr/bin/fast-discovery-server -i "$PMU_DISCOVERY_SERVER_ID" -l 127.0.0.1 -p "$port" -x "$deploy/discovery-server.xml" \
+      > "$work/ds.out" 2>&1 &
     pid=$!
     for _ in $(seq 100); do grep -q "Server is running" "$work/ds.out" && break; sleep 0.1; done
     kill -INT "$pid"; wait "$pid" || true
     grep -q "Server is running" "$work/ds.out" || fail "fast-discovery-server did not start with the shipped id: $(cat "$work/ds.out")"
     grep -q "Server shut down" "$work/ds.out" || fail "fast-discovery-server did not stop cleanly on SIGINT: $(cat "$work/ds.out")"
-    grep -q "Server ID: *$PMU_DISCOVERY_SERVER_ID\$" "$work/ds.out" || fail "unexpected server id: $(cat "$work/ds.out")" )
+    grep -q "Server ID: *$PMU_DISCOVERY_SERVER_ID\$" "$work/ds.out" || fail "unexpected server id: $(cat "$work/ds.out")"
+    # With -x the protocol comes from the file alone: a file without SERVER makes a client.
+    grep -q "Participant Type: *SERVER\$" "$work/ds.out" || fail "discovery-server.xml does not make a SERVER: $(cat "$work/ds.out")"
+    grep -q "Server Addresses: *UDPv4:\[127.0.0.1\]:$port\$" "$work/ds.out" ||
+      fail "the command line's address and port did not take precedence over the XML: $(cat "$work/ds.out")" )
   cat "$work/ds.out"
 else
   echo "--- skipped running fast-discovery-server: not installed (fastdds-tools)"

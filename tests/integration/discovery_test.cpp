@@ -158,10 +158,12 @@ TEST(UnicastDiscovery, WithoutAPeerAtTheirPortsTheyFindNobody) {
 
 // `fastdds discovery -i ID -l 127.0.0.1 -p PORT` runs this program: the fastdds command is a
 // Python wrapper that starts it as a child, so a signal to the wrapper would leave the
-// server running. Stopped with SIGINT, its clean shutdown (SIGTERM would kill it).
+// server running. Stopped with SIGINT, its clean shutdown (SIGTERM would kill it). With the
+// shipped settings (deploy/discovery-server.xml), as pmu-discovery-server.service runs it.
 struct Server {
   Server(int id, std::uint16_t port)
-      : child({kDiscoveryServer, "-i", std::to_string(id), "-l", "127.0.0.1", "-p", std::to_string(port)},
+      : child({kDiscoveryServer, "-i", std::to_string(id), "-l", "127.0.0.1", "-p", std::to_string(port), "-x",
+               PMU_DISCOVERY_SERVER_XML},
               options()) {}
   ~Server() {
     child.signal(SIGINT);

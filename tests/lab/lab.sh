@@ -636,12 +636,14 @@ discovery:
   ground_served "unicast peers"
 }
 
-# The Discovery Server in mc2 (fast-discovery-server, fastdds-tools), multicast stopped:
-# the service in mc1 and pmuctl in gnd are its clients and find each other through it.
+# The Discovery Server in mc2 (fast-discovery-server, fastdds-tools, with the shipped
+# deploy/discovery-server.xml as its unit runs it), multicast stopped: the service in mc1 and
+# pmuctl in gnd are its clients and find each other through it.
 DS_PORT=11811
 scenario_discovery_server() {
   multicast_flood off || fail "cannot stop multicast flooding on the bridge"
-  $NETNS_EXEC mc2 fast-discovery-server -i 0 -l "$(addr_of mc2)" -p "$DS_PORT" >"$WORK/$SCEN.ds.log" 2>&1 &
+  $NETNS_EXEC mc2 fast-discovery-server -i 0 -l "$(addr_of mc2)" -p "$DS_PORT" -x /etc/pmu-dds/discovery-server.xml \
+    >"$WORK/$SCEN.ds.log" 2>&1 &
   track $!
   start_service mc1 "vehicle: uav1
 discovery:

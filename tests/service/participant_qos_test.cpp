@@ -21,6 +21,7 @@ namespace {
 using eprosima::fastdds::dds::DomainParticipantQos;
 using eprosima::fastdds::rtps::SharedMemTransportDescriptor;
 using eprosima::fastdds::rtps::UDPv4TransportDescriptor;
+using eprosima::fastrtps::Duration_t;
 using eprosima::fastrtps::rtps::DiscoveryProtocol_t;
 using eprosima::fastrtps::rtps::IPLocator;
 using eprosima::fastrtps::rtps::Locator_t;
@@ -118,6 +119,25 @@ TEST(ParticipantQos, ServerModeIsAClientOfEachServerByPositionWithFastddsDiscove
   EXPECT_TRUE(b.metatrafficMulticastLocatorList.empty());
   EXPECT_EQ(texts(b.metatrafficUnicastLocatorList), (std::vector<std::string>{"0.0.0.0:0"}));
   EXPECT_TRUE(b.initialPeersList.empty());
+}
+
+// A client's announcements cross the radio link to the server: three per lease, not
+// Fast DDS's every 3 s; the other modes keep Fast DDS's periods (a multicast participant that
+// announced less often would be found later after a lost first announcement).
+TEST(ParticipantQos, AServerClientAnnouncesThreeTimesPerLeaseAndTheOtherModesKeepFastDdsPeriods) {
+  const auto client = participant_qos("x", Transport::Default, server({{{{"10.0.0.1", 11811}}}}), {});
+  const auto& c = client.wire_protocol().builtin.discovery_config;
+  EXPECT_EQ(c.leaseDuration, (Duration_t{20, 0}));
+  EXPECT_EQ(c.leaseDuration_announcementperiod, (Duration_t{6, 666666667}));
+  const DomainParticipantQos fastdds;
+  for (const auto& q : {participant_qos("x", Transport::Default, ResolvedNetwork{}, {}),
+                        participant_qos("x", Transport::Default, unicast({{"127.0.0.1", 0}}), {})}) {
+    const auto& d = q.wire_protocol().builtin.discovery_config;
+    EXPECT_EQ(d.leaseDuration, fastdds.wire_protocol().builtin.discovery_config.leaseDuration);
+    EXPECT_EQ(d.leaseDuration_announcementperiod,
+              fastdds.wire_protocol().builtin.discovery_config.leaseDuration_announcementperiod);
+  }
+  EXPECT_EQ(fastdds.wire_protocol().builtin.discovery_config.leaseDuration_announcementperiod, (Duration_t{3, 0}));
 }
 
 TEST(ParticipantQos, AllowlistReplacesTheBuiltinTransportsSoNoneBypassesIt) {

@@ -334,6 +334,7 @@ for t in "${can_utils[@]}"; do copy_with_libs "$t" "usr/bin/$(basename "$t")"; d
 copy_with_libs "$ip_bin" usr/sbin/ip   # the real ip: busybox's cannot `type vcan`
 rm -f "$root/bin/ip"
 cp "$qos_file" "$root/etc/pmu-dds/qos.xml"
+cp "$source_dir/deploy/discovery-server.xml" "$root/etc/pmu-dds/discovery-server.xml"
 while read -r m; do cp "$kernel_dir/modules/$m.ko" "$root/lib/modules/"; done <"$work/load-order"
 cp "$work/load-order" "$root/lib/modules/load-order"
 cp "$suite_script" "$root/$(basename "$suite_script")"

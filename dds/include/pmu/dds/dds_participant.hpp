@@ -15,7 +15,9 @@
 //              listens on the well-known unicast port of each (allowed) interface.
 //   server:    discovery protocol CLIENT; m_DiscoveryServers = the servers, server i with
 //              the GUID prefix of `fastdds discovery -i i` (44.53.<i>.5f.45.50.52.4f.53.49.4d.41)
-//              and its locators; metatraffic as in unicast (no multicast).
+//              and its locators; metatraffic as in unicast (no multicast); its lease
+//              kClientLease, announced every kClientAnnouncementPeriod (the servers'
+//              own periods are deploy/discovery-server.xml's).
 // Interfaces (allowlist): the UDPv4 transport's interfaceWhiteList = the addresses
 // (127.0.0.1 always among them, see resolve_network), and the builtin transports are
 // replaced by explicit ones (use_builtin_transports = false): left on, Fast DDS would add
@@ -40,6 +42,11 @@
 #include "pmu/security/security_files.hpp"
 
 namespace pmu::dds {
+
+// A Discovery Server client's lease and how often it announces itself to its servers: three
+// announcements per lease, Fast DDS's lease of 20 s (its default announces every 3 s).
+inline const eprosima::fastrtps::Duration_t kClientLease{20, 0};
+inline const eprosima::fastrtps::Duration_t kClientAnnouncementPeriod{6, 666666667};
 
 eprosima::fastdds::dds::DomainParticipantQos participant_qos(const std::string& name, Transport transport,
                                                              const ResolvedNetwork& network,
