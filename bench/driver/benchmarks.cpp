@@ -254,6 +254,23 @@ void realistic_phase(const Settings& s, Rows& rows, WriteTimes& times, int domai
   latency_rows(rows, "CAN->DDS latency, one PMU at 5 packets every 0.1 s", "SHM", st, ref, hop);
 }
 
+// Which step of a start-up did not come within its 20 s, with what the reader saw and the
+// service's log, so that a failed run names its cause.
+std::string startup_failure(ServiceRun& svc, VoltagesProbe& probe, const std::optional<std::int64_t>& ready,
+                            const std::string& name) {
+  std::string what = "start-up over " + name + ": ";
+  if (!ready) {
+    what += "no READY=1 from pmu-service within 20 s";
+  } else {
+    const auto after = std::chrono::duration_cast<std::chrono::milliseconds>(
+        std::chrono::nanoseconds(*ready) - svc.spawned_at().time_since_epoch());
+    what += "READY=1 after " + std::to_string(after.count()) + " ms, but no sample of an injected frame reached the " +
+            "reader within 20 s (reader matched a writer: " + (probe.wait_matched(std::chrono::milliseconds(0)) ? "yes" : "no") +
+            "; samples received since it was created: " + std::to_string(probe.received()) + ")";
+  }
+  return what + "; the service's log: " + svc.log_tail();
+}
+
 // Start-up: exec -> READY=1 on the notify socket, and exec -> the first pmu/voltages sample
 // at a reader that was running before, each the median of d.startups starts over `t`.
 void startup_rows(const Settings& s, const Durations& d, Rows& rows, dds::Transport t, const std::string& name,
@@ -277,7 +294,7 @@ void startup_rows(const Settings& s, const Durations& d, Rows& rows, dds::Transp
     while (probe.first_sample_ns() == 0 && steady_ns() < until) sleep_s(0.0005);
     got = true;
     feeder.join();
-    if (!ready || probe.first_sample_ns() == 0) throw std::runtime_error("pmu-service did not start within 20 s");
+    if (!ready || probe.first_sample_ns() == 0) throw std::runtime_error(startup_failure(*svc, probe, ready, name));
     const auto spawned = std::chrono::duration_cast<std::chrono::nanoseconds>(svc->spawned_at().time_since_epoch()).count();
     ready_ms.push_back(static_cast<double>(*ready - spawned) / 1e6);
     first_ms.push_back(static_cast<double>(probe.first_sample_ns() - spawned) / 1e6);

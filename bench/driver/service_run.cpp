@@ -91,4 +91,6 @@ void ServiceRun::check_alive() {
     throw std::runtime_error("pmu-service exited (" + log_ + "): " + tail(log_));
 }
 
+std::string ServiceRun::log_tail() const { return log_ + ": " + tail(log_, 20); }
+
 }  // namespace pmu::bench

@@ -47,6 +47,8 @@ class ServiceRun {
   std::optional<std::int64_t> wait_ready(std::chrono::milliseconds timeout);
   // Throws with the service log's tail when the service has exited.
   void check_alive();
+  // The last lines of the service's log (its stdout and stderr).
+  std::string log_tail() const;
   int stop() { return process_->stop(); }
 
  private:
