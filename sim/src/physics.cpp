@@ -69,9 +69,11 @@ codec::Currents currents(const Plant& p, const Operating& op) noexcept {
 }
 
 std::uint16_t generator_rpm(const Plant& p, const Operating& op) noexcept {
-  // Chosen: the starter turns the generator while cranking, whatever the generation state.
+  // Chosen: the generator is on the engine's shaft, so it turns (and its speed is measured)
+  // whenever the engine does, cranked or running, whether or not it is generating; the
+  // service tells a started engine from a failed start by this speed alone.
   if (op.engine == EngineState::Cranking) return p.cranking_rpm;
-  return op.engine == EngineState::Running && op.generation_on ? p.engine_rpm : 0;
+  return op.engine == EngineState::Running ? p.engine_rpm : 0;
 }
 
 codec::Voltages clamped(const codec::Voltages& v) noexcept { return codec::clamped_to_fields(v); }

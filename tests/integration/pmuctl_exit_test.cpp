@@ -78,6 +78,8 @@ const Case kDemo[] = {
     // PMU commands consider the PMU alone: the battery and MPPTs share its bus and addresses.
     {"--timeout 10 engine stop", 0, "COMPLETED"},
     {"--timeout 10 outputs get", 0, "COMPLETED"},
+    // The demo's engine runs: a start is refused from the generator speed, not "sent".
+    {"--timeout 10 --confirm engine start", 1, "DENIED: engine already running: 6000 rpm"},
     {"--timeout 10 --address 65535 engine stop", 0, "stop sent to every PMU (broadcast) on sim0"},
     {"--timeout 10 --bus sim0 --address 65535 engine stop", 0, "stop sent to every PMU (broadcast)"},
     {"--timeout 10 config set avionics_voltage 99", 1, "REJECTED"},

@@ -158,19 +158,6 @@ TEST(Commands, EveryKindPutsTheSpecsFramesOnTheBusAndTheResultShowsUp) {
        },
        {pmu_frame(0x0F, 1, {0x08})},
        [](Commands& c, const CommandReplyData&) { EXPECT_GE(c.h.sink.count(codec::PacketId::Temperatures, 1), 1u); }},
-      {"engine start (confirmed)",
-       [](Commands& c) {
-         c.h.pmus().with_model(1, [&](sim::PmuModel& m) { m.set_engine_running(false, c.h.clock().steady_now()); });
-         auto r = c.req(CommandKind::EngineStart);
-         r.confirm = true;
-         return r;
-       },
-       {pmu_frame(0x24, 1, {})},
-       [](Commands& c, const CommandReplyData&) {
-         sim::EngineState e{};
-         c.h.pmus().with_model(1, [&](sim::PmuModel& m) { e = m.engine_state(); });
-         EXPECT_NE(e, sim::EngineState::Stopped);
-       }},
       {"engine stop", [](Commands& c) { return c.req(CommandKind::EngineStop); }, {pmu_frame(0x25, 1, {})}, nullptr},
       {"get avionics_voltage",
        [](Commands& c) {

@@ -26,6 +26,8 @@ buses:
         mode: polling
         period: 0.2
         packets: [voltages, status]
+        engine_running_rpm: 2200
+        engine_running_hold: 0.5
     discover: true
 )";
 
@@ -43,6 +45,10 @@ TEST(Config, GoodFileParses) {
   EXPECT_TRUE(b.discover);
   ASSERT_EQ(b.devices.size(), 2u);
   EXPECT_EQ(b.devices[0].mode, TelemetryMode::Streaming);
+  EXPECT_EQ(b.devices[0].engine.running_rpm, 1500) << "the default";
+  EXPECT_EQ(b.devices[0].engine.running_hold, std::chrono::milliseconds(1000));
+  EXPECT_EQ(b.devices[1].engine.running_rpm, 2200);
+  EXPECT_EQ(b.devices[1].engine.running_hold, std::chrono::milliseconds(500));
   EXPECT_EQ(b.devices[1].mode, TelemetryMode::Polling);
   EXPECT_EQ(b.devices[1].period, std::chrono::milliseconds(200));
   EXPECT_EQ(b.devices[1].groups, 0x11);
@@ -149,7 +155,15 @@ const BadCase kBad[] = {
     {"canopen_publish_period: -0.1\nbuses:\n  - interface: can0\n    discover: true\n",
      "bad.yaml:1: canopen_publish_period -0.1 out of range 0..3600"},
     {"buses:\n  - interface: can0\n    devices:\n      - adress: 1\n",
-     "bad.yaml:4: unknown key 'adress' in device (known: address, mode, period, packets, configure_streaming)"},
+     "bad.yaml:4: unknown key 'adress' in device (known: address, mode, period, packets, configure_streaming, engine_running_rpm, engine_running_hold)"},
+    {"buses:\n  - interface: can0\n    devices:\n      - address: 1\n        engine_running_rpm: 0\n",
+     "bad.yaml:5: engine_running_rpm 0 out of range 1..65534"},
+    {"buses:\n  - interface: can0\n    devices:\n      - address: 1\n        engine_running_rpm: 65535\n",
+     "bad.yaml:5: engine_running_rpm 65535 out of range 1..65534"},
+    {"buses:\n  - interface: can0\n    devices:\n      - address: 1\n        engine_running_hold: 26\n",
+     "bad.yaml:5: engine_running_hold 26 out of range 0..25.5"},
+    {"buses:\n  - interface: can0\n    discover:\n      engine_running_hold: -1\n",
+     "bad.yaml:4: engine_running_hold -1 out of range 0..25.5"},
     {"buses:\n  - interface: can0\n    devices:\n      - address: 65535\n",
      "bad.yaml:4: address 65535 out of range 0..65534"},
     {"buses:\n  - interface: can0\n    devices:\n      - address: 1\n      - address: 1\n",

@@ -285,7 +285,7 @@ struct GeneratorCase {
 const GeneratorCase kGenerator[] = {
     {"stopped", false, false, true, 0, 0},
     {"running, generating", true, false, true, 5200, 48.0},
-    {"running, generation off", true, false, false, 0, 0},
+    {"running, generation off", true, false, false, 5200, 0},
     {"cranking", false, true, true, 300, 0},
 };
 

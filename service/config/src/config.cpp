@@ -140,10 +140,17 @@ void parse_device_settings(const Ctx& c, const YAML::Node& n, DeviceConfig& d) {
   if (const auto p = n["period"]) d.period = period_of(c, p, "period");
   if (const auto p = n["packets"]) d.groups = parse_groups(c, p);
   if (const auto p = n["configure_streaming"]) d.configure_streaming = c.scalar<bool>(p, "configure_streaming", "true or false");
+  // Table 6 carries the speed in 16 bits; a hold past the longest cranking time (25.5 s)
+  // could never be met within one start.
+  if (const auto p = n["engine_running_rpm"])
+    d.engine.running_rpm = static_cast<std::uint16_t>(c.integer(p, "engine_running_rpm", 1, 65534));
+  if (const auto p = n["engine_running_hold"])
+    d.engine.running_hold = std::chrono::milliseconds(std::lround(c.number(p, "engine_running_hold", 0, 25.5) * 1000));
 }
 
 DeviceConfig parse_device(const Ctx& c, const YAML::Node& n) {
-  c.only_keys(n, "device", {"address", "mode", "period", "packets", "configure_streaming"});
+  c.only_keys(n, "device", {"address", "mode", "period", "packets", "configure_streaming", "engine_running_rpm",
+                            "engine_running_hold"});
   DeviceConfig d;
   const auto a = n["address"];
   // 65535 is the broadcast address, never a device's (v1.9 section 4).
@@ -218,7 +225,8 @@ BusConfig parse_bus(const Ctx& c, const YAML::Node& n) {
     if (d.IsScalar()) {
       b.discover = c.scalar<bool>(d, "discover", "true, false or a mapping of device settings");
     } else {
-      c.only_keys(d, "discover", {"mode", "period", "packets", "configure_streaming"});
+      c.only_keys(d, "discover",
+                  {"mode", "period", "packets", "configure_streaming", "engine_running_rpm", "engine_running_hold"});
       b.discover = true;
       parse_device_settings(c, d, b.discovered_defaults);
     }

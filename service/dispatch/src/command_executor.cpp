@@ -1,6 +1,7 @@
 #include "pmu/dispatch/command_executor.hpp"
 
 #include "pmu/codec/encode.hpp"
+#include "pmu/dispatch/engine_start.hpp"
 
 namespace pmu::service {
 namespace {
@@ -42,6 +43,15 @@ void execute_command(DeviceSession& session, const CommandRequest& request, Stea
   if (auto invalid = check_firmware(request, device.firmware)) {
     reply(*invalid);
     return;
+  }
+  if (request.kind() == CommandKind::EngineStop) session.on_engine_stop(request.request_id, now);
+  if (request.kind() == CommandKind::EngineStart) {
+    // One start at a time: a second would restart nothing on the unit (the starter is
+    // already engaged) and its verdict would be the first one's.
+    if (const auto& running = session.engine_start())
+      return reply(make_reply(request, CommandResult::Denied,
+                              "an engine start is in progress (request " + running->request_id + ")"));
+    return run_engine_start(session, request, device, timeouts, EngineStartTiming{}, std::move(reply));
   }
   run_plan(session, request, plan_command(request, device), now, timeouts, std::move(reply));
 }

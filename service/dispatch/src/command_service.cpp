@@ -69,6 +69,14 @@ CommandService::Seen CommandService::remember(const std::string& key, const Comm
 
 void CommandService::finish(const std::string& key, const std::string& sender, const std::string& what,
                             const CommandReplyData& reply) {
+  if (!is_final(reply.result)) {
+    // Progress of a long command (an engine start): passed on, neither recorded as the
+    // answer to resends nor counted; the audit line is the final reply's.
+    spdlog::debug("command {} from {}: {} -> {}: {}", printable(reply.request_id), printable(sender), what,
+                  to_string(reply.result), reply.reason);
+    reply_(reply);
+    return;
+  }
   unsigned copies = 1;
   {
     std::lock_guard<std::mutex> lock(mutex_);
@@ -200,9 +208,16 @@ void CommandService::run_on_worker(BusWorker& worker, const CommandRequest& r) {
 
 void CommandService::broadcast(BusWorker& worker, const CommandRequest& r) {
   // parse_command lets only engine_stop through to the broadcast address; no device answers.
+  stop_engine_starts(worker, r.request_id);
   const auto sent = worker.bus().send(*codec::encode_engine_stop(r.address), timeouts_.send);
   if (sent.ok()) return answer(r, CommandResult::Completed, "stop sent to every PMU (broadcast)");
   answer(r, CommandResult::Failed, "bus refused the engine stop: " + std::string(transport::to_string(sent.status)));
+}
+
+void CommandService::stop_engine_starts(BusWorker& worker, const std::string& request_id) {
+  const auto now = clock_.steady_now();
+  for (const auto address : worker.addresses())
+    if (auto* s = worker.session(address)) s->on_engine_stop(request_id, now);
 }
 
 void CommandService::broadcast_on_every_bus(const CommandRequest& r) {
@@ -218,6 +233,7 @@ void CommandService::broadcast_on_every_bus(const CommandRequest& r) {
   round->left = workers_.size();
   for (auto* w : workers_)
     w->post([this, w, r, round] {
+      stop_engine_starts(*w, r.request_id);
       const auto sent = w->bus().send(*codec::encode_engine_stop(codec::kBroadcastAddress), timeouts_.send);
       std::string done, failed;
       {

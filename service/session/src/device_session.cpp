@@ -173,9 +173,34 @@ void DeviceSession::tick(SteadyTime now) {
     gone_.erase(gone_.begin());
   }
   if (queue_.tick(now)) health_.on_timeout();
+  run_timers(now);
   if (reading_.retry_due(now)) start_reading(now);
   if (reading_.running() && settings_.mode == TelemetryMode::Polling && now >= next_poll_) poll(now);
   update_health(now, false);
+}
+
+void DeviceSession::at(SteadyTime when, std::function<void(SteadyTime)> fn) { timers_.push_back({when, std::move(fn)}); }
+
+void DeviceSession::run_timers(SteadyTime now) {
+  // A timer's function may add timers: take the due ones out first, then call them.
+  std::vector<Timer> due;
+  for (auto it = timers_.begin(); it != timers_.end();) {
+    if (it->at <= now) {
+      due.push_back(std::move(*it));
+      it = timers_.erase(it);
+    } else {
+      ++it;
+    }
+  }
+  for (auto& t : due) t.fn(now);
+}
+
+void DeviceSession::on_engine_stop(const std::string& request_id, SteadyTime now) {
+  now_ = now;
+  if (!engine_start_) return;
+  auto stop = std::move(engine_start_->on_stop);
+  engine_start_.reset();
+  if (stop) stop(request_id, now);
 }
 
 void DeviceSession::poll(SteadyTime now) {

@@ -2,6 +2,7 @@
 
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <fastdds/dds/core/status/PublicationMatchedStatus.hpp>
@@ -218,7 +219,12 @@ int run_command(const GlobalOptions& o, const CommandSpec& spec) {
   constexpr auto kResendAfter = std::chrono::seconds(1);
   auto next_resend = Clock::now() + kResendAfter;
   bool heard = false;
-  while (Clock::now() < deadline + std::chrono::milliseconds(500)) {
+  // A long command (an engine start, which is verified for up to CT + 2 s) reports progress
+  // at least once a second: each report keeps the wait open a little longer than that, so
+  // --timeout bounds the wait for the service, not the engine.
+  constexpr auto kProgressKeepsOpen = std::chrono::seconds(3);
+  auto wait_until = deadline + std::chrono::milliseconds(500);
+  while (Clock::now() < wait_until) {
     if (!heard && Clock::now() >= next_resend && Clock::now() < deadline) {
       (void)writer.write(&c);
       next_resend = Clock::now() + kResendAfter;
@@ -230,6 +236,7 @@ int run_command(const GlobalOptions& o, const CommandSpec& spec) {
       heard = true;
       if (r.result() == pmu::v4::IN_PROGRESS) {
         std::fprintf(stderr, "IN_PROGRESS: %s\n", r.reason().c_str());
+        wait_until = std::max(wait_until, Clock::now() + kProgressKeepsOpen);
         continue;
       }
       if (o.json) {

@@ -12,8 +12,10 @@
 //   Set/Enable/DisableOutputs  0x20/0x21/0x22; read back 0x20              check: the bits
 //   SetGeneration  0x23; read back 0x23                                    check: the state
 //   RequestMeasurements  0x0F, done when the first requested packet arrives
-//   EngineStart / Reset / EngineStop  sent, nothing to read; a reset then re-reads the
-//                  device; the stop goes ahead of the device's queue and never expires
+//   Reset / EngineStop  sent, nothing to read; a reset then re-reads the device; the stop
+//                  goes ahead of the device's queue and never expires
+//   EngineStart    its frame only: the start is verified by the generator speed, a run of
+//                  its own (engine_start.hpp), not by one answer
 //
 // Steps of a run, each one Request on the session (device_session.hpp):
 //   0  `frame` (behind the device's queue, with the command's expiry; ahead and without

@@ -91,6 +91,8 @@ class CommandService {
   void broadcast(BusWorker& worker, const CommandRequest& r);
   // An engine stop to the broadcast address with no bus named: sent on every bus served.
   void broadcast_on_every_bus(const CommandRequest& r);
+  // A broadcast stop reaches every unit: it ends each engine start in progress on `worker`.
+  void stop_engine_starts(BusWorker& worker, const std::string& request_id);
   // Known, read (firmware known) and, for an address change, the new address free.
   std::optional<Refusal> check_device(BusWorker& worker, const DeviceSession* session, const CommandRequest& r);
 

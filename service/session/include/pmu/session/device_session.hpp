@@ -36,6 +36,7 @@
 #include <cstdint>
 #include <functional>
 #include <optional>
+#include <string>
 #include <vector>
 
 #include "pmu/codec/decode.hpp"
@@ -70,6 +71,23 @@ class DeviceSession {
   void submit_front(Request request, SteadyTime now);
   // Reads identity and every stored value again (after a reset).
   void reread(SteadyTime now) { start_reading(now); }
+
+  // Calls `fn` from tick() once `at` has come (within the worker's tick, 20 ms). A command
+  // that waits on the device's behaviour rather than on one answer (an engine start, which
+  // watches the generator speed) paces itself with these. Dropped with the session.
+  void at(SteadyTime when, std::function<void(SteadyTime)> fn);
+
+  // The engine start being verified on this unit, if any (dispatch's engine_start.hpp). Its
+  // `on_stop` ends it when an engine stop is sent meanwhile; the session only holds it so that
+  // the stop, and a second start, find it.
+  struct EngineStartInProgress {
+    std::string request_id;
+    std::function<void(const std::string& stop_request_id, SteadyTime now)> on_stop;
+  };
+  void set_engine_start(std::optional<EngineStartInProgress> start) { engine_start_ = std::move(start); }
+  const std::optional<EngineStartInProgress>& engine_start() const noexcept { return engine_start_; }
+  // An engine stop (`request_id`) is on its way to this unit: ends the start in progress.
+  void on_engine_stop(const std::string& request_id, SteadyTime now);
 
   // During a CAN address change, frames from `alias` belong to this session too; move_to()
   // moves the session to its new address once the change is verified.
@@ -121,6 +139,7 @@ class DeviceSession {
   void on_reading_done(const RequestOutcome& outcome, std::uint64_t round);
   void configure_streaming();
   void poll(SteadyTime now);
+  void run_timers(SteadyTime now);
   void absorb(const codec::PmuMessage& m);
   void update_health(SteadyTime now, bool force);
   std::chrono::milliseconds period() const noexcept;
@@ -142,6 +161,12 @@ class DeviceSession {
     SteadyTime at;
   };
   std::vector<Gone> gone_;  // old keys to dispose, once due (tick)
+  struct Timer {
+    SteadyTime at;
+    std::function<void(SteadyTime)> fn;
+  };
+  std::vector<Timer> timers_;  // at(); run by tick()
+  std::optional<EngineStartInProgress> engine_start_;
   SteadyTime now_{};  // the latest time any call brought
   SteadyTime next_poll_{};
 };
