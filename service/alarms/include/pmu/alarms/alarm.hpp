@@ -37,8 +37,8 @@ class Alarm {
  public:
   explicit Alarm(const AlarmConfig& config) noexcept;
 
-  // A measured value in the row's unit; NaN (not measured) holds the state and restarts any
-  // wait, so it never raises nor clears.
+  // A measured value in the row's unit (for a flag, non-zero is set); NaN (not measured)
+  // holds the state and restarts any wait, so it never raises nor clears.
   bool observe(double value, Time now) noexcept;
   // A flag's input; for a value alarm it is observe(1 or 0).
   bool observe_flag(bool set, Time now) noexcept;

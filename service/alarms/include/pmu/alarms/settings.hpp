@@ -44,7 +44,7 @@ struct AlarmConfig {
   double deadband = 0;
   std::chrono::steady_clock::duration on_delay{};
   std::chrono::steady_clock::duration off_delay{};
-  bool enabled = true;
+  bool enabled = true;  // false: the device's AlarmSet leaves it out
 
   const AlarmSpec& spec() const noexcept { return spec_of(code); }
 };
