@@ -332,7 +332,7 @@ TEST(AlarmTable, RowsAreComplete) {
   }
 }
 
-// The values the brief and the documents name, pinned so a change to them is deliberate.
+// The values taken from the documents, ArduPilot and PX4, pinned so a change to them is deliberate.
 TEST(AlarmTable, DefaultsThatComeFromTheDocumentsOrAreNamedElsewhere) {
   EXPECT_EQ(spec_of(Code::ThermalShutdown).basis, Basis::Documented);
   EXPECT_EQ(spec_of(Code::ThermalShutdown).severity, Severity::Critical);
