@@ -428,4 +428,8 @@ void DdsPublisher::on_mppt(const DeviceKey& key, const MpptState& m, std::chrono
   write_at(w_->mppt, &s, key, newest);
 }
 
+void DdsPublisher::on_alarm(const AlarmReport&) {
+  // pmu/alarms has no writer yet: the topic comes with its IDL type.
+}
+
 }  // namespace pmu::service

@@ -46,6 +46,8 @@ class RecordingSink final : public StateSink {
     mppts.push_back({k, m, t});
   }
 
+  void on_alarm(const AlarmReport& a) override { alarms.push_back(a); }
+
   std::size_t count(codec::PacketId p, std::uint16_t address) const {
     std::size_t n = 0;
     for (const auto& t : telemetry) n += (t.message.packet == p && t.key.address == address) ? 1 : 0;
@@ -58,6 +60,7 @@ class RecordingSink final : public StateSink {
   }
 
   std::vector<Telemetry> telemetry;
+  std::vector<AlarmReport> alarms;
   std::vector<std::pair<DeviceKey, ConfigState>> configs;
   std::vector<std::pair<DeviceKey, InfoState>> infos;
   std::vector<std::pair<DeviceKey, HealthReport>> healths;

@@ -55,6 +55,7 @@ class DdsPublisher final : public StateSink {
   void on_battery_cells(const DeviceKey& key, const BatteryCellsState& cells,
                         std::chrono::system_clock::time_point newest) override;
   void on_mppt(const DeviceKey& key, const MpptState& mppt, std::chrono::system_clock::time_point newest) override;
+  void on_alarm(const AlarmReport& alarm) override;
 
   // A write to another of the service's topics (pmu/command_reply) failed: counted in
   // publish_failures and logged like the publisher's own. Thread-safe.

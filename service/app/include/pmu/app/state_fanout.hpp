@@ -44,6 +44,9 @@ class StateFanout final : public StateSink {
   void on_mppt(const DeviceKey& key, const MpptState& mppt, std::chrono::system_clock::time_point newest) override {
     for (auto* s : sinks_) s->on_mppt(key, mppt, newest);
   }
+  void on_alarm(const AlarmReport& alarm) override {
+    for (auto* s : sinks_) s->on_alarm(alarm);
+  }
 
  private:
   std::vector<StateSink*> sinks_;

@@ -8,6 +8,7 @@
 #include <optional>
 #include <string>
 
+#include "pmu/alarms/alarm.hpp"
 #include "pmu/codec/decode.hpp"
 #include "pmu/codec/parameters.hpp"
 #include "pmu/session/canopen_state.hpp"
@@ -73,6 +74,21 @@ struct HealthReport {
 
 // Where the service's view of the devices goes: the DDS publisher in the daemon, a recorder
 // in tests. Called on the bus worker's thread.
+// An alarm that changed state (interface.md 1.6): the alarms room's Alarm, with where it
+// belongs and its times on the wall clock.
+struct AlarmReport {
+  std::string bus;
+  alarms::DeviceKind source = alarms::DeviceKind::Pmu;  // Pmu, Battery, Mppt, or Bus for the bus's own
+  std::uint16_t device = 0;  // the device's address, node or MPPT device id; 0 for the bus
+  alarms::Code code{};
+  alarms::Severity severity = alarms::Severity::Warning;
+  alarms::AlarmState state = alarms::AlarmState::Normal;
+  double value = 0;  // at the last change, in the table's unit; NaN for a flag or unknown
+  double limit = 0;
+  std::chrono::system_clock::time_point since{};  // the last change of state
+  std::string message;                           // at most 42 characters
+};
+
 class StateSink {
  public:
   virtual ~StateSink() = default;
@@ -94,6 +110,8 @@ class StateSink {
   virtual void on_battery_cells(const DeviceKey& key, const BatteryCellsState& cells,
                                 std::chrono::system_clock::time_point newest) = 0;
   virtual void on_mppt(const DeviceKey& key, const MpptState& mppt, std::chrono::system_clock::time_point newest) = 0;
+  // An alarm changed state (raised, acknowledged, cleared, back to NORMAL).
+  virtual void on_alarm(const AlarmReport& alarm) = 0;
 };
 
 }  // namespace pmu::service
