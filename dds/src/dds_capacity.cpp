@@ -32,6 +32,10 @@ std::string capacity_shortfall(const std::string& profile, EndpointKind kind, co
     need = kind == EndpointKind::Writer
                ? Need{kMaxDevicesPerService, 1, "PMUs per service, pmu::service::kMaxDevicesPerService"}
                : Need{kFleetDevices, 1, "PMUs of a fleet, pmu::service::kFleetDevices"};
+  } else if (profile == qos_profiles::kAlarms) {
+    need = kind == EndpointKind::Writer
+               ? Need{kMaxAlarmsPerService, 1, "alarms per service, pmu::service::kMaxAlarmsPerService"}
+               : Need{kFleetAlarms, 1, "alarms of a fleet, pmu::service::kFleetAlarms"};
   } else if (profile == qos_profiles::kCommand) {
     // pmu/command and pmu/command_reply have no key: one instance holds the whole queue.
     need = Need{1, kCommandQueueDepth, "commands queued, pmu::service::kCommandQueueDepth"};

@@ -15,6 +15,8 @@
 #include "pmu/config/capacity.hpp"
 #include "pmu/config/low_rate.hpp"
 #include "pmu/dds/telemetry_samples.hpp"
+#include "pmu/idl/alarms.h"
+#include "pmu/idl/alarmsPubSubTypes.h"
 #include "pmu/idl/canopen.h"
 #include "pmu/idl/canopenPubSubTypes.h"
 #include "pmu/idl/command.h"
@@ -102,6 +104,9 @@ struct DdsPublisher::Writers {
   DataWriter* battery = nullptr;
   DataWriter* battery_cells = nullptr;
   DataWriter* mppt = nullptr;
+  // Null when the service's DDS-Security permissions do not grant pmu/alarms (made before
+  // it existed): the service runs without it rather than not at all.
+  DataWriter* alarms = nullptr;
   // Bus workers run in threads of their own and share these writers and the rest below.
   std::mutex mutex;
   std::set<std::tuple<std::string, DeviceKind, std::uint16_t>> admitted;
@@ -151,6 +156,15 @@ DdsPublisher::DdsPublisher(dds::DdsContext& dds, std::chrono::milliseconds telem
   w_->config = state(topics::kConfig, TypeSupport(new pmu::v4::ConfigPubSubType()));
   w_->info = state(topics::kInfo, TypeSupport(new pmu::v4::DeviceInfoPubSubType()));
   w_->health = state(topics::kHealth, TypeSupport(new pmu::v4::HealthPubSubType()));
+  try {
+    w_->alarms = &dds.writer(dds.topic(topics::kAlarms, TypeSupport(new pmu::v4::AlarmPubSubType())),
+                             qos_profiles::kAlarms);
+  } catch (const dds::DdsError& e) {
+    if (!dds.secure()) throw;
+    spdlog::error("{} is not published: {}; the DDS-Security permissions were made before it existed "
+                  "(deploy/security/make_pki.sh makes them with it)",
+                  topics::kAlarms, e.what());
+  }
 }
 
 DdsPublisher::~DdsPublisher() = default;
@@ -428,8 +442,49 @@ void DdsPublisher::on_mppt(const DeviceKey& key, const MpptState& m, std::chrono
   write_at(w_->mppt, &s, key, newest);
 }
 
-void DdsPublisher::on_alarm(const AlarmReport&) {
-  // pmu/alarms has no writer yet: the topic comes with its IDL type.
+namespace {
+
+pmu::v4::AlarmSource source_of(alarms::DeviceKind k) {
+  switch (k) {
+    case alarms::DeviceKind::Battery: return pmu::v4::SOURCE_BATTERY;
+    case alarms::DeviceKind::Mppt: return pmu::v4::SOURCE_MPPT;
+    case alarms::DeviceKind::Bus: return pmu::v4::SOURCE_BUS;
+    case alarms::DeviceKind::Pmu:
+    case alarms::DeviceKind::AnyDevice: break;
+  }
+  return pmu::v4::SOURCE_PMU;
+}
+
+pmu::v4::AlarmState state_of(alarms::AlarmState s) {
+  switch (s) {
+    case alarms::AlarmState::ActiveUnacknowledged: return pmu::v4::ALARM_ACTIVE_UNACKNOWLEDGED;
+    case alarms::AlarmState::ActiveAcknowledged: return pmu::v4::ALARM_ACTIVE_ACKNOWLEDGED;
+    case alarms::AlarmState::ClearedUnacknowledged: return pmu::v4::ALARM_CLEARED_UNACKNOWLEDGED;
+    case alarms::AlarmState::Normal: break;
+  }
+  return pmu::v4::ALARM_NORMAL;
+}
+
+}  // namespace
+
+void DdsPublisher::on_alarm(const AlarmReport& a) {
+  const bool flag = alarms::spec_of(a.code).condition == alarms::Condition::Flag;
+  pmu::v4::Alarm s;
+  s.vehicle(w_->vehicle);
+  s.bus(a.bus);
+  s.device(a.device);
+  s.kind(source_of(a.source));
+  s.code(std::string(alarms::to_string(a.code)));
+  s.severity(a.severity == alarms::Severity::Critical ? pmu::v4::SEVERITY_CRITICAL : pmu::v4::SEVERITY_WARNING);
+  s.state(state_of(a.state));
+  s.value(flag ? std::numeric_limits<float>::quiet_NaN() : static_cast<float>(a.value));
+  s.limit(flag ? std::numeric_limits<float>::quiet_NaN() : static_cast<float>(a.limit));
+  s.since(static_cast<std::uint64_t>(
+      std::max<std::int64_t>(0, std::chrono::duration_cast<std::chrono::nanoseconds>(a.since.time_since_epoch()).count())));
+  s.message(a.message.substr(0, alarms::kMaxMessageLength));
+  const DeviceKey key{a.bus, a.device, DeviceKind::Pmu};
+  std::lock_guard<std::mutex> lock(w_->mutex);
+  write_at(w_->alarms, &s, key, a.since);
 }
 
 }  // namespace pmu::service

@@ -38,6 +38,7 @@ const defaultTopics = {
   "pmu/battery": "pmu::v4::Battery",
   "pmu/battery_cells": "pmu::v4::BatteryCells",
   "pmu/mppt": "pmu::v4::Mppt",
+  "pmu/alarms": "pmu::v4::Alarm",
 };
 
 // float32 on the wire: the shortest decimal that is the same float32, as pmuctl prints it.

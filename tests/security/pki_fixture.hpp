@@ -116,20 +116,20 @@ inline std::string write_config(const std::string& name, const SecurityFiles& f,
   return path;
 }
 
-// The contract's topics (interface.md sections 1.2, 1.4 and 1.5).
+// The contract's topics (interface.md sections 1.2, 1.4, 1.5 and 1.6).
 inline const std::set<std::string> kTelemetryAndState = {
     "pmu/voltages",          "pmu/currents",          "pmu/battery_energy",          "pmu/temperatures",
     "pmu/status",            "pmu/low_rate/voltages", "pmu/low_rate/currents",       "pmu/low_rate/battery_energy",
     "pmu/low_rate/temperatures", "pmu/low_rate/status", "pmu/battery", "pmu/battery_cells", "pmu/mppt",
-    "pmu/config",            "pmu/info",              "pmu/health"};
+    "pmu/config",            "pmu/info",              "pmu/health",                  "pmu/alarms"};
 inline const char* const kContractTopics[] = {
     "pmu/voltages",          "pmu/currents",          "pmu/battery_energy",          "pmu/temperatures",
     "pmu/status",            "pmu/low_rate/voltages", "pmu/low_rate/currents",       "pmu/low_rate/battery_energy",
     "pmu/low_rate/temperatures", "pmu/low_rate/status", "pmu/battery", "pmu/battery_cells", "pmu/mppt",
-    "pmu/config",            "pmu/info",              "pmu/health",            "pmu/command",
+    "pmu/config",            "pmu/info",              "pmu/health",            "pmu/alarms",  "pmu/command",
     "pmu/command_reply"};
 
-// What the issue asks: only the ground station commands; the service publishes telemetry,
+// Only the ground station commands; the service publishes telemetry,
 // state and replies; the mission computer only reads telemetry and state.
 inline bool allowed(const std::string& identity, const std::string& topic, bool publish) {
   const bool data = kTelemetryAndState.count(topic) > 0;

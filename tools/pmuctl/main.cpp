@@ -24,6 +24,7 @@
 #include "pmuctl/record/record_verb.hpp"
 #include "pmuctl/serve/serve_verb.hpp"
 #include "pmuctl/verbs/command_verbs.hpp"
+#include "pmuctl/verbs/alarm_verbs.hpp"
 #include "pmuctl/verbs/state_verbs.hpp"
 #include "pmuctl/view/mask_names.hpp"
 #include "pmu/command/command.hpp"
@@ -187,6 +188,7 @@ int main(int argc, char** argv) {
   app.add_subcommand("list", "PMUs the service knows, with health");
   app.add_subcommand("info", "Serial number, firmware and features");
   app.add_subcommand("health", "Link, bus and device health");
+  app.add_subcommand("alarms", "Alarms that are active or wait for acknowledgement");
   auto* config = app.add_subcommand("config", "Stored parameters");
   config->require_subcommand(1);
   auto* config_get = config->add_subcommand("get", "Show the stored parameters (or one)");
@@ -350,6 +352,7 @@ int main(int argc, char** argv) {
     if (app.got_subcommand("list")) return pmu::tools::run_list(g);
     if (app.got_subcommand("info")) return pmu::tools::run_info(g);
     if (app.got_subcommand("health")) return pmu::tools::run_health(g);
+    if (app.got_subcommand("alarms")) return pmu::tools::run_alarms(g);
     if (*config_get) return pmu::tools::run_config_get(g, parameter);
     pmu::tools::CommandSpec spec;
     spec.confirm = confirm;

@@ -5,6 +5,7 @@
 #include <fastdds/dds/subscriber/DataReader.hpp>
 #include <fastdds/dds/subscriber/SampleInfo.hpp>
 
+#include "pmu/idl/alarmsPubSubTypes.h"
 #include "pmu/idl/canopenPubSubTypes.h"
 #include "pmu/idl/commandPubSubTypes.h"
 #include "pmu/idl/statePubSubTypes.h"
@@ -51,6 +52,7 @@ TypeSupport raw_type_support(const std::string& type_name) {
   if (type_name == "pmu::v4::Battery") return TypeSupport(new RawSampleType<pmu::v4::BatteryPubSubType>());
   if (type_name == "pmu::v4::BatteryCells") return TypeSupport(new RawSampleType<pmu::v4::BatteryCellsPubSubType>());
   if (type_name == "pmu::v4::Mppt") return TypeSupport(new RawSampleType<pmu::v4::MpptPubSubType>());
+  if (type_name == "pmu::v4::Alarm") return TypeSupport(new RawSampleType<pmu::v4::AlarmPubSubType>());
   if (type_name == "pmu::v4::Command") return TypeSupport(new RawSampleType<pmu::v4::CommandPubSubType>());
   return TypeSupport(new RawSampleType<pmu::v4::CommandReplyPubSubType>());
 }

@@ -29,7 +29,8 @@ int run_serve(const GlobalOptions& o, const ServeOptions& serve, const std::vect
   std::vector<bool> latched;
   for (std::uint32_t i = 0; i < topics.size(); ++i) {
     channels.push_back(foxglove::Channel{i, topics[i]->topic, topics[i]->type_name, topics[i]->idl});
-    latched.push_back(std::string_view(topics[i]->qos_profile) == pmu::qos_profiles::kState);
+    const std::string_view profile = topics[i]->qos_profile;
+    latched.push_back(profile == pmu::qos_profiles::kState || profile == pmu::qos_profiles::kAlarms);
   }
 
   pmu::transport::StopSignals stop;  // before the server's and Fast DDS's threads

@@ -23,6 +23,8 @@ inline constexpr const char* kLowRateStatus = "pmu/low_rate/status";
 inline constexpr const char* kBattery = "pmu/battery";
 inline constexpr const char* kBatteryCells = "pmu/battery_cells";
 inline constexpr const char* kMppt = "pmu/mppt";
+// Alarms of every device and bus: docs/interface.md 1.6.
+inline constexpr const char* kAlarms = "pmu/alarms";
 inline constexpr const char* kCommand = "pmu/command";
 inline constexpr const char* kCommandReply = "pmu/command_reply";
 
@@ -34,5 +36,6 @@ namespace pmu::qos_profiles {
 inline constexpr const char* kTelemetry = "telemetry";
 inline constexpr const char* kState = "state";
 inline constexpr const char* kCommand = "command";
+inline constexpr const char* kAlarms = "alarms";
 
 }  // namespace pmu::qos_profiles

@@ -7,6 +7,8 @@
 
 #include <cstddef>
 
+#include "pmu/alarms/alarm_table.hpp"
+
 namespace pmu::service {
 
 // PMUs one pmu-service serves (configured plus discovered, all buses together): the
@@ -19,5 +21,9 @@ inline constexpr std::size_t kFleetDevices = kMaxDevicesPerService * kFleetServi
 // Commands (and replies) queued per writer and reader: profile `command`'s KEEP_LAST depth,
 // which a burst of 2,000 commands written at once does not overflow.
 inline constexpr std::size_t kCommandQueueDepth = 4096;
+// pmu/alarms: one instance per alarm of a device or bus that has ever left NORMAL; a device
+// holds at most every code of the table.
+inline constexpr std::size_t kMaxAlarmsPerService = kMaxDevicesPerService * alarms::kCodeCount;
+inline constexpr std::size_t kFleetAlarms = kMaxAlarmsPerService * kFleetServices;
 
 }  // namespace pmu::service
