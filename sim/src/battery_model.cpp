@@ -70,6 +70,11 @@ void check(const BatterySimConfig& c) {
   if (c.period.count() <= 0) bad("period must be positive");
   if (!(c.capacity_ah > 0)) bad("capacity must be positive");
   if (!(c.initial_soc >= 0 && c.initial_soc <= 1)) bad("initial state of charge must be 0..1");
+  if (!c.cell_voltages.empty() && c.cell_voltages.size() != static_cast<std::size_t>(c.cells))
+    bad("cell voltages must be given for every cell or none (" + std::to_string(c.cells) + " cells, " +
+        std::to_string(c.cell_voltages.size()) + " voltages)");
+  for (const double v : c.cell_voltages)
+    if (!(v >= 0 && v <= 65.535)) bad("a cell voltage must be 0..65.535 V (what 0x482 carries)");
 }
 
 }  // namespace

@@ -42,8 +42,10 @@ double cell_spread(int cell) noexcept { return static_cast<double>((cell * 7) % 
 constexpr double kSensorOffset[4] = {0.0, 0.8, 1.6, -0.5};
 
 // The pack's terminal voltage: its cells in series, each at its open-circuit voltage plus
-// the drop (or rise) across its resistance.
+// the drop (or rise) across its resistance, unless the config fixes what the cells read.
 double cell_voltage(const BatterySimConfig& c, double soc, double current, int cell) noexcept {
+  const auto i = static_cast<std::size_t>(cell - 1);
+  if (i < c.cell_voltages.size()) return c.cell_voltages[i];
   return cell_ocv(soc) + cell_spread(cell) + current * c.cell_resistance;
 }
 double pack_voltage(const BatterySimConfig& c, double soc, double current) noexcept {

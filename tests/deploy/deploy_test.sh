@@ -63,12 +63,13 @@ sed -e "s|^# qos_file: .*|qos_file: $deploy/qos.xml|" \
     -e '/^ *discover: false$/d' \
     -e '/^ *# discover:$/,/^ *#   packets:/ s/# //' \
     -e '/^ *# - address: 2$/,/^ *#   packets:/ s/# //' \
-    -e '/^ *# - interface: sim$/,/^ *#       period: 0.5$/ s/# //' \
+    -e '/^ *# - interface: sim$/,/^ *#         panels: 2$/ s/# //' \
     "$deploy/pmu-service.yaml" > "$full"
 changed_lines=$(diff "$deploy/pmu-service.yaml" "$full" | grep -c '^>' || true)
-# qos_file (1) + dds_statistics (1) + dds_type_objects (1) + discover mapping (4) + polling device (4) + sim bus (5)
-[ "$changed_lines" -eq 16 ] ||
-  fail "expected 16 example lines to switch on, got $changed_lines (were the commented examples changed?)"
+# qos_file (1) + dds_statistics (1) + dds_type_objects (1) + discover mapping (4) + polling device (4) + sim bus
+# with its devices' sim: mappings (50)
+[ "$changed_lines" -eq 61 ] ||
+  fail "expected 61 example lines to switch on, got $changed_lines (were the commented examples changed?)"
 out=$("$service_bin" --config "$full" --check-config 2>&1) ||
   fail "pmu-service rejected the example with its commented parts enabled: $out"
 echo "$out"

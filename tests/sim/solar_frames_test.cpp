@@ -187,6 +187,15 @@ TEST(SolarFrames, BadConfigsThrowAtStartUp) {
       {"period 0", battery([](auto& c) { c.period = 0ms; })},
       {"capacity 0", battery([](auto& c) { c.capacity_ah = 0; })},
       {"soc 1.5", battery([](auto& c) { c.initial_soc = 1.5; })},
+      {"3 cell voltages for 12 cells", battery([](auto& c) { c.cell_voltages = {3.9, 3.9, 3.9}; })},
+      {"a negative cell voltage", battery([](auto& c) {
+         c.cells = 2;
+         c.cell_voltages = {3.9, -0.1};
+       })},
+      {"a cell voltage 0x482 cannot carry", battery([](auto& c) {
+         c.cells = 1;
+         c.cell_voltages = {65.6};
+       })},
   };
   for (const auto& b : bad) {
     SCOPED_TRACE(b.what);

@@ -213,6 +213,26 @@ TEST(SolarStory, ParallelBatteriesShareChargeAndLoad) {
   EXPECT_NEAR(latest(node2).at("current_discharge"), 6.0, 0.01);
 }
 
+TEST(SolarStory, FixedCellVoltagesAreSentAsSetWhateverTheCurrent) {
+  SolarHarness h;
+  BatterySimConfig c;
+  c.cells = 3;
+  c.cell_voltages = {3.9, 4.25, 3.1};  // an unbalanced pack the charge curve cannot give
+  h.add(c);
+  h.add(MpptSimConfig{});
+  h.plant->set_irradiance(1000.0, h.now);  // charging current flows through the cells
+  h.run(2s);
+  const auto v = latest(h.take());
+  EXPECT_NEAR(v.at("cell_voltage_1"), 3.9, 0.0005);
+  EXPECT_NEAR(v.at("cell_voltage_2"), 4.25, 0.0005);
+  EXPECT_NEAR(v.at("cell_voltage_3"), 3.1, 0.0005);
+  EXPECT_EQ(v.count("cell_voltage_4"), 0u);
+  EXPECT_NEAR(v.at("cell_voltage_high"), 4.25, 0.0005);
+  EXPECT_NEAR(v.at("cell_voltage_low"), 3.1, 0.0005);
+  EXPECT_NEAR(v.at("voltage"), 3.9 + 4.25 + 3.1, 0.002) << "the pack is the sum of its cells";
+  EXPECT_GT(v.at("current"), 0) << "the charge still flows; only the cell readings are fixed";
+}
+
 TEST(SolarStory, ByDefaultTheSunVariesSlowly) {
   SolarWorld w;
   w.irradiance_mean = 500;

@@ -17,10 +17,12 @@
 #include <memory>
 #include <set>
 #include <sstream>
+#include <string_view>
 #include <utility>
 
 #include "pmu/codec/firmware.hpp"
 #include "pmu/codec/messages.hpp"
+#include "pmu/codec/telemetry.hpp"
 #include "pmu/config/quoted.hpp"
 #include "pmu/config/statistics_settings.hpp"
 #include "pmu/config/vehicle.hpp"
@@ -127,6 +129,104 @@ std::chrono::milliseconds period_of(const Ctx& c, const YAML::Node& n, const cha
   return codec::duration_of(pp, static_cast<std::uint32_t>(std::lround(raw)));
 }
 
+// ---- `sim:` (sim_settings.hpp, docs/interface.md section 4.4) ----
+
+// A `sim:` mapping describes the built-in simulator's world; on a real bus nothing would
+// read it, and a setting that silently does nothing is worse than a refusal.
+void refuse_sim_on_real_bus(const Ctx& c, const YAML::Node& owner, const std::string& interface) {
+  if (interface == "sim") return;
+  for (const auto& kv : owner)
+    if (kv.first.Scalar() == "sim")
+      c.fail(kv.first, "sim: sets up the built-in simulator, but this bus has interface " + quoted(interface) +
+                             ", not sim (remove sim:, or set interface: sim)");
+}
+
+bool sim_bool(const Ctx& c, const YAML::Node& n, const char* name) { return c.scalar<bool>(n, name, "true or false"); }
+
+SimGarble parse_garble(const Ctx& c, const YAML::Node& n) {
+  const auto g = c.scalar<std::string>(n, "garble", "none, wrong_length or unknown_subindex");
+  if (g == "none") return SimGarble::None;
+  if (g == "wrong_length") return SimGarble::WrongLength;
+  if (g == "unknown_subindex") return SimGarble::UnknownSubindex;
+  c.fail(n, "garble must be none, wrong_length or unknown_subindex, not " + quoted(g));
+}
+
+// What a field of the PMU's telemetry can carry (codec/telemetry.hpp): a plant value beyond
+// it would be reported clamped, so the config and the frames would disagree.
+template <class Packet>
+double field_value(const Ctx& c, const YAML::Node& n, const char* name, std::string_view field) {
+  for (const auto& f : codec::Telemetry<Packet>::fields)
+    if (f.name == field) return c.number(n, name, f.min(), f.max());
+  // Only if codec/telemetry.hpp lost the field: a build that cannot check this value says so.
+  c.fail(n, std::string(name) + ": no telemetry field " + std::string(field));
+}
+
+PmuSimSettings parse_pmu_sim(const Ctx& c, const YAML::Node& n) {
+  c.only_keys(n, "the PMU's sim", {"engine", "engine_starts_after", "internal_temperature", "battery_a_voltage",
+                                   "battery_b_voltage", "starter_ready", "silent", "soa_shutdown", "payload_shed"});
+  PmuSimSettings s;
+  if (const auto v = n["engine"]) {
+    const auto e = c.scalar<std::string>(v, "engine", "running or stopped");
+    if (e != "running" && e != "stopped") c.fail(v, "engine must be running or stopped, not " + quoted(e));
+    s.engine_running = e == "running";
+  }
+  if (const auto v = n["engine_starts_after"]) {
+    if (v.IsScalar() && v.Scalar() == "never") {
+      s.engine_never_starts = true;
+    } else {
+      if (!v.IsScalar() || !std::isfinite(v.as<double>(std::nan(""))))
+        c.fail(v, "engine_starts_after must be seconds (0..3600) or never, not " +
+                      quoted(v.IsScalar() ? v.Scalar() : std::string("a list or mapping")));
+      s.engine_starts_after =
+          std::chrono::milliseconds(std::lround(c.number(v, "engine_starts_after", 0, 3600) * 1000));
+    }
+  }
+  if (const auto v = n["internal_temperature"])
+    s.internal_temperature = field_value<codec::Temperatures>(c, v, "internal_temperature", "internal");
+  if (const auto v = n["battery_a_voltage"])
+    s.battery_a_voltage = field_value<codec::Voltages>(c, v, "battery_a_voltage", "battery_a");
+  if (const auto v = n["battery_b_voltage"])
+    s.battery_b_voltage = field_value<codec::Voltages>(c, v, "battery_b_voltage", "battery_b");
+  if (const auto v = n["starter_ready"]) s.starter_ready = sim_bool(c, v, "starter_ready");
+  if (const auto v = n["silent"]) s.silent = sim_bool(c, v, "silent");
+  if (const auto v = n["soa_shutdown"]) s.soa_shutdown = sim_bool(c, v, "soa_shutdown");
+  if (const auto v = n["payload_shed"]) s.payload_shed = sim_bool(c, v, "payload_shed");
+  return s;
+}
+
+// A simulated pack has 1..15 cells: the most whose full voltage fits 0x302's 65.535 V
+// (sim::BatterySimConfig::cells).
+constexpr long kMaxSimCells = 15;
+// A cell voltage a Li-ion cell can show, with room for an over-charged one.
+constexpr double kMaxSimCellVoltage = 5.0;
+
+BatterySimSettings parse_battery_sim(const Ctx& c, const YAML::Node& n) {
+  c.only_keys(n, "the battery's sim", {"state_of_charge", "cells", "cell_voltages", "silent", "garble"});
+  BatterySimSettings s;
+  if (const auto v = n["state_of_charge"]) s.state_of_charge = c.number(v, "state_of_charge", 0, 100);
+  if (const auto v = n["cells"]) s.cells = static_cast<int>(c.integer(v, "cells", 1, kMaxSimCells));
+  if (const auto v = n["cell_voltages"]) {
+    if (!v.IsSequence() || v.size() == 0 || v.size() > static_cast<std::size_t>(kMaxSimCells))
+      c.fail(v, "cell_voltages must be a list of 1..15 voltages, cell 1 first, e.g. [3.9, 3.9, 3.7]");
+    for (const auto& item : v) s.cell_voltages.push_back(c.number(item, "cell voltage", 0, kMaxSimCellVoltage));
+    if (s.cells && static_cast<std::size_t>(*s.cells) != s.cell_voltages.size())
+      c.fail(v, "cell_voltages has " + std::to_string(s.cell_voltages.size()) + " voltages but cells is " +
+                    std::to_string(*s.cells) + " (give one per cell, or leave cells out)");
+  }
+  if (const auto v = n["silent"]) s.silent = sim_bool(c, v, "silent");
+  if (const auto v = n["garble"]) s.garble = parse_garble(c, v);
+  return s;
+}
+
+MpptSimSettings parse_mppt_sim(const Ctx& c, const YAML::Node& n) {
+  c.only_keys(n, "the MPPT's sim", {"panels", "silent", "garble"});
+  MpptSimSettings s;
+  if (const auto v = n["panels"]) s.panels = static_cast<int>(c.integer(v, "panels", 0, 4));
+  if (const auto v = n["silent"]) s.silent = sim_bool(c, v, "silent");
+  if (const auto v = n["garble"]) s.garble = parse_garble(c, v);
+  return s;
+}
+
 void parse_device_settings(const Ctx& c, const YAML::Node& n, DeviceConfig& d) {
   if (const auto m = n["mode"]) {
     const auto mode = c.scalar<std::string>(m, "mode", "streaming or polling");
@@ -148,9 +248,10 @@ void parse_device_settings(const Ctx& c, const YAML::Node& n, DeviceConfig& d) {
     d.engine.running_hold = std::chrono::milliseconds(std::lround(c.number(p, "engine_running_hold", 0, 25.5) * 1000));
 }
 
-DeviceConfig parse_device(const Ctx& c, const YAML::Node& n) {
+DeviceConfig parse_device(const Ctx& c, const YAML::Node& n, BusConfig& b) {
   c.only_keys(n, "device", {"address", "mode", "period", "packets", "configure_streaming", "engine_running_rpm",
-                            "engine_running_hold"});
+                            "engine_running_hold", "sim"});
+  refuse_sim_on_real_bus(c, n, b.interface);
   DeviceConfig d;
   const auto a = n["address"];
   // 65535 is the broadcast address, never a device's (v1.9 section 4).
@@ -158,6 +259,7 @@ DeviceConfig parse_device(const Ctx& c, const YAML::Node& n) {
   d.address = static_cast<std::uint16_t>(c.integer(a, "address", 0, codec::kMaxDeviceAddress));
   d.source_line = c.line_of(a);
   parse_device_settings(c, n, d);
+  if (const auto v = n["sim"]) b.sim.pmus[d.address] = parse_pmu_sim(c, v);
   return d;
 }
 
@@ -171,7 +273,8 @@ void parse_batteries(const Ctx& c, const YAML::Node& n, BusConfig& b) {
   if (!n.IsSequence()) c.fail(n, "batteries must be a list, e.g. [{node: 2, period: 1.0}]");
   std::set<std::uint8_t> seen;
   for (const auto& item : n) {
-    c.only_keys(item, "battery", {"node", "period"});
+    c.only_keys(item, "battery", {"node", "period", "sim"});
+    refuse_sim_on_real_bus(c, item, b.interface);
     BatteryConfig bat;
     const auto node = item["node"];
     if (!node) c.fail(item, "battery needs a node (2: COB-IDs 0x202, 0x302, 0x402, 0x482)");
@@ -179,6 +282,7 @@ void parse_batteries(const Ctx& c, const YAML::Node& n, BusConfig& b) {
     // decoded, and the battery would sit OFFLINE for a reason nobody could see.
     bat.node = static_cast<std::uint8_t>(c.integer(node, "node", 2, 2));
     if (const auto p = item["period"]) bat.period = canopen_period(c, p);
+    if (const auto v = item["sim"]) b.sim.batteries[bat.node] = parse_battery_sim(c, v);
     if (!seen.insert(bat.node).second)
       c.fail(item, "battery node " + std::to_string(bat.node) + " appears twice on bus " + b.name);
     b.batteries.push_back(bat);
@@ -189,12 +293,14 @@ void parse_mppts(const Ctx& c, const YAML::Node& n, BusConfig& b) {
   if (!n.IsSequence()) c.fail(n, "mppts must be a list, e.g. [{device: 0, period: 1.0}]");
   std::set<std::uint8_t> seen;
   for (const auto& item : n) {
-    c.only_keys(item, "mppt", {"device", "period"});
+    c.only_keys(item, "mppt", {"device", "period", "sim"});
+    refuse_sim_on_real_bus(c, item, b.interface);
     MpptConfig m;
     const auto device = item["device"];
     if (!device) c.fail(item, "mppt needs a device (0..7, set by the MPPT's resistors)");
     m.device = static_cast<std::uint8_t>(c.integer(device, "device", 0, 7));
     if (const auto p = item["period"]) m.period = canopen_period(c, p);
+    if (const auto v = item["sim"]) b.sim.mppts[m.device] = parse_mppt_sim(c, v);
     if (!seen.insert(m.device).second)
       c.fail(item, "mppt device " + std::to_string(m.device) + " appears twice on bus " + b.name);
     b.mppts.push_back(m);
@@ -235,7 +341,7 @@ BusConfig parse_bus(const Ctx& c, const YAML::Node& n) {
     if (!devs.IsSequence()) c.fail(devs, "devices must be a list");
     std::set<std::uint16_t> seen;
     for (const auto& dn : devs) {
-      DeviceConfig d = parse_device(c, dn);
+      DeviceConfig d = parse_device(c, dn, b);
       if (!seen.insert(d.address).second)
         c.fail(dn, "address " + std::to_string(d.address) + " appears twice on bus " + b.name);
       b.devices.push_back(d);
@@ -693,6 +799,8 @@ void override_bus(Config& config, const std::string& spec) {
     throw ConfigError("--bus " + spec + ": expected sim or socketcan:IFACE");
   }
   BusConfig b = config.buses.empty() ? default_sim_config().buses.front() : config.buses.front();
+  // The simulator's settings mean nothing on a real bus; `--bus` picks the bus over the file.
+  if (iface != "sim") b.sim = {};
   b.interface = iface;
   b.name = iface == "sim" ? "sim0" : iface.rfind("fd:", 0) == 0 ? "fd" + iface.substr(3) : iface;
   b.source_line = "--bus " + spec;

@@ -6,6 +6,7 @@
 
 #include <chrono>
 #include <cstdint>
+#include <vector>
 
 namespace pmu::sim {
 
@@ -19,6 +20,11 @@ struct BatterySimConfig {
   double capacity_ah = 20.0;
   double initial_soc = 0.8;         // 0..1
   double cell_resistance = 0.002;   // ohm per cell: the pack's voltage drop under current
+  // Empty: each cell's voltage follows the state of charge and the current. Otherwise one
+  // value per cell (cell 1 first, `cells` of them), read as given whatever the charge and
+  // current: a bench setting for a pack the curve cannot produce (an unbalanced or
+  // over-charged cell), which the BMS frames must then show as set.
+  std::vector<double> cell_voltages;
 };
 
 struct MpptSimConfig {

@@ -23,7 +23,8 @@ struct SimulatedBus {
 
 // One simulated PMU per configured address (address 1 when the bus only discovers), each
 // streaming what the config expects with its engine running, plus the bus's batteries and
-// MPPTs on one solar plant. `clock` must outlive the result.
+// MPPTs on one solar plant; each device's `sim:` settings (sim_settings.hpp) change its
+// world and faults from power-up. `clock` must outlive the result.
 SimulatedBus make_simulated_bus(const BusConfig& bus, const transport::Clock& clock);
 
 }  // namespace pmu::service

@@ -16,6 +16,7 @@
 #include "pmu/command/policy.hpp"
 #include "pmu/config/capacity.hpp"
 #include "pmu/config/network_settings.hpp"
+#include "pmu/config/sim_settings.hpp"
 #include "pmu/config/transport_choice.hpp"
 #include "pmu/security/security_files.hpp"
 
@@ -89,6 +90,8 @@ struct BusConfig {
   std::chrono::milliseconds canopen_publish_period{200};
   bool wants_canopen() const noexcept { return listen_canopen || !batteries.empty() || !mppts.empty(); }
   std::string source_line;           // "FILE:LINE" of the bus entry, for later messages
+  // The devices' `sim:` mappings (sim_settings.hpp); only on an `interface: sim` bus.
+  BusSimSettings sim;
 };
 
 struct Timeouts {
@@ -173,7 +176,8 @@ Config default_sim_config();
 bool is_log_level(const std::string& level);
 
 // Applies `--bus sim|socketcan:IFACE`: replaces the buses with one bus on that interface
-// (keeping the devices of the first configured bus, if any). Throws ConfigError.
+// (keeping the devices of the first configured bus, if any, and their `sim:` settings only
+// when the new bus is sim). Throws ConfigError.
 void override_bus(Config& config, const std::string& spec);
 
 }  // namespace pmu::service
