@@ -25,6 +25,7 @@
 #include "pmu/config/statistics_settings.hpp"
 #include "pmu/config/vehicle.hpp"
 #include "pmu/version.hpp"
+#include "alarm_settings.hpp"
 
 namespace pmu::service {
 namespace {
@@ -146,11 +147,12 @@ void parse_device_settings(const Ctx& c, const YAML::Node& n, DeviceConfig& d) {
     d.engine.running_rpm = static_cast<std::uint16_t>(c.integer(p, "engine_running_rpm", 1, 65534));
   if (const auto p = n["engine_running_hold"])
     d.engine.running_hold = std::chrono::milliseconds(std::lround(c.number(p, "engine_running_hold", 0, 25.5) * 1000));
+  if (const auto p = n["alarms"]) d.alarms = parse_alarm_settings(p, alarms::DeviceKind::Pmu, c.source);
 }
 
 DeviceConfig parse_device(const Ctx& c, const YAML::Node& n) {
   c.only_keys(n, "device", {"address", "mode", "period", "packets", "configure_streaming", "engine_running_rpm",
-                            "engine_running_hold"});
+                            "engine_running_hold", "alarms"});
   DeviceConfig d;
   const auto a = n["address"];
   // 65535 is the broadcast address, never a device's (v1.9 section 4).
@@ -171,7 +173,7 @@ void parse_batteries(const Ctx& c, const YAML::Node& n, BusConfig& b) {
   if (!n.IsSequence()) c.fail(n, "batteries must be a list, e.g. [{node: 2, period: 1.0}]");
   std::set<std::uint8_t> seen;
   for (const auto& item : n) {
-    c.only_keys(item, "battery", {"node", "period"});
+    c.only_keys(item, "battery", {"node", "period", "alarms"});
     BatteryConfig bat;
     const auto node = item["node"];
     if (!node) c.fail(item, "battery needs a node (2: COB-IDs 0x202, 0x302, 0x402, 0x482)");
@@ -179,6 +181,7 @@ void parse_batteries(const Ctx& c, const YAML::Node& n, BusConfig& b) {
     // decoded, and the battery would sit OFFLINE for a reason nobody could see.
     bat.node = static_cast<std::uint8_t>(c.integer(node, "node", 2, 2));
     if (const auto p = item["period"]) bat.period = canopen_period(c, p);
+    if (const auto p = item["alarms"]) bat.alarms = parse_alarm_settings(p, alarms::DeviceKind::Battery, c.source);
     if (!seen.insert(bat.node).second)
       c.fail(item, "battery node " + std::to_string(bat.node) + " appears twice on bus " + b.name);
     b.batteries.push_back(bat);
@@ -189,12 +192,13 @@ void parse_mppts(const Ctx& c, const YAML::Node& n, BusConfig& b) {
   if (!n.IsSequence()) c.fail(n, "mppts must be a list, e.g. [{device: 0, period: 1.0}]");
   std::set<std::uint8_t> seen;
   for (const auto& item : n) {
-    c.only_keys(item, "mppt", {"device", "period"});
+    c.only_keys(item, "mppt", {"device", "period", "alarms"});
     MpptConfig m;
     const auto device = item["device"];
     if (!device) c.fail(item, "mppt needs a device (0..7, set by the MPPT's resistors)");
     m.device = static_cast<std::uint8_t>(c.integer(device, "device", 0, 7));
     if (const auto p = item["period"]) m.period = canopen_period(c, p);
+    if (const auto p = item["alarms"]) m.alarms = parse_alarm_settings(p, alarms::DeviceKind::Mppt, c.source);
     if (!seen.insert(m.device).second)
       c.fail(item, "mppt device " + std::to_string(m.device) + " appears twice on bus " + b.name);
     b.mppts.push_back(m);
@@ -202,7 +206,8 @@ void parse_mppts(const Ctx& c, const YAML::Node& n, BusConfig& b) {
 }
 
 BusConfig parse_bus(const Ctx& c, const YAML::Node& n) {
-  c.only_keys(n, "bus", {"name", "interface", "bitrate", "devices", "discover", "batteries", "mppts", "listen_canopen"});
+  c.only_keys(n, "bus", {"name", "interface", "bitrate", "devices", "discover", "batteries", "mppts", "listen_canopen",
+                         "alarms"});
   BusConfig b;
   b.source_line = c.line_of(n);
   const auto iface = n["interface"];
@@ -226,7 +231,8 @@ BusConfig parse_bus(const Ctx& c, const YAML::Node& n) {
       b.discover = c.scalar<bool>(d, "discover", "true, false or a mapping of device settings");
     } else {
       c.only_keys(d, "discover",
-                  {"mode", "period", "packets", "configure_streaming", "engine_running_rpm", "engine_running_hold"});
+                  {"mode", "period", "packets", "configure_streaming", "engine_running_rpm", "engine_running_hold",
+                   "alarms"});
       b.discover = true;
       parse_device_settings(c, d, b.discovered_defaults);
     }
@@ -244,6 +250,7 @@ BusConfig parse_bus(const Ctx& c, const YAML::Node& n) {
   if (const auto v = n["batteries"]) parse_batteries(c, v, b);
   if (const auto v = n["mppts"]) parse_mppts(c, v, b);
   if (const auto v = n["listen_canopen"]) b.listen_canopen = c.scalar<bool>(v, "listen_canopen", "true or false");
+  if (const auto v = n["alarms"]) b.alarms = parse_alarm_settings(v, alarms::DeviceKind::Bus, c.source);
   if (b.devices.empty() && !b.discover && !b.wants_canopen())
     c.fail(n, "bus " + b.name + " has no devices, batteries or mppts, and discover and listen_canopen are off");
   return b;
