@@ -145,6 +145,8 @@ TEST(CanOpenAlarms, TheBusRaisesErrorPassiveAndBusOff) {
   h.network().set_state(transport::BusState::Up);
   h.run_for(50ms);
   EXPECT_EQ(bus_alarm(Code::BusOff), AlarmState::ClearedUnacknowledged) << "critical: latched";
+  EXPECT_EQ(h.worker().acknowledge_bus_alarm(Code::BusOff), alarms::AckResult::Acknowledged);
+  EXPECT_EQ(bus_alarm(Code::BusOff), AlarmState::Normal);
   EXPECT_EQ(bus_alarm(Code::BusErrorPassive), AlarmState::ActiveUnacknowledged) << "5 s off-delay";
   h.run_for(5s);
   EXPECT_EQ(bus_alarm(Code::BusErrorPassive), AlarmState::Normal);

@@ -229,6 +229,24 @@ TEST(PmuAlarms, AFailedStartRaisesNothing) {
   EXPECT_TRUE(a.h.sink.alarms.empty()) << alarms::to_string(a.h.sink.alarms.front().code);
 }
 
+TEST(PmuAlarms, AnAcknowledgementIsReportedAndACriticalThenClearsToNormal) {
+  PmuAlarms a;
+  a.plant([](sim::Plant& p) { p.soa_shutdown = true; });
+  a.h.run_for(1s);
+  ASSERT_EQ(a.last(Code::SoaShutdown), AlarmState::ActiveUnacknowledged);
+  const auto wall = a.h.clock().system_now();
+  EXPECT_EQ(a.session().acknowledge_alarm(Code::SoaShutdown, a.h.clock().steady_now(), wall),
+            alarms::AckResult::Acknowledged);
+  EXPECT_EQ(a.last(Code::SoaShutdown), AlarmState::ActiveAcknowledged);
+  EXPECT_EQ(a.reports(Code::SoaShutdown).back().since, wall);
+  EXPECT_EQ(a.session().acknowledge_alarm(Code::SoaShutdown, a.h.clock().steady_now(), wall),
+            alarms::AckResult::NothingToAcknowledge);
+  EXPECT_EQ(a.session().acknowledge_alarm(Code::CellLow, a.h.clock().steady_now(), wall), alarms::AckResult::NotFound);
+  a.plant([](sim::Plant& p) { p.soa_shutdown = false; });
+  a.h.run_for(1s);
+  EXPECT_EQ(a.last(Code::SoaShutdown), AlarmState::Normal) << "acknowledged while active: nothing left to latch";
+}
+
 TEST(PmuAlarms, ASilentUnitIsStaleThenOfflineAndBothClearWhenItIsBack) {
   PmuAlarms a;
   a.faults([](sim::Faults& f) { f.silent = true; });

@@ -33,6 +33,12 @@ void AlarmFeed::tick(SteadyTime now, WallTime wall) {
   for (const auto code : set_.tick(now)) changed(code, wall);
 }
 
+alarms::AckResult AlarmFeed::acknowledge(alarms::Code code, SteadyTime now, WallTime wall) {
+  const auto r = set_.acknowledge(code, now);
+  if (r == alarms::AckResult::Acknowledged) changed(code, wall);
+  return r;
+}
+
 void AlarmFeed::move_to(std::uint16_t device) {
   device_ = device;
   for (const auto* a : set_.not_normal()) report(*a);

@@ -27,6 +27,8 @@ class AlarmFeed {
   void observe(alarms::Code code, double value, SteadyTime now, WallTime wall);
   void observe_flag(alarms::Code code, bool set, SteadyTime now, WallTime wall);
   void tick(SteadyTime now, WallTime wall);
+  // An operator's acknowledgement; reported when it changed the state.
+  alarms::AckResult acknowledge(alarms::Code code, SteadyTime now, WallTime wall);
 
   // The device answers at another address now: every alarm that is not NORMAL is reported
   // again under it, with the time of its last change, so the new key has the whole picture.

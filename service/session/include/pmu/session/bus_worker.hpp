@@ -107,6 +107,10 @@ class BusWorker final : private transport::BusHandler {
   transport::CanBus& bus() noexcept { return *bus_; }
   // The bus's own alarms. Worker thread only (or before run()).
   const alarms::AlarmSet& bus_alarms() const noexcept { return bus_alarms_.set(); }
+  // As DeviceSession::acknowledge_alarm, at the worker's clock's time.
+  alarms::AckResult acknowledge_bus_alarm(alarms::Code code) {
+    return bus_alarms_.acknowledge(code, clock_.steady_now(), clock_.system_now());
+  }
 
   // Incremented every turn: the watchdog feeds only while this moves. Thread-safe.
   std::uint64_t progress() const noexcept { return progress_.load(std::memory_order_relaxed); }

@@ -65,6 +65,10 @@ class CanOpenSession {
   const BatteryCellsState& cells() const noexcept { return cells_; }
   const MpptState& mppt() const noexcept { return mppt_; }
   const alarms::AlarmSet& alarms() const noexcept { return alarms_.set(); }
+  // As DeviceSession::acknowledge_alarm.
+  alarms::AckResult acknowledge_alarm(alarms::Code code, SteadyTime now, WallTime wall) {
+    return alarms_.acknowledge(code, now, wall);
+  }
 
  private:
   // One published topic's schedule.

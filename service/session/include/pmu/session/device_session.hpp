@@ -141,6 +141,11 @@ class DeviceSession {
   std::optional<codec::FirmwareVersion> firmware() const noexcept { return reading_.firmware(); }
   const HealthReport& health() const noexcept { return health_.report(); }
   const alarms::AlarmSet& alarms() const noexcept { return alarms_.set(); }
+  // An operator acknowledged `code` (ACTIVE -> ACTIVE_ACKNOWLEDGED, CLEARED -> NORMAL).
+  alarms::AckResult acknowledge_alarm(alarms::Code code, SteadyTime now, WallTime wall) {
+    now_ = now;
+    return alarms_.acknowledge(code, now, wall);
+  }
   bool ready() const noexcept { return reading_.running(); }
   std::size_t queued() const noexcept { return queue_.size(); }
 
