@@ -5,7 +5,7 @@
 #   1. pmu-service --check-config accepts deploy/pmu-service.yaml, also with its commented
 #      examples (polling device, discovery, simulated bus, qos_file, dds_statistics,
 #      dds_type_objects,
-#      batteries, MPPTs)
+#      batteries, MPPTs, alarm settings)
 #      switched on, and
 #      rejects a misspelt key (so the check really checks);
 #   2. deploy/install.sh --dry-run changes nothing; a DESTDIR install puts every file in
@@ -91,6 +91,23 @@ grep -q "^    batteries:$" "$canopen" && grep -q "^      - node: 2$" "$canopen" 
   fail "the battery/MPPT examples did not switch on as keys of the bus"
 out=$("$service_bin" --config "$canopen" --check-config 2>&1) ||
   fail "pmu-service rejected the battery and MPPT examples: $out"
+echo "$out"
+grep -q "configuration OK (1 bus(es))" <<<"$out" || fail "unexpected check-config output: $out"
+
+step "check-config with the alarm settings examples switched on"
+# On top of the battery and MPPT examples: a device's, the battery's, the MPPT's and the
+# bus's alarms.
+with_alarms="$work/alarms.yaml"
+sed -e '/^        # alarms:$/,/^        #   payload_shed:/ s/# //' \
+    -e '/^    #     alarms:$/,/^    #       [a-z_]*: {.*}$/ s/# //' \
+    -e '/^    # alarms:$/,/^    #   bus_error_passive:/ s/# //' \
+    "$canopen" > "$with_alarms"
+# device (5) + battery (2) + MPPT (2) + bus (2)
+changed_lines=$(diff "$canopen" "$with_alarms" | grep -c '^>' || true)
+[ "$changed_lines" -eq 11 ] ||
+  fail "expected 11 alarm example lines to switch on, got $changed_lines (were the commented examples changed?)"
+out=$("$service_bin" --config "$with_alarms" --check-config 2>&1) ||
+  fail "pmu-service rejected the alarm settings examples: $out"
 echo "$out"
 grep -q "configuration OK (1 bus(es))" <<<"$out" || fail "unexpected check-config output: $out"
 

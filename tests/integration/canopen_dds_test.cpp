@@ -108,7 +108,7 @@ TEST(DdsCanOpen, HealthHasAnInstancePerDeviceKind) {
   auto& health = client.reader(client.topic(topics::kHealth, TypeSupport(new pmu::v4::HealthPubSubType())),
                                qos_profiles::kState);
   BusConfig config = bus_with_battery_and_mppt();
-  config.mppts.push_back(MpptConfig{2, 1000ms});  // configured, never heard
+  config.mppts.push_back(MpptConfig{2, 1000ms, {}});  // configured, never heard
   Harness h(config, {pmu(1)}, Timeouts{}, &publisher);
   BusThread bus(h, document_frames());
 

@@ -108,7 +108,7 @@ TEST(CanOpenSession, EveryBatteryValueOfTheDocumentReachesItsFieldInItsUnit) {
     RecordingSink sink;
     CanOpenSession s(battery_key(), 1s, 200ms, thresholds(), sink, t0);
     s.on_frame(canopen_frame(row.cob_id, row.index, row.subindex, row.bytes), t0, w0);
-    s.tick(t0);
+    s.tick(t0, {});
     ASSERT_EQ(sink.batteries.size(), 1u);
     EXPECT_TRUE(sink.cells.empty());
     EXPECT_EQ(sink.batteries[0].key, battery_key());
@@ -128,7 +128,7 @@ TEST(CanOpenSession, EveryMpptValueOfTheDocumentReachesItsField) {
     CanOpenSession s(mppt_key(3), 1s, 200ms, thresholds(), sink, t0);
     ASSERT_EQ(canopen_device("can0", canopen_frame(row.cob_id, 0, row.subindex, row.bytes)), mppt_key(3));
     s.on_frame(canopen_frame(row.cob_id, row.index, row.subindex, row.bytes), t0, w0);
-    s.tick(t0);
+    s.tick(t0, {});
     ASSERT_EQ(sink.mppts.size(), 1u);
     const bool map = std::string(row.field).rfind("channel_", 0) == 0;
     expect_only(sink.mppts[0].state, kMpptValues, row,
@@ -170,7 +170,7 @@ TEST(CanOpenSession, CellVoltagesGoToTheirOwnTopicByCellNumber) {
   CanOpenSession s(battery_key(), 1s, 200ms, thresholds(), sink, t0);
   s.on_frame(canopen_frame(0x482, 0x2000, 1, {0xE5, 0x0C}), t0, w0);        // cell 1: 3301 mV
   s.on_frame(canopen_frame(0x482, 0x2000, 12, {0xE7, 0x0C}), t0, w0 + 1ms);  // cell 12: 3303 mV
-  s.tick(t0);
+  s.tick(t0, {});
   EXPECT_TRUE(sink.batteries.empty()) << "cells are not battery values";
   ASSERT_EQ(sink.cells.size(), 1u);
   const auto& v = sink.cells[0].state.volts;
@@ -188,26 +188,26 @@ TEST(CanOpenSession, OneSamplePerPublishPeriodWithTheNewestFramesTime) {
   // A burst in one turn: one sample with both values and the later frame's time.
   s.on_frame(canopen_frame(0x302, 0x2005, 0x01, {0x39, 0x30}), t0, w0 + 5ms);
   s.on_frame(canopen_frame(0x302, 0x2005, 0x05, {50}), t0, w0 + 7ms);
-  s.tick(t0);
+  s.tick(t0, {});
   ASSERT_EQ(sink.batteries.size(), 1u);
   EXPECT_EQ(sink.batteries[0].newest, w0 + 7ms);
   EXPECT_NEAR(sink.batteries[0].state.values[*battery_slot("voltage")], 12.345, 1e-9);
   EXPECT_EQ(sink.batteries[0].state.values[*battery_slot("state_of_charge")], 50);
   // Within the period: held back, not lost.
   s.on_frame(canopen_frame(0x302, 0x2005, 0x05, {49}), t0 + 50ms, w0 + 55ms);
-  s.tick(t0 + 50ms);
-  s.tick(t0 + 199ms);
+  s.tick(t0 + 50ms, {});
+  s.tick(t0 + 199ms, {});
   EXPECT_EQ(sink.batteries.size(), 1u);
-  s.tick(t0 + 200ms);
+  s.tick(t0 + 200ms, {});
   ASSERT_EQ(sink.batteries.size(), 2u);
   EXPECT_EQ(sink.batteries[1].state.values[*battery_slot("state_of_charge")], 49);
   EXPECT_EQ(sink.batteries[1].newest, w0 + 55ms);
   // Nothing new: nothing published.
-  s.tick(t0 + 1000ms);
+  s.tick(t0 + 1000ms, {});
   EXPECT_EQ(sink.batteries.size(), 2u);
   // A frame whose receive time is older than one already in the state keeps the newest time.
   s.on_frame(canopen_frame(0x302, 0x2005, 0x01, {0x3A, 0x30}), t0 + 1100ms, w0 + 40ms);
-  s.tick(t0 + 1100ms);
+  s.tick(t0 + 1100ms, {});
   ASSERT_EQ(sink.batteries.size(), 3u);
   EXPECT_EQ(sink.batteries[2].newest, w0 + 55ms);
 }
@@ -216,11 +216,11 @@ TEST(CanOpenSession, AfterOfflineEveryValueIsForgotten) {
   RecordingSink sink;
   CanOpenSession s(battery_key(), 1s, 200ms, thresholds(), sink, t0);
   s.on_frame(canopen_frame(0x302, 0x2005, 0x01, {0x39, 0x30}), t0, w0);
-  s.tick(t0);
-  s.tick(t0 + 10001ms);  // 10 periods of 1 s without a frame
+  s.tick(t0, {});
+  s.tick(t0 + 10001ms, {});  // 10 periods of 1 s without a frame
   EXPECT_EQ(s.health().state, HealthState::Offline);
   s.on_frame(canopen_frame(0x302, 0x2005, 0x05, {40}), t0 + 12s, w0 + 12s);
-  s.tick(t0 + 12s);
+  s.tick(t0 + 12s, {});
   ASSERT_EQ(sink.batteries.size(), 2u);
   const auto& after = sink.batteries[1].state;
   EXPECT_TRUE(std::isnan(after.values[*battery_slot("voltage")])) << "the old unit's voltage must not survive";
@@ -233,19 +233,19 @@ TEST(CanOpenSession, AfterOfflineEveryValueIsForgotten) {
 TEST(CanOpenSession, HealthFollowsTheConfiguredPeriod) {
   RecordingSink sink;
   CanOpenSession s(battery_key(), 2s, 200ms, thresholds(), sink, t0);
-  s.tick(t0);
+  s.tick(t0, {});
   EXPECT_EQ(s.health().state, HealthState::Unknown);
-  s.tick(t0 + 20001ms);  // never heard: OFFLINE after offline_periods x period
+  s.tick(t0 + 20001ms, {});  // never heard: OFFLINE after offline_periods x period
   EXPECT_EQ(s.health().state, HealthState::Offline);
   const Steady t1 = t0 + 30s;
   s.on_frame(canopen_frame(0x202, 0, 0, {80}), t1, w0);
-  s.tick(t1);
+  s.tick(t1, {});
   EXPECT_EQ(s.health().state, HealthState::Online);
-  s.tick(t1 + 6000ms);  // 3 x 2 s: still ONLINE
+  s.tick(t1 + 6000ms, {});  // 3 x 2 s: still ONLINE
   EXPECT_EQ(s.health().state, HealthState::Online);
-  s.tick(t1 + 6001ms);  // a silent BMS is noticed after stale_periods x period
+  s.tick(t1 + 6001ms, {});  // a silent BMS is noticed after stale_periods x period
   EXPECT_EQ(s.health().state, HealthState::Stale);
-  s.tick(t1 + 20001ms);
+  s.tick(t1 + 20001ms, {});
   EXPECT_EQ(s.health().state, HealthState::Offline);
   ASSERT_FALSE(sink.healths.empty());
   EXPECT_EQ(sink.healths.back().first, battery_key());
@@ -257,7 +257,7 @@ TEST(CanOpenSession, AFrameThatDoesNotDecodeCountsAndPublishesNothing) {
   CanOpenSession s(battery_key(), 1s, 200ms, thresholds(), sink, t0);
   s.on_frame(canopen_frame(0x302, 0x2005, 0x06, {1, 2}), t0, w0);  // 0x06 is blank in the document
   s.on_frame(canopen_frame(0x302, 0x2005, 0x01, {}), t0, w0);      // too short for a value
-  s.tick(t0);
+  s.tick(t0, {});
   EXPECT_TRUE(sink.batteries.empty());
   EXPECT_EQ(s.health().decode_errors, 2u);
   EXPECT_EQ(s.health().frames_received, 2u);

@@ -200,7 +200,7 @@ TEST(CommandRun, AnotherCommandsFailureLeavesAQueuedAddressChangesAliasAlone) {
   DeviceSession s({"can0", 1}, dc, timeouts, sink, [](const codec::CanFrame&) { return transport::SendResult{}; },
                   t0);
   auto t = t0;
-  for (int i = 0; i < 100 && s.queued() > 0; ++i) s.tick(t += 100ms);  // a silent device: the reading round fails
+  for (int i = 0; i < 100 && s.queued() > 0; ++i) s.tick(t += 100ms, {});  // a silent device: the reading round fails
   ASSERT_EQ(s.queued(), 0u);
 
   std::vector<CommandReplyData> replies;
@@ -212,7 +212,7 @@ TEST(CommandRun, AnotherCommandsFailureLeavesAQueuedAddressChangesAliasAlone) {
   move.expires = t + 10s;
   execute_command(s, move, t, timeouts, collect);
   EXPECT_EQ(s.alias(), std::optional<std::uint16_t>(7));
-  for (int i = 0; i < 100 && replies.empty(); ++i) s.tick(t += 100ms);
+  for (int i = 0; i < 100 && replies.empty(); ++i) s.tick(t += 100ms, {});
   ASSERT_EQ(replies.size(), 1u);
   EXPECT_EQ(replies[0].kind, CommandKind::SetOutputs);
   EXPECT_EQ(replies[0].result, CommandResult::Timeout);

@@ -75,14 +75,16 @@ constexpr std::array<AlarmSpec, kCodeCount> kTable{{
      6, 5000ms, 10000ms, Chosen},
     {Code::BatteryBOverTemperature, "battery_b_over_temperature", "battery B", Pmu, Critical, Above, 60, "degC", 0,
      6, 5000ms, 10000ms, Chosen},
-    // The PMU reports no such fault: whoever feeds the alarm raises the flag while generation
-    // is enabled (table 6, flag register 0 bit 4) and the generator turns (rpm > 0) but its
-    // voltage is below V_B, so it cannot charge. 10 s on as for the battery voltages: while
-    // the engine comes up to speed the voltage lags.
+    // The PMU reports no such fault: the PMU's session raises the flag while generation is
+    // enabled (table 6, flag register 0 bit 4) and the engine is at its running speed (the
+    // unit's engine.running_rpm) but the generator voltage (table 2) is below V_B, so it
+    // cannot charge. 10 s on as for the battery voltages: while the engine comes up to speed
+    // the voltage lags.
     {Code::GeneratorNotProducing, "generator_not_producing", "generator not producing", Pmu, Warning, Flag, 0, "", 0,
      0, 10000ms, 5000ms, Chosen},
-    // Whoever feeds the alarm raises the flag when the generator rpm (table 6) falls to 0 with
-    // no engine stop command (0x25) sent. 1 s on: two or more status packets at the service's
+    // The PMU's session raises the flag when the generator speed (table 6) falls below the
+    // unit's engine.running_rpm, having been at it, with no engine stop command (0x25) sent.
+    // 1 s on: two or more status packets at the service's
     // usual 0.5 s, so one bad reading is not a stopped engine. Critical: the aircraft is on
     // battery alone.
     {Code::UncommandedEngineStop, "uncommanded_engine_stop", "engine stopped uncommanded", Pmu, Critical, Flag, 0, "",
@@ -105,9 +107,9 @@ constexpr std::array<AlarmSpec, kCodeCount> kTable{{
     {Code::BmsOverTemperature, "bms_over_temperature", "cells", Battery, Critical, Above, 60, "degC", 0, 6, 5000ms,
      10000ms, Chosen},
     // The document names "MPPT State" (uint8) and "Safety Enabled" (bool) without their
-    // values, so which of them is a fault is for whoever feeds the alarm to say; 5 s each way
-    // so a state passed through on a change of light raises nothing. A warning: the battery
-    // still carries the load.
+    // values, so nothing says which is a fault, and the MPPT's session feeds nothing here
+    // until a document does. 5 s each way so a state passed through on a change of light
+    // raises nothing. A warning: the battery still carries the load.
     {Code::MpptFault, "mppt_fault", "MPPT fault", Mppt, Warning, Flag, 0, "", 0, 0, 5000ms, 5000ms, Chosen},
     // The service's health (STALE / OFFLINE from frame age, docs/interface.md) already waits
     // its configured number of periods, so no delays here.

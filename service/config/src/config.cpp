@@ -27,6 +27,7 @@
 #include "pmu/config/statistics_settings.hpp"
 #include "pmu/config/vehicle.hpp"
 #include "pmu/version.hpp"
+#include "alarm_settings.hpp"
 
 namespace pmu::service {
 namespace {
@@ -246,11 +247,12 @@ void parse_device_settings(const Ctx& c, const YAML::Node& n, DeviceConfig& d) {
     d.engine.running_rpm = static_cast<std::uint16_t>(c.integer(p, "engine_running_rpm", 1, 65534));
   if (const auto p = n["engine_running_hold"])
     d.engine.running_hold = std::chrono::milliseconds(std::lround(c.number(p, "engine_running_hold", 0, 25.5) * 1000));
+  if (const auto p = n["alarms"]) d.alarms = parse_alarm_settings(p, alarms::DeviceKind::Pmu, c.source);
 }
 
 DeviceConfig parse_device(const Ctx& c, const YAML::Node& n, BusConfig& b) {
   c.only_keys(n, "device", {"address", "mode", "period", "packets", "configure_streaming", "engine_running_rpm",
-                            "engine_running_hold", "sim"});
+                            "engine_running_hold", "sim", "alarms"});
   refuse_sim_on_real_bus(c, n, b.interface);
   DeviceConfig d;
   const auto a = n["address"];
@@ -273,7 +275,7 @@ void parse_batteries(const Ctx& c, const YAML::Node& n, BusConfig& b) {
   if (!n.IsSequence()) c.fail(n, "batteries must be a list, e.g. [{node: 2, period: 1.0}]");
   std::set<std::uint8_t> seen;
   for (const auto& item : n) {
-    c.only_keys(item, "battery", {"node", "period", "sim"});
+    c.only_keys(item, "battery", {"node", "period", "sim", "alarms"});
     refuse_sim_on_real_bus(c, item, b.interface);
     BatteryConfig bat;
     const auto node = item["node"];
@@ -283,6 +285,7 @@ void parse_batteries(const Ctx& c, const YAML::Node& n, BusConfig& b) {
     bat.node = static_cast<std::uint8_t>(c.integer(node, "node", 2, 2));
     if (const auto p = item["period"]) bat.period = canopen_period(c, p);
     if (const auto v = item["sim"]) b.sim.batteries[bat.node] = parse_battery_sim(c, v);
+    if (const auto p = item["alarms"]) bat.alarms = parse_alarm_settings(p, alarms::DeviceKind::Battery, c.source);
     if (!seen.insert(bat.node).second)
       c.fail(item, "battery node " + std::to_string(bat.node) + " appears twice on bus " + b.name);
     b.batteries.push_back(bat);
@@ -293,7 +296,7 @@ void parse_mppts(const Ctx& c, const YAML::Node& n, BusConfig& b) {
   if (!n.IsSequence()) c.fail(n, "mppts must be a list, e.g. [{device: 0, period: 1.0}]");
   std::set<std::uint8_t> seen;
   for (const auto& item : n) {
-    c.only_keys(item, "mppt", {"device", "period", "sim"});
+    c.only_keys(item, "mppt", {"device", "period", "sim", "alarms"});
     refuse_sim_on_real_bus(c, item, b.interface);
     MpptConfig m;
     const auto device = item["device"];
@@ -301,6 +304,7 @@ void parse_mppts(const Ctx& c, const YAML::Node& n, BusConfig& b) {
     m.device = static_cast<std::uint8_t>(c.integer(device, "device", 0, 7));
     if (const auto p = item["period"]) m.period = canopen_period(c, p);
     if (const auto v = item["sim"]) b.sim.mppts[m.device] = parse_mppt_sim(c, v);
+    if (const auto p = item["alarms"]) m.alarms = parse_alarm_settings(p, alarms::DeviceKind::Mppt, c.source);
     if (!seen.insert(m.device).second)
       c.fail(item, "mppt device " + std::to_string(m.device) + " appears twice on bus " + b.name);
     b.mppts.push_back(m);
@@ -308,7 +312,8 @@ void parse_mppts(const Ctx& c, const YAML::Node& n, BusConfig& b) {
 }
 
 BusConfig parse_bus(const Ctx& c, const YAML::Node& n) {
-  c.only_keys(n, "bus", {"name", "interface", "bitrate", "devices", "discover", "batteries", "mppts", "listen_canopen"});
+  c.only_keys(n, "bus", {"name", "interface", "bitrate", "devices", "discover", "batteries", "mppts", "listen_canopen",
+                         "alarms"});
   BusConfig b;
   b.source_line = c.line_of(n);
   const auto iface = n["interface"];
@@ -332,7 +337,8 @@ BusConfig parse_bus(const Ctx& c, const YAML::Node& n) {
       b.discover = c.scalar<bool>(d, "discover", "true, false or a mapping of device settings");
     } else {
       c.only_keys(d, "discover",
-                  {"mode", "period", "packets", "configure_streaming", "engine_running_rpm", "engine_running_hold"});
+                  {"mode", "period", "packets", "configure_streaming", "engine_running_rpm", "engine_running_hold",
+                   "alarms"});
       b.discover = true;
       parse_device_settings(c, d, b.discovered_defaults);
     }
@@ -350,6 +356,7 @@ BusConfig parse_bus(const Ctx& c, const YAML::Node& n) {
   if (const auto v = n["batteries"]) parse_batteries(c, v, b);
   if (const auto v = n["mppts"]) parse_mppts(c, v, b);
   if (const auto v = n["listen_canopen"]) b.listen_canopen = c.scalar<bool>(v, "listen_canopen", "true or false");
+  if (const auto v = n["alarms"]) b.alarms = parse_alarm_settings(v, alarms::DeviceKind::Bus, c.source);
   if (b.devices.empty() && !b.discover && !b.wants_canopen())
     c.fail(n, "bus " + b.name + " has no devices, batteries or mppts, and discover and listen_canopen are off");
   return b;

@@ -52,14 +52,17 @@ BusWorker::BusWorker(BusConfig config, std::unique_ptr<transport::CanBus> bus, c
       clock_(clock),
       timeouts_(timeouts),
       sink_(sink),
+      bus_alarms_(config_.name, alarms::DeviceKind::Bus, 0, config_.alarms, sink),
       loop_(clock, config_.name) {
   const int error = loop_.watch(bus_->fd(), transport::EventLoop::kReadable,
                                 [this](std::uint32_t) { turn_frames_ += bus_->drain(*this).frames; });
   if (error != 0) throw std::system_error(error, std::generic_category(), "epoll_ctl");
   const auto now = clock_.steady_now();
   for (const auto& d : config_.devices) add_session(d);
-  for (const auto& b : config_.batteries) add_canopen_session({config_.name, b.node, DeviceKind::Battery}, b.period);
-  for (const auto& m : config_.mppts) add_canopen_session({config_.name, m.device, DeviceKind::Mppt}, m.period);
+  for (const auto& b : config_.batteries)
+    add_canopen_session({config_.name, b.node, DeviceKind::Battery}, b.period, b.alarms);
+  for (const auto& m : config_.mppts) add_canopen_session({config_.name, m.device, DeviceKind::Mppt}, m.period, m.alarms);
+  feed_bus_alarms(bus_->state());
   // Both due at the first turn. Of two timers due together the one added first fires first:
   // discovery before maintenance, their order when they were checks at the end of a turn.
   if (config_.discover)
@@ -81,10 +84,11 @@ DeviceSession& BusWorker::add_session(const DeviceConfig& device) {
   return ref;
 }
 
-CanOpenSession& BusWorker::add_canopen_session(DeviceKey key, milliseconds period) {
+CanOpenSession& BusWorker::add_canopen_session(DeviceKey key, milliseconds period,
+                                               const alarms::DeviceSettings& alarms) {
   const auto id = std::make_pair(key.kind, key.address);
   auto s = std::make_unique<CanOpenSession>(std::move(key), period, config_.canopen_publish_period, timeouts_, sink_,
-                                            clock_.steady_now());
+                                            clock_.steady_now(), alarms);
   auto& ref = *s;
   canopen_[id] = std::move(s);
   ref.on_bus_state(bus_->state(), clock_.steady_now());
@@ -162,6 +166,17 @@ void BusWorker::on_event(const transport::BusEvent& event) {
   const auto now = clock_.steady_now();
   for (auto& [a, s] : sessions_) s->on_bus_state(event.state, now);
   for (auto& [id, s] : canopen_) s->on_bus_state(event.state, now);
+  feed_bus_alarms(event.state);
+}
+
+// Error passive holds at bus off too (both mean an error counter past 127), so it does not
+// clear as the bus gets worse. DOWN (the interface) and ERROR_WARNING have no code.
+void BusWorker::feed_bus_alarms(transport::BusState state) {
+  const auto now = clock_.steady_now();
+  const auto wall = clock_.system_now();
+  const bool off = state == transport::BusState::BusOff;
+  bus_alarms_.observe_flag(alarms::Code::BusErrorPassive, off || state == transport::BusState::ErrorPassive, now, wall);
+  bus_alarms_.observe_flag(alarms::Code::BusOff, off, now, wall);
 }
 
 DeviceSession* BusWorker::session_with_serial(std::uint16_t serial) {
@@ -252,15 +267,17 @@ std::size_t BusWorker::run_once(milliseconds max_wait) {
 
 void BusWorker::end_turn() {
   const auto now = clock_.steady_now();
+  const auto wall = clock_.system_now();
   const auto counters = bus_->counters();
   for (auto& [a, s] : sessions_) {
     s->on_bus_counters(counters);
-    s->tick(now);
+    s->tick(now, wall);
   }
   for (auto& [id, s] : canopen_) {
     s->on_bus_counters(counters);
-    s->tick(now);
+    s->tick(now, wall);
   }
+  bus_alarms_.tick(now, wall);
   rekey_moved_sessions();
   progress_.fetch_add(1, std::memory_order_relaxed);
 }

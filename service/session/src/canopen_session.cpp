@@ -3,8 +3,24 @@
 #include <spdlog/spdlog.h>
 
 #include <algorithm>
+#include <limits>
+#include <string_view>
 
 namespace pmu::service {
+namespace {
+
+constexpr double kNotMeasured = std::numeric_limits<double>::quiet_NaN();
+
+alarms::DeviceKind alarm_kind(DeviceKind k) noexcept {
+  return k == DeviceKind::Mppt ? alarms::DeviceKind::Mppt : alarms::DeviceKind::Battery;
+}
+
+double value_of(const BatteryState& b, std::string_view name) noexcept {
+  const auto slot = battery_slot(name);
+  return slot ? b.values[*slot] : kNotMeasured;
+}
+
+}  // namespace
 
 std::optional<DeviceKey> canopen_device(const std::string& bus, const codec::CanFrame& frame) noexcept {
   namespace co = codec::canopen;
@@ -23,8 +39,9 @@ std::optional<DeviceKey> canopen_device(const std::string& bus, const codec::Can
 
 CanOpenSession::CanOpenSession(DeviceKey key, std::chrono::milliseconds period,
                                std::chrono::milliseconds publish_period, const Timeouts& timeouts, StateSink& sink,
-                               SteadyTime now)
-    : key_(std::move(key)), period_(period), publish_period_(publish_period), sink_(sink), health_(now, timeouts) {}
+                               SteadyTime now, const alarms::DeviceSettings& alarms)
+    : key_(std::move(key)), period_(period), publish_period_(publish_period), sink_(sink), health_(now, timeouts),
+      alarms_(key_.bus, alarm_kind(key_.kind), key_.address, alarms, sink) {}
 
 void CanOpenSession::on_frame(const codec::CanFrame& frame, SteadyTime now, WallTime received) {
   const bool was_offline = health_.offline();
@@ -42,6 +59,26 @@ void CanOpenSession::on_frame(const codec::CanFrame& frame, SteadyTime now, Wall
   };
   if (a.battery || a.mppt) mark(values_);
   if (a.cells) mark(cell_schedule_);
+  if (a.battery) feed_alarms(now, received);
+}
+
+// From the BMS's own figures (0x302, 0x402), so the alarms agree with what pmu/battery
+// shows: state of charge, its lowest cell, highest minus lowest cell, its highest cell
+// temperature. A value not received (NaN) holds the alarm. The MPPT feeds only its health:
+// the document names "MPPT State" (uint8) and "Safety Enabled" (bool) but gives none of their
+// values, so nothing it sends says "fault", and mppt_fault is never raised rather than
+// raised on a guess.
+void CanOpenSession::feed_alarms(SteadyTime now, WallTime wall) {
+  using alarms::Code;
+  if (key_.kind != DeviceKind::Battery) return;
+  const double soc = value_of(battery_, "state_of_charge");
+  const double cell_high = value_of(battery_, "cell_voltage_high");
+  const double cell_low = value_of(battery_, "cell_voltage_low");
+  alarms_.observe(Code::BmsLowSoc, soc, now, wall);
+  alarms_.observe(Code::BmsCriticalSoc, soc, now, wall);
+  alarms_.observe(Code::CellLow, cell_low, now, wall);
+  alarms_.observe(Code::CellImbalance, cell_high - cell_low, now, wall);  // NaN while either is
+  alarms_.observe(Code::BmsOverTemperature, value_of(battery_, "cell_temperature_high"), now, wall);
 }
 
 void CanOpenSession::forget(SteadyTime now) {
@@ -62,7 +99,7 @@ bool CanOpenSession::due(Schedule& s, SteadyTime now) const noexcept {
   return true;
 }
 
-void CanOpenSession::tick(SteadyTime now) {
+void CanOpenSession::tick(SteadyTime now, WallTime wall) {
   if (due(values_, now)) {
     if (key_.kind == DeviceKind::Mppt)
       sink_.on_mppt(key_, mppt_, values_.newest);
@@ -71,6 +108,12 @@ void CanOpenSession::tick(SteadyTime now) {
   }
   if (due(cell_schedule_, now)) sink_.on_battery_cells(key_, cells_, cell_schedule_.newest);
   update_health(now, false);
+  // As a PMU's (device_session.cpp): stale while STALE or OFFLINE, offline while OFFLINE.
+  const HealthState state = health_.report().state;
+  alarms_.observe_flag(alarms::Code::DeviceStale, state == HealthState::Stale || state == HealthState::Offline, now,
+                       wall);
+  alarms_.observe_flag(alarms::Code::DeviceOffline, state == HealthState::Offline, now, wall);
+  alarms_.tick(now, wall);
 }
 
 void CanOpenSession::on_bus_state(transport::BusState state, SteadyTime now) {

@@ -3,6 +3,9 @@
 #include <spdlog/spdlog.h>
 
 #include <algorithm>
+#include <cmath>
+#include <limits>
+#include <variant>
 
 #include "pmu/codec/encode.hpp"
 
@@ -12,6 +15,19 @@ namespace {
 using std::chrono::milliseconds;
 
 bool is_telemetry(codec::PacketId p) noexcept { return static_cast<std::uint8_t>(p) <= 0x04; }
+
+constexpr double kNotMeasured = std::numeric_limits<double>::quiet_NaN();
+
+// A battery input with nothing connected reads about 0 V: v1.9 table 2 has no "absent"
+// value, and the simulator takes a battery below 1 V as absent. Below 5 V the battery is
+// taken as absent and its voltage as not measured (NaN), so a PMU with one battery raises no
+// voltage alarm for the other, and an alarm already raised holds rather than clears when the
+// battery is pulled. 5 V leaves room for what an open input picks up, and no 6S pack in use
+// is that low (0.8 V a cell). A battery that goes absent raises nothing: the table has no
+// code for it.
+constexpr double kBatteryPresentVolts = 5.0;
+
+double battery_volts(double measured) noexcept { return measured < kBatteryPresentVolts ? kNotMeasured : measured; }
 
 }  // namespace
 
@@ -25,7 +41,8 @@ DeviceSession::DeviceSession(DeviceKey key, DeviceConfig device, const Timeouts&
             if (sent.ok()) health_.on_sent();
             return sent;
           },
-          timeouts.reply) {
+          timeouts.reply),
+      alarms_(key_.bus, alarms::DeviceKind::Pmu, key_.address, device.alarms, sink) {
   start_reading(now);
 }
 
@@ -126,7 +143,10 @@ void DeviceSession::on_frame(const codec::PmuId& id, const codec::CanFrame& fram
     update_health(now, false);
     return;  // a zero-length get: the question, not an answer
   }
-  if (is_telemetry(m->packet)) sink_.on_telemetry(key_, *m, received);
+  if (is_telemetry(m->packet)) {
+    sink_.on_telemetry(key_, *m, received);
+    feed_alarms(*m, now, received);
+  }
   absorb(*m);
   queue_.on_answer(*m, now);
   update_health(now, false);
@@ -150,6 +170,7 @@ void DeviceSession::move_to(std::uint16_t address, MoveCause cause, SteadyTime n
   gone_.erase(std::remove_if(gone_.begin(), gone_.end(), [address](const Gone& g) { return g.key.address == address; }),
               gone_.end());
   key_.address = address;
+  alarms_.move_to(address);
   alias_.reset();
   reading_.set_address(address);
   if (cause == MoveCause::ByItself) {
@@ -166,7 +187,7 @@ void DeviceSession::on_bus_state(transport::BusState state, SteadyTime now) {
   if (health_.on_bus_state(state)) update_health(now, true);
 }
 
-void DeviceSession::tick(SteadyTime now) {
+void DeviceSession::tick(SteadyTime now, WallTime wall) {
   now_ = now;
   while (!gone_.empty() && now >= gone_.front().at) {
     sink_.on_gone(gone_.front().key);
@@ -177,6 +198,8 @@ void DeviceSession::tick(SteadyTime now) {
   if (reading_.retry_due(now)) start_reading(now);
   if (reading_.running() && settings_.mode == TelemetryMode::Polling && now >= next_poll_) poll(now);
   update_health(now, false);
+  feed_health_alarms(now, wall);
+  alarms_.tick(now, wall);
 }
 
 void DeviceSession::at(SteadyTime when, std::function<void(SteadyTime)> fn) { timers_.push_back({when, std::move(fn)}); }
@@ -197,6 +220,11 @@ void DeviceSession::run_timers(SteadyTime now) {
 
 void DeviceSession::on_engine_stop(const std::string& request_id, SteadyTime now) {
   now_ = now;
+  // Whatever the engine does next is what was asked. An engine that stopped by itself before
+  // is now stopped on purpose too: its alarm clears at the next 0x04, and, critical, waits
+  // for an acknowledgement.
+  engine_.stop_commanded = true;
+  engine_.stopped_by_itself = false;
   if (!engine_start_) return;
   auto stop = std::move(engine_start_->on_stop);
   engine_start_.reset();
@@ -234,6 +262,88 @@ void DeviceSession::update_health(SteadyTime now, bool force) {
                 "{}/{}: {} (last frame {:.1f} s ago)", key_.bus, key_.address, to_string(report.state),
                 report.last_frame_age);
   if (u.publish) sink_.on_health(key_, report);
+}
+
+// What each decoded packet feeds (the codes: alarm_table.cpp; interface.md 1.6). A value the
+// packet does not carry, or carries as "no sensor", is NaN: the alarm holds its state.
+void DeviceSession::feed_alarms(const codec::PmuMessage& m, SteadyTime now, WallTime wall) {
+  using alarms::Code;
+  if (const auto* v = std::get_if<codec::Voltages>(&m.payload)) {
+    const double a = battery_volts(v->battery_a);
+    const double b = battery_volts(v->battery_b);
+    alarms_.observe(Code::BatteryALowVoltage, a, now, wall);
+    alarms_.observe(Code::BatteryACriticalVoltage, a, now, wall);
+    alarms_.observe(Code::BatteryBLowVoltage, b, now, wall);
+    alarms_.observe(Code::BatteryBCriticalVoltage, b, now, wall);
+    engine_.generator_volts = v->generator;
+    feed_engine_alarms(now, wall);
+  } else if (const auto* t = std::get_if<codec::Temperatures>(&m.payload)) {
+    alarms_.observe(Code::InternalOverTemperature, t->internal, now, wall);
+    alarms_.observe(Code::StarterOverTemperature, t->starter, now, wall);
+    alarms_.observe(Code::GeneratorOverTemperature, t->generator, now, wall);
+    alarms_.observe(Code::BatteryAOverTemperature, t->battery_a, now, wall);
+    alarms_.observe(Code::BatteryBOverTemperature, t->battery_b, now, wall);
+  } else if (const auto* s = std::get_if<codec::Status>(&m.payload)) {
+    alarms_.observe_flag(Code::ThermalShutdown, s->thermal_shutdown, now, wall);
+    // Bit 6 is the start button before firmware 1.16: only a decode that knew the firmware
+    // and read it as the SOA flag says anything about an SOA shutdown.
+    if (s->interpretation.bit6 == codec::Bit6Meaning::SoaShutdown && s->interpretation.firmware_known)
+      alarms_.observe_flag(Code::SoaShutdown, s->soa_shutdown, now, wall);
+    alarms_.observe_flag(Code::PayloadShed, s->payload_shed, now, wall);
+    // uncommanded_engine_stop: the engine "ran" while the generator speed (the engine's shaft,
+    // table 6) was at or above the unit's engine.running_rpm, the speed that also verifies an
+    // ENGINE_START. A fall below it with no engine stop sent since it came up to speed is the
+    // engine stopping by itself; the condition holds until it is at speed again (restarted)
+    // or a stop is sent. A start that fails never reaches the speed, so it never ran and
+    // raises nothing.
+    const bool at_speed = s->generator_rpm >= settings_.engine.running_rpm;
+    if (at_speed) {
+      if (!engine_.running) engine_.stop_commanded = false;  // a new run: an earlier stop is spent
+      engine_.running = true;
+      engine_.stopped_by_itself = false;
+    } else if (engine_.running) {
+      engine_.running = false;
+      engine_.stopped_by_itself = !engine_.stop_commanded;
+      engine_.stop_commanded = false;
+    }
+    alarms_.observe_flag(Code::UncommandedEngineStop, engine_.stopped_by_itself, now, wall);
+    engine_.status = *s;
+    feed_engine_alarms(now, wall);
+  }
+}
+
+// generator_not_producing: generation enabled (0x04 flag register 0 bit 4) and the engine
+// at running speed (0x04 speed >= engine.running_rpm: below it the engine is starting,
+// stopping or idling down, and a low voltage is expected), while the generator voltage (the
+// latest 0x00) is below V_B, the unit's stored battery charging voltage (0x13): below it the
+// generator can charge nothing. Only the voltage decides: 0x01 carries no generator current,
+// and the battery currents also depend on the chargers being enabled and the batteries being
+// full. Until the unit's V_B is read, or while either packet has not come since the session
+// started or the unit came back after OFFLINE, the input is not measured and the alarm holds
+// (a unit polled without voltages or status never feeds it).
+void DeviceSession::feed_engine_alarms(SteadyTime now, WallTime wall) {
+  const auto& vb = reading_.config().raw[static_cast<std::size_t>(codec::Parameter::BatteryVoltage)];
+  if (!engine_.status || !vb || std::isnan(engine_.generator_volts)) {
+    alarms_.observe(alarms::Code::GeneratorNotProducing, kNotMeasured, now, wall);
+    return;
+  }
+  const bool turning = engine_.status->generator_rpm >= settings_.engine.running_rpm;
+  const double charging_volts = codec::parameter_value(codec::Parameter::BatteryVoltage, *vb);
+  alarms_.observe_flag(alarms::Code::GeneratorNotProducing,
+                       engine_.status->generation_enabled && turning && engine_.generator_volts < charging_volts, now,
+                       wall);
+}
+
+// device_stale holds while the health is STALE or OFFLINE (no frame within stale_periods),
+// so it does not clear as the device gets worse; device_offline while it is OFFLINE. What the
+// engine alarms remembered is forgotten at OFFLINE: the unit may come back reset or replaced,
+// and an engine found stopped then was not seen to stop.
+void DeviceSession::feed_health_alarms(SteadyTime now, WallTime wall) {
+  const HealthState state = health_.report().state;
+  alarms_.observe_flag(alarms::Code::DeviceStale, state == HealthState::Stale || state == HealthState::Offline, now,
+                       wall);
+  alarms_.observe_flag(alarms::Code::DeviceOffline, state == HealthState::Offline, now, wall);
+  if (state == HealthState::Offline) engine_ = EngineView{};
 }
 
 }  // namespace pmu::service

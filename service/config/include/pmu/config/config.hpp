@@ -12,6 +12,7 @@
 #include <string>
 #include <vector>
 
+#include "pmu/alarms/settings.hpp"
 #include "pmu/codec/messages.hpp"
 #include "pmu/command/policy.hpp"
 #include "pmu/config/capacity.hpp"
@@ -52,6 +53,9 @@ struct DeviceConfig {
   // default: they live in the PMU's non-volatile memory and belong to whoever set it up.
   bool configure_streaming = false;
   EngineSettings engine;
+  // `alarms:` (interface.md 1.6): what this unit changes of the alarm table's defaults;
+  // checked by alarms::resolve when the config is read.
+  alarms::DeviceSettings alarms;
   // "FILE:LINE" of its `address:` in the config file, for the line to change when the unit
   // moves; empty for a device not from a file (discovered, built in).
   std::string source_line;
@@ -64,12 +68,14 @@ struct BatteryConfig {
   // Seconds between a BMS's frames of one value: health goes STALE after stale_periods and
   // OFFLINE after offline_periods of these without a frame.
   std::chrono::milliseconds period{1000};
+  alarms::DeviceSettings alarms;  // as DeviceConfig::alarms
 };
 
 // An MPPT on the bus, read-only; `device` 0..7 selects COB-IDs 0x4E6 + 8 x device (and + 1).
 struct MpptConfig {
   std::uint8_t device = 0;
   std::chrono::milliseconds period{1000};  // as BatteryConfig::period
+  alarms::DeviceSettings alarms;           // as DeviceConfig::alarms
 };
 
 struct BusConfig {
@@ -83,6 +89,8 @@ struct BusConfig {
   std::vector<MpptConfig> mppts;
   // Also serve batteries and MPPTs heard on the bus but not listed (with a period of 1 s).
   bool listen_canopen = false;
+  // `alarms:` of the bus's own alarms (bus_error_passive, bus_off).
+  alarms::DeviceSettings alarms;
   // True when the bus serves any battery or MPPT: its receive filters must pass CANopen ids.
   // pmu/battery, pmu/battery_cells and pmu/mppt get at most one sample per device per this
   // period (0: one per bus-loop turn that brought a value). The config's top-level

@@ -29,6 +29,9 @@
 // from the start (so a silent one goes OFFLINE); with `listen_canopen`, one heard but not
 // configured gets a session at its first frame, with a period of 1 s.
 //
+// Bus alarms: the worker owns the bus's AlarmSet (bus_error_passive, bus_off; source Bus,
+// device 0), fed from the bus state at start and at every change, its delays run every turn.
+//
 // Lifetime: `clock` and `sink` must outlive the worker, which keeps references to both
 // (main.cpp makes the SystemClock and the DdsPublisher before any worker and destroys the
 // workers first). The worker owns its bus and its sessions, whose send callback refers back
@@ -102,6 +105,12 @@ class BusWorker final : private transport::BusHandler {
   std::size_t device_count() const noexcept { return device_count_.load(std::memory_order_relaxed); }
   const BusConfig& config() const noexcept { return config_; }
   transport::CanBus& bus() noexcept { return *bus_; }
+  // The bus's own alarms. Worker thread only (or before run()).
+  const alarms::AlarmSet& bus_alarms() const noexcept { return bus_alarms_.set(); }
+  // As DeviceSession::acknowledge_alarm, at the worker's clock's time.
+  alarms::AckResult acknowledge_bus_alarm(alarms::Code code) {
+    return bus_alarms_.acknowledge(code, clock_.steady_now(), clock_.system_now());
+  }
 
   // Incremented every turn: the watchdog feeds only while this moves. Thread-safe.
   std::uint64_t progress() const noexcept { return progress_.load(std::memory_order_relaxed); }
@@ -110,7 +119,9 @@ class BusWorker final : private transport::BusHandler {
   void on_frame(const transport::ReceivedFrame& frame) override;
   void on_event(const transport::BusEvent& event) override;
   DeviceSession& add_session(const DeviceConfig& device);
-  CanOpenSession& add_canopen_session(DeviceKey key, std::chrono::milliseconds period);
+  CanOpenSession& add_canopen_session(DeviceKey key, std::chrono::milliseconds period,
+                                      const alarms::DeviceSettings& alarms = {});
+  void feed_bus_alarms(transport::BusState state);
   void on_canopen_frame(const transport::ReceivedFrame& frame);
   void discover();  // the broadcast firmware request (a loop timer, when config_.discover)
   void rekey_moved_sessions();
@@ -132,6 +143,7 @@ class BusWorker final : private transport::BusHandler {
   std::map<std::pair<DeviceKind, std::uint16_t>, std::unique_ptr<CanOpenSession>> canopen_;
   std::map<std::uint16_t, std::chrono::steady_clock::time_point> asked_;  // stranger -> next serial get allowed
   std::function<void(const Moved&)> moved_;
+  AlarmFeed bus_alarms_;
 
   transport::EventLoop loop_;
   std::size_t turn_frames_ = 0;  // frames drained in the run_once() turn in progress

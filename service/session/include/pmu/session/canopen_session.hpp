@@ -14,6 +14,11 @@
 // is a reconnect: every value is forgotten (NaN again) before the frame's own is stored, so a
 // sample never mixes a replaced or restarted unit's values with the old one's.
 //
+// Alarms (interface.md 1.6): the session owns the device's AlarmSet (kind Battery or Mppt),
+// built from its config settings, fed from the assembled values after every frame and from
+// its health at every tick; every change goes to StateSink::on_alarm (canopen_session.cpp
+// says what feeds which code).
+//
 // No I/O and no clock of its own: time comes in with every call.
 //
 // Lifetime: `sink` must outlive the session, which keeps a reference (the DdsPublisher in the
@@ -27,6 +32,7 @@
 
 #include "pmu/codec/can_frame.hpp"
 #include "pmu/config/config.hpp"
+#include "pmu/session/alarm_feed.hpp"
 #include "pmu/session/canopen_state.hpp"
 #include "pmu/session/device_state.hpp"
 #include "pmu/session/health_tracker.hpp"
@@ -40,22 +46,29 @@ std::optional<DeviceKey> canopen_device(const std::string& bus, const codec::Can
 
 class CanOpenSession {
  public:
-  // `key.kind` is Battery or Mppt.
+  // `key.kind` is Battery or Mppt; `alarms` the device's alarm settings (its config entry's).
   CanOpenSession(DeviceKey key, std::chrono::milliseconds period, std::chrono::milliseconds publish_period,
-                 const Timeouts& timeouts, StateSink& sink, SteadyTime now);
+                 const Timeouts& timeouts, StateSink& sink, SteadyTime now,
+                 const alarms::DeviceSettings& alarms = {});
 
   const DeviceKey& key() const noexcept { return key_; }
   // A frame whose id canopen_device() gave this session's key.
   void on_frame(const codec::CanFrame& frame, SteadyTime now, WallTime received);
   void on_bus_state(transport::BusState state, SteadyTime now);
   void on_bus_counters(const transport::BusCounters& counters) noexcept { health_.on_bus_counters(counters); }
-  // Publishes what is due and keeps health current. Call at the end of every bus-loop turn.
-  void tick(SteadyTime now);
+  // Publishes what is due, keeps health current and runs the alarms' delays. Call at the end
+  // of every bus-loop turn; `wall` is the wall time of `now`.
+  void tick(SteadyTime now, WallTime wall);
 
   const HealthReport& health() const noexcept { return health_.report(); }
   const BatteryState& battery() const noexcept { return battery_; }
   const BatteryCellsState& cells() const noexcept { return cells_; }
   const MpptState& mppt() const noexcept { return mppt_; }
+  const alarms::AlarmSet& alarms() const noexcept { return alarms_.set(); }
+  // As DeviceSession::acknowledge_alarm.
+  alarms::AckResult acknowledge_alarm(alarms::Code code, SteadyTime now, WallTime wall) {
+    return alarms_.acknowledge(code, now, wall);
+  }
 
  private:
   // One published topic's schedule.
@@ -67,12 +80,14 @@ class CanOpenSession {
   bool due(Schedule& s, SteadyTime now) const noexcept;
   void forget(SteadyTime now);
   void update_health(SteadyTime now, bool force);
+  void feed_alarms(SteadyTime now, WallTime wall);
 
   DeviceKey key_;
   std::chrono::milliseconds period_;
   std::chrono::milliseconds publish_period_;
   StateSink& sink_;
   HealthTracker health_;
+  AlarmFeed alarms_;
 
   BatteryState battery_;
   BatteryCellsState cells_;

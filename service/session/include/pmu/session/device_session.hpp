@@ -21,8 +21,16 @@
 // frame); the session decodes the payload with the firmware it knows, so firmware-
 // dependent packets are read right from the first frame after the firmware is known.
 //
+// Alarms (alarms room, interface.md 1.6): the session owns the unit's AlarmSet, built from
+// its config settings, feeds it from every decoded telemetry packet and from its health,
+// and reports every change of state through StateSink::on_alarm. What feeds which code, and
+// the rules for inputs the PMU does not report as such (an absent battery, a generator that
+// does not produce, an engine that stops by itself), are in device_session.cpp at
+// feed_alarms().
+//
 // No I/O and no clock of its own: frames go out through a send callback, time comes in
-// through every call, so tests drive it with a fake clock.
+// through every call (steady for waits, wall for what is reported), so tests drive it with a
+// fake clock.
 //
 // Lifetime: `sink` must outlive the session, which keeps a reference (the DdsPublisher in the
 // daemon: main.cpp makes it before the bus workers that own the sessions, and destroys it
@@ -35,12 +43,14 @@
 #include <chrono>
 #include <cstdint>
 #include <functional>
+#include <limits>
 #include <optional>
 #include <string>
 #include <vector>
 
 #include "pmu/codec/decode.hpp"
 #include "pmu/config/config.hpp"
+#include "pmu/session/alarm_feed.hpp"
 #include "pmu/session/device_state.hpp"
 #include "pmu/session/health_tracker.hpp"
 #include "pmu/session/reading_machine.hpp"
@@ -62,8 +72,9 @@ class DeviceSession {
   void on_decode_error() noexcept { health_.on_decode_error(); }
   void on_bus_state(transport::BusState state, SteadyTime now);
   void on_bus_counters(const transport::BusCounters& counters) noexcept { health_.on_bus_counters(counters); }
-  // Timeouts, polling, health. Call at least every few tens of ms.
-  void tick(SteadyTime now);
+  // Timeouts, polling, health, alarm delays. Call at least every few tens of ms; `wall` is
+  // the wall time of `now`, for the alarms that change in it.
+  void tick(SteadyTime now, WallTime wall);
 
   // Queues a request behind those already waiting.
   void submit(Request request, SteadyTime now);
@@ -86,7 +97,8 @@ class DeviceSession {
   };
   void set_engine_start(std::optional<EngineStartInProgress> start) { engine_start_ = std::move(start); }
   const std::optional<EngineStartInProgress>& engine_start() const noexcept { return engine_start_; }
-  // An engine stop (`request_id`) is on its way to this unit: ends the start in progress.
+  // An engine stop (`request_id`) is on its way to this unit: ends the start in progress, and
+  // the engine's next fall below running speed is not uncommanded_engine_stop.
   void on_engine_stop(const std::string& request_id, SteadyTime now);
 
   // During a CAN address change, frames from `alias` belong to this session too; move_to()
@@ -128,6 +140,12 @@ class DeviceSession {
   const std::optional<InfoState>& info() const noexcept { return reading_.info(); }
   std::optional<codec::FirmwareVersion> firmware() const noexcept { return reading_.firmware(); }
   const HealthReport& health() const noexcept { return health_.report(); }
+  const alarms::AlarmSet& alarms() const noexcept { return alarms_.set(); }
+  // An operator acknowledged `code` (ACTIVE -> ACTIVE_ACKNOWLEDGED, CLEARED -> NORMAL).
+  alarms::AckResult acknowledge_alarm(alarms::Code code, SteadyTime now, WallTime wall) {
+    now_ = now;
+    return alarms_.acknowledge(code, now, wall);
+  }
   bool ready() const noexcept { return reading_.running(); }
   std::size_t queued() const noexcept { return queue_.size(); }
 
@@ -143,6 +161,9 @@ class DeviceSession {
   void absorb(const codec::PmuMessage& m);
   void update_health(SteadyTime now, bool force);
   std::chrono::milliseconds period() const noexcept;
+  void feed_alarms(const codec::PmuMessage& m, SteadyTime now, WallTime wall);
+  void feed_engine_alarms(SteadyTime now, WallTime wall);
+  void feed_health_alarms(SteadyTime now, WallTime wall);
 
   DeviceKey key_;
   DeviceConfig settings_;  // the config file's settings for it; what the device stores: reading_.config()
@@ -167,6 +188,17 @@ class DeviceSession {
   };
   std::vector<Timer> timers_;  // at(); run by tick()
   std::optional<EngineStartInProgress> engine_start_;
+
+  AlarmFeed alarms_;
+  // What the alarms derived from more than one packet last heard; forgotten at OFFLINE.
+  struct EngineView {
+    std::optional<codec::Status> status;   // the latest 0x04
+    double generator_volts = std::numeric_limits<double>::quiet_NaN();  // the latest 0x00's
+    bool running = false;                  // the speed was at or above running_rpm
+    bool stop_commanded = false;           // an engine stop was sent since it last came up to speed
+    bool stopped_by_itself = false;        // it fell below running speed with no stop sent
+  };
+  EngineView engine_;
   SteadyTime now_{};  // the latest time any call brought
   SteadyTime next_poll_{};
 };
