@@ -107,6 +107,7 @@ struct DdsPublisher::Writers {
   // Null when the service's DDS-Security permissions do not grant pmu/alarms (made before
   // it existed): the service runs without it rather than not at all.
   DataWriter* alarms = nullptr;
+  DataWriter* readiness = nullptr;
   // Bus workers run in threads of their own and share these writers and the rest below.
   std::mutex mutex;
   std::set<std::tuple<std::string, DeviceKind, std::uint16_t>> admitted;
@@ -156,15 +157,21 @@ DdsPublisher::DdsPublisher(dds::DdsContext& dds, std::chrono::milliseconds telem
   w_->config = state(topics::kConfig, TypeSupport(new pmu::v4::ConfigPubSubType()));
   w_->info = state(topics::kInfo, TypeSupport(new pmu::v4::DeviceInfoPubSubType()));
   w_->health = state(topics::kHealth, TypeSupport(new pmu::v4::HealthPubSubType()));
-  try {
-    w_->alarms = &dds.writer(dds.topic(topics::kAlarms, TypeSupport(new pmu::v4::AlarmPubSubType())),
-                             qos_profiles::kAlarms);
-  } catch (const dds::DdsError& e) {
-    if (!dds.secure()) throw;
-    spdlog::error("{} is not published: {}; the DDS-Security permissions were made before it existed "
-                  "(deploy/security/make_pki.sh makes them with it)",
-                  topics::kAlarms, e.what());
-  }
+  // Topics newer than the DDS-Security permissions a service may have been given: without a
+  // grant the service runs without them rather than not at all.
+  auto newer = [&](const char* name, TypeSupport type, const char* profile) -> DataWriter* {
+    try {
+      return &dds.writer(dds.topic(name, type), profile);
+    } catch (const dds::DdsError& e) {
+      if (!dds.secure()) throw;
+      spdlog::error("{} is not published: {}; the DDS-Security permissions were made before it existed "
+                    "(deploy/security/make_pki.sh makes them with it)",
+                    name, e.what());
+      return nullptr;
+    }
+  };
+  w_->alarms = newer(topics::kAlarms, TypeSupport(new pmu::v4::AlarmPubSubType()), qos_profiles::kAlarms);
+  w_->readiness = newer(topics::kReadiness, TypeSupport(new pmu::v4::ReadinessPubSubType()), qos_profiles::kState);
 }
 
 DdsPublisher::~DdsPublisher() = default;
@@ -485,6 +492,32 @@ void DdsPublisher::on_alarm(const AlarmReport& a) {
   const DeviceKey key{a.bus, a.device, DeviceKind::Pmu};
   std::lock_guard<std::mutex> lock(w_->mutex);
   write_at(w_->alarms, &s, key, a.since);
+}
+
+void DdsPublisher::on_readiness(const ReadinessReport& r) {
+  pmu::v4::Readiness s;
+  s.vehicle(w_->vehicle);
+  s.ready(r.ready);
+  s.level(!r.ready ? pmu::v4::LEVEL_NOT_READY : r.warnings() ? pmu::v4::LEVEL_WARNING : pmu::v4::LEVEL_READY);
+  s.since(static_cast<std::uint64_t>(
+      std::max<std::int64_t>(0, std::chrono::duration_cast<std::chrono::nanoseconds>(r.since.time_since_epoch()).count())));
+  constexpr std::size_t kCarried = 64;  // the IDL's bound; reasons_total counts the rest
+  for (std::size_t i = 0; i < r.reasons.size() && i < kCarried; ++i) {
+    const auto& x = r.reasons[i];
+    pmu::v4::ReadinessReason y;
+    y.code(x.code.substr(0, 31));
+    y.severity(x.severity == alarms::Severity::Critical ? pmu::v4::SEVERITY_CRITICAL : pmu::v4::SEVERITY_WARNING);
+    y.bus(x.bus.substr(0, 15));
+    y.kind(source_of(x.source));
+    y.device(x.device);
+    y.message(x.message.substr(0, 42));
+    y.description(x.description.substr(0, 127));
+    s.reasons().push_back(y);
+  }
+  s.reasons_total(static_cast<std::uint32_t>(r.reasons.size()));
+  const DeviceKey key{"", 0, DeviceKind::Pmu};
+  std::lock_guard<std::mutex> lock(w_->mutex);
+  write_at(w_->readiness, &s, key, std::chrono::system_clock::now());
 }
 
 }  // namespace pmu::service

@@ -39,6 +39,7 @@ const defaultTopics = {
   "pmu/battery_cells": "pmu::v4::BatteryCells",
   "pmu/mppt": "pmu::v4::Mppt",
   "pmu/alarms": "pmu::v4::Alarm",
+  "pmu/readiness": "pmu::v4::Readiness",
 };
 
 // float32 on the wire: the shortest decimal that is the same float32, as pmuctl prints it.

@@ -28,6 +28,7 @@ buses:
         packets: [voltages, status]
         engine_running_rpm: 2200
         engine_running_hold: 0.5
+        min_firmware: 1.2
     discover: true
 )";
 
@@ -49,6 +50,9 @@ TEST(Config, GoodFileParses) {
   EXPECT_EQ(b.devices[0].engine.running_hold, std::chrono::milliseconds(1000));
   EXPECT_EQ(b.devices[1].engine.running_rpm, 2200);
   EXPECT_EQ(b.devices[1].engine.running_hold, std::chrono::milliseconds(500));
+  EXPECT_FALSE(b.devices[0].min_firmware) << "no minimum unless configured";
+  ASSERT_TRUE(b.devices[1].min_firmware);
+  EXPECT_EQ(*b.devices[1].min_firmware, (codec::FirmwareVersion{1, 2})) << "1.2 is minor 2, not 20";
   EXPECT_EQ(b.devices[1].mode, TelemetryMode::Polling);
   EXPECT_EQ(b.devices[1].period, std::chrono::milliseconds(200));
   EXPECT_EQ(b.devices[1].groups, 0x11);
@@ -155,7 +159,13 @@ const BadCase kBad[] = {
     {"canopen_publish_period: -0.1\nbuses:\n  - interface: can0\n    discover: true\n",
      "bad.yaml:1: canopen_publish_period -0.1 out of range 0..3600"},
     {"buses:\n  - interface: can0\n    devices:\n      - adress: 1\n",
-     "bad.yaml:4: unknown key 'adress' in device (known: address, mode, period, packets, configure_streaming, engine_running_rpm, engine_running_hold, sim, alarms)"},
+     "bad.yaml:4: unknown key 'adress' in device (known: address, mode, period, packets, configure_streaming, engine_running_rpm, engine_running_hold, min_firmware, sim, alarms)"},
+    {"buses:\n  - interface: can0\n    devices:\n      - address: 1\n        min_firmware: 1.x\n",
+     "bad.yaml:5: min_firmware '1.x' is not MAJOR.MINOR (each 0..255, e.g. \"1.14\")"},
+    {"buses:\n  - interface: can0\n    devices:\n      - address: 1\n        min_firmware: 1.2.3\n",
+     "bad.yaml:5: min_firmware '1.2.3' is not MAJOR.MINOR (each 0..255, e.g. \"1.14\")"},
+    {"buses:\n  - interface: can0\n    discover:\n      min_firmware: 256.0\n",
+     "bad.yaml:4: min_firmware '256.0' is not MAJOR.MINOR (each 0..255, e.g. \"1.14\")"},
     {"buses:\n  - interface: can0\n    devices:\n      - address: 1\n        engine_running_rpm: 0\n",
      "bad.yaml:5: engine_running_rpm 0 out of range 1..65534"},
     {"buses:\n  - interface: can0\n    devices:\n      - address: 1\n        engine_running_rpm: 65535\n",

@@ -47,6 +47,7 @@ class RecordingSink final : public StateSink {
   }
 
   void on_alarm(const AlarmReport& a) override { alarms.push_back(a); }
+  void on_readiness(const ReadinessReport& r) override { readiness.push_back(r); }
 
   std::size_t count(codec::PacketId p, std::uint16_t address) const {
     std::size_t n = 0;
@@ -61,6 +62,7 @@ class RecordingSink final : public StateSink {
 
   std::vector<Telemetry> telemetry;
   std::vector<AlarmReport> alarms;
+  std::vector<ReadinessReport> readiness;
   std::vector<std::pair<DeviceKey, ConfigState>> configs;
   std::vector<std::pair<DeviceKey, InfoState>> infos;
   std::vector<std::pair<DeviceKey, HealthReport>> healths;

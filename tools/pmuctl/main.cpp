@@ -25,6 +25,7 @@
 #include "pmuctl/serve/serve_verb.hpp"
 #include "pmuctl/verbs/command_verbs.hpp"
 #include "pmuctl/verbs/alarm_verbs.hpp"
+#include "pmuctl/verbs/preflight_verb.hpp"
 #include "pmuctl/verbs/state_verbs.hpp"
 #include "pmuctl/view/mask_names.hpp"
 #include "pmu/command/command.hpp"
@@ -189,6 +190,7 @@ int main(int argc, char** argv) {
   app.add_subcommand("info", "Serial number, firmware and features");
   app.add_subcommand("health", "Link, bus and device health");
   app.add_subcommand("alarms", "Alarms that are active or wait for acknowledgement");
+  app.add_subcommand("preflight", "Whether the vehicle may fly, and every reason it may not (exit 0 ready, 1 not)");
   auto* config = app.add_subcommand("config", "Stored parameters");
   config->require_subcommand(1);
   auto* config_get = config->add_subcommand("get", "Show the stored parameters (or one)");
@@ -353,6 +355,7 @@ int main(int argc, char** argv) {
     if (app.got_subcommand("info")) return pmu::tools::run_info(g);
     if (app.got_subcommand("health")) return pmu::tools::run_health(g);
     if (app.got_subcommand("alarms")) return pmu::tools::run_alarms(g);
+    if (app.got_subcommand("preflight")) return pmu::tools::run_preflight(g);
     if (*config_get) return pmu::tools::run_config_get(g, parameter);
     pmu::tools::CommandSpec spec;
     spec.confirm = confirm;

@@ -19,6 +19,7 @@
 #include <thread>
 #include <vector>
 
+#include "pmu/readiness/readiness_tracker.hpp"
 #include "pmu/app/logging.hpp"
 #include "pmu/app/state_fanout.hpp"
 #include "pmu/app/simulated_bus.hpp"
@@ -137,7 +138,9 @@ int run(const service::Config& cfg, const pmu::dds::ResolvedNetwork& network) {
   }
   std::vector<service::StateSink*> sinks{&publisher};
   if (previous_publisher) sinks.push_back(previous_publisher.get());
-  service::StateFanout state_sink(sinks);
+  service::StateFanout fanout(sinks);
+  // In front of the publishers: pmu/readiness from what the sessions report.
+  service::ReadinessTracker state_sink(cfg.buses, fanout, clock);
 
   service::MovedAddressStore moved(service::moved_addresses_path(std::getenv("STATE_DIRECTORY")), cfg);
   std::vector<BusRuntime> buses(cfg.buses.size());

@@ -228,6 +228,23 @@ MpptSimSettings parse_mppt_sim(const Ctx& c, const YAML::Node& n) {
   return s;
 }
 
+// "1.14": MAJOR.MINOR as packet 0x31 carries them (a byte each). Read as the text written, so
+// that 1.2 is minor 2 and 1.20 minor 20, whatever a YAML number would make of them.
+codec::FirmwareVersion firmware_of(const Ctx& c, const YAML::Node& n) {
+  const auto text = c.scalar<std::string>(n, "min_firmware", "a firmware version such as \"1.14\"");
+  const auto dot = text.find('.');
+  auto part = [&](const std::string& s) -> long {
+    if (s.empty() || s.size() > 3 || s.find_first_not_of("0123456789") != std::string::npos) return -1;
+    const long v = std::stol(s);
+    return v <= 255 ? v : -1;
+  };
+  const long major = dot == std::string::npos ? -1 : part(text.substr(0, dot));
+  const long minor = dot == std::string::npos ? -1 : part(text.substr(dot + 1));
+  if (major < 0 || minor < 0)
+    c.fail(n, "min_firmware " + quoted(text) + " is not MAJOR.MINOR (each 0..255, e.g. \"1.14\")");
+  return {static_cast<std::uint8_t>(major), static_cast<std::uint8_t>(minor)};
+}
+
 void parse_device_settings(const Ctx& c, const YAML::Node& n, DeviceConfig& d) {
   if (const auto m = n["mode"]) {
     const auto mode = c.scalar<std::string>(m, "mode", "streaming or polling");
@@ -248,11 +265,12 @@ void parse_device_settings(const Ctx& c, const YAML::Node& n, DeviceConfig& d) {
   if (const auto p = n["engine_running_hold"])
     d.engine.running_hold = std::chrono::milliseconds(std::lround(c.number(p, "engine_running_hold", 0, 25.5) * 1000));
   if (const auto p = n["alarms"]) d.alarms = parse_alarm_settings(p, alarms::DeviceKind::Pmu, c.source);
+  if (const auto p = n["min_firmware"]) d.min_firmware = firmware_of(c, p);
 }
 
 DeviceConfig parse_device(const Ctx& c, const YAML::Node& n, BusConfig& b) {
   c.only_keys(n, "device", {"address", "mode", "period", "packets", "configure_streaming", "engine_running_rpm",
-                            "engine_running_hold", "sim", "alarms"});
+                            "engine_running_hold", "min_firmware", "sim", "alarms"});
   refuse_sim_on_real_bus(c, n, b.interface);
   DeviceConfig d;
   const auto a = n["address"];
@@ -338,7 +356,7 @@ BusConfig parse_bus(const Ctx& c, const YAML::Node& n) {
     } else {
       c.only_keys(d, "discover",
                   {"mode", "period", "packets", "configure_streaming", "engine_running_rpm", "engine_running_hold",
-                   "alarms"});
+                   "min_firmware", "alarms"});
       b.discover = true;
       parse_device_settings(c, d, b.discovered_defaults);
     }

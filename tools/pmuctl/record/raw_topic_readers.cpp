@@ -53,6 +53,7 @@ TypeSupport raw_type_support(const std::string& type_name) {
   if (type_name == "pmu::v4::BatteryCells") return TypeSupport(new RawSampleType<pmu::v4::BatteryCellsPubSubType>());
   if (type_name == "pmu::v4::Mppt") return TypeSupport(new RawSampleType<pmu::v4::MpptPubSubType>());
   if (type_name == "pmu::v4::Alarm") return TypeSupport(new RawSampleType<pmu::v4::AlarmPubSubType>());
+  if (type_name == "pmu::v4::Readiness") return TypeSupport(new RawSampleType<pmu::v4::ReadinessPubSubType>());
   if (type_name == "pmu::v4::Command") return TypeSupport(new RawSampleType<pmu::v4::CommandPubSubType>());
   return TypeSupport(new RawSampleType<pmu::v4::CommandReplyPubSubType>());
 }

@@ -25,6 +25,8 @@ inline constexpr const char* kBatteryCells = "pmu/battery_cells";
 inline constexpr const char* kMppt = "pmu/mppt";
 // Alarms of every device and bus: docs/interface.md 1.6.
 inline constexpr const char* kAlarms = "pmu/alarms";
+// Whether the vehicle may fly, and why not: docs/interface.md 1.7.
+inline constexpr const char* kReadiness = "pmu/readiness";
 inline constexpr const char* kCommand = "pmu/command";
 inline constexpr const char* kCommandReply = "pmu/command_reply";
 

@@ -47,6 +47,9 @@ class StateFanout final : public StateSink {
   void on_alarm(const AlarmReport& alarm) override {
     for (auto* s : sinks_) s->on_alarm(alarm);
   }
+  void on_readiness(const ReadinessReport& readiness) override {
+    for (auto* s : sinks_) s->on_readiness(readiness);
+  }
 
  private:
   std::vector<StateSink*> sinks_;

@@ -56,6 +56,8 @@ struct DeviceConfig {
   // `alarms:` (interface.md 1.6): what this unit changes of the alarm table's defaults;
   // checked by alarms::resolve when the config is read.
   alarms::DeviceSettings alarms;
+  // The vehicle is not ready while the unit's firmware is older (interface.md 1.7).
+  std::optional<codec::FirmwareVersion> min_firmware;
   // "FILE:LINE" of its `address:` in the config file, for the line to change when the unit
   // moves; empty for a device not from a file (discovered, built in).
   std::string source_line;

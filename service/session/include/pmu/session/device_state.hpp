@@ -7,6 +7,7 @@
 #include <cstdint>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "pmu/alarms/alarm.hpp"
 #include "pmu/codec/decode.hpp"
@@ -72,8 +73,6 @@ struct HealthReport {
   std::uint64_t reconnects = 0;
 };
 
-// Where the service's view of the devices goes: the DDS publisher in the daemon, a recorder
-// in tests. Called on the bus worker's thread.
 // An alarm that changed state (interface.md 1.6): the alarms room's Alarm, with where it
 // belongs and its times on the wall clock.
 struct AlarmReport {
@@ -89,6 +88,27 @@ struct AlarmReport {
   std::string message;                           // at most 42 characters
 };
 
+// The vehicle's readiness (interface.md 1.7): made by the ReadinessTracker from health,
+// identity and alarms.
+struct ReadinessReason {
+  std::string code;  // an alarm's code, or a readiness code (device_not_online, ...)
+  alarms::Severity severity = alarms::Severity::Critical;
+  std::string bus;   // "" for the service's own
+  alarms::DeviceKind source = alarms::DeviceKind::Pmu;
+  std::uint16_t device = 0;
+  std::string message;      // at most 42 characters
+  std::string description;  // at most 127 characters: what to do about it
+};
+struct ReadinessReport {
+  bool ready = true;                               // no critical reason
+  std::chrono::system_clock::time_point since{};  // the last change of `ready`
+  std::vector<ReadinessReason> reasons;            // critical first, then by bus, device, code
+  bool warnings() const noexcept { return !reasons.empty(); }
+};
+
+// Where the service's view of the devices goes: the DDS publisher in the daemon, a recorder
+// in tests. Called on the bus worker's thread (on_readiness: whichever worker's event changed
+// it).
 class StateSink {
  public:
   virtual ~StateSink() = default;
@@ -112,6 +132,7 @@ class StateSink {
   virtual void on_mppt(const DeviceKey& key, const MpptState& mppt, std::chrono::system_clock::time_point newest) = 0;
   // An alarm changed state (raised, acknowledged, cleared, back to NORMAL).
   virtual void on_alarm(const AlarmReport& alarm) = 0;
+  virtual void on_readiness(const ReadinessReport& readiness) = 0;
 };
 
 }  // namespace pmu::service

@@ -1,0 +1,76 @@
+#pragma once
+// ReadinessTracker: a StateSink in front of another (the DDS publisher) that passes every
+// event on and keeps, from health, identity and alarm events, the vehicle's readiness
+// (readiness_rules.hpp). It sends a ReadinessReport on to the next sink when the report
+// changes and at least once a second while events come (each device's health comes once a
+// second), so a reader that missed one sees the next.
+//
+// Lifetime: `next` and `clock` must outlive the tracker, which keeps references to both
+// (main.cpp makes the publisher and the clock first and the bus workers, which write through
+// the tracker, are destroyed before it).
+// Threads: every StateSink member from any bus worker thread at once; `mutex_` serialises
+// the view and the reports, which are handed on under it so they reach `next` in order.
+
+#include <chrono>
+#include <map>
+#include <mutex>
+#include <optional>
+#include <tuple>
+
+#include "pmu/config/config.hpp"
+#include "pmu/readiness/readiness_rules.hpp"
+#include "pmu/session/device_state.hpp"
+#include "pmu/transport/clock.hpp"
+
+namespace pmu::service {
+
+class ReadinessTracker final : public StateSink {
+ public:
+  // `buses`: the config's, for each PMU's min_firmware (a discovered PMU takes its bus's
+  // discover: settings).
+  ReadinessTracker(const std::vector<BusConfig>& buses, StateSink& next, const transport::Clock& clock);
+
+  void on_telemetry(const DeviceKey& key, const codec::PmuMessage& message,
+                    std::chrono::system_clock::time_point received) override {
+    next_.on_telemetry(key, message, received);
+  }
+  void on_config(const DeviceKey& key, const ConfigState& config) override { next_.on_config(key, config); }
+  void on_info(const DeviceKey& key, const InfoState& info) override;
+  void on_health(const DeviceKey& key, const HealthReport& health) override;
+  void on_gone(const DeviceKey& key) override;
+  void on_battery(const DeviceKey& key, const BatteryState& battery,
+                  std::chrono::system_clock::time_point newest) override {
+    next_.on_battery(key, battery, newest);
+  }
+  void on_battery_cells(const DeviceKey& key, const BatteryCellsState& cells,
+                        std::chrono::system_clock::time_point newest) override {
+    next_.on_battery_cells(key, cells, newest);
+  }
+  void on_mppt(const DeviceKey& key, const MpptState& mppt, std::chrono::system_clock::time_point newest) override {
+    next_.on_mppt(key, mppt, newest);
+  }
+  void on_alarm(const AlarmReport& alarm) override;
+  // Reports come from this tracker; one handed to it is passed on unchanged.
+  void on_readiness(const ReadinessReport& readiness) override { next_.on_readiness(readiness); }
+
+  // The latest report (for tests and the start-up log).
+  ReadinessReport current() const;
+
+  static constexpr std::chrono::seconds kRepeat{1};
+
+ private:
+  using Key = std::tuple<std::string, DeviceKind, std::uint16_t>;
+  DeviceView& view_of(const DeviceKey& key);
+  void update(bool force);  // with mutex_ held
+
+  std::map<std::string, BusConfig> buses_;  // by bus name
+  StateSink& next_;
+  const transport::Clock& clock_;
+  mutable std::mutex mutex_;
+  ReadinessInput input_;
+  std::map<std::tuple<std::string, alarms::DeviceKind, std::uint16_t, alarms::Code>, std::size_t> alarm_index_;
+  ReadinessReport report_;
+  std::optional<std::chrono::steady_clock::time_point> last_sent_;
+};
+
+}  // namespace pmu::service

@@ -1,0 +1,86 @@
+// Alarms and readiness as a ground station reads them (docs/interface.md 1.6, 1.7, 3.2):
+// pmu-service on the configured simulator, pmuctl alarms and pmuctl preflight.
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <string>
+#include <thread>
+
+#include "support/configured_service.hpp"
+#include "support/domain.hpp"
+#include "support/json_lines.hpp"
+#include "support/process.hpp"
+
+namespace {
+
+using namespace std::chrono_literals;
+
+std::string config(const std::string& domain, const std::string& device_1) {
+  return "domain: " + domain + "\nqos_file: " PMU_QOS_FILE
+         "\nbuses:\n  - interface: sim\n    devices:\n      - address: 1\n        period: 0.5\n" + device_1;
+}
+
+// Runs `command` until `done` holds for its result, for at most `within`.
+template <class Done>
+pmu::test::RunResult until(const std::string& command, Done done, std::chrono::seconds within) {
+  const auto deadline = std::chrono::steady_clock::now() + within;
+  pmu::test::RunResult r = pmu::test::run_capture(command);
+  while (!done(r) && std::chrono::steady_clock::now() < deadline) {
+    std::this_thread::sleep_for(500ms);
+    r = pmu::test::run_capture(command);
+  }
+  return r;
+}
+
+TEST(ReadinessOverDds, AHealthyVehicleIsReadyWithNoAlarm) {
+  const std::string domain = std::to_string(pmu::test::exclusive_dds_domain());
+  pmu::test::ConfiguredService service(PMU_SERVICE_PATH, config(domain, ""));
+  const std::string p = std::string(PMUCTL_PATH) + " --domain " + domain + " ";
+  const auto ready = until(p + "--timeout 10 --json preflight", [](const auto& r) { return r.status == 0; }, 30s);
+  ASSERT_EQ(ready.status, 0) << ready.out << service.describe();
+  const auto lines = pmu::test::json_lines(ready.out);
+  ASSERT_EQ(lines.size(), 1u) << ready.out;
+  EXPECT_EQ(lines[0]["ready"], true);
+  EXPECT_EQ(lines[0]["level"], "READY");
+  EXPECT_TRUE(lines[0]["reasons"].empty()) << ready.out;
+  const auto alarms = pmu::test::run_capture(p + "--timeout 5 --json alarms");
+  EXPECT_EQ(alarms.status, 0);
+  EXPECT_TRUE(pmu::test::json_lines(alarms.out).empty()) << alarms.out;
+}
+
+TEST(ReadinessOverDds, AHotPmuRaisesItsAlarmAndMakesTheVehicleNotReady) {
+  const std::string domain = std::to_string(pmu::test::exclusive_dds_domain());
+  pmu::test::ConfiguredService service(PMU_SERVICE_PATH,
+                                       config(domain, "        sim: {internal_temperature: 95}\n"));
+  const std::string p = std::string(PMUCTL_PATH) + " --domain " + domain + " ";
+  const auto alarms = until(
+      p + "--timeout 10 --json alarms",
+      [](const auto& r) { return r.out.find("thermal_shutdown") != std::string::npos; }, 30s);
+  ASSERT_EQ(alarms.status, 0) << alarms.out << service.describe();
+  bool found = false;
+  for (const auto& j : pmu::test::json_lines(alarms.out)) {
+    if (j.value("code", "") != "thermal_shutdown") continue;
+    found = true;
+    EXPECT_EQ(j["severity"], "critical");
+    EXPECT_EQ(j["state"], "ACTIVE_UNACKNOWLEDGED");
+    EXPECT_EQ(j["kind"], "pmu");
+    EXPECT_EQ(j["device"], 1);
+    EXPECT_TRUE(j["value"].is_null()) << "a flag";
+  }
+  EXPECT_TRUE(found) << alarms.out;
+
+  const auto r = pmu::test::run_capture(p + "--timeout 10 preflight");
+  EXPECT_EQ(r.status, 1) << r.out;
+  EXPECT_NE(r.out.find("NOT READY"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("CRITICAL thermal_shutdown"), std::string::npos) << r.out;
+}
+
+TEST(ReadinessOverDds, NothingOnTheDomainIsExitThree) {
+  const std::string domain = std::to_string(pmu::test::exclusive_dds_domain());
+  const auto r = pmu::test::run_capture(std::string(PMUCTL_PATH) + " --domain " + domain + " --timeout 1 preflight",
+                                        true);
+  EXPECT_EQ(r.status, 3) << r.out;
+  EXPECT_NE(r.out.find("no pmu-service on domain"), std::string::npos) << r.out;
+}
+
+}  // namespace

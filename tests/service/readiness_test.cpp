@@ -1,0 +1,211 @@
+// The readiness rules (readiness_rules.hpp, interface.md 1.7) from the table of situations a
+// flight-test engineer meets, and the tracker that applies them to what the sessions report:
+// a report on every change and once a second, never more often for an unchanged situation.
+#include <gtest/gtest.h>
+
+#include "pmu/readiness/readiness_tracker.hpp"
+#include "pmu/transport/clock.hpp"
+#include "recording_sink.hpp"
+
+namespace pmu::service::test {
+namespace {
+
+using namespace std::chrono_literals;
+using alarms::AlarmState;
+using alarms::Code;
+using alarms::Severity;
+using Key = std::tuple<std::string, DeviceKind, std::uint16_t>;
+
+DeviceView online(std::optional<codec::FirmwareVersion> fw = codec::FirmwareVersion{1, 17},
+                  std::optional<codec::FirmwareVersion> min = std::nullopt) {
+  DeviceView d;
+  d.state = HealthState::Online;
+  d.firmware = fw;
+  d.min_firmware = min;
+  return d;
+}
+
+AlarmReport alarm(Code code, AlarmState state, std::uint16_t device = 1) {
+  AlarmReport a;
+  a.bus = "can0";
+  a.device = device;
+  a.code = code;
+  a.severity = alarms::spec_of(code).severity;
+  a.state = state;
+  a.message = std::string(alarms::spec_of(code).subject);
+  return a;
+}
+
+struct Situation {
+  const char* what;
+  ReadinessInput input;
+  bool ready;
+  std::vector<std::string> codes;  // the reasons' codes, in order
+};
+
+TEST(ReadinessRules, EachSituationGivesItsReasonsWorstFirst) {
+  const Situation cases[] = {
+      {"everything online", {{{Key{"can0", DeviceKind::Pmu, 1}, online()}}, {}}, true, {}},
+      {"a PMU not online",
+       {{{Key{"can0", DeviceKind::Pmu, 1}, online()},
+         {Key{"can0", DeviceKind::Pmu, 2}, [] { auto d = online(); d.state = HealthState::Offline; return d; }()}},
+        {}},
+       false,
+       {"device_not_online"}},
+      {"never heard (UNKNOWN) is not online",
+       {{{Key{"can0", DeviceKind::Battery, 2}, [] { auto d = online(std::nullopt); d.state = HealthState::Unknown; return d; }()}}, {}},
+       false,
+       {"device_not_online"}},
+      {"bus error-passive: once per bus",
+       {{{Key{"can0", DeviceKind::Pmu, 1}, [] { auto d = online(); d.bus_state = transport::BusState::ErrorPassive; return d; }()},
+         {Key{"can0", DeviceKind::Pmu, 2}, [] { auto d = online(); d.bus_state = transport::BusState::ErrorPassive; return d; }()}},
+        {}},
+       false,
+       {"bus_not_up"}},
+      {"bus error-warning is a warning",
+       {{{Key{"can0", DeviceKind::Pmu, 1}, [] { auto d = online(); d.bus_state = transport::BusState::ErrorWarning; return d; }()}}, {}},
+       true,
+       {"bus_not_up"}},
+      {"firmware below the minimum", {{{Key{"can0", DeviceKind::Pmu, 1}, online(codec::FirmwareVersion{1, 12}, codec::FirmwareVersion{1, 14})}}, {}},
+       false, {"firmware_below_minimum"}},
+      {"firmware at the minimum", {{{Key{"can0", DeviceKind::Pmu, 1}, online(codec::FirmwareVersion{1, 14}, codec::FirmwareVersion{1, 14})}}, {}},
+       true, {}},
+      {"firmware not read yet is not judged", {{{Key{"can0", DeviceKind::Pmu, 1}, online(std::nullopt, codec::FirmwareVersion{1, 14})}}, {}},
+       true, {}},
+      {"an active critical alarm", {{{Key{"can0", DeviceKind::Pmu, 1}, online()}}, {alarm(Code::ThermalShutdown, AlarmState::ActiveUnacknowledged)}},
+       false, {"thermal_shutdown"}},
+      {"an acknowledged critical still active", {{{Key{"can0", DeviceKind::Pmu, 1}, online()}}, {alarm(Code::ThermalShutdown, AlarmState::ActiveAcknowledged)}},
+       false, {"thermal_shutdown"}},
+      {"a critical cleared but not acknowledged", {{{Key{"can0", DeviceKind::Pmu, 1}, online()}}, {alarm(Code::ThermalShutdown, AlarmState::ClearedUnacknowledged)}},
+       false, {"thermal_shutdown"}},
+      {"a critical back to NORMAL", {{{Key{"can0", DeviceKind::Pmu, 1}, online()}}, {alarm(Code::ThermalShutdown, AlarmState::Normal)}},
+       true, {}},
+      {"an active warning lets it fly", {{{Key{"can0", DeviceKind::Pmu, 1}, online()}}, {alarm(Code::PayloadShed, AlarmState::ActiveUnacknowledged)}},
+       true, {"payload_shed"}},
+      {"critical before warning, whatever the device",
+       {{{Key{"can0", DeviceKind::Pmu, 1}, online()}},
+        {alarm(Code::PayloadShed, AlarmState::ActiveUnacknowledged, 1), alarm(Code::ThermalShutdown, AlarmState::ActiveUnacknowledged, 9)}},
+       false, {"thermal_shutdown", "payload_shed"}},
+  };
+  for (const auto& c : cases) {
+    SCOPED_TRACE(c.what);
+    const auto reasons = readiness_reasons(c.input);
+    std::vector<std::string> codes;
+    bool ready = true;
+    for (const auto& r : reasons) {
+      codes.push_back(r.code);
+      ready = ready && r.severity != Severity::Critical;
+      EXPECT_LE(r.message.size(), 42u) << r.message;
+      EXPECT_LE(r.description.size(), 127u) << r.description;
+      EXPECT_FALSE(r.message.empty());
+    }
+    EXPECT_EQ(ready, c.ready);
+    EXPECT_EQ(codes, c.codes);
+  }
+}
+
+TEST(ReadinessRules, MessagesNameTheDeviceAndFitAnAutopilotsPrearmText) {
+  ReadinessInput in;
+  auto d = online(codec::FirmwareVersion{1, 12}, codec::FirmwareVersion{1, 14});
+  in.devices[Key{"avionics_can", DeviceKind::Pmu, 65534}] = d;
+  d = online();
+  d.state = HealthState::Stale;
+  in.devices[Key{"can0", DeviceKind::Mppt, 3}] = d;
+  const auto reasons = readiness_reasons(in);
+  ASSERT_EQ(reasons.size(), 2u);
+  EXPECT_EQ(reasons[0].message, "PMU 65534 firmware 1.12 < 1.14");
+  EXPECT_EQ(reasons[0].bus, "avionics_can");
+  EXPECT_EQ(reasons[1].message, "MPPT 3 on can0 STALE");
+  EXPECT_EQ(reasons[1].source, alarms::DeviceKind::Mppt);
+}
+
+// ---- the tracker ----------------------------------------------------------------------------
+
+BusConfig bus_with_min_firmware() {
+  BusConfig b;
+  b.name = "can0";
+  DeviceConfig d;
+  d.address = 1;
+  d.min_firmware = codec::FirmwareVersion{1, 16};
+  b.devices.push_back(d);
+  b.discovered_defaults.min_firmware = codec::FirmwareVersion{1, 14};
+  return b;
+}
+
+HealthReport health(HealthState s) {
+  HealthReport h;
+  h.state = s;
+  return h;
+}
+
+InfoState info(std::uint8_t minor) {
+  InfoState i;
+  i.firmware.firmware_major = 1;
+  i.firmware.firmware_minor = minor;
+  i.firmware_known = true;
+  return i;
+}
+
+TEST(ReadinessTracker, ReportsEveryChangeAndOnceASecondAndPassesEverythingOn) {
+  transport::ManualClock clock;
+  RecordingSink next;
+  ReadinessTracker t({bus_with_min_firmware()}, next, clock);
+  const DeviceKey pmu1{"can0", 1, DeviceKind::Pmu};
+  t.on_health(pmu1, health(HealthState::Unknown));
+  ASSERT_EQ(next.readiness.size(), 1u);
+  EXPECT_FALSE(next.readiness.back().ready);
+  EXPECT_EQ(next.healths.size(), 1u) << "passed on";
+
+  t.on_health(pmu1, health(HealthState::Unknown));
+  EXPECT_EQ(next.readiness.size(), 1u) << "unchanged within a second: no report";
+  clock.advance(1s);
+  t.on_health(pmu1, health(HealthState::Unknown));
+  EXPECT_EQ(next.readiness.size(), 2u) << "unchanged, but a second has passed";
+
+  clock.advance(100ms);
+  t.on_health(pmu1, health(HealthState::Online));
+  ASSERT_EQ(next.readiness.size(), 3u) << "a change: at once";
+  EXPECT_TRUE(next.readiness.back().ready);
+  EXPECT_EQ(next.readiness.back().since, clock.system_now());
+
+  t.on_info(pmu1, info(15));  // the configured minimum of this PMU is 1.16
+  ASSERT_EQ(next.readiness.size(), 4u);
+  EXPECT_FALSE(next.readiness.back().ready);
+  EXPECT_EQ(next.readiness.back().reasons.at(0).code, "firmware_below_minimum");
+  EXPECT_EQ(next.infos.size(), 1u);
+
+  const DeviceKey found{"can0", 7, DeviceKind::Pmu};  // discovered: the bus's discover: minimum, 1.14
+  t.on_health(found, health(HealthState::Online));
+  t.on_info(found, info(14));
+  EXPECT_EQ(t.current().reasons.size(), 1u) << "1.14 meets the discovered minimum";
+
+  t.on_info(pmu1, info(16));
+  EXPECT_TRUE(next.readiness.back().ready);
+
+  AlarmReport hot;
+  hot.bus = "can0";
+  hot.device = 1;
+  hot.code = Code::ThermalShutdown;
+  hot.severity = Severity::Critical;
+  hot.state = AlarmState::ActiveUnacknowledged;
+  hot.message = "thermal shutdown";
+  t.on_alarm(hot);
+  EXPECT_FALSE(next.readiness.back().ready);
+  EXPECT_EQ(next.alarms.size(), 1u) << "passed on";
+  hot.state = AlarmState::ClearedUnacknowledged;
+  t.on_alarm(hot);
+  EXPECT_FALSE(next.readiness.back().ready) << "a critical blocks until acknowledged";
+  EXPECT_NE(next.readiness.back().reasons.at(0).message.find("unacknowledged"), std::string::npos);
+  hot.state = AlarmState::Normal;
+  t.on_alarm(hot);
+  EXPECT_TRUE(next.readiness.back().ready);
+
+  t.on_health(found, health(HealthState::Offline));
+  EXPECT_FALSE(next.readiness.back().ready);
+  t.on_gone(found);  // it moved to another address: the old key is no reason any more
+  EXPECT_TRUE(next.readiness.back().ready);
+  EXPECT_EQ(next.gone.size(), 1u);
+}
+
+}  // namespace
+}  // namespace pmu::service::test

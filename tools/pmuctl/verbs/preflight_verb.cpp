@@ -1,0 +1,127 @@
+#include "pmuctl/verbs/preflight_verb.hpp"
+
+#include <chrono>
+#include <cstdio>
+#include <fastdds/dds/core/status/SubscriptionMatchedStatus.hpp>
+#include <fastdds/dds/subscriber/SampleInfo.hpp>
+#include <map>
+#include <nlohmann/json.hpp>
+#include <set>
+#include <thread>
+
+#include "pmu/dds/contract_names.hpp"
+#include "pmu/idl/alarmsPubSubTypes.h"
+#include "pmu/idl/guarded_type.hpp"
+#include "pmu/idl/topics.hpp"
+#include "pmuctl/verbs/exit_status.hpp"
+#include "pmuctl/verbs/service_presence.hpp"
+#include "pmuctl/verbs/state_settle.hpp"
+
+namespace pmu::tools {
+namespace {
+
+using namespace eprosima::fastdds::dds;
+using Clock = std::chrono::steady_clock;
+using Json = nlohmann::json;
+
+const char* kind_name(pmu::v4::AlarmSource k) {
+  switch (k) {
+    case pmu::v4::SOURCE_BATTERY: return "battery";
+    case pmu::v4::SOURCE_MPPT: return "mppt";
+    case pmu::v4::SOURCE_BUS: return "bus";
+    case pmu::v4::SOURCE_PMU: break;
+  }
+  return "pmu";
+}
+
+const char* level_name(pmu::v4::ReadinessLevel l) {
+  switch (l) {
+    case pmu::v4::LEVEL_WARNING: return "WARNING";
+    case pmu::v4::LEVEL_NOT_READY: return "NOT_READY";
+    case pmu::v4::LEVEL_READY: break;
+  }
+  return "READY";
+}
+
+void print(const GlobalOptions& o, const pmu::v4::Readiness& r) {
+  const std::string vehicle = r.vehicle().to_string();
+  if (o.json) {
+    Json reasons = Json::array();
+    for (const auto& x : r.reasons())
+      reasons.push_back({{"code", x.code().to_string()},
+                         {"severity", x.severity() == pmu::v4::SEVERITY_CRITICAL ? "critical" : "warning"},
+                         {"bus", x.bus().to_string()},
+                         {"kind", kind_name(x.kind())},
+                         {"device", x.device()},
+                         {"message", x.message().to_string()},
+                         {"description", x.description().to_string()}});
+    Json j{{"topic", "readiness"},
+           {"vehicle", vehicle},
+           {"ready", r.ready()},
+           {"level", level_name(r.level())},
+           {"since", static_cast<double>(r.since()) / 1e9},
+           {"reasons", reasons},
+           {"reasons_total", r.reasons_total()},
+           {"contract", pmu::dds::contract_major()}};
+    std::printf("%s\n", j.dump(-1, ' ', false, Json::error_handler_t::replace).c_str());
+    return;
+  }
+  std::printf("%s: %s", vehicle.empty() ? "(unnamed vehicle)" : vehicle.c_str(),
+              r.ready() ? (r.level() == pmu::v4::LEVEL_WARNING ? "READY, with warnings" : "READY") : "NOT READY");
+  std::printf(r.reasons_total() ? " (%u reason%s)\n" : "\n", r.reasons_total(), r.reasons_total() == 1 ? "" : "s");
+  for (const auto& x : r.reasons()) {
+    std::string where = x.bus().to_string();
+    if (x.kind() != pmu::v4::SOURCE_BUS)
+      where += "/" + std::string(x.kind() == pmu::v4::SOURCE_PMU ? "" : kind_name(x.kind())) + std::to_string(x.device());
+    std::printf("  %-8s %-24s %-14s %s\n           %s\n",
+                x.severity() == pmu::v4::SEVERITY_CRITICAL ? "CRITICAL" : "WARNING", x.code().c_str(), where.c_str(),
+                x.message().c_str(), x.description().c_str());
+  }
+  if (r.reasons_total() > r.reasons().size())
+    std::printf("  ... and %zu more\n", static_cast<std::size_t>(r.reasons_total() - r.reasons().size()));
+}
+
+}  // namespace
+
+int run_preflight(const GlobalOptions& o) {
+  pmu::dds::DdsContext dds(o.domain, o.qos_file, "pmuctl", o.security, pmu::dds::Transport::Default, o.network,
+                           partitions_for(o));
+  DataReader& reader =
+      dds.reader(dds.topic(topics::kReadiness, TypeSupport(new idl::Guarded<pmu::v4::ReadinessPubSubType>())),
+                 qos_profiles::kState);
+  const auto deadline = Clock::now() + std::chrono::duration<double>(o.timeout.value_or(3.0));
+  StateSettle settle(std::chrono::milliseconds(300));
+  std::map<std::string, pmu::v4::Readiness> latest;
+  std::set<InstanceHandle_t> writers;
+  while (Clock::now() < deadline) {
+    pmu::v4::Readiness r;
+    SampleInfo info;
+    while (reader.take_next_sample(&r, &info) == ReturnCode_t::RETCODE_OK) {
+      writers.insert(info.publication_handle);
+      if (info.valid_data && (!o.vehicle || *o.vehicle == r.vehicle().to_string())) latest[r.vehicle().to_string()] = r;
+    }
+    SubscriptionMatchedStatus st;
+    reader.get_subscription_matched_status(st);
+    const auto coming =
+        dds.remote_writers().participants_without_writer(pmu::dds::kServiceParticipantName, topics::kReadiness);
+    settle.observe(Clock::now(), static_cast<std::size_t>(std::max(st.current_count, 0)) + coming, writers.size());
+    if (settle.settled(Clock::now())) break;
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+  if (latest.empty()) {
+    SubscriptionMatchedStatus st;
+    reader.get_subscription_matched_status(st);
+    if (st.current_count == 0) return no_service(o, dds);
+    return fail(o, ExitStatus::NoAnswer,
+                "no readiness from " + (o.vehicle ? vehicle_text(*o.vehicle) : std::string("any vehicle")) +
+                    " within the timeout");
+  }
+  bool ready = true;
+  for (const auto& [vehicle, r] : latest) {
+    print(o, r);
+    ready = ready && r.ready();
+  }
+  return static_cast<int>(ready ? ExitStatus::Ok : ExitStatus::NotDone);
+}
+
+}  // namespace pmu::tools

@@ -1,0 +1,12 @@
+#pragma once
+// pmuctl preflight (interface.md section 3.2): whether each vehicle may fly, from
+// pmu/readiness. Exit status 0 when every vehicle read is ready, 1 when one is not (its
+// reasons printed), 3 when no service answers.
+
+#include "pmuctl/verbs/state_verbs.hpp"
+
+namespace pmu::tools {
+
+int run_preflight(const GlobalOptions& o);
+
+}  // namespace pmu::tools
