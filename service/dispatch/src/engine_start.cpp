@@ -129,7 +129,7 @@ class StartRun : public std::enable_shared_from_this<StartRun> {
     const auto* status = std::get_if<codec::Status>(&o.reply->payload);
     if (!status) return conclude({CommandResult::Failed, "the status answer carries no status", {}, ""});
     if (auto why = refuse_start(*status, device_.firmware, session_.settings().engine))
-      return conclude({CommandResult::Denied, *why, static_cast<double>(status->generator_rpm), ""});
+      return conclude({CommandResult::Denied, *why, {}, ""});
     Request r;
     r.frame = *codec::encode_engine_start(request_.address);
     r.done = [self = shared_from_this()](const RequestOutcome& sent) { self->on_sent(sent); };
