@@ -9,15 +9,13 @@
 namespace pmu::service {
 namespace {
 
-constexpr double kNotMeasured = std::numeric_limits<double>::quiet_NaN();
-
 alarms::DeviceKind alarm_kind(DeviceKind k) noexcept {
   return k == DeviceKind::Mppt ? alarms::DeviceKind::Mppt : alarms::DeviceKind::Battery;
 }
 
 double value_of(const BatteryState& b, std::string_view name) noexcept {
   const auto slot = battery_slot(name);
-  return slot ? b.values[*slot] : kNotMeasured;
+  return slot ? b.values[*slot] : std::numeric_limits<double>::quiet_NaN();
 }
 
 }  // namespace
