@@ -11,6 +11,7 @@
 #include "pmu/config/vehicle.hpp"
 #include "pmu/idl/alarms.h"
 #include "pmu/idl/alarmsPubSubTypes.h"
+#include "pmu/idl/guarded_type.hpp"
 #include "pmu/idl/topics.hpp"
 #include "pmu/session/log_throttle.hpp"
 
@@ -43,6 +44,9 @@ struct DdsAlarmAckEndpoint::Impl final : public DataReaderListener {
   std::mutex write_mutex;
   std::atomic<std::uint64_t> not_ours{0};
   LogThrottle not_ours_reports{std::chrono::seconds(10)};
+  idl::Guarded<pmu::v4::AlarmAckPubSubType>* type = nullptr;  // owned by the registered TypeSupport
+  std::uint64_t malformed_logged = 0;
+  LogThrottle malformed_reports{std::chrono::seconds(10)};
 
   Impl(dds::DdsContext& d, std::string v) : dds(d), vehicle(std::move(v)) {}
 
@@ -62,7 +66,9 @@ struct DdsAlarmAckEndpoint::Impl final : public DataReaderListener {
     if (!service) return;
     pmu::v4::AlarmAck s;
     SampleInfo info;
-    // A payload that does not deserialize never reaches take (Fast DDS drops it).
+    // A payload that does not deserialize is dropped by Fast DDS before take sees it: the type
+    // is Guarded, because fastddsgen's own would throw out of every take, for ever, once one
+    // such sample sat at the head of the history.
     while (r->take_next_sample(&s, &info) == ReturnCode_t::RETCODE_OK) {
       if (!info.valid_data) continue;
       AlarmAckSample sample{guid_of(info), s.request_id().to_string(), s.vehicle().to_string(), s.bus().to_string(),
@@ -80,6 +86,15 @@ struct DdsAlarmAckEndpoint::Impl final : public DataReaderListener {
         spdlog::warn("audit: alarm ack {} from {} was not written in this vehicle's partition alone: not applied, "
                      "not answered ({} since start)",
                      printable(sample.request_id), printable(sample.sender), total);
+    }
+    // Without a readable request id there is nothing to answer: counted, logged now and then
+    // so a flood cannot fill the journal.
+    const auto malformed = type ? type->malformed() : 0;
+    if (malformed != malformed_logged && malformed_reports.allow(LogThrottle::Clock::now())) {
+      spdlog::warn("pmu/alarm_ack: dropped {} sample(s) that are not a pmu::v4::AlarmAck as idl/alarms.idl "
+                   "defines it ({} since start); no reply is possible without a readable request_id",
+                   malformed - malformed_logged, malformed);
+      malformed_logged = malformed;
     }
   }
 
@@ -127,8 +142,10 @@ void DdsAlarmAckEndpoint::start(AlarmAckService& service) {
     impl_->service = &service;
   }
   try {
+    auto* type = new idl::Guarded<pmu::v4::AlarmAckPubSubType>();
+    impl_->type = type;
     impl_->reader = &impl_->dds.reader(
-        impl_->dds.topic(topics::kAlarmAck, TypeSupport(new pmu::v4::AlarmAckPubSubType())), qos_profiles::kCommand,
+        impl_->dds.topic(topics::kAlarmAck, TypeSupport(type)), qos_profiles::kCommand,
         impl_.get());
   } catch (const dds::DdsError& e) {
     if (!impl_->dds.secure()) throw;
