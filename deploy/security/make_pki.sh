@@ -280,6 +280,8 @@ fi
 XML
   topic_rule "pmu/command" ENCRYPT ENCRYPT
   topic_rule "pmu/command_reply" ENCRYPT ENCRYPT
+  topic_rule "pmu/alarm_ack" ENCRYPT ENCRYPT
+  topic_rule "pmu/alarm_ack_reply" ENCRYPT ENCRYPT
   topic_rule "pmu/*" ENCRYPT ENCRYPT
   topic_rule "*" ENCRYPT ENCRYPT
   cat <<XML
@@ -341,15 +343,15 @@ permissions() {  # permissions NAME ROLE VEHICLES -> the permissions XML of NAME
         <domains>$domains_xml</domains>
 XML
   case "$role" in
-    pmu-service)  # publishes telemetry, state and replies; reads commands
-      rule_xml publish "$parts" "${telemetry[@]}" "${state[@]}" pmu/command_reply
-      rule_xml subscribe "$parts" pmu/command
+    pmu-service)  # publishes telemetry, state and replies; reads commands and acknowledgements
+      rule_xml publish "$parts" "${telemetry[@]}" "${state[@]}" pmu/command_reply pmu/alarm_ack_reply
+      rule_xml subscribe "$parts" pmu/command pmu/alarm_ack
       ;;
-    ground-station)  # the only one that may command; reads everything the service publishes
-      rule_xml publish "$parts" pmu/command
-      rule_xml subscribe "$parts" "${telemetry[@]}" "${state[@]}" pmu/command_reply
+    ground-station)  # the only one that may command or acknowledge; reads everything the service publishes
+      rule_xml publish "$parts" pmu/command pmu/alarm_ack
+      rule_xml subscribe "$parts" "${telemetry[@]}" "${state[@]}" pmu/command_reply pmu/alarm_ack_reply
       ;;
-    mission-computer)  # listens to telemetry and state, nothing else
+    mission-computer)  # listens to telemetry and state, nothing else: an alarm is the operator's to acknowledge
       rule_xml subscribe "$parts" "${telemetry[@]}" "${state[@]}"
       ;;
   esac

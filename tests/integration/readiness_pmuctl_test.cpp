@@ -75,6 +75,47 @@ TEST(ReadinessOverDds, AHotPmuRaisesItsAlarmAndMakesTheVehicleNotReady) {
   EXPECT_NE(r.out.find("CRITICAL thermal_shutdown"), std::string::npos) << r.out;
 }
 
+TEST(ReadinessOverDds, AnAlarmAcknowledgedFromTheGroundIsActiveAcknowledged) {
+  const std::string domain = std::to_string(pmu::test::exclusive_dds_domain());
+  pmu::test::ConfiguredService service(PMU_SERVICE_PATH,
+                                       config(domain, "        sim: {internal_temperature: 95}\n"));
+  const std::string p = std::string(PMUCTL_PATH) + " --domain " + domain + " ";
+  const auto raised = until(
+      p + "--timeout 10 --json alarms",
+      [](const auto& r) { return r.out.find("thermal_shutdown") != std::string::npos; }, 30s);
+  ASSERT_NE(raised.out.find("ACTIVE_UNACKNOWLEDGED"), std::string::npos) << raised.out << service.describe();
+
+  const auto ack = pmu::test::run_capture(p + "--timeout 10 --json alarms ack thermal_shutdown");
+  ASSERT_EQ(ack.status, 0) << ack.out << service.describe();
+  const auto reply = pmu::test::json_lines(ack.out);
+  ASSERT_EQ(reply.size(), 1u) << ack.out;
+  EXPECT_EQ(reply[0]["result"], "COMPLETED");
+  EXPECT_EQ(reply[0]["reason"], "acknowledged");
+  EXPECT_EQ(reply[0]["state"], "ACTIVE_ACKNOWLEDGED");
+  EXPECT_EQ(reply[0]["bus"], "sim");
+  EXPECT_EQ(reply[0]["device"], 1);
+
+  const auto alarms = until(
+      p + "--timeout 10 --json alarms",
+      [](const auto& r) { return r.out.find("ACTIVE_ACKNOWLEDGED") != std::string::npos; }, 20s);
+  EXPECT_NE(alarms.out.find("ACTIVE_ACKNOWLEDGED"), std::string::npos) << alarms.out;
+
+  // Again: idempotent, and said so.
+  const auto again = pmu::test::run_capture(p + "--timeout 10 --json alarms ack thermal_shutdown");
+  EXPECT_EQ(again.status, 0) << again.out;
+  EXPECT_NE(again.out.find("nothing to acknowledge: ACTIVE_ACKNOWLEDGED"), std::string::npos) << again.out;
+  const auto bus = pmu::test::run_capture(p + "--timeout 10 --json alarms ack bus_off --kind bus --bus sim");
+  EXPECT_EQ(bus.status, 0) << bus.out;
+  EXPECT_NE(bus.out.find("nothing to acknowledge: NORMAL"), std::string::npos) << bus.out;
+  // A device the bus does not have has no such alarm: REJECTED, exit 1.
+  const auto wrong =
+      pmu::test::run_capture(p + "--timeout 10 --json alarms ack bms_low_soc --kind battery --bus sim --address 9");
+  EXPECT_EQ(wrong.status, 1) << wrong.out;
+  EXPECT_NE(wrong.out.find("\"REJECTED\""), std::string::npos) << wrong.out;
+  const auto bad = pmu::test::run_capture(p + "--timeout 2 alarms ack thermal_shutdown --kind engine", true);
+  EXPECT_EQ(bad.status, 2) << bad.out;
+}
+
 TEST(ReadinessOverDds, NothingOnTheDomainIsExitThree) {
   const std::string domain = std::to_string(pmu::test::exclusive_dds_domain());
   const auto r = pmu::test::run_capture(std::string(PMUCTL_PATH) + " --domain " + domain + " --timeout 1 preflight",

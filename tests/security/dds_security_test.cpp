@@ -42,6 +42,7 @@
 #include "pmu/dds/dds_context.hpp"
 #include "pmu/dds/dds_publisher.hpp"
 #include "pmu/dispatch/command_service.hpp"
+#include "pmu/idl/alarmsPubSubTypes.h"
 #include "pmu/idl/commandPubSubTypes.h"
 #include "pmu/idl/statePubSubTypes.h"
 #include "pmu/idl/telemetryPubSubTypes.h"
@@ -290,6 +291,8 @@ const TopicInfo kTopics[] = {
     {topics::kHealth, [] { return TypeSupport(new pmu::v4::HealthPubSubType()); }, qos_profiles::kState},
     {topics::kCommand, [] { return TypeSupport(new pmu::v4::CommandPubSubType()); }, qos_profiles::kCommand},
     {topics::kCommandReply, [] { return TypeSupport(new pmu::v4::CommandReplyPubSubType()); }, qos_profiles::kCommand},
+    {topics::kAlarmAck, [] { return TypeSupport(new pmu::v4::AlarmAckPubSubType()); }, qos_profiles::kCommand},
+    {topics::kAlarmAckReply, [] { return TypeSupport(new pmu::v4::AlarmAckReplyPubSubType()); }, qos_profiles::kCommand},
 };
 
 TEST(Permissions, EveryIdentityMayCreateExactlyTheWritersAndReadersTheContractAllows) {

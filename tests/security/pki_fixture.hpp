@@ -128,14 +128,16 @@ inline const char* const kContractTopics[] = {
     "pmu/status",            "pmu/low_rate/voltages", "pmu/low_rate/currents",       "pmu/low_rate/battery_energy",
     "pmu/low_rate/temperatures", "pmu/low_rate/status", "pmu/battery", "pmu/battery_cells", "pmu/mppt",
     "pmu/config",            "pmu/info",              "pmu/health",            "pmu/alarms",  "pmu/readiness", "pmu/command",
-    "pmu/command_reply"};
+    "pmu/command_reply",     "pmu/alarm_ack",         "pmu/alarm_ack_reply"};
 
-// Only the ground station commands; the service publishes telemetry,
+// Only the ground station commands and acknowledges alarms; the service publishes telemetry,
 // state and replies; the mission computer only reads telemetry and state.
 inline bool allowed(const std::string& identity, const std::string& topic, bool publish) {
   const bool data = kTelemetryAndState.count(topic) > 0;
-  if (identity == "pmu-service") return publish ? data || topic == "pmu/command_reply" : topic == "pmu/command";
-  if (identity == "ground-station") return publish ? topic == "pmu/command" : data || topic == "pmu/command_reply";
+  const bool request = topic == "pmu/command" || topic == "pmu/alarm_ack";
+  const bool reply = topic == "pmu/command_reply" || topic == "pmu/alarm_ack_reply";
+  if (identity == "pmu-service") return publish ? data || reply : request;
+  if (identity == "ground-station") return publish ? request : data || reply;
   if (identity == "mission-computer") return !publish && data;
   return false;
 }

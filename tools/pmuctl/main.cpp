@@ -189,7 +189,14 @@ int main(int argc, char** argv) {
   app.add_subcommand("list", "PMUs the service knows, with health");
   app.add_subcommand("info", "Serial number, firmware and features");
   app.add_subcommand("health", "Link, bus and device health");
-  app.add_subcommand("alarms", "Alarms that are active or wait for acknowledgement");
+  auto* alarms = app.add_subcommand("alarms", "Alarms that are active or wait for acknowledgement");
+  auto* alarms_ack = alarms->add_subcommand(
+      "ack", "Acknowledge an alarm (a PMU's by default, chosen as for commands; exit 0 COMPLETED, 1 not)");
+  std::string ack_code, ack_kind = "pmu";
+  alarms_ack->add_option("code", ack_code, "The alarm's code, e.g. thermal_shutdown")->required();
+  alarms_ack->add_option("--kind", ack_kind,
+                         "Whose alarm: pmu (default), battery or mppt (--address: the node or device id), bus "
+                         "(--bus)");
   app.add_subcommand("preflight", "Whether the vehicle may fly, and every reason it may not (exit 0 ready, 1 not)");
   auto* config = app.add_subcommand("config", "Stored parameters");
   config->require_subcommand(1);
@@ -354,6 +361,7 @@ int main(int argc, char** argv) {
     if (app.got_subcommand("list")) return pmu::tools::run_list(g);
     if (app.got_subcommand("info")) return pmu::tools::run_info(g);
     if (app.got_subcommand("health")) return pmu::tools::run_health(g);
+    if (*alarms_ack) return pmu::tools::run_alarm_ack(g, ack_code, ack_kind);
     if (app.got_subcommand("alarms")) return pmu::tools::run_alarms(g);
     if (app.got_subcommand("preflight")) return pmu::tools::run_preflight(g);
     if (*config_get) return pmu::tools::run_config_get(g, parameter);

@@ -27,6 +27,7 @@
 #include "pmu/config/config.hpp"
 #include "pmu/config/statistics_settings.hpp"
 #include "pmu/config/vehicle.hpp"
+#include "pmu/dds/dds_alarm_acks.hpp"
 #include "pmu/dds/dds_commands.hpp"
 #include "pmu/dds/dds_context.hpp"
 #include "pmu/dds/dds_publisher.hpp"
@@ -169,6 +170,11 @@ int run(const service::Config& cfg, const pmu::dds::ResolvedNetwork& network) {
     command_topics.publish(r);
     if (previous_command_topics) previous_command_topics->publish(r);
   });
+  // Acknowledgements exist from contract v4 on: the previous contract's participant has no
+  // such topics.
+  service::DdsAlarmAckEndpoint ack_topics(participant, cfg.vehicle);
+  service::AlarmAckService acks(workers, cfg.vehicle, cfg.policy.lifetimes, clock,
+                                [&](const service::AlarmAckReplyData& r) { ack_topics.publish(r); });
   // Declared after everything the running threads use, so it is destroyed first, on every
   // way out of this function: commands stop first (no new request reaches `commands`, and
   // the bus workers are still there to finish the ones in flight), then the worker threads
@@ -177,9 +183,11 @@ int run(const service::Config& cfg, const pmu::dds::ResolvedNetwork& network) {
   struct Shutdown {
     service::DdsCommandEndpoint& command_topics;
     service::DdsCommandEndpoint* previous_command_topics;
+    service::DdsAlarmAckEndpoint& ack_topics;
     std::vector<BusRuntime>& buses;
     ~Shutdown() {
       command_topics.stop();
+      ack_topics.stop();
       if (previous_command_topics) previous_command_topics->stop();
       for (auto& b : buses) b.worker->stop();
       for (auto& b : buses) {
@@ -188,13 +196,14 @@ int run(const service::Config& cfg, const pmu::dds::ResolvedNetwork& network) {
       }
       spdlog::info("pmu-service stopped");
     }
-  } shutdown{command_topics, previous_command_topics.get(), buses};
+  } shutdown{command_topics, previous_command_topics.get(), ack_topics, buses};
   for (auto& b : buses) {
     if (b.simulator) b.simulator->start();
     b.thread = std::thread([w = b.worker.get()] { w->run(); });
   }
   command_topics.start(commands);
   if (previous_command_topics) previous_command_topics->start(commands);
+  ack_topics.start(acks);
   spdlog::info("pmu-service ready on DDS domain {}: {}", cfg.domain, summary(buses));
   systemd.ready(summary(buses));
 

@@ -91,8 +91,15 @@ codec::Result<CommandAction, std::string> parse_action(CommandKind kind, const C
   return Reject{std::string("unknown command kind")};
 }
 
-// The deadline for a sample's expires_at, computed in unsigned nanoseconds: every value from
-// 0 to 2^64-1 has a meaning and none can overflow.
+codec::Result<bool, std::string> within(const std::string& text, std::size_t max, const char* field) {
+  if (text.size() <= max) return true;
+  return Reject{std::string(field) + " is " + std::to_string(text.size()) + " bytes long; at most " +
+                std::to_string(max) + " are allowed"};
+}
+
+}  // namespace
+
+// In unsigned nanoseconds: every value from 0 to 2^64-1 has a meaning and none can overflow.
 codec::Result<std::chrono::steady_clock::time_point, std::string> deadline(std::uint64_t expires_at, const Now& now,
                                                                            const Lifetimes& lt) {
   using std::chrono::nanoseconds;
@@ -105,13 +112,6 @@ codec::Result<std::chrono::steady_clock::time_point, std::string> deadline(std::
   return now.steady + std::chrono::duration_cast<std::chrono::steady_clock::duration>(ahead);
 }
 
-codec::Result<bool, std::string> within(const std::string& text, std::size_t max, const char* field) {
-  if (text.size() <= max) return true;
-  return Reject{std::string(field) + " is " + std::to_string(text.size()) + " bytes long; at most " +
-                std::to_string(max) + " are allowed"};
-}
-
-}  // namespace
 
 std::string_view to_string(CommandKind k) noexcept { return kKindNames[static_cast<std::size_t>(k)]; }
 

@@ -55,7 +55,8 @@ std::vector<ReadinessReason> readiness_reasons(const ReadinessInput& in) {
   for (const auto& a : in.alarms) {
     if (a.state == alarms::AlarmState::Normal) continue;
     const bool waiting = a.state == alarms::AlarmState::ClearedUnacknowledged;
-    std::string description = waiting ? "Cleared, but a critical alarm blocks until it is acknowledged."
+    std::string description = waiting ? "Cleared; a critical alarm blocks until acknowledged: pmuctl alarms ack " +
+                                                std::string(alarms::to_string(a.code)) + "."
                                       : "Active: see pmuctl alarms for its value and limit.";
     out.push_back({std::string(alarms::to_string(a.code)), a.severity, a.bus, a.source, a.device,
                    bounded(waiting ? a.message + " (unacknowledged)" : a.message, 42), std::move(description)});

@@ -11,8 +11,8 @@ const std::vector<RecordedTopic>& recorded_topics() {
   using namespace pmu::topics;
   namespace q = pmu::qos_profiles;
   namespace t = pmu::idl_text;
-  // The low-rate topics repeat the full-rate samples and commands are the operators' own:
-  // recorded only when named.
+  // The low-rate topics repeat the full-rate samples, and commands and acknowledgements are
+  // the operators' own: recorded only when named.
   static const std::vector<RecordedTopic> all = {
       {kVoltages, "pmu::v4::Voltages", t::k_telemetry, q::kTelemetry, true},
       {kCurrents, "pmu::v4::Currents", t::k_telemetry, q::kTelemetry, true},
@@ -34,6 +34,8 @@ const std::vector<RecordedTopic>& recorded_topics() {
       {kLowRateStatus, "pmu::v4::Status", t::k_telemetry, q::kTelemetry, false},
       {kCommand, "pmu::v4::Command", t::k_command, q::kCommand, false},
       {kCommandReply, "pmu::v4::CommandReply", t::k_command, q::kCommand, false},
+      {kAlarmAck, "pmu::v4::AlarmAck", t::k_alarms, q::kCommand, false},
+      {kAlarmAckReply, "pmu::v4::AlarmAckReply", t::k_alarms, q::kCommand, false},
   };
   return all;
 }

@@ -55,6 +55,8 @@ TypeSupport raw_type_support(const std::string& type_name) {
   if (type_name == "pmu::v4::Alarm") return TypeSupport(new RawSampleType<pmu::v4::AlarmPubSubType>());
   if (type_name == "pmu::v4::Readiness") return TypeSupport(new RawSampleType<pmu::v4::ReadinessPubSubType>());
   if (type_name == "pmu::v4::Command") return TypeSupport(new RawSampleType<pmu::v4::CommandPubSubType>());
+  if (type_name == "pmu::v4::AlarmAck") return TypeSupport(new RawSampleType<pmu::v4::AlarmAckPubSubType>());
+  if (type_name == "pmu::v4::AlarmAckReply") return TypeSupport(new RawSampleType<pmu::v4::AlarmAckReplyPubSubType>());
   return TypeSupport(new RawSampleType<pmu::v4::CommandReplyPubSubType>());
 }
 

@@ -18,6 +18,8 @@
 #include "pmu/codec/messages.hpp"
 #include "pmu/command/command.hpp"
 #include "pmu/dds/dds_context.hpp"
+#include "pmu/idl/alarms.h"
+#include "pmu/idl/alarmsPubSubTypes.h"
 #include "pmu/idl/command.h"
 #include "pmu/idl/commandPubSubTypes.h"
 #include "pmu/idl/guarded_type.hpp"
@@ -115,7 +117,134 @@ std::optional<int> resolve_target(const GlobalOptions& o, const std::string& veh
   return std::nullopt;
 }
 
+// Waits until the service's request reader and reply writer are matched: a request written
+// before would be lost, a reply sent before would never be seen. nullopt when matched.
+std::optional<int> wait_for_match(const GlobalOptions& o, pmu::dds::DdsContext& dds, DataWriter& writer,
+                                  DataReader& replies, const std::string& vehicle, Clock::time_point deadline,
+                                  const char* accepts) {
+  for (;;) {
+    PublicationMatchedStatus pub;
+    SubscriptionMatchedStatus sub;
+    writer.get_publication_matched_status(pub);
+    replies.get_subscription_matched_status(sub);
+    if (pub.current_count > 0 && sub.current_count > 0) return std::nullopt;
+    if (Clock::now() >= deadline) {
+      if (pub.current_count == 0 && sub.current_count == 0) return no_service(o, dds);
+      return fail(o, ExitStatus::NoAnswer,
+                  "no pmu-service of " + vehicle_text(vehicle) + " on domain " + std::to_string(o.domain) + " " +
+                      accepts + vehicles_seen_text(vehicles_on_domain(dds)));
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+}
+
+std::uint64_t epoch_ns_after(double seconds) {
+  const auto t = std::chrono::system_clock::now() +
+                 std::chrono::duration_cast<std::chrono::system_clock::duration>(std::chrono::duration<double>(seconds));
+  return static_cast<std::uint64_t>(std::chrono::duration_cast<std::chrono::nanoseconds>(t.time_since_epoch()).count());
+}
+
+const char* ack_state_name(pmu::v4::AlarmState s) {
+  switch (s) {
+    case pmu::v4::ALARM_NORMAL: return "NORMAL";
+    case pmu::v4::ALARM_ACTIVE_UNACKNOWLEDGED: return "ACTIVE_UNACKNOWLEDGED";
+    case pmu::v4::ALARM_ACTIVE_ACKNOWLEDGED: return "ACTIVE_ACKNOWLEDGED";
+    case pmu::v4::ALARM_CLEARED_UNACKNOWLEDGED: return "CLEARED_UNACKNOWLEDGED";
+  }
+  return "?";
+}
+
 }  // namespace
+
+int run_alarm_ack(const GlobalOptions& o, const std::string& code, const std::string& kind) {
+  const double timeout = o.timeout.value_or(5.0);
+  const auto deadline = Clock::now() + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(timeout));
+  const std::string vehicle = o.vehicle.value_or(std::string());
+  pmu::v4::AlarmSource source = pmu::v4::SOURCE_PMU;
+  if (kind == "battery")
+    source = pmu::v4::SOURCE_BATTERY;
+  else if (kind == "mppt")
+    source = pmu::v4::SOURCE_MPPT;
+  else if (kind == "bus")
+    source = pmu::v4::SOURCE_BUS;
+  else if (kind != "pmu")
+    return fail(o, ExitStatus::BadUsage, "--kind '" + pmu::service::printable(kind) + "': pmu, battery, mppt or bus");
+  if (source == pmu::v4::SOURCE_BUS && o.bus.empty())
+    return fail(o, ExitStatus::BadUsage, "a bus alarm needs --bus");
+  if ((source == pmu::v4::SOURCE_BATTERY || source == pmu::v4::SOURCE_MPPT) && (o.bus.empty() || !o.address))
+    return fail(o, ExitStatus::BadUsage, "a " + kind + " alarm needs --bus and --address (the " +
+                                             (source == pmu::v4::SOURCE_BATTERY ? "CANopen node" : "MPPT device id") +
+                                             ")");
+  pmu::dds::DdsContext dds(o.domain, o.qos_file, "pmuctl", o.security, pmu::dds::Transport::Default, o.network,
+                           partitions_for(o));
+  DataReader& replies = dds.reader(
+      dds.topic(topics::kAlarmAckReply, TypeSupport(new idl::Guarded<pmu::v4::AlarmAckReplyPubSubType>())),
+      qos_profiles::kCommand);
+  DataWriter& writer =
+      dds.writer(dds.topic(topics::kAlarmAck, TypeSupport(new pmu::v4::AlarmAckPubSubType())), qos_profiles::kCommand);
+  std::string bus = o.bus;
+  std::uint16_t device = source == pmu::v4::SOURCE_BUS ? 0 : o.address.value_or(0);
+  if (source == pmu::v4::SOURCE_PMU)
+    if (const auto failed = resolve_target(o, vehicle, dds, deadline, bus, device)) return *failed;
+  if (const auto failed = wait_for_match(o, dds, writer, replies, vehicle, deadline, "accepts alarm acknowledgements"))
+    return *failed;
+
+  pmu::v4::AlarmAck a;
+  const std::string id = request_id();
+  a.request_id(id);
+  a.vehicle(vehicle);
+  a.bus(bus);
+  a.kind(source);
+  a.device(device);
+  a.code(code);
+  a.expires_at(epoch_ns_after(timeout));
+  if (!writer.write(&a)) return fail(o, ExitStatus::NotDone, "the acknowledgement could not be written to DDS");
+
+  // Unanswered after 1 s: sent again with the same id, which the service answers again and
+  // never applies twice (interface.md 2.4, and 1.6 for acknowledgements).
+  constexpr auto kResendAfter = std::chrono::seconds(1);
+  auto next_resend = Clock::now() + kResendAfter;
+  const auto wait_until = deadline + std::chrono::milliseconds(500);
+  while (Clock::now() < wait_until) {
+    if (Clock::now() >= next_resend && Clock::now() < deadline) {
+      (void)writer.write(&a);
+      next_resend = Clock::now() + kResendAfter;
+    }
+    pmu::v4::AlarmAckReply r;
+    SampleInfo info;
+    while (replies.take_next_sample(&r, &info) == ReturnCode_t::RETCODE_OK) {
+      if (!info.valid_data || r.request_id().to_string() != id || r.vehicle().to_string() != vehicle) continue;
+      const bool done = r.result() == pmu::v4::ACK_COMPLETED;
+      const char* result = done ? "COMPLETED" : "REJECTED";
+      if (o.json) {
+        Json j{{"request_id", id},
+               {"vehicle", r.vehicle().to_string()},
+               {"bus", r.bus().to_string()},
+               {"kind", kind},
+               {"device", r.device()},
+               {"code", r.code().to_string()},
+               {"result", result},
+               {"reason", r.reason().to_string()},
+               {"state", ack_state_name(r.state())}};
+        std::printf("%s\n", j.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace).c_str());
+      }
+      std::fprintf(stderr, "%s: %s (now %s)\n", result, r.reason().c_str(), ack_state_name(r.state()));
+      return static_cast<int>(done ? ExitStatus::Ok : ExitStatus::NotDone);
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  }
+  char waited[96];
+  std::snprintf(waited, sizeof waited, "no reply from pmu-service within %.1f s (request ", timeout);
+  const std::string message = waited + id + ")";
+  std::fprintf(stderr, "pmuctl: %s\n", message.c_str());
+  if (o.json) {
+    Json j{{"request_id", id}, {"vehicle", vehicle}, {"bus", bus}, {"kind", kind}, {"device", device},
+           {"code", code},     {"result", nullptr},  {"reason", message},
+           {"exit_status", static_cast<int>(ExitStatus::NoAnswer)}};
+    std::printf("%s\n", j.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace).c_str());
+  }
+  return static_cast<int>(ExitStatus::NoAnswer);
+}
 
 bool output_mask(const std::vector<std::string>& names, std::uint8_t& mask) {
   mask = 0;
@@ -176,22 +305,8 @@ int run_command(const GlobalOptions& o, const CommandSpec& spec) {
   if (!broadcast)
     if (const auto failed = resolve_target(o, vehicle, dds, deadline, bus, address)) return *failed;
 
-  // Send only once the service's command reader and reply writer are matched: a command
-  // written before that would be lost, and a reply sent before it would never be seen.
-  for (;;) {
-    PublicationMatchedStatus pub;
-    SubscriptionMatchedStatus sub;
-    writer.get_publication_matched_status(pub);
-    replies.get_subscription_matched_status(sub);
-    if (pub.current_count > 0 && sub.current_count > 0) break;
-    if (Clock::now() >= deadline) {
-      if (pub.current_count == 0 && sub.current_count == 0) return no_service(o, dds);
-      return fail(o, ExitStatus::NoAnswer,
-                  "no pmu-service of " + vehicle_text(vehicle) + " on domain " + std::to_string(o.domain) +
-                      " accepts commands" + vehicles_seen_text(vehicles_on_domain(dds)));
-    }
-    std::this_thread::sleep_for(std::chrono::milliseconds(10));
-  }
+  if (const auto failed = wait_for_match(o, dds, writer, replies, vehicle, deadline, "accepts commands"))
+    return *failed;
 
   pmu::v4::Command c;
   const std::string id = request_id();

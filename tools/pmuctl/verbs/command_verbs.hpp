@@ -23,6 +23,11 @@ struct CommandSpec {
 
 int run_command(const GlobalOptions& o, const CommandSpec& spec);
 
+// pmuctl alarms ack CODE: one pmu::v4::AlarmAck, exactly one AlarmAckReply (interface.md 1.6).
+// `kind` is "pmu" (the PMU chosen as for commands), "battery", "mppt" (--bus and --address the
+// node or device id) or "bus" (--bus). Exit 0 for ACK_COMPLETED, 1 otherwise, 3 no answer.
+int run_alarm_ack(const GlobalOptions& o, const std::string& code, const std::string& kind);
+
 // Why --address 65535 may not go with this command kind, or "" when it may (engine stop alone,
 // or another address).
 std::string broadcast_refusal(const GlobalOptions& o, int kind);

@@ -27,6 +27,9 @@ inline constexpr const char* kMppt = "pmu/mppt";
 inline constexpr const char* kAlarms = "pmu/alarms";
 // Whether the vehicle may fly, and why not: docs/interface.md 1.7.
 inline constexpr const char* kReadiness = "pmu/readiness";
+// Acknowledging an alarm, and its reply (QoS profile `command`): docs/interface.md 1.6.
+inline constexpr const char* kAlarmAck = "pmu/alarm_ack";
+inline constexpr const char* kAlarmAckReply = "pmu/alarm_ack_reply";
 inline constexpr const char* kCommand = "pmu/command";
 inline constexpr const char* kCommandReply = "pmu/command_reply";
 

@@ -145,6 +145,11 @@ struct Now {
   std::chrono::steady_clock::time_point steady;
 };
 
+// The steady deadline of a request's expires_at (0: the default lifetime; held to the
+// maximum lifetime), or "expired N ms ago". Shared by every request a peer can send.
+codec::Result<std::chrono::steady_clock::time_point, std::string> deadline(std::uint64_t expires_at, const Now& now,
+                                                                           const Lifetimes& lifetimes);
+
 // The boundary. A valid sample gives a request; anything else the reason to reject it, which
 // quotes the sample's text through printable(). Firmware-dependent checks come later
 // (check_firmware in command_executor.hpp), when the device is known.
