@@ -6,7 +6,6 @@
 
 #include <atomic>
 #include <mutex>
-#include <sstream>
 
 #include "pmu/config/vehicle.hpp"
 #include "pmu/idl/alarms.h"
@@ -14,6 +13,7 @@
 #include "pmu/idl/guarded_type.hpp"
 #include "pmu/idl/topics.hpp"
 #include "pmu/session/log_throttle.hpp"
+#include "writer_guid.hpp"
 
 namespace pmu::service {
 namespace {
@@ -25,12 +25,6 @@ static_assert(static_cast<int>(pmu::v4::SOURCE_BUS) == static_cast<int>(alarms::
 static_assert(static_cast<int>(pmu::v4::ALARM_CLEARED_UNACKNOWLEDGED) ==
               static_cast<int>(alarms::AlarmState::ClearedUnacknowledged));
 static_assert(static_cast<int>(pmu::v4::ACK_REJECTED) == static_cast<int>(AckReplyResult::Rejected));
-
-std::string guid_of(const SampleInfo& info) {
-  std::ostringstream who;
-  who << info.sample_identity.writer_guid();
-  return who.str();
-}
 
 }  // namespace
 
@@ -71,7 +65,7 @@ struct DdsAlarmAckEndpoint::Impl final : public DataReaderListener {
     // such sample sat at the head of the history.
     while (r->take_next_sample(&s, &info) == ReturnCode_t::RETCODE_OK) {
       if (!info.valid_data) continue;
-      AlarmAckSample sample{guid_of(info), s.request_id().to_string(), s.vehicle().to_string(), s.bus().to_string(),
+      AlarmAckSample sample{writer_guid_text(info), s.request_id().to_string(), s.vehicle().to_string(), s.bus().to_string(),
                             static_cast<std::int64_t>(static_cast<std::uint32_t>(s.kind())), s.device(), s.code().to_string(),
                             s.expires_at()};
       const auto partitions = dds.remote_writers().partitions_of(info);

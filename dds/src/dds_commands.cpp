@@ -9,7 +9,6 @@
 #include <optional>
 #include <map>
 #include <mutex>
-#include <sstream>
 #include <vector>
 
 #include "pmu/config/vehicle.hpp"
@@ -20,6 +19,7 @@
 #include "pmu/idl/commandPubSubTypes.h"
 #include "pmu/idl/topics.hpp"
 #include "pmu/session/log_throttle.hpp"
+#include "writer_guid.hpp"
 
 namespace pmu::service {
 namespace {
@@ -30,15 +30,6 @@ static_assert(static_cast<int>(pmu::v4::GET_FIRMWARE) == static_cast<int>(Comman
 static_assert(static_cast<int>(pmu::v4::IN_PROGRESS) == static_cast<int>(CommandResult::InProgress));
 
 constexpr std::chrono::seconds kMalformedLogInterval{10};
-
-template <class Guid>
-std::string text_of(const Guid& guid) {
-  std::ostringstream who;
-  who << guid;
-  return who.str();
-}
-
-std::string guid_of(const SampleInfo& info) { return text_of(info.sample_identity.writer_guid()); }
 
 std::string partition_list(const std::vector<std::string>& names) {
   if (names.empty()) return "the default partition";
@@ -104,7 +95,7 @@ struct DdsCommandEndpoint::Impl final : public DataReaderListener {
       // Fast DDS 2.9 drops a sample whose deserialize failed before take sees it; a library
       // that hands it over anyway gives an empty Received. Either way it was counted.
       if (!info.valid_data || !received.sample) continue;
-      received.sample->sender = guid_of(info);
+      received.sample->sender = writer_guid_text(info);
       if (ours(*received.sample, dds.remote_writers().partitions_of(info))) service->submit(*received.sample);
     }
     report_malformed();

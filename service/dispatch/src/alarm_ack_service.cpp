@@ -2,6 +2,8 @@
 
 #include <spdlog/spdlog.h>
 
+#include "sender_key.hpp"
+
 namespace pmu::service {
 namespace {
 
@@ -17,11 +19,6 @@ std::optional<Source> kind_of(std::int64_t source) noexcept {
     case 3: return Source::Bus;
     default: return std::nullopt;
   }
-}
-
-// Ids are per sender, as for commands; GUIDs hold no NUL.
-std::string sender_key(const std::string& sender, const std::string& request_id) {
-  return sender + '\0' + request_id;
 }
 
 std::string content_of(const AlarmAckSample& s) {

@@ -7,19 +7,9 @@
 
 #include "pmu/codec/encode.hpp"
 #include "pmu/codec/ids.hpp"
+#include "sender_key.hpp"
 
 namespace pmu::service {
-namespace {
-
-// Request ids are unique per sender: the key is both. Senders are DDS GUIDs (no NUL).
-std::string sender_key(const std::string& sender, const std::string& request_id) {
-  std::string key = sender;
-  key += '\0';
-  key += request_id;
-  return key;
-}
-
-}  // namespace
 
 CommandService::CommandService(std::vector<BusWorker*> workers, PolicyConfig policy, Timeouts timeouts,
                                const transport::Clock& clock, ReplyFn reply)

@@ -15,6 +15,7 @@
 #include "pmu/idl/alarmsPubSubTypes.h"
 #include "pmu/idl/guarded_type.hpp"
 #include "pmu/idl/topics.hpp"
+#include "pmuctl/verbs/alarm_names.hpp"
 #include "pmuctl/verbs/exit_status.hpp"
 #include "pmuctl/verbs/service_presence.hpp"
 
@@ -23,27 +24,6 @@ namespace {
 
 using namespace eprosima::fastdds::dds;
 using Clock = std::chrono::steady_clock;
-using Json = nlohmann::json;
-
-const char* kind_name(pmu::v4::AlarmSource k) {
-  switch (k) {
-    case pmu::v4::SOURCE_BATTERY: return "battery";
-    case pmu::v4::SOURCE_MPPT: return "mppt";
-    case pmu::v4::SOURCE_BUS: return "bus";
-    case pmu::v4::SOURCE_PMU: break;
-  }
-  return "pmu";
-}
-
-const char* state_name(pmu::v4::AlarmState s) {
-  switch (s) {
-    case pmu::v4::ALARM_ACTIVE_UNACKNOWLEDGED: return "ACTIVE_UNACKNOWLEDGED";
-    case pmu::v4::ALARM_ACTIVE_ACKNOWLEDGED: return "ACTIVE_ACKNOWLEDGED";
-    case pmu::v4::ALARM_CLEARED_UNACKNOWLEDGED: return "CLEARED_UNACKNOWLEDGED";
-    case pmu::v4::ALARM_NORMAL: break;
-  }
-  return "NORMAL";
-}
 
 // One alarm instance: the sample's keys.
 using AlarmKey = std::tuple<std::string, std::string, int, std::uint16_t, std::string>;
@@ -62,7 +42,7 @@ std::string where(const pmu::v4::Alarm& a) {
   std::string w = a.vehicle().size() ? a.vehicle().to_string() + "/" : std::string();
   w += a.bus().to_string();
   if (a.kind() == pmu::v4::SOURCE_BUS) return w;
-  return w + "/" + (a.kind() == pmu::v4::SOURCE_PMU ? std::string() : kind_name(a.kind())) + std::to_string(a.device());
+  return w + "/" + (a.kind() == pmu::v4::SOURCE_PMU ? std::string() : alarm_source_name(a.kind())) + std::to_string(a.device());
 }
 
 std::string utc(std::uint64_t ns) {
@@ -74,29 +54,29 @@ std::string utc(std::uint64_t ns) {
   return buf;
 }
 
-Json number_or_null(float v) { return std::isfinite(v) ? Json(v) : Json(nullptr); }
+nlohmann::json number_or_null(float v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr); }
 
 void print(const GlobalOptions& o, const pmu::v4::Alarm& a) {
   const bool critical = a.severity() == pmu::v4::SEVERITY_CRITICAL;
   if (o.json) {
-    Json j{{"topic", "alarms"},
+    nlohmann::json j{{"topic", "alarms"},
            {"vehicle", a.vehicle().to_string()},
            {"bus", a.bus().to_string()},
-           {"kind", kind_name(a.kind())},
+           {"kind", alarm_source_name(a.kind())},
            {"device", a.device()},
            {"code", a.code().to_string()},
            {"severity", critical ? "critical" : "warning"},
-           {"state", state_name(a.state())},
+           {"state", alarm_state_name(a.state())},
            {"value", number_or_null(a.value())},
            {"limit", number_or_null(a.limit())},
            {"since", static_cast<double>(a.since()) / 1e9},
            {"message", a.message().to_string()},
            {"contract", pmu::dds::contract_major()}};
-    std::printf("%s\n", j.dump(-1, ' ', false, Json::error_handler_t::replace).c_str());
+    std::printf("%s\n", j.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace).c_str());
     return;
   }
   std::printf("%-18s %-8s %-22s %-28s since %s  %s\n", where(a).c_str(), critical ? "CRITICAL" : "WARNING",
-              state_name(a.state()), a.code().c_str(), utc(a.since()).c_str(), a.message().c_str());
+              alarm_state_name(a.state()), a.code().c_str(), utc(a.since()).c_str(), a.message().c_str());
 }
 
 }  // namespace

@@ -26,6 +26,7 @@
 #include "pmu/idl/state.h"
 #include "pmu/idl/statePubSubTypes.h"
 #include "pmu/idl/topics.hpp"
+#include "pmuctl/verbs/alarm_names.hpp"
 #include "pmuctl/verbs/exit_status.hpp"
 #include "pmuctl/verbs/service_presence.hpp"
 #include "pmuctl/view/sample_json.hpp"
@@ -144,16 +145,6 @@ std::uint64_t epoch_ns_after(double seconds) {
   return static_cast<std::uint64_t>(std::chrono::duration_cast<std::chrono::nanoseconds>(t.time_since_epoch()).count());
 }
 
-const char* ack_state_name(pmu::v4::AlarmState s) {
-  switch (s) {
-    case pmu::v4::ALARM_NORMAL: return "NORMAL";
-    case pmu::v4::ALARM_ACTIVE_UNACKNOWLEDGED: return "ACTIVE_UNACKNOWLEDGED";
-    case pmu::v4::ALARM_ACTIVE_ACKNOWLEDGED: return "ACTIVE_ACKNOWLEDGED";
-    case pmu::v4::ALARM_CLEARED_UNACKNOWLEDGED: return "CLEARED_UNACKNOWLEDGED";
-  }
-  return "?";
-}
-
 }  // namespace
 
 int run_alarm_ack(const GlobalOptions& o, const std::string& code, const std::string& kind) {
@@ -225,10 +216,10 @@ int run_alarm_ack(const GlobalOptions& o, const std::string& code, const std::st
                {"code", r.code().to_string()},
                {"result", result},
                {"reason", r.reason().to_string()},
-               {"state", ack_state_name(r.state())}};
+               {"state", alarm_state_name(r.state())}};
         std::printf("%s\n", j.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace).c_str());
       }
-      std::fprintf(stderr, "%s: %s (now %s)\n", result, r.reason().c_str(), ack_state_name(r.state()));
+      std::fprintf(stderr, "%s: %s (now %s)\n", result, r.reason().c_str(), alarm_state_name(r.state()));
       return static_cast<int>(done ? ExitStatus::Ok : ExitStatus::NotDone);
     }
     std::this_thread::sleep_for(std::chrono::milliseconds(5));

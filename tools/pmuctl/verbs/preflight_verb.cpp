@@ -13,6 +13,7 @@
 #include "pmu/idl/alarmsPubSubTypes.h"
 #include "pmu/idl/guarded_type.hpp"
 #include "pmu/idl/topics.hpp"
+#include "pmuctl/verbs/alarm_names.hpp"
 #include "pmuctl/verbs/exit_status.hpp"
 #include "pmuctl/verbs/service_presence.hpp"
 #include "pmuctl/verbs/state_settle.hpp"
@@ -22,17 +23,6 @@ namespace {
 
 using namespace eprosima::fastdds::dds;
 using Clock = std::chrono::steady_clock;
-using Json = nlohmann::json;
-
-const char* kind_name(pmu::v4::AlarmSource k) {
-  switch (k) {
-    case pmu::v4::SOURCE_BATTERY: return "battery";
-    case pmu::v4::SOURCE_MPPT: return "mppt";
-    case pmu::v4::SOURCE_BUS: return "bus";
-    case pmu::v4::SOURCE_PMU: break;
-  }
-  return "pmu";
-}
 
 const char* level_name(pmu::v4::ReadinessLevel l) {
   switch (l) {
@@ -46,16 +36,16 @@ const char* level_name(pmu::v4::ReadinessLevel l) {
 void print(const GlobalOptions& o, const pmu::v4::Readiness& r) {
   const std::string vehicle = r.vehicle().to_string();
   if (o.json) {
-    Json reasons = Json::array();
+    nlohmann::json reasons = nlohmann::json::array();
     for (const auto& x : r.reasons())
       reasons.push_back({{"code", x.code().to_string()},
                          {"severity", x.severity() == pmu::v4::SEVERITY_CRITICAL ? "critical" : "warning"},
                          {"bus", x.bus().to_string()},
-                         {"kind", kind_name(x.kind())},
+                         {"kind", alarm_source_name(x.kind())},
                          {"device", x.device()},
                          {"message", x.message().to_string()},
                          {"description", x.description().to_string()}});
-    Json j{{"topic", "readiness"},
+    nlohmann::json j{{"topic", "readiness"},
            {"vehicle", vehicle},
            {"ready", r.ready()},
            {"level", level_name(r.level())},
@@ -63,7 +53,7 @@ void print(const GlobalOptions& o, const pmu::v4::Readiness& r) {
            {"reasons", reasons},
            {"reasons_total", r.reasons_total()},
            {"contract", pmu::dds::contract_major()}};
-    std::printf("%s\n", j.dump(-1, ' ', false, Json::error_handler_t::replace).c_str());
+    std::printf("%s\n", j.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace).c_str());
     return;
   }
   std::printf("%s: %s", vehicle.empty() ? "(unnamed vehicle)" : vehicle.c_str(),
@@ -72,7 +62,7 @@ void print(const GlobalOptions& o, const pmu::v4::Readiness& r) {
   for (const auto& x : r.reasons()) {
     std::string where = x.bus().to_string();
     if (x.kind() != pmu::v4::SOURCE_BUS)
-      where += "/" + std::string(x.kind() == pmu::v4::SOURCE_PMU ? "" : kind_name(x.kind())) + std::to_string(x.device());
+      where += "/" + std::string(x.kind() == pmu::v4::SOURCE_PMU ? "" : alarm_source_name(x.kind())) + std::to_string(x.device());
     std::printf("  %-8s %-24s %-14s %s\n           %s\n",
                 x.severity() == pmu::v4::SEVERITY_CRITICAL ? "CRITICAL" : "WARNING", x.code().c_str(), where.c_str(),
                 x.message().c_str(), x.description().c_str());
