@@ -10,6 +10,7 @@
 #include <linux/can.h>
 #include <sys/socket.h>
 
+#include "alarm_probe.hpp"
 #include "dds_probes.hpp"
 #include "pacer.hpp"
 #include "proc_stats.hpp"
@@ -57,11 +58,11 @@ struct Stream {
 
 struct Durations {
   double idle, latency, throughput, realistic;
-  int startups, commands;
+  int startups, commands, alarms;
 };
 
 Durations durations(const Settings& s) {
-  Durations d = s.quick ? Durations{1.0, 1.0, 1.0, 2.0, 1, 20} : Durations{10.0, 10.0, 30.0, 60.0, 5, 1000};
+  Durations d = s.quick ? Durations{1.0, 1.0, 1.0, 2.0, 1, 20, 3} : Durations{10.0, 10.0, 30.0, 60.0, 5, 1000, 30};
   if (s.latency_seconds > 0) d.latency = s.latency_seconds;
   if (s.realistic_seconds > 0) d.realistic = s.realistic_seconds;
   if (s.startups > 0) d.startups = s.startups;
@@ -405,6 +406,28 @@ Rows run_all(const Settings& s) {
                                " timed out, other results: " + json(cmd.results).dump());
     const Percentiles cmd_p = percentiles(cmd.rtt_ns);
 
+    progress("alarm latency");
+    // Each status frame with the flag raises thermal_shutdown (critical, no on-delay); the
+    // frame without it, and the model's own, clear it again before the next.
+    AlarmProbe alarm_probe(dds);
+    if (!alarm_probe.wait_matched(seconds(10))) throw std::runtime_error("pmu/status and pmu/alarms did not match");
+    std::vector<std::int64_t> alarm_ns, status_ns;
+    for (int i = 0; i < d.alarms; ++i) {
+      alarm_probe.reset();
+      const auto written = svc->pmu().write_status(true);
+      const auto until = steady_ns() + 2000000000;
+      while ((!alarm_probe.alarm_at() || !alarm_probe.status_at()) && steady_ns() < until) sleep_s(0.001);
+      if (alarm_probe.alarm_at()) alarm_ns.push_back(alarm_probe.alarm_at() - written);
+      if (alarm_probe.status_at()) status_ns.push_back(alarm_probe.status_at() - written);
+      (void)svc->pmu().write_status(false);
+      sleep_s(0.2);
+    }
+    if (alarm_ns.size() < static_cast<std::size_t>(d.alarms))
+      throw std::runtime_error("alarm latency: " + std::to_string(alarm_ns.size()) + " of " +
+                               std::to_string(d.alarms) + " thermal_shutdown alarms arrived within 2 s");
+    const Percentiles alarm_p = percentiles(alarm_ns);
+    const Percentiles flag_p = percentiles(status_ns);
+
     // ---- the references, over shared memory too ----------------------------------
     dds::DdsContext ref_dds(d_ref_shm, s.qos_file, "pmu-bench-ref", {}, kShm);
     VoltagesProbe ref_probe(ref_dds, nullptr);
@@ -480,6 +503,9 @@ Rows run_all(const Settings& s) {
                        std::to_string(d.commands) + " sequential commands each"));
     rows.push_back(row("command round trip (GET outputs), p99", cmd_p.p99_us, "us", echo_p.p99_us,
                        "bare DDS request/reply", "ratio <= 2", cmd_p.p99_us / echo_p.p99_us <= 2));
+    rows.push_back(row("alarm latency (status frame -> pmu/alarms), p50", alarm_p.p50_us, "us", flag_p.p50_us,
+                       "the same frame's pmu/status sample", "ratio <= 3", alarm_p.p50_us / flag_p.p50_us <= 3,
+                       std::to_string(d.alarms) + " thermal shutdowns raised, SHM"));
     rows.push_back(row("RSS, one PMU, all topics", footprint.rss_mib, "MiB", ref_footprint.rss_mib,
                        "bare participant + one writer", "ratio <= 1.5", footprint.rss_mib / ref_footprint.rss_mib <= 1.5));
     rows.push_back(row("threads, one PMU, all topics", footprint.threads, "threads", ref_footprint.threads,

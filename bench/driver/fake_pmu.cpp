@@ -64,6 +64,20 @@ void FakePmu::run() {
   }
 }
 
+std::int64_t FakePmu::write_status(bool thermal_shutdown) {
+  codec::Status s;
+  s.generator_rpm = 6000;
+  s.generation_enabled = true;
+  s.thermal_shutdown = thermal_shutdown;
+  s.starter_ready = true;
+  s.outputs = 0x0F;
+  const auto frame = codec::encode_status(s, 1);
+  const struct can_frame raw = transport::to_linux(*frame);
+  const std::int64_t now = steady_ns();
+  write_raw(&raw);
+  return now;
+}
+
 Injection FakePmu::inject(double rate, std::chrono::nanoseconds duration, WriteTimes& times,
                           const std::atomic<bool>* stop) {
   codec::Voltages v;

@@ -70,6 +70,10 @@ class FakePmu {
   // paced by absolute sleeps; a late writer catches up without sleeping.
   Injection inject(double rate, std::chrono::nanoseconds duration, WriteTimes& times,
                    const std::atomic<bool>* stop = nullptr);
+  // Writes one status frame (0x04) of PMU 1, engine running, with the thermal shutdown flag
+  // as given; returns the steady_clock ns of the write. The model's own status frames (flag
+  // clear) follow once a second.
+  std::int64_t write_status(bool thermal_shutdown);
   std::uint64_t frames_from_service() const noexcept { return from_service_.load(); }
 
  private:

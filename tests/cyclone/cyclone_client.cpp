@@ -2,7 +2,7 @@
 // API (not Fast DDS), written against interface.md alone: the contract's topic names, type
 // names and QoS. Started after pmu-service is up (a late joiner), it checks that
 //   - every topic delivers a sample of the device (telemetry within --telemetry-ms),
-//   - pmu/config, pmu/info and pmu/health arrive within --state-ms of matching their writer,
+//   - pmu/config, pmu/info, pmu/health and pmu/readiness arrive within --state-ms of matching their writer,
 //   - each command sent right after matching gets exactly one final reply (request id);
 //     one unanswered after --resend-ms is sent again with the same id (see below).
 // Prints one line per check ("ok ..." or "MISS ..."), then a "summary" line of key=value
@@ -28,6 +28,7 @@
 
 #include <cmath>
 
+#include "alarms.h"
 #include "canopen.h"
 #include "command.h"
 #include "state.h"
@@ -319,10 +320,11 @@ int main(int argc, char** argv) {
   if (!o.canopen_bus.empty()) return run_canopen(o, pp.get());
   std::vector<Topic> telemetry = {Topic("pmu/voltages"), Topic("pmu/currents"), Topic("pmu/battery_energy"),
                                   Topic("pmu/temperatures"), Topic("pmu/status")};
-  std::vector<Topic> state = {Topic("pmu/config"), Topic("pmu/info"), Topic("pmu/health")};
+  std::vector<Topic> state = {Topic("pmu/config"), Topic("pmu/info"), Topic("pmu/health"), Topic("pmu/readiness")};
   const dds_topic_descriptor_t* telemetry_types[] = {&pmu_v4_Voltages_desc, &pmu_v4_Currents_desc, &pmu_v4_BatteryEnergy_desc,
                                                      &pmu_v4_Temperatures_desc, &pmu_v4_Status_desc};
-  const dds_topic_descriptor_t* state_types[] = {&pmu_v4_Config_desc, &pmu_v4_DeviceInfo_desc, &pmu_v4_Health_desc};
+  const dds_topic_descriptor_t* state_types[] = {&pmu_v4_Config_desc, &pmu_v4_DeviceInfo_desc, &pmu_v4_Health_desc,
+                                                 &pmu_v4_Readiness_desc};
   for (std::size_t i = 0; i < state.size(); ++i) state[i].reader = reader(pp.get(), state_types[i], state[i].name, state_qos());
   for (std::size_t i = 0; i < telemetry.size(); ++i)
     telemetry[i].reader = reader(pp.get(), telemetry_types[i], telemetry[i].name, telemetry_qos());
@@ -407,6 +409,12 @@ int main(int argc, char** argv) {
     take_all<pmu_v4_Config>(state[0].reader, [&](const pmu_v4_Config& s) { mark(state[0], s.bus, s.address); });
     take_all<pmu_v4_DeviceInfo>(state[1].reader, [&](const pmu_v4_DeviceInfo& s) { mark(state[1], s.bus, s.address); });
     take_all<pmu_v4_Health>(state[2].reader, [&](const pmu_v4_Health& s) { mark(state[2], s.bus, s.address); });
+    // One instance per vehicle: any sample with its reasons decoded counts (a sequence of
+    // structs with bounded strings, the contract's deepest type).
+    take_all<pmu_v4_Readiness>(state[3].reader, [&](const pmu_v4_Readiness& s) {
+      if (!state[3].received && s.reasons._length <= 64 && s.reasons_total >= s.reasons._length)
+        state[3].received = Clock::now();
+    });
     take_all<pmu_v4_Voltages>(telemetry[0].reader, [&](const pmu_v4_Voltages& s) { mark(telemetry[0], s.bus, s.address); });
     take_all<pmu_v4_Currents>(telemetry[1].reader, [&](const pmu_v4_Currents& s) { mark(telemetry[1], s.bus, s.address); });
     take_all<pmu_v4_BatteryEnergy>(telemetry[2].reader,
