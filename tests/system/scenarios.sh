@@ -13,7 +13,7 @@
 #                                 command line (all when absent), one after another
 #   sh /scenarios.sh one NAME     a single scenario (what `all` runs for each)
 
-ALL_SCENARIOS="telemetry link_down_up iface_recreate iface_absent_at_start sim_restart two_pmus discovery flood commands_candump power_system"
+ALL_SCENARIOS="telemetry link_down_up iface_recreate iface_absent_at_start sim_restart two_pmus discovery flood commands_candump power_system flight_readiness"
 
 export PATH=/opt/pmu/bin:/usr/sbin:/usr/bin:/sbin:/bin
 export PMU_QOS_FILE=/etc/pmu-dds/qos.xml
@@ -510,6 +510,63 @@ scenario_power_system() {
   wait_until 20 mppts_back_battery_not || fail "after the restart without the battery: $(printf '%s' "$LIST_OUT" | tr '\n' ' ' | cut -c1-500)"
   alive "$pid" || fail "pmu-service died"
   detail "BMS silent: battery 2 $state after $took s (bound $BMS_SILENT_BOUND s); MPPTs ONLINE again; same pid"
+}
+
+# A verified engine start and readiness on a real bus. A flooded engine (pmu-sim cranks but
+# never fires) is FAILED once the cranking time and its margin are over, with pmuctl's exit
+# status 1; then a hot PMU (95 degC, above the stored T_U) raises thermal_shutdown and the
+# over-temperature warning, preflight says NOT READY with the alarm as the reason, and a start
+# is DENIED.
+ctl_text() { pmuctl --domain "$DOMAIN" "$@"; }
+pmu_listed() {
+  LIST_OUT=$(ctl --timeout 10 list 2>/dev/null)
+  [ "$(kind_state pmu address 1)" = ONLINE ]
+}
+thermal_alarm_active() {
+  ALARMS_OUT=$(ctl --timeout 10 alarms 2>/dev/null)
+  printf '%s\n' "$ALARMS_OUT" | grep '"code":"thermal_shutdown"' | grep -q '"state":"ACTIVE_UNACKNOWLEDGED"'
+}
+scenario_flight_readiness() {
+  printf 'buses:\n  - interface: %s\n    devices:\n      - address: 1\n' "$IFACE" >"$WORK/$SCEN.yaml"
+  start_sim --engine stopped --engine-starts-after never
+  start_service --config "$WORK/$SCEN.yaml"
+  pid=$SVC_PID
+  wait_until 90 pmu_listed || fail "PMU 1 not ONLINE within 90 s: $(printf '%s' "$LIST_OUT" | cut -c1-300 | tr '\n' ' ')"
+  # A start needs the configuration read (the cranking time): config get answers once it is.
+  ctl_text --timeout 30 --address 1 config get cranking_time >/dev/null 2>&1 || fail "config get cranking_time failed"
+  ctl_text --timeout 20 preflight >"$WORK/$SCEN.preflight0" 2>&1
+  st=$?
+  [ "$st" -eq 0 ] || fail "preflight with a cool PMU and a stopped engine: exit $st, $(tr '\n' ' ' <"$WORK/$SCEN.preflight0" | cut -c1-300)"
+  t0=$(now)
+  ctl_text --timeout 10 --address 1 --confirm engine start >"$WORK/$SCEN.start" 2>&1
+  st=$?
+  took=$(since "$t0")
+  out=$(tr '\n' '|' <"$WORK/$SCEN.start")
+  [ "$st" -eq 1 ] || fail "engine start of a flooded engine: exit $st (want 1): $out"
+  grep -q '^FAILED: no start: rpm 0 after ' "$WORK/$SCEN.start" || fail "no 'FAILED: no start' line: $out"
+  n=$(grep -c '^IN_PROGRESS: cranking' "$WORK/$SCEN.start")
+  [ "$n" -ge 2 ] || fail "$n IN_PROGRESS lines before the final reply (want >= 2): $out"
+  detail "flooded engine: $(grep '^FAILED' "$WORK/$SCEN.start" | head -n1), $n IN_PROGRESS lines, exit 1 after $took s"
+  # The hot PMU: the same unit again at 95 degC.
+  kill "$SIM_PID"; wait "$SIM_PID" 2>/dev/null
+  start_sim --engine stopped --internal-temperature 95
+  t1=$(now)
+  wait_until 60 thermal_alarm_active || fail "no active thermal_shutdown on pmu/alarms within 60 s: $(printf '%s' "$ALARMS_OUT" | cut -c1-400 | tr '\n' ' ')"
+  detail "thermal_shutdown ACTIVE_UNACKNOWLEDGED $(since "$t1") s after the hot PMU started"
+  printf '%s\n' "$ALARMS_OUT" | grep '"code":"internal_over_temperature"' | grep -q '"severity":"warning"' ||
+    fail "no internal_over_temperature warning: $(printf '%s' "$ALARMS_OUT" | cut -c1-400 | tr '\n' ' ')"
+  ctl_text --timeout 20 --json preflight >"$WORK/$SCEN.preflight1" 2>&1
+  st=$?
+  [ "$st" -eq 1 ] || fail "preflight with a PMU in thermal shutdown: exit $st (want 1): $(cut -c1-300 "$WORK/$SCEN.preflight1")"
+  grep -q '"ready":false' "$WORK/$SCEN.preflight1" || fail "readiness is not false: $(cut -c1-300 "$WORK/$SCEN.preflight1")"
+  sed 's/},{/}\n{/g' "$WORK/$SCEN.preflight1" | grep '"code":"thermal_shutdown"' | grep -q '"severity":"critical"' ||
+    fail "thermal_shutdown is not a critical reason: $(cut -c1-400 "$WORK/$SCEN.preflight1")"
+  ctl_text --timeout 10 --address 1 --confirm engine start >"$WORK/$SCEN.start2" 2>&1
+  st=$?
+  [ "$st" -eq 1 ] && grep -q '^DENIED: the PMU is in thermal shutdown' "$WORK/$SCEN.start2" ||
+    fail "a start during thermal shutdown: exit $st, $(tr '\n' '|' <"$WORK/$SCEN.start2")"
+  alive "$pid" || fail "pmu-service died"
+  detail "preflight exit 1 NOT READY (thermal_shutdown critical); start $(head -n1 "$WORK/$SCEN.start2")"
 }
 
 scenario_limit() {  # seconds a scenario may take in the (slow, emulated) VM
