@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <chrono>
+#include <regex>
 #include <string>
 #include <thread>
 
@@ -73,6 +74,45 @@ TEST(ReadinessOverDds, AHotPmuRaisesItsAlarmAndMakesTheVehicleNotReady) {
   EXPECT_EQ(r.status, 1) << r.out;
   EXPECT_NE(r.out.find("NOT READY"), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("CRITICAL thermal_shutdown"), std::string::npos) << r.out;
+}
+
+// watch shows the alarm with the device's telemetry: a marker on its lines, and with --json
+// the alarm's own line, as `pmuctl alarms --json` prints it.
+TEST(ReadinessOverDds, WatchMarksTheHotPmusLinesWithItsAlarm) {
+  const std::string domain = std::to_string(pmu::test::exclusive_dds_domain());
+  pmu::test::ConfiguredService service(PMU_SERVICE_PATH,
+                                       config(domain, "        sim: {internal_temperature: 95}\n"));
+  const std::string p = std::string(PMUCTL_PATH) + " --domain " + domain + " ";
+  // After the state and age, before the values: "... sim/1 temperatures ONLINE 0.3s ALARM ... internal=95.0degC ...";
+  // 1 alarm, or 2 once internal_over_temperature's on-delay is over: the critical is the worst either way.
+  const std::regex marked(" sim/1 temperatures [A-Z]+ [0-9.]+s ALARM [12] CRIT unacked \\(thermal_shutdown\\) internal=");
+  const auto text = until(
+      p + "--timeout 20 watch --count 15", [&marked](const auto& r) { return std::regex_search(r.out, marked); }, 30s);
+  ASSERT_EQ(text.status, 0) << text.out << service.describe();
+  EXPECT_TRUE(std::regex_search(text.out, marked)) << text.out;
+  EXPECT_NE(text.out.find(" sim/1 alarms CRITICAL ACTIVE_UNACKNOWLEDGED thermal_shutdown"), std::string::npos)
+      << text.out;
+
+  const auto json = pmu::test::run_capture(p + "--timeout 20 --json watch --count 30");
+  ASSERT_EQ(json.status, 0) << json.out;
+  std::size_t alarms = 0, telemetry = 0;
+  for (const auto& j : pmu::test::json_lines(json.out)) {
+    if (j.value("topic", "") != "alarms") {
+      ++telemetry;
+      continue;
+    }
+    ++alarms;
+    if (j.value("code", "") != "thermal_shutdown") continue;
+    EXPECT_EQ(j["severity"], "critical");
+    EXPECT_EQ(j["state"], "ACTIVE_UNACKNOWLEDGED");
+    EXPECT_EQ(j["kind"], "pmu");
+    EXPECT_EQ(j["device"], 1);
+    EXPECT_EQ(j["bus"], "sim");
+    EXPECT_TRUE(j.contains("contract"));
+  }
+  EXPECT_EQ(telemetry, 30u) << "--count counts the telemetry only: " << json.out;
+  EXPECT_GE(alarms, 1u) << json.out;
+  EXPECT_NE(json.out.find("\"code\":\"thermal_shutdown\""), std::string::npos) << json.out;
 }
 
 TEST(ReadinessOverDds, AnAlarmAcknowledgedFromTheGroundIsActiveAcknowledged) {

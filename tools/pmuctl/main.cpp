@@ -180,9 +180,9 @@ int main(int argc, char** argv) {
                  "(default: $PMU_DDS_INTERFACES, comma separated; none: every interface)")
       ->allow_extra_args(false);
 
-  auto* watch = app.add_subcommand("watch", "Live telemetry: a refreshing table, or one JSON object per sample");
+  auto* watch = app.add_subcommand("watch", "Live telemetry with each device's alarm marker: a refreshing table, or one JSON object per sample");
   std::string count_text;
-  watch->add_option("--count", count_text, "Stop after N samples")->type_name("N");
+  watch->add_option("--count", count_text, "Stop after N telemetry samples (alarm samples are not counted)")->type_name("N");
   watch->add_flag("--low-rate", g.low_rate,
                   "The low-rate topics pmu/low_rate/*: at most one sample per device and packet per the service's "
                   "low_rate_period (1 s by default), for slow links");

@@ -1,7 +1,6 @@
 #include "pmuctl/verbs/alarm_verbs.hpp"
 
 #include <chrono>
-#include <cmath>
 #include <cstdio>
 #include <ctime>
 #include <fastdds/dds/core/status/SubscriptionMatchedStatus.hpp>
@@ -15,7 +14,7 @@
 #include "pmu/idl/alarmsPubSubTypes.h"
 #include "pmu/idl/guarded_type.hpp"
 #include "pmu/idl/topics.hpp"
-#include "pmuctl/verbs/alarm_names.hpp"
+#include "pmuctl/verbs/alarm_sample.hpp"
 #include "pmuctl/verbs/exit_status.hpp"
 #include "pmuctl/verbs/service_presence.hpp"
 
@@ -25,24 +24,11 @@ namespace {
 using namespace eprosima::fastdds::dds;
 using Clock = std::chrono::steady_clock;
 
-// One alarm instance: the sample's keys.
+// One alarm instance: the sample's keys, the kind as the contract orders it (PMU, battery,
+// MPPT, bus), which is the order the lines come in.
 using AlarmKey = std::tuple<std::string, std::string, int, std::uint16_t, std::string>;
 AlarmKey key_of(const pmu::v4::Alarm& a) {
   return {a.vehicle().to_string(), a.bus().to_string(), static_cast<int>(a.kind()), a.device(), a.code().to_string()};
-}
-
-// --address names a PMU: the alarms of batteries, MPPTs and buses drop out then.
-bool selected(const GlobalOptions& o, const pmu::v4::Alarm& a) {
-  return (!o.vehicle || *o.vehicle == a.vehicle().to_string()) && (o.bus.empty() || o.bus == a.bus().to_string()) &&
-         (!o.address || (a.kind() == pmu::v4::SOURCE_PMU && *o.address == a.device()));
-}
-
-// "uav1/can0/1", "can0/battery2", "can0" for the bus's own.
-std::string where(const pmu::v4::Alarm& a) {
-  std::string w = a.vehicle().size() ? a.vehicle().to_string() + "/" : std::string();
-  w += a.bus().to_string();
-  if (a.kind() == pmu::v4::SOURCE_BUS) return w;
-  return w + "/" + (a.kind() == pmu::v4::SOURCE_PMU ? std::string() : alarm_source_name(a.kind())) + std::to_string(a.device());
 }
 
 std::string utc(std::uint64_t ns) {
@@ -54,29 +40,13 @@ std::string utc(std::uint64_t ns) {
   return buf;
 }
 
-nlohmann::json number_or_null(float v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr); }
-
-void print(const GlobalOptions& o, const pmu::v4::Alarm& a) {
-  const bool critical = a.severity() == pmu::v4::SEVERITY_CRITICAL;
+void print(const GlobalOptions& o, const AlarmEntry& a) {
   if (o.json) {
-    nlohmann::json j{{"topic", "alarms"},
-           {"vehicle", a.vehicle().to_string()},
-           {"bus", a.bus().to_string()},
-           {"kind", alarm_source_name(a.kind())},
-           {"device", a.device()},
-           {"code", a.code().to_string()},
-           {"severity", critical ? "critical" : "warning"},
-           {"state", alarm_state_name(a.state())},
-           {"value", number_or_null(a.value())},
-           {"limit", number_or_null(a.limit())},
-           {"since", static_cast<double>(a.since()) / 1e9},
-           {"message", a.message().to_string()},
-           {"contract", pmu::dds::contract_major()}};
-    std::printf("%s\n", j.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace).c_str());
+    std::printf("%s\n", alarm_json(a, pmu::dds::contract_major()).dump(-1, ' ', false, nlohmann::ordered_json::error_handler_t::replace).c_str());
     return;
   }
-  std::printf("%-18s %-8s %-22s %-28s since %s  %s\n", where(a).c_str(), critical ? "CRITICAL" : "WARNING",
-              alarm_state_name(a.state()), a.code().c_str(), utc(a.since()).c_str(), a.message().c_str());
+  std::printf("%-18s %-8s %-22s %-28s since %s  %s\n", alarm_source(a).c_str(), a.critical ? "CRITICAL" : "WARNING",
+              to_string(a.state), a.code.c_str(), utc(a.since).c_str(), a.message.c_str());
 }
 
 }  // namespace
@@ -91,7 +61,7 @@ int run_alarms(const GlobalOptions& o) {
   // cannot end on a sample: it ends once every service discovered has matched and nothing
   // new came for the quiet time (a matched writer sends what it holds at once).
   constexpr auto kQuiet = std::chrono::milliseconds(500);
-  std::map<AlarmKey, pmu::v4::Alarm> latest;
+  std::map<AlarmKey, AlarmEntry> latest;
   auto last_change = Clock::now();
   std::int32_t matched = 0;
   std::size_t coming = 0;
@@ -100,7 +70,9 @@ int run_alarms(const GlobalOptions& o) {
     SampleInfo info;
     while (reader.take_next_sample(&a, &info) == ReturnCode_t::RETCODE_OK) {
       last_change = Clock::now();
-      if (info.valid_data && selected(o, a)) latest[key_of(a)] = a;
+      if (!info.valid_data) continue;
+      const AlarmEntry e = alarm_entry_of(a);
+      if (selected(o, e)) latest[key_of(a)] = e;
     }
     SubscriptionMatchedStatus st;
     reader.get_subscription_matched_status(st);
@@ -115,7 +87,7 @@ int run_alarms(const GlobalOptions& o) {
   if (matched == 0) return no_service(o, dds);
   std::size_t shown = 0;
   for (const auto& [key, a] : latest) {
-    if (a.state() == pmu::v4::ALARM_NORMAL) continue;
+    if (a.state == AlarmStatus::Normal) continue;
     print(o, a);
     ++shown;
   }

@@ -17,6 +17,7 @@
 #include "pmu/command/command.hpp"
 #include "pmu/config/vehicle.hpp"
 #include "pmu/dds/dds_context.hpp"
+#include "pmu/idl/alarmsPubSubTypes.h"
 #include "pmu/idl/canopenPubSubTypes.h"
 #include "pmu/idl/commandPubSubTypes.h"
 #include "pmu/idl/guarded_type.hpp"
@@ -24,9 +25,11 @@
 #include "pmu/idl/telemetryPubSubTypes.h"
 #include "pmu/idl/topics.hpp"
 #include "pmu/transport/stop_signals.hpp"
+#include "pmuctl/verbs/alarm_sample.hpp"
 #include "pmuctl/verbs/exit_status.hpp"
 #include "pmuctl/verbs/service_presence.hpp"
 #include "pmuctl/verbs/state_settle.hpp"
+#include "pmuctl/view/alarm_marker.hpp"
 #include "pmuctl/view/sample_fields.hpp"
 #include "pmuctl/view/sample_json.hpp"
 #include "pmuctl/view/table_text.hpp"
@@ -312,6 +315,24 @@ int run_watch(const GlobalOptions& o, long count) {
     }
   }
 
+  // Each device's alarms beside its values (interface.md 1.6). Permissions made before
+  // pmu/alarms existed do not grant it: then watch shows the telemetry and says what it leaves out.
+  DataReader* alarm_reader = nullptr;
+  try {
+    alarm_reader = &dds.reader(
+        dds.topic(topics::kAlarms, TypeSupport(new idl::Guarded<pmu::v4::AlarmPubSubType>())), qos_profiles::kAlarms);
+  } catch (const pmu::dds::DdsError& e) {
+    std::fprintf(stderr, "pmuctl: not showing alarms: %s\n", e.what());
+  }
+  // The latest sample of each alarm instance, NORMAL ones too: one that went back to NORMAL
+  // takes its marker away.
+  std::map<std::tuple<std::string, std::string, std::string, std::uint16_t, std::string>, AlarmEntry> alarms;
+  const auto alarm_list = [&alarms] {
+    std::vector<AlarmEntry> list;
+    for (const auto& [key, a] : alarms) list.push_back(a);
+    return list;
+  };
+
   // Every row says its device's health and its values' age: a device gone OFFLINE keeps
   // its last row, which must not look live.
   StateCollector<pmu::v4::Health, pmu::v4::HealthPubSubType> health(dds, topics::kHealth);
@@ -331,6 +352,25 @@ int run_watch(const GlobalOptions& o, long count) {
   while (stop.received() == 0 && Clock::now() < deadline && (count <= 0 || seen < count)) {
     bool any = false;
     health.poll(o);
+    // Before the telemetry, so the lines of a device whose alarm came with them carry its marker.
+    pmu::v4::Alarm alarm;
+    SampleInfo alarm_info;
+    while (alarm_reader && alarm_reader->take_next_sample(&alarm, &alarm_info) == ReturnCode_t::RETCODE_OK) {
+      if (!alarm_info.valid_data) continue;
+      const AlarmEntry a = alarm_entry_of(alarm);
+      if (!selected(o, a)) continue;
+      alarms[{a.vehicle, a.bus, a.kind, a.device, a.code}] = a;
+      any = true;
+      // Not counted by --count, which counts telemetry samples.
+      if (o.json) {
+        std::printf("%s\n",
+                    alarm_json(a, pmu::dds::contract_major()).dump(-1, ' ', false, Json::error_handler_t::replace).c_str());
+      } else if (!refresh) {
+        std::printf("%s %s alarms %s %s %s %s\n", clock_text(static_cast<double>(a.since) / 1e9).c_str(),
+                    alarm_source(a).c_str(), a.critical ? "CRITICAL" : "WARNING", to_string(a.state), a.code.c_str(),
+                    a.message.c_str());
+      }
+    }
     TelemetryLine line;
     for (auto& r : readers) {
       while ((count <= 0 || seen < count) && r->take(o, line)) {
@@ -339,9 +379,10 @@ int run_watch(const GlobalOptions& o, long count) {
         if (o.json) {
           print_json(line.topic.c_str(), line.device, json_of(line.values), line.time);
         } else if (!refresh) {
-          std::printf("%s %s %s %s %s\n", clock_text(line.time).c_str(), label(line.device).c_str(),
+          const std::string marker = alarm_marker(alarms_of(alarm_list(), label(line.device)));
+          std::printf("%s %s %s %s%s %s\n", clock_text(line.time).c_str(), label(line.device).c_str(),
                       line.topic.c_str(), freshness(health_of(line.device), now_s() - line.time).c_str(),
-                      row_values(line.values).c_str());
+                      marker.empty() ? "" : (" " + marker).c_str(), row_values(line.values).c_str());
         }
         latest[{line.device, line.topic}] = line;
       }
@@ -357,7 +398,7 @@ int run_watch(const GlobalOptions& o, long count) {
       for (const auto& r : readers)
         for (const auto& [key, l] : latest)
           if (l.topic == r->name()) rows.push_back({label(l.device), l.topic, health_of(l.device), now - l.time, l.values});
-      for (const auto& r : watch_table(rows)) std::printf("%s\n", r.c_str());
+      for (const auto& r : watch_table(rows, alarm_list())) std::printf("%s\n", r.c_str());
       std::fflush(stdout);
     }
     if (!any) std::this_thread::sleep_for(std::chrono::milliseconds(10));

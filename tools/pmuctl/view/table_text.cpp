@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cstdio>
+#include <map>
 
 namespace pmu::tools {
 
@@ -47,16 +48,38 @@ std::vector<std::string> aligned_columns(const std::vector<std::vector<std::stri
   return lines;
 }
 
-std::vector<std::string> watch_table(const std::vector<WatchRow>& rows) {
+std::vector<std::string> watch_table(const std::vector<WatchRow>& rows, const std::vector<AlarmEntry>& alarms) {
+  std::vector<std::string> lines;
+  std::map<std::string, std::string> markers;  // by source, so buses come before their devices
+  for (const auto& a : alarms) {
+    const std::string source = alarm_source(a);
+    if (markers.count(source)) continue;
+    const std::string m = alarm_marker(alarms_of(alarms, source));
+    if (!m.empty()) markers[source] = m;
+  }
+  if (!markers.empty()) {
+    std::vector<std::vector<std::string>> cells;
+    for (const auto& [source, m] : markers) cells.push_back({source, m});
+    lines.push_back("alarms:");
+    for (auto& l : aligned_columns(cells)) lines.push_back(std::move(l));
+  }
+  const auto marker_of = [&markers](const std::string& label) {
+    const auto it = markers.find(label);
+    return it == markers.end() ? std::string() : it->second;
+  };
   std::vector<std::string> topics;
   for (const auto& r : rows)
     if (std::find(topics.begin(), topics.end(), r.topic) == topics.end()) topics.push_back(r.topic);
-  std::vector<std::string> lines;
   for (const auto& t : topics) {
+    bool with_marker = false;
+    for (const auto& r : rows) with_marker = with_marker || (r.topic == t && !marker_of(r.label).empty());
     std::vector<std::vector<std::string>> cells;
-    for (const auto& r : rows)
-      if (r.topic == t)
-        cells.push_back({r.label, to_string(r.state.value_or(pmu::v4::UNKNOWN)), age_text(r.age), row_values(r.values)});
+    for (const auto& r : rows) {
+      if (r.topic != t) continue;
+      cells.push_back({r.label, to_string(r.state.value_or(pmu::v4::UNKNOWN)), age_text(r.age)});
+      if (with_marker) cells.back().push_back(marker_of(r.label));
+      cells.back().push_back(row_values(r.values));
+    }
     lines.push_back(t + ":");
     for (auto& l : aligned_columns(cells)) lines.push_back(std::move(l));
   }

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "pmu/idl/state.h"
+#include "pmuctl/view/alarm_marker.hpp"
 #include "pmuctl/view/sample_fields.hpp"
 
 namespace pmu::tools {
@@ -32,8 +33,11 @@ struct WatchRow {
   SampleFields values;
 };
 // The refreshing table: per topic, in the order the rows come, a "topic:" line, then one
-// line per device, its label, state and age aligned within the topic.
-std::vector<std::string> watch_table(const std::vector<WatchRow>& rows);
+// line per device, its label, state and age aligned within the topic. When an alarm is not
+// NORMAL, an "alarms:" section comes first, a line per bus or device with its alarm_marker,
+// so a bus (which has no row) and a device with no row yet are seen too; and a device's rows
+// carry its marker after the age (the column is there only in a topic where one has one).
+std::vector<std::string> watch_table(const std::vector<WatchRow>& rows, const std::vector<AlarmEntry>& alarms = {});
 
 // Rows of cells as lines, each column as wide as its widest cell, two spaces apart; the
 // last column is not padded. Rows may have fewer cells than others.
