@@ -15,7 +15,7 @@ namespace {
 const std::vector<dds::ProfileUse>& service_profiles() {
   static const std::vector<dds::ProfileUse> uses{
       {qos_profiles::kTelemetry, dds::EndpointKind::Writer, "the telemetry topics' writers"},
-      {qos_profiles::kState, dds::EndpointKind::Writer, "the pmu/config, pmu/info, pmu/health, pmu/readiness and pmu/energy writers"},
+      {qos_profiles::kState, dds::EndpointKind::Writer, "the pmu/config, pmu/info and pmu/health writers"},
       {qos_profiles::kAlarms, dds::EndpointKind::Writer, "the pmu/alarms writer"},
       {qos_profiles::kCommand, dds::EndpointKind::Writer, "the pmu/command_reply writer"},
       {qos_profiles::kCommand, dds::EndpointKind::Reader, "the pmu/command reader"},
