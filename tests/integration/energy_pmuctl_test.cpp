@@ -13,6 +13,9 @@
 #include "support/json_lines.hpp"
 #include "support/process.hpp"
 
+// A namespace of its own: the unity builds put this file in one translation unit with the
+// other integration tests, whose helpers have the same names.
+namespace energy_pmuctl_test {
 namespace {
 
 using namespace std::chrono_literals;
@@ -134,3 +137,4 @@ TEST(EnergyOverDds, GeneratorStoppedTheBatteriesFeedTheOutputs) {
 }
 
 }  // namespace
+}  // namespace energy_pmuctl_test

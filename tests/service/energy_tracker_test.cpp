@@ -8,7 +8,7 @@
 #include "pmu/energy_sink/energy_tracker.hpp"
 #include "recording_sink.hpp"
 
-namespace pmu::service::test {
+namespace pmu::service::test::energy_tracker {
 namespace {
 
 using namespace std::chrono_literals;
@@ -113,4 +113,4 @@ TEST(EnergyTracker, AGoneDeviceStartsAgain) {
 }
 
 }  // namespace
-}  // namespace pmu::service::test
+}  // namespace pmu::service::test::energy_tracker

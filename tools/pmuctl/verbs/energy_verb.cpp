@@ -22,6 +22,9 @@
 #include "pmuctl/view/sample_fields.hpp"
 
 namespace pmu::tools {
+// A namespace of its own: the unity builds put this file in one translation unit with the
+// other verbs, whose helpers have the same names.
+namespace energy_verb {
 namespace {
 
 using namespace eprosima::fastdds::dds;
@@ -104,9 +107,7 @@ void print(const GlobalOptions& o, const pmu::v4::Energy& e) {
   print_battery("battery B", e.battery_b());
 }
 
-}  // namespace
-
-int run_energy(const GlobalOptions& o) {
+int run(const GlobalOptions& o) {
   pmu::dds::DdsContext dds(o.domain, o.qos_file, "pmuctl", o.security, pmu::dds::Transport::Default, o.network,
                            partitions_for(o));
   DataReader& reader =
@@ -155,5 +156,10 @@ int run_energy(const GlobalOptions& o) {
   for (const auto& [key, e] : latest) print(o, e);
   return 0;
 }
+
+}  // namespace
+}  // namespace energy_verb
+
+int run_energy(const GlobalOptions& o) { return energy_verb::run(o); }
 
 }  // namespace pmu::tools
