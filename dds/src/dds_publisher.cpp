@@ -21,6 +21,8 @@
 #include "pmu/idl/canopenPubSubTypes.h"
 #include "pmu/idl/command.h"
 #include "pmu/idl/commandPubSubTypes.h"
+#include "pmu/idl/energy.h"
+#include "pmu/idl/energyPubSubTypes.h"
 #include "pmu/idl/state.h"
 #include "pmu/idl/statePubSubTypes.h"
 #include "pmu/idl/telemetry.h"
@@ -108,6 +110,7 @@ struct DdsPublisher::Writers {
   // it existed): the service runs without it rather than not at all.
   DataWriter* alarms = nullptr;
   DataWriter* readiness = nullptr;
+  DataWriter* derived_energy = nullptr;  // pmu/energy (`energy` is pmu/battery_energy)
   // Bus workers run in threads of their own and share these writers and the rest below.
   std::mutex mutex;
   std::set<std::tuple<std::string, DeviceKind, std::uint16_t>> admitted;
@@ -172,6 +175,7 @@ DdsPublisher::DdsPublisher(dds::DdsContext& dds, std::chrono::milliseconds telem
   };
   w_->alarms = newer(topics::kAlarms, TypeSupport(new pmu::v4::AlarmPubSubType()), qos_profiles::kAlarms);
   w_->readiness = newer(topics::kReadiness, TypeSupport(new pmu::v4::ReadinessPubSubType()), qos_profiles::kState);
+  w_->derived_energy = newer(topics::kEnergy, TypeSupport(new pmu::v4::EnergyPubSubType()), qos_profiles::kState);
 }
 
 DdsPublisher::~DdsPublisher() = default;
@@ -355,6 +359,9 @@ void DdsPublisher::on_gone(const DeviceKey& key) {
   pmu::v4::DeviceInfo info;
   set_key(info, w_->vehicle, key);
   gone(w_->info, &info);
+  pmu::v4::Energy derived;
+  set_key(derived, w_->vehicle, key);
+  gone(w_->derived_energy, &derived);
 }
 
 }  // namespace pmu::service
@@ -518,6 +525,35 @@ void DdsPublisher::on_readiness(const ReadinessReport& r) {
   const DeviceKey key{"", 0, DeviceKind::Pmu};
   std::lock_guard<std::mutex> lock(w_->mutex);
   write_at(w_->readiness, &s, key, std::chrono::system_clock::now());
+}
+
+namespace {
+
+pmu::v4::EnergyBattery battery_of(const energy::BatteryFigures& b) {
+  pmu::v4::EnergyBattery s;
+  s.power(idl_float(b.power));
+  s.used_wh(b.used_wh);
+  s.integrated_s(idl_float(b.integrated_s));
+  s.endurance_s(idl_float(b.endurance_s));
+  s.critical_voltage(idl_float(b.critical_voltage));
+  return s;
+}
+
+}  // namespace
+
+void DdsPublisher::on_energy(const DeviceKey& key, const energy::Figures& f, std::chrono::system_clock::time_point at) {
+  pmu::v4::Energy s;
+  set_key(s, w_->vehicle, key);
+  s.avionics_power(idl_float(f.avionics_power));
+  s.output_28v_power(idl_float(f.output_28v_power));
+  s.payload_power(idl_float(f.payload_power));
+  s.servo_power(idl_float(f.servo_power));
+  s.generator_power(idl_float(f.generator_power));
+  s.battery_a(battery_of(f.battery_a));
+  s.battery_b(battery_of(f.battery_b));
+  std::lock_guard<std::mutex> lock(w_->mutex);
+  if (!admit(key)) return;
+  write_at(w_->derived_energy, &s, key, at);
 }
 
 }  // namespace pmu::service

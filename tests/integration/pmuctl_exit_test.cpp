@@ -139,6 +139,7 @@ const Case kNobody[] = {
     {"--timeout 1 list", 3, "no pmu-service on domain"},
     {"--timeout 1 info", 3, "no pmu-service on domain"},
     {"--timeout 1 alarms", 3, "no pmu-service on domain"},
+    {"--timeout 1 energy", 3, "no pmu-service on domain"},
     {"--timeout 1 health", 3, "no pmu-service on domain"},
     {"--timeout 1 config get", 3, "no pmu-service on domain"},
     {"--timeout 1 watch --count 1", 3, "no pmu-service on domain"},

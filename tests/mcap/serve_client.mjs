@@ -40,6 +40,7 @@ const defaultTopics = {
   "pmu/mppt": "pmu::v4::Mppt",
   "pmu/alarms": "pmu::v4::Alarm",
   "pmu/readiness": "pmu::v4::Readiness",
+  "pmu/energy": "pmu::v4::Energy",
 };
 
 // float32 on the wire: the shortest decimal that is the same float32, as pmuctl prints it.

@@ -48,6 +48,14 @@ class RecordingSink final : public StateSink {
 
   void on_alarm(const AlarmReport& a) override { alarms.push_back(a); }
   void on_readiness(const ReadinessReport& r) override { readiness.push_back(r); }
+  struct Energy {
+    DeviceKey key;
+    energy::Figures figures;
+    std::chrono::system_clock::time_point at;
+  };
+  void on_energy(const DeviceKey& k, const energy::Figures& f, std::chrono::system_clock::time_point at) override {
+    energy.push_back({k, f, at});
+  }
 
   std::size_t count(codec::PacketId p, std::uint16_t address) const {
     std::size_t n = 0;
@@ -63,6 +71,7 @@ class RecordingSink final : public StateSink {
   std::vector<Telemetry> telemetry;
   std::vector<AlarmReport> alarms;
   std::vector<ReadinessReport> readiness;
+  std::vector<Energy> energy;
   std::vector<std::pair<DeviceKey, ConfigState>> configs;
   std::vector<std::pair<DeviceKey, InfoState>> infos;
   std::vector<std::pair<DeviceKey, HealthReport>> healths;

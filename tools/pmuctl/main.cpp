@@ -25,6 +25,7 @@
 #include "pmuctl/serve/serve_verb.hpp"
 #include "pmuctl/verbs/command_verbs.hpp"
 #include "pmuctl/verbs/alarm_verbs.hpp"
+#include "pmuctl/verbs/energy_verb.hpp"
 #include "pmuctl/verbs/preflight_verb.hpp"
 #include "pmuctl/verbs/state_verbs.hpp"
 #include "pmuctl/view/mask_names.hpp"
@@ -198,6 +199,7 @@ int main(int argc, char** argv) {
                          "Whose alarm: pmu (default), battery or mppt (--address: the node or device id), bus "
                          "(--bus)");
   app.add_subcommand("preflight", "Whether the vehicle may fly, and every reason it may not (exit 0 ready, 1 not)");
+  app.add_subcommand("energy", "Power per output, generator power, energy used and endurance of each battery");
   auto* config = app.add_subcommand("config", "Stored parameters");
   config->require_subcommand(1);
   auto* config_get = config->add_subcommand("get", "Show the stored parameters (or one)");
@@ -364,6 +366,7 @@ int main(int argc, char** argv) {
     if (*alarms_ack) return pmu::tools::run_alarm_ack(g, ack_code, ack_kind);
     if (app.got_subcommand("alarms")) return pmu::tools::run_alarms(g);
     if (app.got_subcommand("preflight")) return pmu::tools::run_preflight(g);
+    if (app.got_subcommand("energy")) return pmu::tools::run_energy(g);
     if (*config_get) return pmu::tools::run_config_get(g, parameter);
     pmu::tools::CommandSpec spec;
     spec.confirm = confirm;

@@ -19,6 +19,7 @@
 #include <thread>
 #include <vector>
 
+#include "pmu/energy_sink/energy_tracker.hpp"
 #include "pmu/readiness/readiness_tracker.hpp"
 #include "pmu/app/logging.hpp"
 #include "pmu/app/state_fanout.hpp"
@@ -141,7 +142,9 @@ int run(const service::Config& cfg, const pmu::dds::ResolvedNetwork& network) {
   if (previous_publisher) sinks.push_back(previous_publisher.get());
   service::StateFanout fanout(sinks);
   // In front of the publishers: pmu/readiness from what the sessions report.
-  service::ReadinessTracker state_sink(cfg.buses, fanout, clock);
+  service::ReadinessTracker readiness(cfg.buses, fanout, clock);
+  // In front of readiness: pmu/energy from each PMU's voltages and currents.
+  service::EnergyTracker state_sink(cfg.buses, cfg.timeouts.stale_periods, readiness);
 
   service::MovedAddressStore moved(service::moved_addresses_path(std::getenv("STATE_DIRECTORY")), cfg);
   std::vector<BusRuntime> buses(cfg.buses.size());

@@ -8,6 +8,7 @@
 #include "pmu/idl/alarmsPubSubTypes.h"
 #include "pmu/idl/canopenPubSubTypes.h"
 #include "pmu/idl/commandPubSubTypes.h"
+#include "pmu/idl/energyPubSubTypes.h"
 #include "pmu/idl/statePubSubTypes.h"
 #include "pmu/idl/telemetryPubSubTypes.h"
 
@@ -54,6 +55,7 @@ TypeSupport raw_type_support(const std::string& type_name) {
   if (type_name == "pmu::v4::Mppt") return TypeSupport(new RawSampleType<pmu::v4::MpptPubSubType>());
   if (type_name == "pmu::v4::Alarm") return TypeSupport(new RawSampleType<pmu::v4::AlarmPubSubType>());
   if (type_name == "pmu::v4::Readiness") return TypeSupport(new RawSampleType<pmu::v4::ReadinessPubSubType>());
+  if (type_name == "pmu::v4::Energy") return TypeSupport(new RawSampleType<pmu::v4::EnergyPubSubType>());
   if (type_name == "pmu::v4::Command") return TypeSupport(new RawSampleType<pmu::v4::CommandPubSubType>());
   if (type_name == "pmu::v4::AlarmAck") return TypeSupport(new RawSampleType<pmu::v4::AlarmAckPubSubType>());
   if (type_name == "pmu::v4::AlarmAckReply") return TypeSupport(new RawSampleType<pmu::v4::AlarmAckReplyPubSubType>());

@@ -57,6 +57,8 @@ class DdsPublisher final : public StateSink {
   void on_mppt(const DeviceKey& key, const MpptState& mppt, std::chrono::system_clock::time_point newest) override;
   void on_alarm(const AlarmReport& alarm) override;
   void on_readiness(const ReadinessReport& readiness) override;
+  void on_energy(const DeviceKey& key, const energy::Figures& figures,
+                 std::chrono::system_clock::time_point at) override;
 
   // A write to another of the service's topics (pmu/command_reply) failed: counted in
   // publish_failures and logged like the publisher's own. Thread-safe.

@@ -27,6 +27,8 @@ inline constexpr const char* kMppt = "pmu/mppt";
 inline constexpr const char* kAlarms = "pmu/alarms";
 // Whether the vehicle may fly, and why not: docs/interface.md 1.7.
 inline constexpr const char* kReadiness = "pmu/readiness";
+// Power, energy and endurance derived from each PMU's telemetry: docs/interface.md 1.8.
+inline constexpr const char* kEnergy = "pmu/energy";
 // Acknowledging an alarm, and its reply (QoS profile `command`): docs/interface.md 1.6.
 inline constexpr const char* kAlarmAck = "pmu/alarm_ack";
 inline constexpr const char* kAlarmAckReply = "pmu/alarm_ack_reply";

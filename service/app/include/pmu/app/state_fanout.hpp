@@ -50,6 +50,10 @@ class StateFanout final : public StateSink {
   void on_readiness(const ReadinessReport& readiness) override {
     for (auto* s : sinks_) s->on_readiness(readiness);
   }
+  void on_energy(const DeviceKey& key, const energy::Figures& figures,
+                 std::chrono::system_clock::time_point at) override {
+    for (auto* s : sinks_) s->on_energy(key, figures, at);
+  }
 
  private:
   std::vector<StateSink*> sinks_;

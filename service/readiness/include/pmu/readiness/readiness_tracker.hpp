@@ -52,6 +52,10 @@ class ReadinessTracker final : public StateSink {
   void on_alarm(const AlarmReport& alarm) override;
   // Reports come from this tracker; one handed to it is passed on unchanged.
   void on_readiness(const ReadinessReport& readiness) override { next_.on_readiness(readiness); }
+  void on_energy(const DeviceKey& key, const energy::Figures& figures,
+                 std::chrono::system_clock::time_point at) override {
+    next_.on_energy(key, figures, at);
+  }
 
   // The latest report (for tests and the start-up log).
   ReadinessReport current() const;

@@ -12,6 +12,7 @@
 #include "pmu/alarms/alarm.hpp"
 #include "pmu/codec/decode.hpp"
 #include "pmu/codec/parameters.hpp"
+#include "pmu/energy/figures.hpp"
 #include "pmu/session/canopen_state.hpp"
 #include "pmu/transport/can_bus.hpp"
 
@@ -133,6 +134,10 @@ class StateSink {
   // An alarm changed state (raised, acknowledged, cleared, back to NORMAL).
   virtual void on_alarm(const AlarmReport& alarm) = 0;
   virtual void on_readiness(const ReadinessReport& readiness) = 0;
+  // A PMU's derived energy (interface.md 1.8), from the EnergyTracker; `at` is the receive
+  // time of the sample that made it due.
+  virtual void on_energy(const DeviceKey& key, const energy::Figures& figures,
+                         std::chrono::system_clock::time_point at) = 0;
 };
 
 }  // namespace pmu::service

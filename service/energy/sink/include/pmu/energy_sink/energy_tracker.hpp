@@ -1,0 +1,72 @@
+#pragma once
+// EnergyTracker: a StateSink in front of another (the publishers) that passes every event on
+// and feeds each PMU's voltages and currents, with their receive times, to a PmuEnergy
+// (pmu/energy/pmu_energy.hpp). When a PMU's figures are due (at most once a second of receive
+// time) it hands them on with on_energy. It reads no clock: time is the samples'.
+//
+// The critical voltages come from the config: the battery_a/b_critical_voltage alarms' limits
+// as the device's `alarms:` sets them (its bus's `discover:` settings for a discovered PMU),
+// so the endurance runs to the same voltage that raises the alarm.
+//
+// Lifetime: `next` must outlive the tracker, which keeps a reference to it (main.cpp makes the
+// publishers first, and the bus workers, which write through the tracker, are destroyed
+// before it). `buses` is copied.
+// Threads: every StateSink member from any bus worker thread at once; `mutex_` serialises
+// the PMUs' state and the figures, which are handed on under it so they reach `next` in order.
+
+#include <chrono>
+#include <map>
+#include <mutex>
+#include <string>
+#include <tuple>
+#include <vector>
+
+#include "pmu/config/config.hpp"
+#include "pmu/energy/pmu_energy.hpp"
+#include "pmu/session/device_state.hpp"
+
+namespace pmu::service {
+
+class EnergyTracker final : public StateSink {
+ public:
+  // `stale_periods`: the config's timeouts.stale_periods; a device's period times this is the
+  // longest gap integrated (the time after which its health reads STALE).
+  EnergyTracker(const std::vector<BusConfig>& buses, double stale_periods, StateSink& next);
+
+  void on_telemetry(const DeviceKey& key, const codec::PmuMessage& message,
+                    std::chrono::system_clock::time_point received) override;
+  void on_config(const DeviceKey& key, const ConfigState& config) override { next_.on_config(key, config); }
+  void on_info(const DeviceKey& key, const InfoState& info) override { next_.on_info(key, info); }
+  void on_health(const DeviceKey& key, const HealthReport& health) override { next_.on_health(key, health); }
+  void on_gone(const DeviceKey& key) override;
+  void on_battery(const DeviceKey& key, const BatteryState& battery,
+                  std::chrono::system_clock::time_point newest) override {
+    next_.on_battery(key, battery, newest);
+  }
+  void on_battery_cells(const DeviceKey& key, const BatteryCellsState& cells,
+                        std::chrono::system_clock::time_point newest) override {
+    next_.on_battery_cells(key, cells, newest);
+  }
+  void on_mppt(const DeviceKey& key, const MpptState& mppt, std::chrono::system_clock::time_point newest) override {
+    next_.on_mppt(key, mppt, newest);
+  }
+  void on_alarm(const AlarmReport& alarm) override { next_.on_alarm(alarm); }
+  void on_readiness(const ReadinessReport& readiness) override { next_.on_readiness(readiness); }
+  // Figures come from this tracker; ones handed to it are passed on unchanged.
+  void on_energy(const DeviceKey& key, const energy::Figures& figures,
+                 std::chrono::system_clock::time_point at) override {
+    next_.on_energy(key, figures, at);
+  }
+
+ private:
+  using Key = std::tuple<std::string, std::uint16_t>;  // (bus, PMU address)
+  energy::PmuEnergy& energy_of(const DeviceKey& key);  // with mutex_ held
+
+  std::map<std::string, BusConfig> buses_;  // by bus name
+  double stale_periods_;
+  StateSink& next_;
+  std::mutex mutex_;
+  std::map<Key, energy::PmuEnergy> pmus_;
+};
+
+}  // namespace pmu::service

@@ -1,0 +1,13 @@
+#pragma once
+// pmuctl energy (interface.md section 3.2): each PMU's power per output, generator power,
+// energy out of each battery and endurance, from pmu/energy (TRANSIENT_LOCAL: the latest
+// figures of each PMU arrive at once). Exit 0 with figures, 2 when the selected PMU has none,
+// 3 when no service answers.
+
+#include "pmuctl/verbs/state_verbs.hpp"
+
+namespace pmu::tools {
+
+int run_energy(const GlobalOptions& o);
+
+}  // namespace pmu::tools
