@@ -136,11 +136,7 @@ int run(const GlobalOptions& o) {
       latest[key] = e;
       handles[info.instance_handle] = key;
     }
-    SubscriptionMatchedStatus st;
-    reader.get_subscription_matched_status(st);
-    const auto coming =
-        dds.remote_writers().participants_without_writer(pmu::dds::kServiceParticipantName, topics::kEnergy);
-    settle.observe(Clock::now(), static_cast<std::size_t>(std::max(st.current_count, 0)) + coming, writers.size());
+    settle.observe(Clock::now(), writers_expected(dds, reader, topics::kEnergy), writers.size());
     if (settle.settled(Clock::now())) break;
     std::this_thread::sleep_for(std::chrono::milliseconds(20));
   }

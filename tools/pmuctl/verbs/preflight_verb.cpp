@@ -90,11 +90,7 @@ int run_preflight(const GlobalOptions& o) {
       writers.insert(info.publication_handle);
       if (info.valid_data && (!o.vehicle || *o.vehicle == r.vehicle().to_string())) latest[r.vehicle().to_string()] = r;
     }
-    SubscriptionMatchedStatus st;
-    reader.get_subscription_matched_status(st);
-    const auto coming =
-        dds.remote_writers().participants_without_writer(pmu::dds::kServiceParticipantName, topics::kReadiness);
-    settle.observe(Clock::now(), static_cast<std::size_t>(std::max(st.current_count, 0)) + coming, writers.size());
+    settle.observe(Clock::now(), writers_expected(dds, reader, topics::kReadiness), writers.size());
     if (settle.settled(Clock::now())) break;
     std::this_thread::sleep_for(std::chrono::milliseconds(20));
   }

@@ -1,5 +1,8 @@
 #include "pmuctl/verbs/service_presence.hpp"
 
+#include <algorithm>
+#include <fastdds/dds/core/status/SubscriptionMatchedStatus.hpp>
+
 #include "pmu/dds/contract_names.hpp"
 #include "pmu/idl/topics.hpp"
 #include "pmuctl/verbs/exit_status.hpp"
@@ -75,6 +78,14 @@ int no_service(const GlobalOptions& o, const pmu::dds::DdsContext& dds) {
                 "no pmu-service" + (o.vehicle ? " of " + vehicle_text(*o.vehicle) : std::string()) + domain);
   return fail(o, ExitStatus::BadUsage,
               "no pmu-service of " + vehicle_text(*o.vehicle) + domain + vehicles_seen_text(vehicles));
+}
+
+std::size_t writers_expected(const pmu::dds::DdsContext& dds, eprosima::fastdds::dds::DataReader& reader,
+                             const std::string& topic) {
+  eprosima::fastdds::dds::SubscriptionMatchedStatus st;
+  reader.get_subscription_matched_status(st);
+  return static_cast<std::size_t>(std::max(st.current_count, 0)) +
+         dds.remote_writers().participants_without_writer(pmu::dds::kServiceParticipantName, topic);
 }
 
 }  // namespace pmu::tools

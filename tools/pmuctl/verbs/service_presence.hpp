@@ -10,6 +10,8 @@
 //
 // Call from the verb's thread, with the DdsContext the verb used (it must still be open).
 
+#include <cstddef>
+#include <fastdds/dds/subscriber/DataReader.hpp>
 #include <map>
 #include <set>
 #include <string>
@@ -32,6 +34,11 @@ std::string other_contracts_text(const std::map<int, std::set<std::string>>& oth
 
 // "; vehicles seen: (unnamed), uav1 (choose one with --vehicle)", or "" for none.
 std::string vehicles_seen_text(const std::set<std::string>& vehicles);
+
+// The writers of `topic` a state verb waits for (state_settle.hpp): those `reader` matched,
+// plus the services discovered whose writer of it discovery has not reported yet.
+std::size_t writers_expected(const pmu::dds::DdsContext& dds, eprosima::fastdds::dds::DataReader& reader,
+                             const std::string& topic);
 
 // "the unnamed vehicle" / "vehicle uav1".
 std::string vehicle_text(const std::string& vehicle);
