@@ -128,6 +128,8 @@ step "release tests (all but the VM suites, which ran above)"
 ctest --preset release -LE '^system$' -j"$jobs"
 
 if [ "$vm_status" -ne 0 ]; then
+  # CI keeps only the tail of this output: repeat each failed scenario's own verdict here.
+  grep -E '^RESULT .* FAIL |: FAIL|tests failed|\*\*\*(Failed|Timeout)' "$vm_log" >&2 || true
   echo "test.sh: the VM suites failed (their output is above, after 'waiting for the VM suites')" >&2
   exit "$vm_status"
 fi
