@@ -23,9 +23,11 @@ constexpr std::array<std::string_view, kConfirmRuleCount> kRuleWhy{
     "sets packets_streamed to 0: the PMU stops the telemetry this service listens for, and goes OFFLINE",
 };
 
+}  // namespace
+
 // Judged on the typed request, whose values are already what the wire will carry: a
 // requested 0.0004 that rounds to 0 is 0 here.
-std::optional<ConfirmRule> rule_for(const CommandRequest& r, const DeviceUse& device) {
+std::optional<ConfirmRule> confirm_rule_for(const CommandRequest& r, const DeviceUse& device) {
   using codec::output_bit::AvionicsServo;
   if (const auto* off = std::get_if<action::DisableOutputs>(&r.action))
     return off->mask & AvionicsServo ? std::optional(ConfirmRule::DisableAvionics) : std::nullopt;
@@ -54,7 +56,8 @@ std::optional<ConfirmRule> rule_for(const CommandRequest& r, const DeviceUse& de
   return std::nullopt;
 }
 
-}  // namespace
+
+std::string_view rule_why(ConfirmRule r) noexcept { return kRuleWhy[static_cast<std::size_t>(r)]; }
 
 std::string_view to_string(ConfirmRule r) noexcept { return kRuleNames[static_cast<std::size_t>(r)]; }
 
@@ -74,7 +77,7 @@ PolicyVerdict check_policy(const CommandRequest& r, const PolicyConfig& p, const
   if (r.kind() == CommandKind::EngineStop) return {};  // never refused by policy
   if (p.deny[static_cast<std::size_t>(r.kind())])
     return {CommandResult::Denied, std::string(to_string(r.kind())) + " is denied by the service's policy"};
-  if (const auto rule = rule_for(r, device); rule && p.confirm[static_cast<std::size_t>(*rule)] && !r.confirm) {
+  if (const auto rule = confirm_rule_for(r, device); rule && p.confirm[static_cast<std::size_t>(*rule)] && !r.confirm) {
     return {CommandResult::Denied, std::string(to_string(r.kind())) + " " +
                                        std::string(kRuleWhy[static_cast<std::size_t>(*rule)]) +
                                        ": it needs confirm (pmuctl --confirm); rule " + std::string(to_string(*rule))};

@@ -8,23 +8,10 @@
 namespace pmu::tools {
 namespace {
 
-// Protocol v1.9 table 16: bits 0..3 are the outputs of tables 19..21, named as they are.
-constexpr std::array<codec::NamedBit, 7> kPowerUpNames{{
-    {codec::power_up_bit::AvionicsServo, codec::kOutputNames[0].name},
-    {codec::power_up_bit::Payload, codec::kOutputNames[1].name},
-    {codec::power_up_bit::ChargerA, codec::kOutputNames[2].name},
-    {codec::power_up_bit::ChargerB, codec::kOutputNames[3].name},
-    {codec::power_up_bit::BatteryDisconnectDetect, "battery_disconnect_detect"},
-    {codec::power_up_bit::PayloadShedding, "payload_shedding"},
-    {codec::power_up_bit::SoaManagement, "soa_management"},
-}};
-static_assert(codec::kOutputNames[0].bit == codec::power_up_bit::AvionicsServo &&
-              codec::kOutputNames[3].bit == codec::power_up_bit::ChargerB);
-
 const MaskNames kMasks[] = {
     {"outputs", codec::kOutputNames.data(), codec::kOutputNames.size()},
     {codec::spec_of(codec::Parameter::PacketsStreamed).name, codec::kGroupNames.data(), codec::kGroupNames.size()},
-    {codec::spec_of(codec::Parameter::PowerUpState).name, kPowerUpNames.data(), kPowerUpNames.size()},
+    {codec::spec_of(codec::Parameter::PowerUpState).name, codec::kPowerUpNames.data(), codec::kPowerUpNames.size()},
 };
 
 // The range said is the mask the names cover (0x1F for packets_streamed), never the byte's

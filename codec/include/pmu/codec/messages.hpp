@@ -92,6 +92,18 @@ inline constexpr std::uint8_t PayloadShedding = 1u << 5;
 inline constexpr std::uint8_t SoaManagement = 1u << 6;
 }  // namespace power_up_bit
 
+// Table 16: bits 0..3 are the outputs of tables 19..21, named as they are.
+inline constexpr std::array<NamedBit, 7> kPowerUpNames{{
+    {power_up_bit::AvionicsServo, kOutputNames[0].name},
+    {power_up_bit::Payload, kOutputNames[1].name},
+    {power_up_bit::ChargerA, kOutputNames[2].name},
+    {power_up_bit::ChargerB, kOutputNames[3].name},
+    {power_up_bit::BatteryDisconnectDetect, "battery_disconnect_detect"},
+    {power_up_bit::PayloadShedding, "payload_shedding"},
+    {power_up_bit::SoaManagement, "soa_management"},
+}};
+static_assert(kOutputNames[0].bit == power_up_bit::AvionicsServo && kOutputNames[3].bit == power_up_bit::ChargerB);
+
 inline constexpr double kNoSensor = std::numeric_limits<double>::quiet_NaN();
 
 struct Voltages {  // 0x00, table 2

@@ -59,6 +59,12 @@ struct DeviceUse {
   bool streaming = true;
 };
 
+// The confirm rule `r` falls under, whether or not the policy has it on; nullopt for none.
+// pmuctl checks a whole configuration file with it before it sends anything.
+std::optional<ConfirmRule> confirm_rule_for(const CommandRequest& r, const DeviceUse& device = {});
+// What the rule protects against: "switches the avionics/servo output off".
+std::string_view rule_why(ConfirmRule r) noexcept;
+
 // Deny list and confirm rules for `r`. `device` matters only to stop_streaming: PS = 0 needs
 // confirm for a device the service expects to stream, not for a polled one. The rate limit is
 // RateLimiter's, not this function's.
