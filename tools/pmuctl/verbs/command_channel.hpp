@@ -1,0 +1,75 @@
+#pragma once
+// One participant that sends pmu::v4::Commands to one vehicle's service and takes their
+// replies (interface.md 2.1, 2.4): `pmuctl` command verbs send one, `config apply` a series
+// over the same participant, so a change of ten settings costs one discovery, not ten.
+//
+// Lifetime: owns its DdsContext; the readers and writer it hands out live as long as it.
+// Threads: the verb's thread only.
+
+#include <chrono>
+#include <cstdint>
+#include <optional>
+#include <string>
+
+#include "pmu/dds/dds_context.hpp"
+#include "pmu/idl/command.h"
+#include "pmuctl/verbs/command_verbs.hpp"
+
+namespace pmu::tools {
+
+// "COMPLETED", "REJECTED", ...: the service's names of its results.
+const char* result_name(pmu::v4::CommandResult r);
+
+// A request id unique per sender: "pmuctl-HOST-PID-NANOSECONDS".
+std::string request_id();
+
+// Finds the PMU a command is for: --bus/--address when both are given, else the only PMU
+// (Health.kind: batteries and MPPTs take no commands) the service of `vehicle` knows.
+// nullopt when found; else the exit status, after saying why in words a person can act on.
+// The vehicle is never guessed: a command names --vehicle, or goes to the unnamed vehicle.
+std::optional<int> resolve_target(const GlobalOptions& o, const std::string& vehicle, pmu::dds::DdsContext& dds,
+                                  std::chrono::steady_clock::time_point deadline, std::string& bus,
+                                  std::uint16_t& address);
+
+// Waits until the service's request reader and reply writer are matched: a request written
+// before would be lost, a reply sent before would never be seen. nullopt when matched.
+std::optional<int> wait_for_match(const GlobalOptions& o, pmu::dds::DdsContext& dds,
+                                  eprosima::fastdds::dds::DataWriter& writer,
+                                  eprosima::fastdds::dds::DataReader& replies, const std::string& vehicle,
+                                  std::chrono::steady_clock::time_point deadline, const char* accepts);
+
+// The time `seconds` from now as ns since the Unix epoch (a request's expires_at).
+std::uint64_t epoch_ns_after(double seconds);
+
+class CommandChannel {
+ public:
+  using Clock = std::chrono::steady_clock;
+  explicit CommandChannel(const GlobalOptions& o);
+
+  pmu::dds::DdsContext& dds() { return dds_; }
+  const std::string& vehicle() const { return vehicle_; }
+
+  // The PMU (resolve_target; skipped when `broadcast`) and the matched endpoints. nullopt
+  // when ready to send; else the exit status, after saying why.
+  std::optional<int> open(Clock::time_point deadline, std::string& bus, std::uint16_t& address,
+                          bool broadcast = false);
+
+  struct Outcome {
+    std::string request_id;
+    std::optional<pmu::v4::CommandReply> reply;  // the final reply; nullopt: none within the timeout
+    bool written = true;                         // false: DDS refused the first write
+  };
+  // Sends one command and waits for its final reply, resending with the same id after 1 s
+  // without a reply (never executed twice: interface.md 2.4). Each IN_PROGRESS reply is
+  // printed on stderr and keeps the wait open 3 s more than `timeout` would.
+  Outcome send(const CommandSpec& spec, const std::string& bus, std::uint16_t address, double timeout);
+
+ private:
+  const GlobalOptions& options_;
+  std::string vehicle_;
+  pmu::dds::DdsContext dds_;
+  eprosima::fastdds::dds::DataReader& replies_;
+  eprosima::fastdds::dds::DataWriter& writer_;
+};
+
+}  // namespace pmu::tools
