@@ -187,6 +187,10 @@ void ModelState::handle_parameter(const codec::PmuMessage& msg, TimePoint now) n
     ++counters.rejected_sets;
     return;
   }
+  if (outbox.faults().ignored_set == *parameter) {
+    ++counters.ignored_sets;
+    return;
+  }
   ++counters.handled;
   params.set_raw(*parameter, set->raw);
   switch (*parameter) {

@@ -26,6 +26,9 @@ const char* const kEveryKey = R"(buses:
           silent: true
           soa_shutdown: true
           payload_shed: true
+          firmware: "1.14"
+          serial: 4242
+          ignores_set: cranking_time
       - address: 2
         sim:
           engine_starts_after: never
@@ -63,6 +66,9 @@ TEST(SimConfig, EveryKeyIsRead) {
   EXPECT_TRUE(p.silent);
   EXPECT_EQ(p.soa_shutdown, true);
   EXPECT_EQ(p.payload_shed, true);
+  EXPECT_EQ(p.firmware, (codec::FirmwareVersion{1, 14}));
+  EXPECT_EQ(p.serial, std::optional<std::uint16_t>(4242));
+  EXPECT_EQ(p.ignores_set, codec::Parameter::CrankingTime);
 
   ASSERT_EQ(b.sim.pmus.count(2), 1u);
   const PmuSimSettings& flooded = b.sim.pmus.at(2);
@@ -127,7 +133,8 @@ const char* const kMppt = "buses:\n  - interface: sim\n    mppts:\n      - devic
 const BadCase kBadPmu[] = {
     {"          engin: stopped\n",
      "bad.yaml:6: unknown key 'engin' in the PMU's sim (known: engine, engine_starts_after, internal_temperature, "
-     "battery_a_voltage, battery_b_voltage, starter_ready, silent, soa_shutdown, payload_shed)"},
+     "battery_a_voltage, battery_b_voltage, starter_ready, silent, soa_shutdown, payload_shed, firmware, serial, "
+     "ignores_set)"},
     {"          engine: off\n", "bad.yaml:6: engine must be running or stopped, not 'off'"},
     {"          engine: [running]\n", "bad.yaml:6: engine must be running or stopped"},
     {"          engine_starts_after: soon\n",
@@ -144,6 +151,12 @@ const BadCase kBadPmu[] = {
     {"          silent: 2\n", "bad.yaml:6: silent must be true or false, not '2'"},
     {"          soa_shutdown: yes please\n", "bad.yaml:6: soa_shutdown must be true or false, not 'yes please'"},
     {"          payload_shed: []\n", "bad.yaml:6: payload_shed must be true or false"},
+    {"          firmware: 1.x\n", "bad.yaml:6: firmware '1.x' is not MAJOR.MINOR (each 0..255, e.g. \"1.14\")"},
+    {"          serial: 65536\n", "bad.yaml:6: serial 65536 out of range 0..65535"},
+    {"          serial: 0x10\n",
+     "bad.yaml:6: serial must be a decimal integer (digits, optionally after '-'; no leading 0, '+', 0x, 0o, "
+     "exponent or fraction), not '0x10'"},
+    {"          ignores_set: cranking\n", "bad.yaml:6: ignores_set: 'cranking' is not a stored parameter"},
     {"          silent: true\n          silent: false\n",
      "bad.yaml:7: key 'silent' appears twice in one mapping (first on line 6); give each key once"},
     {"          - engine\n", "bad.yaml:6: the PMU's sim must be a mapping of key: value"},

@@ -119,6 +119,11 @@ const PmuCase kPmuCases[] = {
        EXPECT_TRUE(s.last<codec::Status>()->soa_shutdown);
        EXPECT_TRUE(s.last<codec::Status>()->payload_shed);
      }},
+    {"firmware: \"1.14\", serial: 4242", [](const SimulatedService& s) {
+       ASSERT_FALSE(s.sink.infos.empty());
+       EXPECT_EQ(s.sink.infos.back().second.serial_number, 4242);
+       EXPECT_EQ(s.sink.infos.back().second.firmware.version(), (codec::FirmwareVersion{1, 14}));
+     }},
 };
 
 TEST(SimulatedBus, EachPmuSettingShowsInWhatTheServiceReads) {

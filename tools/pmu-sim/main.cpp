@@ -21,6 +21,7 @@
 #include <vector>
 
 #include "pmu/codec/firmware.hpp"
+#include "pmu/codec/parameters.hpp"
 #include "pmu/codec/ids.hpp"
 #include "pmu/codec/telemetry.hpp"
 #include "pmu/sim/bus_runner.hpp"
@@ -109,6 +110,10 @@ int main(int argc, char** argv) {
   app.add_flag("--payload-shed", pmu_plant.payload_shed, "Report payload shedding");
   bool silent = false;
   app.add_flag("--silent", silent, "The PMUs are off the bus: they hear and send nothing");
+  std::string ignores_set;
+  app.add_option("--ignores-set", ignores_set,
+                 "A stored parameter the PMUs' memory does not take: its sets change nothing, so a read-back "
+                 "shows the old value");
   bool no_pmu = false;
   std::vector<int> batteries, mppts;
   int cells = 12, battery_period_ms = 1000, mppt_period_ms = 1000;
@@ -133,7 +138,7 @@ int main(int argc, char** argv) {
   // A world option for a device that is not played would do nothing without saying so.
   for (const char* pmu_option : {"--engine", "--engine-starts-after", "--internal-temperature", "--battery-a-voltage",
                                   "--battery-b-voltage", "--starter-ready", "--soa-shutdown", "--payload-shed",
-                                  "--silent"})
+                                  "--silent", "--ignores-set"})
     app.get_option("--no-pmu")->excludes(pmu_option);
   auto* battery_opt = app.get_option("--battery");
   auto* mppt_opt = app.get_option("--mppt");
@@ -171,6 +176,14 @@ int main(int argc, char** argv) {
     return app.exit(e) == 0 ? 0 : 2;
   }
 
+  std::optional<pmu::codec::Parameter> ignored_set;
+  if (!ignores_set.empty()) {
+    ignored_set = pmu::codec::parameter_from_name(ignores_set);
+    if (!ignored_set) {
+      std::fprintf(stderr, "pmu-sim: --ignores-set '%s' is not a stored parameter\n", ignores_set.c_str());
+      return 2;
+    }
+  }
   const auto fw = pmu::codec::parse_firmware(firmware);
   if (!fw) {
     std::fprintf(stderr, "pmu-sim: --firmware '%s' is not a version like 1.16\n", firmware.c_str());
@@ -224,6 +237,7 @@ int main(int argc, char** argv) {
         if (engine_running) m.set_engine_running(true, clock.steady_now());
         pmu::sim::Faults faults = m.faults();
         faults.silent = silent;
+        faults.ignored_set = ignored_set;
         m.set_faults(faults);
       });
     }

@@ -59,8 +59,10 @@ SimulatedBus make_simulated_bus(const BusConfig& bus, const transport::Clock& cl
                                   codec::duration_value(codec::Parameter::PacketPeriod, dev.period));
     if (pp) d.parameters.set_raw(codec::Parameter::PacketPeriod, *pp);  // the config checked it is a PP
     d.parameters.set_raw(codec::Parameter::PacketsStreamed, dev.groups);
-    s.simulator->add(d);
     const auto settings = settings_of(bus.sim.pmus, dev.address);
+    if (settings.firmware) d.firmware = *settings.firmware;
+    if (settings.serial) d.serial_number = *settings.serial;
+    s.simulator->add(d);
     s.simulator->with_model(dev.address, [&](sim::PmuModel& m) {
       const auto now = clock.steady_now();
       m.set_plant(plant_of(settings), now);
@@ -69,6 +71,7 @@ SimulatedBus make_simulated_bus(const BusConfig& bus, const transport::Clock& cl
       if (settings.engine_running) m.set_engine_running(true, now);
       sim::Faults faults = m.faults();
       faults.silent = settings.silent;
+      faults.ignored_set = settings.ignores_set;
       m.set_faults(faults);
     });
     addresses.push_back(dev.address);

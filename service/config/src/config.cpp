@@ -162,9 +162,27 @@ double field_value(const Ctx& c, const YAML::Node& n, const char* name, std::str
   c.fail(n, std::string(name) + ": no telemetry field " + std::string(field));
 }
 
+// "1.14": MAJOR.MINOR as packet 0x31 carries them (a byte each). Read as the text written, so
+// that 1.2 is minor 2 and 1.20 minor 20, whatever a YAML number would make of them.
+codec::FirmwareVersion firmware_of(const Ctx& c, const YAML::Node& n, const char* name) {
+  const auto text = c.scalar<std::string>(n, name, "a firmware version such as \"1.14\"");
+  const auto dot = text.find('.');
+  auto part = [&](const std::string& s) -> long {
+    if (s.empty() || s.size() > 3 || s.find_first_not_of("0123456789") != std::string::npos) return -1;
+    const long v = std::stol(s);
+    return v <= 255 ? v : -1;
+  };
+  const long major = dot == std::string::npos ? -1 : part(text.substr(0, dot));
+  const long minor = dot == std::string::npos ? -1 : part(text.substr(dot + 1));
+  if (major < 0 || minor < 0)
+    c.fail(n, std::string(name) + " " + quoted(text) + " is not MAJOR.MINOR (each 0..255, e.g. \"1.14\")");
+  return {static_cast<std::uint8_t>(major), static_cast<std::uint8_t>(minor)};
+}
+
 PmuSimSettings parse_pmu_sim(const Ctx& c, const YAML::Node& n) {
   c.only_keys(n, "the PMU's sim", {"engine", "engine_starts_after", "internal_temperature", "battery_a_voltage",
-                                   "battery_b_voltage", "starter_ready", "silent", "soa_shutdown", "payload_shed"});
+                                   "battery_b_voltage", "starter_ready", "silent", "soa_shutdown", "payload_shed",
+                                   "firmware", "serial", "ignores_set"});
   PmuSimSettings s;
   if (const auto v = n["engine"]) {
     const auto e = c.scalar<std::string>(v, "engine", "running or stopped");
@@ -192,6 +210,13 @@ PmuSimSettings parse_pmu_sim(const Ctx& c, const YAML::Node& n) {
   if (const auto v = n["silent"]) s.silent = sim_bool(c, v, "silent");
   if (const auto v = n["soa_shutdown"]) s.soa_shutdown = sim_bool(c, v, "soa_shutdown");
   if (const auto v = n["payload_shed"]) s.payload_shed = sim_bool(c, v, "payload_shed");
+  if (const auto v = n["firmware"]) s.firmware = firmware_of(c, v, "firmware");
+  if (const auto v = n["serial"]) s.serial = static_cast<std::uint16_t>(c.integer(v, "serial", 0, 65535));
+  if (const auto v = n["ignores_set"]) {
+    const auto name = c.scalar<std::string>(v, "ignores_set", "a stored parameter's name");
+    s.ignores_set = codec::parameter_from_name(name);
+    if (!s.ignores_set) c.fail(v, "ignores_set: " + quoted(name) + " is not a stored parameter");
+  }
   return s;
 }
 
@@ -228,23 +253,6 @@ MpptSimSettings parse_mppt_sim(const Ctx& c, const YAML::Node& n) {
   return s;
 }
 
-// "1.14": MAJOR.MINOR as packet 0x31 carries them (a byte each). Read as the text written, so
-// that 1.2 is minor 2 and 1.20 minor 20, whatever a YAML number would make of them.
-codec::FirmwareVersion firmware_of(const Ctx& c, const YAML::Node& n) {
-  const auto text = c.scalar<std::string>(n, "min_firmware", "a firmware version such as \"1.14\"");
-  const auto dot = text.find('.');
-  auto part = [&](const std::string& s) -> long {
-    if (s.empty() || s.size() > 3 || s.find_first_not_of("0123456789") != std::string::npos) return -1;
-    const long v = std::stol(s);
-    return v <= 255 ? v : -1;
-  };
-  const long major = dot == std::string::npos ? -1 : part(text.substr(0, dot));
-  const long minor = dot == std::string::npos ? -1 : part(text.substr(dot + 1));
-  if (major < 0 || minor < 0)
-    c.fail(n, "min_firmware " + quoted(text) + " is not MAJOR.MINOR (each 0..255, e.g. \"1.14\")");
-  return {static_cast<std::uint8_t>(major), static_cast<std::uint8_t>(minor)};
-}
-
 void parse_device_settings(const Ctx& c, const YAML::Node& n, DeviceConfig& d) {
   if (const auto m = n["mode"]) {
     const auto mode = c.scalar<std::string>(m, "mode", "streaming or polling");
@@ -265,7 +273,7 @@ void parse_device_settings(const Ctx& c, const YAML::Node& n, DeviceConfig& d) {
   if (const auto p = n["engine_running_hold"])
     d.engine.running_hold = std::chrono::milliseconds(std::lround(c.number(p, "engine_running_hold", 0, 25.5) * 1000));
   if (const auto p = n["alarms"]) d.alarms = parse_alarm_settings(p, alarms::DeviceKind::Pmu, c.source);
-  if (const auto p = n["min_firmware"]) d.min_firmware = firmware_of(c, p);
+  if (const auto p = n["min_firmware"]) d.min_firmware = firmware_of(c, p, "min_firmware");
 }
 
 DeviceConfig parse_device(const Ctx& c, const YAML::Node& n, BusConfig& b) {

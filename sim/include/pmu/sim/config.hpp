@@ -110,6 +110,9 @@ struct Faults {
   // Telemetry (0x00..0x04, streamed or requested) goes out with this data length instead of
   // the spec's (capped at 8; bytes past the real payload are zero).
   std::optional<std::uint8_t> telemetry_length;
+  // A unit whose memory does not take this stored parameter: a set of it is acknowledged by
+  // nothing and changes nothing, so a read-back shows the old value (a worn EEPROM cell).
+  std::optional<codec::Parameter> ignored_set;
 };
 
 }  // namespace pmu::sim

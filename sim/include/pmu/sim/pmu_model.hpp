@@ -52,6 +52,7 @@ struct Counters {
   std::uint64_t wrong_length = 0;   // to us, data length not allowed for the packet
   std::uint64_t malformed = 0;      // to us, remote frame or length code above 8
   std::uint64_t rejected_sets = 0;  // out of range / undefined bits: stored value kept
+  std::uint64_t ignored_sets = 0;   // valid, but Faults::ignored_set: stored value kept
   std::uint64_t unsupported = 0;    // packet this firmware lacks (0x0F before 1.14)
   std::uint64_t not_commands = 0;   // data-carrying telemetry or replies (another unit's)
   std::uint64_t ignored_commands = 0;  // 0x24 while cranking/running or starter not ready

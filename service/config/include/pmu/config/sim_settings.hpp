@@ -11,6 +11,9 @@
 #include <optional>
 #include <vector>
 
+#include "pmu/codec/firmware.hpp"
+#include "pmu/codec/parameters.hpp"
+
 namespace pmu::service {
 
 struct PmuSimSettings {
@@ -26,6 +29,9 @@ struct PmuSimSettings {
   std::optional<bool> soa_shutdown;
   std::optional<bool> payload_shed;
   bool silent = false;  // off the bus: answers and streams nothing
+  std::optional<codec::FirmwareVersion> firmware;  // the firmware it behaves as
+  std::optional<std::uint16_t> serial;             // its serial number
+  std::optional<codec::Parameter> ignores_set;     // a stored parameter its memory does not take
 };
 
 // How a battery's or MPPT's frames are spoiled, each one failing to decode.
