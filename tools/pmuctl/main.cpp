@@ -24,6 +24,7 @@
 #include "pmuctl/record/record_verb.hpp"
 #include "pmuctl/serve/serve_verb.hpp"
 #include "pmuctl/verbs/command_verbs.hpp"
+#include "pmuctl/verbs/config_file_verbs.hpp"
 #include "pmuctl/verbs/alarm_verbs.hpp"
 #include "pmuctl/verbs/energy_verb.hpp"
 #include "pmuctl/verbs/preflight_verb.hpp"
@@ -213,6 +214,22 @@ int main(int argc, char** argv) {
   config_set->add_option("param", set_param, parameter_names)->required();
   config_set->add_option("value", set_value, "Value in the parameter's unit (V, s, degC, a number); a mask: names a,b or none, or a number")->required();
 
+  auto* config_snapshot = config->add_subcommand(
+      "snapshot", "Write the PMU's configuration to a file (- for stdout): what `config apply` reads back");
+  std::string config_file;
+  bool force = false;
+  config_snapshot->add_option("file", config_file, "The file to write; an existing one is kept unless --force")
+      ->required();
+  config_snapshot->add_flag("--force", force, "Replace an existing file");
+  auto* config_diff = config->add_subcommand(
+      "diff", "Compare the PMU with a configuration file (exit 0 equal, 1 different, 2 bad file, 3 no answer)");
+  config_diff->add_option("file", config_file, "A file written by `config snapshot` or by hand")->required();
+  auto* config_apply = config->add_subcommand(
+      "apply", "Write what differs from a configuration file, verified, in a safe order; undone on a failure");
+  bool dry_run = false;
+  config_apply->add_option("file", config_file, "A file written by `config snapshot` or by hand")->required();
+  config_apply->add_flag("--dry-run", dry_run, "Check the file and print the changes in order; send nothing");
+
   bool confirm = false;
   app.add_flag("--confirm", confirm, "Confirm a command the safety policy guards (avionics off, reset, engine start...)");
   auto* outputs = app.add_subcommand(
@@ -368,6 +385,9 @@ int main(int argc, char** argv) {
     if (app.got_subcommand("preflight")) return pmu::tools::run_preflight(g);
     if (app.got_subcommand("energy")) return pmu::tools::run_energy(g);
     if (*config_get) return pmu::tools::run_config_get(g, parameter);
+    if (*config_snapshot) return pmu::tools::run_config_snapshot(g, config_file, force);
+    if (*config_diff) return pmu::tools::run_config_diff(g, config_file);
+    if (*config_apply) return pmu::tools::run_config_apply(g, config_file, dry_run, confirm);
     pmu::tools::CommandSpec spec;
     spec.confirm = confirm;
     if (*config_set) {

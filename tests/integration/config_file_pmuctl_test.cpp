@@ -1,0 +1,211 @@
+// A PMU's configuration as a file, as an operator uses it (docs/interface.md 3.2, 4.6):
+// pmuctl config snapshot, diff and apply against pmu-service on the built-in simulator, with
+// one simulated PMU for each firmware the documents describe.
+#include <gtest/gtest.h>
+
+#include <cstdio>
+#include <fstream>
+#include <regex>
+#include <sstream>
+#include <string>
+
+#include "support/configured_service.hpp"
+#include "support/domain.hpp"
+#include "support/json_lines.hpp"
+#include "support/process.hpp"
+
+// A namespace of its own: the unity builds put this file in one translation unit with the
+// other integration tests, whose helpers have the same names.
+namespace config_file_pmuctl_test {
+namespace {
+
+using Json = nlohmann::json;
+
+// Addresses 12..17 play firmware 1.12..1.17; address 20 is a unit whose memory does not take
+// cranking_time.
+std::string config(const std::string& domain) {
+  std::string c = "domain: " + domain + "\nqos_file: " PMU_QOS_FILE "\nbuses:\n  - interface: sim\n    devices:\n";
+  for (int minor = 12; minor <= 17; ++minor)
+    c += "      - address: " + std::to_string(minor) + "\n        period: 0.5\n        sim: {firmware: \"1." +
+         std::to_string(minor) + "\"}\n";
+  c += "      - address: 20\n        period: 0.5\n        sim: {ignores_set: cranking_time}\n";
+  return c;
+}
+
+class Files {
+ public:
+  Files() {
+    char tmpl[] = "/tmp/pmu-config-file-XXXXXX";
+    dir_ = ::mkdtemp(tmpl);
+  }
+  ~Files() { pmu::test::run_capture("rm -rf '" + dir_ + "'"); }
+  std::string path(const std::string& name) const { return dir_ + "/" + name; }
+  std::string write(const std::string& name, const std::string& text) const {
+    std::ofstream(path(name)) << text;
+    return path(name);
+  }
+  static std::string read(const std::string& p) {
+    std::ostringstream s;
+    s << std::ifstream(p).rdbuf();
+    return s.str();
+  }
+
+ private:
+  std::string dir_;
+};
+
+std::size_t count_of(const std::string& text, const std::string& what) {
+  std::size_t n = 0;
+  for (auto at = text.find(what); at != std::string::npos; at = text.find(what, at + 1)) ++n;
+  return n;
+}
+
+// A file that changes every one of the thirteen settings from the simulator's factory
+// values, to values the firmware has (S0's newer bits only where it has them).
+std::string every_setting_changed(int minor, int new_address) {
+  std::string s0 = "[avionics_servo, payload";
+  if (minor >= 15) s0 += ", battery_disconnect_detect";
+  if (minor >= 16) s0 += ", soa_management";
+  s0 += "]";
+  return "parameters:\n"
+         "  avionics_voltage: 22.0\n"
+         "  payload_voltage: 13.5\n"
+         "  servo_voltage: 7.5\n"
+         "  battery_voltage: 24.0\n"
+         "  packet_period: 0.4\n"
+         "  packets_streamed: [voltages, currents, temperatures, status]\n"
+         "  temperature_offset: 100\n"
+         "  upper_temperature_limit: 90\n"
+         "  power_up_state: " + s0 + "\n"
+         "  cranking_time: 3.5\n"
+         "  can_address: " + std::to_string(new_address) + "\n"
+         "outputs: [avionics_servo, charger_a]\n"
+         "generation_enabled: false\n";
+}
+
+TEST(ConfigFilesOverDds, SnapshotApplyAndBackOnEveryFirmware) {
+  const std::string domain = std::to_string(pmu::test::exclusive_dds_domain());
+  pmu::test::ConfiguredService service(PMU_SERVICE_PATH, config(domain));
+  const std::string p = std::string(PMUCTL_PATH) + " --domain " + domain + " --bus sim ";
+  Files files;
+  for (int minor = 17; minor >= 12; --minor) {
+    SCOPED_TRACE("firmware 1." + std::to_string(minor));
+    const bool first = minor == 17;  // what does not depend on the firmware, once
+    const std::string at = "--address " + std::to_string(minor) + " ";
+    const std::string factory = files.path("factory-" + std::to_string(minor) + ".yaml");
+    const auto snap = pmu::test::run_capture(p + "--timeout 30 " + at + "config snapshot " + factory + " 2>&1");
+    ASSERT_EQ(snap.status, 0) << snap.out << service.describe();
+    const std::string text = Files::read(factory);
+    EXPECT_NE(text.find("firmware: \"1." + std::to_string(minor) + "\""), std::string::npos) << text;
+    EXPECT_NE(text.find("serial: " + std::to_string(1000 + minor)), std::string::npos) << text;
+
+    const int moved = minor + 100;
+    const std::string changed =
+        files.write("changed-" + std::to_string(minor) + ".yaml", every_setting_changed(minor, moved));
+    if (first) {
+      // A second snapshot to the same file is refused and leaves it as it was.
+      const auto again = pmu::test::run_capture(p + at + "config snapshot " + factory + " 2>&1");
+      EXPECT_EQ(again.status, 2) << again.out;
+      EXPECT_EQ(Files::read(factory), text);
+      const auto before = pmu::test::run_capture(p + at + "--json config diff " + changed);
+      EXPECT_EQ(before.status, 1) << before.out;
+      const auto d = Json::parse(before.out);
+      EXPECT_EQ(d["differences"].size(), 13u) << before.out;
+      EXPECT_EQ(d["equal"], false);
+      // can_address needs --confirm: without it the file is refused whole and nothing is sent.
+      const auto audits = count_of(service.describe(), "audit: command");
+      const auto unconfirmed = pmu::test::run_capture(p + at + "config apply " + changed + " 2>&1");
+      EXPECT_EQ(unconfirmed.status, 2) << unconfirmed.out;
+      EXPECT_NE(unconfirmed.out.find(changed + ":12: can_address"), std::string::npos) << unconfirmed.out;
+      EXPECT_NE(unconfirmed.out.find("rule set_can_address"), std::string::npos) << unconfirmed.out;
+      EXPECT_EQ(count_of(service.describe(), "audit: command"), audits) << "a command was sent";
+    }
+
+    const auto apply = pmu::test::run_capture(p + at + "--confirm config apply " + changed + " 2>&1");
+    ASSERT_EQ(apply.status, 0) << apply.out << service.describe();
+    EXPECT_EQ(count_of(apply.out, ": COMPLETED"), 13u) << apply.out;
+    // The address last (section 4.6).
+    EXPECT_GT(apply.out.find("can_address " + std::to_string(minor)), apply.out.find("packets_streamed"))
+        << apply.out;
+    const std::string now = "--address " + std::to_string(moved) + " ";
+    const auto there = pmu::test::run_capture(p + now + "config diff " + changed + " 2>&1");
+    EXPECT_EQ(there.status, 0) << there.out;
+
+    // Back to the snapshot, at the new address: the file's can_address moves it home.
+    const auto back = pmu::test::run_capture(p + now + "--confirm config apply " + factory + " 2>&1");
+    ASSERT_EQ(back.status, 0) << back.out << service.describe();
+    const auto home = pmu::test::run_capture(p + at + "config diff " + factory + " 2>&1");
+    EXPECT_EQ(home.status, 0) << home.out;
+  }
+}
+
+// A set the unit does not take, in the middle of a file: the change fails on its read-back,
+// the changes before it are restored (each verified), the exit status is 1 and the device is
+// as it was.
+TEST(ConfigFilesOverDds, AFailedChangeRestoresWhatWasApplied) {
+  const std::string domain = std::to_string(pmu::test::exclusive_dds_domain());
+  pmu::test::ConfiguredService service(PMU_SERVICE_PATH, config(domain));
+  const std::string p = std::string(PMUCTL_PATH) + " --domain " + domain + " --bus sim --address 20 ";
+  Files files;
+  const std::string factory = files.path("factory.yaml");
+  ASSERT_EQ(pmu::test::run_capture(p + "--timeout 30 config snapshot " + factory).status, 0) << service.describe();
+  // Applied in the order temperature_offset, cranking_time (fails), avionics_voltage.
+  const std::string file = files.write("bad-memory.yaml",
+                                       "parameters:\n  avionics_voltage: 22.0\n  cranking_time: 3.5\n"
+                                       "  temperature_offset: 100\n");
+  const auto r = pmu::test::run_capture(p + "--json config apply " + file + " 2>&1");
+  EXPECT_EQ(r.status, 1) << r.out << service.describe();
+  EXPECT_NE(r.out.find("temperature_offset 128 -> 100: COMPLETED"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("cranking_time 5.0 s -> 3.5 s: FAILED"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("restored temperature_offset to 128: COMPLETED"), std::string::npos) << r.out;
+  EXPECT_EQ(r.out.find("avionics_voltage 12.0 V -> 22.0 V"), std::string::npos) << "sent after the failure";
+  EXPECT_NE(r.out.find("1 of 1 applied change(s) restored"), std::string::npos) << r.out;
+  std::smatch json;
+  const std::string out = r.out;
+  ASSERT_TRUE(std::regex_search(out, json, std::regex(R"(\{"address".*\})"))) << r.out;
+  const auto j = Json::parse(json.str());
+  EXPECT_EQ(j["applied"], false);
+  EXPECT_EQ(j["restored"].size(), 1u);
+  EXPECT_EQ(j["exit_status"], 1);
+  EXPECT_EQ(pmu::test::run_capture(p + "config diff " + factory).status, 0) << "the device is as it was";
+}
+
+// A bad file is exit 2 with FILE:LINE and no frame; a file for a newer firmware is refused for
+// this device at the line of the bit it lacks.
+TEST(ConfigFilesOverDds, BadFilesSendNothing) {
+  const std::string domain = std::to_string(pmu::test::exclusive_dds_domain());
+  pmu::test::ConfiguredService service(PMU_SERVICE_PATH, config(domain));
+  const std::string p = std::string(PMUCTL_PATH) + " --domain " + domain + " --bus sim --address 14 ";
+  Files files;
+  ASSERT_EQ(pmu::test::run_capture(p + "--timeout 30 config get can_address").status, 0) << service.describe();
+  struct Bad {
+    std::string text;
+    std::string says;
+    int diff_status;  // diff reads the file alone: only the file's own faults are its
+  };
+  const Bad kBad[] = {
+      {"parameters:\n  avionics_voltage: 30.0\n", ":2: value 30.0 V out of range 12.0..24.0 V", 2},
+      {"parameters:\n  avionics_voltage: 22.0\n  cranking: 3\n", ":3: unknown parameter 'cranking'", 2},
+      // For this unit's firmware: bit 6 comes with 1.16.
+      {"parameters:\n  power_up_state: [avionics_servo, soa_management]\n", ":2: power_up_state", 1},
+      // Avionics off: needs --confirm.
+      {"outputs: [payload]\n", ":1: outputs", 1},
+      {"device:\n  min_firmware: \"1.16\"\noutputs: [avionics_servo, payload, charger_a, charger_b]\n",
+       ":2: sim/14 has firmware 1.14", 0},
+  };
+  const auto audits = count_of(service.describe(), "audit: command");
+  for (const auto& b : kBad) {
+    const std::string file = files.write("bad.yaml", b.text);
+    const auto r = pmu::test::run_capture(p + "config apply " + file + " 2>&1");
+    EXPECT_EQ(r.status, 2) << b.text << r.out;
+    EXPECT_NE(r.out.find(file + b.says), std::string::npos) << b.text << r.out;
+    const auto d = pmu::test::run_capture(p + "config diff " + file + " 2>&1");
+    EXPECT_EQ(d.status, b.diff_status) << b.text << d.out;
+  }
+  EXPECT_EQ(count_of(service.describe(), "audit: command"), audits) << "a bad file sent a command";
+  const auto missing = pmu::test::run_capture(p + "config diff " + files.path("none.yaml") + " 2>&1");
+  EXPECT_EQ(missing.status, 2) << missing.out;
+}
+
+}  // namespace
+}  // namespace config_file_pmuctl_test

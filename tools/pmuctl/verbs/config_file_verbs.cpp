@@ -1,0 +1,471 @@
+#include "pmuctl/verbs/config_file_verbs.hpp"
+
+#include <fcntl.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <ctime>
+#include <fastdds/dds/core/status/SubscriptionMatchedStatus.hpp>
+#include <fastdds/dds/subscriber/SampleInfo.hpp>
+#include <fstream>
+#include <map>
+#include <nlohmann/json.hpp>
+#include <sstream>
+#include <thread>
+#include <utility>
+
+#include "pmu/baseline/apply_plan.hpp"
+#include "pmu/baseline/config_diff.hpp"
+#include "pmu/baseline/config_file.hpp"
+#include "pmu/command/command.hpp"
+#include "pmu/dds/dds_context.hpp"
+#include "pmu/idl/guarded_type.hpp"
+#include "pmu/idl/state.h"
+#include "pmu/idl/statePubSubTypes.h"
+#include "pmu/idl/topics.hpp"
+#include "pmuctl/verbs/command_channel.hpp"
+#include "pmuctl/verbs/exit_status.hpp"
+#include "pmuctl/verbs/service_presence.hpp"
+
+namespace pmu::tools {
+// A namespace of its own: the unity builds put this file in one translation unit with the
+// other verbs, whose helpers have the same names.
+namespace config_file_verbs {
+namespace {
+
+using namespace eprosima::fastdds::dds;
+using Clock = std::chrono::steady_clock;
+using Json = nlohmann::json;
+using baseline::Setting;
+
+Clock::time_point deadline_after(double seconds) {
+  return Clock::now() + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(seconds));
+}
+
+// The raw wire values pmu/config stands for: the floats are the service's raw / divisor.
+baseline::Settings settings_of(const pmu::v4::Config& c) {
+  baseline::Settings s;
+  auto scaled = [](codec::Parameter p, float v) {
+    return static_cast<std::uint32_t>(std::lround(static_cast<double>(v) * codec::spec_of(p).divisor));
+  };
+  using P = codec::Parameter;
+  s[Setting::AvionicsVoltage] = scaled(P::AvionicsVoltage, c.avionics_voltage());
+  s[Setting::PayloadVoltage] = scaled(P::PayloadVoltage, c.payload_voltage());
+  s[Setting::ServoVoltage] = scaled(P::ServoVoltage, c.servo_voltage());
+  s[Setting::BatteryVoltage] = scaled(P::BatteryVoltage, c.battery_voltage());
+  s[Setting::PacketPeriod] = scaled(P::PacketPeriod, c.packet_period());
+  s[Setting::PacketsStreamed] = c.packets_streamed();
+  s[Setting::TemperatureOffset] = c.temperature_offset();
+  s[Setting::UpperTemperatureLimit] = c.upper_temperature_limit();
+  s[Setting::PowerUpState] = c.power_up_state();
+  s[Setting::CrankingTime] = scaled(P::CrankingTime, c.cranking_time());
+  s[Setting::CanAddress] = c.can_address();
+  s[Setting::Outputs] = c.outputs();
+  s[Setting::GenerationEnabled] = c.generation_enabled() ? 1u : 0u;
+  return s;
+}
+
+// The chosen PMU's pmu/config and pmu/info as the service publishes them (TRANSIENT_LOCAL:
+// the current values come at once), kept up to date while the verb runs.
+class DeviceReader {
+ public:
+  DeviceReader(pmu::dds::DdsContext& dds, std::string vehicle)
+      : vehicle_(std::move(vehicle)),
+        config_(dds.reader(dds.topic(topics::kConfig, TypeSupport(new idl::Guarded<pmu::v4::ConfigPubSubType>())),
+                           qos_profiles::kState)),
+        info_(dds.reader(dds.topic(topics::kInfo, TypeSupport(new idl::Guarded<pmu::v4::DeviceInfoPubSubType>())),
+                         qos_profiles::kState)) {}
+
+  void poll() {
+    SampleInfo si;
+    pmu::v4::Config c;
+    while (config_.take_next_sample(&c, &si) == ReturnCode_t::RETCODE_OK)
+      if (si.valid_data && c.vehicle().to_string() == vehicle_) configs_[{c.bus().to_string(), c.address()}] = c;
+    pmu::v4::DeviceInfo i;
+    while (info_.take_next_sample(&i, &si) == ReturnCode_t::RETCODE_OK)
+      if (si.valid_data && i.vehicle().to_string() == vehicle_) infos_[{i.bus().to_string(), i.address()}] = i;
+  }
+  const pmu::v4::Config* config(const std::string& bus, std::uint16_t address) const {
+    const auto it = configs_.find({bus, address});
+    return it == configs_.end() ? nullptr : &it->second;
+  }
+  const pmu::v4::DeviceInfo* info(const std::string& bus, std::uint16_t address) const {
+    const auto it = infos_.find({bus, address});
+    return it == infos_.end() ? nullptr : &it->second;
+  }
+  // Both read, or the deadline passed.
+  bool wait(const std::string& bus, std::uint16_t address, Clock::time_point deadline) {
+    for (;;) {
+      poll();
+      if (config(bus, address) && info(bus, address)) return true;
+      if (Clock::now() >= deadline) return false;
+      std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    }
+  }
+
+ private:
+  std::string vehicle_;
+  DataReader& config_;
+  DataReader& info_;
+  std::map<std::pair<std::string, std::uint16_t>, pmu::v4::Config> configs_;
+  std::map<std::pair<std::string, std::uint16_t>, pmu::v4::DeviceInfo> infos_;
+};
+
+codec::FirmwareVersion firmware_of(const pmu::v4::DeviceInfo& i) { return {i.firmware_major(), i.firmware_minor()}; }
+
+// The file's text, or the exit status after saying why it cannot be read.
+std::optional<std::string> read_text(const GlobalOptions& o, const std::string& path, int& status) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) {
+    status = fail(o, ExitStatus::BadUsage, path + ": cannot be read: " + std::strerror(errno));
+    return std::nullopt;
+  }
+  std::ostringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
+
+// The file read and checked, or the exit status (2) after saying FILE:LINE: what.
+std::optional<baseline::ConfigFile> read_file(const GlobalOptions& o, const std::string& path, int& status) {
+  const auto text = read_text(o, path, status);
+  if (!text) return std::nullopt;
+  auto f = baseline::read_config_file(*text);
+  if (!f) {
+    status = fail(o, ExitStatus::BadUsage, baseline::describe(f.error(), path));
+    return std::nullopt;
+  }
+  return std::move(f).value();
+}
+
+// The PMU to work on and its configuration and identity, read from its service. nullopt
+// with `status` set when there is none.
+struct Target {
+  std::string bus;
+  std::uint16_t address = 0;
+};
+std::optional<Target> find_device(const GlobalOptions& o, pmu::dds::DdsContext& dds, DeviceReader& device,
+                                  const std::string& vehicle, Clock::time_point deadline, int& status) {
+  Target t;
+  if (const auto failed = resolve_target(o, vehicle, dds, deadline, t.bus, t.address)) {
+    status = *failed;
+    return std::nullopt;
+  }
+  if (!device.wait(t.bus, t.address, deadline)) {
+    status = fail(o, ExitStatus::NoAnswer,
+                  device_label(vehicle, t.bus, t.address) + ": its " +
+                      (device.config(t.bus, t.address) ? "identity (pmu/info)" : "configuration (pmu/config)") +
+                      " did not come in time: the service has not read the PMU yet");
+    return std::nullopt;
+  }
+  return t;
+}
+
+std::string utc_now() {
+  const std::time_t now = std::time(nullptr);
+  std::tm tm{};
+  gmtime_r(&now, &tm);
+  char buf[32];
+  std::strftime(buf, sizeof buf, "%Y-%m-%dT%H:%M:%SZ", &tm);
+  return buf;
+}
+
+// Writes `text` to `path` whole or not at all: a temporary file beside it, synced, then
+// renamed over nothing (link() fails if `path` appeared meanwhile) or, with `force`, over
+// the old file.
+std::string write_whole(const std::string& path, const std::string& text, bool force) {
+  const std::string tmp = path + ".tmp-" + std::to_string(::getpid());
+  const int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0644);
+  if (fd < 0) return tmp + ": " + std::strerror(errno);
+  std::size_t done = 0;
+  while (done < text.size()) {
+    const auto n = ::write(fd, text.data() + done, text.size() - done);
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) {
+      const std::string why = std::strerror(errno);
+      ::close(fd);
+      ::unlink(tmp.c_str());
+      return path + ": " + why;
+    }
+    done += static_cast<std::size_t>(n);
+  }
+  if (::fsync(fd) != 0 || ::close(fd) != 0) {
+    const std::string why = std::strerror(errno);
+    ::unlink(tmp.c_str());
+    return path + ": " + why;
+  }
+  const int rc = force ? ::rename(tmp.c_str(), path.c_str()) : ::link(tmp.c_str(), path.c_str());
+  const std::string why = rc == 0 ? std::string() : std::strerror(errno);
+  ::unlink(tmp.c_str());  // after link(): the name `path` keeps the file
+  return rc == 0 ? std::string() : path + ": " + why;
+}
+
+Json difference_json(const baseline::Difference& d) {
+  return {{"name", std::string(baseline::setting_name(d.setting))},
+          {"line", d.line},
+          {"device", d.device ? Json(baseline::value_text(d.setting, *d.device)) : Json(nullptr)},
+          {"file", baseline::value_text(d.setting, d.file)}};
+}
+
+CommandSpec command_for(Setting s, std::uint32_t raw, bool confirm) {
+  CommandSpec spec;
+  spec.confirm = confirm;
+  if (s == Setting::Outputs) {
+    spec.kind = pmu::v4::SET_OUTPUTS;
+    spec.outputs = static_cast<std::uint8_t>(raw);
+  } else if (s == Setting::GenerationEnabled) {
+    spec.kind = pmu::v4::SET_GENERATION;
+    spec.enable = raw != 0;
+  } else {
+    const auto p = *baseline::parameter_of(s);
+    spec.kind = pmu::v4::SET_PARAMETER;
+    spec.parameter = std::string(codec::spec_of(p).name);
+    spec.value = codec::parameter_value(p, raw);
+  }
+  return spec;
+}
+
+// "COMPLETED", or "TIMEOUT: no reply within 5.0 s".
+std::string outcome_text(const CommandChannel::Outcome& out, double timeout) {
+  if (!out.written) return "FAILED: the command could not be written to DDS";
+  if (!out.reply) {
+    char buf[64];
+    std::snprintf(buf, sizeof buf, "no reply within %.1f s", timeout);
+    return buf;
+  }
+  const std::string reason = out.reply->reason().to_string();
+  return std::string(result_name(out.reply->result())) + (reason.empty() ? "" : ": " + reason);
+}
+bool completed(const CommandChannel::Outcome& out) {
+  return out.written && out.reply && out.reply->result() == pmu::v4::COMPLETED;
+}
+
+}  // namespace
+
+int snapshot(const GlobalOptions& o, const std::string& file, bool force) {
+  if (file != "-" && !force && ::access(file.c_str(), F_OK) == 0)
+    return fail(o, ExitStatus::BadUsage, file + ": exists; a snapshot never overwrites one (--force to replace it)");
+  const double timeout = o.timeout.value_or(5.0);
+  const auto deadline = deadline_after(timeout);
+  const std::string vehicle = o.vehicle.value_or(std::string());
+  pmu::dds::DdsContext dds(o.domain, o.qos_file, "pmuctl", o.security, pmu::dds::Transport::Default, o.network,
+                           partitions_for(o));
+  DeviceReader device(dds, vehicle);
+  int status = 0;
+  const auto t = find_device(o, dds, device, vehicle, deadline, status);
+  if (!t) return status;
+  const auto& info = *device.info(t->bus, t->address);
+  baseline::Header h;
+  h.vehicle = vehicle;
+  h.bus = t->bus;
+  h.address = t->address;
+  h.serial = info.serial_number();
+  h.firmware = firmware_of(info);
+  h.date = utc_now();
+  const std::string text = baseline::write_config_file(h, settings_of(*device.config(t->bus, t->address)));
+  if (file == "-") {
+    std::fwrite(text.data(), 1, text.size(), stdout);
+    return 0;
+  }
+  if (const auto why = write_whole(file, text, force); !why.empty())
+    return fail(o, ExitStatus::NotDone, "the snapshot was not written: " + why);
+  std::fprintf(stderr, "%s (serial %u, firmware %s): %zu settings written to %s\n",
+               device_label(vehicle, t->bus, t->address).c_str(), unsigned{info.serial_number()},
+               codec::to_string(firmware_of(info)).c_str(), baseline::kSettingCount, file.c_str());
+  return 0;
+}
+
+int diff(const GlobalOptions& o, const std::string& file) {
+  int status = 0;
+  const auto f = read_file(o, file, status);
+  if (!f) return status;
+  const double timeout = o.timeout.value_or(5.0);
+  const auto deadline = deadline_after(timeout);
+  const std::string vehicle = o.vehicle.value_or(std::string());
+  pmu::dds::DdsContext dds(o.domain, o.qos_file, "pmuctl", o.security, pmu::dds::Transport::Default, o.network,
+                           partitions_for(o));
+  DeviceReader device(dds, vehicle);
+  const auto t = find_device(o, dds, device, vehicle, deadline, status);
+  if (!t) return status;
+  const auto have = settings_of(*device.config(t->bus, t->address));
+  const auto diffs = baseline::differences(have, *f);
+  const auto missing = baseline::not_in_file(have, *f);
+  const std::size_t compared = baseline::kSettingCount - missing.size();
+  const std::string label = device_label(vehicle, t->bus, t->address);
+  if (o.json) {
+    Json j{{"vehicle", vehicle},       {"bus", t->bus},          {"address", t->address}, {"file", file},
+           {"equal", diffs.empty()},  {"compared", compared},  {"differences", Json::array()},
+           {"not_in_file", Json::array()}};
+    for (const auto& d : diffs) j["differences"].push_back(difference_json(d));
+    for (const auto s : missing) j["not_in_file"].push_back(std::string(baseline::setting_name(s)));
+    std::printf("%s\n", j.dump(-1, ' ', false, Json::error_handler_t::replace).c_str());
+  } else {
+    for (const auto& d : diffs) std::printf("%s:%d: %s\n", file.c_str(), d.line, baseline::describe(d).c_str());
+  }
+  if (diffs.empty())
+    std::fprintf(stderr, "%s matches %s (%zu settings)\n", label.c_str(), file.c_str(), compared);
+  else
+    std::fprintf(stderr, "%s differs from %s in %zu of %zu settings\n", label.c_str(), file.c_str(), diffs.size(),
+                 compared);
+  if (!missing.empty()) {
+    std::string names;
+    for (const auto s : missing) names += (names.empty() ? "" : ", ") + std::string(baseline::setting_name(s));
+    std::fprintf(stderr, "not in the file, so not compared: %s\n", names.c_str());
+  }
+  const auto& info = *device.info(t->bus, t->address);
+  if (f->header.serial && *f->header.serial != info.serial_number())
+    std::fprintf(stderr, "the file was read from serial %u; this PMU is serial %u\n", unsigned{*f->header.serial},
+                 unsigned{info.serial_number()});
+  return static_cast<int>(diffs.empty() ? ExitStatus::Ok : ExitStatus::NotDone);
+}
+
+int apply(const GlobalOptions& o, const std::string& file, bool dry_run, bool confirm) {
+  int status = 0;
+  const auto f = read_file(o, file, status);
+  if (!f) return status;
+  const double timeout = o.timeout.value_or(5.0);
+  CommandChannel channel(o);
+  DeviceReader device(channel.dds(), channel.vehicle());
+  std::string bus;
+  std::uint16_t address = 0;
+  if (const auto failed = channel.open(deadline_after(timeout), bus, address)) return *failed;
+  if (!device.wait(bus, address, deadline_after(timeout)))
+    return fail(o, ExitStatus::NoAnswer,
+                device_label(channel.vehicle(), bus, address) + ": its configuration did not come in time");
+  const std::string label = device_label(channel.vehicle(), bus, address);
+  const auto firmware = firmware_of(*device.info(bus, address));
+
+  // Everything is judged before the first frame: a file this device cannot take is refused
+  // whole.
+  if (const auto e = baseline::check_firmware(*f, firmware))
+    return fail(o, ExitStatus::BadUsage,
+                baseline::describe(*e, file) + " (" + label + " has firmware " + codec::to_string(firmware) + ")");
+  if (f->header.min_firmware && firmware < *f->header.min_firmware)
+    return fail(o, ExitStatus::BadUsage,
+                file + ":" + std::to_string(f->min_firmware_line) + ": " + label + " has firmware " +
+                    codec::to_string(firmware) + ", older than min_firmware " +
+                    codec::to_string(*f->header.min_firmware));
+  const auto plan = baseline::apply_plan(baseline::differences(settings_of(*device.config(bus, address)), *f));
+  if (plan.empty()) {
+    std::fprintf(stderr, "%s already matches %s: nothing to apply\n", label.c_str(), file.c_str());
+    return 0;
+  }
+  std::vector<std::string> unconfirmed;
+  for (const auto& c : plan)
+    if (c.confirm && !confirm)
+      unconfirmed.push_back(file + ":" + std::to_string(c.line) + ": " + std::string(baseline::setting_name(c.setting)) +
+                            " " + baseline::value_text(c.setting, c.to) + " " +
+                            std::string(service::rule_why(*c.confirm)) + ": it needs --confirm (rule " +
+                            std::string(service::to_string(*c.confirm)) + ")");
+  for (std::size_t i = 0; i < plan.size(); ++i) {
+    const auto& c = plan[i];
+    if (!dry_run) break;
+    std::printf("%zu. %s:%d: %s: %s -> %s%s\n", i + 1, file.c_str(), c.line,
+                std::string(baseline::setting_name(c.setting)).c_str(),
+                baseline::value_text(c.setting, c.from).c_str(), baseline::value_text(c.setting, c.to).c_str(),
+                c.confirm ? (" (needs --confirm: " + std::string(service::to_string(*c.confirm)) + ")").c_str() : "");
+  }
+  if (!unconfirmed.empty() && !dry_run) {
+    for (std::size_t i = 0; i + 1 < unconfirmed.size(); ++i) std::fprintf(stderr, "pmuctl: %s\n", unconfirmed[i].c_str());
+    return fail(o, ExitStatus::BadUsage, unconfirmed.back() + "; nothing was sent");
+  }
+  if (dry_run) {
+    std::fprintf(stderr, "%s: %zu change(s) to apply from %s; nothing was sent (--dry-run)\n", label.c_str(),
+                 plan.size(), file.c_str());
+    return 0;
+  }
+
+  Json changes = Json::array();
+  std::vector<const baseline::Change*> applied;
+  std::string failure;
+  std::uint16_t at = address;  // the unit's address now: can_address, applied last, moves it
+  for (const auto& c : plan) {
+    const auto out = channel.send(command_for(c.setting, c.to, confirm && c.confirm), bus, at, timeout);
+    const std::string result = outcome_text(out, timeout);
+    // One line per change, like the service's audit line for the command.
+    std::fprintf(stderr, "%s: %s %s -> %s: %s\n", label.c_str(), std::string(baseline::setting_name(c.setting)).c_str(),
+                 baseline::value_text(c.setting, c.from).c_str(), baseline::value_text(c.setting, c.to).c_str(),
+                 result.c_str());
+    changes.push_back({{"name", std::string(baseline::setting_name(c.setting))},
+                       {"from", baseline::value_text(c.setting, c.from)},
+                       {"to", baseline::value_text(c.setting, c.to)},
+                       {"result", result}});
+    if (!completed(out)) {
+      failure = std::string(baseline::setting_name(c.setting)) + " (" + result + ")";
+      break;
+    }
+    applied.push_back(&c);
+    if (c.setting == Setting::CanAddress) at = static_cast<std::uint16_t>(c.to);
+  }
+
+  if (!failure.empty()) {
+    // Undo, newest first, to the values read before: the device goes back to the state it
+    // was in, so each restore is sent confirmed.
+    Json restored = Json::array();
+    std::size_t ok = 0;
+    for (auto it = applied.rbegin(); it != applied.rend(); ++it) {
+      const auto& c = **it;
+      const auto out = channel.send(command_for(c.setting, c.from, true), bus, at, timeout);
+      const std::string result = outcome_text(out, timeout);
+      std::fprintf(stderr, "%s: restored %s to %s: %s\n", label.c_str(), std::string(baseline::setting_name(c.setting)).c_str(),
+                   baseline::value_text(c.setting, c.from).c_str(), result.c_str());
+      restored.push_back({{"name", std::string(baseline::setting_name(c.setting))},
+                          {"to", baseline::value_text(c.setting, c.from)},
+                          {"result", result}});
+      if (completed(out)) ++ok;
+      if (c.setting == Setting::CanAddress && completed(out)) at = static_cast<std::uint16_t>(c.from);
+    }
+    const std::string summary = "apply stopped at " + failure + "; " + std::to_string(ok) + " of " +
+                                std::to_string(applied.size()) + " applied change(s) restored" +
+                                (ok == applied.size() ? "" : ": THE DEVICE IS PARTLY CHANGED, see the lines above");
+    std::fprintf(stderr, "%s: %s\n", label.c_str(), summary.c_str());
+    if (o.json) {
+      Json j{{"vehicle", channel.vehicle()}, {"bus", bus},          {"address", address}, {"file", file},
+             {"applied", false},             {"changes", changes},  {"restored", restored}, {"reason", summary},
+             {"exit_status", static_cast<int>(ExitStatus::NotDone)}};
+      std::printf("%s\n", j.dump(-1, ' ', false, Json::error_handler_t::replace).c_str());
+    }
+    return static_cast<int>(ExitStatus::NotDone);
+  }
+
+  // Each change was read back by the service; the final diff is the file against the whole
+  // configuration as the service now publishes it (at the unit's address now).
+  std::vector<baseline::Difference> left;
+  const auto settle = deadline_after(timeout);
+  for (;;) {
+    device.poll();
+    const auto* now = device.config(bus, at);
+    left = now ? baseline::differences(settings_of(*now), *f) : baseline::differences({}, *f);
+    if (left.empty() || Clock::now() >= settle) break;
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+  const std::string final_label = device_label(channel.vehicle(), bus, at);
+  for (const auto& d : left) std::printf("%s:%d: %s\n", file.c_str(), d.line, baseline::describe(d).c_str());
+  if (left.empty())
+    std::fprintf(stderr, "%s: %zu change(s) applied; it matches %s\n", final_label.c_str(), plan.size(), file.c_str());
+  else
+    std::fprintf(stderr, "%s: %zu change(s) applied and verified, but it still differs from %s in %zu setting(s)\n",
+                 final_label.c_str(), plan.size(), file.c_str(), left.size());
+  if (o.json) {
+    Json j{{"vehicle", channel.vehicle()}, {"bus", bus},         {"address", at}, {"file", file},
+           {"applied", left.empty()},      {"changes", changes}, {"differences", Json::array()}};
+    for (const auto& d : left) j["differences"].push_back(difference_json(d));
+    std::printf("%s\n", j.dump(-1, ' ', false, Json::error_handler_t::replace).c_str());
+  }
+  return static_cast<int>(left.empty() ? ExitStatus::Ok : ExitStatus::NotDone);
+}
+
+}  // namespace config_file_verbs
+
+int run_config_snapshot(const GlobalOptions& o, const std::string& file, bool force) {
+  return config_file_verbs::snapshot(o, file, force);
+}
+int run_config_diff(const GlobalOptions& o, const std::string& file) { return config_file_verbs::diff(o, file); }
+int run_config_apply(const GlobalOptions& o, const std::string& file, bool dry_run, bool confirm) {
+  return config_file_verbs::apply(o, file, dry_run, confirm);
+}
+
+}  // namespace pmu::tools
