@@ -13,7 +13,7 @@
 #                                 command line (all when absent), one after another
 #   sh /scenarios.sh one NAME     a single scenario (what `all` runs for each)
 
-ALL_SCENARIOS="telemetry link_down_up iface_recreate iface_absent_at_start sim_restart two_pmus discovery flood commands_candump power_system flight_readiness"
+ALL_SCENARIOS="telemetry link_down_up iface_recreate iface_absent_at_start sim_restart two_pmus discovery flood commands_candump power_system flight_readiness config_file"
 
 export PATH=/opt/pmu/bin:/usr/sbin:/usr/bin:/sbin:/bin
 export PMU_QOS_FILE=/etc/pmu-dds/qos.xml
@@ -573,6 +573,81 @@ scenario_flight_readiness() {
     fail "a start during thermal shutdown: exit $st, $(tr '\n' '|' <"$WORK/$SCEN.start2")"
   alive "$pid" || fail "pmu-service died"
   detail "preflight exit 1 NOT READY (thermal_shutdown critical); start $(head -n1 "$WORK/$SCEN.start2")"
+}
+
+# A PMU's configuration as a file on a real bus (interface.md 4.6): a snapshot of a unit of
+# firmware 1.16, a file that sets all thirteen settings applied to it (can_address last,
+# so it ends at address 9) and found equal at its new address, the snapshot applied back;
+# then a unit whose memory does not take cranking_time: the apply stops there, the change
+# before it is restored, exit status 1, and the unit is as it was.
+config_equal() {  # FILE [pmuctl options]: the unit matches FILE
+  local file=$1
+  shift
+  ctl_text --timeout 10 "$@" config diff "$file" >"$WORK/$SCEN.diff" 2>&1
+}
+scenario_config_file() {
+  printf 'buses:\n  - interface: %s\n    devices:\n      - address: 1\n' "$IFACE" >"$WORK/$SCEN.yaml"
+  start_sim --firmware 1.16 --serial 700
+  start_service --config "$WORK/$SCEN.yaml"
+  pid=$SVC_PID
+  wait_until 90 pmu_listed || fail "PMU 1 not ONLINE within 90 s: $(printf '%s' "$LIST_OUT" | cut -c1-300 | tr '\n' ' ')"
+  ctl_text --timeout 30 --address 1 config snapshot "$WORK/factory.yaml" >"$WORK/$SCEN.snap" 2>&1 ||
+    fail "config snapshot: $(tr '\n' ' ' <"$WORK/$SCEN.snap")"
+  grep -q '^  serial: 700$' "$WORK/factory.yaml" && grep -q '^  firmware: "1.16"$' "$WORK/factory.yaml" ||
+    fail "the snapshot's header is not the unit's: $(head -n 12 "$WORK/factory.yaml" | tr '\n' ' ')"
+  cat >"$WORK/changed.yaml" <<'YAML'
+parameters:
+  avionics_voltage: 22.0
+  payload_voltage: 13.5
+  servo_voltage: 7.5
+  battery_voltage: 24.0
+  packet_period: 0.4
+  packets_streamed: [voltages, currents, temperatures, status]
+  temperature_offset: 100
+  upper_temperature_limit: 90
+  power_up_state: [avionics_servo, payload, battery_disconnect_detect, soa_management]
+  cranking_time: 3.5
+  can_address: 9
+outputs: [avionics_servo, charger_a]
+generation_enabled: false
+YAML
+  # What differs: every setting but those the service set itself at the start (it streams
+  # what its config asks for).
+  ctl --timeout 10 --address 1 config diff "$WORK/changed.yaml" >"$WORK/$SCEN.diff0" 2>/dev/null
+  want=$(grep -o '"name":' "$WORK/$SCEN.diff0" | wc -l)
+  [ "$want" -ge 11 ] || fail "config diff finds $want differences (want 11 or more): $(cut -c1-400 "$WORK/$SCEN.diff0")"
+  t0=$(now)
+  ctl_text --timeout 10 --address 1 --confirm config apply "$WORK/changed.yaml" >"$WORK/$SCEN.apply" 2>&1
+  st=$?
+  took=$(since "$t0")
+  [ "$st" -eq 0 ] || fail "config apply of 13 changes: exit $st: $(tr '\n' '|' <"$WORK/$SCEN.apply" | cut -c1-600)"
+  n=$(grep -c ': COMPLETED' "$WORK/$SCEN.apply")
+  [ "$n" -eq "$want" ] || fail "$n changes COMPLETED (want $want): $(grep -v ': COMPLETED' "$WORK/$SCEN.apply" | tr '\n' '|' | cut -c1-600)"
+  tail -n 2 "$WORK/$SCEN.apply" | head -n 1 | grep -q 'can_address 1 -> 9: COMPLETED' ||
+    fail "can_address was not the last change: $(tr '\n' '|' <"$WORK/$SCEN.apply" | cut -c1-600)"
+  config_equal "$WORK/changed.yaml" --address 9 || fail "after the apply, diff at address 9: $(tr '\n' '|' <"$WORK/$SCEN.diff")"
+  detail "$n changes applied and verified in $took s (pmuctl start to exit), the unit now at address 9 and equal to the file"
+  t1=$(now)
+  ctl_text --timeout 10 --address 9 --confirm config apply "$WORK/factory.yaml" >"$WORK/$SCEN.back" 2>&1 ||
+    fail "applying the snapshot back: $(tr '\n' '|' <"$WORK/$SCEN.back" | cut -c1-600)"
+  config_equal "$WORK/factory.yaml" --address 1 || fail "back at address 1, diff: $(tr '\n' '|' <"$WORK/$SCEN.diff")"
+  detail "the snapshot applied back in $(since "$t1") s: address 1, equal"
+  # A unit whose memory does not take cranking_time.
+  kill "$SIM_PID"; wait "$SIM_PID" 2>/dev/null
+  start_sim --firmware 1.16 --serial 700 --ignores-set cranking_time
+  wait_until 60 pmu_listed || fail "PMU 1 not ONLINE again within 60 s"
+  ctl_text --timeout 30 --address 1 config get cranking_time >/dev/null 2>&1 || fail "config get after the restart failed"
+  printf 'parameters:\n  temperature_offset: 100\n  cranking_time: 3.5\n  avionics_voltage: 22.0\n' >"$WORK/bad_memory.yaml"
+  ctl_text --timeout 10 --address 1 config apply "$WORK/bad_memory.yaml" >"$WORK/$SCEN.fail" 2>&1
+  st=$?
+  out=$(tr '\n' '|' <"$WORK/$SCEN.fail" | cut -c1-700)
+  [ "$st" -eq 1 ] || fail "an apply the unit does not take: exit $st (want 1): $out"
+  grep -q 'cranking_time 5.0 s -> 3.5 s: FAILED' "$WORK/$SCEN.fail" || fail "no FAILED cranking_time line: $out"
+  grep -q 'restored temperature_offset to 128: COMPLETED' "$WORK/$SCEN.fail" || fail "temperature_offset not restored: $out"
+  grep -q 'avionics_voltage' "$WORK/$SCEN.fail" && fail "a change was sent after the failure: $out"
+  config_equal "$WORK/factory.yaml" --address 1 || fail "after the restore, diff: $(tr '\n' '|' <"$WORK/$SCEN.diff")"
+  alive "$pid" || fail "pmu-service died"
+  detail "a set the unit does not take: $(grep 'apply stopped' "$WORK/$SCEN.fail" | head -n 1 | cut -c1-200), exit 1, equal to the snapshot again"
 }
 
 scenario_limit() {  # seconds a scenario may take in the (slow, emulated) VM
