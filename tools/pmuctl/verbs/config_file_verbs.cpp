@@ -141,8 +141,7 @@ std::optional<baseline::ConfigFile> read_file(const GlobalOptions& o, const std:
   return std::move(f).value();
 }
 
-// The PMU to work on and its configuration and identity, read from its service. nullopt
-// with `status` set when there is none.
+// The PMU to work on and its configuration and identity, read from its service.
 struct Target {
   std::string bus;
   std::uint16_t address = 0;
@@ -163,6 +162,29 @@ std::optional<Target> find_device(const GlobalOptions& o, pmu::dds::DdsContext& 
   }
   return t;
 }
+
+// A participant that only reads (snapshot and diff need no command writer, which an identity
+// of a mission computer may not be granted), and the PMU it found.
+class ReadOnlyView {
+ public:
+  explicit ReadOnlyView(const GlobalOptions& o)
+      : o_(o),
+        vehicle_(o.vehicle.value_or(std::string())),
+        dds_(o.domain, o.qos_file, "pmuctl", o.security, pmu::dds::Transport::Default, o.network, partitions_for(o)),
+        device_(dds_, vehicle_) {}
+  // nullopt with `status` set when there is none.
+  std::optional<Target> find(int& status) {
+    return find_device(o_, dds_, device_, vehicle_, deadline_after(o_.timeout.value_or(5.0)), status);
+  }
+  const std::string& vehicle() const { return vehicle_; }
+  const DeviceReader& device() const { return device_; }
+
+ private:
+  const GlobalOptions& o_;
+  std::string vehicle_;
+  pmu::dds::DdsContext dds_;
+  DeviceReader device_;
+};
 
 std::string utc_now() {
   const std::time_t now = std::time(nullptr);
@@ -248,15 +270,12 @@ bool completed(const CommandChannel::Outcome& out) {
 int snapshot(const GlobalOptions& o, const std::string& file, bool force) {
   if (file != "-" && !force && ::access(file.c_str(), F_OK) == 0)
     return fail(o, ExitStatus::BadUsage, file + ": exists; a snapshot never overwrites one (--force to replace it)");
-  const double timeout = o.timeout.value_or(5.0);
-  const auto deadline = deadline_after(timeout);
-  const std::string vehicle = o.vehicle.value_or(std::string());
-  pmu::dds::DdsContext dds(o.domain, o.qos_file, "pmuctl", o.security, pmu::dds::Transport::Default, o.network,
-                           partitions_for(o));
-  DeviceReader device(dds, vehicle);
+  ReadOnlyView view(o);
   int status = 0;
-  const auto t = find_device(o, dds, device, vehicle, deadline, status);
+  const auto t = view.find(status);
   if (!t) return status;
+  const std::string& vehicle = view.vehicle();
+  const DeviceReader& device = view.device();
   const auto& info = *device.info(t->bus, t->address);
   baseline::Header h;
   h.vehicle = vehicle;
@@ -282,14 +301,11 @@ int diff(const GlobalOptions& o, const std::string& file) {
   int status = 0;
   const auto f = read_file(o, file, status);
   if (!f) return status;
-  const double timeout = o.timeout.value_or(5.0);
-  const auto deadline = deadline_after(timeout);
-  const std::string vehicle = o.vehicle.value_or(std::string());
-  pmu::dds::DdsContext dds(o.domain, o.qos_file, "pmuctl", o.security, pmu::dds::Transport::Default, o.network,
-                           partitions_for(o));
-  DeviceReader device(dds, vehicle);
-  const auto t = find_device(o, dds, device, vehicle, deadline, status);
+  ReadOnlyView view(o);
+  const auto t = view.find(status);
   if (!t) return status;
+  const std::string& vehicle = view.vehicle();
+  const DeviceReader& device = view.device();
   const auto have = settings_of(*device.config(t->bus, t->address));
   const auto diffs = baseline::differences(have, *f);
   const auto missing = baseline::not_in_file(have, *f);
