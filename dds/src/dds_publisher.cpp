@@ -14,6 +14,7 @@
 
 #include "pmu/config/capacity.hpp"
 #include "pmu/config/low_rate.hpp"
+#include "pmu/dds/baseline_sample.hpp"
 #include "pmu/dds/telemetry_samples.hpp"
 #include "pmu/idl/alarms.h"
 #include "pmu/idl/alarmsPubSubTypes.h"
@@ -111,6 +112,7 @@ struct DdsPublisher::Writers {
   DataWriter* alarms = nullptr;
   DataWriter* readiness = nullptr;
   DataWriter* derived_energy = nullptr;  // pmu/energy (`energy` is pmu/battery_energy)
+  DataWriter* baseline = nullptr;
   // Bus workers run in threads of their own and share these writers and the rest below.
   std::mutex mutex;
   std::set<std::tuple<std::string, DeviceKind, std::uint16_t>> admitted;
@@ -176,6 +178,7 @@ DdsPublisher::DdsPublisher(dds::DdsContext& dds, std::chrono::milliseconds telem
   w_->alarms = newer(topics::kAlarms, TypeSupport(new pmu::v4::AlarmPubSubType()), qos_profiles::kAlarms);
   w_->readiness = newer(topics::kReadiness, TypeSupport(new pmu::v4::ReadinessPubSubType()), qos_profiles::kState);
   w_->derived_energy = newer(topics::kEnergy, TypeSupport(new pmu::v4::EnergyPubSubType()), qos_profiles::kState);
+  w_->baseline = newer(topics::kBaseline, TypeSupport(new pmu::v4::BaselinePubSubType()), qos_profiles::kState);
 }
 
 DdsPublisher::~DdsPublisher() = default;
@@ -213,6 +216,18 @@ void DdsPublisher::count(bool ok, const char* topic, const DeviceKey& key, const
 void DdsPublisher::count_failed_write(const char* topic, const DeviceKey& key, const char* why) {
   std::lock_guard<std::mutex> lock(w_->mutex);
   count(false, topic, key, why);
+}
+
+void DdsPublisher::publish_baselines(const std::vector<BusConfig>& buses) {
+  std::lock_guard<std::mutex> lock(w_->mutex);
+  for (const auto& b : buses)
+    for (const auto& d : b.devices) {
+      if (!d.baseline) continue;
+      const DeviceKey key{b.name, d.address, DeviceKind::Pmu};
+      if (!admit(key)) continue;
+      auto s = baseline_sample(w_->vehicle, b.name, d);
+      write_at(w_->baseline, &s, key, std::chrono::system_clock::now());
+    }
 }
 
 void DdsPublisher::on_telemetry(const DeviceKey& key, const codec::PmuMessage& m,

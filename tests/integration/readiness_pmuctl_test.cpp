@@ -1,8 +1,10 @@
 // Alarms and readiness as a ground station reads them (docs/interface.md 1.6, 1.7, 3.2):
 // pmu-service on the configured simulator, pmuctl alarms and pmuctl preflight.
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <chrono>
+#include <cstdlib>
 #include <regex>
 #include <string>
 #include <thread>
@@ -154,6 +156,39 @@ TEST(ReadinessOverDds, AnAlarmAcknowledgedFromTheGroundIsActiveAcknowledged) {
   EXPECT_NE(wrong.out.find("\"REJECTED\""), std::string::npos) << wrong.out;
   const auto bad = pmu::test::run_capture(p + "--timeout 2 alarms ack thermal_shutdown --kind engine", true);
   EXPECT_EQ(bad.status, 2) << bad.out;
+}
+
+// A baseline that the simulator's factory values do not meet (V_A 12.0 V, not 22.0 V):
+// preflight names the setting and the fix, and pmu/baseline carries the file.
+TEST(ReadinessOverDds, ASettingThatDiffersFromTheBaselineMakesTheVehicleNotReady) {
+  const std::string domain = std::to_string(pmu::test::exclusive_dds_domain());
+  char path[] = "/tmp/pmu-baseline-XXXXXX";
+  const int fd = ::mkstemp(path);
+  ASSERT_GE(fd, 0);
+  const std::string text = "device:\n  serial: 1001\nparameters:\n  avionics_voltage: 22.0\n";
+  ASSERT_EQ(::write(fd, text.data(), text.size()), static_cast<ssize_t>(text.size()));
+  ::close(fd);
+  pmu::test::ConfiguredService service(PMU_SERVICE_PATH, config(domain, std::string("        baseline: ") + path + "\n"));
+  const std::string p = std::string(PMUCTL_PATH) + " --domain " + domain + " ";
+  const auto r = until(
+      p + "--timeout 10 --json preflight",
+      [](const auto& x) { return x.out.find("config_differs") != std::string::npos; }, 30s);
+  ::unlink(path);
+  ASSERT_EQ(r.status, 1) << r.out << service.describe();
+  const auto lines = pmu::test::json_lines(r.out);
+  ASSERT_EQ(lines.size(), 1u) << r.out;
+  bool found = false;
+  for (const auto& reason : lines[0]["reasons"]) {
+    if (reason.value("code", "") != "config_differs") continue;
+    found = true;
+    EXPECT_EQ(reason["severity"], "critical");
+    EXPECT_EQ(reason["device"], 1);
+    EXPECT_EQ(reason["message"], "config differs: avionics_voltage");
+    EXPECT_NE(reason.value("description", "").find("avionics_voltage 12.0 V->22.0 V"), std::string::npos) << r.out;
+  }
+  EXPECT_TRUE(found) << r.out;
+  EXPECT_EQ(r.out.find("serial_differs"), std::string::npos) << "the simulated unit at address 1 has serial 1001: " << r.out;
+  EXPECT_NE(service.describe().find("configuration differs from baseline"), std::string::npos) << service.describe();
 }
 
 TEST(ReadinessOverDds, NothingOnTheDomainIsExitThree) {

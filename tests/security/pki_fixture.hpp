@@ -116,18 +116,18 @@ inline std::string write_config(const std::string& name, const SecurityFiles& f,
   return path;
 }
 
-// The contract's topics (interface.md sections 1.2, 1.4, 1.5, 1.6, 1.7 and 1.8).
+// The contract's topics (interface.md sections 1.2, 1.4, 1.5, 1.6, 1.7, 1.8 and 1.9).
 inline const std::set<std::string> kTelemetryAndState = {
     "pmu/voltages",          "pmu/currents",          "pmu/battery_energy",          "pmu/temperatures",
     "pmu/status",            "pmu/low_rate/voltages", "pmu/low_rate/currents",       "pmu/low_rate/battery_energy",
     "pmu/low_rate/temperatures", "pmu/low_rate/status", "pmu/battery", "pmu/battery_cells", "pmu/mppt",
     "pmu/config",            "pmu/info",              "pmu/health",                  "pmu/alarms",
-    "pmu/readiness",         "pmu/energy"};
+    "pmu/readiness",         "pmu/energy",            "pmu/baseline"};
 inline const char* const kContractTopics[] = {
     "pmu/voltages",          "pmu/currents",          "pmu/battery_energy",          "pmu/temperatures",
     "pmu/status",            "pmu/low_rate/voltages", "pmu/low_rate/currents",       "pmu/low_rate/battery_energy",
     "pmu/low_rate/temperatures", "pmu/low_rate/status", "pmu/battery", "pmu/battery_cells", "pmu/mppt",
-    "pmu/config",            "pmu/info",              "pmu/health",            "pmu/alarms",  "pmu/readiness", "pmu/energy", "pmu/command",
+    "pmu/config",            "pmu/info",              "pmu/health",            "pmu/alarms",  "pmu/readiness", "pmu/energy", "pmu/baseline", "pmu/command",
     "pmu/command_reply",     "pmu/alarm_ack",         "pmu/alarm_ack_reply"};
 
 // Only the ground station commands and acknowledges alarms; the service publishes telemetry,

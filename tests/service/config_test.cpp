@@ -159,7 +159,7 @@ const BadCase kBad[] = {
     {"canopen_publish_period: -0.1\nbuses:\n  - interface: can0\n    discover: true\n",
      "bad.yaml:1: canopen_publish_period -0.1 out of range 0..3600"},
     {"buses:\n  - interface: can0\n    devices:\n      - adress: 1\n",
-     "bad.yaml:4: unknown key 'adress' in device (known: address, mode, period, packets, configure_streaming, engine_running_rpm, engine_running_hold, min_firmware, sim, alarms)"},
+     "bad.yaml:4: unknown key 'adress' in device (known: address, mode, period, packets, configure_streaming, engine_running_rpm, engine_running_hold, min_firmware, sim, alarms, baseline)"},
     {"buses:\n  - interface: can0\n    devices:\n      - address: 1\n        min_firmware: 1.x\n",
      "bad.yaml:5: min_firmware '1.x' is not MAJOR.MINOR (each 0..255, e.g. \"1.14\")"},
     {"buses:\n  - interface: can0\n    devices:\n      - address: 1\n        min_firmware: 1.2.3\n",

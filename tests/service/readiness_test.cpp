@@ -3,6 +3,7 @@
 // a report on every change and once a second, never more often for an unchanged situation.
 #include <gtest/gtest.h>
 
+#include "pmu/baseline/config_file.hpp"
 #include "pmu/readiness/readiness_tracker.hpp"
 #include "pmu/transport/clock.hpp"
 #include "recording_sink.hpp"
@@ -117,6 +118,131 @@ TEST(ReadinessRules, MessagesNameTheDeviceAndFitAnAutopilotsPrearmText) {
   EXPECT_EQ(reasons[0].bus, "avionics_can");
   EXPECT_EQ(reasons[1].message, "MPPT 3 on can0 STALE");
   EXPECT_EQ(reasons[1].source, alarms::DeviceKind::Mppt);
+}
+
+// ---- drift from a baseline file ---------------------------------------------------------------
+
+baseline::ConfigFile baseline_text(const std::string& text) {
+  auto f = baseline::read_config_file(text);
+  EXPECT_TRUE(f.ok()) << (f.ok() ? "" : f.error().message);
+  return f.ok() ? *f : baseline::ConfigFile{};
+}
+
+// A PMU online at firmware 1.17, serial 1001, with `file` as its baseline and every setting
+// read as the simulator's factory values (V_A 12.0 V, V_P 12.0 V, T_U 80 degC, outputs 0x0F, ...).
+DeviceView pinned_pmu(const std::string& file) {
+  DeviceView d = online();
+  d.serial = 1001;
+  d.baseline = baseline_text(file);
+  d.baseline_file = "/etc/pmu-dds/pmu1.yaml";
+  ConfigState c;
+  const std::uint32_t factory[] = {120, 120, 60, 252, 10, 0x1F, 128, 80, 0x0F, 50, 1};
+  for (std::size_t i = 0; i < codec::kParameterCount; ++i) c.raw[i] = factory[i];
+  c.outputs = 0x0F;
+  c.generation_enabled = true;
+  d.settings = settings_of(c);
+  return d;
+}
+
+TEST(ReadinessRules, ABaselineMakesDriftAReplacedUnitAndItsFirmwarePinReasons) {
+  struct Case {
+    const char* what;
+    DeviceView device;
+    std::vector<std::string> codes;
+    std::string message;  // of the first reason, when given
+  };
+  const auto unread = [](DeviceView d, baseline::Setting s) {
+    d.settings[s].reset();
+    return d;
+  };
+  const auto firmware = [](DeviceView d, std::uint8_t minor, std::optional<std::uint8_t> config_min) {
+    d.firmware = codec::FirmwareVersion{1, minor};
+    if (config_min) d.min_firmware = codec::FirmwareVersion{1, *config_min};
+    return d;
+  };
+  const auto serial = [](DeviceView d, std::optional<std::uint16_t> sn) {
+    d.serial = sn;
+    return d;
+  };
+  const Case cases[] = {
+      {"every setting as the file says", pinned_pmu("parameters:\n  avionics_voltage: 12.0\noutputs: 15\n"), {}, ""},
+      {"12.04 V is the 12.0 V the wire carries",
+       pinned_pmu("parameters:\n  avionics_voltage: 12.04\n"), {}, ""},
+      {"one setting differs", pinned_pmu("parameters:\n  avionics_voltage: 22.0\n"), {"config_differs"},
+       "config differs: avionics_voltage"},
+      {"three differ: the names that fit, and how many more",
+       pinned_pmu("parameters:\n  avionics_voltage: 22.0\n  payload_voltage: 20.0\n  servo_voltage: 7.0\n"),
+       {"config_differs"}, "config differs: avionics_voltage +2 more"},
+      {"a long name with a count takes the shorter lead",
+       pinned_pmu("parameters:\n  upper_temperature_limit: 85\n  cranking_time: 3.0\n"), {"config_differs"},
+       "differs: upper_temperature_limit +1 more"},
+      {"outputs and generation are settings too", pinned_pmu("outputs: [avionics_servo]\ngeneration_enabled: false\n"),
+       {"config_differs"}, "config differs: outputs +1 more"},
+      {"a setting not read yet is no drift",
+       unread(pinned_pmu("parameters:\n  avionics_voltage: 22.0\n"), baseline::Setting::AvionicsVoltage), {}, ""},
+      {"nothing read yet is no drift", [] {
+         auto d = pinned_pmu("parameters:\n  avionics_voltage: 22.0\n");
+         d.settings = {};
+         return d;
+       }(), {}, ""},
+      {"another unit's serial", pinned_pmu("device:\n  serial: 1002\n"), {"serial_differs"},
+       "PMU 1 serial 1001, baseline 1002"},
+      {"the serial not read yet is not judged", serial(pinned_pmu("device:\n  serial: 1002\n"), std::nullopt), {}, ""},
+      {"the serial it pins", pinned_pmu("device:\n  serial: 1001\n"), {}, ""},
+      {"the baseline's firmware pin is above the unit's",
+       firmware(pinned_pmu("device:\n  min_firmware: \"1.16\"\n"), 15, std::nullopt), {"firmware_below_minimum"},
+       "PMU 1 firmware 1.15 < 1.16"},
+      {"the higher of the pin and the config's min_firmware: the config's",
+       firmware(pinned_pmu("device:\n  min_firmware: \"1.12\"\n"), 15, 16), {"firmware_below_minimum"},
+       "PMU 1 firmware 1.15 < 1.16"},
+      {"the pin met", firmware(pinned_pmu("device:\n  min_firmware: \"1.15\"\n"), 15, 12), {}, ""},
+      {"a replaced unit that also differs: both",
+       pinned_pmu("device:\n  serial: 7\nparameters:\n  avionics_voltage: 22.0\n"),
+       {"config_differs", "serial_differs"}, ""},
+  };
+  for (const auto& c : cases) {
+    SCOPED_TRACE(c.what);
+    ReadinessInput in;
+    in.devices[Key{"can0", DeviceKind::Pmu, 1}] = c.device;
+    const auto reasons = readiness_reasons(in);
+    std::vector<std::string> codes;
+    for (const auto& r : reasons) {
+      codes.push_back(r.code);
+      EXPECT_EQ(r.severity, Severity::Critical);
+      EXPECT_LE(r.message.size(), 42u) << r.message;
+      EXPECT_LE(r.description.size(), 127u) << r.description;
+    }
+    EXPECT_EQ(codes, c.codes);
+    if (!c.message.empty() && !reasons.empty()) {
+      EXPECT_EQ(reasons[0].message, c.message);
+    }
+  }
+}
+
+// However many settings differ and however long their names and values, the message fits an
+// autopilot's pre-arm text and the description names items device->baseline and the fix.
+TEST(ReadinessRules, DriftTextsFitTheirBoundsAndSayHowToFix) {
+  const auto everything = pinned_pmu(
+      "parameters:\n  avionics_voltage: 24.0\n  payload_voltage: 24.0\n  servo_voltage: 12.0\n"
+      "  battery_voltage: 20.0\n  packet_period: 25.5\n  packets_streamed: [status]\n  temperature_offset: 0\n"
+      "  upper_temperature_limit: 255\n  power_up_state: none\n  cranking_time: 25.5\n  can_address: 9\n"
+      "outputs: none\ngeneration_enabled: false\n");
+  ReadinessInput in;
+  in.devices[Key{"can0", DeviceKind::Pmu, 1}] = everything;
+  const auto all = readiness_reasons(in);
+  ASSERT_EQ(all.size(), 1u);
+  EXPECT_EQ(all[0].message, "config differs: avionics_voltage +12 more");
+  EXPECT_LE(all[0].description.size(), 127u);
+  EXPECT_EQ(all[0].description.rfind("avionics_voltage 12.0 V->24.0 V; payload_voltage 12.0 V->24.0 V; ", 0), 0u)
+      << all[0].description;
+  EXPECT_NE(all[0].description.find(" more. pmuctl config diff / apply pmu1.yaml"), std::string::npos)
+      << all[0].description;
+
+  in.devices[Key{"can0", DeviceKind::Pmu, 1}] = pinned_pmu("outputs: [payload]\n");
+  const auto one = readiness_reasons(in);
+  ASSERT_EQ(one.size(), 1u);
+  EXPECT_EQ(one[0].description,
+            "outputs avionics_servo,payload,charger_a,charger_b (0x0F)->payload (0x02). pmuctl config diff / apply pmu1.yaml");
 }
 
 // ---- the tracker ----------------------------------------------------------------------------

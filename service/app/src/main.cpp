@@ -138,6 +138,11 @@ int run(const service::Config& cfg, const pmu::dds::ResolvedNetwork& network) {
     spdlog::info("DDS: also serving contract v{} on a second participant (also_serve_contract)",
                  *cfg.also_serve_contract);
   }
+  // Once, before any session reads a device: a reader compares pmu/config with it.
+  publisher.publish_baselines(cfg.buses);
+  for (const auto& b : cfg.buses)
+    for (const auto& d : b.devices)
+      if (d.baseline) spdlog::info("{}/{}: watched against baseline {}", b.name, d.address, d.baseline_path);
   std::vector<service::StateSink*> sinks{&publisher};
   if (previous_publisher) sinks.push_back(previous_publisher.get());
   service::StateFanout fanout(sinks);

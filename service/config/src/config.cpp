@@ -28,6 +28,7 @@
 #include "pmu/config/vehicle.hpp"
 #include "pmu/version.hpp"
 #include "alarm_settings.hpp"
+#include "baseline_setting.hpp"
 
 namespace pmu::service {
 namespace {
@@ -278,7 +279,7 @@ void parse_device_settings(const Ctx& c, const YAML::Node& n, DeviceConfig& d) {
 
 DeviceConfig parse_device(const Ctx& c, const YAML::Node& n, BusConfig& b) {
   c.only_keys(n, "device", {"address", "mode", "period", "packets", "configure_streaming", "engine_running_rpm",
-                            "engine_running_hold", "min_firmware", "sim", "alarms"});
+                            "engine_running_hold", "min_firmware", "sim", "alarms", "baseline"});
   refuse_sim_on_real_bus(c, n, b.interface);
   DeviceConfig d;
   const auto a = n["address"];
@@ -288,6 +289,8 @@ DeviceConfig parse_device(const Ctx& c, const YAML::Node& n, BusConfig& b) {
   d.source_line = c.line_of(a);
   parse_device_settings(c, n, d);
   if (const auto v = n["sim"]) b.sim.pmus[d.address] = parse_pmu_sim(c, v);
+  // After min_firmware: the baseline's values must fit the firmware the unit has at least.
+  if (const auto v = n["baseline"]) read_baseline(v, c.source, d);
   return d;
 }
 

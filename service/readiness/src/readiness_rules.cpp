@@ -1,7 +1,9 @@
 #include "pmu/readiness/readiness_rules.hpp"
 
 #include <algorithm>
+#include <initializer_list>
 #include <set>
+#include <string>
 
 namespace pmu::service {
 namespace {
@@ -28,7 +30,74 @@ std::string bounded(std::string s, std::size_t n) {
   return s;
 }
 
+constexpr std::size_t kMessage = 42;       // ArduPilot's pre-arm text
+constexpr std::size_t kDescription = 127;  // pmu::v4::ReadinessReason's bound
+
+// "config differs: avionics_voltage, outputs", or as many names as fit and "+N more"; with a
+// shorter lead when even one long name and its count do not fit.
+std::string drift_message(const std::vector<baseline::Difference>& diffs) {
+  for (const char* lead : {"config differs: ", "differs: "}) {
+    for (std::size_t shown = diffs.size(); shown > 0; --shown) {
+      std::string m = lead;
+      for (std::size_t i = 0; i < shown; ++i) m += (i ? ", " : "") + std::string(baseline::setting_name(diffs[i].setting));
+      if (shown < diffs.size()) m += " +" + std::to_string(diffs.size() - shown) + " more";
+      if (m.size() <= kMessage) return m;
+    }
+  }
+  return bounded("config differs: " + std::to_string(diffs.size()) + " settings", kMessage);
+}
+
+// "avionics_voltage 24.0 V->22.0 V; outputs ... . pmuctl config diff / apply pmu1.yaml": each
+// item device->baseline while they fit, then the way to fix it.
+std::string drift_description(const std::vector<baseline::Difference>& diffs, const std::string& file) {
+  const auto slash = file.rfind('/');
+  std::string name = slash == std::string::npos ? file : file.substr(slash + 1);
+  if (name.empty() || name.size() > 24) name = "FILE";
+  const std::string fix = ". pmuctl config diff / apply " + name;
+  std::string items;
+  std::size_t shown = 0;
+  for (const auto& d : diffs) {
+    const std::string item = std::string(baseline::setting_name(d.setting)) + " " + baseline::value_text(d.setting, *d.device) +
+                             "->" + baseline::value_text(d.setting, d.file);
+    const std::size_t left = diffs.size() - shown - 1;
+    const std::string more = left ? "; +" + std::to_string(left) + " more" : "";
+    if ((items.empty() ? 0 : items.size() + 2) + item.size() + more.size() + fix.size() > kDescription) break;
+    items += (items.empty() ? "" : "; ") + item;
+    ++shown;
+  }
+  if (shown == 0) items = std::to_string(diffs.size()) + " settings differ from the baseline";
+  else if (shown < diffs.size()) items += "; +" + std::to_string(diffs.size() - shown) + " more";
+  return bounded(items + fix, kDescription);
+}
+
 }  // namespace
+
+baseline::Settings settings_of(const ConfigState& config) {
+  baseline::Settings s;
+  for (std::size_t i = 0; i < codec::kParameterCount; ++i) s.raw[i] = config.raw[i];
+  if (config.outputs) s[baseline::Setting::Outputs] = *config.outputs;
+  if (config.generation_enabled) s[baseline::Setting::GenerationEnabled] = *config.generation_enabled ? 1u : 0u;
+  return s;
+}
+
+std::vector<baseline::Difference> drift(const DeviceView& d) {
+  if (!d.baseline) return {};
+  auto diffs = baseline::differences(d.settings, *d.baseline);
+  diffs.erase(std::remove_if(diffs.begin(), diffs.end(), [](const baseline::Difference& x) { return !x.device; }),
+              diffs.end());
+  return diffs;
+}
+
+bool serial_differs(const DeviceView& d) {
+  return d.baseline && d.baseline->header.serial && d.serial && *d.serial != *d.baseline->header.serial;
+}
+
+std::optional<codec::FirmwareVersion> min_firmware(const DeviceView& d) {
+  const auto pin = d.baseline ? d.baseline->header.min_firmware : std::nullopt;
+  if (!pin) return d.min_firmware;
+  if (!d.min_firmware) return pin;
+  return pin->ordinal() > d.min_firmware->ordinal() ? pin : d.min_firmware;
+}
 
 std::vector<ReadinessReason> readiness_reasons(const ReadinessInput& in) {
   using alarms::Severity;
@@ -47,10 +116,24 @@ std::vector<ReadinessReason> readiness_reasons(const ReadinessInput& in) {
                      bounded("bus " + bus + " " + std::string(transport::to_string(d.bus_state)), 42),
                      "The CAN controller reports errors: check termination, wiring and bit rate."});
     }
-    if (d.firmware && d.min_firmware && d.firmware->ordinal() < d.min_firmware->ordinal())
+    const auto minimum = min_firmware(d);
+    if (d.firmware && minimum && d.firmware->ordinal() < minimum->ordinal()) {
+      const bool pinned = minimum != d.min_firmware;  // the baseline's is the higher
       out.push_back({"firmware_below_minimum", Severity::Critical, bus, source_of(kind), address,
-                     bounded(name + " firmware " + version(*d.firmware) + " < " + version(*d.min_firmware), 42),
-                     "Update the unit's firmware, or lower min_firmware in the service's config."});
+                     bounded(name + " firmware " + version(*d.firmware) + " < " + version(*minimum), kMessage),
+                     pinned ? "Update the unit's firmware, or lower min_firmware in its baseline file."
+                            : "Update the unit's firmware, or lower min_firmware in the service's config."});
+    }
+    if (serial_differs(d))
+      out.push_back({"serial_differs", Severity::Critical, bus, source_of(kind), address,
+                     bounded(name + " serial " + std::to_string(*d.serial) + ", baseline " +
+                                 std::to_string(*d.baseline->header.serial),
+                             kMessage),
+                     "Another unit answers here: fit the baseline's unit, or make a baseline of this one "
+                     "(pmuctl config snapshot)."});
+    if (const auto diffs = drift(d); !diffs.empty())
+      out.push_back({"config_differs", Severity::Critical, bus, source_of(kind), address, drift_message(diffs),
+                     drift_description(diffs, d.baseline_file)});
   }
   for (const auto& a : in.alarms) {
     if (a.state == alarms::AlarmState::Normal) continue;

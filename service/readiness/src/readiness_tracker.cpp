@@ -1,5 +1,7 @@
 #include "pmu/readiness/readiness_tracker.hpp"
 
+#include <spdlog/spdlog.h>
+
 namespace pmu::service {
 namespace {
 
@@ -7,7 +9,8 @@ bool same(const std::vector<ReadinessReason>& a, const std::vector<ReadinessReas
   if (a.size() != b.size()) return false;
   for (std::size_t i = 0; i < a.size(); ++i)
     if (a[i].code != b[i].code || a[i].severity != b[i].severity || a[i].bus != b[i].bus ||
-        a[i].source != b[i].source || a[i].device != b[i].device || a[i].message != b[i].message)
+        a[i].source != b[i].source || a[i].device != b[i].device || a[i].message != b[i].message ||
+        a[i].description != b[i].description)
       return false;
   return true;
 }
@@ -27,16 +30,66 @@ DeviceView& ReadinessTracker::view_of(const DeviceKey& key) {
     if (auto b = buses_.find(key.bus); b != buses_.end()) {
       it->second.min_firmware = b->second.discovered_defaults.min_firmware;
       for (const auto& d : b->second.devices)
-        if (d.address == key.address) it->second.min_firmware = d.min_firmware;
+        if (d.address == key.address) {
+          it->second.min_firmware = d.min_firmware;
+          it->second.baseline = d.baseline;
+          it->second.baseline_file = d.baseline_path;
+        }
     }
   }
   return it->second;
 }
 
+void ReadinessTracker::on_config(const DeviceKey& key, const ConfigState& config) {
+  next_.on_config(key, config);
+  std::lock_guard<std::mutex> lock(mutex_);
+  auto& v = view_of(key);
+  v.settings = settings_of(config);
+  log_drift(key, v);
+  update(false);
+}
+
+void ReadinessTracker::log_drift(const DeviceKey& key, const DeviceView& v) {
+  if (!v.baseline) return;
+  Drift& logged = drift_logged_[Key{key.bus, key.kind, key.address}];
+  const bool serial = serial_differs(v);
+  if (serial != logged.serial) {
+    if (serial)
+      spdlog::warn("{}/{}: PMU serial {} is not the serial {} of baseline {}: another unit answers at this address",
+                   key.bus, key.address, *v.serial, *v.baseline->header.serial, v.baseline_file);
+    else
+      spdlog::info("{}/{}: PMU serial {} matches baseline {} again", key.bus, key.address,
+                   v.serial ? std::to_string(*v.serial) : std::string("?"), v.baseline_file);
+    logged.serial = serial;
+  }
+  bool compared = false;  // a setting of the baseline has been read: until then, no verdict
+  for (std::size_t i = 0; i < baseline::kSettingCount; ++i)
+    compared = compared || (v.settings.raw[i] && v.baseline->settings.raw[i]);
+  if (!compared) return;
+  const auto diffs = drift(v);
+  std::vector<baseline::Setting> differing;
+  for (const auto& d : diffs) differing.push_back(d.setting);
+  if (logged.settings == differing) return;
+  if (!differing.empty()) {
+    std::string items;
+    for (const auto& d : diffs)
+      items += (items.empty() ? "" : "; ") + std::string(baseline::setting_name(d.setting)) + " device " +
+               baseline::value_text(d.setting, *d.device) + ", baseline " + baseline::value_text(d.setting, d.file);
+    spdlog::warn("{}/{}: configuration differs from baseline {}: {}", key.bus, key.address, v.baseline_file, items);
+  } else {
+    spdlog::info("{}/{}: configuration matches baseline {}{}", key.bus, key.address, v.baseline_file,
+                 logged.settings ? " again" : "");
+  }
+  logged.settings = std::move(differing);
+}
+
 void ReadinessTracker::on_info(const DeviceKey& key, const InfoState& info) {
   next_.on_info(key, info);
   std::lock_guard<std::mutex> lock(mutex_);
-  if (info.firmware_known) view_of(key).firmware = info.firmware.version();
+  auto& v = view_of(key);
+  if (info.firmware_known) v.firmware = info.firmware.version();
+  v.serial = info.serial_number;
+  log_drift(key, v);
   update(false);
 }
 
@@ -54,6 +107,7 @@ void ReadinessTracker::on_gone(const DeviceKey& key) {
   std::lock_guard<std::mutex> lock(mutex_);
   // A unit that moved to another address: its new key reports on its own.
   input_.devices.erase(Key{key.bus, key.kind, key.address});
+  drift_logged_.erase(Key{key.bus, key.kind, key.address});
   update(true);
 }
 

@@ -21,7 +21,9 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <vector>
 
+#include "pmu/config/config.hpp"
 #include "pmu/dds/dds_context.hpp"
 #include "pmu/session/device_state.hpp"
 
@@ -59,6 +61,11 @@ class DdsPublisher final : public StateSink {
   void on_readiness(const ReadinessReport& readiness) override;
   void on_energy(const DeviceKey& key, const energy::Figures& figures,
                  std::chrono::system_clock::time_point at) override;
+
+  // pmu/baseline: one sample per configured PMU with a `baseline:`, written once at start
+  // (interface.md 1.9); the state profile keeps it for late joiners. Not from a session:
+  // the baseline is the config's. Call before the bus workers start.
+  void publish_baselines(const std::vector<BusConfig>& buses);
 
   // A write to another of the service's topics (pmu/command_reply) failed: counted in
   // publish_failures and logged like the publisher's own. Thread-safe.

@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "pmu/alarms/settings.hpp"
+#include "pmu/baseline/config_file.hpp"
 #include "pmu/codec/messages.hpp"
 #include "pmu/command/policy.hpp"
 #include "pmu/config/capacity.hpp"
@@ -22,6 +23,9 @@
 #include "pmu/security/security_files.hpp"
 
 namespace pmu::service {
+
+// The longest `baseline:` path: pmu/baseline's `file` is a string<255>.
+inline constexpr std::size_t kMaxBaselinePath = 255;
 
 class ConfigError : public std::runtime_error {
  public:
@@ -58,6 +62,13 @@ struct DeviceConfig {
   alarms::DeviceSettings alarms;
   // The vehicle is not ready while the unit's firmware is older (interface.md 1.7).
   std::optional<codec::FirmwareVersion> min_firmware;
+  // `baseline:` (interface.md 4.1): the configuration file the unit's settings are watched
+  // against, read and checked with the config; none when unset (always for a discovered
+  // PMU). `baseline_file` as the config writes it (pmu/baseline carries it), `baseline_path`
+  // the file read (a relative one is relative to the config file's folder).
+  std::optional<baseline::ConfigFile> baseline;
+  std::string baseline_file;
+  std::string baseline_path;
   // "FILE:LINE" of its `address:` in the config file, for the line to change when the unit
   // moves; empty for a device not from a file (discovered, built in).
   std::string source_line;
@@ -176,7 +187,8 @@ struct ConfigEnvironment {
 // types, integers not in plain decimal, values out of range, duplicate names/addresses; and
 // "path: ..." with the system's reason when the file cannot be opened or read.
 Config load_config(const std::string& path);
-// Parses YAML text; `source` names it in messages.
+// Parses YAML text; `source` names it in messages, and a relative `baseline:` is relative to
+// its folder. The one file it reads is each device's `baseline:`.
 Config parse_config(const std::string& text, const std::string& source, const ConfigEnvironment& env = {});
 
 // What `pmu-service --bus sim` with no config runs: one simulated PMU at address 1 on a bus

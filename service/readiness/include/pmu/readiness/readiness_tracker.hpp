@@ -1,9 +1,12 @@
 #pragma once
 // ReadinessTracker: a StateSink in front of another (the DDS publisher) that passes every
-// event on and keeps, from health, identity and alarm events, the vehicle's readiness
-// (readiness_rules.hpp). It sends a ReadinessReport on to the next sink when the report
-// changes and at least once a second while events come (each device's health comes once a
-// second), so a reader that missed one sees the next.
+// event on and keeps, from health, identity, configuration and alarm events, the vehicle's
+// readiness (readiness_rules.hpp). It sends a ReadinessReport on to the next sink when the
+// report changes and at least once a second while events come (each device's health comes
+// once a second), so a reader that missed one sees the next.
+// A PMU with a `baseline:` is compared with it after every reading of its configuration
+// (start, a reconnect's re-read, a verified set) and identity; each change of what differs
+// (which settings, the serial) is logged once, and so is the match that follows.
 //
 // Lifetime: `next` and `clock` must outlive the tracker, which keeps references to both
 // (main.cpp makes the publisher and the clock first and the bus workers, which write through
@@ -26,15 +29,15 @@ namespace pmu::service {
 
 class ReadinessTracker final : public StateSink {
  public:
-  // `buses`: the config's, for each PMU's min_firmware (a discovered PMU takes its bus's
-  // discover: settings).
+  // `buses`: the config's, for each PMU's min_firmware and baseline (a discovered PMU takes
+  // its bus's discover: settings, and has no baseline).
   ReadinessTracker(const std::vector<BusConfig>& buses, StateSink& next, const transport::Clock& clock);
 
   void on_telemetry(const DeviceKey& key, const codec::PmuMessage& message,
                     std::chrono::system_clock::time_point received) override {
     next_.on_telemetry(key, message, received);
   }
-  void on_config(const DeviceKey& key, const ConfigState& config) override { next_.on_config(key, config); }
+  void on_config(const DeviceKey& key, const ConfigState& config) override;
   void on_info(const DeviceKey& key, const InfoState& info) override;
   void on_health(const DeviceKey& key, const HealthReport& health) override;
   void on_gone(const DeviceKey& key) override;
@@ -66,6 +69,13 @@ class ReadinessTracker final : public StateSink {
   using Key = std::tuple<std::string, DeviceKind, std::uint16_t>;
   DeviceView& view_of(const DeviceKey& key);
   void update(bool force);  // with mutex_ held
+  // What of a PMU's baseline differs, as last logged; settings: none before the first
+  // comparison. log_drift() logs a change of either (mutex_ held).
+  struct Drift {
+    std::optional<std::vector<baseline::Setting>> settings;
+    bool serial = false;
+  };
+  void log_drift(const DeviceKey& key, const DeviceView& view);
 
   std::map<std::string, BusConfig> buses_;  // by bus name
   StateSink& next_;
@@ -75,6 +85,7 @@ class ReadinessTracker final : public StateSink {
   std::map<std::tuple<std::string, alarms::DeviceKind, std::uint16_t, alarms::Code>, std::size_t> alarm_index_;
   ReadinessReport report_;
   std::optional<std::chrono::steady_clock::time_point> last_sent_;
+  std::map<Key, Drift> drift_logged_;  // PMUs with a baseline
 };
 
 }  // namespace pmu::service

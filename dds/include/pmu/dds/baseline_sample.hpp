@@ -1,0 +1,25 @@
+#pragma once
+// pmu/baseline's sample (idl/state.idl, interface.md 1.9) from a configured PMU's `baseline:`,
+// and back: the service writes it, `pmuctl config diff` without a file reads it and compares
+// the device's pmu/config with it by pmu::baseline's rules, on the wire's values.
+
+#include <string>
+
+#include "pmu/baseline/config_file.hpp"
+#include "pmu/config/config.hpp"
+#include "pmu/idl/state.h"
+
+namespace pmu::service {
+
+// `device` must have a baseline. `bus` is the device's bus name; the file is the path as the
+// config writes it.
+pmu::v4::Baseline baseline_sample(const std::string& vehicle, const std::string& bus, const DeviceConfig& device);
+
+// What the sample holds, as read_config_file() would have given it: the settings `present`
+// names, as raw values, and the serial and minimum firmware pins. Lines are 0 (not a file's).
+baseline::ConfigFile config_file_of(const pmu::v4::Baseline& sample);
+
+// pmu/config's values as raw values; every setting is there.
+baseline::Settings settings_of(const pmu::v4::Config& config);
+
+}  // namespace pmu::service

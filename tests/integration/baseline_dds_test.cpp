@@ -1,0 +1,71 @@
+// pmu/baseline over real Fast DDS (interface.md 1.9): one instance per configured PMU with a
+// baseline, none for one without, and a reader that joins later gets it at once.
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <fastdds/dds/subscriber/SampleInfo.hpp>
+#include <map>
+#include <thread>
+
+#include "pmu/dds/baseline_sample.hpp"
+#include "pmu/dds/dds_context.hpp"
+#include "pmu/dds/dds_publisher.hpp"
+#include "pmu/idl/statePubSubTypes.h"
+#include "pmu/idl/topics.hpp"
+#include "support/domain.hpp"
+#include "support/wait.hpp"
+
+namespace pmu::service::baseline_dds_test {
+namespace {
+
+using namespace eprosima::fastdds::dds;
+using namespace std::chrono_literals;
+
+TEST(DdsBaseline, ALateJoinerGetsEachConfiguredBaselineAndNoOther) {
+  BusConfig bus;
+  bus.name = "can0";
+  DeviceConfig with;
+  with.address = 1;
+  with.baseline_file = "baselines/pmu1.yaml";
+  with.baseline = *baseline::read_config_file("device:\n  serial: 1001\nparameters:\n  avionics_voltage: 22.0\n");
+  DeviceConfig without;
+  without.address = 2;
+  bus.devices = {with, without};
+
+  dds::DdsContext service_side(pmu::test::exclusive_dds_domain(), "", "pmu-service-test");
+  DdsPublisher publisher(service_side, 3s, "uav1");
+  publisher.publish_baselines({bus});
+
+  dds::DdsContext client(pmu::test::exclusive_dds_domain(), "", "reader-test");
+  DataReader& reader =
+      client.reader(client.topic(topics::kBaseline, TypeSupport(new pmu::v4::BaselinePubSubType())), qos_profiles::kState);
+  std::map<std::uint16_t, pmu::v4::Baseline> got;
+  ASSERT_TRUE(pmu::test::wait_until(
+      [&] {
+        pmu::v4::Baseline b;
+        SampleInfo info;
+        while (reader.take_next_sample(&b, &info) == ReturnCode_t::RETCODE_OK)
+          if (info.valid_data) got[b.address()] = b;
+        return !got.empty();
+      },
+      20s, 10ms));
+  std::this_thread::sleep_for(200ms);  // a second instance, were there one, has come by now
+  pmu::v4::Baseline b;
+  SampleInfo info;
+  while (reader.take_next_sample(&b, &info) == ReturnCode_t::RETCODE_OK)
+    if (info.valid_data) got[b.address()] = b;
+  ASSERT_EQ(got.size(), 1u) << "PMU 2 has no baseline";
+  const auto& one = got.at(1);
+  EXPECT_EQ(one.vehicle(), "uav1");
+  EXPECT_EQ(one.bus(), "can0");
+  EXPECT_EQ(one.file(), "baselines/pmu1.yaml") << "as configured";
+  EXPECT_TRUE(one.has_serial());
+  EXPECT_EQ(one.serial(), 1001);
+  EXPECT_FALSE(one.has_min_firmware());
+  EXPECT_EQ(one.present(), 1u);
+  const auto back = config_file_of(one);
+  EXPECT_EQ(back.settings.raw, with.baseline->settings.raw);
+}
+
+}  // namespace
+}  // namespace pmu::service::baseline_dds_test
