@@ -29,6 +29,8 @@ inline constexpr const char* kAlarms = "pmu/alarms";
 inline constexpr const char* kReadiness = "pmu/readiness";
 // Power, energy and endurance derived from each PMU's telemetry: docs/interface.md 1.8.
 inline constexpr const char* kEnergy = "pmu/energy";
+// Power, energy and endurance derived from each BMS's pmu/battery: docs/interface.md 1.8.
+inline constexpr const char* kBmsEnergy = "pmu/bms_energy";
 // Acknowledging an alarm, and its reply (QoS profile `command`): docs/interface.md 1.6.
 inline constexpr const char* kAlarmAck = "pmu/alarm_ack";
 inline constexpr const char* kAlarmAckReply = "pmu/alarm_ack_reply";
