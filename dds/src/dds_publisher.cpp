@@ -113,6 +113,8 @@ struct DdsPublisher::Writers {
   DataWriter* readiness = nullptr;
   DataWriter* derived_energy = nullptr;  // pmu/energy (`energy` is pmu/battery_energy)
   DataWriter* baseline = nullptr;
+  // pmu/bms_energy: null too when the service serves no battery or MPPT, as pmu/battery.
+  DataWriter* bms_energy = nullptr;
   // Bus workers run in threads of their own and share these writers and the rest below.
   std::mutex mutex;
   std::set<std::tuple<std::string, DeviceKind, std::uint16_t>> admitted;
@@ -179,6 +181,8 @@ DdsPublisher::DdsPublisher(dds::DdsContext& dds, std::chrono::milliseconds telem
   w_->readiness = newer(topics::kReadiness, TypeSupport(new pmu::v4::ReadinessPubSubType()), qos_profiles::kState);
   w_->derived_energy = newer(topics::kEnergy, TypeSupport(new pmu::v4::EnergyPubSubType()), qos_profiles::kState);
   w_->baseline = newer(topics::kBaseline, TypeSupport(new pmu::v4::BaselinePubSubType()), qos_profiles::kState);
+  if (canopen_deadline)
+    w_->bms_energy = newer(topics::kBmsEnergy, TypeSupport(new pmu::v4::BmsEnergyPubSubType()), qos_profiles::kState);
 }
 
 DdsPublisher::~DdsPublisher() = default;
@@ -569,6 +573,23 @@ void DdsPublisher::on_energy(const DeviceKey& key, const energy::Figures& f, std
   std::lock_guard<std::mutex> lock(w_->mutex);
   if (!admit(key)) return;
   write_at(w_->derived_energy, &s, key, at);
+}
+
+void DdsPublisher::on_bms_energy(const DeviceKey& key, const energy::BmsFigures& f,
+                                 std::chrono::system_clock::time_point at) {
+  pmu::v4::BmsEnergy s;
+  s.vehicle(w_->vehicle);
+  s.bus(key.bus);
+  s.node(octet_id(key));
+  s.power(idl_float(f.power));
+  s.used_wh(f.used_wh);
+  s.integrated_s(idl_float(f.integrated_s));
+  s.endurance_s(idl_float(f.endurance_s));
+  s.capacity_ah(idl_float(f.capacity_ah));
+  s.critical_state_of_charge(idl_float(f.critical_state_of_charge));
+  std::lock_guard<std::mutex> lock(w_->mutex);
+  if (!admit(key)) return;
+  write_at(w_->bms_energy, &s, key, at);
 }
 
 }  // namespace pmu::service

@@ -15,7 +15,7 @@ using namespace std::chrono_literals;
 
 inline BusConfig bus_with_battery_and_mppt() {
   BusConfig b = sim_bus({device(1)});
-  b.batteries.push_back(BatteryConfig{2, 1000ms, {}});
+  b.batteries.push_back(BatteryConfig{2, 1000ms, {}, {}});
   b.mppts.push_back(MpptConfig{4, 1000ms, {}});
   b.canopen_publish_period = 100ms;
   return b;

@@ -215,7 +215,7 @@ TEST(TypeObject, ReaderBuiltFromTheDiscoveredTypeDecodesVoltages) {
   const std::set<std::string> self_contained = {
       "pmu/voltages", "pmu/currents", "pmu/battery_energy", "pmu/temperatures", "pmu/status",
       "pmu/low_rate/voltages", "pmu/low_rate/currents", "pmu/low_rate/battery_energy", "pmu/low_rate/temperatures",
-      "pmu/low_rate/status", "pmu/config", "pmu/info", "pmu/battery", "pmu/mppt", "pmu/baseline"};
+      "pmu/low_rate/status", "pmu/config", "pmu/info", "pmu/battery", "pmu/mppt", "pmu/baseline", "pmu/bms_energy"};
   std::set<std::string> with_types;
   EXPECT_TRUE(pmu::test::wait_until([&] { return (with_types = tool.discovery().topics_with_types()) == self_contained; },
                                     30s));

@@ -41,6 +41,7 @@ const defaultTopics = {
   "pmu/alarms": "pmu::v4::Alarm",
   "pmu/readiness": "pmu::v4::Readiness",
   "pmu/energy": "pmu::v4::Energy",
+  "pmu/bms_energy": "pmu::v4::BmsEnergy",
 };
 
 // float32 on the wire: the shortest decimal that is the same float32, as pmuctl prints it.

@@ -33,7 +33,7 @@ struct BatteryBench {
   BatteryBench() : h(bus_of(), {pmu(1)}), node(h.network().attach("bms")) {}
   static BusConfig bus_of() {
     BusConfig b = sim_bus({device(1)});
-    b.batteries.push_back(BatteryConfig{2, 1000ms, {}});
+    b.batteries.push_back(BatteryConfig{2, 1000ms, {}, {}});
     return b;
   }
   void send() {

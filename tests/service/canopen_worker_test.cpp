@@ -20,7 +20,7 @@ BusConfig bus_with(std::vector<BatteryConfig> batteries, std::vector<MpptConfig>
 }
 
 TEST(CanOpenWorker, ConfiguredDevicesArePublishedBesideThePmu) {
-  Harness h(bus_with({BatteryConfig{2, 1000ms, {}}}, {MpptConfig{5, 1000ms, {}}}), {pmu(1)});
+  Harness h(bus_with({BatteryConfig{2, 1000ms, {}, {}}}, {MpptConfig{5, 1000ms, {}}}), {pmu(1)});
   auto node = h.network().attach("bms-and-mppt");
   ASSERT_TRUE(h.worker().canopen_session(DeviceKind::Battery, 2));
   ASSERT_TRUE(h.worker().canopen_session(DeviceKind::Mppt, 5));
@@ -48,7 +48,7 @@ TEST(CanOpenWorker, ASilentBatteryIsNoticedWithinPeriodTimesStalePeriods) {
   Timeouts t;
   t.stale_periods = 3;
   t.offline_periods = 10;
-  Harness h(bus_with({BatteryConfig{2, 500ms, {}}}, {}), {pmu(1)}, t);
+  Harness h(bus_with({BatteryConfig{2, 500ms, {}, {}}}, {}), {pmu(1)}, t);
   auto node = h.network().attach("bms");
   ASSERT_TRUE(node->send(canopen_frame(0x202, 0, 0, {90}), 0ms).ok());
   h.run_for(100ms);
@@ -64,7 +64,7 @@ TEST(CanOpenWorker, ASilentBatteryIsNoticedWithinPeriodTimesStalePeriods) {
 }
 
 TEST(CanOpenWorker, AConfiguredBatteryNeverHeardGoesOffline) {
-  Harness h(bus_with({BatteryConfig{2, 1000ms, {}}}, {}), {pmu(1)});
+  Harness h(bus_with({BatteryConfig{2, 1000ms, {}, {}}}, {}), {pmu(1)});
   h.run_for(10500ms);
   const auto* report = h.sink.last_health(2, DeviceKind::Battery);
   ASSERT_NE(report, nullptr);
@@ -92,7 +92,7 @@ TEST(CanOpenWorker, UnlistedDevicesAreServedOnlyWithListenCanopen) {
 }
 
 TEST(CanOpenWorker, BusStateReachesBatteriesToo) {
-  Harness h(bus_with({BatteryConfig{2, 1000ms, {}}}, {}), {pmu(1)});
+  Harness h(bus_with({BatteryConfig{2, 1000ms, {}, {}}}, {}), {pmu(1)});
   h.network().set_state(transport::BusState::BusOff);
   h.run_for(50ms);
   const auto* report = h.sink.last_health(2, DeviceKind::Battery);

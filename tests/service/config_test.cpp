@@ -4,6 +4,8 @@
 #include <unistd.h>
 
 #include <cstdlib>
+#include <optional>
+#include <string>
 
 #include "pmu/config/config.hpp"
 #include "pmu/config/statistics_settings.hpp"
@@ -66,6 +68,7 @@ buses:
     batteries:
       - node: 2
         period: 2.5
+        capacity_ah: 20.5
     mppts:
       - device: 0
       - device: 7
@@ -82,6 +85,7 @@ buses:
   ASSERT_EQ(b.batteries.size(), 1u);
   EXPECT_EQ(b.batteries[0].node, 2);
   EXPECT_EQ(b.batteries[0].period, std::chrono::milliseconds(2500));
+  EXPECT_EQ(b.batteries[0].capacity_ah, 20.5);
   ASSERT_EQ(b.mppts.size(), 2u);
   EXPECT_EQ(b.mppts[0].device, 0);
   EXPECT_EQ(b.mppts[0].period, std::chrono::milliseconds(1000));  // the default
@@ -146,7 +150,7 @@ const BadCase kBad[] = {
     {"buses:\n  - interface: can0\n    batteries:\n      - node: 2\n        period: 0\n",
      "bad.yaml:5: period 0 out of range 0.01..3600"},
     {"buses:\n  - interface: can0\n    batteries:\n      - node: 2\n        rate: 1\n",
-     "bad.yaml:5: unknown key 'rate' in battery (known: node, period, sim, alarms)"},
+     "bad.yaml:5: unknown key 'rate' in battery (known: node, period, capacity_ah, sim, alarms)"},
     {"buses:\n  - interface: can0\n    batteries: 2\n",
      "bad.yaml:3: batteries must be a list, e.g. [{node: 2, period: 1.0}]"},
     {"buses:\n  - interface: can0\n    mppts:\n      - device: 8\n", "bad.yaml:4: device 8 out of range 0..7"},
@@ -223,6 +227,30 @@ const BadCase kBad[] = {
 
 TEST(Config, EveryBadValueIsRefusedWithItsLine) {
   for (const auto& c : kBad) expect_refused(c.yaml, c.message);
+}
+
+TEST(Config, BatteryCapacityIsOptionalAndMoreThanZeroAh) {
+  struct Good {
+    const char* value;
+    std::optional<double> ah;
+  };
+  const Good good[] = {{nullptr, std::nullopt}, {"20", 20.0}, {"0.5", 0.5}, {"10000", 10000.0}};
+  for (const auto& g : good) {
+    SCOPED_TRACE(g.value ? g.value : "absent");
+    const std::string yaml = std::string("buses:\n  - interface: can0\n    batteries:\n      - node: 2\n") +
+                             (g.value ? std::string("        capacity_ah: ") + g.value + "\n" : "");
+    EXPECT_EQ(parse_config(yaml, "good.yaml").buses[0].batteries[0].capacity_ah, g.ah);
+  }
+  const std::string battery = "buses:\n  - interface: can0\n    batteries:\n      - node: 2\n        capacity_ah: ";
+  const BadCase bad[] = {
+      {"0\n", "bad.yaml:5: capacity_ah must be more than 0 Ah"},
+      {"-20\n", "bad.yaml:5: capacity_ah -20 out of range 0..10000"},
+      {"20000\n", "bad.yaml:5: capacity_ah 20000 out of range 0..10000"},
+      {"20Ah\n", "bad.yaml:5: capacity_ah must be a number, not '20Ah'"},
+      {".nan\n", "bad.yaml:5: capacity_ah .nan out of range 0..10000"},
+      {"[20]\n", "bad.yaml:5: capacity_ah must be a number"},
+  };
+  for (const auto& b : bad) expect_refused(battery + b.yaml, b.message);
 }
 
 // discovery: and interfaces: (interface.md 7.2). Each case is appended to a valid bus

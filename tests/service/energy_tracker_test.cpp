@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <limits>
 
 #include "pmu/energy_sink/energy_tracker.hpp"
 #include "recording_sink.hpp"
@@ -110,6 +111,76 @@ TEST(EnergyTracker, AGoneDeviceStartsAgain) {
   ASSERT_EQ(sink.energy.back().at, t0 + 200s);
   EXPECT_EQ(sink.energy.back().figures.battery_a.used_wh, 0);
   EXPECT_TRUE(std::isnan(sink.energy.back().figures.battery_a.endurance_s));
+}
+
+// A pmu/battery sample: voltage, current (+ charging) and state of charge; the rest not received.
+BatteryState battery(double volts, double amps, double soc) {
+  BatteryState b;
+  b.values[*battery_slot("voltage")] = volts;
+  b.values[*battery_slot("current")] = amps;
+  b.values[*battery_slot("state_of_charge")] = soc;
+  return b;
+}
+
+// Bus can0 lists battery 2 with 20 Ah and bms_critical_soc at 10 %; can1 hears batteries
+// through listen_canopen.
+std::vector<BusConfig> battery_buses() {
+  BusConfig b;
+  b.name = "can0";
+  BatteryConfig two;
+  two.node = 2;
+  two.capacity_ah = 20.0;
+  two.alarms[alarms::Code::BmsCriticalSoc].limit = 10;
+  b.batteries = {two};
+  BusConfig heard;
+  heard.name = "can1";
+  heard.listen_canopen = true;
+  return {b, heard};
+}
+
+TEST(EnergyTracker, BatteryFiguresUseItsCapacityAndCriticalStateOfCharge) {
+  struct Row {
+    const char* bus;
+    double capacity_ah, critical;  // the config's, or none and the table's bms_critical_soc
+  };
+  const Row rows[] = {{"can0", 20, 10},
+                      {"can1", std::numeric_limits<double>::quiet_NaN(),
+                       alarms::spec_of(alarms::Code::BmsCriticalSoc).limit}};
+  for (const auto& r : rows) {
+    SCOPED_TRACE(r.bus);
+    RecordingSink sink;
+    EnergyTracker tracker(battery_buses(), 3, sink);
+    const DeviceKey key{r.bus, 2, DeviceKind::Battery};
+    // 0.2 s apart for 10 s: 48 V, 5 A out, 60 %.
+    for (int i = 0; i <= 50; ++i) tracker.on_battery(key, battery(48, -5, 60), t0 + i * 200ms);
+    EXPECT_EQ(sink.batteries.size(), 51u) << "every sample goes on to the publishers";
+    ASSERT_EQ(sink.bms_energy.size(), 11u) << "one a second over 0..10 s";
+    for (std::size_t i = 1; i < sink.bms_energy.size(); ++i)
+      EXPECT_EQ(sink.bms_energy[i].at - sink.bms_energy[i - 1].at, 1s);
+    const auto& last = sink.bms_energy.back();
+    EXPECT_EQ(last.key, key);
+    EXPECT_EQ(last.at, t0 + 10s);
+    EXPECT_DOUBLE_EQ(last.figures.power, -240);
+    EXPECT_NEAR(last.figures.used_wh, 240.0 * 10 / 3600, 1e-12);
+    EXPECT_NEAR(last.figures.integrated_s, 10, 1e-9);
+    EXPECT_DOUBLE_EQ(last.figures.critical_state_of_charge, r.critical);
+    if (std::isnan(r.capacity_ah)) {
+      EXPECT_TRUE(std::isnan(last.figures.capacity_ah));
+      EXPECT_TRUE(std::isnan(last.figures.endurance_s)) << "no capacity, no endurance";
+    } else {
+      EXPECT_DOUBLE_EQ(last.figures.capacity_ah, r.capacity_ah);
+      EXPECT_NEAR(last.figures.endurance_s, (60 - r.critical) / 100 * r.capacity_ah / 5 * 3600, 1e-6);
+    }
+  }
+}
+
+TEST(EnergyTracker, MpptsAndPmusGiveNoBatteryFigures) {
+  RecordingSink sink;
+  EnergyTracker tracker(battery_buses(), 3, sink);
+  discharge(tracker, 1);
+  tracker.on_mppt(DeviceKey{"can0", 0, DeviceKind::Mppt}, MpptState{}, t0);
+  EXPECT_TRUE(sink.bms_energy.empty());
+  EXPECT_EQ(sink.mppts.size(), 1u);
 }
 
 }  // namespace

@@ -56,6 +56,14 @@ class RecordingSink final : public StateSink {
   void on_energy(const DeviceKey& k, const energy::Figures& f, std::chrono::system_clock::time_point at) override {
     energy.push_back({k, f, at});
   }
+  struct BmsEnergy {
+    DeviceKey key;
+    energy::BmsFigures figures;
+    std::chrono::system_clock::time_point at;
+  };
+  void on_bms_energy(const DeviceKey& k, const energy::BmsFigures& f, std::chrono::system_clock::time_point at) override {
+    bms_energy.push_back({k, f, at});
+  }
 
   std::size_t count(codec::PacketId p, std::uint16_t address) const {
     std::size_t n = 0;
@@ -72,6 +80,7 @@ class RecordingSink final : public StateSink {
   std::vector<AlarmReport> alarms;
   std::vector<ReadinessReport> readiness;
   std::vector<Energy> energy;
+  std::vector<BmsEnergy> bms_energy;
   std::vector<std::pair<DeviceKey, ConfigState>> configs;
   std::vector<std::pair<DeviceKey, InfoState>> infos;
   std::vector<std::pair<DeviceKey, HealthReport>> healths;

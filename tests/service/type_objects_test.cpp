@@ -23,10 +23,10 @@ TEST(TypeObjects, SelfContainedAreExactlyTheTypesWithoutMembersNamedByHash) {
   register_type_objects();  // idempotent
   for (const char* t : {"pmu::v4::Voltages", "pmu::v4::Currents", "pmu::v4::BatteryEnergy", "pmu::v4::Temperatures", "pmu::v4::Status",
                         "pmu::v4::Config", "pmu::v4::DeviceInfo", "pmu::v4::Battery", "pmu::v4::Mppt", "pmu::v4::BatteryCell",
-                        "pmu::v4::Baseline"})
+                        "pmu::v4::Baseline", "pmu::v4::BmsEnergy"})
     EXPECT_TRUE(type_object_is_self_contained(t)) << t;
   for (const char* t : {"pmu::v4::Health", "pmu::v4::BatteryCells", "pmu::v4::Command", "pmu::v4::CommandReply",
-                        "pmu::v4::DeviceKind", "pmu::NoSuchType"})
+                        "pmu::v4::DeviceKind", "pmu::v4::Energy", "pmu::NoSuchType"})
     EXPECT_FALSE(type_object_is_self_contained(t)) << t;
 }
 

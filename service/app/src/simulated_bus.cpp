@@ -83,6 +83,9 @@ SimulatedBus make_simulated_bus(const BusConfig& bus, const transport::Clock& cl
     sim::BatterySimConfig c;
     c.node = battery.node;
     c.period = battery.period;
+    // The simulated pack is the battery the config describes, so its BMS's time to go and
+    // pmu/bms_energy's endurance count the same ampere-hours.
+    if (battery.capacity_ah) c.capacity_ah = *battery.capacity_ah;
     const auto settings = settings_of(bus.sim.batteries, battery.node);
     if (settings.state_of_charge) c.initial_soc = *settings.state_of_charge / 100.0;
     if (!settings.cell_voltages.empty()) c.cells = static_cast<int>(settings.cell_voltages.size());

@@ -300,11 +300,19 @@ std::chrono::milliseconds canopen_period(const Ctx& c, const YAML::Node& n) {
   return std::chrono::milliseconds(std::lround(c.number(n, "period", 0.01, 3600) * 1000));
 }
 
+// A battery's nameplate capacity. The top bound only catches a slip of units (mAh for Ah):
+// no battery on a bus with a 250 W PMU holds 10,000 Ah.
+double capacity_ah(const Ctx& c, const YAML::Node& n) {
+  const double ah = c.number(n, "capacity_ah", 0, 10000);
+  if (ah == 0) c.fail(n, "capacity_ah must be more than 0 Ah");
+  return ah;
+}
+
 void parse_batteries(const Ctx& c, const YAML::Node& n, BusConfig& b) {
   if (!n.IsSequence()) c.fail(n, "batteries must be a list, e.g. [{node: 2, period: 1.0}]");
   std::set<std::uint8_t> seen;
   for (const auto& item : n) {
-    c.only_keys(item, "battery", {"node", "period", "sim", "alarms"});
+    c.only_keys(item, "battery", {"node", "period", "capacity_ah", "sim", "alarms"});
     refuse_sim_on_real_bus(c, item, b.interface);
     BatteryConfig bat;
     const auto node = item["node"];
@@ -313,6 +321,7 @@ void parse_batteries(const Ctx& c, const YAML::Node& n, BusConfig& b) {
     // decoded, and the battery would sit OFFLINE for a reason nobody could see.
     bat.node = static_cast<std::uint8_t>(c.integer(node, "node", 2, 2));
     if (const auto p = item["period"]) bat.period = canopen_period(c, p);
+    if (const auto v = item["capacity_ah"]) bat.capacity_ah = capacity_ah(c, v);
     if (const auto v = item["sim"]) b.sim.batteries[bat.node] = parse_battery_sim(c, v);
     if (const auto p = item["alarms"]) bat.alarms = parse_alarm_settings(p, alarms::DeviceKind::Battery, c.source);
     if (!seen.insert(bat.node).second)

@@ -28,6 +28,7 @@ const std::vector<RecordedTopic>& recorded_topics() {
       {kAlarms, "pmu::v4::Alarm", t::k_alarms, q::kAlarms, true},
       {kReadiness, "pmu::v4::Readiness", t::k_alarms, q::kState, true},
       {kEnergy, "pmu::v4::Energy", t::k_energy, q::kState, true},
+      {kBmsEnergy, "pmu::v4::BmsEnergy", t::k_energy, q::kState, true},
       {kLowRateVoltages, "pmu::v4::Voltages", t::k_telemetry, q::kTelemetry, false},
       {kLowRateCurrents, "pmu::v4::Currents", t::k_telemetry, q::kTelemetry, false},
       {kLowRateBatteryEnergy, "pmu::v4::BatteryEnergy", t::k_telemetry, q::kTelemetry, false},

@@ -37,8 +37,8 @@ class DdsPublisher final : public StateSink {
   // low-rate telemetry topics, one sample per device and packet per period (low_rate.hpp).
   // `canopen_deadline`: DEADLINE of pmu/battery, pmu/battery_cells and pmu/mppt (3 x the
   // longest battery/MPPT period, or the publish period if longer); nullopt: a service that
-  // serves no battery or MPPT does not offer those topics, so DDS-Security permissions made
-  // before they existed still let it start.
+  // serves no battery or MPPT does not offer those topics nor pmu/bms_energy, so DDS-Security
+  // permissions made before they existed still let it start.
   DdsPublisher(dds::DdsContext& dds, std::chrono::milliseconds telemetry_deadline, std::string vehicle = {},
                std::chrono::milliseconds low_rate_period = {},
                std::optional<std::chrono::milliseconds> canopen_deadline = std::chrono::seconds(3));
@@ -61,6 +61,8 @@ class DdsPublisher final : public StateSink {
   void on_readiness(const ReadinessReport& readiness) override;
   void on_energy(const DeviceKey& key, const energy::Figures& figures,
                  std::chrono::system_clock::time_point at) override;
+  void on_bms_energy(const DeviceKey& key, const energy::BmsFigures& figures,
+                     std::chrono::system_clock::time_point at) override;
 
   // pmu/baseline: one sample per configured PMU with a `baseline:`, written once at start
   // (interface.md 1.9); the state profile keeps it for late joiners. Not from a session:

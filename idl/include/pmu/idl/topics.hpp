@@ -31,6 +31,8 @@ inline constexpr const char* kReadiness = "pmu/readiness";
 inline constexpr const char* kEnergy = "pmu/energy";
 // The configuration file each configured PMU is watched against: docs/interface.md 1.9.
 inline constexpr const char* kBaseline = "pmu/baseline";
+// Power, energy and endurance derived from each BMS's pmu/battery: docs/interface.md 1.8.
+inline constexpr const char* kBmsEnergy = "pmu/bms_energy";
 // Acknowledging an alarm, and its reply (QoS profile `command`): docs/interface.md 1.6.
 inline constexpr const char* kAlarmAck = "pmu/alarm_ack";
 inline constexpr const char* kAlarmAckReply = "pmu/alarm_ack_reply";

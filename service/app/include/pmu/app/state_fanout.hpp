@@ -54,6 +54,10 @@ class StateFanout final : public StateSink {
                  std::chrono::system_clock::time_point at) override {
     for (auto* s : sinks_) s->on_energy(key, figures, at);
   }
+  void on_bms_energy(const DeviceKey& key, const energy::BmsFigures& figures,
+                     std::chrono::system_clock::time_point at) override {
+    for (auto* s : sinks_) s->on_bms_energy(key, figures, at);
+  }
 
  private:
   std::vector<StateSink*> sinks_;

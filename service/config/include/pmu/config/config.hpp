@@ -82,6 +82,9 @@ struct BatteryConfig {
   // OFFLINE after offline_periods of these without a frame.
   std::chrono::milliseconds period{1000};
   alarms::DeviceSettings alarms;  // as DeviceConfig::alarms
+  // Ah, the nameplate capacity (> 0): with the state of charge it gives pmu/bms_energy's
+  // endurance. Unset: no endurance, as the BMS does not send its capacity.
+  std::optional<double> capacity_ah;
 };
 
 // An MPPT on the bus, read-only; `device` 0..7 selects COB-IDs 0x4E6 + 8 x device (and + 1).

@@ -27,8 +27,6 @@
 
 namespace pmu::energy {
 
-inline constexpr std::chrono::seconds kReportPeriod{1};
-
 // The battery_a_critical_voltage and battery_b_critical_voltage alarms' limits as the
 // device's config sets them (V).
 struct CriticalVoltages {

@@ -59,6 +59,10 @@ class ReadinessTracker final : public StateSink {
                  std::chrono::system_clock::time_point at) override {
     next_.on_energy(key, figures, at);
   }
+  void on_bms_energy(const DeviceKey& key, const energy::BmsFigures& figures,
+                     std::chrono::system_clock::time_point at) override {
+    next_.on_bms_energy(key, figures, at);
+  }
 
   // The latest report (for tests and the start-up log).
   ReadinessReport current() const;

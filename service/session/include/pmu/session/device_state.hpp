@@ -138,6 +138,10 @@ class StateSink {
   // time of the sample that made it due.
   virtual void on_energy(const DeviceKey& key, const energy::Figures& figures,
                          std::chrono::system_clock::time_point at) = 0;
+  // A BMS-reported battery's derived energy (pmu/bms_energy), from the EnergyTracker; `at`
+  // is the receive time of the pmu/battery sample that made it due.
+  virtual void on_bms_energy(const DeviceKey& key, const energy::BmsFigures& figures,
+                             std::chrono::system_clock::time_point at) = 0;
 };
 
 }  // namespace pmu::service

@@ -1,18 +1,22 @@
 #pragma once
 // EnergyTracker: a StateSink in front of another (the publishers) that passes every event on
-// and feeds each PMU's voltages and currents, with their receive times, to a PmuEnergy
-// (pmu/energy/pmu_energy.hpp). When a PMU's figures are due (at most once a second of receive
-// time) it hands them on with on_energy. It reads no clock: time is the samples'.
+// and derives energy figures from what the sessions report, with the samples' receive times:
+// each PMU's voltages and currents feed a PmuEnergy (pmu/energy/pmu_energy.hpp), each
+// battery's pmu/battery values a BmsEnergy (pmu/energy/bms_energy.hpp). When a device's
+// figures are due (at most once a second of receive time) it hands them on with on_energy or
+// on_bms_energy. It reads no clock: time is the samples'.
 //
-// The critical voltages come from the config: the battery_a/b_critical_voltage alarms' limits
-// as the device's `alarms:` sets them (its bus's `discover:` settings for a discovered PMU),
-// so the endurance runs to the same voltage that raises the alarm.
+// Limits come from the config, as the device's alarms run with them: a PMU's critical voltages
+// are its battery_a/b_critical_voltage alarms' limits as its `alarms:` sets them (its bus's
+// `discover:` settings for a discovered PMU), a battery's critical state of charge its
+// bms_critical_soc alarm's limit, and its capacity its `capacity_ah` (none for a battery heard
+// through listen_canopen but not listed). So the endurance runs to what raises the alarm.
 //
 // Lifetime: `next` must outlive the tracker, which keeps a reference to it (main.cpp makes the
 // publishers first, and the bus workers, which write through the tracker, are destroyed
 // before it). `buses` is copied.
 // Threads: every StateSink member from any bus worker thread at once; `mutex_` serialises
-// the PMUs' state and the figures, which are handed on under it so they reach `next` in order.
+// the devices' state and the figures, which are handed on under it so they reach `next` in order.
 
 #include <chrono>
 #include <map>
@@ -22,6 +26,7 @@
 #include <vector>
 
 #include "pmu/config/config.hpp"
+#include "pmu/energy/bms_energy.hpp"
 #include "pmu/energy/pmu_energy.hpp"
 #include "pmu/session/device_state.hpp"
 
@@ -40,9 +45,7 @@ class EnergyTracker final : public StateSink {
   void on_health(const DeviceKey& key, const HealthReport& health) override { next_.on_health(key, health); }
   void on_gone(const DeviceKey& key) override;
   void on_battery(const DeviceKey& key, const BatteryState& battery,
-                  std::chrono::system_clock::time_point newest) override {
-    next_.on_battery(key, battery, newest);
-  }
+                  std::chrono::system_clock::time_point newest) override;
   void on_battery_cells(const DeviceKey& key, const BatteryCellsState& cells,
                         std::chrono::system_clock::time_point newest) override {
     next_.on_battery_cells(key, cells, newest);
@@ -57,16 +60,23 @@ class EnergyTracker final : public StateSink {
                  std::chrono::system_clock::time_point at) override {
     next_.on_energy(key, figures, at);
   }
+  void on_bms_energy(const DeviceKey& key, const energy::BmsFigures& figures,
+                     std::chrono::system_clock::time_point at) override {
+    next_.on_bms_energy(key, figures, at);
+  }
 
  private:
-  using Key = std::tuple<std::string, std::uint16_t>;  // (bus, PMU address)
-  energy::PmuEnergy& energy_of(const DeviceKey& key);  // with mutex_ held
+  using Key = std::tuple<std::string, std::uint16_t>;  // (bus, PMU address or battery node)
+  energy::PmuEnergy& energy_of(const DeviceKey& key);      // with mutex_ held
+  energy::BmsEnergy& bms_energy_of(const DeviceKey& key);  // with mutex_ held
+  std::chrono::nanoseconds max_gap(std::chrono::milliseconds period) const;
 
   std::map<std::string, BusConfig> buses_;  // by bus name
   double stale_periods_;
   StateSink& next_;
   std::mutex mutex_;
   std::map<Key, energy::PmuEnergy> pmus_;
+  std::map<Key, energy::BmsEnergy> batteries_;
 };
 
 }  // namespace pmu::service
