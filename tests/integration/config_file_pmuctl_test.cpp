@@ -207,5 +207,38 @@ TEST(ConfigFilesOverDds, BadFilesSendNothing) {
   EXPECT_EQ(missing.status, 2) << missing.out;
 }
 
+// Without a file, diff compares the PMU with the baseline its service watches it with
+// (pmu/baseline), and says so when there is none.
+TEST(ConfigFilesOverDds, DiffWithoutAFileUsesTheServicesBaseline) {
+  Files files;
+  const std::string settings = files.write("settings.yaml", "parameters:\n  avionics_voltage: 22.0\n");
+  const std::string pinned = files.write("pinned.yaml", "device:\n  serial: 4242\noutputs: [avionics_servo, payload, charger_a, charger_b]\n");
+  const std::string domain = std::to_string(pmu::test::exclusive_dds_domain());
+  pmu::test::ConfiguredService service(
+      PMU_SERVICE_PATH, "domain: " + domain + "\nqos_file: " PMU_QOS_FILE
+                            "\nbuses:\n  - interface: sim\n    devices:\n"
+                            "      - address: 1\n        period: 0.5\n        baseline: " + settings + "\n"
+                            "      - address: 2\n        period: 0.5\n        baseline: " + pinned + "\n"
+                            "      - address: 3\n        period: 0.5\n");
+  const std::string p = std::string(PMUCTL_PATH) + " --domain " + domain + " --bus sim ";
+  const auto differs = pmu::test::run_capture(p + "--timeout 30 --address 1 config diff 2>&1");
+  EXPECT_EQ(differs.status, 1) << differs.out << service.describe();
+  EXPECT_NE(differs.out.find(settings + ": avionics_voltage: device 12.0 V, file 22.0 V"), std::string::npos)
+      << differs.out;
+  EXPECT_NE(differs.out.find("differs from " + settings + " in 1 of 1 settings"), std::string::npos) << differs.out;
+  const auto set = pmu::test::run_capture(p + "--address 1 config set avionics_voltage 22.0 2>&1");
+  ASSERT_EQ(set.status, 0) << set.out;
+  const auto equal = pmu::test::run_capture(p + "--address 1 config diff 2>&1");
+  EXPECT_EQ(equal.status, 0) << equal.out;
+
+  const auto other_unit = pmu::test::run_capture(p + "--address 2 config diff 2>&1");
+  EXPECT_EQ(other_unit.status, 1) << other_unit.out;
+  EXPECT_NE(other_unit.out.find("serial: device 1002, baseline 4242"), std::string::npos) << other_unit.out;
+
+  const auto none = pmu::test::run_capture(p + "--address 3 config diff 2>&1");
+  EXPECT_EQ(none.status, 2) << none.out;
+  EXPECT_NE(none.out.find("no baseline configured for PMU sim/3"), std::string::npos) << none.out;
+}
+
 }  // namespace
 }  // namespace config_file_pmuctl_test

@@ -223,7 +223,9 @@ int main(int argc, char** argv) {
   config_snapshot->add_flag("--force", force, "Replace an existing file");
   auto* config_diff = config->add_subcommand(
       "diff", "Compare the PMU with a configuration file (exit 0 equal, 1 different, 2 bad file, 3 no answer)");
-  config_diff->add_option("file", config_file, "A file written by `config snapshot` or by hand")->required();
+  config_diff->add_option("file", config_file,
+                          "A file written by `config snapshot` or by hand; without it the service's baseline of "
+                          "the PMU (pmu-service.yaml `baseline:`)");
   auto* config_apply = config->add_subcommand(
       "apply", "Write what differs from a configuration file, verified, in a safe order; undone on a failure");
   bool dry_run = false;

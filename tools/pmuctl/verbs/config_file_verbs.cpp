@@ -22,6 +22,7 @@
 #include "pmu/baseline/config_diff.hpp"
 #include "pmu/baseline/config_file.hpp"
 #include "pmu/command/command.hpp"
+#include "pmu/dds/baseline_sample.hpp"
 #include "pmu/dds/dds_context.hpp"
 #include "pmu/idl/guarded_type.hpp"
 #include "pmu/idl/state.h"
@@ -46,28 +47,7 @@ Clock::time_point deadline_after(double seconds) {
   return Clock::now() + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(seconds));
 }
 
-// The raw wire values pmu/config stands for: the floats are the service's raw / divisor.
-baseline::Settings settings_of(const pmu::v4::Config& c) {
-  baseline::Settings s;
-  auto scaled = [](codec::Parameter p, float v) {
-    return static_cast<std::uint32_t>(std::lround(static_cast<double>(v) * codec::spec_of(p).divisor));
-  };
-  using P = codec::Parameter;
-  s[Setting::AvionicsVoltage] = scaled(P::AvionicsVoltage, c.avionics_voltage());
-  s[Setting::PayloadVoltage] = scaled(P::PayloadVoltage, c.payload_voltage());
-  s[Setting::ServoVoltage] = scaled(P::ServoVoltage, c.servo_voltage());
-  s[Setting::BatteryVoltage] = scaled(P::BatteryVoltage, c.battery_voltage());
-  s[Setting::PacketPeriod] = scaled(P::PacketPeriod, c.packet_period());
-  s[Setting::PacketsStreamed] = c.packets_streamed();
-  s[Setting::TemperatureOffset] = c.temperature_offset();
-  s[Setting::UpperTemperatureLimit] = c.upper_temperature_limit();
-  s[Setting::PowerUpState] = c.power_up_state();
-  s[Setting::CrankingTime] = scaled(P::CrankingTime, c.cranking_time());
-  s[Setting::CanAddress] = c.can_address();
-  s[Setting::Outputs] = c.outputs();
-  s[Setting::GenerationEnabled] = c.generation_enabled() ? 1u : 0u;
-  return s;
-}
+using service::settings_of;  // pmu/config as raw wire values (dds/baseline_sample.hpp)
 
 // The chosen PMU's pmu/config and pmu/info as the service publishes them (TRANSIENT_LOCAL:
 // the current values come at once), kept up to date while the verb runs.
@@ -78,7 +58,9 @@ class DeviceReader {
         config_(dds.reader(dds.topic(topics::kConfig, TypeSupport(new idl::Guarded<pmu::v4::ConfigPubSubType>())),
                            qos_profiles::kState)),
         info_(dds.reader(dds.topic(topics::kInfo, TypeSupport(new idl::Guarded<pmu::v4::DeviceInfoPubSubType>())),
-                         qos_profiles::kState)) {}
+                         qos_profiles::kState)),
+        baseline_(dds.reader(dds.topic(topics::kBaseline, TypeSupport(new idl::Guarded<pmu::v4::BaselinePubSubType>())),
+                             qos_profiles::kState)) {}
 
   void poll() {
     SampleInfo si;
@@ -88,6 +70,15 @@ class DeviceReader {
     pmu::v4::DeviceInfo i;
     while (info_.take_next_sample(&i, &si) == ReturnCode_t::RETCODE_OK)
       if (si.valid_data && i.vehicle().to_string() == vehicle_) infos_[{i.bus().to_string(), i.address()}] = i;
+    pmu::v4::Baseline b;
+    while (baseline_.take_next_sample(&b, &si) == ReturnCode_t::RETCODE_OK)
+      if (si.valid_data && b.vehicle().to_string() == vehicle_) baselines_[{b.bus().to_string(), b.address()}] = b;
+  }
+  // The service's baseline of the PMU at (bus, address): written once at its start for a PMU
+  // configured with `baseline:`, so it comes with the rest of the state, or never.
+  const pmu::v4::Baseline* baseline(const std::string& bus, std::uint16_t address) const {
+    const auto it = baselines_.find({bus, address});
+    return it == baselines_.end() ? nullptr : &it->second;
   }
   const pmu::v4::Config* config(const std::string& bus, std::uint16_t address) const {
     const auto it = configs_.find({bus, address});
@@ -111,7 +102,9 @@ class DeviceReader {
   std::string vehicle_;
   DataReader& config_;
   DataReader& info_;
+  DataReader& baseline_;
   std::map<std::pair<std::string, std::uint16_t>, pmu::v4::Config> configs_;
+  std::map<std::pair<std::string, std::uint16_t>, pmu::v4::Baseline> baselines_;
   std::map<std::pair<std::string, std::uint16_t>, pmu::v4::DeviceInfo> infos_;
 };
 
@@ -177,7 +170,7 @@ class ReadOnlyView {
     return find_device(o_, dds_, device_, vehicle_, deadline_after(o_.timeout.value_or(5.0)), status);
   }
   const std::string& vehicle() const { return vehicle_; }
-  const DeviceReader& device() const { return device_; }
+  DeviceReader& device() { return device_; }
 
  private:
   const GlobalOptions& o_;
@@ -297,15 +290,31 @@ int snapshot(const GlobalOptions& o, const std::string& file, bool force) {
   return 0;
 }
 
-int diff(const GlobalOptions& o, const std::string& file) {
+int diff(const GlobalOptions& o, const std::string& path) {
   int status = 0;
-  const auto f = read_file(o, file, status);
-  if (!f) return status;
+  std::optional<baseline::ConfigFile> f;
+  if (!path.empty()) {
+    f = read_file(o, path, status);
+    if (!f) return status;
+  }
   ReadOnlyView view(o);
   const auto t = view.find(status);
   if (!t) return status;
   const std::string& vehicle = view.vehicle();
-  const DeviceReader& device = view.device();
+  DeviceReader& device = view.device();
+  std::string file = path;
+  if (!f) {
+    // The service's samples of one PMU come in one burst, so its baseline is there with its
+    // configuration, or there is none.
+    device.poll();
+    const auto* b = device.baseline(t->bus, t->address);
+    if (!b)
+      return fail(o, ExitStatus::BadUsage,
+                  "no baseline configured for PMU " + device_label(vehicle, t->bus, t->address) +
+                      " (pmu-service.yaml `baseline:`, interface.md 1.9): name a file, pmuctl config diff FILE");
+    f = service::config_file_of(*b);
+    file = b->file().to_string();
+  }
   const auto have = settings_of(*device.config(t->bus, t->address));
   const auto diffs = baseline::differences(have, *f);
   const auto missing = baseline::not_in_file(have, *f);
@@ -319,7 +328,11 @@ int diff(const GlobalOptions& o, const std::string& file) {
     for (const auto s : missing) j["not_in_file"].push_back(std::string(baseline::setting_name(s)));
     std::printf("%s\n", j.dump(-1, ' ', false, Json::error_handler_t::replace).c_str());
   } else {
-    for (const auto& d : diffs) std::printf("%s:%d: %s\n", file.c_str(), d.line, baseline::describe(d).c_str());
+    for (const auto& d : diffs)
+      if (d.line > 0)
+        std::printf("%s:%d: %s\n", file.c_str(), d.line, baseline::describe(d).c_str());
+      else  // the service's baseline: its lines are not published
+        std::printf("%s: %s\n", file.c_str(), baseline::describe(d).c_str());
   }
   if (diffs.empty())
     std::fprintf(stderr, "%s matches %s (%zu settings)\n", label.c_str(), file.c_str(), compared);
@@ -332,7 +345,14 @@ int diff(const GlobalOptions& o, const std::string& file) {
     std::fprintf(stderr, "not in the file, so not compared: %s\n", names.c_str());
   }
   const auto& info = *device.info(t->bus, t->address);
-  if (f->header.serial && *f->header.serial != info.serial_number())
+  const bool other_unit = f->header.serial && *f->header.serial != info.serial_number();
+  if (other_unit && path.empty()) {
+    // A baseline's serial pins it to one unit (serial_differs, interface.md 1.7).
+    std::fprintf(stderr, "%s: serial: device %u, baseline %u: another unit than the baseline's\n", file.c_str(),
+                 unsigned{info.serial_number()}, unsigned{*f->header.serial});
+    return static_cast<int>(ExitStatus::NotDone);
+  }
+  if (other_unit)
     std::fprintf(stderr, "the file was read from serial %u; this PMU is serial %u\n", unsigned{*f->header.serial},
                  unsigned{info.serial_number()});
   return static_cast<int>(diffs.empty() ? ExitStatus::Ok : ExitStatus::NotDone);

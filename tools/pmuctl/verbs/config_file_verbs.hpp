@@ -14,7 +14,9 @@ namespace pmu::tools {
 // 2 bad usage or an existing file, 3 no answer.
 int run_config_snapshot(const GlobalOptions& o, const std::string& file, bool force);
 
-// The device against `file`: exit 0 equal, 1 different, 2 a bad file (FILE:LINE), 3 nothing
+// The device against `file`, or against the baseline its service watches it with
+// (pmu/baseline) when `file` is empty: exit 0 equal, 1 different (for the baseline also
+// another unit than its serial pin), 2 a bad file (FILE:LINE) or no baseline, 3 nothing
 // answers.
 int run_config_diff(const GlobalOptions& o, const std::string& file);
 
