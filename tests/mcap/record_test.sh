@@ -172,8 +172,13 @@ grep -q "written to standard output" "$work/dash.err" || fail "record -: $(cat "
 if [ "$(id -u)" -ne 0 ]; then
   echo "note: disk-full case skipped: mounting a small tmpfs needs root"
 else
-  mkdir "$work/small" && mount -t tmpfs -o size=64k tmpfs "$work/small"
-  # the file's first chunk (schemas and channels) is about 35 kB: room for it and a few seconds more
+  # Room for the file's first chunk (its schemas and channels) and a few seconds more. The
+  # chunk grows with every topic of the contract, so it is measured: a recording of nothing (a
+  # vehicle no service serves) holds it twice (the chunk, and the summary's copy), and little
+  # else.
+  timeout -s INT 2 "$ctl" --domain "$domain" --vehicle no-such-vehicle record "$work/empty.mcap" 2>/dev/null
+  chunk=$(($(stat -c %s "$work/empty.mcap") / 2))
+  mkdir "$work/small" && mount -t tmpfs -o size=$(((chunk + 16384 + 12288 + 4095) / 4096 * 4))k tmpfs "$work/small"
   head -c 16384 /dev/zero >"$work/small/filler"
   timeout 60 "$ctl" --domain "$domain" record "$work/small/full.mcap" 2>"$work/full.err"; status=$?
   [ $status -eq 1 ] || fail "record on a full disk exited $status: $(cat "$work/full.err")"

@@ -42,6 +42,7 @@ const defaultTopics = {
   "pmu/readiness": "pmu::v4::Readiness",
   "pmu/energy": "pmu::v4::Energy",
   "pmu/bms_energy": "pmu::v4::BmsEnergy",
+  "pmu/baseline": "pmu::v4::Baseline",
 };
 
 // float32 on the wire: the shortest decimal that is the same float32, as pmuctl prints it.

@@ -29,6 +29,7 @@ const std::vector<RecordedTopic>& recorded_topics() {
       {kReadiness, "pmu::v4::Readiness", t::k_alarms, q::kState, true},
       {kEnergy, "pmu::v4::Energy", t::k_energy, q::kState, true},
       {kBmsEnergy, "pmu::v4::BmsEnergy", t::k_energy, q::kState, true},
+      {kBaseline, "pmu::v4::Baseline", t::k_state, q::kState, true},
       {kLowRateVoltages, "pmu::v4::Voltages", t::k_telemetry, q::kTelemetry, false},
       {kLowRateCurrents, "pmu::v4::Currents", t::k_telemetry, q::kTelemetry, false},
       {kLowRateBatteryEnergy, "pmu::v4::BatteryEnergy", t::k_telemetry, q::kTelemetry, false},

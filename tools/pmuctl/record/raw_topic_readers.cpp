@@ -57,6 +57,7 @@ TypeSupport raw_type_support(const std::string& type_name) {
   if (type_name == "pmu::v4::Readiness") return TypeSupport(new RawSampleType<pmu::v4::ReadinessPubSubType>());
   if (type_name == "pmu::v4::Energy") return TypeSupport(new RawSampleType<pmu::v4::EnergyPubSubType>());
   if (type_name == "pmu::v4::BmsEnergy") return TypeSupport(new RawSampleType<pmu::v4::BmsEnergyPubSubType>());
+  if (type_name == "pmu::v4::Baseline") return TypeSupport(new RawSampleType<pmu::v4::BaselinePubSubType>());
   if (type_name == "pmu::v4::Command") return TypeSupport(new RawSampleType<pmu::v4::CommandPubSubType>());
   if (type_name == "pmu::v4::AlarmAck") return TypeSupport(new RawSampleType<pmu::v4::AlarmAckPubSubType>());
   if (type_name == "pmu::v4::AlarmAckReply") return TypeSupport(new RawSampleType<pmu::v4::AlarmAckReplyPubSubType>());
