@@ -86,6 +86,17 @@ TEST(ConfigFile, PowerUpStateRoundTripsOnEveryFirmware) {
   EXPECT_NE(old->message.find("power_up_state"), std::string::npos) << old->message;
 }
 
+// A unit can hold what no set writes (packet_period 0 here): its file is refused at that
+// value's line, which is how `config snapshot` knows not to write it.
+TEST(ConfigFile, AValueNoSetCanWriteDoesNotReadBack) {
+  Settings s = full_settings();
+  s[Setting::PacketPeriod] = 0;
+  const auto back = read_config_file(write_config_file(header_for(codec::kCurrentFirmware), s));
+  ASSERT_FALSE(back.ok());
+  EXPECT_NE(back.error().message.find("packet_period"), std::string::npos) << back.error().message;
+  EXPECT_EQ(back.error().line, 16) << back.error().message;  // packet_period's line in the written file
+}
+
 TEST(ConfigFile, TheHeaderReadsBack) {
   Header h = header_for({1, 15});
   h.vehicle = "uav \"7\"";

@@ -278,6 +278,13 @@ int snapshot(const GlobalOptions& o, const std::string& file, bool force) {
   h.firmware = firmware_of(info);
   h.date = utc_now();
   const std::string text = baseline::write_config_file(h, settings_of(*device.config(t->bus, t->address)));
+  // A unit may hold a value no set can write (a factory value, or one a newer firmware
+  // wrote): such a file could never be applied, so it is not written.
+  if (const auto back = baseline::read_config_file(text); !back)
+    return fail(o, ExitStatus::NotDone,
+                device_label(vehicle, t->bus, t->address) + " holds a value no set can write, so a snapshot could not be " +
+                    "applied: " + baseline::describe(back.error(), file == "-" ? "(stdout)" : file) +
+                    "; the snapshot was not written");
   if (file == "-") {
     std::fwrite(text.data(), 1, text.size(), stdout);
     return 0;
