@@ -29,31 +29,12 @@ std::optional<Setting> setting_from_name(std::string_view name) noexcept {
   return std::nullopt;
 }
 
-namespace {
-
-template <std::size_t N>
-std::string mask_text(const std::array<codec::NamedBit, N>& names, std::uint32_t raw) {
-  std::string s;
-  for (unsigned bit = 0; bit < 8; ++bit) {
-    const auto b = static_cast<std::uint8_t>(1u << bit);
-    if (!(raw & b)) continue;
-    std::string name = "bit" + std::to_string(bit);
-    for (const auto& n : names)
-      if (n.bit == b) name = std::string(n.name);
-    s += (s.empty() ? "" : ",") + name;
-  }
-  char hex[8];
-  std::snprintf(hex, sizeof hex, "0x%02X", static_cast<unsigned>(raw & 0xFF));
-  return (s.empty() ? std::string("none") : s) + " (" + hex + ")";
-}
-
-}  // namespace
-
 std::string value_text(Setting s, std::uint32_t raw) {
-  if (s == Setting::Outputs) return mask_text(codec::kOutputNames, raw);
-  if (s == Setting::GenerationEnabled) return raw ? "on" : "off";
-  if (s == Setting::PacketsStreamed) return mask_text(codec::kGroupNames, raw);
-  if (s == Setting::PowerUpState) return mask_text(codec::kPowerUpNames, raw);
+  const auto byte = static_cast<std::uint8_t>(raw);
+  if (s == Setting::Outputs) return codec::mask_text(codec::kOutputNames, byte);
+  if (s == Setting::GenerationEnabled) return raw ? "yes" : "no";  // as `config get` says it
+  if (s == Setting::PacketsStreamed) return codec::mask_text(codec::kGroupNames, byte);
+  if (s == Setting::PowerUpState) return codec::mask_text(codec::kPowerUpNames, byte);
   const auto& spec = codec::spec_of(*parameter_of(s));
   std::string text;
   if (spec.kind == codec::ParameterKind::Scaled) {

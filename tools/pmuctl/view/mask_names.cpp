@@ -76,21 +76,6 @@ const MaskNames* mask_names(std::string_view field) noexcept {
   return nullptr;
 }
 
-std::string mask_text(const MaskNames& names, std::uint8_t mask) {
-  std::string s;
-  for (unsigned bit = 0; bit < 8; ++bit) {
-    const auto b = static_cast<std::uint8_t>(1u << bit);
-    if (!(mask & b)) continue;
-    std::string name = "bit" + std::to_string(bit);
-    for (std::size_t i = 0; i < names.count; ++i)
-      if (names.bits[i].bit == b) name = std::string(names.bits[i].name);
-    s += (s.empty() ? "" : ",") + name;
-  }
-  char hex[8];
-  std::snprintf(hex, sizeof hex, "0x%02X", mask);
-  return (s.empty() ? std::string("none") : s) + " (" + hex + ")";
-}
-
 ConfigValue parse_config_value(std::string_view parameter, std::string_view text) {
   if (const auto* m = mask_names(parameter)) return parse_mask(*m, text);
   const auto v = number(text);

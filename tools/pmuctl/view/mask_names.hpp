@@ -21,9 +21,6 @@ struct MaskNames {
 // The names of a Config mask field; nullptr for a field that is not a mask.
 const MaskNames* mask_names(std::string_view field) noexcept;
 
-// "avionics_servo,payload (0x03)"; "none (0x00)"; a bit without a name as "bit7".
-std::string mask_text(const MaskNames& names, std::uint8_t mask);
-
 // `config set PARAM VALUE`'s value, from the command line: the number to send, or why not
 // (naming the bad token and what is valid). A mask parameter takes a comma list of its
 // names, `none`, or a whole number 0..255 (decimal or 0x hex); any other parameter a finite

@@ -184,7 +184,8 @@ SampleFields fields_of(const pmu::v4::Config& s) {
   out.push_back(integer("outputs", s.outputs()));
   out.push_back(flag("generation_enabled", s.generation_enabled()));
   for (auto& f : out)
-    if (const auto* m = mask_names(f.name)) f.text = mask_text(*m, static_cast<std::uint8_t>(f.json.get<int>()));
+    if (const auto* m = mask_names(f.name))
+      f.text = codec::mask_text(m->bits, m->count, static_cast<std::uint8_t>(f.json.get<int>()));
   return out;
 }
 

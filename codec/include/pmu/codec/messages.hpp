@@ -4,6 +4,7 @@
 
 #include <array>
 #include <cstdint>
+#include <cstdio>
 #include <limits>
 #include <optional>
 #include <string>
@@ -79,6 +80,27 @@ std::string names_of(const std::array<NamedBit, N>& table, std::uint8_t mask, st
     s += b.name;
   }
   return s;
+}
+
+// A mask as a person reads it, the same in every view: "avionics_servo,payload (0x03)",
+// "none (0x00)", a bit the table does not name as "bit7".
+inline std::string mask_text(const NamedBit* names, std::size_t count, std::uint8_t mask) {
+  std::string s;
+  for (unsigned bit = 0; bit < 8; ++bit) {
+    const auto b = static_cast<std::uint8_t>(1u << bit);
+    if (!(mask & b)) continue;
+    std::string name = "bit" + std::to_string(bit);
+    for (std::size_t i = 0; i < count; ++i)
+      if (names[i].bit == b) name = std::string(names[i].name);
+    s += (s.empty() ? "" : ",") + name;
+  }
+  char hex[8];
+  std::snprintf(hex, sizeof hex, "0x%02X", static_cast<unsigned>(mask));
+  return (s.empty() ? std::string("none") : s) + " (" + hex + ")";
+}
+template <std::size_t N>
+std::string mask_text(const std::array<NamedBit, N>& names, std::uint8_t mask) {
+  return mask_text(names.data(), N, mask);
 }
 
 // S0 bits (table 16). Bits 4 and 6 exist only on newer firmware, see firmware.hpp.

@@ -40,7 +40,7 @@ std::optional<codec::Parameter> parameter_of(Setting s) noexcept;
 Setting setting_of(codec::Parameter p) noexcept;
 
 // A raw value in its unit, as `config get` shows it: "24.0 V", "1.5 s", "40 degC",
-// "avionics_servo,payload (0x03)", "none (0x00)", "on", "off".
+// "avionics_servo,payload (0x03)", "none (0x00)", "yes", "no".
 std::string value_text(Setting s, std::uint32_t raw);
 
 struct Settings {
