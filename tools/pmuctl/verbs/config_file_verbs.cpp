@@ -1,6 +1,5 @@
 #include "pmuctl/verbs/config_file_verbs.hpp"
 
-#include <fcntl.h>
 #include <unistd.h>
 
 #include <cerrno>
@@ -28,6 +27,7 @@
 #include "pmu/idl/state.h"
 #include "pmu/idl/statePubSubTypes.h"
 #include "pmu/idl/topics.hpp"
+#include "pmu/mcap/output_file.hpp"
 #include "pmuctl/verbs/command_channel.hpp"
 #include "pmuctl/verbs/exit_status.hpp"
 #include "pmuctl/verbs/service_presence.hpp"
@@ -139,6 +139,16 @@ struct Target {
   std::string bus;
   std::uint16_t address = 0;
 };
+// Both of the PMU's state samples, or the exit status after saying which did not come.
+std::optional<int> await_device(const GlobalOptions& o, DeviceReader& device, const std::string& vehicle,
+                                const Target& t, Clock::time_point deadline) {
+  if (device.wait(t.bus, t.address, deadline)) return std::nullopt;
+  return fail(o, ExitStatus::NoAnswer,
+              device_label(vehicle, t.bus, t.address) + ": its " +
+                  (device.config(t.bus, t.address) ? "identity (pmu/info)" : "configuration (pmu/config)") +
+                  " did not come in time: the service has not read the PMU yet");
+}
+
 std::optional<Target> find_device(const GlobalOptions& o, pmu::dds::DdsContext& dds, DeviceReader& device,
                                   const std::string& vehicle, Clock::time_point deadline, int& status) {
   Target t;
@@ -146,11 +156,8 @@ std::optional<Target> find_device(const GlobalOptions& o, pmu::dds::DdsContext& 
     status = *failed;
     return std::nullopt;
   }
-  if (!device.wait(t.bus, t.address, deadline)) {
-    status = fail(o, ExitStatus::NoAnswer,
-                  device_label(vehicle, t.bus, t.address) + ": its " +
-                      (device.config(t.bus, t.address) ? "identity (pmu/info)" : "configuration (pmu/config)") +
-                      " did not come in time: the service has not read the PMU yet");
+  if (const auto failed = await_device(o, device, vehicle, t, deadline)) {
+    status = *failed;
     return std::nullopt;
   }
   return t;
@@ -188,36 +195,6 @@ std::string utc_now() {
   return buf;
 }
 
-// Writes `text` to `path` whole or not at all: a temporary file beside it, synced, then
-// renamed over nothing (link() fails if `path` appeared meanwhile) or, with `force`, over
-// the old file.
-std::string write_whole(const std::string& path, const std::string& text, bool force) {
-  const std::string tmp = path + ".tmp-" + std::to_string(::getpid());
-  const int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0644);
-  if (fd < 0) return tmp + ": " + std::strerror(errno);
-  std::size_t done = 0;
-  while (done < text.size()) {
-    const auto n = ::write(fd, text.data() + done, text.size() - done);
-    if (n < 0 && errno == EINTR) continue;
-    if (n <= 0) {
-      const std::string why = std::strerror(errno);
-      ::close(fd);
-      ::unlink(tmp.c_str());
-      return path + ": " + why;
-    }
-    done += static_cast<std::size_t>(n);
-  }
-  if (::fsync(fd) != 0 || ::close(fd) != 0) {
-    const std::string why = std::strerror(errno);
-    ::unlink(tmp.c_str());
-    return path + ": " + why;
-  }
-  const int rc = force ? ::rename(tmp.c_str(), path.c_str()) : ::link(tmp.c_str(), path.c_str());
-  const std::string why = rc == 0 ? std::string() : std::strerror(errno);
-  ::unlink(tmp.c_str());  // after link(): the name `path` keeps the file
-  return rc == 0 ? std::string() : path + ": " + why;
-}
-
 Json difference_json(const baseline::Difference& d) {
   return {{"name", std::string(baseline::setting_name(d.setting))},
           {"line", d.line},
@@ -225,20 +202,23 @@ Json difference_json(const baseline::Difference& d) {
           {"file", baseline::value_text(d.setting, d.file)}};
 }
 
+// The plan's own action as a command sample, so what is sent is what its confirm rule was
+// judged on.
 CommandSpec command_for(Setting s, std::uint32_t raw, bool confirm) {
   CommandSpec spec;
   spec.confirm = confirm;
-  if (s == Setting::Outputs) {
+  const auto action = baseline::action_for(s, raw);
+  if (const auto* o = std::get_if<service::action::SetOutputs>(&action)) {
     spec.kind = pmu::v4::SET_OUTPUTS;
-    spec.outputs = static_cast<std::uint8_t>(raw);
-  } else if (s == Setting::GenerationEnabled) {
+    spec.outputs = o->mask;
+  } else if (const auto* g = std::get_if<service::action::SetGeneration>(&action)) {
     spec.kind = pmu::v4::SET_GENERATION;
-    spec.enable = raw != 0;
+    spec.enable = g->enable;
   } else {
-    const auto p = *baseline::parameter_of(s);
+    const auto& p = std::get<service::action::SetParameter>(action);
     spec.kind = pmu::v4::SET_PARAMETER;
-    spec.parameter = std::string(codec::spec_of(p).name);
-    spec.value = codec::parameter_value(p, raw);
+    spec.parameter = std::string(codec::spec_of(p.parameter).name);
+    spec.value = codec::parameter_value(p.parameter, p.raw);
   }
   return spec;
 }
@@ -285,12 +265,19 @@ int snapshot(const GlobalOptions& o, const std::string& file, bool force) {
                 device_label(vehicle, t->bus, t->address) + " holds a value no set can write, so a snapshot could not be " +
                     "applied: " + baseline::describe(back.error(), file == "-" ? "(stdout)" : file) +
                     "; the snapshot was not written");
-  if (file == "-") {
-    std::fwrite(text.data(), 1, text.size(), stdout);
-    return 0;
+  // The recordings' output file: a temporary file beside FILE, renamed over it only when
+  // complete; "-" is standard output.
+  pmu::mcap::OutputFile out;
+  if (const auto why = out.open(file); !why.empty()) return fail(o, ExitStatus::BadUsage, why);
+  int error = out.sink().write(reinterpret_cast<const std::uint8_t*>(text.data()), text.size());
+  if (error == 0) error = out.close();
+  if (error != 0) {
+    out.discard();
+    return fail(o, ExitStatus::NotDone, "the snapshot was not written: " + out.name() + ": " + std::strerror(error));
   }
-  if (const auto why = write_whole(file, text, force); !why.empty())
+  if (const auto why = out.commit(); !why.empty())
     return fail(o, ExitStatus::NotDone, "the snapshot was not written: " + why);
+  if (out.streaming()) return 0;
   std::fprintf(stderr, "%s (serial %u, firmware %s): %zu settings written to %s\n",
                device_label(vehicle, t->bus, t->address).c_str(), unsigned{info.serial_number()},
                codec::to_string(firmware_of(info)).c_str(), baseline::kSettingCount, file.c_str());
@@ -375,9 +362,8 @@ int apply(const GlobalOptions& o, const std::string& file, bool dry_run, bool co
   std::string bus;
   std::uint16_t address = 0;
   if (const auto failed = channel.open(deadline_after(timeout), bus, address)) return *failed;
-  if (!device.wait(bus, address, deadline_after(timeout)))
-    return fail(o, ExitStatus::NoAnswer,
-                device_label(channel.vehicle(), bus, address) + ": its configuration did not come in time");
+  if (const auto failed = await_device(o, device, channel.vehicle(), {bus, address}, deadline_after(timeout)))
+    return *failed;
   const std::string label = device_label(channel.vehicle(), bus, address);
   const auto firmware = firmware_of(*device.info(bus, address));
 
@@ -396,6 +382,20 @@ int apply(const GlobalOptions& o, const std::string& file, bool dry_run, bool co
     std::fprintf(stderr, "%s already matches %s: nothing to apply\n", label.c_str(), file.c_str());
     return 0;
   }
+  if (dry_run) {
+    for (std::size_t i = 0; i < plan.size(); ++i) {
+      const auto& c = plan[i];
+      const std::string rule =
+          c.confirm ? " (needs --confirm: " + std::string(service::to_string(*c.confirm)) + ")" : std::string();
+      std::printf("%zu. %s:%d: %s: %s -> %s%s\n", i + 1, file.c_str(), c.line,
+                  std::string(baseline::setting_name(c.setting)).c_str(),
+                  baseline::value_text(c.setting, c.from).c_str(), baseline::value_text(c.setting, c.to).c_str(),
+                  rule.c_str());
+    }
+    std::fprintf(stderr, "%s: %zu change(s) to apply from %s; nothing was sent (--dry-run)\n", label.c_str(),
+                 plan.size(), file.c_str());
+    return 0;
+  }
   std::vector<std::string> unconfirmed;
   for (const auto& c : plan)
     if (c.confirm && !confirm)
@@ -403,22 +403,9 @@ int apply(const GlobalOptions& o, const std::string& file, bool dry_run, bool co
                             " " + baseline::value_text(c.setting, c.to) + " " +
                             std::string(service::rule_why(*c.confirm)) + ": it needs --confirm (rule " +
                             std::string(service::to_string(*c.confirm)) + ")");
-  for (std::size_t i = 0; i < plan.size(); ++i) {
-    const auto& c = plan[i];
-    if (!dry_run) break;
-    std::printf("%zu. %s:%d: %s: %s -> %s%s\n", i + 1, file.c_str(), c.line,
-                std::string(baseline::setting_name(c.setting)).c_str(),
-                baseline::value_text(c.setting, c.from).c_str(), baseline::value_text(c.setting, c.to).c_str(),
-                c.confirm ? (" (needs --confirm: " + std::string(service::to_string(*c.confirm)) + ")").c_str() : "");
-  }
-  if (!unconfirmed.empty() && !dry_run) {
+  if (!unconfirmed.empty()) {
     for (std::size_t i = 0; i + 1 < unconfirmed.size(); ++i) std::fprintf(stderr, "pmuctl: %s\n", unconfirmed[i].c_str());
     return fail(o, ExitStatus::BadUsage, unconfirmed.back() + "; nothing was sent");
-  }
-  if (dry_run) {
-    std::fprintf(stderr, "%s: %zu change(s) to apply from %s; nothing was sent (--dry-run)\n", label.c_str(),
-                 plan.size(), file.c_str());
-    return 0;
   }
 
   Json changes = Json::array();
