@@ -94,57 +94,60 @@ void expect_common(const Measured& m) {
   EXPECT_GE(e["integrated_s"].get<double>(), 3);
 }
 
-TEST(BmsEnergyOverDds, DischargingIntoTheLoad) {
+// A service with the bus's `extra` config (its MPPTs), the battery's figures measured over
+// 3 s, and what every line carries checked; `check` gets pmuctl's command prefix, the
+// figures, and the latest pmu/battery voltage and current.
+template <class Check>
+void with_figures(const std::string& extra, Check check) {
   const std::string domain = std::to_string(pmu::test::exclusive_dds_domain());
-  pmu::test::ConfiguredService service(PMU_SERVICE_PATH, config(domain, ""));
+  pmu::test::ConfiguredService service(PMU_SERVICE_PATH, config(domain, extra));
   const std::string p = std::string(PMUCTL_PATH) + " --domain " + domain + " ";
   const auto m = measure(p, 3);
   ASSERT_FALSE(m.energy.is_null()) << service.describe();
   ASSERT_TRUE(m.battery.is_object()) << service.describe();
   expect_common(m);
-  const Json& e = m.energy["values"];
-  const double volts = m.battery["voltage"].get<double>(), amps = m.battery["current"].get<double>();
-  ASSERT_LT(amps, 0) << "without sun the load discharges the battery";
-  // No sun, a steady load and fixed cells: the simulator's power does not change.
-  expect_close(e["power"], volts * amps, 1e-3 * std::abs(volts * amps), "power: V x I, negative out of the battery");
-  expect_close(e["used_wh"], -volts * amps * e["integrated_s"].get<double>() / 3600, 1e-6, "used_wh");
-  EXPECT_GT(e["used_wh"].get<double>(), 0) << "discharged";
-  // (state of charge - critical) of the capacity at the steady current, with the state of
-  // charge the BMS sent (whole percent; it may tick once while this runs).
-  const auto endurance = [&](double soc) { return (soc - kCriticalSoc) / 100 * kCapacityAh * 3600 / -amps; };
-  ASSERT_TRUE(e["endurance_s"].is_number()) << m.energy.dump();
-  EXPECT_GE(e["endurance_s"].get<double>(), endurance(m.soc_low) - 1) << m.energy.dump();
-  EXPECT_LE(e["endurance_s"].get<double>(), endurance(m.soc_high) + 1) << m.energy.dump();
-  // The BMS's own time to go runs to empty, so it is longer, in the same proportion.
-  if (m.battery["time_to_go"].is_number()) {
-    EXPECT_GT(m.battery["time_to_go"].get<double>(), e["endurance_s"].get<double>());
-  }
+  check(p, m, m.battery["voltage"].get<double>(), m.battery["current"].get<double>());
+}
 
-  const auto text = pmu::test::run_capture(p + "--timeout 5 energy");
-  EXPECT_EQ(text.status, 0);
-  EXPECT_NE(text.out.find("sim/battery2"), std::string::npos) << text.out;
-  EXPECT_NE(text.out.find("to 10 % SoC, capacity 20.0 Ah"), std::string::npos) << text.out;
-  // --address names a PMU: the battery is not shown.
-  const auto pmu_only = pmu::test::run_capture(p + "--timeout 5 --json --address 1 energy");
-  EXPECT_EQ(pmu_only.status, 0);
-  EXPECT_TRUE(battery_line(pmu_only.out).is_null()) << pmu_only.out;
+TEST(BmsEnergyOverDds, DischargingIntoTheLoad) {
+  with_figures("", [](const std::string& p, const Measured& m, double volts, double amps) {
+    const Json& e = m.energy["values"];
+    ASSERT_LT(amps, 0) << "without sun the load discharges the battery";
+    // No sun, a steady load and fixed cells: the simulator's power does not change.
+    expect_close(e["power"], volts * amps, 1e-3 * std::abs(volts * amps), "power: V x I, negative out of the battery");
+    expect_close(e["used_wh"], -volts * amps * e["integrated_s"].get<double>() / 3600, 1e-6, "used_wh");
+    EXPECT_GT(e["used_wh"].get<double>(), 0) << "discharged";
+    // (state of charge - critical) of the capacity at the steady current, with the state of
+    // charge the BMS sent (whole percent; it may tick once while this runs).
+    const auto endurance = [&](double soc) { return (soc - kCriticalSoc) / 100 * kCapacityAh * 3600 / -amps; };
+    ASSERT_TRUE(e["endurance_s"].is_number()) << m.energy.dump();
+    EXPECT_GE(e["endurance_s"].get<double>(), endurance(m.soc_low) - 1) << m.energy.dump();
+    EXPECT_LE(e["endurance_s"].get<double>(), endurance(m.soc_high) + 1) << m.energy.dump();
+    // The BMS's own time to go runs to empty, so it is longer, in the same proportion.
+    if (m.battery["time_to_go"].is_number()) {
+      EXPECT_GT(m.battery["time_to_go"].get<double>(), e["endurance_s"].get<double>());
+    }
+
+    const auto text = pmu::test::run_capture(p + "--timeout 5 energy");
+    EXPECT_EQ(text.status, 0);
+    EXPECT_NE(text.out.find("sim/battery2"), std::string::npos) << text.out;
+    EXPECT_NE(text.out.find("to 10 % SoC, capacity 20.0 Ah"), std::string::npos) << text.out;
+    // --address names a PMU: the battery is not shown.
+    const auto pmu_only = pmu::test::run_capture(p + "--timeout 5 --json --address 1 energy");
+    EXPECT_EQ(pmu_only.status, 0);
+    EXPECT_TRUE(battery_line(pmu_only.out).is_null()) << pmu_only.out;
+  });
 }
 
 TEST(BmsEnergyOverDds, ChargedByTheSunNoEndurance) {
-  const std::string domain = std::to_string(pmu::test::exclusive_dds_domain());
-  pmu::test::ConfiguredService service(PMU_SERVICE_PATH, config(domain, "    mppts:\n      - device: 0\n"));
-  const std::string p = std::string(PMUCTL_PATH) + " --domain " + domain + " ";
-  const auto m = measure(p, 3);
-  ASSERT_FALSE(m.energy.is_null()) << service.describe();
-  ASSERT_TRUE(m.battery.is_object()) << service.describe();
-  expect_common(m);
-  const Json& e = m.energy["values"];
-  const double volts = m.battery["voltage"].get<double>(), amps = m.battery["current"].get<double>();
-  ASSERT_GT(amps, 0) << "the MPPT's panels give more than the load takes";
-  // The sun drifts slowly, so the power read a few seconds apart is close, not equal.
-  expect_close(e["power"], volts * amps, 0.1 * volts * amps, "power: V x I, positive into the battery");
-  EXPECT_LT(e["used_wh"].get<double>(), 0) << "charged: less used than none";
-  EXPECT_TRUE(e["endurance_s"].is_null()) << "charging: no endurance";
+  with_figures("    mppts:\n      - device: 0\n", [](const std::string&, const Measured& m, double volts, double amps) {
+    const Json& e = m.energy["values"];
+    ASSERT_GT(amps, 0) << "the MPPT's panels give more than the load takes";
+    // The sun drifts slowly, so the power read a few seconds apart is close, not equal.
+    expect_close(e["power"], volts * amps, 0.1 * volts * amps, "power: V x I, positive into the battery");
+    EXPECT_LT(e["used_wh"].get<double>(), 0) << "charged: less used than none";
+    EXPECT_TRUE(e["endurance_s"].is_null()) << "charging: no endurance";
+  });
 }
 
 }  // namespace

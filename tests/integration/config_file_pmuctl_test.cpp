@@ -125,8 +125,11 @@ TEST(ConfigFilesOverDds, SnapshotApplyAndBackOnEveryFirmware) {
     ASSERT_EQ(apply.status, 0) << apply.out << service.describe();
     EXPECT_EQ(count_of(apply.out, ": COMPLETED"), 13u) << apply.out;
     // The address last (section 4.6).
-    EXPECT_GT(apply.out.find("can_address " + std::to_string(minor)), apply.out.find("packets_streamed"))
-        << apply.out;
+    const auto moved_at = apply.out.find("can_address " + std::to_string(minor) + " -> ");
+    const auto streamed_at = apply.out.find("packets_streamed ");
+    ASSERT_NE(moved_at, std::string::npos) << apply.out;
+    ASSERT_NE(streamed_at, std::string::npos) << apply.out;
+    EXPECT_GT(moved_at, streamed_at) << apply.out;
     const std::string now = "--address " + std::to_string(moved) + " ";
     const auto there = pmu::test::run_capture(p + now + "config diff " + changed + " 2>&1");
     EXPECT_EQ(there.status, 0) << there.out;

@@ -10,6 +10,7 @@
 
 #include "pmu/energy/bms_energy.hpp"
 #include "pmu/energy/mean_current.hpp"
+#include "energy_times.hpp"
 
 namespace pmu::energy {
 // A namespace of its own: the unity builds put this file in one translation unit with the
@@ -18,12 +19,7 @@ namespace bms_energy_test {
 namespace {
 
 using namespace std::chrono_literals;
-constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
-const Time t0 = Time{} + std::chrono::hours(24 * 365 * 56);  // a wall-clock time in 2026
-
-Time at(double seconds) {
-  return t0 + std::chrono::duration_cast<Time::duration>(std::chrono::duration<double>(seconds));
-}
+using namespace test_times;
 
 // One pmu/battery sample: receive time (s from t0), volts, amps (+ into the battery), SoC %.
 struct Sample {

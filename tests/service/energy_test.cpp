@@ -9,17 +9,13 @@
 #include "pmu/energy/endurance.hpp"
 #include "pmu/energy/energy_integral.hpp"
 #include "pmu/energy/pmu_energy.hpp"
+#include "energy_times.hpp"
 
 namespace pmu::energy {
 namespace {
 
 using namespace std::chrono_literals;
-constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
-const Time t0 = Time{} + std::chrono::hours(24 * 365 * 56);  // a wall-clock time in 2026
-
-Time at(double seconds) {
-  return t0 + std::chrono::duration_cast<Time::duration>(std::chrono::duration<double>(seconds));
-}
+using namespace test_times;
 
 codec::Voltages volts(double avionics, double v28, double payload, double servo, double a, double b) {
   codec::Voltages v;
