@@ -10,22 +10,7 @@
 #
 # One service for all runs; prints one row per run and the medians.
 set -euo pipefail
-build=build/dev
-runs=5
-while [ $# -gt 0 ]; do
-  case "$1" in
-    --build-dir) build=$2; shift 2 ;;
-    --runs) runs=$2; shift 2 ;;
-    *) echo "usage: $0 [--build-dir DIR] [--runs N]" >&2; exit 2 ;;
-  esac
-done
-here=$(cd "$(dirname "$0")/.." && pwd)
-service=$build/service/pmu-service
-ctl=$build/tools/pmuctl
-[ -x "$service" ] && [ -x "$ctl" ] || { echo "config_apply.sh: build $build first (pmu-service, pmuctl)" >&2; exit 2; }
-export PMU_QOS_FILE=$here/deploy/qos.xml
-domain=$((150 + RANDOM % 50))
-work=$(mktemp -d)
+source "$(dirname "$0")/pmuctl_runs.sh"
 trap 'kill "$svc" 2>/dev/null || true; rm -rf "$work"' EXIT
 cat >"$work/service.yaml" <<YAML
 domain: $domain
@@ -35,39 +20,23 @@ buses:
       - address: 1
         period: 0.5
 YAML
-cat >"$work/changed.yaml" <<'YAML'
-parameters:
-  avionics_voltage: 22.0
-  payload_voltage: 13.5
-  servo_voltage: 7.5
-  battery_voltage: 24.0
-  packet_period: 0.4
-  packets_streamed: [voltages, currents, temperatures, status]
-  temperature_offset: 100
-  upper_temperature_limit: 90
-  power_up_state: [avionics_servo, payload, battery_disconnect_detect, soa_management]
-  cranking_time: 3.5
-  can_address: 2
-outputs: [avionics_servo, charger_a]
-generation_enabled: false
-YAML
+changed=$here/tests/data/config_every_setting.yaml
 
 ms() { local s; s=$(date +%s%N); "$@" >/dev/null 2>"$work/err" || { cat "$work/err" >&2; return 1; }; echo $(( ($(date +%s%N) - s) / 1000000 )); }
-median() { sort -n | awk '{a[NR]=$1} END {print (NR % 2) ? a[(NR + 1) / 2] : (a[NR / 2] + a[NR / 2 + 1]) / 2}'; }
 
 "$service" --config "$work/service.yaml" >"$work/service.log" 2>&1 &
 svc=$!
 "$ctl" --domain "$domain" --timeout 30 --address 1 config snapshot "$work/factory.yaml" 2>/dev/null
 # diff exits 1 when the PMU differs, as it must here.
-"$ctl" --domain "$domain" --json --address 1 config diff "$work/changed.yaml" >"$work/diff" 2>/dev/null || true
+"$ctl" --domain "$domain" --json --address 1 config diff "$changed" >"$work/diff" 2>/dev/null || true
 changes=$(grep -o '"name":' "$work/diff" | wc -l)
 echo "| run | outputs get (ms) | apply $changes changes (ms) | apply back (ms) |"
 echo "|---|---|---|---|"
 : >"$work/rows"
 for run in $(seq 1 "$runs"); do
   ref=$(ms "$ctl" --domain "$domain" --timeout 10 --address 1 outputs get)
-  forth=$(ms "$ctl" --domain "$domain" --timeout 10 --address 1 --confirm config apply "$work/changed.yaml")
-  back=$(ms "$ctl" --domain "$domain" --timeout 10 --address 2 --confirm config apply "$work/factory.yaml")
+  forth=$(ms "$ctl" --domain "$domain" --timeout 10 --address 1 --confirm config apply "$changed")
+  back=$(ms "$ctl" --domain "$domain" --timeout 10 --address 9 --confirm config apply "$work/factory.yaml")
   echo "| $run | $ref | $forth | $back |"
   echo "$ref $forth $back" >>"$work/rows"
 done

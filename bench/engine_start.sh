@@ -11,22 +11,7 @@
 # Each run starts a fresh pmu-service (its engine stopped by the config), so every start is a
 # first start. Prints one row per run and the medians.
 set -euo pipefail
-build=build/dev
-runs=5
-while [ $# -gt 0 ]; do
-  case "$1" in
-    --build-dir) build=$2; shift 2 ;;
-    --runs) runs=$2; shift 2 ;;
-    *) echo "usage: $0 [--build-dir DIR] [--runs N]" >&2; exit 2 ;;
-  esac
-done
-here=$(cd "$(dirname "$0")/.." && pwd)
-service=$build/service/pmu-service
-ctl=$build/tools/pmuctl
-[ -x "$service" ] && [ -x "$ctl" ] || { echo "engine_start.sh: build $build first (pmu-service, pmuctl)" >&2; exit 2; }
-export PMU_QOS_FILE=$here/deploy/qos.xml
-domain=$((150 + RANDOM % 50))
-work=$(mktemp -d)
+source "$(dirname "$0")/pmuctl_runs.sh"
 trap 'kill "$svc" 2>/dev/null || true; rm -rf "$work"' EXIT
 cat >"$work/service.yaml" <<YAML
 domain: $domain
@@ -45,7 +30,6 @@ timed() {
   start=$(date +%s%N)
   "$@" 2>&1 | while IFS= read -r line; do echo "$(ms_since "$start") $line"; done
 }
-median() { sort -n | awk '{a[NR]=$1} END {print (NR % 2) ? a[(NR + 1) / 2] : (a[NR / 2] + a[NR / 2 + 1]) / 2}'; }
 
 echo "| run | outputs get (ms) | first IN_PROGRESS (ms) | final COMPLETED (ms) | progress lines |"
 echo "|---|---|---|---|---|"

@@ -340,6 +340,7 @@ cp "$work/load-order" "$root/lib/modules/load-order"
 cp "$suite_script" "$root/$(basename "$suite_script")"
 chmod 755 "$root/$(basename "$suite_script")"
 cp "$script_dir/scenario_lib.sh" "$root/scenario_lib.sh"   # sourced by either suite
+cp "$source_dir/tests/data/config_every_setting.yaml" "$root/config_every_setting.yaml"   # scenario config_file
 echo "root:x:0:0:root:/root:/bin/sh" >"$root/etc/passwd"
 echo "root:x:0:" >"$root/etc/group"
 echo "127.0.0.1 localhost" >"$root/etc/hosts"

@@ -595,22 +595,8 @@ scenario_config_file() {
     fail "config snapshot: $(tr '\n' ' ' <"$WORK/$SCEN.snap")"
   grep -q '^  serial: 700$' "$WORK/factory.yaml" && grep -q '^  firmware: "1.16"$' "$WORK/factory.yaml" ||
     fail "the snapshot's header is not the unit's: $(head -n 12 "$WORK/factory.yaml" | tr '\n' ' ')"
-  cat >"$WORK/changed.yaml" <<'YAML'
-parameters:
-  avionics_voltage: 22.0
-  payload_voltage: 13.5
-  servo_voltage: 7.5
-  battery_voltage: 24.0
-  packet_period: 0.4
-  packets_streamed: [voltages, currents, temperatures, status]
-  temperature_offset: 100
-  upper_temperature_limit: 90
-  power_up_state: [avionics_servo, payload, battery_disconnect_detect, soa_management]
-  cranking_time: 3.5
-  can_address: 9
-outputs: [avionics_servo, charger_a]
-generation_enabled: false
-YAML
+  # Every setting changed, the unit moved to address 9 (tests/data, copied beside this script).
+  cp "$(dirname "$0")/config_every_setting.yaml" "$WORK/changed.yaml"
   # What differs: every setting but those the service set itself at the start (it streams
   # what its config asks for).
   ctl --timeout 10 --address 1 config diff "$WORK/changed.yaml" >"$WORK/$SCEN.diff0" 2>/dev/null
