@@ -1,7 +1,7 @@
 # pmu_idl_generate(): the one place that turns the contract's IDL into code at build time,
 # for each IDL compiler the project uses. Nothing generated is committed.
 #
-#   pmu_idl_generate(<sources-var> COMPILER <compiler> DESTINATION <dir> IDL <file>...)
+#   pmu_idl_generate(<sources-var> COMPILER <compiler> DESTINATION <dir> [INCLUDE <dir>] IDL <file>...)
 #
 # Appends the generated files to compile to <sources-var> (in the caller's scope); the headers
 # land beside them in <dir>. <compiler> is one of
@@ -9,6 +9,9 @@
 #   fastddsgen-typeobject  <stem>TypeObject.h/.cxx only (the XTypes type objects); it compiles
 #                          against the <stem>.h of a `fastddsgen` run into the same <dir>
 #   idlc                   <stem>.h/.c (Eclipse Cyclone DDS's C types, final extensibility)
+#   fastddsgen-ros2        as fastddsgen, for ROS 2 IDL (rosidl's, under INCLUDE as
+#                          <pkg>/msg/<Name>.idl): type names as rmw_fastrtps registers them,
+#                          <pkg>::msg::dds_::<Name>_
 #
 # PMU_IDL_FILES: the contract's IDL files (absolute paths), for every caller.
 get_filename_component(_pmu_idl_dir "${CMAKE_CURRENT_LIST_DIR}/../idl" ABSOLUTE)
@@ -16,7 +19,7 @@ set(PMU_IDL_FILES ${_pmu_idl_dir}/telemetry.idl ${_pmu_idl_dir}/state.idl ${_pmu
                   ${_pmu_idl_dir}/canopen.idl ${_pmu_idl_dir}/alarms.idl ${_pmu_idl_dir}/energy.idl)
 
 function(pmu_idl_generate sources_var)
-  cmake_parse_arguments(PARSE_ARGV 1 arg "" "COMPILER;DESTINATION" "IDL")
+  cmake_parse_arguments(PARSE_ARGV 1 arg "" "COMPILER;DESTINATION;INCLUDE" "IDL")
   if(NOT arg_COMPILER OR NOT arg_DESTINATION OR NOT arg_IDL)
     message(FATAL_ERROR "pmu_idl_generate: COMPILER, DESTINATION and IDL are required")
   endif()
@@ -57,6 +60,27 @@ function(pmu_idl_generate sources_var)
         COMMENT "fastddsgen -typeobject ${stem}.idl"
         VERBATIM)
       list(APPEND sources ${dir}/${stem}TypeObject.cxx)
+    elseif(arg_COMPILER STREQUAL "fastddsgen-ros2")
+      find_program(FASTDDSGEN fastddsgen REQUIRED)
+      if(NOT arg_INCLUDE)
+        message(FATAL_ERROR "pmu_idl_generate: fastddsgen-ros2 needs INCLUDE, the root of the ROS 2 IDL")
+      endif()
+      # fastddsgen also generates every IDL the file includes, into the same folder: two runs
+      # into one package's folder would write the same files at once. Each run has a folder of
+      # its own, and only the file's own four are copied out.
+      file(RELATIVE_PATH rel ${arg_INCLUDE} ${idl})
+      string(REGEX REPLACE "\\.idl$" "" rel ${rel})
+      set(run_dir ${CMAKE_CURRENT_BINARY_DIR}/fastddsgen-ros2/${rel})
+      set(own ${run_dir}/${stem}.h ${run_dir}/${stem}.cxx ${run_dir}/${stem}PubSubTypes.h ${run_dir}/${stem}PubSubTypes.cxx)
+      add_custom_command(
+        OUTPUT ${dir}/${stem}.h ${dir}/${stem}.cxx ${dir}/${stem}PubSubTypes.h ${dir}/${stem}PubSubTypes.cxx
+        COMMAND ${CMAKE_COMMAND} -E make_directory ${run_dir}/tmp
+        COMMAND ${FASTDDSGEN} -typeros2 -replace -t ${run_dir}/tmp -I ${arg_INCLUDE} -d ${run_dir} ${idl}
+        COMMAND ${CMAKE_COMMAND} -E copy ${own} ${dir}
+        DEPENDS ${idl}
+        COMMENT "fastddsgen -typeros2 ${rel}.idl"
+        VERBATIM)
+      list(APPEND sources ${dir}/${stem}.cxx ${dir}/${stem}PubSubTypes.cxx)
     elseif(arg_COMPILER STREQUAL "idlc")
       find_program(CYCLONE_IDLC idlc PATHS /usr/bin REQUIRED)
       # -x final: fastddsgen 2.3 treats these structs as final (plain CDR, no DHEADER); idlc's
@@ -69,7 +93,7 @@ function(pmu_idl_generate sources_var)
         VERBATIM)
       list(APPEND sources ${dir}/${stem}.c)
     else()
-      message(FATAL_ERROR "pmu_idl_generate: unknown COMPILER '${arg_COMPILER}' (fastddsgen, fastddsgen-typeobject, idlc)")
+      message(FATAL_ERROR "pmu_idl_generate: unknown COMPILER '${arg_COMPILER}' (fastddsgen, fastddsgen-typeobject, fastddsgen-ros2, idlc)")
     endif()
   endforeach()
   set(${sources_var} ${sources} PARENT_SCOPE)

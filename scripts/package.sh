@@ -66,6 +66,11 @@ if git -C "$root" rev-parse --git-dir >/dev/null 2>&1; then
 else
   tar -C "$root" --exclude=./build --exclude=./.git -cf - . | tar -xf - -C "$src"
 fi
+# The ROS 2 .msg files the build generates types from are npm's (scripts/setup.sh), which git
+# ignores; Debian has no package of them for the Build-Depends.
+if [ -d "$root/ros2/node_modules" ] && [ ! -d "$src/ros2/node_modules" ]; then
+  cp -a "$root/ros2/node_modules" "$src/ros2/"
+fi
 
 echo "package.sh: building pmu-dds $version for $arch (${profiles[*]:-no profiles}) in $src"
 start=$(date +%s)

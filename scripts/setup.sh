@@ -1,9 +1,10 @@
 #!/usr/bin/env bash
 # Installs the Debian packages of one set:
 #   run   what building and running pmu-dds need (a tree with PMU_BUILD_TESTS and
-#         PMU_BUILD_BENCH off, as a plain `cmake -S . -B build` configures it): scripts/run.sh
+#         PMU_BUILD_BENCH off, as a plain `cmake -S . -B build` configures it), and the ROS 2
+#         message definitions from npm (npm ci in ros2/): scripts/run.sh
 #   test  everything: the run set, the tests' and benchmarks' libraries, the VMs, the Debian
-#         packaging and its arm64 cross build, ccache, Node.js for tests/mcap: scripts/test.sh
+#         packaging and its arm64 cross build, ccache, tests/mcap's npm packages: scripts/test.sh
 #   scripts/setup.sh [run|test]        install the set (default: test)
 #   scripts/setup.sh --list run|test   print the set's Debian packages, one per line
 # Idempotent: packages already present are left alone, and apt is not touched at all
@@ -33,6 +34,10 @@ run_packages=(
   # pmuctl serve: a WebSocket server (header-only) on standalone asio
   libwebsocketpp-dev libasio-dev
   libssl-dev libtinyxml2-dev
+  # ros2/: rosidl_adapter turns ROS 2 .msg files into IDL (python3-rosidl; its rosidl_adapter
+  # imports em, which the package does not depend on). tests/contract's IDL layout guard
+  # parses idl/ with the IDL 4.2 grammar (lark) of the same package.
+  python3-rosidl python3-empy
 )
 test_only_packages=(
   ccache
@@ -42,8 +47,6 @@ test_only_packages=(
   fastdds-tools openssl
   cyclonedds-dev cyclonedds-tools
   can-utils iproute2 python3 python3-can
-  # tests/contract: the IDL 4.2 grammar (lark) the IDL layout guard parses idl/ with
-  python3-rosidl
   # The VM of the system tests and the network lab (tests/lab: iproute2's ip and tc with
   # netem's distribution tables go into it; its kernel is downloaded, not installed)
   qemu-system-x86 busybox-static cpio kmod
@@ -62,15 +65,15 @@ arm64_packages=(
   libsystemd-dev:arm64 libyaml-cpp0.7:arm64 libssl-dev:arm64 libtinyxml2-dev:arm64
   libgtest-dev:arm64 libgmock-dev:arm64 pkg-config:arm64 libwebsocketpp-dev:arm64
 )
-# Node.js for the MCAP tests (tests/mcap), installed below only when node or npm is missing.
+# Node.js's npm, which fetches the ROS 2 message definitions (ros2/) and the MCAP tests'
+# readers (tests/mcap); installed below only when node or npm is missing.
 node_packages=(nodejs npm)
 
 packages=("${run_packages[@]}")
 if [ "$set_name" = test ]; then packages+=("${test_only_packages[@]}" "${arm64_packages[@]}"); fi
 
 if [ "$list" = 1 ]; then
-  printf '%s\n' "${packages[@]}"
-  if [ "$set_name" = test ]; then printf '%s\n' "${node_packages[@]}"; fi
+  printf '%s\n' "${packages[@]}" "${node_packages[@]}"
   exit 0
 fi
 
@@ -106,24 +109,32 @@ else
   $SUDO apt-get install -y -q --no-install-recommends "${missing[@]}"
 fi
 
-[ "$set_name" = test ] || exit 0
-
-# The MCAP tests (tests/mcap) read pmuctl's files with the ecosystem's own npm packages on
-# Node.js. Node.js may come from elsewhere (NodeSource bundles npm): Debian's nodejs and npm
-# are installed only when the commands are missing. The packages come from the lock file
-# (npm ci), and only when it changed since the last install.
+# npm packages, each folder's from its lock file (npm ci), and only when the lock file changed
+# since the last install. Node.js may come from elsewhere (NodeSource bundles npm): Debian's
+# nodejs and npm are installed only when the commands are missing.
 if ! command -v node >/dev/null || ! command -v npm >/dev/null; then
   need_root "${node_packages[*]}"
-  echo "setup: installing ${node_packages[*]} (Debian) for tests/mcap"
+  echo "setup: installing ${node_packages[*]} (Debian) for npm"
   export DEBIAN_FRONTEND=noninteractive
   $SUDO apt-get update -q
   $SUDO apt-get install -y -q --no-install-recommends "${node_packages[@]}"
 fi
-mcap_dir="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)/tests/mcap"
-stamp="$mcap_dir/node_modules/.package-lock.json"
-if [ ! -f "$stamp" ] || [ "$mcap_dir/package-lock.json" -nt "$stamp" ]; then
-  echo "setup: npm ci in tests/mcap (@mcap/core, @foxglove/ws-protocol, ws, @foxglove/omgidl-parser, @foxglove/omgidl-serialization)"
-  (cd "$mcap_dir" && npm ci --no-audit --no-fund --loglevel=error)
-else
-  echo "setup: tests/mcap npm packages present"
-fi
+root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+npm_ci() {  # npm_ci FOLDER WHAT
+  local stamp="$root/$1/node_modules/.package-lock.json"
+  if [ ! -f "$stamp" ] || [ "$root/$1/package-lock.json" -nt "$stamp" ]; then
+    echo "setup: npm ci in $1 ($2)"
+    (cd "$root/$1" && npm ci --no-audit --no-fund --loglevel=error)
+  else
+    echo "setup: $1 npm packages present"
+  fi
+}
+
+# The build generates ROS 2's types from the upstream .msg files, which no Debian package has
+# for ROS 2 (ros2/CMakeLists.txt).
+npm_ci ros2 "@foxglove/rosmsg-msgs-common: the ROS 2 .msg definitions"
+
+[ "$set_name" = test ] || exit 0
+
+# The MCAP tests (tests/mcap) read pmuctl's files with the ecosystem's own npm packages.
+npm_ci tests/mcap "@mcap/core, @foxglove/ws-protocol, ws, @foxglove/omgidl-parser, @foxglove/omgidl-serialization"
