@@ -132,6 +132,7 @@ DdsContext::DdsContext(int domain, const std::string& qos_file, const std::strin
 DdsContext::~DdsContext() {
   if (!participant_) return;
   unmatch_writers_before_deleting_them(*publisher_);
+  if (default_publisher_) unmatch_writers_before_deleting_them(*default_publisher_);
   participant_->delete_contained_entities();
   DomainParticipantFactory::get_instance()->delete_participant(participant_);
 }
@@ -171,6 +172,18 @@ DataReader& DdsContext::reader(Topic& topic, const std::string& profile, DataRea
                    ": raise its <resourceLimitsQos> (deploy/qos.xml says how each number is derived)");
   }
   return *r;
+}
+
+DataWriter& DdsContext::default_partition_writer(Topic& topic, const DataWriterQos& qos) {
+  if (!default_publisher_) default_publisher_ = participant_->create_publisher(PUBLISHER_QOS_DEFAULT);
+  if (!default_publisher_) throw DdsError("cannot create a DDS publisher in the default partition for " + topic.get_name());
+  DataWriter* w = default_publisher_->create_datawriter(&topic, qos);
+  if (!w) {
+    const std::string what = "cannot create a writer for " + topic.get_name() + " in the default partition";
+    if (!secure_) throw DdsError(what);
+    throw DdsError(what + " (DDS-Security: this identity's permissions may not allow publishing it there)");
+  }
+  return *w;
 }
 
 void DdsContext::refused(const std::string& topic, const std::string& profile, bool publish) const {

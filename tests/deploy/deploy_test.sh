@@ -60,16 +60,17 @@ full="$work/full.yaml"
 sed -e "s|^# qos_file: .*|qos_file: $deploy/qos.xml|" \
     -e 's/^# dds_statistics:/dds_statistics:/' \
     -e 's/^# dds_type_objects:/dds_type_objects:/' \
+    -e '/^# ros2:$/,/^#   namespace:/ s/^# //' \
     -e '/^ *discover: false$/d' \
     -e '/^ *# discover:$/,/^ *#   packets:/ s/# //' \
     -e '/^ *# - address: 2$/,/^ *#   packets:/ s/# //' \
     -e '/^ *# - interface: sim$/,/^ *#         panels: 2$/ s/# //' \
     "$deploy/pmu-service.yaml" > "$full"
 changed_lines=$(diff "$deploy/pmu-service.yaml" "$full" | grep -c '^>' || true)
-# qos_file (1) + dds_statistics (1) + dds_type_objects (1) + discover mapping (4) + polling device (4) + sim bus
-# with its devices' sim: mappings (50)
-[ "$changed_lines" -eq 61 ] ||
-  fail "expected 61 example lines to switch on, got $changed_lines (were the commented examples changed?)"
+# qos_file (1) + dds_statistics (1) + dds_type_objects (1) + ros2 (3) + discover mapping (4) + polling device (4)
+# + sim bus with its devices' sim: mappings (50)
+[ "$changed_lines" -eq 64 ] ||
+  fail "expected 64 example lines to switch on, got $changed_lines (were the commented examples changed?)"
 out=$("$service_bin" --config "$full" --check-config 2>&1) ||
   fail "pmu-service rejected the example with its commented parts enabled: $out"
 echo "$out"

@@ -32,6 +32,7 @@
 #include "pmu/dds/dds_commands.hpp"
 #include "pmu/dds/dds_context.hpp"
 #include "pmu/dds/dds_publisher.hpp"
+#include "pmu/dds/ros2_publisher.hpp"
 #include "pmu/dds/startup_check.hpp"
 #include "pmu/dispatch/command_service.hpp"
 #include "pmu/session/bus_worker.hpp"
@@ -145,6 +146,14 @@ int run(const service::Config& cfg, const pmu::dds::ResolvedNetwork& network) {
       if (d.baseline) spdlog::info("{}/{}: watched against baseline {}", b.name, d.address, d.baseline_path);
   std::vector<service::StateSink*> sinks{&publisher};
   if (previous_publisher) sinks.push_back(previous_publisher.get());
+  // ROS 2's names and types, on the service's own participant (this build's contract).
+  std::unique_ptr<pmu::dds::Ros2Publisher> ros2;
+  if (cfg.ros2.enabled) {
+    ros2 = std::make_unique<pmu::dds::Ros2Publisher>(participant, cfg.ros2, cfg.vehicle, cfg.buses);
+    sinks.push_back(ros2.get());
+    spdlog::info("ROS 2: sensor_msgs/BatteryState and /diagnostics under '{}' (ros2)",
+                 cfg.ros2.name_space.empty() ? "/" : cfg.ros2.name_space);
+  }
   service::StateFanout fanout(sinks);
   // In front of the publishers: pmu/readiness from what the sessions report.
   service::ReadinessTracker readiness(cfg.buses, fanout, clock);

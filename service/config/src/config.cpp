@@ -411,6 +411,18 @@ void parse_timeouts(const Ctx& c, const YAML::Node& n, Timeouts& t) {
     c.fail(n["offline_periods"] ? n["offline_periods"] : n, "offline_periods must be greater than stale_periods");
 }
 
+void parse_ros2(const Ctx& c, const YAML::Node& n, Ros2Settings& r) {
+  if (!n.IsMap()) c.fail(n, "ros2 must be a map: {enabled: true, namespace: /fleet}");
+  c.only_keys(n, "ros2", {"enabled", "namespace"});
+  r.source_line = c.line_of(n);
+  if (const auto v = n["enabled"]) r.enabled = c.scalar<bool>(v, "ros2 enabled", "true or false");
+  if (const auto v = n["namespace"]) {
+    if (!v.IsNull()) r.name_space = c.scalar<std::string>(v, "ros2 namespace", "a ROS 2 namespace");
+    if (const auto why = ros2_namespace_problem(r.name_space); !why.empty())
+      c.fail(v, "ros2 namespace " + quoted(r.name_space) + " " + why);
+  }
+}
+
 void parse_policy(const Ctx& c, const YAML::Node& n, PolicyConfig& p) {
   c.only_keys(n, "policy", {"confirm", "deny", "rate_limit", "burst", "command_lifetime",
                                 "max_command_lifetime"});
@@ -682,7 +694,7 @@ Config parse_config(const std::string& text, const std::string& source, const Co
   c.only_keys(root, "the top level", {"domain", "vehicle", "low_rate_period", "qos_file", "dds_transport", "log_level",
                                       "buses", "timeouts", "policy", "security", "discovery", "interfaces",
                                       "canopen_publish_period", "dds_statistics", "dds_type_objects",
-                                      "also_serve_contract"});
+                                      "also_serve_contract", "ros2"});
   if (const auto v = root["domain"]) cfg.domain = static_cast<int>(c.integer(v, "domain", 0, 232));
   if (const auto v = root["vehicle"]) {
     // `vehicle:` with nothing after it is YAML null: the unnamed vehicle, like no key.
@@ -744,6 +756,7 @@ Config parse_config(const std::string& text, const std::string& source, const Co
     }
   }
   if (const auto v = root["timeouts"]) parse_timeouts(c, v, cfg.timeouts);
+  if (const auto v = root["ros2"]) parse_ros2(c, v, cfg.ros2);
   if (const auto v = root["policy"]) parse_policy(c, v, cfg.policy);
   for (const auto& kv : root)
     if (kv.first.as<std::string>() == "security") parse_security(c, kv.first, kv.second, cfg.security);
@@ -756,6 +769,7 @@ Config parse_config(const std::string& text, const std::string& source, const Co
   if (!buses) c.fail(root, "no buses: the service needs at least one bus");
   if (!buses.IsSequence() || buses.size() == 0) c.fail(buses, "buses must be a non-empty list");
   std::set<std::string> names, interfaces;
+  std::map<std::string, std::string> ros2_names;  // ROS 2 token -> the bus name it came from
   std::size_t devices = 0;
   for (const auto& bn : buses) {
     BusConfig b = parse_bus(c, bn);
@@ -777,6 +791,10 @@ Config parse_config(const std::string& text, const std::string& source, const Co
                  "pmu::service::kMaxDevicesPerService); split them across services");
     devices += canopen;
     if (!names.insert(b.name).second) c.fail(bn, "bus name " + quoted(b.name) + " appears twice");
+    // ROS 2 names allow fewer characters than bus names: two buses must not share one.
+    if (cfg.ros2.enabled && !ros2_names.emplace(ros2_token(b.name), b.name).second)
+      c.fail(bn, "bus names " + quoted(ros2_names[ros2_token(b.name)]) + " and " + quoted(b.name) +
+                     " are both " + quoted(ros2_token(b.name)) + " in ROS 2 topic names (ros2 enabled); rename one");
     if (b.interface != "sim" && !interfaces.insert(b.interface).second)
       c.fail(bn, "interface " + quoted(b.interface) + " is used by two buses (the service owns each bus alone)");
     cfg.buses.push_back(std::move(b));

@@ -21,7 +21,7 @@
 // writer() or reader() must outlive the context (Fast DDS may call it until the participant
 // is deleted), or be removed from its endpoint first (set_listener(nullptr), as
 // DdsCommandEndpoint::stop() does).
-// Threads: the constructor, topic(), writer() and reader() on one thread at a time (start-up;
+// Threads: the constructor, topic(), writer(), default_partition_writer() and reader() on one thread at a time (start-up;
 // they share the topic map unlocked); remote_writers() from any thread (it locks).
 
 #include <fastdds/dds/domain/DomainParticipant.hpp>
@@ -132,6 +132,12 @@ class DdsContext {
   eprosima::fastdds::dds::DataReader& reader(eprosima::fastdds::dds::Topic& topic, const std::string& profile,
                                              eprosima::fastdds::dds::DataReaderListener* listener = nullptr);
 
+  // A writer in the default partition with `qos` as given, not from qos.xml: for ROS 2's
+  // topics (ros2_publisher.hpp), whose partition and QoS are what ROS 2 subscribers expect
+  // rather than a tuning of this service. Throws DdsError like writer().
+  eprosima::fastdds::dds::DataWriter& default_partition_writer(eprosima::fastdds::dds::Topic& topic,
+                                                               const eprosima::fastdds::dds::DataWriterQos& qos);
+
  private:
   // Throws the DdsError for an endpoint Fast DDS refused ("cannot create a writer for ...").
   [[noreturn]] void refused(const std::string& topic, const std::string& profile, bool publish) const;
@@ -146,6 +152,7 @@ class DdsContext {
   RemoteWriters remote_writers_;  // the participant's listener: outlives it
   eprosima::fastdds::dds::DomainParticipant* participant_ = nullptr;
   eprosima::fastdds::dds::Publisher* publisher_ = nullptr;
+  eprosima::fastdds::dds::Publisher* default_publisher_ = nullptr;  // made by the first default_partition_writer()
   eprosima::fastdds::dds::Subscriber* subscriber_ = nullptr;
   std::map<std::string, eprosima::fastdds::dds::Topic*> topics_;
 };

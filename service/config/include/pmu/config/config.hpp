@@ -18,6 +18,7 @@
 #include "pmu/command/policy.hpp"
 #include "pmu/config/capacity.hpp"
 #include "pmu/config/network_settings.hpp"
+#include "pmu/config/ros2_names.hpp"
 #include "pmu/config/sim_settings.hpp"
 #include "pmu/config/transport_choice.hpp"
 #include "pmu/security/security_files.hpp"
@@ -171,6 +172,9 @@ struct Config {
   // only value accepted is the one before this build's. Unset (the default): only this
   // build's contract.
   std::optional<int> also_serve_contract;
+  // `ros2`: sensor_msgs/BatteryState and diagnostic_msgs/DiagnosticArray in ROS 2's own
+  // names and types (ros2_names.hpp, docs/interface.md section 11).
+  Ros2Settings ros2;
   std::string log_level = "info";
   std::vector<BusConfig> buses;
   Timeouts timeouts;

@@ -1,0 +1,68 @@
+#pragma once
+// Ros2Publisher: the StateSink that offers the power system to ROS 2 nodes in ROS 2's own
+// names and types (docs/interface.md section 11), beside the contract's topics:
+//   <device namespace>/battery_a, /battery_b   sensor_msgs/BatteryState of a PMU's inputs,
+//                                               one per pmu/voltages sample
+//   <device namespace>/battery                 sensor_msgs/BatteryState of a BMS, one per
+//                                               pmu/battery sample
+//   /diagnostics                               diagnostic_msgs/DiagnosticArray: a device's
+//                                               status with each of its health reports (1 s)
+// as ROS 2 nodes see them: DDS topics "rt/...", type names sensor_msgs::msg::dds_::..._, no
+// key, the default partition, RELIABLE + TRANSIENT_LOCAL + KEEP_LAST 1 (a default, a
+// sensor-data and a latched subscriber all match), no type object. Only pmu-service writes
+// them: it owns the bus.
+//
+// Lifetime: `dds` must outlive the publisher (it owns the writers' participant). The publisher
+// must outlive every BusWorker that writes through it.
+// Threads: every StateSink member from any bus worker thread (one mutex); a device's topics
+// are created at its first sample, under that mutex, so no other code may call the
+// context's topic() or writer() functions after the bus workers start.
+
+#include <chrono>
+#include <map>
+#include <memory>
+#include <mutex>
+#include <string>
+#include <tuple>
+#include <vector>
+
+#include "pmu/config/config.hpp"
+#include "pmu/dds/dds_context.hpp"
+#include "pmu/session/device_state.hpp"
+
+namespace pmu::dds {
+
+class Ros2Publisher final : public service::StateSink {
+ public:
+  // `buses`: the configured batteries' capacity_ah. Creates /diagnostics's writer; throws
+  // DdsError at start-up.
+  Ros2Publisher(DdsContext& dds, const service::Ros2Settings& settings, std::string vehicle,
+                const std::vector<service::BusConfig>& buses);
+  ~Ros2Publisher() override;
+
+  void on_telemetry(const service::DeviceKey& key, const codec::PmuMessage& message,
+                    std::chrono::system_clock::time_point received) override;
+  void on_config(const service::DeviceKey&, const service::ConfigState&) override {}
+  void on_info(const service::DeviceKey& key, const service::InfoState& info) override;
+  void on_health(const service::DeviceKey& key, const service::HealthReport& health) override;
+  void on_gone(const service::DeviceKey& key) override;
+  void on_battery(const service::DeviceKey& key, const service::BatteryState& battery,
+                  std::chrono::system_clock::time_point newest) override;
+  void on_battery_cells(const service::DeviceKey& key, const service::BatteryCellsState& cells,
+                        std::chrono::system_clock::time_point newest) override;
+  void on_mppt(const service::DeviceKey&, const service::MpptState&, std::chrono::system_clock::time_point) override {}
+  void on_alarm(const service::AlarmReport& alarm) override;
+  void on_readiness(const service::ReadinessReport&) override {}
+  void on_energy(const service::DeviceKey&, const energy::Figures&, std::chrono::system_clock::time_point) override {}
+  void on_bms_energy(const service::DeviceKey&, const energy::BmsFigures&,
+                     std::chrono::system_clock::time_point) override {}
+
+  // Writes Fast DDS refused (logged at most every few seconds too). Any thread.
+  std::uint64_t write_failures() const;
+
+ private:
+  struct State;
+  std::unique_ptr<State> s_;
+};
+
+}  // namespace pmu::dds

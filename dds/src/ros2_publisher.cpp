@@ -1,0 +1,239 @@
+#include "pmu/dds/ros2_publisher.hpp"
+
+#include <spdlog/spdlog.h>
+
+#include <fastdds/dds/publisher/qos/DataWriterQos.hpp>
+
+#include "diagnostic_msgs/msg/DiagnosticArrayPubSubTypes.h"
+#include "pmu/dds/ros2_messages.hpp"
+#include "sensor_msgs/msg/BatteryStatePubSubTypes.h"
+
+namespace pmu::dds {
+
+using eprosima::fastdds::dds::DataWriter;
+using eprosima::fastdds::dds::DataWriterQos;
+using service::DeviceKey;
+using service::DeviceKind;
+using service::Ros2Device;
+
+namespace ros2_publisher {
+
+// What ROS 2 subscribers of every usual profile match (rmw's default: RELIABLE, VOLATILE,
+// KEEP_LAST 10; sensor data: BEST_EFFORT; latched: TRANSIENT_LOCAL), with the newest sample
+// kept for a late joiner.
+DataWriterQos ros2_writer_qos() {
+  DataWriterQos q = eprosima::fastdds::dds::DATAWRITER_QOS_DEFAULT;
+  q.reliability().kind = eprosima::fastdds::dds::RELIABLE_RELIABILITY_QOS;
+  q.durability().kind = eprosima::fastdds::dds::TRANSIENT_LOCAL_DURABILITY_QOS;
+  q.history().kind = eprosima::fastdds::dds::KEEP_LAST_HISTORY_QOS;
+  q.history().depth = 1;
+  q.ownership().kind = eprosima::fastdds::dds::SHARED_OWNERSHIP_QOS;
+  return q;
+}
+
+using Key = std::tuple<std::string, std::uint16_t, DeviceKind>;
+Key key_of(const DeviceKey& k) { return {k.bus, k.address, k.kind}; }
+Key key_of(const service::AlarmReport& a) {
+  const DeviceKind kind = a.source == alarms::DeviceKind::Battery ? DeviceKind::Battery
+                          : a.source == alarms::DeviceKind::Mppt  ? DeviceKind::Mppt
+                                                                  : DeviceKind::Pmu;
+  return {a.bus, a.device, kind};
+}
+Ros2Device ros2_kind(DeviceKind k) {
+  return k == DeviceKind::Battery ? Ros2Device::Bms : k == DeviceKind::Mppt ? Ros2Device::Mppt : Ros2Device::Pmu;
+}
+
+struct Device {
+  service::HealthReport health;
+  std::map<alarms::Code, service::AlarmReport> alarms;  // the newest report of each code
+  // PMU
+  codec::Voltages voltages;
+  bool voltages_known = false;
+  double current_a = kUnknown, current_b = kUnknown;
+  double temperature_a = kUnknown, temperature_b = kUnknown;
+  std::optional<std::uint16_t> serial;
+  std::string firmware;
+  DataWriter* battery_a = nullptr;
+  DataWriter* battery_b = nullptr;
+  // BMS
+  service::BatteryCellsState cells;
+  DataWriter* battery = nullptr;
+
+  std::vector<service::AlarmReport> active() const {
+    std::vector<service::AlarmReport> out;
+    for (const auto& [code, a] : alarms)
+      if (alarm_active(a)) out.push_back(a);
+    return out;
+  }
+};
+
+}  // namespace ros2_publisher
+
+struct Ros2Publisher::State {
+  DdsContext& dds;
+  service::Ros2Settings settings;
+  std::string vehicle;
+  std::map<std::pair<std::string, std::uint8_t>, double> capacity_ah;  // (bus, node)
+  std::mutex mutex;
+  std::map<ros2_publisher::Key, ros2_publisher::Device> devices;
+  DataWriter* diagnostics = nullptr;
+  std::uint64_t failures = 0;
+  std::chrono::steady_clock::time_point next_failure_log{};
+
+  State(DdsContext& d, service::Ros2Settings s, std::string v) : dds(d), settings(std::move(s)), vehicle(std::move(v)) {}
+
+  std::string name_of(const DeviceKey& k) const {
+    return service::ros2_status_name(settings.name_space, vehicle, k.bus, ros2_publisher::ros2_kind(k.kind), k.address);
+  }
+  DataWriter* battery_writer(const DeviceKey& k, const char* leaf) {
+    const std::string ros_name =
+        service::ros2_device_namespace(settings.name_space, vehicle, k.bus, ros2_publisher::ros2_kind(k.kind), k.address) + "/" + leaf;
+    try {
+      auto& topic = dds.topic(service::ros2_dds_topic(ros_name), eprosima::fastdds::dds::TypeSupport(new sensor_msgs::msg::BatteryStatePubSubType()));
+      return &dds.default_partition_writer(topic, ros2_publisher::ros2_writer_qos());
+    } catch (const DdsError& e) {
+      failed(ros_name.c_str(), e.what());
+      return nullptr;
+    }
+  }
+  void write(DataWriter* w, void* sample, const char* what) {
+    if (!w) return;
+    if (!w->write(sample)) failed(what, "the write failed");
+  }
+  void failed(const char* what, const char* why) {
+    ++failures;
+    const auto now = std::chrono::steady_clock::now();
+    if (now < next_failure_log) return;
+    next_failure_log = now + std::chrono::seconds(5);
+    spdlog::warn("ROS 2: {}: {} ({} failure(s) so far)", what, why, failures);
+  }
+  void write_pmu_batteries(const DeviceKey& k, ros2_publisher::Device& d, std::chrono::system_clock::time_point at) {
+    if (!d.battery_a) d.battery_a = battery_writer(k, "battery_a");
+    if (!d.battery_b) d.battery_b = battery_writer(k, "battery_b");
+    for (const char input : {'A', 'B'}) {
+      PmuBatteryView v;
+      v.input = input;
+      v.voltage = input == 'A' ? d.voltages.battery_a : d.voltages.battery_b;
+      v.current = input == 'A' ? d.current_a : d.current_b;
+      v.temperature = input == 'A' ? d.temperature_a : d.temperature_b;
+      v.pmu_serial = d.serial;
+      v.health = d.health.state;
+      v.active = d.active();
+      v.stamp = at;
+      v.frame_id = name_of(k);
+      auto m = pmu_battery_message(v);
+      write(input == 'A' ? d.battery_a : d.battery_b, &m, "battery");
+    }
+  }
+};
+
+Ros2Publisher::Ros2Publisher(DdsContext& dds, const service::Ros2Settings& settings, std::string vehicle,
+                             const std::vector<service::BusConfig>& buses)
+    : s_(std::make_unique<State>(dds, settings, std::move(vehicle))) {
+  for (const auto& b : buses)
+    for (const auto& battery : b.batteries)
+      if (battery.capacity_ah) s_->capacity_ah[{b.name, battery.node}] = *battery.capacity_ah;
+  auto& topic = dds.topic("rt/diagnostics", eprosima::fastdds::dds::TypeSupport(new diagnostic_msgs::msg::DiagnosticArrayPubSubType()));
+  s_->diagnostics = &dds.default_partition_writer(topic, ros2_publisher::ros2_writer_qos());
+}
+
+Ros2Publisher::~Ros2Publisher() = default;
+
+std::uint64_t Ros2Publisher::write_failures() const {
+  std::lock_guard<std::mutex> lock(s_->mutex);
+  return s_->failures;
+}
+
+void Ros2Publisher::on_telemetry(const DeviceKey& key, const codec::PmuMessage& m,
+                                 std::chrono::system_clock::time_point received) {
+  std::lock_guard<std::mutex> lock(s_->mutex);
+  auto& d = s_->devices[ros2_publisher::key_of(key)];
+  if (const auto* c = std::get_if<codec::Currents>(&m.payload)) {
+    d.current_a = c->battery_a;
+    d.current_b = c->battery_b;
+  } else if (const auto* t = std::get_if<codec::Temperatures>(&m.payload)) {
+    d.temperature_a = t->battery_a;
+    d.temperature_b = t->battery_b;
+  } else if (const auto* v = std::get_if<codec::Voltages>(&m.payload)) {
+    d.voltages = *v;
+    d.voltages_known = true;
+    s_->write_pmu_batteries(key, d, received);
+  }
+}
+
+void Ros2Publisher::on_info(const DeviceKey& key, const service::InfoState& info) {
+  std::lock_guard<std::mutex> lock(s_->mutex);
+  auto& d = s_->devices[ros2_publisher::key_of(key)];
+  d.serial = info.serial_number;
+  if (info.firmware_known)
+    d.firmware = std::to_string(info.firmware.firmware_major) + "." + std::to_string(info.firmware.firmware_minor);
+}
+
+void Ros2Publisher::on_health(const DeviceKey& key, const service::HealthReport& health) {
+  std::lock_guard<std::mutex> lock(s_->mutex);
+  auto& d = s_->devices[ros2_publisher::key_of(key)];
+  d.health = health;
+  DeviceDiagnosticsView v;
+  v.name = s_->name_of(key);
+  switch (key.kind) {
+    case DeviceKind::Pmu:
+      v.hardware_id = d.serial ? "pmu serial " + std::to_string(*d.serial) : "pmu at address " + std::to_string(key.address);
+      if (!d.firmware.empty()) v.extra.emplace_back("firmware", d.firmware);
+      if (d.serial) v.extra.emplace_back("serial_number", std::to_string(*d.serial));
+      break;
+    case DeviceKind::Battery: v.hardware_id = "bms node " + std::to_string(key.address); break;
+    case DeviceKind::Mppt: v.hardware_id = "mppt device " + std::to_string(key.address); break;
+  }
+  v.extra.emplace(v.extra.begin(), "bus", key.bus);
+  v.health = health;
+  v.active = d.active();
+  diagnostic_msgs::msg::DiagnosticArray array;
+  set_stamp(array.header(), std::chrono::system_clock::now());
+  array.status().push_back(device_status(v));
+  s_->write(s_->diagnostics, &array, "/diagnostics");
+}
+
+void Ros2Publisher::on_gone(const DeviceKey& key) {
+  // A ROS 2 topic has no instance to dispose; the device's topics stay, silent.
+  std::lock_guard<std::mutex> lock(s_->mutex);
+  auto it = s_->devices.find(ros2_publisher::key_of(key));
+  if (it == s_->devices.end()) return;
+  ros2_publisher::Device fresh;
+  fresh.battery_a = it->second.battery_a;
+  fresh.battery_b = it->second.battery_b;
+  fresh.battery = it->second.battery;
+  it->second = std::move(fresh);
+}
+
+void Ros2Publisher::on_battery(const DeviceKey& key, const service::BatteryState& battery,
+                               std::chrono::system_clock::time_point newest) {
+  std::lock_guard<std::mutex> lock(s_->mutex);
+  auto& d = s_->devices[ros2_publisher::key_of(key)];
+  if (!d.battery) d.battery = s_->battery_writer(key, "battery");
+  BmsView v;
+  v.values = battery;
+  v.cells = d.cells;
+  if (auto it = s_->capacity_ah.find({key.bus, static_cast<std::uint8_t>(key.address)}); it != s_->capacity_ah.end())
+    v.capacity_ah = it->second;
+  v.health = d.health.state;
+  v.active = d.active();
+  v.stamp = newest;
+  v.frame_id = s_->name_of(key);
+  v.location = "bms node " + std::to_string(key.address);
+  auto m = bms_battery_message(v);
+  s_->write(d.battery, &m, "battery");
+}
+
+void Ros2Publisher::on_battery_cells(const DeviceKey& key, const service::BatteryCellsState& cells,
+                                     std::chrono::system_clock::time_point) {
+  std::lock_guard<std::mutex> lock(s_->mutex);
+  s_->devices[ros2_publisher::key_of(key)].cells = cells;
+}
+
+void Ros2Publisher::on_alarm(const service::AlarmReport& alarm) {
+  if (alarm.source == alarms::DeviceKind::Bus) return;  // a bus is no device of /diagnostics
+  std::lock_guard<std::mutex> lock(s_->mutex);
+  s_->devices[ros2_publisher::key_of(alarm)].alarms[alarm.code] = alarm;
+}
+
+}  // namespace pmu::dds
