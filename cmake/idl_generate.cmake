@@ -8,7 +8,8 @@
 #   fastddsgen             <stem>.h/.cxx and <stem>PubSubTypes.h/.cxx (Fast DDS's types)
 #   fastddsgen-typeobject  <stem>TypeObject.h/.cxx only (the XTypes type objects); it compiles
 #                          against the <stem>.h of a `fastddsgen` run into the same <dir>
-#   idlc                   <stem>.h/.c (Eclipse Cyclone DDS's C types, final extensibility)
+#   idlc                   <stem>.h/.c (Eclipse Cyclone DDS's C types, final extensibility); with
+#                          INCLUDE, the root its #includes are found under
 #   fastddsgen-ros2        as fastddsgen, for ROS 2 IDL (rosidl's, under INCLUDE as
 #                          <pkg>/msg/<Name>.idl): type names as rmw_fastrtps registers them,
 #                          <pkg>::msg::dds_::<Name>_
@@ -85,9 +86,13 @@ function(pmu_idl_generate sources_var)
       find_program(CYCLONE_IDLC idlc PATHS /usr/bin REQUIRED)
       # -x final: fastddsgen 2.3 treats these structs as final (plain CDR, no DHEADER); idlc's
       # default is final today but says it may become appendable, which would not interoperate.
+      set(include_args)
+      if(arg_INCLUDE)
+        set(include_args -I ${arg_INCLUDE})
+      endif()
       add_custom_command(
         OUTPUT ${dir}/${stem}.h ${dir}/${stem}.c
-        COMMAND ${CYCLONE_IDLC} -l c -x final -o ${dir} ${idl}
+        COMMAND ${CYCLONE_IDLC} -l c -x final ${include_args} -o ${dir} ${idl}
         DEPENDS ${idl}
         COMMENT "idlc (Cyclone DDS) ${stem}.idl"
         VERBATIM)

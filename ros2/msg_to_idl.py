@@ -1,11 +1,15 @@
 #!/usr/bin/python3
 """ROS 2 .msg definitions -> ROS 2 IDL, with Debian's rosidl_adapter.
 
-    msg_to_idl.py --msg-dir DIR --out-dir OUT PKG/Name...
+    msg_to_idl.py [--dds-names] --msg-dir DIR --out-dir OUT PKG/Name...
 
 Writes OUT/PKG/msg/Name.idl for each PKG/Name from DIR/PKG/msg/Name.msg: the IDL that every
 ROS 2 build makes from its .msg files (rosidl_adapter's msg.idl.em), which fastddsgen -typeros2
 compiles under the type names rmw_fastrtps registers (PKG::msg::dds_::Name_).
+
+--dds-names: the same types as plain DDS IDL under those names (PKG::msg::dds_::Name_, as
+rmw_cyclonedds registers them too), for an IDL compiler without a ROS 2 mode (Cyclone's
+idlc): annotations and the constants modules left out, which change nothing on the wire.
 
 DIR is a msgdefs/ros2<distro> folder of the npm package @foxglove/rosmsg-msgs-common. Its
 files hold the upstream .msg text followed by the definitions it depends on, each after a
@@ -45,7 +49,38 @@ def stdout_silenced():
         os.close(saved)
 
 
-def convert(msg_dir, out_dir, work_dir, package, name):
+ANNOTATION = re.compile(r'@\w+\s*\((?:[^()"]|"(?:[^"\\]|\\.)*")*\)\s*')
+QUALIFIED = re.compile(r'\b(\w+)::msg::(\w+)\b')
+
+
+def block_end(text, open_brace):
+    """The index after the '};' that closes the block whose '{' is at open_brace."""
+    depth = 0
+    for i in range(open_brace, len(text)):
+        if text[i] == '{':
+            depth += 1
+        elif text[i] == '}':
+            depth -= 1
+            if depth == 0:
+                return text.index(';', i) + 1
+    raise ValueError('unbalanced braces')
+
+
+def dds_names(idl):
+    """rosidl's IDL -> the same structs as PKG::msg::dds_::Name_."""
+    idl = ANNOTATION.sub('', idl)
+    while (m := re.search(r'module \w+_Constants\s*{', idl)):
+        idl = idl[:m.start()] + idl[block_end(idl, m.end() - 1):]
+    idl = QUALIFIED.sub(r'\1::msg::dds_::\2_', idl)
+    m = re.search(r'struct (\w+)\s*{', idl)
+    if not m:
+        raise ValueError('no struct')
+    end = block_end(idl, m.end() - 1)
+    return (idl[:m.start()] + 'module dds_ {\n' + f'struct {m.group(1)}_ ' + idl[m.end() - 1:end] + '\n};' +
+            idl[end:])
+
+
+def convert(msg_dir, out_dir, work_dir, package, name, dds):
     source = msg_dir / package / 'msg' / f'{name}.msg'
     package_dir = work_dir / package
     (package_dir / 'msg').mkdir(parents=True, exist_ok=True)
@@ -55,10 +90,14 @@ def convert(msg_dir, out_dir, work_dir, package, name):
     idl_dir.mkdir(parents=True, exist_ok=True)
     with stdout_silenced():
         convert_msg_to_idl(package_dir, package, pathlib.Path('msg') / source.name, idl_dir)
+    if dds:
+        idl = idl_dir / f'{name}.idl'
+        idl.write_text(dds_names(idl.read_text(encoding='utf-8')), encoding='utf-8')
 
 
 def main(argv):
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument('--dds-names', action='store_true')
     parser.add_argument('--msg-dir', required=True, type=pathlib.Path)
     parser.add_argument('--out-dir', required=True, type=pathlib.Path)
     parser.add_argument('types', nargs='+', metavar='PKG/Name')
@@ -70,7 +109,7 @@ def main(argv):
                 print(f'msg_to_idl: {type_name}: expected PKG/Name', file=sys.stderr)
                 return 2
             try:
-                convert(args.msg_dir, args.out_dir, pathlib.Path(work), package, name)
+                convert(args.msg_dir, args.out_dir, pathlib.Path(work), package, name, args.dds_names)
             except Exception as error:  # rosidl_adapter raises plain exceptions on bad input
                 print(f'msg_to_idl: {type_name}: {error}', file=sys.stderr)
                 return 1
