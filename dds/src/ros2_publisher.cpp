@@ -113,7 +113,7 @@ struct Ros2Publisher::State {
     for (const char input : {'A', 'B'}) {
       PmuBatteryView v;
       v.input = input;
-      v.voltage = input == 'A' ? d.voltages.battery_a : d.voltages.battery_b;
+      if (d.voltages_known) v.voltage = input == 'A' ? d.voltages.battery_a : d.voltages.battery_b;
       v.current = input == 'A' ? d.current_a : d.current_b;
       v.temperature = input == 'A' ? d.temperature_a : d.temperature_b;
       v.pmu_serial = d.serial;
@@ -194,7 +194,8 @@ void Ros2Publisher::on_health(const DeviceKey& key, const service::HealthReport&
 }
 
 void Ros2Publisher::on_gone(const DeviceKey& key) {
-  // A ROS 2 topic has no instance to dispose; the device's topics stay, silent.
+  // A ROS 2 topic has no instance to dispose, and its writer keeps the last message for late
+  // joiners: the last one says that nothing is there (not present, nothing measured).
   std::lock_guard<std::mutex> lock(s_->mutex);
   auto it = s_->devices.find(ros2_publisher::key_of(key));
   if (it == s_->devices.end()) return;
@@ -202,7 +203,20 @@ void Ros2Publisher::on_gone(const DeviceKey& key) {
   fresh.battery_a = it->second.battery_a;
   fresh.battery_b = it->second.battery_b;
   fresh.battery = it->second.battery;
+  fresh.health.state = service::HealthState::Offline;
   it->second = std::move(fresh);
+  auto& d = it->second;
+  const auto now = std::chrono::system_clock::now();
+  if (d.battery_a || d.battery_b) s_->write_pmu_batteries(key, d, now);
+  if (d.battery) {
+    BmsView v;
+    v.health = d.health.state;
+    v.stamp = now;
+    v.frame_id = s_->name_of(key);
+    v.location = "bms node " + std::to_string(key.address);
+    auto m = bms_battery_message(v);
+    s_->write(d.battery, &m, "battery");
+  }
 }
 
 void Ros2Publisher::on_battery(const DeviceKey& key, const service::BatteryState& battery,

@@ -27,6 +27,8 @@
 
 #include "../../tools/pmuctl/record/raw_sample_type.hpp"
 #include "diagnostic_msgs/msg/DiagnosticArrayPubSubTypes.h"
+#include "pmu/dds/dds_context.hpp"
+#include "pmu/dds/ros2_publisher.hpp"
 #include "sensor_msgs/msg/BatteryStatePubSubTypes.h"
 #include "support/configured_service.hpp"
 #include "support/domain.hpp"
@@ -305,6 +307,43 @@ TEST(Ros2OverDds, BatteriesAndDiagnosticsReachARos2DefaultReaderWithTheSimulator
   EXPECT_TRUE(next<Battery>(*latched, raw, m, 10s, [](const auto&) { return true; }));
   const auto log = service.describe();
   EXPECT_EQ(log.find("ROS 2: "), log.find("ROS 2: sensor_msgs/BatteryState")) << "a ROS 2 warning:\n" << log;
+}
+
+// A PMU that is gone (it moved to another CAN address): a latched subscriber that joins later
+// gets, as each battery's last message, one that says nothing is there.
+TEST(Ros2OverDds, AGoneDeviceLeavesANotPresentBatteryForLateJoiners) {
+  const int domain = pmu::test::exclusive_dds_domain();
+  pmu::dds::DdsContext service_side(domain, PMU_QOS_FILE, "pmu-service-ros2");
+  pmu::service::Ros2Settings settings;
+  settings.enabled = true;
+  pmu::dds::Ros2Publisher publisher(service_side, settings, "uav1", {});
+  const pmu::service::DeviceKey key{"can0", 1, pmu::service::DeviceKind::Pmu};
+  pmu::service::HealthReport online;
+  online.state = pmu::service::HealthState::Online;
+  publisher.on_health(key, online);
+  pmu::codec::PmuMessage voltages;
+  voltages.payload = pmu::codec::Voltages{12, 28, 12, 6, 24.5, 24.1, 0};
+  publisher.on_telemetry(key, voltages, std::chrono::system_clock::now());
+
+  Ros2Side ros2(domain);
+  ASSERT_TRUE(ros2.ready());
+  using Battery = sensor_msgs::msg::BatteryStatePubSubType;
+  RawSample raw;
+  sensor_msgs::msg::BatteryState m;
+  DataReader* before = ros2.reader("rt/uav1/can0/pmu_1/battery_a", reader_qos(RELIABLE_RELIABILITY_QOS, TRANSIENT_LOCAL_DURABILITY_QOS));
+  ASSERT_NE(before, nullptr);
+  ASSERT_TRUE(next<Battery>(*before, raw, m, 10s, [](const auto&) { return true; }));
+  EXPECT_TRUE(m.present());
+  EXPECT_FLOAT_EQ(m.voltage(), 24.5f);
+
+  publisher.on_gone(key);
+  DataReader* after = ros2.reader("rt/uav1/can0/pmu_1/battery_b", reader_qos(RELIABLE_RELIABILITY_QOS, TRANSIENT_LOCAL_DURABILITY_QOS));
+  ASSERT_NE(after, nullptr);
+  ASSERT_TRUE(next<Battery>(*after, raw, m, 10s, [](const auto&) { return true; }));
+  EXPECT_FALSE(m.present());
+  EXPECT_TRUE(std::isnan(m.voltage()));
+  EXPECT_EQ(m.power_supply_health(), Bs::POWER_SUPPLY_HEALTH_UNKNOWN);
+  EXPECT_EQ(m.power_supply_status(), Bs::POWER_SUPPLY_STATUS_UNKNOWN);
 }
 
 }  // namespace
