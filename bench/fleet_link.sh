@@ -57,15 +57,16 @@ while [ $# -gt 0 ]; do
     *) echo "fleet_link.sh: unknown argument '$1'" >&2; exit 2 ;;
   esac
 done
-[ -n "$svc" ] || svc=$(find "$build_dir" -type f -name pmu-service -perm -u+x | head -n1)
-[ -n "$ctl" ] || ctl=$(find "$build_dir" -type f -name pmuctl -perm -u+x | head -n1)
-[ -x "$svc" ] && [ -x "$ctl" ] || { echo "fleet_link.sh: build pmu-service and pmuctl in $build_dir first" >&2; exit 2; }
-[ -r "$qos" ] || { echo "fleet_link.sh: cannot read $qos" >&2; exit 2; }
 case "$cut_s" in '' | *[!0-9]* | 0) echo "fleet_link.sh: --cut takes whole seconds, at least 1 (got '$cut_s')" >&2; exit 2 ;; esac
 for n in $aircraft; do
   case "$n" in '' | *[!0-9]* | 0) echo "fleet_link.sh: --aircraft takes counts of at least 1 (got '$n')" >&2; exit 2 ;; esac
   [ "$n" -le 60 ] || { echo "fleet_link.sh: at most 60 aircraft (their two commands each set payload_voltage to its own value in 12.1..24.0)" >&2; exit 2; }
 done
+# A missing build directory is the error below, not find's.
+[ -n "$svc" ] || svc=$(find "$build_dir" -type f -name pmu-service -perm -u+x 2>/dev/null | head -n1 || true)
+[ -n "$ctl" ] || ctl=$(find "$build_dir" -type f -name pmuctl -perm -u+x 2>/dev/null | head -n1 || true)
+[ -x "$svc" ] && [ -x "$ctl" ] || { echo "fleet_link.sh: build pmu-service and pmuctl in $build_dir first" >&2; exit 2; }
+[ -r "$qos" ] || { echo "fleet_link.sh: cannot read $qos" >&2; exit 2; }
 [ "$(id -u)" = 0 ] || { echo "fleet_link.sh: SKIP: needs root for network namespaces" >&2; exit 77; }
 
 . "$root/tests/support/dds_domain.sh"
