@@ -753,28 +753,33 @@ missed() { MISSED="$MISSED${MISSED:+; }$*"; detail "TARGET MISSED: $*"; }
 resends_answered() { _n=0; for _j in $FLEET_STARTED; do _n=$((_n + $(duplicate_lines pmuctl- "$(fleet_log "$_j")" | wc -l))); done; echo "$_n"; }
 
 # The longest time without a sample of each VEHICLE in stream NAME between uptimes A and B
-# (A to the first sample, between samples, the last to B): "VEHICLE GAP SAMPLES" lines.
+# (A to the first sample, between samples, the last to B): "VEHICLE GAP SAMPLES FROM" lines,
+# FROM the uptime at which that longest gap began.
 stream_gaps() {  # NAME A B VEHICLE...
   _n=$1 _from=$2 _to=$3; shift 3
   stream_between "$_n" "$_from" "$_to" | awk -v a="$_from" -v b="$_to" -v want="$*" '
-    BEGIN { n = split(want, w, " "); for (i = 1; i <= n; i++) { last[w[i]] = a; gap[w[i]] = 0; c[w[i]] = 0 } }
+    BEGIN { n = split(want, w, " "); for (i = 1; i <= n; i++) { last[w[i]] = a; gap[w[i]] = 0; c[w[i]] = 0; from[w[i]] = a } }
     { if (!match($0, /"vehicle":"[^"]*"/)) next
       v = substr($0, RSTART + 11, RLENGTH - 12)
       if (!(v in last)) next
-      if ($1 - last[v] > gap[v]) gap[v] = $1 - last[v]
+      if ($1 - last[v] > gap[v]) { gap[v] = $1 - last[v]; from[v] = last[v] }
       last[v] = $1; c[v]++ }
-    END { for (i = 1; i <= n; i++) { v = w[i]; if (b - last[v] > gap[v]) gap[v] = b - last[v]; printf "%s %.1f %d\n", v, gap[v], c[v] } }'
+    END { for (i = 1; i <= n; i++) { v = w[i]; if (b - last[v] > gap[v]) { gap[v] = b - last[v]; from[v] = last[v] }
+                                     printf "%s %.1f %d %.2f\n", v, gap[v], c[v], from[v] } }'
 }
 stream_has_all() {  # NAME T VEHICLE...: a sample of each since T
   _n=$1 _t=$2; shift 2
   for _v in "$@"; do stream_between "$_n" "$_t" | grep -q "\"vehicle\":\"$_v\"" || return 1; done
 }
-# fails when a vehicle's telemetry stopped for more than FLEET_GAP_BOUND s: WHAT NAME A B VEHICLE...
+# A vehicle's telemetry paused for more than FLEET_GAP_BOUND s is a missed bound, none at all
+# a failure: WHAT NAME A B VEHICLE... (each gap's start counted from uav9's start)
 check_gaps() {
   _what=$1; shift
   _g=$(stream_gaps "$@")
-  _bad=$(printf '%s\n' "$_g" | awk -v m="$FLEET_GAP_BOUND" '$2 > m || $3 == 0')
-  [ -z "$_bad" ] || fail "$_what: telemetry stopped (vehicle, longest gap s, samples): $(printf '%s' "$_bad" | tr '\n' ';')"
+  _none=$(printf '%s\n' "$_g" | awk '$3 == 0 { printf "%s ", $1 }')
+  [ -z "$_none" ] || fail "$_what: no telemetry at all of $_none"
+  _bad=$(printf '%s\n' "$_g" | awk -v m="$FLEET_GAP_BOUND" -v j="$t_join" '$2 > m { printf "%s %.1f s from %.1f s; ", $1, $2, $4 - j }')
+  [ -z "$_bad" ] || missed "$_what: telemetry paused longer than $FLEET_GAP_BOUND s (vehicle, longest gap, its start after uav9's start): $_bad(uav9's first sample at $(calc "$t9 - $t_join") s, uav8 stopped at $(calc "$t_leave - $t_join") s)"
   GAPS=$(printf '%s\n' "$_g" | awk '{ if ($2 > m) m = $2; n += $3 } END { printf "longest gap %.1f s, %d samples", m, n }')
 }
 
