@@ -4,7 +4,7 @@
 #
 #   bench/fleet_link.sh [--aircraft "1 4 8"] [--rate 250kbit] [--build-dir DIR] [--qos FILE]
 #                       [--pmuctl BIN] [--service BIN] [--discovery-server [--server-xml FILE|none]]
-#                       [--json FILE]
+#                       [--cut SECONDS] [--json FILE]
 #
 # Two network namespaces joined by one veth pair, shaped by tbf to RATE each way (a radio
 # modem's queue of about 2 s; no delay or loss: the VM lab adds those): in `air`, N pmu-service
@@ -18,7 +18,16 @@
 # --qos, --pmuctl and --service measure another qos.xml, pmuctl or pmu-service (a before and
 # after, one run each). --discovery-server: Fast DDS's Discovery Server (fast-discovery-server)
 # runs on the ground host with the shipped deploy/discovery-server.xml (--server-xml: another
-# file, or none for the program's own defaults), and the services and pmuctl are its clients. Needs root (ip netns); exit status 77 when namespaces cannot be made.
+# file, or none for the program's own defaults), and the services and pmuctl are its clients.
+# With it, two more steps per N, and a second table:
+#   round    one `pmuctl --vehicle uavI config set payload_voltage` to each aircraft in turn:
+#            each call's seconds (start to exit), p50 / p99 / max (nearest rank), COMPLETED of N
+#   cut      the veth down for CUT s (30), then up: seconds from its return until a `pmuctl
+#            list` lists all N, and until a command to each (all at once, after that list)
+#            COMPLETED; then every command's id is counted in the services' audit trails
+#            (`audit: command ID ...` lines): executions must equal commands, none twice
+# Needs root (ip netns); exit status 77 when namespaces cannot be made. Exit status 1 when
+# a --discovery-server run found a command executed twice or by another vehicle.
 set -euo pipefail
 
 root=$(cd "$(dirname "$0")/.." && pwd)
@@ -31,6 +40,7 @@ json_out=""
 ds=0
 svc=""
 server_xml="$root/deploy/discovery-server.xml"
+cut_s=30
 while [ $# -gt 0 ]; do
   case "$1" in
     --aircraft) aircraft=$2; shift 2 ;;
@@ -42,12 +52,19 @@ while [ $# -gt 0 ]; do
     --service) svc=$(realpath "$2"); shift 2 ;;
     --discovery-server) ds=1; shift ;;
     --server-xml) server_xml=$2; [ "$2" = none ] || server_xml=$(realpath "$2"); shift 2 ;;
-    -h|--help) sed -n '2,21p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
+    --cut) cut_s=$2; shift 2 ;;
+    -h|--help) sed -n '2,30p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
     *) echo "fleet_link.sh: unknown argument '$1'" >&2; exit 2 ;;
   esac
 done
-[ -n "$svc" ] || svc=$(find "$build_dir" -type f -name pmu-service -perm -u+x | head -n1)
-[ -n "$ctl" ] || ctl=$(find "$build_dir" -type f -name pmuctl -perm -u+x | head -n1)
+case "$cut_s" in '' | *[!0-9]* | 0) echo "fleet_link.sh: --cut takes whole seconds, at least 1 (got '$cut_s')" >&2; exit 2 ;; esac
+for n in $aircraft; do
+  case "$n" in '' | *[!0-9]* | 0) echo "fleet_link.sh: --aircraft takes counts of at least 1 (got '$n')" >&2; exit 2 ;; esac
+  [ "$n" -le 60 ] || { echo "fleet_link.sh: at most 60 aircraft (their two commands each set payload_voltage to its own value in 12.1..24.0)" >&2; exit 2; }
+done
+# A missing build directory is the error below, not find's.
+[ -n "$svc" ] || svc=$(find "$build_dir" -type f -name pmu-service -perm -u+x 2>/dev/null | head -n1 || true)
+[ -n "$ctl" ] || ctl=$(find "$build_dir" -type f -name pmuctl -perm -u+x 2>/dev/null | head -n1 || true)
 [ -x "$svc" ] && [ -x "$ctl" ] || { echo "fleet_link.sh: build pmu-service and pmuctl in $build_dir first" >&2; exit 2; }
 [ -r "$qos" ] || { echo "fleet_link.sh: cannot read $qos" >&2; exit 2; }
 [ "$(id -u)" = 0 ] || { echo "fleet_link.sh: SKIP: needs root for network namespaces" >&2; exit 77; }
@@ -97,8 +114,99 @@ ds_option=()
 [ "$ds" = 1 ] && ds_option=(--discovery-server 10.79.0.2)
 pmuctl_gnd() { PMU_QOS_FILE="$qos" ip netns exec "$gnd" "$ctl" --domain "$domain" --interface gnd0 "${ds_option[@]}" --json "$@"; }
 now() { date +%s.%N; }
+# The audit trail (`audit: command ...` lines) is logged at info.
+svc_log_level=warn
+[ "$ds" = 1 ] && svc_log_level=info
+# Command K of a run sets payload_voltage to its own value (12.1, 12.2, ...).
+value_for() { printf '%d.%d' $((12 + $1 / 10)) $(($1 % 10)); }
+# timed_command VEHICLE VALUE: "SECONDS RESULT REQUEST_ID END" of one pmuctl config set, start to exit.
+timed_command() {
+  local t0 t1 out
+  t0=$(now)
+  out=$(pmuctl_gnd --vehicle "$1" --timeout 30 config set payload_voltage "$2" 2>>"$work/commands.err" | head -n1) || true
+  t1=$(now)
+  python3 -c '
+import json, sys
+t0, t1 = float(sys.argv[1]), float(sys.argv[2])
+try:
+    j = json.loads(sys.argv[3])
+except ValueError:
+    j = {}
+result, request = j.get("result") or "none", j.get("request_id") or "none"
+print(f"{t1 - t0:.2f} {result} {request} {t1:.3f}")' "$t0" "$t1" "$out"
+}
+vehicles_listed() { sed -n 's/.*"vehicle":"\([^"]*\)".*/\1/p' "$1" | sort -u | wc -l; }
+# The command round, the cut and the audit count of one fleet (--discovery-server runs): a
+# row of the second table.
+round_and_cut() {  # N
+  local n=$1 i t_up t_list pids=() r listed_s
+  : >"$work/round"; : >"$work/after"
+  for i in $(seq 1 "$n"); do
+    r=$(timed_command "uav$i" "$(value_for "$i")")
+    echo "uav$i $r" >>"$work/round"
+  done
+  # A radio fade as the interface sees it: the carrier gone, on both ends, for cut_s seconds.
+  ip -n "$gnd" link set gnd0 down
+  sleep "$cut_s"
+  ip -n "$gnd" link set gnd0 up
+  t_up=$(now)
+  # Down deleted the routes through gnd0; only the default one (for multicast) is not re-made.
+  ip -n "$gnd" route replace default dev gnd0
+  listed_s=none
+  while python3 -c "import sys; sys.exit(not float(sys.argv[2]) - float(sys.argv[1]) < 120)" "$t_up" "$(now)"; do
+    pmuctl_gnd --timeout 10 list >"$work/relist.out" 2>/dev/null || true
+    if [ "$(vehicles_listed "$work/relist.out")" -ge "$n" ]; then
+      t_list=$(now); listed_s=$(python3 -c "print(round($t_list - $t_up, 2))"); break
+    fi
+    sleep 0.5
+  done
+  # Then a command to each at once: the whole fleet checked after the link's return.
+  for i in $(seq 1 "$n"); do
+    (r=$(timed_command "uav$i" "$(value_for $((n + i)))"); echo "uav$i $r" >>"$work/after") &
+    pids+=($!)
+  done
+  for i in "${pids[@]}"; do wait "$i" || true; done
+  python3 - "$n" "$work" "$t_up" "$listed_s" <<'PY'
+import re, sys
+n, work, t_up, listed = int(sys.argv[1]), sys.argv[2], float(sys.argv[3]), sys.argv[4]
+def read(name):
+    rows = []
+    for line in open(f"{work}/{name}"):
+        v, secs, result, rid, end = line.split()
+        rows.append(dict(vehicle=v, secs=float(secs), result=result, id=rid, end=float(end)))
+    return rows
+round_, after = read("round"), read("after")
+def rank(values, p):
+    v = sorted(values)
+    return v[max(0, -(-len(v) * p // 100) - 1)]
+secs = [r["secs"] for r in round_]
+done_round = sum(r["result"] == "COMPLETED" for r in round_)
+done_after = sum(r["result"] == "COMPLETED" for r in after)
+back = max(r["end"] for r in after) - t_up if after else float("nan")
+# Every execution is one `audit: command ID from ...` line in the log of the service that ran it.
+ids = {r["id"]: r["vehicle"] for r in round_ + after if r["id"] != "none"}
+executed, dupes, problems = {}, 0, []
+for i in range(1, n + 1):
+    for line in open(f"{work}/uav{i}.log", errors="replace"):
+        m = re.search(r"audit: command (\S+) from .* -> ([A-Z_]+)", line)
+        if m and "reuses that id" not in line and m.group(1) in ids:
+            executed.setdefault(m.group(1), []).append(f"uav{i}")
+        if re.search(r"audit: duplicate command \S+ from", line):
+            dupes += 1
+for rid, vehicle in ids.items():
+    ran = executed.get(rid, [])
+    if len(ran) > 1 or any(v != vehicle for v in ran):
+        problems.append(f"{rid} for {vehicle} executed by {','.join(ran)}")
+execs = sum(len(v) for v in executed.values())
+print(f"{rank(secs, 50):.2f} {rank(secs, 99):.2f} {max(secs):.2f} {done_round} {listed} {back:.2f} {done_after} "
+      f"{execs} {len(round_) + len(after)} {dupes} {len(problems)}")
+for p in problems:
+    print("fleet_link.sh: " + p, file=sys.stderr)
+PY
+}
 
 rows=()
+ds_rows=()
 for n in $aircraft; do
   link_up
   ds_yaml=""
@@ -116,7 +224,7 @@ vehicle: uav$i
 qos_file: $qos
 dds_transport: udp
 interfaces: [air0]
-log_level: warn
+log_level: $svc_log_level
 $ds_yaml
 buses:
   - interface: sim
@@ -155,13 +263,14 @@ EOF
   drops=$(( $(link_drops) - d0 ))
 
   rows+=("$n $idle $list_bytes $list_s $listed $cmd_bytes $cmd_s $result $low $low_samples $drops")
+  [ "$ds" = 1 ] && ds_rows+=("$n $(round_and_cut "$n")")
   stop_all
   wait 2>/dev/null || true
 done
 
-ROWS=$(printf '%s\n' "${rows[@]}") python3 - "$rate" "$json_out" "$qos" "$ctl" "$ds" "$svc" "$server_xml" <<'PY'
+ROWS=$(printf '%s\n' "${rows[@]}") DS_ROWS=$(printf '%s\n' "${ds_rows[@]}") python3 - "$rate" "$json_out" "$qos" "$ctl" "$ds" "$svc" "$server_xml" "$cut_s" <<'PY'
 import json, os, re, sys
-rate, json_out, qos, ctl, ds, svc, server_xml = sys.argv[1:8]
+rate, json_out, qos, ctl, ds, svc, server_xml, cut_s = sys.argv[1:9]
 m = re.match(r"(\d+)kbit", rate)
 cap = int(m.group(1)) * 1000 / 8 if m else None
 out = []
@@ -178,8 +287,29 @@ for line in os.environ["ROWS"].splitlines():
     out.append(dict(aircraft=n, idle_bytes_per_s=idle, list_bytes=lb, list_seconds=ls, listed=listed,
                     command_bytes=cb, command_seconds=cs, command_result=result,
                     low_rate_bytes_per_s=low, low_rate_samples_per_s=low_samples, drops=drops))
+failed = 0
+if ds == "1":
+    print()
+    print(f"| aircraft | command round, one to each in turn: p50 / p99 / max s, COMPLETED | after a {cut_s} s cut (veth down): all listed after, a command to each (at once) COMPLETED after, COMPLETED | audit trails: executions / commands, resends answered again, executed twice or elsewhere |")
+    print("|---|---|---|---|")
+    by_n = {r["aircraft"]: r for r in out}
+    for line in os.environ["DS_ROWS"].splitlines():
+        f = line.split()
+        n = int(f[0])
+        p50, p99, mx, done, listed, back, done_after, execs, cmds, dupes, bad = f[1:12]
+        listed_text = f"{listed} s" if listed != "none" else "not all within 120 s"
+        print(f"| {n} | {p50} / {p99} / {mx} s, {done} of {n} | {listed_text}, {back} s, {done_after} of {n} | {execs} / {cmds}, {dupes}, {bad} |")
+        failed += int(bad)
+        by_n[n].update(round_p50_seconds=float(p50), round_p99_seconds=float(p99), round_max_seconds=float(mx),
+                       round_completed=int(done), cut_seconds=int(cut_s),
+                       relisted_seconds=None if listed == "none" else float(listed),
+                       recommanded_seconds=float(back), after_cut_completed=int(done_after),
+                       executions=int(execs), commands=int(cmds), resends_answered=int(dupes), executed_wrongly=int(bad))
 if json_out:
     with open(json_out, "w") as fh:
         json.dump({"rate": rate, "qos": qos, "pmuctl": ctl, "pmu_service": svc, "discovery_server": ds == "1",
                    "server_xml": server_xml if ds == "1" else None, "rows": out}, fh, indent=1)
+if failed:
+    print(f"fleet_link.sh: {failed} command(s) executed twice or by another vehicle", file=sys.stderr)
+    sys.exit(1)
 PY

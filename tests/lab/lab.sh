@@ -15,7 +15,7 @@
 #                           line (all when absent): the topology is built once, then each runs
 #   sh /lab.sh one NAME     a single scenario (what `all` runs for each)
 
-ALL_SCENARIOS="topology consumers commands cut cut_lifespan fleet unicast discovery_server security"
+ALL_SCENARIOS="topology consumers commands cut cut_lifespan fleet unicast discovery_server security fleet8"
 
 export PATH=/opt/pmu/bin:/usr/sbin:/usr/bin:/sbin:/bin
 export PMU_QOS_FILE=/etc/pmu-dds/qos.xml
@@ -169,14 +169,15 @@ CTL_EXTRA=""
 ctl() { _h=$1; shift; on "$_h" pmuctl --domain "$DOMAIN" --json $CTL_EXTRA "$@"; }
 
 # A background `pmuctl watch --json` in HOST whose every line is prefixed with the VM uptime
-# at which it was read: start_watch HOST NAME; the lines go to $WORK/$SCEN.NAME.stream.
+# at which it was read: start_watch HOST NAME [watch options]; the lines go to
+# $WORK/$SCEN.NAME.stream.
 start_watch() {
-  _s="$WORK/$SCEN.$2.stream"
+  _h=$1 _s="$WORK/$SCEN.$2.stream"; shift 2
   rm -f "$_s.fifo"; mkfifo "$_s.fifo"; : >"$_s"
   (while IFS= read -r l; do read -r u _ </proc/uptime; echo "$u $l"; done <"$_s.fifo" >"$_s") &
   track $!
   # shellcheck disable=SC2086
-  $NETNS_EXEC "$1" pmuctl --domain "$DOMAIN" --json $CTL_EXTRA watch >"$_s.fifo" 2>"$_s.err" &
+  $NETNS_EXEC "$_h" pmuctl --domain "$DOMAIN" --json $CTL_EXTRA watch "$@" >"$_s.fifo" 2>"$_s.err" &
   track $!
 }
 # Lines of stream NAME read at or after uptime T (and before U, if given).
@@ -655,6 +656,223 @@ discovery:
   ground_served "discovery server in mc2"
 }
 
+# Eight aircraft over the ground link, each a client of a Discovery Server on the ground
+# host (deploy/README.md, "A fleet on one ground link": with multicast discovery every new
+# ground participant makes each aircraft send it all its endpoints, about 17 kB, which
+# eight aircraft cannot fit through 250 kbit/s). Multicast is stopped at the bridge; the
+# server in gnd runs with the shipped radio periods. The lab has two mission computers, so
+# each runs four services (uav1..4 in mc1, uav5..8 in mc2): a vehicle is a service, whatever
+# host it runs on, and each service has its own participant, ports and audit trail.
+FLEET_SIZE=8
+FLEET_LIST_BOUND=30     # s from the ground's first `pmuctl list` to the return of one listing every aircraft
+FLEET_COMMAND_BOUND=5   # s one `pmuctl config set` may take, start to exit (p99 of a round)
+FLEET_RESUME_BOUND=20   # s from the link's return to every aircraft listed and a command to each COMPLETED
+FLEET_GAP_BOUND=5       # s without a low-rate sample (one per packet a second) that count as stopped telemetry
+# How long discovery is waited for at all: a missed bound is measured to the end and named,
+# and the scenario goes on to measure the rest; it fails at its end when any bound was missed.
+FLEET_LIST_LIMIT=90
+FLEET_DS="$(addr_of gnd):$DS_PORT"
+FLEET_NUMS="1 2 3 4 5 6 7 8"
+FLEET_NAMES="uav1 uav2 uav3 uav4 uav5 uav6 uav7 uav8"
+
+fleet_host() { if [ "$1" -le 4 ] || [ "$1" -gt "$FLEET_SIZE" ]; then echo mc1; else echo mc2; fi; }
+# start_aircraft N: the service of vehicle uavN, a client of the ground's server;
+# its log and pid are FLEET_LOG_N and FLEET_PID_N.
+FLEET_STARTED=""
+start_aircraft() {
+  start_service "$(fleet_host "$1")" "vehicle: uav$1
+discovery:
+  mode: server
+  servers: [\"$FLEET_DS\"]"
+  eval "FLEET_LOG_$1=\$SVC_LOG FLEET_PID_$1=\$SVC_PID"
+  FLEET_STARTED="$FLEET_STARTED $1"
+}
+fleet_log() { eval "echo \"\$FLEET_LOG_$1\""; }
+fleet_ready() { for _i in $FLEET_STARTED; do grep -q 'pmu-service ready on DDS domain' "$(fleet_log "$_i")" || return 1; done; }
+
+# The vehicles one `pmuctl list` in gnd shows with sim0/1, sorted, in SEEN.
+fleet_seen() {
+  SEEN=$(ctl gnd --timeout 10 list 2>>"$WORK/$SCEN.list.err" | grep '"bus":"sim0",' | grep '"kind":"pmu","address":1,' |
+    sed -n 's/.*"vehicle":"\([^"]*\)".*/\1/p' | sort -u | tr '\n' ' ' | sed 's/ $//')
+}
+# list_all T0 BOUND: `pmuctl list` in gnd, one call after another, until one lists the eight;
+# LISTED_AT is the uptime at which that call returned, LIST_CALLS the calls made. False when
+# BOUND s since T0 passed without one.
+list_all() {
+  LIST_CALLS=0
+  while :; do
+    LIST_CALLS=$((LIST_CALLS + 1))
+    fleet_seen
+    if [ "$SEEN" = "$FLEET_NAMES" ]; then LISTED_AT=$(now); return 0; fi
+    true_that "$(since "$1") >= $2" && return 1
+    sleep 0.5
+  done
+}
+
+# fleet_command N VALUE ROUND: `pmuctl config set payload_voltage VALUE` from gnd to uavN; appends
+# "uavN START END RESULT REQUEST_ID" (uptimes) to $WORK/$SCEN.ROUND.cmds.
+fleet_command() {
+  _a=$(now)
+  _o=$(ctl gnd --vehicle "uav$1" --timeout 30 config set payload_voltage "$2" 2>>"$WORK/$SCEN.cmd.err" | head -n1)
+  _r=$(jv "$_o" result) _id=$(jv "$_o" request_id)
+  echo "uav$1 $_a $(now) ${_r:-none} ${_id:-none}" >>"$WORK/$SCEN.$3.cmds"
+}
+# Seconds, one a line, on stdin: "min p50 p99 max" (nearest rank: of eight, p99 is the max).
+rank_stats() {
+  sort -n | awk '{ v[NR] = $1 } END { a = int((NR * 50 + 99) / 100); b = int((NR * 99 + 99) / 100)
+    printf "%.2f %.2f %.2f %.2f", v[1], v[a], v[b], v[NR] }'
+}
+# check_round ROUND: one command to each of the eight, every one COMPLETED.
+check_round() {
+  _bad=$(awk -v n="$FLEET_SIZE" '{ c[$1]++; if ($4 != "COMPLETED") print $1 " " $4 " (request " $5 ")" }
+    END { for (i = 1; i <= n; i++) if (c["uav" i] != 1) print "uav" i ": " c["uav" i] + 0 " commands" }' "$WORK/$SCEN.$1.cmds")
+  [ -z "$_bad" ] || fail "$1 round: $(printf '%s' "$_bad" | tr '\n' ';') (pmuctl: $(tail -n 2 "$WORK/$SCEN.cmd.err" | tr '\n' ' '))"
+}
+# Every command of the ROUNDs executed exactly once, by its own vehicle: one final audit line
+# with its id in that vehicle's log, COMPLETED on uavN/sim0/1, and none in any other service's.
+check_executed_once() {  # ROUND...
+  for _round in "$@"; do
+    while read -r _v _a _b _r _id; do
+      for _j in $FLEET_STARTED; do
+        _lines=$(audit_lines "$_id" "$(fleet_log "$_j")")
+        _c=$(printf '%s' "$_lines" | grep -c .)
+        if [ "uav$_j" = "$_v" ]; then
+          [ "$_c" = 1 ] || fail "audit trail of $_v: its command $_id ($_round round) executed $_c times"
+          grep -q "audit: command $_id .* to $_v/sim0/1 -> COMPLETED" "$(fleet_log "$_j")" ||
+            fail "audit trail of $_v: $_id ($_round round) is not COMPLETED on $_v/sim0/1: $_lines"
+        else
+          [ "$_c" = 0 ] || fail "uav$_j's service executed $_v's command $_id: $_lines"
+        fi
+      done
+    done <"$WORK/$SCEN.$_round.cmds"
+  done
+}
+# A time bound missed: recorded, the scenario fails at its end naming all of them.
+MISSED=""
+missed() { MISSED="$MISSED${MISSED:+; }$*"; detail "TARGET MISSED: $*"; }
+resends_answered() { _n=0; for _j in $FLEET_STARTED; do _n=$((_n + $(duplicate_lines pmuctl- "$(fleet_log "$_j")" | wc -l))); done; echo "$_n"; }
+
+# The longest time without a sample of each VEHICLE in stream NAME between uptimes A and B
+# (A to the first sample, between samples, the last to B): "VEHICLE GAP SAMPLES FROM" lines,
+# FROM the uptime at which that longest gap began.
+stream_gaps() {  # NAME A B VEHICLE...
+  _n=$1 _from=$2 _to=$3; shift 3
+  stream_between "$_n" "$_from" "$_to" | awk -v a="$_from" -v b="$_to" -v want="$*" '
+    BEGIN { n = split(want, w, " "); for (i = 1; i <= n; i++) { last[w[i]] = a; gap[w[i]] = 0; c[w[i]] = 0; from[w[i]] = a } }
+    { if (!match($0, /"vehicle":"[^"]*"/)) next
+      v = substr($0, RSTART + 11, RLENGTH - 12)
+      if (!(v in last)) next
+      if ($1 - last[v] > gap[v]) { gap[v] = $1 - last[v]; from[v] = last[v] }
+      last[v] = $1; c[v]++ }
+    END { for (i = 1; i <= n; i++) { v = w[i]; if (b - last[v] > gap[v]) { gap[v] = b - last[v]; from[v] = last[v] }
+                                     printf "%s %.1f %d %.2f\n", v, gap[v], c[v], from[v] } }'
+}
+stream_has_all() {  # NAME T VEHICLE...: a sample of each since T
+  _n=$1 _t=$2; shift 2
+  for _v in "$@"; do stream_between "$_n" "$_t" | grep -q "\"vehicle\":\"$_v\"" || return 1; done
+}
+# A vehicle's telemetry paused for more than FLEET_GAP_BOUND s is a missed bound, none at all
+# a failure: WHAT NAME A B VEHICLE... (each gap's start counted from uav9's start)
+check_gaps() {
+  _what=$1; shift
+  _g=$(stream_gaps "$@")
+  _none=$(printf '%s\n' "$_g" | awk '$3 == 0 { printf "%s ", $1 }')
+  [ -z "$_none" ] || fail "$_what: no telemetry at all of $_none"
+  _bad=$(printf '%s\n' "$_g" | awk -v m="$FLEET_GAP_BOUND" -v j="$t_join" '$2 > m { printf "%s %.1f s from %.1f s; ", $1, $2, $4 - j }')
+  [ -z "$_bad" ] || missed "$_what: telemetry paused longer than $FLEET_GAP_BOUND s (vehicle, longest gap, its start after uav9's start): $_bad(uav9's first sample at $(calc "$t9 - $t_join") s, uav8 stopped at $(calc "$t_leave - $t_join") s)"
+  GAPS=$(printf '%s\n' "$_g" | awk '{ if ($2 > m) m = $2; n += $3 } END { printf "longest gap %.1f s, %d samples", m, n }')
+}
+
+# shellcheck disable=SC2046,SC2086 # `set -- $(...)` splits figures into fields on purpose
+scenario_fleet8() {
+  t_start=$(now)
+  set -- $(vm_ticks); vb0=$1 vt0=$2; l0=$(link_bytes)
+  multicast_flood off || fail "cannot stop multicast flooding on the bridge"
+  $NETNS_EXEC gnd fast-discovery-server -i 0 -l "$(addr_of gnd)" -p "$DS_PORT" -x /etc/pmu-dds/discovery-server.xml \
+    >"$WORK/$SCEN.ds.log" 2>&1 &
+  track $!
+  CTL_EXTRA="--discovery-server $FLEET_DS"
+  for i in $FLEET_NUMS; do start_aircraft "$i"; done
+  wait_until 60 fleet_ready || fail "not every service ready within 60 s of the start: $(for i in $FLEET_STARTED; do grep -q 'ready on DDS' "$(fleet_log "$i")" || printf 'uav%s ' "$i"; done)"
+  t_ready=$(now)
+  detail "8 services (uav1-4 in mc1, uav5-8 in mc2), clients of the Discovery Server in gnd, multicast stopped; all ready $(calc "$t_ready - $t_start") s after the start"
+
+  # Discovery: the ground's first call, and calls after it until one lists the eight.
+  l1=$(link_bytes)
+  list_all "$t_ready" "$FLEET_LIST_LIMIT" || fail "gnd: no pmuctl list showed all eight within $FLEET_LIST_LIMIT s of the first call ($LIST_CALLS calls; the last listed: '$SEEN'; $(tail -n1 "$WORK/$SCEN.list.err")); ground link: $(link_backlog) packets queued (toward gnd, toward the aircraft)"
+  t_listed=$LISTED_AT
+  took=$(calc "$t_listed - $t_ready")
+  set -- $l1 $(link_bytes)
+  detail "gnd lists uav1..uav8 (sim0/1 each) $took s after its first pmuctl list ($LIST_CALLS calls; bound $FLEET_LIST_BOUND s); meanwhile the ground link carried $(calc "($3 - $1) * 8 / 1000 / $took") kbit/s to gnd, $(calc "($4 - $2) * 8 / 1000 / $took") kbit/s to the aircraft (cap 250)"
+  true_that "$took <= $FLEET_LIST_BOUND" || missed "every aircraft listed $took s after the ground's first call (bound $FLEET_LIST_BOUND s)"
+
+  # A command round: one config set to each aircraft, one after another, as an operator would.
+  : >"$WORK/$SCEN.round.cmds"
+  for i in $FLEET_NUMS; do fleet_command "$i" "12.$i" round; done
+  check_round round
+  set -- $(awk '{ print $3 - $2 }' "$WORK/$SCEN.round.cmds" | rank_stats)
+  r_p50=$2 r_p99=$3 r_max=$4
+  check_executed_once round
+  t_round=$(now)
+  detail "command round, one pmuctl config set to each of the eight in turn: all COMPLETED, each executed once by its own vehicle (audit trails); pmuctl start to exit min $1 s, p50 $r_p50 s, p99 = max $r_p99 s (bound $FLEET_COMMAND_BOUND s); $(resends_answered) resends answered again, not executed"
+  true_that "$r_p99 <= $FLEET_COMMAND_BOUND" || missed "command round p99 $r_p99 s (each: $(awk '{ printf "%s %.2f s, ", $1, $3 - $2 }' "$WORK/$SCEN.round.cmds" | sed 's/, $//'); bound $FLEET_COMMAND_BOUND s)"
+
+  # A cut longer than every lease (clients 20 s, the server 30 s).
+  set_link_loss 100%
+  T_CUT=$(now)
+  restore_after "$CUT_SECONDS"
+  sleep_until "$(calc "$T_CUT + 21")"
+  o=$(ctl gnd --timeout 5 list 2>/dev/null | grep -c '"vehicle":"uav')
+  [ "$o" -eq 0 ] || fail "premise: $o aircraft listed in gnd 21 s into the cut: the cut did not cut"
+  restored
+  detail "ground link cut (netem loss 100 % both ways) for $(calc "$T_UP - $T_CUT") s; 21 s into it gnd listed no aircraft"
+  list_all "$T_UP" "$FLEET_LIST_LIMIT" || fail "after the restore: no pmuctl list showed all eight within $FLEET_LIST_LIMIT s ($LIST_CALLS calls; the last listed: '$SEEN'); ground link: $(link_backlog) packets queued (toward gnd, toward the aircraft)"
+  relisted=$(calc "$LISTED_AT - $T_UP")
+  detail "after the restore: all eight listed again after $relisted s ($LIST_CALLS calls)"
+  # Then a command to each at once: the operator checking the whole fleet is back.
+  : >"$WORK/$SCEN.after.cmds"
+  pids=""
+  for i in $FLEET_NUMS; do fleet_command "$i" "13.$i" after & pids="$pids $!"; done
+  for p in $pids; do wait "$p"; done
+  check_round after
+  last=$(awk '{ if ($3 > m) m = $3 } END { print m }' "$WORK/$SCEN.after.cmds")
+  back=$(calc "$last - $T_UP")
+  set -- $(awk '{ print $3 - $2 }' "$WORK/$SCEN.after.cmds" | rank_stats)
+  check_executed_once round after
+  detail "after the restore: a command to each (all eight at once, after that list) COMPLETED by $back s (bound $FLEET_RESUME_BOUND s; each pmuctl p50 $2 s, max $4 s); no command of either round executed twice or by another vehicle"
+  true_that "$back <= $FLEET_RESUME_BOUND" || missed "after the link's return, every aircraft listed after $relisted s and commanded by $back s (bound $FLEET_RESUME_BOUND s)"
+
+  # A ninth aircraft joins, then uav8 leaves, while gnd watches the fleet's low-rate topics.
+  start_watch gnd fleet --low-rate
+  tw=$(now)
+  # shellcheck disable=SC2086 # FLEET_NAMES is a word list
+  wait_until 30 stream_has_all fleet "$tw" $FLEET_NAMES || fail "gnd: watch --low-rate got no sample of every aircraft within 30 s ($(stream_gaps fleet "$tw" "$(now)" $FLEET_NAMES | tr '\n' ';'))"
+  t_join=$(now)
+  start_aircraft 9
+  wait_until 40 stream_has_all fleet "$t_join" uav9 || fail "gnd: no telemetry of uav9 within 40 s of its start ($(tail -n1 "$(fleet_log 9)"))"
+  t9=$(stream_between fleet "$t_join" | grep -m1 '"vehicle":"uav9"' | cut -d' ' -f1)
+  sleep_until "$(calc "$t9 + 10")"
+  t_leave=$(now)
+  kill "$FLEET_PID_8"; wait "$FLEET_PID_8" 2>/dev/null
+  sleep_until "$(calc "$t_leave + 15")"
+  t_end=$(now)
+  check_gaps "while uav9 joined and uav8 left" fleet "$t_join" "$t_end" uav1 uav2 uav3 uav4 uav5 uav6 uav7
+  others=$GAPS
+  check_gaps "uav8 before it left" fleet "$t_join" "$t_leave" uav8
+  check_gaps "uav9 after it joined" fleet "$t9" "$t_end" uav9
+  late8=$(stream_between fleet "$(calc "$t_leave + 5")" | grep -c '"vehicle":"uav8"')
+  [ "$late8" -eq 0 ] || fail "premise: $late8 samples of uav8 more than 5 s after its service was stopped"
+  detail "uav9 joined (its first sample in gnd $(calc "$t9 - $t_join") s after its start) and uav8 left: uav1..uav7 $others over the $(calc "$t_end - $t_join") s (bound $FLEET_GAP_BOUND s); uav9 $GAPS after it joined"
+  check_executed_once round after
+
+  # What the scenario costs the lab's run, phase by phase, and what it asked of the VM.
+  set -- $(vm_ticks); vb1=$1 vt1=$2; l1=$(link_bytes)
+  all=$(since "$t_start")
+  set -- $l0 $l1
+  detail "scenario $all s: start-up $(calc "$t_ready - $t_start"), discovery $took, command round $(calc "$t_round - $t_listed"), cut and recovery $(calc "$last - $t_round"), join and leave $(calc "$t_end - $last"), checks $(calc "$(now) - $t_end") s; VM CPUs $(calc "100 * ($vb1 - $vb0) / ($vt1 - $vt0)") % busy; ground link $(calc "($3 - $1) * 8 / 1000 / $all") kbit/s to gnd, $(calc "($4 - $2) * 8 / 1000 / $all") kbit/s to the aircraft on average (cap 250)"
+  [ -z "$MISSED" ] || fail "time bounds missed: $MISSED"
+}
+
 # DDS-Security across the ground link (the PKI run_vm_tests.sh made with make_pki.sh): the
 # ground-station identity commands; the mission-computer identity reads but its command is
 # never executed; a participant without a certificate receives nothing.
@@ -691,6 +909,7 @@ security:
 scenario_limit() {  # seconds a scenario may take in the (slow, emulated) VM
   case "$1" in
     commands) echo 300 ;;
+    fleet8) echo 420 ;;
     cut | cut_lifespan | fleet | security) echo 200 ;;
     topology) echo 60 ;;
     *) echo 150 ;;
