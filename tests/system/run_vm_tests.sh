@@ -92,11 +92,13 @@ build_dir=$(cd "$build_dir" 2>/dev/null && pwd) || die "build directory '$build_
 
 all_scenarios=$(sed -n 's/^ALL_SCENARIOS="\(.*\)"$/\1/p' "$suite_script")
 [ -n "$all_scenarios" ] || die "cannot read ALL_SCENARIOS from $suite_script"
+# Scenarios run only when named (--scenario), never in the whole suite.
+named_scenarios=$(sed -n 's/^NAMED_SCENARIOS="\(.*\)"$/\1/p' "$suite_script")
 if [ ${#scenarios[@]} -eq 0 ]; then
   read -r -a scenarios <<<"$all_scenarios"
 else
   for s in "${scenarios[@]}"; do
-    case " $all_scenarios " in *" $s "*) ;; *) die "unknown scenario '$s' (known: $all_scenarios)" ;; esac
+    case " $all_scenarios $named_scenarios " in *" $s "*) ;; *) die "unknown scenario '$s' (known: $all_scenarios $named_scenarios)" ;; esac
   done
 fi
 

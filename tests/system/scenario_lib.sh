@@ -99,9 +99,10 @@ run_list() {  # NAME...: each in turn, a RESULT line for each
   i=0
   for s in "$@"; do
     i=$((i + 1))
-    case " $ALL_SCENARIOS " in
+    # NAMED_SCENARIOS (a suite may have them): run when named, never by `all`.
+    case " $ALL_SCENARIOS ${NAMED_SCENARIOS:-} " in
       *" $s "*) SCEN=$s run_one "$s" "$i" ;;
-      *) echo "RESULT $s FAIL 0s no such scenario (known: $ALL_SCENARIOS)" ;;
+      *) echo "RESULT $s FAIL 0s no such scenario (known: $ALL_SCENARIOS ${NAMED_SCENARIOS:-})" ;;
     esac
   done
 }
