@@ -58,6 +58,9 @@ struct Device {
   // BMS
   service::BatteryCellsState cells;
   DataWriter* battery = nullptr;
+  // A battery writer Fast DDS refused (DDS-Security permissions) is not asked for again with
+  // every frame: refused once, said once.
+  bool refused = false;
 
   std::vector<service::AlarmReport> active() const {
     std::vector<service::AlarmReport> out;
@@ -108,8 +111,9 @@ struct Ros2Publisher::State {
     spdlog::warn("ROS 2: {}: {} ({} failure(s) so far)", what, why, failures);
   }
   void write_pmu_batteries(const DeviceKey& k, ros2_publisher::Device& d, std::chrono::system_clock::time_point at) {
-    if (!d.battery_a) d.battery_a = battery_writer(k, "battery_a");
-    if (!d.battery_b) d.battery_b = battery_writer(k, "battery_b");
+    if (!d.refused && !d.battery_a) d.battery_a = battery_writer(k, "battery_a");
+    if (!d.refused && !d.battery_b) d.battery_b = battery_writer(k, "battery_b");
+    d.refused = !d.battery_a || !d.battery_b;
     for (const char input : {'A', 'B'}) {
       PmuBatteryView v;
       v.input = input;
@@ -203,6 +207,7 @@ void Ros2Publisher::on_gone(const DeviceKey& key) {
   fresh.battery_a = it->second.battery_a;
   fresh.battery_b = it->second.battery_b;
   fresh.battery = it->second.battery;
+  fresh.refused = it->second.refused;
   fresh.health.state = service::HealthState::Offline;
   it->second = std::move(fresh);
   auto& d = it->second;
@@ -223,7 +228,8 @@ void Ros2Publisher::on_battery(const DeviceKey& key, const service::BatteryState
                                std::chrono::system_clock::time_point newest) {
   std::lock_guard<std::mutex> lock(s_->mutex);
   auto& d = s_->devices[ros2_publisher::key_of(key)];
-  if (!d.battery) d.battery = s_->battery_writer(key, "battery");
+  if (!d.refused && !d.battery) d.battery = s_->battery_writer(key, "battery");
+  d.refused = !d.battery;
   BmsView v;
   v.values = battery;
   v.cells = d.cells;
