@@ -6,6 +6,7 @@
 
 #include "diagnostic_msgs/msg/DiagnosticArrayPubSubTypes.h"
 #include "pmu/dds/ros2_messages.hpp"
+#include "pmu/session/log_throttle.hpp"
 #include "sensor_msgs/msg/BatteryStatePubSubTypes.h"
 
 namespace pmu::dds {
@@ -17,19 +18,6 @@ using service::DeviceKind;
 using service::Ros2Device;
 
 namespace ros2_publisher {
-
-// What ROS 2 subscribers of every usual profile match (rmw's default: RELIABLE, VOLATILE,
-// KEEP_LAST 10; sensor data: BEST_EFFORT; latched: TRANSIENT_LOCAL), with the newest sample
-// kept for a late joiner.
-DataWriterQos ros2_writer_qos() {
-  DataWriterQos q = eprosima::fastdds::dds::DATAWRITER_QOS_DEFAULT;
-  q.reliability().kind = eprosima::fastdds::dds::RELIABLE_RELIABILITY_QOS;
-  q.durability().kind = eprosima::fastdds::dds::TRANSIENT_LOCAL_DURABILITY_QOS;
-  q.history().kind = eprosima::fastdds::dds::KEEP_LAST_HISTORY_QOS;
-  q.history().depth = 1;
-  q.ownership().kind = eprosima::fastdds::dds::SHARED_OWNERSHIP_QOS;
-  return q;
-}
 
 using Key = std::tuple<std::string, std::uint16_t, DeviceKind>;
 Key key_of(const DeviceKey& k) { return {k.bus, k.address, k.kind}; }
@@ -72,6 +60,17 @@ struct Device {
 
 }  // namespace ros2_publisher
 
+// With the newest sample kept for a late (latched) joiner.
+DataWriterQos ros2_writer_qos() {
+  DataWriterQos q = eprosima::fastdds::dds::DATAWRITER_QOS_DEFAULT;
+  q.reliability().kind = eprosima::fastdds::dds::RELIABLE_RELIABILITY_QOS;
+  q.durability().kind = eprosima::fastdds::dds::TRANSIENT_LOCAL_DURABILITY_QOS;
+  q.history().kind = eprosima::fastdds::dds::KEEP_LAST_HISTORY_QOS;
+  q.history().depth = 1;
+  q.ownership().kind = eprosima::fastdds::dds::SHARED_OWNERSHIP_QOS;
+  return q;
+}
+
 struct Ros2Publisher::State {
   DdsContext& dds;
   service::Ros2Settings settings;
@@ -81,7 +80,7 @@ struct Ros2Publisher::State {
   std::map<ros2_publisher::Key, ros2_publisher::Device> devices;
   DataWriter* diagnostics = nullptr;
   std::uint64_t failures = 0;
-  std::chrono::steady_clock::time_point next_failure_log{};
+  service::LogThrottle failure_reports{std::chrono::seconds(5)};
 
   State(DdsContext& d, service::Ros2Settings s, std::string v) : dds(d), settings(std::move(s)), vehicle(std::move(v)) {}
 
@@ -93,7 +92,7 @@ struct Ros2Publisher::State {
         service::ros2_device_namespace(settings.name_space, vehicle, k.bus, ros2_publisher::ros2_kind(k.kind), k.address) + "/" + leaf;
     try {
       auto& topic = dds.topic(service::ros2_dds_topic(ros_name), eprosima::fastdds::dds::TypeSupport(new sensor_msgs::msg::BatteryStatePubSubType()));
-      return &dds.default_partition_writer(topic, ros2_publisher::ros2_writer_qos());
+      return &dds.default_partition_writer(topic, ros2_writer_qos());
     } catch (const DdsError& e) {
       failed(ros_name.c_str(), e.what());
       return nullptr;
@@ -105,10 +104,8 @@ struct Ros2Publisher::State {
   }
   void failed(const char* what, const char* why) {
     ++failures;
-    const auto now = std::chrono::steady_clock::now();
-    if (now < next_failure_log) return;
-    next_failure_log = now + std::chrono::seconds(5);
-    spdlog::warn("ROS 2: {}: {} ({} failure(s) so far)", what, why, failures);
+    if (failure_reports.allow(service::LogThrottle::Clock::now()))
+      spdlog::warn("ROS 2: {}: {} ({} failure(s) so far)", what, why, failures);
   }
   void write_pmu_batteries(const DeviceKey& k, ros2_publisher::Device& d, std::chrono::system_clock::time_point at) {
     if (!d.refused && !d.battery_a) d.battery_a = battery_writer(k, "battery_a");
@@ -129,6 +126,24 @@ struct Ros2Publisher::State {
       write(input == 'A' ? d.battery_a : d.battery_b, &m, "battery");
     }
   }
+  // `values` NaN throughout: the message of a device that is gone.
+  void write_bms(const DeviceKey& k, ros2_publisher::Device& d, const service::BatteryState& values,
+                 std::chrono::system_clock::time_point at) {
+    if (!d.refused && !d.battery) d.battery = battery_writer(k, "battery");
+    d.refused = !d.battery;
+    BmsView v;
+    v.values = values;
+    v.cells = d.cells;
+    if (auto it = capacity_ah.find({k.bus, static_cast<std::uint8_t>(k.address)}); it != capacity_ah.end())
+      v.capacity_ah = it->second;
+    v.health = d.health.state;
+    v.active = d.active();
+    v.stamp = at;
+    v.frame_id = name_of(k);
+    v.location = "bms node " + std::to_string(k.address);
+    auto m = bms_battery_message(v);
+    write(d.battery, &m, "battery");
+  }
 };
 
 Ros2Publisher::Ros2Publisher(DdsContext& dds, const service::Ros2Settings& settings, std::string vehicle,
@@ -138,7 +153,7 @@ Ros2Publisher::Ros2Publisher(DdsContext& dds, const service::Ros2Settings& setti
     for (const auto& battery : b.batteries)
       if (battery.capacity_ah) s_->capacity_ah[{b.name, battery.node}] = *battery.capacity_ah;
   auto& topic = dds.topic("rt/diagnostics", eprosima::fastdds::dds::TypeSupport(new diagnostic_msgs::msg::DiagnosticArrayPubSubType()));
-  s_->diagnostics = &dds.default_partition_writer(topic, ros2_publisher::ros2_writer_qos());
+  s_->diagnostics = &dds.default_partition_writer(topic, ros2_writer_qos());
 }
 
 Ros2Publisher::~Ros2Publisher() = default;
@@ -213,35 +228,13 @@ void Ros2Publisher::on_gone(const DeviceKey& key) {
   auto& d = it->second;
   const auto now = std::chrono::system_clock::now();
   if (d.battery_a || d.battery_b) s_->write_pmu_batteries(key, d, now);
-  if (d.battery) {
-    BmsView v;
-    v.health = d.health.state;
-    v.stamp = now;
-    v.frame_id = s_->name_of(key);
-    v.location = "bms node " + std::to_string(key.address);
-    auto m = bms_battery_message(v);
-    s_->write(d.battery, &m, "battery");
-  }
+  if (d.battery) s_->write_bms(key, d, service::BatteryState{}, now);
 }
 
 void Ros2Publisher::on_battery(const DeviceKey& key, const service::BatteryState& battery,
                                std::chrono::system_clock::time_point newest) {
   std::lock_guard<std::mutex> lock(s_->mutex);
-  auto& d = s_->devices[ros2_publisher::key_of(key)];
-  if (!d.refused && !d.battery) d.battery = s_->battery_writer(key, "battery");
-  d.refused = !d.battery;
-  BmsView v;
-  v.values = battery;
-  v.cells = d.cells;
-  if (auto it = s_->capacity_ah.find({key.bus, static_cast<std::uint8_t>(key.address)}); it != s_->capacity_ah.end())
-    v.capacity_ah = it->second;
-  v.health = d.health.state;
-  v.active = d.active();
-  v.stamp = newest;
-  v.frame_id = s_->name_of(key);
-  v.location = "bms node " + std::to_string(key.address);
-  auto m = bms_battery_message(v);
-  s_->write(d.battery, &m, "battery");
+  s_->write_bms(key, s_->devices[ros2_publisher::key_of(key)], battery, newest);
 }
 
 void Ros2Publisher::on_battery_cells(const DeviceKey& key, const service::BatteryCellsState& cells,

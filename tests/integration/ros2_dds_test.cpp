@@ -26,6 +26,7 @@
 #include <vector>
 
 #include "../../tools/pmuctl/record/raw_sample_type.hpp"
+#include "../ros2/ros2_reader_qos.hpp"
 #include "diagnostic_msgs/msg/DiagnosticArrayPubSubTypes.h"
 #include "pmu/dds/dds_context.hpp"
 #include "pmu/dds/ros2_publisher.hpp"
@@ -61,12 +62,7 @@ std::string config(int domain) {
 }
 
 DataReaderQos reader_qos(ReliabilityQosPolicyKind reliability, DurabilityQosPolicyKind durability) {
-  DataReaderQos q = DATAREADER_QOS_DEFAULT;
-  q.reliability().kind = reliability;
-  q.durability().kind = durability;
-  q.history().kind = KEEP_LAST_HISTORY_QOS;
-  q.history().depth = 10;
-  return q;
+  return pmu::test::ros2_reader_qos(reliability, durability);
 }
 DataReaderQos ros2_default() { return reader_qos(RELIABLE_RELIABILITY_QOS, VOLATILE_DURABILITY_QOS); }
 

@@ -1,5 +1,5 @@
-// A BatteryState writer with the QoS the service's `state` profile gives (RELIABLE,
-// TRANSIENT_LOCAL, KEEP_LAST 1) matches a reader with ROS 2's default QoS (rclcpp's
+// A BatteryState writer with the QoS the service's ROS 2 writers have (ros2_writer_qos:
+// RELIABLE, TRANSIENT_LOCAL, KEEP_LAST 1) matches a reader with ROS 2's default QoS (rclcpp's
 // rmw_qos_profile_default: RELIABLE, VOLATILE, KEEP_LAST 10) on a ROS 2 topic name, and the
 // reader gets the sample; a TRANSIENT_LOCAL reader that joins later (`ros2 topic echo` with
 // that durability) gets the last sample at once.
@@ -16,6 +16,8 @@
 #include <fastdds/dds/topic/Topic.hpp>
 #include <fastdds/dds/topic/TypeSupport.hpp>
 
+#include "pmu/dds/ros2_publisher.hpp"
+#include "ros2_reader_qos.hpp"
 #include "sensor_msgs/msg/BatteryStatePubSubTypes.h"
 #include "support/domain.hpp"
 #include "support/wait.hpp"
@@ -26,24 +28,6 @@ using namespace eprosima::fastdds::dds;
 using namespace std::chrono_literals;
 
 constexpr const char* kTopic = "rt/test/battery_state";
-
-DataWriterQos state_writer_qos() {
-  DataWriterQos qos = DATAWRITER_QOS_DEFAULT;
-  qos.reliability().kind = RELIABLE_RELIABILITY_QOS;
-  qos.durability().kind = TRANSIENT_LOCAL_DURABILITY_QOS;
-  qos.history().kind = KEEP_LAST_HISTORY_QOS;
-  qos.history().depth = 1;
-  return qos;
-}
-
-DataReaderQos ros2_reader_qos(DurabilityQosPolicyKind durability) {
-  DataReaderQos qos = DATAREADER_QOS_DEFAULT;
-  qos.reliability().kind = RELIABLE_RELIABILITY_QOS;
-  qos.durability().kind = durability;
-  qos.history().kind = KEEP_LAST_HISTORY_QOS;
-  qos.history().depth = 10;
-  return qos;
-}
 
 sensor_msgs::msg::BatteryState sample(float voltage) {
   sensor_msgs::msg::BatteryState battery;
@@ -100,8 +84,8 @@ bool take_one(DataReader& reader, sensor_msgs::msg::BatteryState& out) {
 TEST(Ros2Qos, StateWriterMatchesRos2DefaultReader) {
   Participant dds;
   ASSERT_TRUE(dds.ready());
-  DataWriter* writer = dds.writer(state_writer_qos());
-  DataReader* reader = dds.reader(ros2_reader_qos(VOLATILE_DURABILITY_QOS));
+  DataWriter* writer = dds.writer(pmu::dds::ros2_writer_qos());
+  DataReader* reader = dds.reader(pmu::test::ros2_reader_qos(RELIABLE_RELIABILITY_QOS, VOLATILE_DURABILITY_QOS));
   ASSERT_NE(writer, nullptr);
   ASSERT_NE(reader, nullptr);
 
@@ -124,14 +108,14 @@ TEST(Ros2Qos, StateWriterMatchesRos2DefaultReader) {
 TEST(Ros2Qos, LateTransientLocalReaderGetsTheLastSample) {
   Participant dds;
   ASSERT_TRUE(dds.ready());
-  DataWriter* writer = dds.writer(state_writer_qos());
+  DataWriter* writer = dds.writer(pmu::dds::ros2_writer_qos());
   ASSERT_NE(writer, nullptr);
   auto first = sample(48.0f);
   auto last = sample(47.5f);
   ASSERT_TRUE(writer->write(&first));
   ASSERT_TRUE(writer->write(&last));
 
-  DataReader* reader = dds.reader(ros2_reader_qos(TRANSIENT_LOCAL_DURABILITY_QOS));
+  DataReader* reader = dds.reader(pmu::test::ros2_reader_qos(RELIABLE_RELIABILITY_QOS, TRANSIENT_LOCAL_DURABILITY_QOS));
   ASSERT_NE(reader, nullptr);
   sensor_msgs::msg::BatteryState read;
   ASSERT_TRUE(take_one(*reader, read)) << "no sample";

@@ -26,11 +26,16 @@
 #include <tuple>
 #include <vector>
 
+#include <fastdds/dds/publisher/qos/DataWriterQos.hpp>
+
 #include "pmu/config/config.hpp"
 #include "pmu/dds/dds_context.hpp"
 #include "pmu/session/device_state.hpp"
 
 namespace pmu::dds {
+
+// The QoS of every ROS 2 writer (above): what ROS 2 subscribers of every usual profile match.
+eprosima::fastdds::dds::DataWriterQos ros2_writer_qos();
 
 class Ros2Publisher final : public service::StateSink {
  public:
