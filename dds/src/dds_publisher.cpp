@@ -118,6 +118,9 @@ struct DdsPublisher::Writers {
   // Bus workers run in threads of their own and share these writers and the rest below.
   std::mutex mutex;
   std::set<std::tuple<std::string, DeviceKind, std::uint16_t>> admitted;
+  // PMUs (bus, address) configured with a `baseline:`; every other PMU's pmu/baseline
+  // instance is disposed when it is first admitted.
+  std::set<std::pair<std::string, std::uint16_t>> with_baseline;
   LogThrottle failure_reports{kReportInterval};
   LogThrottle refusal_reports{kReportInterval};
 };
@@ -192,6 +195,7 @@ bool DdsPublisher::admit(const DeviceKey& key) {
   if (w_->admitted.count(id)) return true;
   if (w_->admitted.size() < service::kMaxDevicesPerService) {
     w_->admitted.insert(id);
+    if (key.kind == DeviceKind::Pmu && !w_->with_baseline.count({key.bus, key.address})) dispose_baseline(key);
     return true;
   }
   const auto refused = refused_.fetch_add(1, std::memory_order_relaxed) + 1;
@@ -222,12 +226,33 @@ void DdsPublisher::count_failed_write(const char* topic, const DeviceKey& key, c
   count(false, topic, key, why);
 }
 
+// Without this, a reader could not tell a PMU that has no baseline from one whose baseline
+// has not reached it yet: samples of different topics arrive independently. The disposed
+// instance is kept for late joiners like a written one (state profile).
+void DdsPublisher::dispose_baseline(const DeviceKey& key) {
+  if (w_->baseline == nullptr) return;
+  pmu::v4::Baseline s;
+  s.vehicle(w_->vehicle);
+  s.bus(key.bus);
+  s.address(key.address);
+  const InstanceHandle_t handle = w_->baseline->register_instance(&s);
+  const ReturnCode_t rc = handle == HANDLE_NIL ? ReturnCode_t::RETCODE_OUT_OF_RESOURCES : w_->baseline->dispose(&s, handle);
+  // A failure is a sample not published; a disposal is no sample of the PMU's own.
+  if (rc != ReturnCode_t::RETCODE_OK) count(false, topics::kBaseline, key, why(rc));
+}
+
 void DdsPublisher::publish_baselines(const std::vector<BusConfig>& buses) {
   std::lock_guard<std::mutex> lock(w_->mutex);
   for (const auto& b : buses)
+    for (const auto& d : b.devices)
+      if (d.baseline) w_->with_baseline.insert({b.name, d.address});
+  for (const auto& b : buses)
     for (const auto& d : b.devices) {
-      if (!d.baseline) continue;
       const DeviceKey key{b.name, d.address, DeviceKind::Pmu};
+      if (!d.baseline) {
+        admit(key);  // says at once that it has none
+        continue;
+      }
       if (!admit(key)) continue;
       auto s = baseline_sample(w_->vehicle, b.name, d);
       write_at(w_->baseline, &s, key, std::chrono::system_clock::now());

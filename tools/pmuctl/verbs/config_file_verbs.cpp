@@ -9,10 +9,12 @@
 #include <cstring>
 #include <ctime>
 #include <fastdds/dds/core/status/SubscriptionMatchedStatus.hpp>
+#include <fastdds/dds/subscriber/InstanceState.hpp>
 #include <fastdds/dds/subscriber/SampleInfo.hpp>
 #include <fstream>
 #include <map>
 #include <nlohmann/json.hpp>
+#include <set>
 #include <sstream>
 #include <thread>
 #include <utility>
@@ -71,11 +73,37 @@ class DeviceReader {
     while (info_.take_next_sample(&i, &si) == ReturnCode_t::RETCODE_OK)
       if (si.valid_data && i.vehicle().to_string() == vehicle_) infos_[{i.bus().to_string(), i.address()}] = i;
     pmu::v4::Baseline b;
-    while (baseline_.take_next_sample(&b, &si) == ReturnCode_t::RETCODE_OK)
-      if (si.valid_data && b.vehicle().to_string() == vehicle_) baselines_[{b.bus().to_string(), b.address()}] = b;
+    while (baseline_.take_next_sample(&b, &si) == ReturnCode_t::RETCODE_OK) {
+      if (si.valid_data) {
+        if (b.vehicle().to_string() == vehicle_) baselines_[{b.bus().to_string(), b.address()}] = b;
+      } else if (si.instance_state == NOT_ALIVE_DISPOSED_INSTANCE_STATE) {
+        disposed_.insert(si.instance_handle);
+      }
+    }
   }
-  // The service's baseline of the PMU at (bus, address): written once at its start for a PMU
-  // configured with `baseline:`, so it comes with the rest of the state, or never.
+  // What the service said of the baseline of the PMU at (bus, address): its sample, that it
+  // has none (the instance disposed, interface.md 1.9), or nothing yet. Each topic's samples
+  // come on their own, so the PMU's configuration may well come before either.
+  enum class Said { Nothing, NoBaseline, Baseline };
+  Said baseline_said(const std::string& bus, std::uint16_t address) {
+    if (baselines_.count({bus, address})) return Said::Baseline;
+    pmu::v4::Baseline key;
+    key.vehicle(vehicle_);
+    key.bus(bus);
+    key.address(address);
+    InstanceHandle_t handle;
+    if (baseline_.type().get_key(&key, &handle) && disposed_.count(handle)) return Said::NoBaseline;
+    return Said::Nothing;
+  }
+  // Polls until the service has said either, or the deadline passed.
+  Said await_baseline(const std::string& bus, std::uint16_t address, Clock::time_point deadline) {
+    for (;;) {
+      poll();
+      const Said said = baseline_said(bus, address);
+      if (said != Said::Nothing || Clock::now() >= deadline) return said;
+      std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    }
+  }
   const pmu::v4::Baseline* baseline(const std::string& bus, std::uint16_t address) const {
     const auto it = baselines_.find({bus, address});
     return it == baselines_.end() ? nullptr : &it->second;
@@ -105,6 +133,7 @@ class DeviceReader {
   DataReader& baseline_;
   std::map<std::pair<std::string, std::uint16_t>, pmu::v4::Config> configs_;
   std::map<std::pair<std::string, std::uint16_t>, pmu::v4::Baseline> baselines_;
+  std::set<InstanceHandle_t> disposed_;  // pmu/baseline instances of PMUs without one
   std::map<std::pair<std::string, std::uint16_t>, pmu::v4::DeviceInfo> infos_;
 };
 
@@ -173,9 +202,8 @@ class ReadOnlyView {
         dds_(o.domain, o.qos_file, "pmuctl", o.security, pmu::dds::Transport::Default, o.network, partitions_for(o)),
         device_(dds_, vehicle_) {}
   // nullopt with `status` set when there is none.
-  std::optional<Target> find(int& status) {
-    return find_device(o_, dds_, device_, vehicle_, deadline_after(o_.timeout.value_or(5.0)), status);
-  }
+  std::optional<Target> find(int& status) { return find_device(o_, dds_, device_, vehicle_, deadline_, status); }
+  Clock::time_point deadline() const { return deadline_; }
   const std::string& vehicle() const { return vehicle_; }
   DeviceReader& device() { return device_; }
 
@@ -184,6 +212,7 @@ class ReadOnlyView {
   std::string vehicle_;
   pmu::dds::DdsContext dds_;
   DeviceReader device_;
+  Clock::time_point deadline_ = deadline_after(o_.timeout.value_or(5.0));
 };
 
 std::string utc_now() {
@@ -298,14 +327,20 @@ int diff(const GlobalOptions& o, const std::string& path) {
   DeviceReader& device = view.device();
   std::string file = path;
   if (!f) {
-    // The service's samples of one PMU come in one burst, so its baseline is there with its
-    // configuration, or there is none.
-    device.poll();
+    switch (device.await_baseline(t->bus, t->address, view.deadline())) {
+      case DeviceReader::Said::Baseline:
+        break;
+      case DeviceReader::Said::NoBaseline:
+        return fail(o, ExitStatus::BadUsage,
+                    "no baseline configured for PMU " + device_label(vehicle, t->bus, t->address) +
+                        " (pmu-service.yaml `baseline:`, interface.md 1.9): name a file, pmuctl config diff FILE");
+      case DeviceReader::Said::Nothing:
+        return fail(o, ExitStatus::NoAnswer,
+                    device_label(vehicle, t->bus, t->address) + ": its service did not say within the timeout " +
+                        "whether it has a baseline (pmu/baseline, interface.md 1.9): name a file, pmuctl config " +
+                        "diff FILE");
+    }
     const auto* b = device.baseline(t->bus, t->address);
-    if (!b)
-      return fail(o, ExitStatus::BadUsage,
-                  "no baseline configured for PMU " + device_label(vehicle, t->bus, t->address) +
-                      " (pmu-service.yaml `baseline:`, interface.md 1.9): name a file, pmuctl config diff FILE");
     f = service::config_file_of(*b);
     file = b->file().to_string();
   }

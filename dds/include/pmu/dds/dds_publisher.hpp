@@ -66,7 +66,9 @@ class DdsPublisher final : public StateSink {
 
   // pmu/baseline: one sample per configured PMU with a `baseline:`, written once at start
   // (interface.md 1.9); the state profile keeps it for late joiners. Not from a session:
-  // the baseline is the config's. Call before the bus workers start.
+  // the baseline is the config's. Every other PMU's instance is disposed: the configured
+  // ones here, one found on the bus when it is first published. Call before the bus workers
+  // start.
   void publish_baselines(const std::vector<BusConfig>& buses);
 
   // A write to another of the service's topics (pmu/command_reply) failed: counted in
@@ -83,8 +85,9 @@ class DdsPublisher final : public StateSink {
 
  private:
   struct Writers;
-  // Both called with Writers::mutex held.
+  // These called with Writers::mutex held.
   bool admit(const DeviceKey& key);
+  void dispose_baseline(const DeviceKey& key);
   // Writes with a source timestamp and counts the result.
   void write_at(eprosima::fastdds::dds::DataWriter* writer, void* sample, const DeviceKey& key,
                 std::chrono::system_clock::time_point when);
