@@ -18,10 +18,13 @@
 #      packages (build/packages/amd64)
 # The VM suites spend most of their time waiting (link delays, cuts, leases, timeouts) with the
 # VM's CPUs mostly idle, so they run, one suite at a time (RUN_SERIAL), while the sanitizer and
-# fuzz builds compile and their tests run, and while the arm64 packages are built. The
-# sanitizer and fuzz builds are unity builds (their presets): they compile each target's files
-# in a few batches, in about half the time; the release build compiles every file on its own,
-# so a file that does not include what it uses still fails there. The release tests run last,
+# fuzz builds compile and their tests run, and while the arm64 packages are built. Every
+# build here is a unity build (its preset): each target's files are compiled in a few batches,
+# in about half the time, and with -Werror the release build also fails on what only a unity
+# build meets (two files' internal names that clash or shadow). The `dev` preset, the inner
+# loop, compiles every file on its own, so a file that does not include what it uses fails
+# there. Debug information is line tables only (-g1): enough for the sanitizers' and a
+# debugger's stack frames, and a third less compile time than -g. The release tests run last,
 # on a machine that only tests.
 # tests/README.md gives each step's measured time.
 # Set PMU_FUZZ_SECONDS to change the fuzz time per target (default 30).
@@ -103,6 +106,11 @@ step "ThreadSanitizer tests"
 # same unsymbolised race (libfastrtps+0x294b87, pthread_mutex_timedlock against mmap of a
 # shared-memory segment) in their 2,000-command burst; the service's threads they exercise run
 # here through the integration tests. crossvendor: the Cyclone DDS client is not built here.
+# DemoPowerSystem.*, PmuctlExit.* and the config files' round over every firmware run pmuctl
+# dozens of times each to check its output and exit statuses: each run under TSan is a new
+# instrumented participant (these six tests took 256 of the step's 564 test-seconds), and the service
+# paths they reach (commands, reads, config sets) run here through the other integration
+# tests; they run in the release build.
 # TSAN_OPTIONS (tests/tsan.supp) and these exclusions are the preset's.
 setarch "$(uname -m)" -R ctest --preset tsan -j"$jobs"
 
@@ -125,7 +133,10 @@ trap - EXIT
 cat "$vm_log"
 
 step "release tests (all but the VM suites, which ran above)"
-ctest --preset release -LE '^system$' -j"$jobs"
+# Twice as many at once as there are CPUs: these tests mostly wait (discovery, replies, a
+# service's start), and at one per CPU the CPUs were 97 % idle. The longest carry a COST so
+# that they start first.
+ctest --preset release -LE '^system$' -j"$((2 * jobs))"
 
 if [ "$vm_status" -ne 0 ]; then
   # CI keeps only the tail of this output: repeat each failed scenario's own verdict here.

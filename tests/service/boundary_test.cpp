@@ -89,11 +89,11 @@ TEST(Boundary, EverySampleThatCannotBeExecutedGetsItsReason) {
 
 TEST(Boundary, EveryExpiryFromNowTo2To64Minus1IsALiveRequestHeldToTheCap) {
   const Lifetimes lt{10s, 60s};
-  struct Case {
+  struct ExpiryCase {
     std::uint64_t expires_at;
     std::chrono::nanoseconds lives;
   };
-  const Case cases[] = {
+  const ExpiryCase cases[] = {
       {0, 10s},  // the default lifetime
       {kNowNs + 1, 1ns},
       {kNowNs + 5000000000ull, 5s},
@@ -115,13 +115,13 @@ TEST(Boundary, EveryExpiryFromNowTo2To64Minus1IsALiveRequestHeldToTheCap) {
 }
 
 TEST(Boundary, SetValuesAreCarriedInWireUnitsAsTheyWillBeSent) {
-  struct Case {
+  struct SetCase {
     const char* parameter;
     double value;
     codec::Parameter p;
     std::uint32_t raw;
   };
-  const Case cases[] = {
+  const SetCase cases[] = {
       {"avionics_voltage", 24.0, codec::Parameter::AvionicsVoltage, 240},
       {"avionics_voltage", 12.3f, codec::Parameter::AvionicsVoltage, 123},  // a float32 from DDS
       {"upper_temperature_limit", 0.0005, codec::Parameter::UpperTemperatureLimit, 0},

@@ -193,13 +193,13 @@ TEST(CommandPlan, ACanAddressChangeReadsBackAtTheNewAddressUnderAnAlias) {
 TEST(CommandRun, AnotherCommandsFailureLeavesAQueuedAddressChangesAliasAlone) {
   using namespace std::chrono_literals;
   test::RecordingSink sink;
-  const auto t0 = SteadyTime{} + 1h;
+  const auto start = SteadyTime{} + 1h;
   DeviceConfig dc;
   dc.address = 1;
   Timeouts timeouts;
   DeviceSession s({"can0", 1}, dc, timeouts, sink, [](const codec::CanFrame&) { return transport::SendResult{}; },
-                  t0);
-  auto t = t0;
+                  start);
+  auto t = start;
   for (int i = 0; i < 100 && s.queued() > 0; ++i) s.tick(t += 100ms, {});  // a silent device: the reading round fails
   ASSERT_EQ(s.queued(), 0u);
 

@@ -33,6 +33,11 @@ constexpr int kSocketSendBuffer = 64 * 1024;
 // Largest client message: subscribe requests are small.
 constexpr std::size_t kMaxClientMessage = 1024 * 1024;
 
+}  // namespace
+
+// Named, not anonymous: FoxgloveServer::Impl, which has external linkage, holds them.
+namespace foxglove_server_parts {
+
 using Instance = std::array<std::uint8_t, 16>;
 
 struct Pending {
@@ -48,6 +53,12 @@ struct Client {
   ClientBacklog backlog;
 };
 
+}  // namespace foxglove_server_parts
+
+namespace {
+using foxglove_server_parts::Client;
+using foxglove_server_parts::Instance;
+using foxglove_server_parts::Pending;
 }  // namespace
 
 struct FoxgloveServer::Impl {
