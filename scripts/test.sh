@@ -24,8 +24,8 @@
 # build meets (two files' internal names that clash or shadow). The `dev` preset, the inner
 # loop, compiles every file on its own, so a file that does not include what it uses fails
 # there. Debug information is line tables only (-g1): enough for the sanitizers' and a
-# debugger's stack frames, and a third less compile time than -g. The release tests run last,
-# on a machine that only tests.
+# debugger's stack frames, and a third less compile time than -g. The release tests run once
+# the VM suites are done, beside the arm64 cross build, which yields the CPUs to them (nice).
 # tests/README.md gives each step's measured time.
 # Set PMU_FUZZ_SECONDS to change the fuzz time per target (default 30).
 set -euo pipefail
@@ -123,20 +123,33 @@ cmake --build --preset fuzz -j"$jobs"
 step "fuzz runs"
 ctest --preset fuzz
 
-step "arm64 packages (tests under qemu-user)"
-env "${no_debug[@]}" DEB_BUILD_OPTIONS=noautodbgsym "$root/scripts/package.sh" --arch arm64
-
 step "waiting for the VM suites"
 vm_status=0
 wait "$vm_pid" || vm_status=$?
 trap - EXIT
 cat "$vm_log"
 
-step "release tests (all but the VM suites, which ran above)"
-# Twice as many at once as there are CPUs: these tests mostly wait (discovery, replies, a
+step "arm64 packages (tests under qemu-user), beside the release tests that do not use them"
+# The release tests (all but the VM suites, which ran above, and the package tests, which use
+# the arm64 packages) run at -j twice the CPUs: they mostly wait (discovery, replies, a
 # service's start), and at one per CPU the CPUs were 97 % idle. The longest carry a COST so
-# that they start first.
-ctest --preset release -LE '^system$' -j"$((2 * jobs))"
+# that they start first. package.sh builds at nice 10, so the tests have the CPUs first and
+# the cross build takes what they leave.
+release_log="$root/build/release/release-tests.log"
+ctest --preset release -LE '^(system|package)$' -j"$((2 * jobs))" >"$release_log" 2>&1 &
+tests_pid=$!
+trap 'kill "$tests_pid" 2>/dev/null || true' EXIT
+env "${no_debug[@]}" DEB_BUILD_OPTIONS=noautodbgsym "$root/scripts/package.sh" --arch arm64
+tests_status=0
+wait "$tests_pid" || tests_status=$?
+trap - EXIT
+
+step "release tests: their output"
+cat "$release_log"
+
+step "package tests (the arm64 pmu-service from its package, pmuctl from pmu-dds-tools alone)"
+package_status=0
+ctest --preset release -L '^package$' -j"$jobs" || package_status=$?
 
 if [ "$vm_status" -ne 0 ]; then
   # CI keeps only the tail of this output: repeat each failed scenario's own verdict here.
@@ -144,4 +157,11 @@ if [ "$vm_status" -ne 0 ]; then
   echo "test.sh: the VM suites failed (their output is above, after 'waiting for the VM suites')" >&2
   exit "$vm_status"
 fi
+if [ "$tests_status" -ne 0 ]; then
+  # Their summary, again, where CI's tail shows it.
+  sed -n '/tests passed/,$p' "$release_log" >&2
+  echo "test.sh: the release tests failed (their output is above, after 'release tests: their output')" >&2
+  exit "$tests_status"
+fi
+[ "$package_status" -eq 0 ] || exit "$package_status"
 step "done"
