@@ -17,14 +17,14 @@
 #      against this build's pmuctl (label package), and the VM suites install the amd64
 #      packages (build/packages/amd64)
 # The VM suites spend most of their time waiting (link delays, cuts, leases, timeouts) with the
-# VM's CPUs mostly idle, so they run, one suite at a time (RUN_SERIAL), while the sanitizer and
-# fuzz builds compile and their tests run, and while the arm64 packages are built. Every
+# VM's CPUs mostly idle, so they run, one suite at a time (RUN_SERIAL), while the amd64
+# packages are built and the sanitizer and fuzz builds compile and their tests run. Every
 # build here is a unity build (its preset): each target's files are compiled in a few batches,
 # in about half the time, and with -Werror the release build also fails on what only a unity
 # build meets (two files' internal names that clash or shadow). The `dev` preset, the inner
 # loop, compiles every file on its own, so a file that does not include what it uses fails
 # there. Debug information is line tables only (-g1): enough for the sanitizers' and a
-# debugger's stack frames, and a third less compile time than -g. The release tests run once
+# debugger's stack frames, and 30 % less compile time than -g. The release tests run once
 # the VM suites are done, beside the arm64 cross build, which yields the CPUs to them (nice).
 # tests/README.md gives each step's measured time.
 # Set PMU_FUZZ_SECONDS to change the fuzz time per target (default 30).

@@ -97,12 +97,8 @@ class DeviceReader {
   }
   // Polls until the service has said either, or the deadline passed.
   Said await_baseline(const std::string& bus, std::uint16_t address, Clock::time_point deadline) {
-    for (;;) {
-      poll();
-      const Said said = baseline_said(bus, address);
-      if (said != Said::Nothing || Clock::now() >= deadline) return said;
-      std::this_thread::sleep_for(std::chrono::milliseconds(20));
-    }
+    poll_until([&] { return baseline_said(bus, address) != Said::Nothing; }, deadline);
+    return baseline_said(bus, address);
   }
   const pmu::v4::Baseline* baseline(const std::string& bus, std::uint16_t address) const {
     const auto it = baselines_.find({bus, address});
@@ -118,15 +114,21 @@ class DeviceReader {
   }
   // Both read, or the deadline passed.
   bool wait(const std::string& bus, std::uint16_t address, Clock::time_point deadline) {
+    return poll_until([&] { return config(bus, address) && info(bus, address); }, deadline);
+  }
+
+ private:
+  // Polls until `done()`, or the deadline passed; whether `done()`.
+  template <class Done>
+  bool poll_until(Done done, Clock::time_point deadline) {
     for (;;) {
       poll();
-      if (config(bus, address) && info(bus, address)) return true;
+      if (done()) return true;
       if (Clock::now() >= deadline) return false;
       std::this_thread::sleep_for(std::chrono::milliseconds(20));
     }
   }
 
- private:
   std::string vehicle_;
   DataReader& config_;
   DataReader& info_;
