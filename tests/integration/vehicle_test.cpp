@@ -102,6 +102,18 @@ struct Ground {
     EXPECT_TRUE(others.empty()) << "replies to more than the probe";
     return ok;
   }
+  // What this station's discovery knows, for a failure message: a vehicle whose samples never
+  // come is either unmatched (discovery never reported its writers) or matched and silent.
+  std::string discovery_text() {
+    SubscriptionMatchedStatus c, v;
+    configs.get_subscription_matched_status(c);
+    voltages.get_subscription_matched_status(v);
+    return "; its pmu/config reader matched " + std::to_string(c.current_count) + " writers, its pmu/voltages reader " +
+           std::to_string(v.current_count) + "; discovery reported " +
+           std::to_string(dds.remote_writers().writers_of(topics::kConfig).size()) + " pmu/config writers and " +
+           std::to_string(dds.remote_writers().participants_without_writer("pmu-service", topics::kConfig)) +
+           " pmu-service participants without one";
+  }
   static constexpr const char* kProbe = "probe-";
   bool probes_answered = false;
 
@@ -153,7 +165,7 @@ class Vehicles : public ::testing::Test {
         },
         30s))
         << "the watcher got pmu/config from " << configured.size() << " of " << services_.size()
-        << " vehicles: " << seen_text(configured);
+        << " vehicles: " << seen_text(configured) << watcher.discovery_text();
   }
   static std::string seen_text(const std::set<std::string>& vehicles) {
     std::string out;
@@ -178,7 +190,9 @@ TEST_F(Vehicles, AGroundStationWithDefaultSettingsSeesEveryVehicleAndWhichSample
           if (i.valid_data) voltage_vehicles.insert(v.vehicle().to_string());
         return config_vehicles.size() == 3 && voltage_vehicles.size() == 3;
       },
-      30s));
+      30s))
+      << "pmu/config from " << seen_text(config_vehicles) << ", pmu/voltages from " << seen_text(voltage_vehicles)
+      << g.discovery_text();
   EXPECT_EQ(config_vehicles, (std::set<std::string>{"", "uav1", "uav2"}));
   EXPECT_EQ(voltage_vehicles, (std::set<std::string>{"", "uav1", "uav2"}));
   // Same bus and address, three instances: the state a late joiner gets holds all three.
