@@ -111,7 +111,7 @@ struct Ground {
     return "; its pmu/config reader matched " + std::to_string(c.current_count) + " writers, its pmu/voltages reader " +
            std::to_string(v.current_count) + "; discovery reported " +
            std::to_string(dds.remote_writers().writers_of(topics::kConfig).size()) + " pmu/config writers and " +
-           std::to_string(dds.remote_writers().participants_without_writer("pmu-service", topics::kConfig)) +
+           std::to_string(dds.remote_writers().participants_without_writer(dds::kServiceParticipantName, topics::kConfig)) +
            " pmu-service participants without one";
   }
   static constexpr const char* kProbe = "probe-";

@@ -39,7 +39,7 @@ class InProcessService {
   InProcessService(int domain, const Options& o)
       : network(clock),
         pmus(network.attach("pmu-sim"), clock),
-        dds(domain, "", "pmu-service", o.security, o.transport, {},
+        dds(domain, "", dds::kServiceParticipantName, o.security, o.transport, {},
             {service::vehicle_partitions(o.vehicle), service::vehicle_partitions(o.vehicle)}),
         publisher(dds, std::chrono::seconds(3), o.vehicle),
         worker(bus_config(o.bus_name), network.attach(o.bus_name), clock, service::Timeouts{}, publisher),
