@@ -159,6 +159,7 @@ DataWriter& DdsContext::writer(Topic& topic, const std::string& profile, DataWri
     throw DdsError(qos_file_ + ": <data_writer profile_name=\"" + profile + "\"> (" + topic.get_name() + "): " + s +
                    ": raise its <resourceLimitsQos> (deploy/qos.xml says how each number is derived)");
   }
+  writers_.push_back(w);
   return *w;
 }
 
@@ -171,7 +172,36 @@ DataReader& DdsContext::reader(Topic& topic, const std::string& profile, DataRea
     throw DdsError(qos_file_ + ": <data_reader profile_name=\"" + profile + "\"> (" + topic.get_name() + "): " + s +
                    ": raise its <resourceLimitsQos> (deploy/qos.xml says how each number is derived)");
   }
+  readers_.push_back(r);
   return *r;
+}
+
+bool DdsContext::set_partitions(const Partitions& partitions) {
+  PublisherQos pub_qos = publisher_->get_qos();
+  pub_qos.partition().clear();
+  for (const auto& p : partitions.publisher) pub_qos.partition().push_back(p.c_str());
+  SubscriberQos sub_qos = subscriber_->get_qos();
+  sub_qos.partition().clear();
+  for (const auto& p : partitions.subscriber) sub_qos.partition().push_back(p.c_str());
+  if (publisher_->set_qos(pub_qos) != ReturnCode_t::RETCODE_OK ||
+      subscriber_->set_qos(sub_qos) != ReturnCode_t::RETCODE_OK)
+    return false;
+  partitions_ = partitions;
+  return true;
+}
+
+void DdsContext::delete_endpoints_since(EndpointMark mark) {
+  while (writers_.size() > mark.writers) {
+    (void)publisher_->delete_datawriter(writers_.back());
+    writers_.pop_back();
+  }
+  while (readers_.size() > mark.readers) {
+    // A reader with outstanding loans or read conditions is refused; pmuctl's verbs keep
+    // neither once they return.
+    (void)readers_.back()->delete_contained_entities();
+    (void)subscriber_->delete_datareader(readers_.back());
+    readers_.pop_back();
+  }
 }
 
 DataWriter& DdsContext::default_partition_writer(Topic& topic, const DataWriterQos& qos) {

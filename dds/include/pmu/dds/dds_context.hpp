@@ -31,6 +31,7 @@
 #include <fastdds/dds/subscriber/Subscriber.hpp>
 #include <fastdds/dds/topic/Topic.hpp>
 #include <fastdds/dds/topic/TypeSupport.hpp>
+#include <cstddef>
 #include <map>
 #include <optional>
 #include <stdexcept>
@@ -138,6 +139,23 @@ class DdsContext {
   eprosima::fastdds::dds::DataWriter& default_partition_writer(eprosima::fastdds::dds::Topic& topic,
                                                                const eprosima::fastdds::dds::DataWriterQos& qos);
 
+  // The writers and readers made by writer() and reader() so far. A long-lived context that
+  // serves one job after another (`pmuctl agent`) deletes each job's endpoints when it ends
+  // (delete_endpoints_since), so its participant does not grow with every job. Same thread
+  // rule as writer() and reader(); every reference to a deleted endpoint is then dangling.
+  // Moves the publisher and subscriber to other partitions (Fast DDS lets a partition change
+  // while the participant lives). For a context that serves one job after another, each job
+  // in its own vehicle's partitions, set while it has no endpoints. False when Fast DDS
+  // refuses. Same thread rule as writer() and reader().
+  bool set_partitions(const Partitions& partitions);
+
+  struct EndpointMark {
+    std::size_t writers = 0;
+    std::size_t readers = 0;
+  };
+  EndpointMark endpoint_mark() const noexcept { return {writers_.size(), readers_.size()}; }
+  void delete_endpoints_since(EndpointMark mark);
+
  private:
   // Throws the DdsError for an endpoint Fast DDS refused ("cannot create a writer for ...").
   [[noreturn]] void refused(const std::string& topic, const std::string& profile, bool publish) const;
@@ -155,6 +173,8 @@ class DdsContext {
   eprosima::fastdds::dds::Publisher* default_publisher_ = nullptr;  // made by the first default_partition_writer()
   eprosima::fastdds::dds::Subscriber* subscriber_ = nullptr;
   std::map<std::string, eprosima::fastdds::dds::Topic*> topics_;
+  std::vector<eprosima::fastdds::dds::DataWriter*> writers_;  // made by writer(), in order
+  std::vector<eprosima::fastdds::dds::DataReader*> readers_;  // made by reader(), in order
 };
 
 }  // namespace pmu::dds
