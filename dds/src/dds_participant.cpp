@@ -109,8 +109,8 @@ DomainParticipantQos participant_qos(const std::string& name, Transport transpor
     case DiscoveryMode::Server:
       builtin.discovery_config.discoveryProtocol = eprosima::fastrtps::rtps::DiscoveryProtocol_t::CLIENT;
       // A client's announcements go to its servers alone, which for an aircraft means across
-      // the radio link: three per lease (Fast DDS's 20 s) instead of every 3 s, so a lossy
-      // link must lose three in a row before the server gives the client up.
+      // the radio link: three per lease instead of every 3 s, so a lossy link must lose three
+      // in a row, or be down longer than the lease, before the server gives the client up.
       builtin.discovery_config.leaseDuration = kClientLease;
       builtin.discovery_config.leaseDuration_announcementperiod = kClientAnnouncementPeriod;
       builtin.discovery_config.m_DiscoveryServers.clear();

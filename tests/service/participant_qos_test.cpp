@@ -122,13 +122,13 @@ TEST(ParticipantQos, ServerModeIsAClientOfEachServerByPositionWithFastddsDiscove
 }
 
 // A client's announcements cross the radio link to the server: three per lease, not
-// Fast DDS's every 3 s; the other modes keep Fast DDS's periods (a multicast participant that
+// Fast DDS's every 3 s, and a lease longer than a 30 s dropout; the other modes keep Fast DDS's periods (a multicast participant that
 // announced less often would be found later after a lost first announcement).
 TEST(ParticipantQos, AServerClientAnnouncesThreeTimesPerLeaseAndTheOtherModesKeepFastDdsPeriods) {
   const auto client = participant_qos("x", Transport::Default, server({{{{"10.0.0.1", 11811}}}}), {});
   const auto& c = client.wire_protocol().builtin.discovery_config;
-  EXPECT_EQ(c.leaseDuration, (Duration_t{20, 0}));
-  EXPECT_EQ(c.leaseDuration_announcementperiod, (Duration_t{6, 666666667}));
+  EXPECT_EQ(c.leaseDuration, (Duration_t{60, 0}));
+  EXPECT_EQ(c.leaseDuration_announcementperiod, (Duration_t{20, 0}));
   const DomainParticipantQos fastdds;
   for (const auto& q : {participant_qos("x", Transport::Default, ResolvedNetwork{}, {}),
                         participant_qos("x", Transport::Default, unicast({{"127.0.0.1", 0}}), {})}) {

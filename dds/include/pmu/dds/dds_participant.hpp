@@ -44,9 +44,11 @@
 namespace pmu::dds {
 
 // A Discovery Server client's lease and how often it announces itself to its servers: three
-// announcements per lease, Fast DDS's lease of 20 s (its default announces every 3 s).
-inline const eprosima::fastrtps::Duration_t kClientLease{20, 0};
-inline const eprosima::fastrtps::Duration_t kClientAnnouncementPeriod{6, 666666667};
+// announcements per lease (Fast DDS's default: every 3 s, lease 20 s). The lease outlasts a
+// radio dropout of 30 s and more: a client and a server that expired each other during one
+// do not always exchange their endpoints again (deploy/discovery-server.xml says more).
+inline const eprosima::fastrtps::Duration_t kClientLease{60, 0};
+inline const eprosima::fastrtps::Duration_t kClientAnnouncementPeriod{20, 0};
 
 eprosima::fastdds::dds::DomainParticipantQos participant_qos(const std::string& name, Transport transport,
                                                              const ResolvedNetwork& network,
