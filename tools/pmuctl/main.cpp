@@ -37,6 +37,10 @@
 #include "pmu/version.hpp"
 #include "pmuctl/verbs/exit_status.hpp"
 #include "pmuctl/verbs/option_values.hpp"
+#include "pmuctl/agent/agent_client.hpp"
+#include "pmuctl/agent/agent_request.hpp"
+#include "pmuctl/agent/agent_server.hpp"
+#include "pmuctl/verbs/context_lease.hpp"
 
 namespace {
 
@@ -137,9 +141,15 @@ bool setup_vehicle(pmu::tools::GlobalOptions& g, const CLI::Option* option, cons
   return true;
 }
 
-}  // namespace
+// Set when `pmuctl agent` runs a call: its participants, its DDS settings, and why it
+// declined the call (left empty when it ran it).
+struct AgentCall {
+  pmu::tools::ContextPool& pool;
+  const pmu::tools::GlobalOptions& settings;
+  std::string& declined;
+};
 
-int main(int argc, char** argv) {
+int run_cli(int argc, char** argv, const AgentCall* served) {
   CLI::App app{"pmuctl: operate and inspect Millswood 250W PMUs served by pmu-service"};
   app.require_subcommand(1);
   app.fallthrough();  // global options may follow the verb: `pmuctl decode --json`
@@ -181,6 +191,16 @@ int main(int argc, char** argv) {
                  "DDS over UDP only on this interface (name or IPv4 address); repeat for more "
                  "(default: $PMU_DDS_INTERFACES, comma separated; none: every interface)")
       ->allow_extra_args(false);
+  app.add_flag("--no-agent", g.no_agent, "Run this call on its own, not through a `pmuctl agent` of this host");
+
+  auto* agent = app.add_subcommand(
+      "agent", "Keep this host's DDS participants for the pmuctl calls made on it (a ground station on a radio "
+               "link) until Ctrl-C or SIGTERM");
+  std::string agent_socket;
+  agent->add_option("--socket", agent_socket,
+                    "The socket calls find it at (default: $PMU_AGENT_SOCKET, else $XDG_RUNTIME_DIR/pmu-dds/"
+                    "agent-DOMAIN.sock, else /run/pmu-dds/agent-DOMAIN.sock)")
+      ->type_name("PATH");
 
   auto* watch = app.add_subcommand("watch", "Live telemetry with each device's alarm marker: a refreshing table, or one JSON object per sample");
   std::string count_text;
@@ -375,7 +395,39 @@ int main(int argc, char** argv) {
   if (!setup_vehicle(g, vehicle_option, vehicle)) return 2;
   if (!pmu::tools::resolve_network_options(network, pmu::dds::system_lookup(), !g.security.empty(), g.network))
     return 2;
+  // Calls that end by themselves go through the agent; those that run until stopped keep a
+  // participant of their own anyway.
+  const bool agent_serves = !*agent && !*watch && !*record && !*serve;
+  if (served) {
+    if (!agent_serves) {
+      served->declined = "an agent serves calls that end by themselves, not watch, record, serve or agent";
+      return 2;
+    }
+    if (!pmu::tools::same_dds_settings(g, served->settings)) {
+      served->declined = "its domain, QoS file, security or network options are not the agent's";
+      return 2;
+    }
+    g.pool = &served->pool;
+  } else if (agent_serves && !g.no_agent) {
+    if (const auto status =
+            pmu::tools::call_agent(pmu::tools::agent_socket_path(g.domain), std::vector<std::string>(argv + 1, argv + argc), g.json))
+      return *status;
+  }
   try {
+    if (*agent) {
+      const std::string socket = agent_socket.empty() ? pmu::tools::agent_socket_path(g.domain) : agent_socket;
+      return pmu::tools::run_agent(
+          g, socket,
+          [&g](const std::vector<std::string>& arguments, pmu::tools::ContextPool& pool, std::string& declined) {
+            std::vector<std::string> words{"pmuctl"};
+            words.insert(words.end(), arguments.begin(), arguments.end());
+            std::vector<char*> args;
+            for (auto& w : words) args.push_back(w.data());
+            args.push_back(nullptr);
+            const AgentCall call{pool, g, declined};
+            return run_cli(static_cast<int>(words.size()), args.data(), &call);
+          });
+    }
     if (*watch) return pmu::tools::run_watch(g, count);
     if (*record) return pmu::tools::run_record(g, record_path, record_topics);
     if (*serve) return pmu::tools::run_serve(g, serve_options, serve_topics);
@@ -444,3 +496,7 @@ int main(int argc, char** argv) {
   }
   return 2;
 }
+
+}  // namespace
+
+int main(int argc, char** argv) { return run_cli(argc, argv, nullptr); }

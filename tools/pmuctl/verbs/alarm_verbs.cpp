@@ -17,6 +17,7 @@
 #include "pmuctl/verbs/alarm_sample.hpp"
 #include "pmuctl/verbs/exit_status.hpp"
 #include "pmuctl/verbs/service_presence.hpp"
+#include "pmuctl/verbs/context_lease.hpp"
 
 namespace pmu::tools {
 namespace {
@@ -52,8 +53,8 @@ void print(const GlobalOptions& o, const AlarmEntry& a) {
 }  // namespace
 
 int run_alarms(const GlobalOptions& o) {
-  pmu::dds::DdsContext dds(o.domain, o.qos_file, "pmuctl", o.security, pmu::dds::Transport::Default, o.network,
-                           partitions_for(o));
+  ContextLease lease(o, "pmuctl");
+  pmu::dds::DdsContext& dds = *lease;
   DataReader& reader = dds.reader(
       dds.topic(topics::kAlarms, TypeSupport(new idl::Guarded<pmu::v4::AlarmPubSubType>())), qos_profiles::kAlarms);
   const auto deadline = Clock::now() + std::chrono::duration<double>(o.timeout.value_or(3.0));

@@ -138,7 +138,8 @@ std::uint64_t epoch_ns_after(double seconds) {
 CommandChannel::CommandChannel(const GlobalOptions& o)
     : options_(o),
       vehicle_(o.vehicle.value_or(std::string())),
-      dds_(o.domain, o.qos_file, "pmuctl", o.security, pmu::dds::Transport::Default, o.network, partitions_for(o)),
+      lease_(o, "pmuctl"),
+      dds_(*lease_),
       replies_(dds_.reader(
           dds_.topic(topics::kCommandReply, TypeSupport(new idl::Guarded<pmu::v4::CommandReplyPubSubType>())),
           qos_profiles::kCommand)),

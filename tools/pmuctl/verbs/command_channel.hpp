@@ -3,7 +3,7 @@
 // replies (interface.md 2.1, 2.4): `pmuctl` command verbs send one, `config apply` a series
 // over the same participant, so a change of ten settings costs one discovery, not ten.
 //
-// Lifetime: owns its DdsContext; the readers and writer it hands out live as long as it.
+// Lifetime: owns its participant, or borrows one of `pmuctl agent` (context_lease.hpp); the readers and writer it hands out live as long as it.
 // Threads: the verb's thread only.
 
 #include <chrono>
@@ -14,6 +14,7 @@
 #include "pmu/dds/dds_context.hpp"
 #include "pmu/idl/command.h"
 #include "pmuctl/verbs/command_verbs.hpp"
+#include "pmuctl/verbs/context_lease.hpp"
 
 namespace pmu::tools {
 
@@ -67,7 +68,8 @@ class CommandChannel {
  private:
   const GlobalOptions& options_;
   std::string vehicle_;
-  pmu::dds::DdsContext dds_;
+  ContextLease lease_;
+  pmu::dds::DdsContext& dds_;
   eprosima::fastdds::dds::DataReader& replies_;
   eprosima::fastdds::dds::DataWriter& writer_;
 };

@@ -31,6 +31,7 @@
 #include "pmuctl/verbs/exit_status.hpp"
 #include "pmuctl/verbs/service_presence.hpp"
 #include "pmuctl/view/sample_json.hpp"
+#include "pmuctl/verbs/context_lease.hpp"
 
 namespace pmu::tools {
 namespace {
@@ -59,8 +60,8 @@ int run_alarm_ack(const GlobalOptions& o, const std::string& code, const std::st
     return fail(o, ExitStatus::BadUsage, "a " + kind + " alarm needs --bus and --address (the " +
                                              (source == pmu::v4::SOURCE_BATTERY ? "CANopen node" : "MPPT device id") +
                                              ")");
-  pmu::dds::DdsContext dds(o.domain, o.qos_file, "pmuctl", o.security, pmu::dds::Transport::Default, o.network,
-                           partitions_for(o));
+  ContextLease lease(o, "pmuctl");
+  pmu::dds::DdsContext& dds = *lease;
   DataReader& replies = dds.reader(
       dds.topic(topics::kAlarmAckReply, TypeSupport(new idl::Guarded<pmu::v4::AlarmAckReplyPubSubType>())),
       qos_profiles::kCommand);

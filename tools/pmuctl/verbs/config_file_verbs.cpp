@@ -33,6 +33,7 @@
 #include "pmuctl/verbs/command_channel.hpp"
 #include "pmuctl/verbs/exit_status.hpp"
 #include "pmuctl/verbs/service_presence.hpp"
+#include "pmuctl/verbs/context_lease.hpp"
 
 namespace pmu::tools {
 // A namespace of its own: the unity builds put this file in one translation unit with the
@@ -201,7 +202,8 @@ class ReadOnlyView {
   explicit ReadOnlyView(const GlobalOptions& o)
       : o_(o),
         vehicle_(o.vehicle.value_or(std::string())),
-        dds_(o.domain, o.qos_file, "pmuctl", o.security, pmu::dds::Transport::Default, o.network, partitions_for(o)),
+        lease_(o, "pmuctl"),
+        dds_(*lease_),
         device_(dds_, vehicle_) {}
   // nullopt with `status` set when there is none.
   std::optional<Target> find(int& status) { return find_device(o_, dds_, device_, vehicle_, deadline_, status); }
@@ -212,7 +214,8 @@ class ReadOnlyView {
  private:
   const GlobalOptions& o_;
   std::string vehicle_;
-  pmu::dds::DdsContext dds_;
+  ContextLease lease_;
+  pmu::dds::DdsContext& dds_;
   DeviceReader device_;
   Clock::time_point deadline_ = deadline_after(o_.timeout.value_or(5.0));
 };

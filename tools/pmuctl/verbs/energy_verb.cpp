@@ -16,6 +16,7 @@
 #include "pmuctl/verbs/exit_status.hpp"
 #include "pmuctl/verbs/service_presence.hpp"
 #include "pmuctl/verbs/state_settle.hpp"
+#include "pmuctl/verbs/context_lease.hpp"
 
 namespace pmu::tools {
 // A namespace of its own: the unity builds put this file in one translation unit with the
@@ -74,8 +75,8 @@ std::size_t matched(DataReader& reader) {
 }
 
 int run(const GlobalOptions& o) {
-  pmu::dds::DdsContext dds(o.domain, o.qos_file, "pmuctl", o.security, pmu::dds::Transport::Default, o.network,
-                           partitions_for(o));
+  ContextLease lease(o, "pmuctl");
+  pmu::dds::DdsContext& dds = *lease;
   DataReader& pmus =
       dds.reader(dds.topic(topics::kEnergy, TypeSupport(new idl::Guarded<pmu::v4::EnergyPubSubType>())),
                  qos_profiles::kState);

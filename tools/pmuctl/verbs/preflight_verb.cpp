@@ -17,6 +17,7 @@
 #include "pmuctl/verbs/exit_status.hpp"
 #include "pmuctl/verbs/service_presence.hpp"
 #include "pmuctl/verbs/state_settle.hpp"
+#include "pmuctl/verbs/context_lease.hpp"
 
 namespace pmu::tools {
 namespace {
@@ -74,8 +75,8 @@ void print(const GlobalOptions& o, const pmu::v4::Readiness& r) {
 }  // namespace
 
 int run_preflight(const GlobalOptions& o) {
-  pmu::dds::DdsContext dds(o.domain, o.qos_file, "pmuctl", o.security, pmu::dds::Transport::Default, o.network,
-                           partitions_for(o));
+  ContextLease lease(o, "pmuctl");
+  pmu::dds::DdsContext& dds = *lease;
   DataReader& reader =
       dds.reader(dds.topic(topics::kReadiness, TypeSupport(new idl::Guarded<pmu::v4::ReadinessPubSubType>())),
                  qos_profiles::kState);

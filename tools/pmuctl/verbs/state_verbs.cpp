@@ -33,6 +33,7 @@
 #include "pmuctl/view/sample_fields.hpp"
 #include "pmuctl/view/sample_json.hpp"
 #include "pmuctl/view/table_text.hpp"
+#include "pmuctl/verbs/context_lease.hpp"
 
 namespace pmu::tools {
 namespace {
@@ -284,8 +285,8 @@ int run_watch(const GlobalOptions& o, long count) {
   // Ctrl-C or SIGTERM ends the watch like its count or timeout does (the summary and the exit
   // status follow), read before Fast DDS starts its threads.
   pmu::transport::StopSignals stop;
-  pmu::dds::DdsContext dds(o.domain, o.qos_file, "pmuctl", o.security, pmu::dds::Transport::Default, o.network,
-                           partitions_for(o));
+  ContextLease lease(o, "pmuctl");
+  pmu::dds::DdsContext& dds = *lease;
   std::vector<std::unique_ptr<TelemetryReader>> readers;
   // --low-rate: only the low-rate topics' writers match, so only their samples cross the link.
   const bool low = o.low_rate;
@@ -424,8 +425,8 @@ std::string contracts_cell(const std::set<int>& contracts) {
 }
 
 int run_list(const GlobalOptions& o) {
-  pmu::dds::DdsContext dds(o.domain, o.qos_file, "pmuctl", o.security, pmu::dds::Transport::Default, o.network,
-                           partitions_for(o));
+  ContextLease lease(o, "pmuctl");
+  pmu::dds::DdsContext& dds = *lease;
   StateCollector<pmu::v4::Health, pmu::v4::HealthPubSubType> health(dds, topics::kHealth);
   StateCollector<pmu::v4::DeviceInfo, pmu::v4::DeviceInfoPubSubType> info(dds, topics::kInfo);
   if (int rc = collect(o, dds, health, 3.0)) return rc;
@@ -489,15 +490,15 @@ int run_list(const GlobalOptions& o) {
 }
 
 int run_info(const GlobalOptions& o) {
-  pmu::dds::DdsContext dds(o.domain, o.qos_file, "pmuctl", o.security, pmu::dds::Transport::Default, o.network,
-                           partitions_for(o));
+  ContextLease lease(o, "pmuctl");
+  pmu::dds::DdsContext& dds = *lease;
   StateCollector<pmu::v4::DeviceInfo, pmu::v4::DeviceInfoPubSubType> c(dds, topics::kInfo);
   return print_state(o, dds, c, "info");
 }
 
 int run_health(const GlobalOptions& o) {
-  pmu::dds::DdsContext dds(o.domain, o.qos_file, "pmuctl", o.security, pmu::dds::Transport::Default, o.network,
-                           partitions_for(o));
+  ContextLease lease(o, "pmuctl");
+  pmu::dds::DdsContext& dds = *lease;
   StateCollector<pmu::v4::Health, pmu::v4::HealthPubSubType> c(dds, topics::kHealth);
   return print_state(o, dds, c, "health", true);
 }
@@ -509,8 +510,8 @@ int run_config_get(const GlobalOptions& o, const std::string& parameter) {
                 "unknown parameter '" + service::printable(parameter) + "'" +
                     " (parameters: " + config_names() + ")");
   }
-  pmu::dds::DdsContext dds(o.domain, o.qos_file, "pmuctl", o.security, pmu::dds::Transport::Default, o.network,
-                           partitions_for(o));
+  ContextLease lease(o, "pmuctl");
+  pmu::dds::DdsContext& dds = *lease;
   StateCollector<pmu::v4::Config, pmu::v4::ConfigPubSubType> c(dds, topics::kConfig);
   if (parameter.empty()) return print_state(o, dds, c, "config");
   if (int rc = collect(o, dds, c, 3.0)) return rc;

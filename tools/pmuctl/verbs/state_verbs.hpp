@@ -13,6 +13,8 @@
 
 namespace pmu::tools {
 
+class ContextPool;  // context_lease.hpp
+
 struct GlobalOptions {
   int domain = 0;
   // --vehicle / $PMU_VEHICLE. Readers: only that vehicle, or every vehicle when absent.
@@ -26,6 +28,10 @@ struct GlobalOptions {
   std::string qos_file;                 // empty: the installed qos.xml
   pmu::dds::SecurityFiles security;     // empty: no DDS-Security (--security-dir/--identity)
   pmu::dds::ResolvedNetwork network;    // discovery and interfaces (--peer, --discovery-server, --interface)
+  bool no_agent = false;                // --no-agent: never through `pmuctl agent`
+  // Set while `pmuctl agent` serves the call: the verbs borrow its participants
+  // (context_lease.hpp). Null for a call of its own.
+  ContextPool* pool = nullptr;
 };
 
 // The partitions of pmuctl's participant for these options (service/vehicle.hpp).

@@ -1,0 +1,238 @@
+// `pmuctl agent` (interface.md section 3.2): calls made on its host go through it with the
+// caller's arguments, environment, directory, output and exit status; a command through it
+// is executed once; calls it must not serve (another domain, watch, --no-agent) run on their
+// own; one agent per socket, a stale socket is taken over, and an agent that ends during a
+// call leaves the caller with "no answer", never a second run.
+#include <gtest/gtest.h>
+#include <sys/stat.h>
+#include <sys/socket.h>
+#include <sys/un.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <csignal>
+#include <cstdlib>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <regex>
+#include <string>
+#include <thread>
+
+#include "support/configured_service.hpp"
+#include "support/domain.hpp"
+#include "support/json_lines.hpp"
+#include "support/process.hpp"
+
+namespace {
+
+using namespace std::chrono_literals;
+namespace fs = std::filesystem;
+
+pmu::test::RunResult sh(const std::string& cmd) { return pmu::test::run_capture(cmd, true); }
+
+std::string read_file(const std::string& path) {
+  std::ifstream in(path);
+  return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+}
+
+std::size_t count(const std::string& text, const std::string& what) {
+  std::size_t n = 0;
+  for (auto at = text.find(what); at != std::string::npos; at = text.find(what, at + 1)) ++n;
+  return n;
+}
+
+class TempDir {
+ public:
+  TempDir() {
+    char tmpl[] = "/tmp/pmu-agent-test.XXXXXX";
+    path_ = ::mkdtemp(tmpl);
+  }
+  ~TempDir() {
+    std::error_code ec;
+    fs::remove_all(path_, ec);
+  }
+  const std::string& path() const { return path_; }
+
+ private:
+  std::string path_;
+};
+
+// An agent on `socket`, its log in `log`; started from the test's main thread.
+pmu::test::Child start_agent(int domain, const std::string& socket, const std::string& log) {
+  pmu::test::ChildOptions o;
+  o.stderr_path = log;
+  o.stdout_path = log;
+  pmu::test::Child agent({PMUCTL_PATH, "--domain", std::to_string(domain), "agent", "--socket", socket}, o);
+  return agent;
+}
+
+bool wait_for_socket(const std::string& path) {
+  for (int i = 0; i < 200; ++i) {
+    struct stat st{};
+    if (::lstat(path.c_str(), &st) == 0 && S_ISSOCK(st.st_mode)) return true;
+    std::this_thread::sleep_for(50ms);
+  }
+  return false;
+}
+
+// True when something listens on the Unix socket at `path`.
+bool connects(const std::string& path) {
+  const int fd = ::socket(AF_UNIX, SOCK_SEQPACKET | SOCK_CLOEXEC, 0);
+  sockaddr_un addr{};
+  addr.sun_family = AF_UNIX;
+  std::strncpy(addr.sun_path, path.c_str(), sizeof addr.sun_path - 1);
+  const bool ok = ::connect(fd, reinterpret_cast<const sockaddr*>(&addr), sizeof addr) == 0;
+  ::close(fd);
+  return ok;
+}
+
+class Uav1 : public pmu::test::ConfiguredService {
+ public:
+  explicit Uav1(int domain)
+      : ConfiguredService(PMU_SERVICE_PATH, "domain: " + std::to_string(domain) + "\nvehicle: uav1\nqos_file: " +
+                                                PMU_QOS_FILE +
+                                                "\nlog_level: info\nbuses:\n  - interface: sim\n    name: can0\n"
+                                                "    devices:\n      - address: 1\n        period: 0.5\n") {}
+};
+
+TEST(PmuctlAgent, CallsGoThroughItWithTheCallersOutputStatusAndDirectory) {
+  const int domain = pmu::test::exclusive_dds_domain();
+  Uav1 uav1(domain);
+  TempDir dir;
+  const std::string socket = dir.path() + "/agent.sock", log = dir.path() + "/agent.log";
+  auto agent = start_agent(domain, socket, log);
+  ASSERT_TRUE(wait_for_socket(socket)) << read_file(log);
+  EXPECT_EQ(fs::status(socket).permissions() & fs::perms::all, fs::perms::owner_read | fs::perms::owner_write)
+      << "only the agent's user may call it";
+  const std::string p = "cd " + dir.path() + " && PMU_AGENT_SOCKET=" + socket + " " + PMUCTL_PATH + " --domain " +
+                        std::to_string(domain) + " ";
+
+  // The first call waits for the service as long as a loaded run needs.
+  bool listed = false;
+  for (int attempt = 0; attempt < 10 && !listed; ++attempt) {
+    const auto r = sh(p + "--timeout 10 --json list");
+    for (const auto& j : pmu::test::json_lines(r.out))
+      listed = listed || (!j.is_discarded() && j.contains("vehicle") && j["vehicle"] == "uav1");
+  }
+  ASSERT_TRUE(listed) << read_file(log) << uav1.describe();
+
+  // A command: its reply on the caller's stdout, exit 0, executed once by the service.
+  auto r = sh(p + "--timeout 30 --vehicle uav1 --json config set payload_voltage 23");
+  EXPECT_EQ(r.status, 0) << r.out;
+  std::smatch m;
+  ASSERT_TRUE(std::regex_search(r.out, m, std::regex("\"request_id\":\"([^\"]+)\""))) << r.out;
+  const std::string id = m[1];
+  EXPECT_NE(r.out.find("\"result\":\"COMPLETED\""), std::string::npos) << r.out;
+  // The variable reaches the call: PMU_VEHICLE instead of --vehicle.
+  r = sh("PMU_VEHICLE=uav1 " + p + "--timeout 20 config get payload_voltage");
+  EXPECT_EQ(r.status, 0) << r.out;
+  EXPECT_NE(r.out.find("uav1/can0/1 payload_voltage = 23.0"), std::string::npos) << r.out;
+  // A failing call's message on the caller's stderr and its exit status.
+  r = sh(p + "--timeout 2 --vehicle uav9 config set payload_voltage 23");
+  EXPECT_EQ(r.status, 2) << r.out;
+  EXPECT_NE(r.out.find("no pmu-service of vehicle uav9"), std::string::npos) << r.out;
+  // A relative path is the caller's: the snapshot lands in the caller's directory.
+  r = sh(p + "--timeout 20 --vehicle uav1 config snapshot snap.yaml");
+  EXPECT_EQ(r.status, 0) << r.out;
+  EXPECT_NE(read_file(dir.path() + "/snap.yaml").find("payload_voltage: 23.0"), std::string::npos);
+
+  // Not served: --no-agent, watch (runs until stopped), another domain (declined, said).
+  r = sh(p + "--no-agent --timeout 10 --vehicle uav1 config get payload_voltage");
+  EXPECT_EQ(r.status, 0) << r.out;
+  r = sh(p + "--timeout 10 watch --count 1 --low-rate");
+  EXPECT_EQ(r.status, 0) << r.out;
+  r = sh("PMU_AGENT_SOCKET=" + socket + " " + PMUCTL_PATH + " --domain " + std::to_string(domain + 1) +
+         " --timeout 1 list");
+  EXPECT_EQ(r.status, 3) << r.out;
+  EXPECT_NE(r.out.find("pmuctl: the agent on " + socket + " does not serve this call (its domain, QoS file, "
+                       "security or network options are not the agent's); it runs on its own"),
+            std::string::npos)
+      << r.out;
+
+  ASSERT_TRUE(agent.signal(SIGTERM));
+  const auto st = agent.wait_for(10s);
+  ASSERT_TRUE(st);
+  EXPECT_TRUE(WIFEXITED(*st) && WEXITSTATUS(*st) == 0);
+  EXPECT_FALSE(fs::exists(socket)) << "an agent that ends removes its socket";
+  const std::string agent_log = read_file(log);
+  EXPECT_NE(agent_log.find("--vehicle uav1 --json config set payload_voltage 23: exit 0"), std::string::npos)
+      << agent_log;
+  EXPECT_NE(agent_log.find("--vehicle uav9 config set payload_voltage 23: exit 2"), std::string::npos) << agent_log;
+  EXPECT_NE(agent_log.find("config snapshot snap.yaml: exit 0"), std::string::npos) << agent_log;
+  EXPECT_EQ(count(agent_log, "--no-agent"), 0u) << agent_log;
+  EXPECT_EQ(count(agent_log, "watch"), 0u) << agent_log;
+  EXPECT_EQ(count(agent_log, ": declined (its domain"), 1u) << agent_log;
+  // Executed once: one audit line for the command's id in the service's log.
+  const std::string service_log = uav1.describe();
+  EXPECT_EQ(count(service_log, "audit: command " + id + " "), 1u) << service_log;
+}
+
+TEST(PmuctlAgent, OneAgentPerSocketAndAStaleSocketIsTakenOver) {
+  const int domain = pmu::test::exclusive_dds_domain();
+  TempDir dir;
+  const std::string socket = dir.path() + "/agent.sock";
+  {
+    // What a killed agent leaves: a socket file nobody listens on.
+    const int fd = ::socket(AF_UNIX, SOCK_SEQPACKET, 0);
+    sockaddr_un addr{};
+    addr.sun_family = AF_UNIX;
+    std::strcpy(addr.sun_path, socket.c_str());
+    ASSERT_EQ(::bind(fd, reinterpret_cast<const sockaddr*>(&addr), sizeof addr), 0);
+    ::close(fd);
+  }
+  auto first = start_agent(domain, socket, dir.path() + "/first.log");
+  // The stale file is replaced by a socket that is listened on.
+  bool listening = false;
+  for (int i = 0; i < 200 && !listening && first.running(); ++i) {
+    listening = connects(socket);
+    if (!listening) std::this_thread::sleep_for(50ms);
+  }
+  ASSERT_TRUE(listening) << read_file(dir.path() + "/first.log");
+  // A second agent finds it taken (`timeout`: one that wrongly listened would never end).
+  const auto second =
+      sh("timeout 20 " + std::string(PMUCTL_PATH) + " --domain " + std::to_string(domain) + " agent --socket " + socket);
+  EXPECT_EQ(second.status, 2) << second.out;
+  EXPECT_NE(second.out.find("pmuctl agent: another agent listens on " + socket), std::string::npos) << second.out;
+  EXPECT_TRUE(first.running()) << read_file(dir.path() + "/first.log");
+
+  // A path that is not a socket is never replaced.
+  const std::string file = dir.path() + "/not-a-socket";
+  std::ofstream(file) << "keep me\n";
+  const auto r = sh("timeout 20 " + std::string(PMUCTL_PATH) + " agent --socket " + file);
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.out.find("pmuctl agent: " + file + " exists and is not a socket: not replaced"), std::string::npos)
+      << r.out;
+  EXPECT_EQ(read_file(file), "keep me\n");
+}
+
+TEST(PmuctlAgent, AnAgentThatEndsDuringACallLeavesNoAnswerAndNoSecondRun) {
+  const int domain = pmu::test::exclusive_dds_domain();
+  TempDir dir;
+  const std::string socket = dir.path() + "/agent.sock", log = dir.path() + "/agent.log";
+  auto agent = start_agent(domain, socket, log);
+  ASSERT_TRUE(wait_for_socket(socket)) << read_file(log);
+  // No service on the domain: the call waits its whole timeout inside the agent.
+  pmu::test::ChildOptions o;
+  o.env = {"PMU_AGENT_SOCKET=" + socket};
+  o.stdout_path = dir.path() + "/call.out";
+  o.stderr_path = o.stdout_path;
+  pmu::test::Child call({PMUCTL_PATH, "--domain", std::to_string(domain), "--timeout", "20", "--vehicle", "uav1",
+                         "config", "set", "payload_voltage", "23"},
+                        o);
+  std::this_thread::sleep_for(1500ms);
+  ASSERT_TRUE(agent.signal(SIGKILL));
+  const auto st = call.wait_for(15s);
+  ASSERT_TRUE(st) << "the call did not end when its agent did";
+  EXPECT_TRUE(WIFEXITED(*st) && WEXITSTATUS(*st) == 3) << read_file(o.stdout_path);
+  // Had it run the call again on its own, that run would have said there is no service.
+  EXPECT_EQ(read_file(o.stdout_path).find("no pmu-service"), std::string::npos) << read_file(o.stdout_path);
+  EXPECT_NE(read_file(o.stdout_path).find("pmuctl: the agent on " + socket +
+                                           " ended during the call: it may have been carried out (see the agent's "
+                                           "log), so it is not run again"),
+            std::string::npos)
+      << read_file(o.stdout_path);
+}
+
+}  // namespace

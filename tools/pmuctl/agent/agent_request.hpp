@@ -1,0 +1,52 @@
+#pragma once
+// What a pmuctl call sends `pmuctl agent` over its socket, and what comes back: one
+// SOCK_SEQPACKET message each way. The request carries the call's working directory, the
+// environment variables that change what pmuctl does, and its arguments; its standard
+// input, output and error go along as file descriptors (SCM_RIGHTS), so the agent writes
+// straight to the caller's terminal or pipe. The reply is the call's exit status, or why
+// the agent did not run it (the caller then runs it on its own).
+//
+// Encoding: NUL-terminated strings: "pmuctl-agent-1", the directory, the number of
+// variables, NAME=VALUE for each, then the arguments (without argv[0]). Decoding is total:
+// anything else is an error naming what was wrong, never a partial request.
+
+#include <optional>
+#include <string>
+#include <string_view>
+#include <utility>
+#include <vector>
+
+namespace pmu::tools {
+
+// The variables a call reads (pmuctl(1), ENVIRONMENT). A call sends those it has set; the
+// agent runs it with exactly those set and the others unset.
+inline constexpr const char* kAgentEnvironment[] = {
+    "PMU_VEHICLE",          "PMU_QOS_FILE",       "PMU_SECURITY_DIR",  "PMU_SECURITY_IDENTITY",
+    "PMU_DDS_PEERS",        "PMU_DISCOVERY_SERVER", "PMU_DDS_INTERFACES",
+};
+
+struct AgentRequest {
+  std::string directory;
+  std::vector<std::pair<std::string, std::string>> environment;
+  std::vector<std::string> arguments;
+};
+
+std::string encode_request(const AgentRequest& request);
+// The request, or nullopt with `error` saying what is wrong with `bytes`.
+std::optional<AgentRequest> decode_request(std::string_view bytes, std::string& error);
+
+// The agent's answer: "exit N" (the call ran; N its exit status), "declined WHY" (not run).
+struct AgentReply {
+  bool ran = false;
+  int status = 0;
+  std::string declined;  // why, when !ran
+};
+std::string encode_reply(const AgentReply& reply);
+std::optional<AgentReply> decode_reply(std::string_view bytes);
+
+// The socket of the agent for `domain`: $PMU_AGENT_SOCKET when set; else
+// $XDG_RUNTIME_DIR/pmu-dds/agent-DOMAIN.sock for a user with a runtime directory, else
+// /run/pmu-dds/agent-DOMAIN.sock (a system service's RuntimeDirectory).
+std::string agent_socket_path(int domain);
+
+}  // namespace pmu::tools

@@ -1,0 +1,65 @@
+#pragma once
+// Where a verb's DDS participant comes from. A plain pmuctl call makes its own and deletes
+// it when the verb ends. A call that `pmuctl agent` serves borrows one of the agent's
+// long-lived participants instead: the aircraft have discovered it once, so over a radio
+// link a call costs its few endpoints and their samples rather than a whole participant's
+// discovery, and the endpoints the verb made are deleted when it ends.
+//
+// Lifetime: a ContextPool outlives every lease taken from it (the agent owns it for its
+// whole run); a lease outlives every reference the verb took from its context.
+// Threads: the verb's thread only; the agent serves one call at a time.
+
+#include <map>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "pmu/dds/dds_context.hpp"
+#include "pmuctl/verbs/state_verbs.hpp"
+
+namespace pmu::tools {
+
+class ContextPool {
+ public:
+  // `settings`: the domain, QoS file, security files and network of every participant made.
+  explicit ContextPool(const GlobalOptions& settings);
+  ContextPool(const ContextPool&) = delete;
+  ContextPool& operator=(const ContextPool&) = delete;
+
+  // The participant of this name, made at its first use, its publisher and subscriber moved
+  // to `partitions`: one participant serves every vehicle in turn, so the aircraft discover
+  // one participant of the agent, once. Throws DdsError like DdsContext's constructor, and
+  // when the partitions cannot be set.
+  pmu::dds::DdsContext& context(const std::string& participant_name, const pmu::dds::Partitions& partitions);
+  // Deletes every participant: the next call makes new ones (after the network came back).
+  void clear() { contexts_.clear(); }
+  std::size_t size() const noexcept { return contexts_.size(); }
+
+ private:
+  GlobalOptions settings_;
+  std::map<std::string, std::unique_ptr<pmu::dds::DdsContext>> contexts_;
+};
+
+// True when a call with options `o` would make the same participants as the pool of
+// `agent`: the same domain, QoS file, security files and network. Anything else (another
+// domain, identity or discovery server) is not the agent's to serve.
+bool same_dds_settings(const GlobalOptions& o, const GlobalOptions& agent);
+
+class ContextLease {
+ public:
+  // From o.pool when set, else a participant of its own; partitions_for(o).
+  ContextLease(const GlobalOptions& o, const std::string& participant_name);
+  ~ContextLease();
+  ContextLease(const ContextLease&) = delete;
+  ContextLease& operator=(const ContextLease&) = delete;
+
+  pmu::dds::DdsContext& operator*() noexcept { return *context_; }
+  pmu::dds::DdsContext* operator->() noexcept { return context_; }
+
+ private:
+  std::unique_ptr<pmu::dds::DdsContext> owned_;
+  pmu::dds::DdsContext* context_;
+  pmu::dds::DdsContext::EndpointMark mark_;
+};
+
+}  // namespace pmu::tools
