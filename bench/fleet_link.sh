@@ -4,7 +4,7 @@
 #
 #   bench/fleet_link.sh [--aircraft "1 4 8"] [--rate 250kbit] [--build-dir DIR] [--qos FILE]
 #                       [--pmuctl BIN] [--service BIN] [--discovery-server [--server-xml FILE|none]]
-#                       [--cut SECONDS] [--json FILE]
+#                       [--cut SECONDS] [--agent] [--json FILE]
 #
 # Two network namespaces joined by one veth pair, shaped by tbf to RATE each way (a radio
 # modem's queue of about 2 s; no delay or loss: the VM lab adds those): in `air`, N pmu-service
@@ -26,6 +26,9 @@
 #            list` lists all N, and until a command to each (all at once, after that list)
 #            COMPLETED; then every command's id is counted in the services' audit trails
 #            (`audit: command ID ...` lines): executions must equal commands, none twice
+# --agent: the ground's pmuctl calls go through one `pmuctl agent`, started in `gnd` after the
+# idle step (so its first call, the list, pays for its participants' discovery); watch is
+# never served by an agent and runs on its own as before. Without it, calls run on their own.
 # Needs root (ip netns); exit status 77 when namespaces cannot be made. Exit status 1 when
 # a --discovery-server run found a command executed twice or by another vehicle.
 set -euo pipefail
@@ -41,6 +44,7 @@ ds=0
 svc=""
 server_xml="$root/deploy/discovery-server.xml"
 cut_s=30
+agent=0
 while [ $# -gt 0 ]; do
   case "$1" in
     --aircraft) aircraft=$2; shift 2 ;;
@@ -53,6 +57,7 @@ while [ $# -gt 0 ]; do
     --discovery-server) ds=1; shift ;;
     --server-xml) server_xml=$2; [ "$2" = none ] || server_xml=$(realpath "$2"); shift 2 ;;
     --cut) cut_s=$2; shift 2 ;;
+    --agent) agent=1; shift ;;
     -h|--help) sed -n '2,30p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
     *) echo "fleet_link.sh: unknown argument '$1'" >&2; exit 2 ;;
   esac
@@ -112,7 +117,19 @@ link_drops() {
 }
 ds_option=()
 [ "$ds" = 1 ] && ds_option=(--discovery-server 10.79.0.2)
-pmuctl_gnd() { PMU_QOS_FILE="$qos" ip netns exec "$gnd" "$ctl" --domain "$domain" --interface gnd0 "${ds_option[@]}" --json "$@"; }
+# Without --agent the socket names nothing, so an agent of this host's user is never used.
+pmuctl_gnd() {
+  if [ "${exec_gnd:-0}" = 1 ]; then  # in a subshell of its own: become pmuctl
+    PMU_AGENT_SOCKET="$work/agent.sock" PMU_QOS_FILE="$qos" exec ip netns exec "$gnd" "$ctl" --domain "$domain" --interface gnd0 "${ds_option[@]}" --json "$@"
+  fi
+  PMU_AGENT_SOCKET="$work/agent.sock" PMU_QOS_FILE="$qos" ip netns exec "$gnd" "$ctl" --domain "$domain" --interface gnd0 "${ds_option[@]}" --json "$@"
+}
+start_agent() {
+  PMU_AGENT_SOCKET="$work/agent.sock" PMU_QOS_FILE="$qos" ip netns exec "$gnd" "$ctl" --domain "$domain" --interface gnd0 "${ds_option[@]}" agent >"$work/agent.log" 2>&1 &
+  local i
+  for i in $(seq 1 50); do [ -S "$work/agent.sock" ] && return 0; sleep 0.1; done
+  echo "fleet_link.sh: the agent did not start: $(cat "$work/agent.log")" >&2; exit 1
+}
 now() { date +%s.%N; }
 # The audit trail (`audit: command ...` lines) is logged at info.
 svc_log_level=warn
@@ -238,6 +255,7 @@ EOF
   sleep 20
   b0=$(link_bytes); sleep 10; b1=$(link_bytes)
   idle=$(( (b1 - b0) / 10 ))
+  [ "$agent" = 1 ] && start_agent
 
   d0=$(link_drops); b0=$(link_bytes); t0=$(now)
   pmuctl_gnd --timeout 20 list >"$work/list.out" 2>"$work/list.err" || true
@@ -254,11 +272,16 @@ EOF
   cmd_bytes=$((b1 - b0)); cmd_s=$(python3 -c "print(round($t1 - $t0, 2))")
   sleep 5
 
-  pmuctl_gnd watch --low-rate >"$work/low.out" 2>/dev/null &
+  # exec: $! is pmuctl itself, so the kill below ends the watch rather than only its shell,
+  # and the round and the cut that follow have the link to themselves.
+  (exec_gnd=1 pmuctl_gnd watch --low-rate >"$work/low.out" 2>/dev/null) &
   watcher=$!
   sleep 15  # the watcher's own discovery and the state it gets first are not the steady cost
   b0=$(link_bytes); l0=$(wc -l <"$work/low.out"); sleep 10; b1=$(link_bytes); l1=$(wc -l <"$work/low.out")
   kill "$watcher" 2>/dev/null || true; wait "$watcher" 2>/dev/null || true
+  if [ -n "$(ip netns pids "$gnd" | xargs -r ps -o args= -p | grep ' watch ')" ]; then
+    echo "fleet_link.sh: the low-rate watch did not end" >&2; exit 1
+  fi
   low=$(( (b1 - b0) / 10 )); low_samples=$(python3 -c "print(round(($l1 - $l0) / 10, 1))")
   drops=$(( $(link_drops) - d0 ))
 
@@ -268,13 +291,13 @@ EOF
   wait 2>/dev/null || true
 done
 
-ROWS=$(printf '%s\n' "${rows[@]}") DS_ROWS=$(printf '%s\n' "${ds_rows[@]}") python3 - "$rate" "$json_out" "$qos" "$ctl" "$ds" "$svc" "$server_xml" "$cut_s" <<'PY'
+ROWS=$(printf '%s\n' "${rows[@]}") DS_ROWS=$(printf '%s\n' "${ds_rows[@]}") python3 - "$rate" "$json_out" "$qos" "$ctl" "$ds" "$svc" "$server_xml" "$cut_s" "$agent" <<'PY'
 import json, os, re, sys
-rate, json_out, qos, ctl, ds, svc, server_xml, cut_s = sys.argv[1:9]
+rate, json_out, qos, ctl, ds, svc, server_xml, cut_s, agent = sys.argv[1:10]
 m = re.match(r"(\d+)kbit", rate)
 cap = int(m.group(1)) * 1000 / 8 if m else None
 out = []
-print(f"fleet over a {rate} link (tbf each way){', Discovery Server on the ground (' + server_xml + ')' if ds == '1' else ''}; qos {qos}; pmuctl {ctl}; pmu-service {svc}")
+print(f"fleet over a {rate} link (tbf each way){', Discovery Server on the ground (' + server_xml + ')' if ds == '1' else ''}{'; the calls through pmuctl agent' if agent == '1' else ''}; qos {qos}; pmuctl {ctl}; pmu-service {svc}")
 print("| aircraft | idle B/s | list: bytes, s, listed | command: bytes, s, result | watch --low-rate B/s (samples/s) | low-rate watch / one way's capacity | queue drops |")
 print("|---|---|---|---|---|---|---|")
 for line in os.environ["ROWS"].splitlines():
