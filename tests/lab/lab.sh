@@ -795,6 +795,13 @@ scenario_fleet8() {
     >"$WORK/$SCEN.ds.log" 2>&1 &
   track $!
   CTL_EXTRA="--discovery-server $FLEET_DS"
+  # The ground station a radio link wants: one pmuctl agent, through which every pmuctl call
+  # in gnd goes (interface.md 7.3); watch keeps a participant of its own.
+  export PMU_AGENT_SOCKET="$WORK/$SCEN.agent.sock"
+  # shellcheck disable=SC2086 # CTL_EXTRA is a word list
+  on gnd pmuctl --domain "$DOMAIN" $CTL_EXTRA agent >"$WORK/$SCEN.agent.log" 2>&1 &
+  track $!
+  wait_until 10 test -S "$PMU_AGENT_SOCKET" || fail "gnd: pmuctl agent did not start: $(tail -n1 "$WORK/$SCEN.agent.log")"
   for i in $FLEET_NUMS; do start_aircraft "$i"; done
   wait_until 60 fleet_ready || fail "not every service ready within 60 s of the start: $(for i in $FLEET_STARTED; do grep -q 'ready on DDS' "$(fleet_log "$i")" || printf 'uav%s ' "$i"; done)"
   t_ready=$(now)
@@ -820,7 +827,8 @@ scenario_fleet8() {
   detail "command round, one pmuctl config set to each of the eight in turn: all COMPLETED, each executed once by its own vehicle (audit trails); pmuctl start to exit min $1 s, p50 $r_p50 s, p99 = max $r_p99 s (bound $FLEET_COMMAND_BOUND s); $(resends_answered) resends answered again, not executed"
   true_that "$r_p99 <= $FLEET_COMMAND_BOUND" || missed "command round p99 $r_p99 s (each: $(awk '{ printf "%s %.2f s, ", $1, $3 - $2 }' "$WORK/$SCEN.round.cmds" | sed 's/, $//'); bound $FLEET_COMMAND_BOUND s)"
 
-  # A cut longer than every lease (clients 20 s, the server 30 s).
+  # A cut of 30 s: longer than Fast DDS's default lease (20 s), shorter than the Discovery
+  # Server set-up's (clients 60 s, the server 90 s), which it must ride through.
   set_link_loss 100%
   T_CUT=$(now)
   restore_after "$CUT_SECONDS"
@@ -867,6 +875,7 @@ scenario_fleet8() {
   [ "$late8" -eq 0 ] || fail "premise: $late8 samples of uav8 more than 5 s after its service was stopped"
   detail "uav9 joined (its first sample in gnd $(calc "$t9 - $t_join") s after its start) and uav8 left: uav1..uav7 $others over the $(calc "$t_end - $t_join") s (bound $FLEET_GAP_BOUND s); uav9 $GAPS after it joined"
   check_executed_once round after
+  detail "gnd: $(grep -c ': exit [0-9]* in ' "$WORK/$SCEN.agent.log") pmuctl calls went through its agent, $(grep -c ': declined' "$WORK/$SCEN.agent.log") declined"
 
   # What the scenario costs the lab's run, phase by phase, and what it asked of the VM.
   set -- $(vm_ticks); vb1=$1 vt1=$2; l1=$(link_bytes)
@@ -963,7 +972,7 @@ before_scenario() {
   fi
   detail "started on an idle ground link ($_q packets queued, $_moved bytes in 1 s)"
 }
-FAIL_LOGS="service*.log ground.out.err *.err ds.log"
+FAIL_LOGS="service*.log ground.out.err *.err ds.log agent.log"
 DOMAIN_BASE=40
 
 case "${1:-all}" in
