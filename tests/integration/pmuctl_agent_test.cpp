@@ -25,7 +25,7 @@
 #include "support/json_lines.hpp"
 #include "support/process.hpp"
 
-namespace {
+namespace pmuctl_agent_test {  // named: the unity build joins this file with others that have an `sh`
 
 using namespace std::chrono_literals;
 namespace fs = std::filesystem;
@@ -235,4 +235,4 @@ TEST(PmuctlAgent, AnAgentThatEndsDuringACallLeavesNoAnswerAndNoSecondRun) {
       << read_file(o.stdout_path);
 }
 
-}  // namespace
+}  // namespace pmuctl_agent_test
