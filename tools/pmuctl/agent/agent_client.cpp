@@ -1,7 +1,5 @@
 #include "pmuctl/agent/agent_client.hpp"
 
-#include <sys/socket.h>
-#include <sys/un.h>
 #include <unistd.h>
 
 #include <cerrno>

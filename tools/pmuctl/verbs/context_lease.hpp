@@ -31,9 +31,6 @@ class ContextPool {
   // one participant of the agent, once. Throws DdsError like DdsContext's constructor, and
   // when the partitions cannot be set.
   pmu::dds::DdsContext& context(const std::string& participant_name, const pmu::dds::Partitions& partitions);
-  // Deletes every participant: the next call makes new ones (after the network came back).
-  void clear() { contexts_.clear(); }
-  std::size_t size() const noexcept { return contexts_.size(); }
 
  private:
   GlobalOptions settings_;
