@@ -191,6 +191,9 @@ bool DdsContext::set_partitions(const Partitions& partitions) {
 }
 
 void DdsContext::delete_endpoints_since(EndpointMark mark) {
+  // The hang above threatens any writer deleted while matched, so its publisher goes to the
+  // closing partition first; the next job sets its own partitions (set_partitions).
+  if (writers_.size() > mark.writers) unmatch_writers_before_deleting_them(*publisher_);
   while (writers_.size() > mark.writers) {
     (void)publisher_->delete_datawriter(writers_.back());
     writers_.pop_back();

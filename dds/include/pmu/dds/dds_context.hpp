@@ -141,8 +141,11 @@ class DdsContext {
 
   // The writers and readers made by writer() and reader() so far. A long-lived context that
   // serves one job after another (`pmuctl agent`) deletes each job's endpoints when it ends
-  // (delete_endpoints_since), so its participant does not grow with every job. Same thread
-  // rule as writer() and reader(); every reference to a deleted endpoint is then dangling.
+  // (delete_endpoints_since), so its participant does not grow with every job. Deleting
+  // writers moves the publisher to a partition nobody uses first (the Fast DDS 2.9 hang the
+  // destructor avoids the same way): call set_partitions before the next job's endpoints.
+  // Same thread rule as writer() and reader(); every reference to a deleted endpoint is then
+  // dangling.
   // Moves the publisher and subscriber to other partitions (Fast DDS lets a partition change
   // while the participant lives). For a context that serves one job after another, each job
   // in its own vehicle's partitions, set while it has no endpoints. False when Fast DDS
