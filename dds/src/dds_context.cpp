@@ -6,11 +6,13 @@
 #include <fstream>
 #include <memory>
 #include <mutex>
+#include <spdlog/spdlog.h>
 
 #include "pmu/dds/dds_capacity.hpp"
 #include "pmu/dds/dds_participant.hpp"
 #include "pmu/dds/dds_qos_file.hpp"
 #include "pmu/dds/dds_type_objects.hpp"
+#include "pmu/dds/security_match_guard.hpp"
 #include "pmu/sysconf_dir.hpp"
 
 namespace pmu::dds {
@@ -97,6 +99,11 @@ DdsContext::DdsContext(int domain, const std::string& qos_file, const std::strin
     if (const auto topic = statistics_topic_not_granted(security_, statistics))
       throw DdsError("dds_statistics: this identity's permissions do not allow publishing " + *topic +
                      " in the default partition (DDS-Security; docs/interface.md section 6 says what to grant)");
+  // Without the guard a secured participant may never authenticate a peer it found at the
+  // same time as another (security_match_guard.hpp).
+  if (secure_ && !security_match_guard_active())
+    spdlog::warn("DDS-Security without the guard against Fast DDS 2.9.1's matching race: a peer found at the same "
+                 "moment as another may stay unauthenticated until one of them restarts");
   // Transports, discovery, interfaces, security and statistics: dds_participant.hpp says what each sets.
   DomainParticipantQos pqos;
   try {
