@@ -16,6 +16,9 @@ set(PMU_DATADIR "${CMAKE_INSTALL_FULL_DATADIR}/pmu-dds" CACHE PATH
 # an install under /usr/local wants PREFIX/lib/systemd/system: debian/rules sets it.
 set(PMU_SYSTEMD_UNITDIR "${CMAKE_INSTALL_PREFIX}/lib/systemd/system" CACHE PATH
     "Where the systemd units are installed")
+# User units (pmuctl-agent@.service): /usr/lib/systemd/user under the /usr prefix, as Debian has them.
+set(PMU_SYSTEMD_USERUNITDIR "${CMAKE_INSTALL_PREFIX}/lib/systemd/user" CACHE PATH
+    "Where the systemd user units are installed")
 
 # The binaries learn the directory from this one generated header, so nothing else in the
 # sources names it and no build-tree path reaches an installed binary.

@@ -23,6 +23,8 @@
 #   PREFIX/lib/systemd/system/pmu-discovery-server.service
 #                                                    the Fast DDS Discovery Server unit
 #                                                    (runs Debian's fast-discovery-server)
+#   PREFIX/lib/systemd/user/pmuctl-agent@.service    a user's pmuctl agent (ExecStart= follows
+#                                                    PREFIX), with pmuctl
 #   /etc/pmu-dds/discovery-server.env                its id and address, only if absent; the
 #   /etc/pmu-dds/discovery-server.env.example          example itself is always refreshed
 #   /etc/pmu-dds/discovery-server.xml                its announcement period and lease, only
@@ -89,7 +91,8 @@ pmuctl_bin=$(find_binary pmuctl tools) || pmuctl_bin=
 sim_bin=$(find_binary pmu-sim tools) || sim_bin=
 
 for f in qos.xml pmu-service.yaml systemd/pmu-service.service systemd/80-can0.network README.md \
-         security/make_pki.sh security/README.md systemd/pmu-discovery-server.service discovery-server.env discovery-server.xml; do
+         security/make_pki.sh security/README.md systemd/pmu-discovery-server.service discovery-server.env discovery-server.xml \
+         systemd/pmuctl-agent@.service; do
   [ -f "$script_dir/$f" ] || die "missing deploy/$f in $script_dir"
 done
 
@@ -155,6 +158,7 @@ root="$destdir"
 bindir="$root$prefix/bin"
 [ "$prefix" = / ] && bindir="$root/bin"
 unitdir="$root${prefix%/}/lib/systemd/system"
+userunitdir="$root${prefix%/}/lib/systemd/user"
 docdir="$root${prefix%/}/share/doc/pmu-dds"
 datadir="$root${prefix%/}/share/pmu-dds"
 confdir="$root/etc/pmu-dds"
@@ -188,6 +192,14 @@ sed -e "s#/usr/share/doc/pmu-dds#${prefix%/}/share/doc/pmu-dds#g" \
     "$script_dir/systemd/pmu-discovery-server.service" > "$ds_unit_src"
 put 0644 "$ds_unit_src" "$unitdir/pmu-discovery-server.service" "$script_dir/systemd/pmu-discovery-server.service"
 if [ "$last_changed" -eq 1 ]; then unit_changed=1; fi
+# The user unit runs pmuctl: installed with it. Users enable it themselves (systemctl --user).
+if [ -n "$pmuctl_bin" ]; then
+  agent_unit_src="$tmp/pmuctl-agent@.service"
+  sed -e "s#/usr/bin/pmuctl#$bin_path/pmuctl#g" \
+      -e "s#/usr/share/doc/pmu-dds#${prefix%/}/share/doc/pmu-dds#g" \
+      "$script_dir/systemd/pmuctl-agent@.service" > "$agent_unit_src"
+  put 0644 "$agent_unit_src" "$userunitdir/pmuctl-agent@.service" "$script_dir/systemd/pmuctl-agent@.service (ExecStart= under $bin_path)"
+fi
 put_keep 0644 "$script_dir/discovery-server.env" "$confdir/discovery-server.env"
 put 0644 "$script_dir/discovery-server.env" "$confdir/discovery-server.env.example"
 put_keep 0644 "$script_dir/discovery-server.xml" "$confdir/discovery-server.xml"

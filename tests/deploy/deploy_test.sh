@@ -16,7 +16,8 @@
 #      at most 1.5 (measured 1.3 with systemd 252), when systemd-analyze exists; the same
 #      for pmu-discovery-server.service (measured 1.1), whose ExecStart= uses exactly the
 #      variables discovery-server.env sets, and whose program takes those arguments and
-#      discovery-server.xml (a SERVER on the command line's address and port).
+#      discovery-server.xml (a SERVER on the command line's address and port); and
+#      systemd-analyze --user verify accepts pmuctl-agent@.service for a domain.
 # Exits non-zero on the first failure.
 
 set -euo pipefail
@@ -186,7 +187,12 @@ expect 644 /usr/share/doc/pmu-dds/README.md
 expect 644 /usr/share/doc/pmu-dds/security.md
 expect 755 /usr/share/pmu-dds/make_pki.sh
 cmp -s "$deploy/security/make_pki.sh" "$dest/usr/share/pmu-dds/make_pki.sh" || fail "installed make_pki.sh differs from deploy/security/make_pki.sh"
-[ -f "$build_dir/tools/pmuctl" ] && expect 755 /usr/bin/pmuctl
+if [ -f "$build_dir/tools/pmuctl" ]; then
+  expect 755 /usr/bin/pmuctl
+  expect 644 /usr/lib/systemd/user/pmuctl-agent@.service
+  grep -qx "ExecStart=/usr/bin/pmuctl --domain %i agent" "$dest/usr/lib/systemd/user/pmuctl-agent@.service" ||
+    fail "installed pmuctl agent user unit has an unexpected ExecStart="
+fi
 [ -f "$build_dir/tools/pmu-sim" ] && expect 755 /usr/bin/pmu-sim
 cmp -s "$deploy/qos.xml" "$dest/etc/pmu-dds/qos.xml" || fail "installed qos.xml differs from deploy/qos.xml"
 cmp -s "$deploy/pmu-service.yaml" "$dest/etc/pmu-dds/pmu-service.yaml" || fail "installed config differs from the example"
@@ -212,6 +218,10 @@ local_dest=$(mktemp -d "$work/prefix.XXXXXX")
 [ -x "$local_dest/usr/local/bin/pmu-service" ] || fail "--prefix /usr/local: no usr/local/bin/pmu-service"
 grep -q "^ExecStart=/usr/local/bin/pmu-service " "$local_dest/usr/local/lib/systemd/system/pmu-service.service" ||
   fail "--prefix /usr/local: the unit's ExecStart= does not follow the prefix"
+if [ -f "$build_dir/tools/pmuctl" ]; then
+  grep -q "^ExecStart=/usr/local/bin/pmuctl " "$local_dest/usr/local/lib/systemd/user/pmuctl-agent@.service" ||
+    fail "--prefix /usr/local: the agent user unit's ExecStart= does not follow the prefix"
+fi
 
 # ---- 3. the unit -----------------------------------------------------------------------
 if command -v systemd-analyze >/dev/null 2>&1; then
@@ -252,6 +262,21 @@ if command -v systemd-analyze >/dev/null 2>&1; then
     awk -v s="$score" 'BEGIN { exit !(s <= 1.5) }' || fail "discovery server exposure $score is above 1.5: the unit was weakened"
   else
     echo "skipped: this systemd-analyze has no --offline ($out)"
+  fi
+
+  # The user unit, for one domain, checked as the user's manager would load it (it needs a
+  # runtime directory; man pages are not installed here).
+  if [ -f "$build_dir/tools/pmuctl" ]; then
+    step "systemd-analyze --user verify pmuctl-agent@73.service"
+    user_dir="$work/user-unit"
+    mkdir -p "$user_dir" "$work/runtime"
+    chmod 700 "$work/runtime"
+    sed "s#^ExecStart=/usr/bin/pmuctl #ExecStart=$build_dir/tools/pmuctl #" \
+      "$deploy/systemd/pmuctl-agent@.service" > "$user_dir/pmuctl-agent@.service"
+    grep -q "^ExecStart=$build_dir/tools/pmuctl " "$user_dir/pmuctl-agent@.service" ||
+      fail "could not point the agent unit's ExecStart= at $build_dir/tools/pmuctl"
+    (cd "$user_dir" && XDG_RUNTIME_DIR="$work/runtime" systemd-analyze --user --man=no verify pmuctl-agent@73.service) ||
+      fail "systemd-analyze --user verify rejected pmuctl-agent@.service"
   fi
 else
   echo "--- skipped systemd-analyze checks: systemd-analyze is not installed"
