@@ -104,7 +104,9 @@ note "packages: $(basename "$deb_main") $(basename "$deb_tools") (from $deb_dir)
 # the ordinary way (modprobe from /lib/modules), and its vmlinuz and an initramfs made by
 # initramfs-tools in the image boot the VM.
 kernel_pkg=$(kernel_package)
-base_packages="systemd udev dbus libnss-systemd kmod iproute2 can-utils openssl initramfs-tools"
+# libpam-systemd: a user's systemd manager (user@UID.service) gets its XDG_RUNTIME_DIR from it,
+# as on an ordinary Debian install; the agent_user scenario runs pmuctl-agent@ under one.
+base_packages="systemd udev dbus libnss-systemd libpam-systemd kmod iproute2 can-utils openssl initramfs-tools"
 # The packages' own run-time dependencies are installed in the image ahead of time, so
 # that the test's `dpkg -i` needs no archive; the packages themselves are not.
 deb_depends() {  # DEB...: first alternative of each Depends/Pre-Depends, no versions

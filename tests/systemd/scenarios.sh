@@ -13,7 +13,7 @@
 #   sh scenarios.sh all        the scenarios named by pmu.scenarios= on the kernel command line
 #   sh scenarios.sh one NAME   one scenario in this shell
 
-ALL_SCENARIOS="networkd_vcan install ready_status journal pmuctl_user stop_fast watchdog bad_config other_iface security upgrade remove purge"
+ALL_SCENARIOS="networkd_vcan install ready_status journal pmuctl_user agent_user stop_fast watchdog bad_config other_iface security upgrade remove purge"
 
 export PATH=/usr/sbin:/usr/bin:/sbin:/bin
 export DEBIAN_FRONTEND=noninteractive
@@ -202,6 +202,39 @@ scenario_pmuctl_user() {
   done
   field_is avionics_voltage 12.5 config get avionics_voltage || fail "config get avionics_voltage '$LAST' after setting 12.5"
   detail "5 commands completed (exit 0), avionics_voltage read back 12.5"
+}
+
+# The operator's pmuctl agent as a systemd user service (pmuctl-agent@.service of
+# pmu-dds-tools), started by the operator's own manager (lingering, so no login is
+# needed): its socket is where the operator's calls look, a call goes through it (one line
+# in the operator's journal), and stopping it removes the socket.
+agent_uid() { id -u "$OPUSER"; }
+# systemctl --user of the operator: its manager's private socket under XDG_RUNTIME_DIR (no
+# session bus in this image).
+uctl() { runuser -u "$OPUSER" -- env XDG_RUNTIME_DIR="/run/user/$(agent_uid)" systemctl --user "$@"; }
+user_manager_up() { [ -S "/run/user/$(agent_uid)/systemd/private" ]; }
+agent_log() { journalctl _SYSTEMD_USER_UNIT=pmuctl-agent@0.service -o cat --no-pager 2>/dev/null; }
+scenario_agent_user() {
+  need_service
+  need_user
+  sock="/run/user/$(agent_uid)/pmu-dds/agent-0.sock"
+  loginctl enable-linger "$OPUSER" || fail "loginctl enable-linger $OPUSER failed"
+  wait_until 60 user_manager_up ||
+    fail "no systemd user manager for $OPUSER within 60 s (user@$(agent_uid).service $(systemctl is-active "user@$(agent_uid).service"); $(journalctl -b -u "user@$(agent_uid).service" -u systemd-logind -o cat --no-pager | tail -n4 | tr '\n' ' '))"
+  uctl start pmuctl-agent@0 2>"$WORK/$SCEN.err" || fail "systemctl --user start pmuctl-agent@0: $(tail -n1 "$WORK/$SCEN.err")"
+  wait_until 30 test -S "$sock" || fail "no agent socket at $sock within 30 s ($(uctl is-active pmuctl-agent@0))"
+  detail "agent active, socket $sock"
+  wait_until 90 agent_lists || fail "pmuctl list through the agent: no ONLINE PMU within 90 s (last: '$LAST_LINE')"
+  agent_log | grep -q -- "--timeout 10 list: exit 0" || fail "the agent's journal has no line for the list: $(agent_log | tail -n2 | tr '\n' ' ')"
+  detail "list as $OPUSER went through it (its journal: $(agent_log | grep -c ': exit ') calls)"
+  uctl stop pmuctl-agent@0 || fail "systemctl --user stop pmuctl-agent@0 failed"
+  [ ! -e "$sock" ] || fail "the stopped agent left its socket $sock"
+  loginctl disable-linger "$OPUSER"
+  detail "stopped, socket removed"
+}
+agent_lists() {
+  LAST_LINE=$(runuser -u "$OPUSER" -- env XDG_RUNTIME_DIR="/run/user/$(agent_uid)" pmuctl --json --timeout 10 list 2>&1 | head -n1)
+  same "$(jv "$LAST_LINE" state)" ONLINE
 }
 
 # systemctl stop is quick: SIGTERM, and the service is gone within a second. Asserted on
@@ -411,6 +444,7 @@ after_scenario() {
     systemctl daemon-reload
   fi
   rm -rf /etc/pmu-dds/security
+  loginctl disable-linger "$OPUSER" 2>/dev/null
   [ -d "/home/$OPUSER/security" ] && rm -rf "/home/$OPUSER/security"
   systemctl stop pmu-sim-vcan1 2>/dev/null; systemctl reset-failed pmu-sim-vcan1 2>/dev/null
   ip link del vcan1 2>/dev/null
