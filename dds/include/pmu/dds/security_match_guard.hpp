@@ -17,7 +17,8 @@
 // that reader.
 //
 // Linking: DdsContext refers to security_match_guard_active(), so every program with a
-// DdsContext has the guard; a program without one links pmu::fastdds_guard and calls it.
+// DdsContext has the guard. The source file needs nothing but libdl: a client of its own can
+// carry a copy.
 // Threads: any.
 
 namespace pmu::dds {
