@@ -177,28 +177,23 @@ put_keep 0644 "$script_dir/pmu-service.yaml" "$confdir/pmu-service.yaml"
 put 0644 "$script_dir/pmu-service.yaml" "$confdir/pmu-service.yaml.example"
 
 # ---- systemd -------------------------------------------------------------------------------
-# The unit names /usr/bin/pmu-service and /usr/share/doc/pmu-dds; follow --prefix.
-unit_src="$tmp/pmu-service.service"
+# The units name /usr/bin/pmu-service or /usr/bin/pmuctl and /usr/share/doc/pmu-dds; follow
+# --prefix. (/usr/bin/fast-discovery-server is Debian's, and stays.)
 bin_path="${prefix%/}/bin"
-sed -e "s#/usr/bin/pmu-service#$bin_path/pmu-service#g" \
-    -e "s#/usr/share/doc/pmu-dds#${prefix%/}/share/doc/pmu-dds#g" \
-    "$script_dir/systemd/pmu-service.service" > "$unit_src"
-put 0644 "$unit_src" "$unitdir/pmu-service.service" "$script_dir/systemd/pmu-service.service (ExecStart= under $bin_path)"
+for_prefix() {  # UNIT: deploy/systemd/UNIT with this prefix's paths, into $tmp
+  sed -e "s#/usr/bin/pmu#$bin_path/pmu#g" -e "s#/usr/share/doc/pmu-dds#${prefix%/}/share/doc/pmu-dds#g" \
+    "$script_dir/systemd/$1" > "$tmp/$1"
+}
+for_prefix pmu-service.service
+put 0644 "$tmp/pmu-service.service" "$unitdir/pmu-service.service" "$script_dir/systemd/pmu-service.service (ExecStart= under $bin_path)"
 unit_changed=$last_changed
-# The Discovery Server unit runs Debian's /usr/bin/fast-discovery-server (fastdds-tools),
-# not a binary of this build, so only its documentation path follows PREFIX.
-ds_unit_src="$tmp/pmu-discovery-server.service"
-sed -e "s#/usr/share/doc/pmu-dds#${prefix%/}/share/doc/pmu-dds#g" \
-    "$script_dir/systemd/pmu-discovery-server.service" > "$ds_unit_src"
-put 0644 "$ds_unit_src" "$unitdir/pmu-discovery-server.service" "$script_dir/systemd/pmu-discovery-server.service"
+for_prefix pmu-discovery-server.service
+put 0644 "$tmp/pmu-discovery-server.service" "$unitdir/pmu-discovery-server.service" "$script_dir/systemd/pmu-discovery-server.service"
 if [ "$last_changed" -eq 1 ]; then unit_changed=1; fi
 # The user unit runs pmuctl: installed with it. Users enable it themselves (systemctl --user).
 if [ -n "$pmuctl_bin" ]; then
-  agent_unit_src="$tmp/pmuctl-agent@.service"
-  sed -e "s#/usr/bin/pmuctl#$bin_path/pmuctl#g" \
-      -e "s#/usr/share/doc/pmu-dds#${prefix%/}/share/doc/pmu-dds#g" \
-      "$script_dir/systemd/pmuctl-agent@.service" > "$agent_unit_src"
-  put 0644 "$agent_unit_src" "$userunitdir/pmuctl-agent@.service" "$script_dir/systemd/pmuctl-agent@.service (ExecStart= under $bin_path)"
+  for_prefix pmuctl-agent@.service
+  put 0644 "$tmp/pmuctl-agent@.service" "$userunitdir/pmuctl-agent@.service" "$script_dir/systemd/pmuctl-agent@.service (ExecStart= under $bin_path)"
 fi
 put_keep 0644 "$script_dir/discovery-server.env" "$confdir/discovery-server.env"
 put 0644 "$script_dir/discovery-server.env" "$confdir/discovery-server.env.example"
