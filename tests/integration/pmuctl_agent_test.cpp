@@ -126,7 +126,7 @@ TEST(PmuctlAgent, CallsGoThroughItWithTheCallersOutputStatusAndDirectory) {
   const std::string id = m[1];
   EXPECT_NE(r.out.find("\"result\":\"COMPLETED\""), std::string::npos) << r.out;
   // The variable reaches the call: PMU_VEHICLE instead of --vehicle.
-  r = sh("PMU_VEHICLE=uav1 " + p + "--timeout 20 config get payload_voltage");
+  r = sh("export PMU_VEHICLE=uav1; " + p + "--timeout 20 config get payload_voltage");
   EXPECT_EQ(r.status, 0) << r.out;
   EXPECT_NE(r.out.find("uav1/can0/1 payload_voltage = 23.0"), std::string::npos) << r.out;
   // A failing call's message on the caller's stderr and its exit status.
@@ -153,6 +153,17 @@ TEST(PmuctlAgent, CallsGoThroughItWithTheCallersOutputStatusAndDirectory) {
             std::string::npos)
       << r.out;
 
+  // Another QoS file in the caller's environment is another participant's tuning: declined too.
+  // The agent's own file, named by the option instead, is the agent's to serve.
+  fs::copy_file(PMU_QOS_FILE, dir.path() + "/other-qos.xml");
+  r = sh("export PMU_QOS_FILE=other-qos.xml; " + p + "--timeout 20 --vehicle uav1 config get payload_voltage");
+  EXPECT_EQ(r.status, 0) << r.out;
+  EXPECT_NE(r.out.find("does not serve this call (its domain, QoS file"), std::string::npos) << r.out;
+  r = sh(p + "--qos-file " + fs::relative(PMU_QOS_FILE, dir.path()).string() +
+         " --timeout 20 --vehicle uav1 config get payload_voltage");
+  EXPECT_EQ(r.status, 0) << r.out;
+  EXPECT_EQ(r.out.find("does not serve"), std::string::npos) << r.out;
+
   ASSERT_TRUE(agent.signal(SIGTERM));
   const auto st = agent.wait_for(10s);
   ASSERT_TRUE(st);
@@ -165,7 +176,7 @@ TEST(PmuctlAgent, CallsGoThroughItWithTheCallersOutputStatusAndDirectory) {
   EXPECT_NE(agent_log.find("config snapshot snap.yaml: exit 0"), std::string::npos) << agent_log;
   EXPECT_EQ(count(agent_log, "--no-agent"), 0u) << agent_log;
   EXPECT_EQ(count(agent_log, "watch"), 0u) << agent_log;
-  EXPECT_EQ(count(agent_log, ": declined (its domain"), 1u) << agent_log;
+  EXPECT_EQ(count(agent_log, ": declined (its domain"), 2u) << agent_log;
   // Executed once: one audit line for the command's id in the service's log.
   const std::string service_log = uav1.describe();
   EXPECT_EQ(count(service_log, "audit: command " + id + " "), 1u) << service_log;

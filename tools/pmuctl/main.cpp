@@ -415,6 +415,8 @@ int run_cli(int argc, char** argv, const AgentCall* served) {
   }
   try {
     if (*agent) {
+      // Its calls compare their QoS file with this one, read while the environment is still the agent's own.
+      g.qos_file = pmu::tools::effective_qos_file(g.qos_file);
       const std::string socket = agent_socket.empty() ? pmu::tools::agent_socket_path(g.domain) : agent_socket;
       return pmu::tools::run_agent(
           g, socket,

@@ -1,5 +1,7 @@
 #include "pmuctl/verbs/context_lease.hpp"
 
+#include <filesystem>
+
 namespace pmu::tools {
 namespace {
 
@@ -40,8 +42,16 @@ pmu::dds::DdsContext& ContextPool::context(const std::string& participant_name,
   return *slot;
 }
 
+std::string effective_qos_file(const std::string& qos_file) {
+  const std::string file = qos_file.empty() ? pmu::dds::default_qos_file() : qos_file;
+  if (file.empty()) return file;
+  std::error_code ec;
+  const auto path = std::filesystem::weakly_canonical(std::filesystem::absolute(file, ec), ec);
+  return ec ? file : path.string();
+}
+
 bool same_dds_settings(const GlobalOptions& o, const GlobalOptions& agent) {
-  return o.domain == agent.domain && o.qos_file == agent.qos_file && same_security(o.security, agent.security) &&
+  return o.domain == agent.domain && effective_qos_file(o.qos_file) == effective_qos_file(agent.qos_file) && same_security(o.security, agent.security) &&
          same_network(o.network, agent.network);
 }
 

@@ -37,9 +37,15 @@ class ContextPool {
   std::map<std::string, std::unique_ptr<pmu::dds::DdsContext>> contexts_;
 };
 
+// The QoS file a participant made now would load (`qos_file`, else default_qos_file(), which
+// reads $PMU_QOS_FILE), as an absolute path without symbolic links; empty when there is none.
+// The agent resolves its own once at start-up: during a call the environment is the caller's.
+std::string effective_qos_file(const std::string& qos_file);
+
 // True when a call with options `o` would make the same participants as the pool of
-// `agent`: the same domain, QoS file, security files and network. Anything else (another
-// domain, identity or discovery server) is not the agent's to serve.
+// `agent`: the same domain, QoS file (effective_qos_file: the caller's $PMU_QOS_FILE counts),
+// security files and network. Anything else (another domain, QoS file, identity or discovery
+// server) is not the agent's to serve.
 bool same_dds_settings(const GlobalOptions& o, const GlobalOptions& agent);
 
 class ContextLease {
