@@ -19,6 +19,7 @@
 #include <regex>
 #include <string>
 #include <thread>
+#include <vector>
 
 #include "support/configured_service.hpp"
 #include "support/domain.hpp"
@@ -180,6 +181,72 @@ TEST(PmuctlAgent, CallsGoThroughItWithTheCallersOutputStatusAndDirectory) {
   // Executed once: one audit line for the command's id in the service's log.
   const std::string service_log = uav1.describe();
   EXPECT_EQ(count(service_log, "audit: command " + id + " "), 1u) << service_log;
+}
+
+// The pids of the agent's workers (its child processes).
+std::vector<pid_t> workers_of(pid_t agent) {
+  std::vector<pid_t> pids;
+  std::ifstream children("/proc/" + std::to_string(agent) + "/task/" + std::to_string(agent) + "/children");
+  for (pid_t pid = 0; children >> pid;) pids.push_back(pid);
+  return pids;
+}
+
+TEST(PmuctlAgent, ACallThatWaitsForASilentAircraftHoldsUpNoOtherAndADeadWorkerIsReplaced) {
+  const int domain = pmu::test::exclusive_dds_domain();
+  Uav1 uav1(domain);
+  TempDir dir;
+  const std::string socket = dir.path() + "/agent.sock", log = dir.path() + "/agent.log";
+  auto agent = start_agent(domain, socket, log);
+  ASSERT_TRUE(wait_for_socket(socket)) << read_file(log);
+  const std::string p = "PMU_AGENT_SOCKET=" + socket + " " + PMUCTL_PATH + " --domain " + std::to_string(domain) + " ";
+  bool served = false;
+  for (int attempt = 0; attempt < 10 && !served; ++attempt)
+    served = sh(p + "--timeout 10 --vehicle uav1 config get payload_voltage").status == 0;
+  ASSERT_TRUE(served) << read_file(log) << uav1.describe();
+
+  // uav9 has no service: its command waits out its whole timeout inside one worker.
+  pmu::test::ChildOptions o;
+  o.env = {"PMU_AGENT_SOCKET=" + socket};
+  o.stdout_path = dir.path() + "/silent.out";
+  o.stderr_path = o.stdout_path;
+  pmu::test::Child silent({PMUCTL_PATH, "--domain", std::to_string(domain), "--timeout", "25", "--vehicle", "uav9",
+                           "config", "set", "payload_voltage", "23"},
+                          o);
+  std::this_thread::sleep_for(1s);
+  ASSERT_TRUE(silent.running()) << read_file(o.stdout_path);
+  // Meanwhile a command to uav1 goes through another worker and completes.
+  auto r = sh(p + "--timeout 20 --vehicle uav1 --json config set payload_voltage 22");
+  EXPECT_EQ(r.status, 0) << r.out;
+  EXPECT_NE(r.out.find("\"result\":\"COMPLETED\""), std::string::npos) << r.out;
+  EXPECT_TRUE(silent.running()) << "uav1's command waited for uav9's to end: " << read_file(log);
+  const auto st = silent.wait_for(40s);
+  ASSERT_TRUE(st);
+  EXPECT_TRUE(WIFEXITED(*st) && WEXITSTATUS(*st) == 2) << read_file(o.stdout_path);
+
+  // A worker that dies is replaced; calls go on being served by the agent.
+  auto workers = workers_of(agent.pid());
+  ASSERT_EQ(workers.size(), 4u) << "the default is four workers: " << read_file(log);
+  ASSERT_EQ(::kill(workers.front(), SIGKILL), 0);
+  bool replaced = false;
+  for (int i = 0; i < 100 && !replaced; ++i) {
+    std::this_thread::sleep_for(100ms);
+    replaced = read_file(log).find("worker pid " + std::to_string(workers.front()) +
+                                   " ended (signal 9); a new one takes its place") != std::string::npos &&
+               workers_of(agent.pid()).size() == 4u;
+  }
+  EXPECT_TRUE(replaced) << read_file(log);
+  for (int i = 0; i < 4; ++i) {
+    r = sh(p + "--timeout 20 --vehicle uav1 config get payload_voltage");
+    EXPECT_EQ(r.status, 0) << r.out;
+    EXPECT_NE(r.out.find("uav1/can0/1 payload_voltage = 22.0"), std::string::npos) << r.out;
+  }
+
+  // Stopping the agent stops every worker.
+  workers = workers_of(agent.pid());
+  ASSERT_TRUE(agent.signal(SIGTERM));
+  ASSERT_TRUE(agent.wait_for(20s));
+  for (const pid_t w : workers) EXPECT_NE(::kill(w, 0), 0) << "worker " << w << " outlived its agent";
+  EXPECT_FALSE(fs::exists(socket));
 }
 
 TEST(PmuctlAgent, OneAgentPerSocketAndAStaleSocketIsTakenOver) {

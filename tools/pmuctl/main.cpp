@@ -201,6 +201,11 @@ int run_cli(int argc, char** argv, const AgentCall* served) {
                     "The socket calls find it at (default: $PMU_AGENT_SOCKET, else $XDG_RUNTIME_DIR/pmu-dds/"
                     "agent-DOMAIN.sock, else /run/pmu-dds/agent-DOMAIN.sock)")
       ->type_name("PATH");
+  int agent_workers = 4;
+  agent->add_option("--workers", agent_workers,
+                    "Calls served at once, each by a process with its own DDS participant (default 4): a call "
+                    "that waits for a silent aircraft then holds up no other")
+      ->check(CLI::Range(1, 16));
 
   auto* watch = app.add_subcommand("watch", "Live telemetry with each device's alarm marker: a refreshing table, or one JSON object per sample");
   std::string count_text;
@@ -419,7 +424,7 @@ int run_cli(int argc, char** argv, const AgentCall* served) {
       g.qos_file = pmu::tools::effective_qos_file(g.qos_file);
       const std::string socket = agent_socket.empty() ? pmu::tools::agent_socket_path(g.domain) : agent_socket;
       return pmu::tools::run_agent(
-          g, socket,
+          g, socket, agent_workers,
           [&g](const std::vector<std::string>& arguments, pmu::tools::ContextPool& pool, std::string& declined) {
             std::vector<std::string> words{"pmuctl"};
             words.insert(words.end(), arguments.begin(), arguments.end());

@@ -3,9 +3,11 @@
 #include <fcntl.h>
 #include <poll.h>
 #include <sys/file.h>
+#include <sys/prctl.h>
 #include <sys/socket.h>
 #include <sys/stat.h>
 #include <sys/un.h>
+#include <sys/wait.h>
 #include <unistd.h>
 
 #include <atomic>
@@ -16,6 +18,8 @@
 #include <cstdlib>
 #include <cstring>
 #include <optional>
+#include <thread>
+#include <vector>
 
 #include "pmuctl/agent/agent_request.hpp"
 #include "pmuctl/agent/unix_socket.hpp"
@@ -171,12 +175,49 @@ UniqueFd listen_at(const std::string& path, UniqueFd& lock) {
   return fd;
 }
 
+// One worker: takes calls from the shared listening socket until a stop signal, one at a time,
+// with participants of its own. The socket is non-blocking: every idle worker wakes for a new
+// connection and the one whose accept() gets it serves it.
+void serve_calls(int listener, const GlobalOptions& settings, const AgentCallRunner& run) {
+  ContextPool pool(settings);
+  // The participant from the start rather than at the worker's first call: the aircraft then
+  // discover every worker's participant at once, and no call waits for that.
+  try {
+    (void)pool.context(kPmuctlParticipant, {});
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "pmuctl agent: worker pid %d: %s (each call will say so)\n", static_cast<int>(::getpid()),
+                 e.what());
+  }
+  while (!g_stop) {
+    pollfd p{listener, POLLIN, 0};
+    const int ready = ::poll(&p, 1, 200);  // the signal flag is looked at between waits
+    if (ready <= 0) continue;
+    UniqueFd connection(::accept4(listener, nullptr, nullptr, SOCK_CLOEXEC));
+    if (!connection) continue;  // another worker took it
+    serve(connection.get(), pool, run);
+  }
+}
+
+// A worker process, forked before any DDS thread exists. It dies with the agent: a caller
+// whose agent was killed must get no answer rather than one from an orphan.
+pid_t start_worker(int listener, const GlobalOptions& settings, const AgentCallRunner& run) {
+  const pid_t agent = ::getpid();
+  const pid_t pid = ::fork();
+  if (pid != 0) return pid;
+  (void)::prctl(PR_SET_PDEATHSIG, SIGKILL);
+  if (::getppid() != agent) std::_Exit(1);  // the agent ended before the line above
+  serve_calls(listener, settings, run);
+  std::fflush(nullptr);
+  std::exit(0);  // the participants are gone (serve_calls' pool); Fast DDS's own statics follow
+}
+
 }  // namespace
 
-int run_agent(const GlobalOptions& settings, const std::string& socket, const AgentCallRunner& run) {
+int run_agent(const GlobalOptions& settings, const std::string& socket, int workers, const AgentCallRunner& run) {
   UniqueFd lock;
   UniqueFd listener = listen_at(socket, lock);
   if (!listener) return 2;
+  (void)::fcntl(listener.get(), F_SETFL, ::fcntl(listener.get(), F_GETFL) | O_NONBLOCK);
   struct sigaction sa{};
   sa.sa_handler = on_stop_signal;
   ::sigemptyset(&sa.sa_mask);
@@ -187,17 +228,32 @@ int run_agent(const GlobalOptions& settings, const std::string& socket, const Ag
   // Line by line, as on a terminal: a caller's output and messages then interleave as they
   // would in a call on its own (stdout's buffering is chosen once, for the agent's own fd 1).
   std::setvbuf(stdout, nullptr, _IOLBF, 0);
-  ContextPool pool(settings);
-  std::fprintf(stderr, "pmuctl agent: serving domain %d (%s) on %s\n", settings.domain,
+  std::fprintf(stderr, "pmuctl agent: serving domain %d (%s) on %s, up to %d call%s at once\n", settings.domain,
                settings.network.summary.empty() ? "multicast discovery" : settings.network.summary.c_str(),
-               socket.c_str());
-  while (!g_stop) {
-    pollfd p{listener.get(), POLLIN, 0};
-    const int ready = ::poll(&p, 1, 200);  // the signal flag is looked at between waits
-    if (ready <= 0) continue;
-    UniqueFd connection(::accept4(listener.get(), nullptr, nullptr, SOCK_CLOEXEC));
-    if (!connection) continue;
-    serve(connection.get(), pool, run);
+               socket.c_str(), workers, workers == 1 ? "" : "s");
+  if (workers <= 1) {
+    serve_calls(listener.get(), settings, run);
+  } else {
+    std::vector<pid_t> pids;
+    for (int i = 0; i < workers; ++i) pids.push_back(start_worker(listener.get(), settings, run));
+    while (!g_stop) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(200));
+      for (auto& pid : pids) {
+        int status = 0;
+        if (pid > 0 && ::waitpid(pid, &status, WNOHANG) != pid) continue;
+        // A worker that failed or was killed: the others serve on, and a new one takes its place.
+        if (pid > 0)
+          std::fprintf(stderr, "pmuctl agent: worker pid %d ended (%s %d); a new one takes its place\n",
+                       static_cast<int>(pid), WIFSIGNALED(status) ? "signal" : "exit",
+                       WIFSIGNALED(status) ? WTERMSIG(status) : WEXITSTATUS(status));
+        pid = g_stop ? -1 : start_worker(listener.get(), settings, run);
+      }
+    }
+    // Each worker ends after the call it is serving.
+    for (const pid_t pid : pids)
+      if (pid > 0) (void)::kill(pid, SIGTERM);
+    for (const pid_t pid : pids)
+      if (pid > 0) (void)::waitpid(pid, nullptr, 0);
   }
   (void)::unlink(socket.c_str());
   std::fprintf(stderr, "pmuctl agent: stopped\n");

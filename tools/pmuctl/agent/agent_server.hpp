@@ -1,13 +1,18 @@
 #pragma once
 // `pmuctl agent`: one process on the ground host that keeps pmuctl's participants for the
 // calls made on that host (context_lease.hpp says why). It listens on a Unix socket
-// (agent_request.hpp), takes one call at a time in the order they come, runs it with the
-// caller's working directory, environment and standard streams, and answers its exit
-// status. Only the caller's own user may call (the socket is 0600 and the peer's uid is
-// checked). It ends on SIGINT or SIGTERM, removing its socket.
+// (agent_request.hpp) and takes up to `workers` calls at once: each worker is a process of
+// its own with its own participants, forked before any DDS thread exists, and serves one
+// call at a time with the caller's working directory, environment and standard streams
+// (which are per process), answering its exit status. A call to an aircraft that does not
+// answer then holds one worker, not the ground station. Only the caller's own user may call
+// (the socket is 0600 and the peer's uid is checked). It ends on SIGINT or SIGTERM, after
+// each worker's current call, removing its socket; a worker that dies is replaced, and the
+// workers die with the agent.
 //
-// Threads: run_agent blocks the calling (main) thread; `run` is called on it, one call at
-// a time. The pool outlives every call (run_agent owns it).
+// Threads: run_agent blocks the calling (main) thread, which must not have started other
+// threads (it forks); `run` is called on a worker's main thread, one call at a time per
+// worker. Each worker's pool outlives every call it serves.
 
 #include <functional>
 #include <string>
@@ -23,6 +28,7 @@ using AgentCallRunner =
     std::function<int(const std::vector<std::string>& arguments, ContextPool& pool, std::string& declined)>;
 
 // Exit status 0 after a signal; 2 when the socket cannot be made or another agent listens.
-int run_agent(const GlobalOptions& settings, const std::string& socket, const AgentCallRunner& run);
+// `workers` 1 serves in this process, without forking.
+int run_agent(const GlobalOptions& settings, const std::string& socket, int workers, const AgentCallRunner& run);
 
 }  // namespace pmu::tools

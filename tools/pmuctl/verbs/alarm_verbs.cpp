@@ -53,7 +53,7 @@ void print(const GlobalOptions& o, const AlarmEntry& a) {
 }  // namespace
 
 int run_alarms(const GlobalOptions& o) {
-  ContextLease lease(o, "pmuctl");
+  ContextLease lease(o, kPmuctlParticipant);
   pmu::dds::DdsContext& dds = *lease;
   DataReader& reader = dds.reader(
       dds.topic(topics::kAlarms, TypeSupport(new idl::Guarded<pmu::v4::AlarmPubSubType>())), qos_profiles::kAlarms);

@@ -138,7 +138,7 @@ std::uint64_t epoch_ns_after(double seconds) {
 CommandChannel::CommandChannel(const GlobalOptions& o)
     : options_(o),
       vehicle_(o.vehicle.value_or(std::string())),
-      lease_(o, "pmuctl"),
+      lease_(o, kPmuctlParticipant),
       dds_(*lease_),
       replies_(dds_.reader(
           dds_.topic(topics::kCommandReply, TypeSupport(new idl::Guarded<pmu::v4::CommandReplyPubSubType>())),

@@ -60,7 +60,7 @@ int run_alarm_ack(const GlobalOptions& o, const std::string& code, const std::st
     return fail(o, ExitStatus::BadUsage, "a " + kind + " alarm needs --bus and --address (the " +
                                              (source == pmu::v4::SOURCE_BATTERY ? "CANopen node" : "MPPT device id") +
                                              ")");
-  ContextLease lease(o, "pmuctl");
+  ContextLease lease(o, kPmuctlParticipant);
   pmu::dds::DdsContext& dds = *lease;
   DataReader& replies = dds.reader(
       dds.topic(topics::kAlarmAckReply, TypeSupport(new idl::Guarded<pmu::v4::AlarmAckReplyPubSubType>())),

@@ -202,7 +202,7 @@ class ReadOnlyView {
   explicit ReadOnlyView(const GlobalOptions& o)
       : o_(o),
         vehicle_(o.vehicle.value_or(std::string())),
-        lease_(o, "pmuctl"),
+        lease_(o, kPmuctlParticipant),
         dds_(*lease_),
         device_(dds_, vehicle_) {}
   // nullopt with `status` set when there is none.

@@ -7,7 +7,7 @@
 //
 // Lifetime: a ContextPool outlives every lease taken from it (the agent owns it for its
 // whole run); a lease outlives every reference the verb took from its context.
-// Threads: the verb's thread only; the agent serves one call at a time.
+// Threads: the verb's thread only; each of the agent's workers serves one call at a time.
 
 #include <map>
 #include <memory>
@@ -18,6 +18,10 @@
 #include "pmuctl/verbs/state_verbs.hpp"
 
 namespace pmu::tools {
+
+// The participant name of every verb's lease: an agent's worker serves all its calls with one
+// participant of this name.
+inline constexpr const char* kPmuctlParticipant = "pmuctl";
 
 class ContextPool {
  public:

@@ -75,7 +75,7 @@ std::size_t matched(DataReader& reader) {
 }
 
 int run(const GlobalOptions& o) {
-  ContextLease lease(o, "pmuctl");
+  ContextLease lease(o, kPmuctlParticipant);
   pmu::dds::DdsContext& dds = *lease;
   DataReader& pmus =
       dds.reader(dds.topic(topics::kEnergy, TypeSupport(new idl::Guarded<pmu::v4::EnergyPubSubType>())),

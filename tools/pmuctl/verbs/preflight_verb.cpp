@@ -75,7 +75,7 @@ void print(const GlobalOptions& o, const pmu::v4::Readiness& r) {
 }  // namespace
 
 int run_preflight(const GlobalOptions& o) {
-  ContextLease lease(o, "pmuctl");
+  ContextLease lease(o, kPmuctlParticipant);
   pmu::dds::DdsContext& dds = *lease;
   DataReader& reader =
       dds.reader(dds.topic(topics::kReadiness, TypeSupport(new idl::Guarded<pmu::v4::ReadinessPubSubType>())),

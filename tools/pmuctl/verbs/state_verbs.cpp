@@ -285,7 +285,7 @@ int run_watch(const GlobalOptions& o, long count) {
   // Ctrl-C or SIGTERM ends the watch like its count or timeout does (the summary and the exit
   // status follow), read before Fast DDS starts its threads.
   pmu::transport::StopSignals stop;
-  ContextLease lease(o, "pmuctl");
+  ContextLease lease(o, kPmuctlParticipant);
   pmu::dds::DdsContext& dds = *lease;
   std::vector<std::unique_ptr<TelemetryReader>> readers;
   // --low-rate: only the low-rate topics' writers match, so only their samples cross the link.
@@ -425,7 +425,7 @@ std::string contracts_cell(const std::set<int>& contracts) {
 }
 
 int run_list(const GlobalOptions& o) {
-  ContextLease lease(o, "pmuctl");
+  ContextLease lease(o, kPmuctlParticipant);
   pmu::dds::DdsContext& dds = *lease;
   StateCollector<pmu::v4::Health, pmu::v4::HealthPubSubType> health(dds, topics::kHealth);
   StateCollector<pmu::v4::DeviceInfo, pmu::v4::DeviceInfoPubSubType> info(dds, topics::kInfo);
@@ -490,14 +490,14 @@ int run_list(const GlobalOptions& o) {
 }
 
 int run_info(const GlobalOptions& o) {
-  ContextLease lease(o, "pmuctl");
+  ContextLease lease(o, kPmuctlParticipant);
   pmu::dds::DdsContext& dds = *lease;
   StateCollector<pmu::v4::DeviceInfo, pmu::v4::DeviceInfoPubSubType> c(dds, topics::kInfo);
   return print_state(o, dds, c, "info");
 }
 
 int run_health(const GlobalOptions& o) {
-  ContextLease lease(o, "pmuctl");
+  ContextLease lease(o, kPmuctlParticipant);
   pmu::dds::DdsContext& dds = *lease;
   StateCollector<pmu::v4::Health, pmu::v4::HealthPubSubType> c(dds, topics::kHealth);
   return print_state(o, dds, c, "health", true);
@@ -510,7 +510,7 @@ int run_config_get(const GlobalOptions& o, const std::string& parameter) {
                 "unknown parameter '" + service::printable(parameter) + "'" +
                     " (parameters: " + config_names() + ")");
   }
-  ContextLease lease(o, "pmuctl");
+  ContextLease lease(o, kPmuctlParticipant);
   pmu::dds::DdsContext& dds = *lease;
   StateCollector<pmu::v4::Config, pmu::v4::ConfigPubSubType> c(dds, topics::kConfig);
   if (parameter.empty()) return print_state(o, dds, c, "config");
