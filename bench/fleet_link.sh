@@ -4,7 +4,7 @@
 #
 #   bench/fleet_link.sh [--aircraft "1 4 8"] [--rate 250kbit] [--build-dir DIR] [--qos FILE]
 #                       [--pmuctl BIN] [--service BIN] [--discovery-server [--server-xml FILE|none]]
-#                       [--cut SECONDS] [--agent] [--json FILE]
+#                       [--cut SECONDS] [--agent] [--json FILE] [--keep DIR [--capture]]
 #
 # Two network namespaces joined by one veth pair, shaped by tbf to RATE each way (a radio
 # modem's queue of about 2 s; no delay or loss: the VM lab adds those): in `air`, N pmu-service
@@ -29,6 +29,10 @@
 # --agent: the ground's pmuctl calls go through one `pmuctl agent`, started in `gnd` after the
 # idle step (so its first call, the list, pays for its participants' discovery); watch is
 # never served by an agent and runs on its own as before. Without it, calls run on their own.
+# --keep DIR: the run's logs (services, agent, calls) are copied to DIR at the end; with
+# --capture also a packet capture of the ground interface per fleet size (link-N.pcap, the
+# first 256 bytes of each packet) and when each step began (steps-N: its name, uptime and
+# wall-clock time, which the capture's timestamps use).
 # Needs root (ip netns); exit status 77 when namespaces cannot be made. Exit status 1 when
 # a --discovery-server run found a command executed twice or by another vehicle.
 set -euo pipefail
@@ -45,6 +49,8 @@ svc=""
 server_xml="$root/deploy/discovery-server.xml"
 cut_s=30
 agent=0
+keep=""
+capture=0
 while [ $# -gt 0 ]; do
   case "$1" in
     --aircraft) aircraft=$2; shift 2 ;;
@@ -58,10 +64,13 @@ while [ $# -gt 0 ]; do
     --server-xml) server_xml=$2; [ "$2" = none ] || server_xml=$(realpath "$2"); shift 2 ;;
     --cut) cut_s=$2; shift 2 ;;
     --agent) agent=1; shift ;;
-    -h|--help) sed -n '2,30p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
+    --keep) keep=$2; shift 2 ;;
+    --capture) capture=1; shift ;;
+    -h|--help) sed -n '2,37p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
     *) echo "fleet_link.sh: unknown argument '$1'" >&2; exit 2 ;;
   esac
 done
+[ "$capture" = 0 ] || [ -n "$keep" ] || { echo "fleet_link.sh: --capture needs --keep DIR" >&2; exit 2; }
 case "$cut_s" in '' | *[!0-9]* | 0) echo "fleet_link.sh: --cut takes whole seconds, at least 1 (got '$cut_s')" >&2; exit 2 ;; esac
 for n in $aircraft; do
   case "$n" in '' | *[!0-9]* | 0) echo "fleet_link.sh: --aircraft takes counts of at least 1 (got '$n')" >&2; exit 2 ;; esac
@@ -86,6 +95,7 @@ cleanup() {
   sleep 1
   ip netns del "$air" 2>/dev/null || true
   ip netns del "$gnd" 2>/dev/null || true
+  if [ -n "$keep" ]; then mkdir -p "$keep" && cp -r "$work"/. "$keep"/; fi
   rm -rf "$work"
 }
 trap cleanup EXIT
@@ -107,7 +117,13 @@ link_up() {
     # A radio modem's queue: about 2 s at 250 kbit/s.
     ip netns exec "$ns" tc qdisc add dev "$dev" root tbf rate "$rate" burst 3000 limit 64000
   done
+  if [ "$capture" = 1 ]; then
+    ip netns exec "$gnd" tcpdump -i gnd0 -s 256 -w "$work/link-$1.pcap" >/dev/null 2>&1 &
+    sleep 1
+  fi
 }
+# step NAME: the uptime a step starts at, for a capture's reader (--capture).
+step() { echo "$1 $(cut -d' ' -f1 /proc/uptime) $(date +%s.%N)" >>"$work/steps-$n"; }
 link_bytes() {
   ip -n "$gnd" -j -s link show gnd0 | python3 -c 'import json,sys; s=json.load(sys.stdin)[0]["stats64"]; print(s["rx"]["bytes"] + s["tx"]["bytes"])'
 }
@@ -158,15 +174,18 @@ vehicles_listed() { sed -n 's/.*"vehicle":"\([^"]*\)".*/\1/p' "$1" | sort -u | w
 round_and_cut() {  # N
   local n=$1 i t_up t_list pids=() r listed_s
   : >"$work/round"; : >"$work/after"
+  step round
   for i in $(seq 1 "$n"); do
     r=$(timed_command "uav$i" "$(value_for "$i")")
     echo "uav$i $r" >>"$work/round"
   done
   # A radio fade as the interface sees it: the carrier gone, on both ends, for cut_s seconds.
+  step cut
   ip -n "$gnd" link set gnd0 down
   sleep "$cut_s"
   ip -n "$gnd" link set gnd0 up
   t_up=$(now)
+  step restored
   # Down deleted the routes through gnd0; only the default one (for multicast) is not re-made.
   ip -n "$gnd" route replace default dev gnd0
   listed_s=none
@@ -178,11 +197,13 @@ round_and_cut() {  # N
     sleep 0.5
   done
   # Then a command to each at once: the whole fleet checked after the link's return.
+  step at-once
   for i in $(seq 1 "$n"); do
     (r=$(timed_command "uav$i" "$(value_for $((n + i)))"); echo "uav$i $r" >>"$work/after") &
     pids+=($!)
   done
   for i in "${pids[@]}"; do wait "$i" || true; done
+  step finished
   python3 - "$n" "$work" "$t_up" "$listed_s" <<'PY'
 import re, sys
 n, work, t_up, listed = int(sys.argv[1]), sys.argv[2], float(sys.argv[3]), sys.argv[4]
@@ -225,7 +246,7 @@ PY
 rows=()
 ds_rows=()
 for n in $aircraft; do
-  link_up
+  link_up "$n"
   ds_yaml=""
   if [ "$ds" = 1 ]; then
     command -v fast-discovery-server >/dev/null || { echo "fleet_link.sh: fast-discovery-server not found (fastdds-tools)" >&2; exit 2; }
@@ -258,6 +279,7 @@ EOF
   [ "$agent" = 1 ] && start_agent
 
   d0=$(link_drops); b0=$(link_bytes); t0=$(now)
+  step list
   pmuctl_gnd --timeout 20 list >"$work/list.out" 2>"$work/list.err" || true
   t1=$(now); b1=$(link_bytes)
   listed=$(sed -n 's/.*"vehicle":"\([^"]*\)".*/\1/p' "$work/list.out" | sort -u | wc -l)
@@ -265,11 +287,13 @@ EOF
   sleep 5
 
   b0=$(link_bytes); t0=$(now)
+  step command
   pmuctl_gnd --vehicle "uav$n" --timeout 30 config set payload_voltage 13.0 >"$work/cmd.out" 2>"$work/cmd.err" || true
   t1=$(now); b1=$(link_bytes)
   result=$(sed -n 's/.*"result":"\([A-Z_]*\)".*/\1/p' "$work/cmd.out" | head -n1)
   [ -n "$result" ] || result="none ($(tail -n1 "$work/cmd.err" | tr -d '"' | cut -c1-60))"
   cmd_bytes=$((b1 - b0)); cmd_s=$(python3 -c "print(round($t1 - $t0, 2))")
+  step idle-after-command
   sleep 5
 
   # exec: $! is pmuctl itself, so the kill below ends the watch rather than only its shell,
