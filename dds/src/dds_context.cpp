@@ -2,6 +2,9 @@
 
 #include <fastdds/dds/domain/DomainParticipantFactory.hpp>
 
+#include <fastdds/dds/subscriber/SampleInfo.hpp>
+
+#include <algorithm>
 #include <cstdlib>
 #include <fstream>
 #include <memory>
@@ -13,6 +16,7 @@
 #include "pmu/dds/dds_qos_file.hpp"
 #include "pmu/dds/dds_type_objects.hpp"
 #include "pmu/dds/security_match_guard.hpp"
+#include "pmu/idl/topics.hpp"
 #include "pmu/sysconf_dir.hpp"
 
 namespace pmu::dds {
@@ -45,6 +49,30 @@ void unmatch_writers_before_deleting_them(Publisher& publisher) {
   qos.partition().clear();
   qos.partition().push_back(kClosingPartition);
   (void)publisher.set_qos(qos);  // if refused, the deletion runs as before: nothing else to do
+}
+
+bool move_to(Publisher& publisher, const std::vector<std::string>& partitions) {
+  PublisherQos qos = publisher.get_qos();
+  qos.partition().clear();
+  for (const auto& p : partitions) qos.partition().push_back(p.c_str());
+  return publisher.set_qos(qos) == ReturnCode_t::RETCODE_OK;
+}
+
+bool move_to(Subscriber& subscriber, const std::vector<std::string>& partitions) {
+  SubscriberQos qos = subscriber.get_qos();
+  qos.partition().clear();
+  for (const auto& p : partitions) qos.partition().push_back(p.c_str());
+  return subscriber.set_qos(qos) == ReturnCode_t::RETCODE_OK;
+}
+
+// Takes every sample a reader holds, whatever its type (through the reader's type support).
+void drain(DataReader& reader) {
+  TypeSupport type = reader.type();
+  void* sample = type->createData();
+  SampleInfo info;
+  while (reader.take_next_sample(sample, &info) == ReturnCode_t::RETCODE_OK) {
+  }
+  type->deleteData(sample);
 }
 
 // `"uav1"`, or `the default partition` for "", in messages.
@@ -138,6 +166,8 @@ DdsContext::DdsContext(int domain, const std::string& qos_file, const std::strin
 
 DdsContext::~DdsContext() {
   if (!participant_) return;
+  for (const auto& k : kept_)
+    if (k.publisher) unmatch_writers_before_deleting_them(*k.publisher);
   unmatch_writers_before_deleting_them(*publisher_);
   if (default_publisher_) unmatch_writers_before_deleting_them(*default_publisher_);
   participant_->delete_contained_entities();
@@ -158,6 +188,11 @@ Topic& DdsContext::topic(const std::string& name, TypeSupport type) {
 }
 
 DataWriter& DdsContext::writer(Topic& topic, const std::string& profile, DataWriterListener* listener) {
+  if (reuse_ && !listener) {
+    DataWriter* w = kept_writer(topic, profile);
+    writers_.push_back(w);
+    return *w;
+  }
   DataWriter* w = publisher_->create_datawriter_with_profile(&topic, profile, listener);
   if (!w) refused(topic.get_name(), profile, true);
   const DataWriterQos q = w->get_qos();
@@ -171,6 +206,11 @@ DataWriter& DdsContext::writer(Topic& topic, const std::string& profile, DataWri
 }
 
 DataReader& DdsContext::reader(Topic& topic, const std::string& profile, DataReaderListener* listener) {
+  if (reuse_ && !listener) {
+    DataReader* r = kept_reader(topic, profile);
+    readers_.push_back(r);
+    return *r;
+  }
   DataReader* r = subscriber_->create_datareader_with_profile(&topic, profile, listener);
   if (!r) refused(topic.get_name(), profile, false);
   const DataReaderQos q = r->get_qos();
@@ -197,7 +237,110 @@ bool DdsContext::set_partitions(const Partitions& partitions) {
   return true;
 }
 
+DataWriter* DdsContext::kept_writer(Topic& topic, const std::string& profile) {
+  // One still in this job's partitions first: taking it up costs the link nothing.
+  for (const bool same_partitions : {true, false})
+    for (auto& k : kept_)
+      if (k.writer && !k.in_use && k.topic == topic.get_name() && k.profile == profile &&
+          (k.partitions == partitions_.publisher) == same_partitions &&
+          (same_partitions || move_to(*k.publisher, partitions_.publisher))) {
+        k.partitions = partitions_.publisher;
+        k.in_use = true;
+        return k.writer;
+      }
+  Publisher* publisher = participant_->create_publisher(PUBLISHER_QOS_DEFAULT);
+  if (!publisher || !move_to(*publisher, partitions_.publisher)) {
+    if (publisher) participant_->delete_publisher(publisher);
+    refused(topic.get_name(), profile, true);
+  }
+  DataWriter* w = publisher->create_datawriter_with_profile(&topic, profile, nullptr);
+  if (!w) {
+    participant_->delete_publisher(publisher);
+    refused(topic.get_name(), profile, true);
+  }
+  const DataWriterQos q = w->get_qos();
+  if (const auto s = capacity_shortfall(profile, EndpointKind::Writer, q.resource_limits(), q.history()); !s.empty()) {
+    publisher->delete_datawriter(w);
+    participant_->delete_publisher(publisher);
+    throw DdsError(qos_file_ + ": <data_writer profile_name=\"" + profile + "\"> (" + topic.get_name() + "): " + s +
+                   ": raise its <resourceLimitsQos> (deploy/qos.xml says how each number is derived)");
+  }
+  kept_.push_back({topic.get_name(), profile, partitions_.publisher, publisher, w, nullptr, nullptr, true});
+  return w;
+}
+
+DataReader* DdsContext::kept_reader(Topic& topic, const std::string& profile) {
+  for (const bool same_partitions : {true, false})
+    for (auto& k : kept_)
+      if (k.reader && !k.in_use && k.topic == topic.get_name() && k.profile == profile &&
+          (k.partitions == partitions_.subscriber) == same_partitions) {
+        // What it holds is an earlier job's (a command reply reader left in its partitions
+        // may also hold replies to other clients since).
+        drain(*k.reader);
+        if (!same_partitions && !move_to(*k.subscriber, partitions_.subscriber)) continue;
+        k.partitions = partitions_.subscriber;
+        k.in_use = true;
+        return k.reader;
+      }
+  Subscriber* subscriber = participant_->create_subscriber(SUBSCRIBER_QOS_DEFAULT);
+  if (!subscriber || !move_to(*subscriber, partitions_.subscriber)) {
+    if (subscriber) participant_->delete_subscriber(subscriber);
+    refused(topic.get_name(), profile, false);
+  }
+  DataReader* r = subscriber->create_datareader_with_profile(&topic, profile, nullptr);
+  if (!r) {
+    participant_->delete_subscriber(subscriber);
+    refused(topic.get_name(), profile, false);
+  }
+  const DataReaderQos q = r->get_qos();
+  if (const auto s = capacity_shortfall(profile, EndpointKind::Reader, q.resource_limits(), q.history()); !s.empty()) {
+    subscriber->delete_datareader(r);
+    participant_->delete_subscriber(subscriber);
+    throw DdsError(qos_file_ + ": <data_reader profile_name=\"" + profile + "\"> (" + topic.get_name() + "): " + s +
+                   ": raise its <resourceLimitsQos> (deploy/qos.xml says how each number is derived)");
+  }
+  kept_.push_back({topic.get_name(), profile, partitions_.subscriber, nullptr, nullptr, subscriber, r, true});
+  return r;
+}
+
+void DdsContext::park(DataWriter* writer, DataReader* reader) {
+  for (auto& k : kept_)
+    if (k.in_use && ((writer && k.writer == writer) || (reader && k.reader == reader))) {
+      k.in_use = false;
+      // Command endpoints carry only a job's requests and their replies: left matched while
+      // idle they cost the link nothing, and the next job for the same vehicle finds them
+      // matched. Anything else would go on receiving what its writers publish.
+      if (k.profile == qos_profiles::kCommand) return;
+      k.partitions = {kClosingPartition};
+      if (k.publisher) (void)move_to(*k.publisher, k.partitions);
+      if (k.subscriber) {
+        (void)move_to(*k.subscriber, k.partitions);
+        drain(*k.reader);
+      }
+      return;
+    }
+}
+
 void DdsContext::delete_endpoints_since(EndpointMark mark) {
+  if (reuse_) {
+    // The kept ones are parked; one made with a listener was not kept, and is deleted below.
+    std::vector<DataWriter*> writers;
+    std::vector<DataReader*> readers;
+    for (std::size_t i = mark.writers; i < writers_.size(); ++i) {
+      const bool kept = std::any_of(kept_.begin(), kept_.end(), [&](const Kept& k) { return k.writer == writers_[i]; });
+      if (kept) park(writers_[i], nullptr);
+      else writers.push_back(writers_[i]);
+    }
+    for (std::size_t i = mark.readers; i < readers_.size(); ++i) {
+      const bool kept = std::any_of(kept_.begin(), kept_.end(), [&](const Kept& k) { return k.reader == readers_[i]; });
+      if (kept) park(nullptr, readers_[i]);
+      else readers.push_back(readers_[i]);
+    }
+    writers_.resize(mark.writers);
+    readers_.resize(mark.readers);
+    writers_.insert(writers_.end(), writers.begin(), writers.end());
+    readers_.insert(readers_.end(), readers.begin(), readers.end());
+  }
   // The hang above threatens any writer deleted while matched, so its publisher goes to the
   // closing partition first; the next job sets its own partitions (set_partitions).
   if (writers_.size() > mark.writers) unmatch_writers_before_deleting_them(*publisher_);

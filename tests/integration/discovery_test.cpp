@@ -30,6 +30,7 @@
 
 #include "pmu/config/network_settings.hpp"
 #include "pmu/dds/dds_context.hpp"
+#include "pmu/idl/commandPubSubTypes.h"
 #include "pmu/idl/telemetryPubSubTypes.h"
 #include "pmu/idl/topics.hpp"
 #include "support/domain.hpp"
@@ -202,6 +203,79 @@ TEST(DiscoveryServer, ClientsFindEachOtherOnlyThroughTheServerWithTheIdOfTheirPo
   Server server(0, port);
   ASSERT_TRUE(exchange(service, client, 20s)) << "no sample through the Discovery Server";
   EXPECT_TRUE(pmu::test::dds_discovery_port_free(pmu::test::exclusive_dds_domain()));
+}
+
+std::int32_t matched_readers(DataWriter& w) {
+  PublicationMatchedStatus s;
+  w.get_publication_matched_status(s);
+  return s.current_count;
+}
+
+// A long-lived client that serves one job after another (`pmuctl agent`) ends each job's
+// readers. Fast DDS's server, processing one reader's disposal, drops the participant's
+// other announcements its clients have not all received, so of two readers deleted at once
+// one stayed matched at the other clients for good (and a reliable writer heartbeats it for
+// ever). Parked instead (DdsContext::reuse_endpoints), both are unmatched after every job,
+// and the next job gets them back empty.
+TEST(DiscoveryServer, ALongLivedClientsEndedReadersAreUnmatchedAtTheOtherClientsAfterEveryJob) {
+  if (::access(kDiscoveryServer, X_OK) != 0)
+    GTEST_SKIP() << kDiscoveryServer << " is missing: install Debian's fastdds-tools (scripts/setup.sh does)";
+  const std::uint16_t port = pmu::test::free_udp_port();
+  Server server(0, port);
+  DdsContext service(pmu::test::exclusive_dds_domain(), "", "ds-service", {}, Transport::UdpOnly, client_of(port));
+  Topic& voltages_topic = service.topic(topics::kVoltages, TypeSupport(new pmu::v4::VoltagesPubSubType()));
+  Topic& currents_topic = service.topic(topics::kCurrents, TypeSupport(new pmu::v4::CurrentsPubSubType()));
+  DataWriter& voltages = service.writer(voltages_topic, qos_profiles::kTelemetry);
+  DataWriter& currents = service.writer(currents_topic, qos_profiles::kTelemetry);
+
+  DdsContext agent(pmu::test::exclusive_dds_domain(), "", "ds-agent", {}, Transport::UdpOnly, client_of(port));
+  agent.reuse_endpoints();
+  Topic& v_topic = agent.topic(topics::kVoltages, TypeSupport(new pmu::v4::VoltagesPubSubType()));
+  Topic& c_topic = agent.topic(topics::kCurrents, TypeSupport(new pmu::v4::CurrentsPubSubType()));
+  DataReader* first_job_reader = nullptr;
+  for (int job = 1; job <= 4; ++job) {
+    const auto mark = agent.endpoint_mark();
+    DataReader& v = agent.reader(v_topic, qos_profiles::kTelemetry);
+    (void)agent.reader(c_topic, qos_profiles::kTelemetry);
+    if (job == 1) first_job_reader = &v;
+    if (job > 1) {
+      EXPECT_EQ(&v, first_job_reader) << "job " << job << " made a new reader instead of taking up the parked one";
+      EXPECT_EQ(v.get_unread_count(), 0u) << "job " << job << "'s reader came back with the last job's samples";
+    }
+    ASSERT_TRUE(pmu::test::wait_until([&] { return matched_readers(voltages) == 1 && matched_readers(currents) == 1; },
+                                      20s, 20ms))
+        << "job " << job << ": the service's writers matched " << matched_readers(voltages) << " and "
+        << matched_readers(currents) << " readers";
+    // A sample the job leaves unread.
+    pmu::v4::Voltages sample;
+    sample.bus("sim0");
+    sample.address(1);
+    ASSERT_TRUE(pmu::test::wait_until([&] { voltages.write(&sample); return v.get_unread_count() > 0; }, 10s, 50ms));
+
+    agent.delete_endpoints_since(mark);
+    EXPECT_TRUE(pmu::test::wait_until([&] { return matched_readers(voltages) == 0 && matched_readers(currents) == 0; },
+                                      20s, 20ms))
+        << "job " << job << " ended, and the service's writers still match " << matched_readers(voltages) << " and "
+        << matched_readers(currents) << " of its readers";
+  }
+
+  // A command reply reader stays matched between jobs (nothing flows to it unasked), and the
+  // next job in the same partitions takes it up without waiting for a match.
+  DataWriter& replies = service.writer(
+      service.topic(topics::kCommandReply, TypeSupport(new pmu::v4::CommandReplyPubSubType())), qos_profiles::kCommand);
+  Topic& r_topic = agent.topic(topics::kCommandReply, TypeSupport(new pmu::v4::CommandReplyPubSubType()));
+  auto mark = agent.endpoint_mark();
+  DataReader* reply_reader = &agent.reader(r_topic, qos_profiles::kCommand);
+  ASSERT_TRUE(pmu::test::wait_until([&] { return matched_readers(replies) == 1; }, 20s, 20ms));
+  agent.delete_endpoints_since(mark);
+  std::this_thread::sleep_for(2s);
+  EXPECT_EQ(matched_readers(replies), 1) << "an idle command reply reader was unmatched";
+  mark = agent.endpoint_mark();
+  EXPECT_EQ(&agent.reader(r_topic, qos_profiles::kCommand), reply_reader);
+  SubscriptionMatchedStatus s;
+  reply_reader->get_subscription_matched_status(s);
+  EXPECT_EQ(s.current_count, 1) << "the next job's reply reader is not matched at once";
+  agent.delete_endpoints_since(mark);
 }
 
 // ---- the interface allowlist ---------------------------------------------------------------

@@ -144,11 +144,13 @@ TEST(PmuctlAgent, CallsGoThroughItWithTheCallersOutputStatusAndDirectory) {
   EXPECT_EQ(r.status, 0) << r.out;
   r = sh(p + "--timeout 10 watch --count 1 --low-rate");
   EXPECT_EQ(r.status, 0) << r.out;
-  // A neighbouring domain that is in range: this test's may be the highest, 232.
+  // A neighbouring domain that is in range: this test's may be the highest, 232. It may be
+  // another test's at the same time, with a service on it: the call's own result (listed, or
+  // exit 3 for none) is not the point, only that it ran on its own.
   const int other_domain = domain > 0 ? domain - 1 : domain + 1;
   r = sh("PMU_AGENT_SOCKET=" + socket + " " + PMUCTL_PATH + " --domain " + std::to_string(other_domain) +
          " --timeout 1 list");
-  EXPECT_EQ(r.status, 3) << r.out;
+  EXPECT_TRUE(r.status == 0 || r.status == 3) << r.out;
   EXPECT_NE(r.out.find("pmuctl: the agent on " + socket + " does not serve this call (its domain, QoS file, "
                        "security or network options are not the agent's); it runs on its own"),
             std::string::npos)

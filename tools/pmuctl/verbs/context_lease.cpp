@@ -32,6 +32,7 @@ pmu::dds::DdsContext& ContextPool::context(const std::string& participant_name,
   if (!slot) {
     try {
       slot = make_context(settings_, participant_name, partitions);
+      slot->reuse_endpoints();
     } catch (...) {
       contexts_.erase(participant_name);
       throw;

@@ -3,7 +3,8 @@
 // it when the verb ends. A call that `pmuctl agent` serves borrows one of the agent's
 // long-lived participants instead: the aircraft have discovered it once, so over a radio
 // link a call costs its few endpoints and their samples rather than a whole participant's
-// discovery, and the endpoints the verb made are deleted when it ends.
+// discovery. The endpoints the verb made are parked when it ends and taken up again by a
+// later call (DdsContext::reuse_endpoints says why they are not deleted).
 //
 // Lifetime: a ContextPool outlives every lease taken from it (the agent owns it for its
 // whole run); a lease outlives every reference the verb took from its context.

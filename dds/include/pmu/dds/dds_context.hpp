@@ -159,6 +159,23 @@ class DdsContext {
   EndpointMark endpoint_mark() const noexcept { return {writers_.size(), readers_.size()}; }
   void delete_endpoints_since(EndpointMark mark);
 
+  // From now on a job's writers and readers (those without a listener) are parked rather
+  // than deleted by delete_endpoints_since, and a later job's writer() or reader() of the
+  // same topic and profile gets a parked one back, moved to that job's partitions; a reader
+  // comes back without the samples it held. Each such endpoint has a publisher or subscriber
+  // of its own, which parking moves to a partition nobody uses, so the remote endpoints
+  // unmatch it on an update of its discovery data; endpoints of the `command` profile stay in
+  // their partitions while idle instead (nothing flows to them between jobs), and a job in
+  // the same partitions takes them up already matched. Why not delete: a Fast DDS Discovery
+  // Server (2.9 to 3.x), processing one endpoint's disposal, drops from its history every
+  // other announcement of the same participant that its clients have not all received,
+  // disposals included. A participant that deletes two endpoints at once then leaves one
+  // matched at the other clients for as long as it lives, and a reliable writer heartbeats
+  // such a reader every period, for ever: a long-lived participant of a ground station over
+  // a radio link filled the link with them. The parked endpoints are bounded by the most a
+  // job uses at once, per topic and profile. Same thread rule as writer() and reader().
+  void reuse_endpoints() noexcept { reuse_ = true; }
+
  private:
   // Throws the DdsError for an endpoint Fast DDS refused ("cannot create a writer for ...").
   [[noreturn]] void refused(const std::string& topic, const std::string& profile, bool publish) const;
@@ -178,6 +195,23 @@ class DdsContext {
   std::map<std::string, eprosima::fastdds::dds::Topic*> topics_;
   std::vector<eprosima::fastdds::dds::DataWriter*> writers_;  // made by writer(), in order
   std::vector<eprosima::fastdds::dds::DataReader*> readers_;  // made by reader(), in order
+
+  // An endpoint kept for reuse (reuse_endpoints), with its own publisher or subscriber.
+  struct Kept {
+    std::string topic;
+    std::string profile;
+    std::vector<std::string> partitions;  // its publisher's or subscriber's now
+    eprosima::fastdds::dds::Publisher* publisher = nullptr;    // a writer's
+    eprosima::fastdds::dds::DataWriter* writer = nullptr;
+    eprosima::fastdds::dds::Subscriber* subscriber = nullptr;  // a reader's
+    eprosima::fastdds::dds::DataReader* reader = nullptr;
+    bool in_use = false;
+  };
+  bool reuse_ = false;
+  std::vector<Kept> kept_;
+  eprosima::fastdds::dds::DataWriter* kept_writer(eprosima::fastdds::dds::Topic& topic, const std::string& profile);
+  eprosima::fastdds::dds::DataReader* kept_reader(eprosima::fastdds::dds::Topic& topic, const std::string& profile);
+  void park(eprosima::fastdds::dds::DataWriter* writer, eprosima::fastdds::dds::DataReader* reader);
 };
 
 }  // namespace pmu::dds
