@@ -188,39 +188,41 @@ Topic& DdsContext::topic(const std::string& name, TypeSupport type) {
 }
 
 DataWriter& DdsContext::writer(Topic& topic, const std::string& profile, DataWriterListener* listener) {
-  if (reuse_ && !listener) {
-    DataWriter* w = kept_writer(topic, profile);
-    writers_.push_back(w);
-    return *w;
-  }
-  DataWriter* w = publisher_->create_datawriter_with_profile(&topic, profile, listener);
-  if (!w) refused(topic.get_name(), profile, true);
-  const DataWriterQos q = w->get_qos();
-  if (const auto s = capacity_shortfall(profile, EndpointKind::Writer, q.resource_limits(), q.history()); !s.empty()) {
-    publisher_->delete_datawriter(w);
-    throw DdsError(qos_file_ + ": <data_writer profile_name=\"" + profile + "\"> (" + topic.get_name() + "): " + s +
-                   ": raise its <resourceLimitsQos> (deploy/qos.xml says how each number is derived)");
-  }
+  DataWriter* w = reuse_ && !listener ? kept_writer(topic, profile) : make_writer(*publisher_, topic, profile, listener);
   writers_.push_back(w);
   return *w;
 }
 
-DataReader& DdsContext::reader(Topic& topic, const std::string& profile, DataReaderListener* listener) {
-  if (reuse_ && !listener) {
-    DataReader* r = kept_reader(topic, profile);
-    readers_.push_back(r);
-    return *r;
+DataWriter* DdsContext::make_writer(Publisher& publisher, Topic& topic, const std::string& profile,
+                                    DataWriterListener* listener) {
+  DataWriter* w = publisher.create_datawriter_with_profile(&topic, profile, listener);
+  if (!w) refused(topic.get_name(), profile, true);
+  const DataWriterQos q = w->get_qos();
+  if (const auto s = capacity_shortfall(profile, EndpointKind::Writer, q.resource_limits(), q.history()); !s.empty()) {
+    publisher.delete_datawriter(w);
+    throw DdsError(qos_file_ + ": <data_writer profile_name=\"" + profile + "\"> (" + topic.get_name() + "): " + s +
+                   ": raise its <resourceLimitsQos> (deploy/qos.xml says how each number is derived)");
   }
-  DataReader* r = subscriber_->create_datareader_with_profile(&topic, profile, listener);
+  return w;
+}
+
+DataReader& DdsContext::reader(Topic& topic, const std::string& profile, DataReaderListener* listener) {
+  DataReader* r = reuse_ && !listener ? kept_reader(topic, profile) : make_reader(*subscriber_, topic, profile, listener);
+  readers_.push_back(r);
+  return *r;
+}
+
+DataReader* DdsContext::make_reader(Subscriber& subscriber, Topic& topic, const std::string& profile,
+                                    DataReaderListener* listener) {
+  DataReader* r = subscriber.create_datareader_with_profile(&topic, profile, listener);
   if (!r) refused(topic.get_name(), profile, false);
   const DataReaderQos q = r->get_qos();
   if (const auto s = capacity_shortfall(profile, EndpointKind::Reader, q.resource_limits(), q.history()); !s.empty()) {
-    subscriber_->delete_datareader(r);
+    subscriber.delete_datareader(r);
     throw DdsError(qos_file_ + ": <data_reader profile_name=\"" + profile + "\"> (" + topic.get_name() + "): " + s +
                    ": raise its <resourceLimitsQos> (deploy/qos.xml says how each number is derived)");
   }
-  readers_.push_back(r);
-  return *r;
+  return r;
 }
 
 bool DdsContext::set_partitions(const Partitions& partitions) {
@@ -249,21 +251,13 @@ DataWriter* DdsContext::kept_writer(Topic& topic, const std::string& profile) {
         return k.writer;
       }
   Publisher* publisher = participant_->create_publisher(PUBLISHER_QOS_DEFAULT);
-  if (!publisher || !move_to(*publisher, partitions_.publisher)) {
+  DataWriter* w = nullptr;
+  try {
+    if (!publisher || !move_to(*publisher, partitions_.publisher)) refused(topic.get_name(), profile, true);
+    w = make_writer(*publisher, topic, profile, nullptr);
+  } catch (...) {
     if (publisher) participant_->delete_publisher(publisher);
-    refused(topic.get_name(), profile, true);
-  }
-  DataWriter* w = publisher->create_datawriter_with_profile(&topic, profile, nullptr);
-  if (!w) {
-    participant_->delete_publisher(publisher);
-    refused(topic.get_name(), profile, true);
-  }
-  const DataWriterQos q = w->get_qos();
-  if (const auto s = capacity_shortfall(profile, EndpointKind::Writer, q.resource_limits(), q.history()); !s.empty()) {
-    publisher->delete_datawriter(w);
-    participant_->delete_publisher(publisher);
-    throw DdsError(qos_file_ + ": <data_writer profile_name=\"" + profile + "\"> (" + topic.get_name() + "): " + s +
-                   ": raise its <resourceLimitsQos> (deploy/qos.xml says how each number is derived)");
+    throw;
   }
   kept_.push_back({topic.get_name(), profile, partitions_.publisher, publisher, w, nullptr, nullptr, true});
   return w;
@@ -283,21 +277,13 @@ DataReader* DdsContext::kept_reader(Topic& topic, const std::string& profile) {
         return k.reader;
       }
   Subscriber* subscriber = participant_->create_subscriber(SUBSCRIBER_QOS_DEFAULT);
-  if (!subscriber || !move_to(*subscriber, partitions_.subscriber)) {
+  DataReader* r = nullptr;
+  try {
+    if (!subscriber || !move_to(*subscriber, partitions_.subscriber)) refused(topic.get_name(), profile, false);
+    r = make_reader(*subscriber, topic, profile, nullptr);
+  } catch (...) {
     if (subscriber) participant_->delete_subscriber(subscriber);
-    refused(topic.get_name(), profile, false);
-  }
-  DataReader* r = subscriber->create_datareader_with_profile(&topic, profile, nullptr);
-  if (!r) {
-    participant_->delete_subscriber(subscriber);
-    refused(topic.get_name(), profile, false);
-  }
-  const DataReaderQos q = r->get_qos();
-  if (const auto s = capacity_shortfall(profile, EndpointKind::Reader, q.resource_limits(), q.history()); !s.empty()) {
-    subscriber->delete_datareader(r);
-    participant_->delete_subscriber(subscriber);
-    throw DdsError(qos_file_ + ": <data_reader profile_name=\"" + profile + "\"> (" + topic.get_name() + "): " + s +
-                   ": raise its <resourceLimitsQos> (deploy/qos.xml says how each number is derived)");
+    throw;
   }
   kept_.push_back({topic.get_name(), profile, partitions_.subscriber, nullptr, nullptr, subscriber, r, true});
   return r;

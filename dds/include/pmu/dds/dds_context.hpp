@@ -177,6 +177,14 @@ class DdsContext {
   void reuse_endpoints() noexcept { reuse_ = true; }
 
  private:
+  // An endpoint of `publisher` or `subscriber` with the named profile, its capacity checked;
+  // throws like writer() and reader().
+  eprosima::fastdds::dds::DataWriter* make_writer(eprosima::fastdds::dds::Publisher& publisher,
+                                                  eprosima::fastdds::dds::Topic& topic, const std::string& profile,
+                                                  eprosima::fastdds::dds::DataWriterListener* listener);
+  eprosima::fastdds::dds::DataReader* make_reader(eprosima::fastdds::dds::Subscriber& subscriber,
+                                                  eprosima::fastdds::dds::Topic& topic, const std::string& profile,
+                                                  eprosima::fastdds::dds::DataReaderListener* listener);
   // Throws the DdsError for an endpoint Fast DDS refused ("cannot create a writer for ...").
   [[noreturn]] void refused(const std::string& topic, const std::string& profile, bool publish) const;
 
