@@ -14,7 +14,8 @@
 #   list     one `pmuctl --json list`: bytes over the link, seconds, vehicles listed of N
 #   command  one `pmuctl --vehicle uavN config set payload_voltage 13.0`: bytes, seconds, result
 #   low      10 s of `pmuctl watch --low-rate` (started 15 s before): the steady cost of watching
-# Bytes are the ground interface's received + sent IP bytes; drops are the tbf queues'.
+# Bytes are the ground interface's received + sent IP bytes; drops are the tbf queues', from
+# the list to the watch's end and, after discovery, in the watch's measured 10 s.
 # --qos, --pmuctl and --service measure another qos.xml, pmuctl or pmu-service (a before and
 # after, one run each). --discovery-server: Fast DDS's Discovery Server (fast-discovery-server)
 # runs on the ground host with the shipped deploy/discovery-server.xml (--server-xml: another
@@ -66,7 +67,7 @@ while [ $# -gt 0 ]; do
     --agent) agent=1; shift ;;
     --keep) keep=$2; shift 2 ;;
     --capture) capture=1; shift ;;
-    -h|--help) sed -n '2,37p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
+    -h|--help) sed -n '2,38p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
     *) echo "fleet_link.sh: unknown argument '$1'" >&2; exit 2 ;;
   esac
 done
@@ -301,7 +302,9 @@ EOF
   (exec_gnd=1 pmuctl_gnd watch --low-rate >"$work/low.out" 2>/dev/null) &
   watcher=$!
   sleep 15  # the watcher's own discovery and the state it gets first are not the steady cost
-  b0=$(link_bytes); l0=$(wc -l <"$work/low.out"); sleep 10; b1=$(link_bytes); l1=$(wc -l <"$work/low.out")
+  b0=$(link_bytes); l0=$(wc -l <"$work/low.out"); w0=$(link_drops)
+  sleep 10
+  b1=$(link_bytes); l1=$(wc -l <"$work/low.out"); steady_drops=$(( $(link_drops) - w0 ))
   kill "$watcher" 2>/dev/null || true; wait "$watcher" 2>/dev/null || true
   if [ -n "$(ip netns pids "$gnd" | xargs -r ps -o args= -p | grep ' watch ')" ]; then
     echo "fleet_link.sh: the low-rate watch did not end" >&2; exit 1
@@ -309,7 +312,7 @@ EOF
   low=$(( (b1 - b0) / 10 )); low_samples=$(python3 -c "print(round(($l1 - $l0) / 10, 1))")
   drops=$(( $(link_drops) - d0 ))
 
-  rows+=("$n $idle $list_bytes $list_s $listed $cmd_bytes $cmd_s $result $low $low_samples $drops")
+  rows+=("$n $idle $list_bytes $list_s $listed $cmd_bytes $cmd_s $result $low $low_samples $drops $steady_drops")
   [ "$ds" = 1 ] && ds_rows+=("$n $(round_and_cut "$n")")
   stop_all
   wait 2>/dev/null || true
@@ -322,18 +325,19 @@ m = re.match(r"(\d+)kbit", rate)
 cap = int(m.group(1)) * 1000 / 8 if m else None
 out = []
 print(f"fleet over a {rate} link (tbf each way){', Discovery Server on the ground (' + server_xml + ')' if ds == '1' else ''}{'; the calls through pmuctl agent' if agent == '1' else ''}; qos {qos}; pmuctl {ctl}; pmu-service {svc}")
-print("| aircraft | idle B/s | list: bytes, s, listed | command: bytes, s, result | watch --low-rate B/s (samples/s) | low-rate watch / one way's capacity | queue drops |")
+print("| aircraft | idle B/s | list: bytes, s, listed | command: bytes, s, result | watch --low-rate B/s (samples/s) | low-rate watch / one way's capacity | queue drops: from the list on / in the watch's 10 s |")
 print("|---|---|---|---|---|---|---|")
 for line in os.environ["ROWS"].splitlines():
     f = line.split(" ", 7)
     n, idle, lb, ls, listed, cb, cs = (int(f[0]), int(f[1]), int(f[2]), float(f[3]), int(f[4]), int(f[5]), float(f[6]))
-    rest = f[7].rsplit(" ", 3)
-    result, low, low_samples, drops = rest[0], int(rest[1]), float(rest[2]), int(rest[3])
+    rest = f[7].rsplit(" ", 4)
+    result, low, low_samples, drops, steady = rest[0], int(rest[1]), float(rest[2]), int(rest[3]), int(rest[4])
     share = f"{low / cap:.2f}" if cap else "-"
-    print(f"| {n} | {idle} | {lb}, {ls} s, {listed} of {n} | {cb}, {cs} s, {result} | {low} ({low_samples}) | {share} | {drops} |")
+    print(f"| {n} | {idle} | {lb}, {ls} s, {listed} of {n} | {cb}, {cs} s, {result} | {low} ({low_samples}) | {share} | {drops} / {steady} |")
     out.append(dict(aircraft=n, idle_bytes_per_s=idle, list_bytes=lb, list_seconds=ls, listed=listed,
                     command_bytes=cb, command_seconds=cs, command_result=result,
-                    low_rate_bytes_per_s=low, low_rate_samples_per_s=low_samples, drops=drops))
+                    low_rate_bytes_per_s=low, low_rate_samples_per_s=low_samples, drops=drops,
+                    steady_drops=steady))
 failed = 0
 if ds == "1":
     print()
