@@ -591,6 +591,9 @@ vehicles_listed() {
   SEEN=$(ctl gnd --timeout 20 list 2>/dev/null | grep '"bus":"sim0",' | grep '"kind":"pmu","address":1,' | sed -n 's/.*"vehicle":"\([^"]*\)".*/\1/p' | sort -u | tr '\n' ' ')
   [ "$SEEN" = "uav1 uav2 " ]
 }
+# The pmu/voltages samples of VEHICLE in the fleet scenario's watch so far.
+voltages_of() { grep '"topic":"voltages"' "$WORK/$SCEN.watch.stream" | grep -c "\"vehicle\":\"$1\""; }
+voltages_of_each() { [ "$(voltages_of uav1)" -ge "$1" ] && [ "$(voltages_of uav2)" -ge "$1" ]; }
 scenario_fleet() {
   start_service mc1 "vehicle: uav1"; LOG1=$SVC_LOG
   start_service mc2 "vehicle: uav2"; LOG2=$SVC_LOG
@@ -605,16 +608,27 @@ scenario_fleet() {
   ran_value_in 13.5 "$LOG2" && fail "uav2 executed uav1's command: $(grep 'payload_voltage=13.5' "$LOG2")"
   ran_value_in 14.5 "$LOG1" && fail "uav1 executed uav2's command: $(grep 'payload_voltage=14.5' "$LOG1")"
   detail "a command to each over the ground link: each executed by its vehicle only (audit trails)"
-  # Every vehicle's samples in one watch without --vehicle; the first of each vehicle may
-  # have been written before its command, so it is not judged.
-  ctl gnd --timeout 60 watch --count 60 >"$WORK/$SCEN.watch" 2>"$WORK/$SCEN.err"
-  bad=$(grep '"topic":"voltages"' "$WORK/$SCEN.watch" | sed -n 's/.*"vehicle":"\([^"]*\)".*"payload":\([^,}]*\).*/\1 \2/p' |
+  # Every vehicle's samples in one watch without --vehicle, until each has given five
+  # pmu/voltages samples; the first of each vehicle may have been written before its command,
+  # so it is not judged. Not a count of samples overall: every pmuctl is a new participant,
+  # which each service discovers over the impaired link (30 kB of endpoints each), and
+  # under that load one service's discovery may finish half a minute after the other's,
+  # whose telemetry alone would then fill any count.
+  t_w=$(now)
+  start_watch gnd watch
+  watch_pid=$!
+  wait_until 60 voltages_of_each 5 ||
+    fail "gnd: within 60 s of its watch's start, $(voltages_of uav1) pmu/voltages samples of uav1 and $(voltages_of uav2) of uav2, want 5 of each"
+  kill "$watch_pid" 2>/dev/null
+  first1=$(stream_between watch "$t_w" | grep -m1 '"vehicle":"uav1"' | cut -d' ' -f1)
+  first2=$(stream_between watch "$t_w" | grep -m1 '"vehicle":"uav2"' | cut -d' ' -f1)
+  bad=$(grep '"topic":"voltages"' "$WORK/$SCEN.watch.stream" | sed -n 's/.*"vehicle":"\([^"]*\)".*"payload":\([^,}]*\).*/\1 \2/p' |
     awk '{ n[$1]++; if (n[$1] == 1) next
            want = ($1 == "uav1") ? 13.5 : ($1 == "uav2") ? 14.5 : -1
            if ($2 + 0 != want) print $1 " payload " $2 }
          END { if (!n["uav1"]) print "no uav1 sample"; if (!n["uav2"]) print "no uav2 sample" }')
   [ -z "$bad" ] || fail "gnd: pmu/voltages attributed wrongly: $(printf '%s' "$bad" | head -n 3 | tr '\n' ';')"
-  detail "gnd: every pmu/voltages sample of each vehicle shows that vehicle's own payload setpoint ($(grep -c '"vehicle":"uav1"' "$WORK/$SCEN.watch") uav1, $(grep -c '"vehicle":"uav2"' "$WORK/$SCEN.watch") uav2 samples of 60)"
+  detail "gnd: every pmu/voltages sample of each vehicle shows that vehicle's own payload setpoint ($(voltages_of uav1) uav1, $(voltages_of uav2) uav2 samples; the watch's first of uav1 after $(calc "$first1 - $t_w") s, of uav2 after $(calc "$first2 - $t_w") s)"
   for v in uav1 uav2; do
     c=$(ctl gnd --vehicle $v --timeout 30 config get 2>/dev/null | head -n1)
     want=13.5; [ $v = uav2 ] && want=14.5
