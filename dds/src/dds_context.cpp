@@ -16,7 +16,6 @@
 #include "pmu/dds/dds_qos_file.hpp"
 #include "pmu/dds/dds_type_objects.hpp"
 #include "pmu/dds/security_match_guard.hpp"
-#include "pmu/idl/topics.hpp"
 #include "pmu/sysconf_dir.hpp"
 
 namespace pmu::dds {
@@ -44,25 +43,18 @@ bool readable(const std::string& path) { return std::ifstream(path).good(); }
 // name can (vehicle.hpp), so even the every-vehicle readers' pattern does not match it.
 constexpr const char* kClosingPartition = "#pmu-dds-closing";
 
+// A publisher or subscriber moved to other partitions (Fast DDS lets them change while the
+// participant lives). False when Fast DDS refuses.
+template <class Entity>
+bool move_to(Entity& entity, const std::vector<std::string>& partitions) {
+  auto qos = entity.get_qos();
+  qos.partition().clear();
+  for (const auto& p : partitions) qos.partition().push_back(p.c_str());
+  return entity.set_qos(qos) == ReturnCode_t::RETCODE_OK;
+}
+
 void unmatch_writers_before_deleting_them(Publisher& publisher) {
-  PublisherQos qos = publisher.get_qos();
-  qos.partition().clear();
-  qos.partition().push_back(kClosingPartition);
-  (void)publisher.set_qos(qos);  // if refused, the deletion runs as before: nothing else to do
-}
-
-bool move_to(Publisher& publisher, const std::vector<std::string>& partitions) {
-  PublisherQos qos = publisher.get_qos();
-  qos.partition().clear();
-  for (const auto& p : partitions) qos.partition().push_back(p.c_str());
-  return publisher.set_qos(qos) == ReturnCode_t::RETCODE_OK;
-}
-
-bool move_to(Subscriber& subscriber, const std::vector<std::string>& partitions) {
-  SubscriberQos qos = subscriber.get_qos();
-  qos.partition().clear();
-  for (const auto& p : partitions) qos.partition().push_back(p.c_str());
-  return subscriber.set_qos(qos) == ReturnCode_t::RETCODE_OK;
+  (void)move_to(publisher, {kClosingPartition});  // if refused, the deletion runs as before: nothing else to do
 }
 
 // Takes every sample a reader holds, whatever its type (through the reader's type support).
@@ -226,30 +218,36 @@ DataReader* DdsContext::make_reader(Subscriber& subscriber, Topic& topic, const 
 }
 
 bool DdsContext::set_partitions(const Partitions& partitions) {
-  PublisherQos pub_qos = publisher_->get_qos();
-  pub_qos.partition().clear();
-  for (const auto& p : partitions.publisher) pub_qos.partition().push_back(p.c_str());
-  SubscriberQos sub_qos = subscriber_->get_qos();
-  sub_qos.partition().clear();
-  for (const auto& p : partitions.subscriber) sub_qos.partition().push_back(p.c_str());
-  if (publisher_->set_qos(pub_qos) != ReturnCode_t::RETCODE_OK ||
-      subscriber_->set_qos(sub_qos) != ReturnCode_t::RETCODE_OK)
-    return false;
+  if (!move_to(*publisher_, partitions.publisher) || !move_to(*subscriber_, partitions.subscriber)) return false;
   partitions_ = partitions;
   return true;
 }
 
-DataWriter* DdsContext::kept_writer(Topic& topic, const std::string& profile) {
+bool DdsContext::move(Kept& k, const std::vector<std::string>& partitions) {
+  if (!(k.publisher ? move_to(*k.publisher, partitions) : move_to(*k.subscriber, partitions))) return false;
+  k.partitions = partitions;
+  return true;
+}
+
+DdsContext::Kept* DdsContext::take_up(const std::string& topic, const std::string& profile, bool writer,
+                                      const std::vector<std::string>& partitions) {
   // One still in this job's partitions first: taking it up costs the link nothing.
   for (const bool same_partitions : {true, false})
     for (auto& k : kept_)
-      if (k.writer && !k.in_use && k.topic == topic.get_name() && k.profile == profile &&
-          (k.partitions == partitions_.publisher) == same_partitions &&
-          (same_partitions || move_to(*k.publisher, partitions_.publisher))) {
-        k.partitions = partitions_.publisher;
+      if (!k.in_use && (k.writer != nullptr) == writer && k.topic == topic && k.profile == profile &&
+          (k.partitions == partitions) == same_partitions) {
+        // What a reader holds is an earlier job's (one left matched may also hold replies to
+        // other clients since).
+        if (k.reader) drain(*k.reader);
+        if (!same_partitions && !move(k, partitions)) continue;
         k.in_use = true;
-        return k.writer;
+        return &k;
       }
+  return nullptr;
+}
+
+DataWriter* DdsContext::kept_writer(Topic& topic, const std::string& profile) {
+  if (Kept* k = take_up(topic.get_name(), profile, true, partitions_.publisher)) return k->writer;
   Publisher* publisher = participant_->create_publisher(PUBLISHER_QOS_DEFAULT);
   DataWriter* w = nullptr;
   try {
@@ -264,18 +262,7 @@ DataWriter* DdsContext::kept_writer(Topic& topic, const std::string& profile) {
 }
 
 DataReader* DdsContext::kept_reader(Topic& topic, const std::string& profile) {
-  for (const bool same_partitions : {true, false})
-    for (auto& k : kept_)
-      if (k.reader && !k.in_use && k.topic == topic.get_name() && k.profile == profile &&
-          (k.partitions == partitions_.subscriber) == same_partitions) {
-        // What it holds is an earlier job's (a command reply reader left in its partitions
-        // may also hold replies to other clients since).
-        drain(*k.reader);
-        if (!same_partitions && !move_to(*k.subscriber, partitions_.subscriber)) continue;
-        k.partitions = partitions_.subscriber;
-        k.in_use = true;
-        return k.reader;
-      }
+  if (Kept* k = take_up(topic.get_name(), profile, false, partitions_.subscriber)) return k->reader;
   Subscriber* subscriber = participant_->create_subscriber(SUBSCRIBER_QOS_DEFAULT);
   DataReader* r = nullptr;
   try {
@@ -289,43 +276,29 @@ DataReader* DdsContext::kept_reader(Topic& topic, const std::string& profile) {
   return r;
 }
 
-void DdsContext::park(DataWriter* writer, DataReader* reader) {
+bool DdsContext::park(const DomainEntity* endpoint) {
   for (auto& k : kept_)
-    if (k.in_use && ((writer && k.writer == writer) || (reader && k.reader == reader))) {
+    if (k.in_use && (k.writer == endpoint || k.reader == endpoint)) {
       k.in_use = false;
-      // Command endpoints carry only a job's requests and their replies: left matched while
-      // idle they cost the link nothing, and the next job for the same vehicle finds them
-      // matched. Anything else would go on receiving what its writers publish.
-      if (k.profile == qos_profiles::kCommand) return;
-      k.partitions = {kClosingPartition};
-      if (k.publisher) (void)move_to(*k.publisher, k.partitions);
-      if (k.subscriber) {
-        (void)move_to(*k.subscriber, k.partitions);
-        drain(*k.reader);
-      }
-      return;
+      // Left matched while idle (reuse_endpoints' `idle_matched` profiles), or moved away so
+      // that nothing its remote writers publish comes to it.
+      if (std::find(idle_matched_.begin(), idle_matched_.end(), k.profile) != idle_matched_.end()) return true;
+      (void)move(k, {kClosingPartition});
+      if (k.reader) drain(*k.reader);
+      return true;
     }
+  return false;
 }
 
 void DdsContext::delete_endpoints_since(EndpointMark mark) {
   if (reuse_) {
     // The kept ones are parked; one made with a listener was not kept, and is deleted below.
-    std::vector<DataWriter*> writers;
-    std::vector<DataReader*> readers;
-    for (std::size_t i = mark.writers; i < writers_.size(); ++i) {
-      const bool kept = std::any_of(kept_.begin(), kept_.end(), [&](const Kept& k) { return k.writer == writers_[i]; });
-      if (kept) park(writers_[i], nullptr);
-      else writers.push_back(writers_[i]);
-    }
-    for (std::size_t i = mark.readers; i < readers_.size(); ++i) {
-      const bool kept = std::any_of(kept_.begin(), kept_.end(), [&](const Kept& k) { return k.reader == readers_[i]; });
-      if (kept) park(nullptr, readers_[i]);
-      else readers.push_back(readers_[i]);
-    }
-    writers_.resize(mark.writers);
-    readers_.resize(mark.readers);
-    writers_.insert(writers_.end(), writers.begin(), writers.end());
-    readers_.insert(readers_.end(), readers.begin(), readers.end());
+    writers_.erase(std::remove_if(writers_.begin() + static_cast<std::ptrdiff_t>(mark.writers), writers_.end(),
+                                  [this](DataWriter* w) { return park(w); }),
+                   writers_.end());
+    readers_.erase(std::remove_if(readers_.begin() + static_cast<std::ptrdiff_t>(mark.readers), readers_.end(),
+                                  [this](DataReader* r) { return park(r); }),
+                   readers_.end());
   }
   // The hang above threatens any writer deleted while matched, so its publisher goes to the
   // closing partition first; the next job sets its own partitions (set_partitions).

@@ -229,7 +229,7 @@ TEST(DiscoveryServer, ALongLivedClientsEndedReadersAreUnmatchedAtTheOtherClients
   DataWriter& currents = service.writer(currents_topic, qos_profiles::kTelemetry);
 
   DdsContext agent(pmu::test::exclusive_dds_domain(), "", "ds-agent", {}, Transport::UdpOnly, client_of(port));
-  agent.reuse_endpoints();
+  agent.reuse_endpoints({qos_profiles::kCommand});
   Topic& v_topic = agent.topic(topics::kVoltages, TypeSupport(new pmu::v4::VoltagesPubSubType()));
   Topic& c_topic = agent.topic(topics::kCurrents, TypeSupport(new pmu::v4::CurrentsPubSubType()));
   DataReader* first_job_reader = nullptr;

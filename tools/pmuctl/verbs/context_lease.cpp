@@ -2,6 +2,8 @@
 
 #include <filesystem>
 
+#include "pmu/idl/topics.hpp"
+
 namespace pmu::tools {
 namespace {
 
@@ -32,7 +34,9 @@ pmu::dds::DdsContext& ContextPool::context(const std::string& participant_name,
   if (!slot) {
     try {
       slot = make_context(settings_, participant_name, partitions);
-      slot->reuse_endpoints();
+      // Command endpoints carry only a call's requests and the replies to them: left matched
+      // in their vehicle's partitions, the next command to it finds them matched.
+      slot->reuse_endpoints({qos_profiles::kCommand});
     } catch (...) {
       contexts_.erase(participant_name);
       throw;
@@ -52,8 +56,8 @@ std::string effective_qos_file(const std::string& qos_file) {
 }
 
 bool same_dds_settings(const GlobalOptions& o, const GlobalOptions& agent) {
-  return o.domain == agent.domain && effective_qos_file(o.qos_file) == effective_qos_file(agent.qos_file) && same_security(o.security, agent.security) &&
-         same_network(o.network, agent.network);
+  return o.domain == agent.domain && effective_qos_file(o.qos_file) == effective_qos_file(agent.qos_file) &&
+         same_security(o.security, agent.security) && same_network(o.network, agent.network);
 }
 
 ContextLease::ContextLease(const GlobalOptions& o, const std::string& participant_name)

@@ -164,9 +164,8 @@ class DdsContext {
   // same topic and profile gets a parked one back, moved to that job's partitions; a reader
   // comes back without the samples it held. Each such endpoint has a publisher or subscriber
   // of its own, which parking moves to a partition nobody uses, so the remote endpoints
-  // unmatch it on an update of its discovery data; endpoints of the `command` profile stay in
-  // their partitions while idle instead (nothing flows to them between jobs), and a job in
-  // the same partitions takes them up already matched. Why not delete: a Fast DDS Discovery
+  // unmatch it on an update of its discovery data, unless its profile is one of
+  // `idle_matched`. Why not delete: a Fast DDS Discovery
   // Server (2.9 to 3.x), processing one endpoint's disposal, drops from its history every
   // other announcement of the same participant that its clients have not all received,
   // disposals included. A participant that deletes two endpoints at once then leaves one
@@ -174,7 +173,13 @@ class DdsContext {
   // such a reader every period, for ever: a long-lived participant of a ground station over
   // a radio link filled the link with them. The parked endpoints are bounded by the most a
   // job uses at once, per topic and profile. Same thread rule as writer() and reader().
-  void reuse_endpoints() noexcept { reuse_ = true; }
+  // `idle_matched`: profiles whose endpoints stay matched in their partitions while idle
+  // (nothing flows to them unasked, so a later job in the same partitions finds them matched
+  // at no cost to the link); the others are parked.
+  void reuse_endpoints(std::vector<std::string> idle_matched) {
+    reuse_ = true;
+    idle_matched_ = std::move(idle_matched);
+  }
 
  private:
   // An endpoint of `publisher` or `subscriber` with the named profile, its capacity checked;
@@ -216,10 +221,18 @@ class DdsContext {
     bool in_use = false;
   };
   bool reuse_ = false;
+  std::vector<std::string> idle_matched_;
   std::vector<Kept> kept_;
   eprosima::fastdds::dds::DataWriter* kept_writer(eprosima::fastdds::dds::Topic& topic, const std::string& profile);
   eprosima::fastdds::dds::DataReader* kept_reader(eprosima::fastdds::dds::Topic& topic, const std::string& profile);
-  void park(eprosima::fastdds::dds::DataWriter* writer, eprosima::fastdds::dds::DataReader* reader);
+  // An idle kept writer (`writer`) or reader of this topic and profile, in `partitions` (one
+  // already there first), marked in use; a reader emptied. Null when there is none.
+  Kept* take_up(const std::string& topic, const std::string& profile, bool writer,
+                const std::vector<std::string>& partitions);
+  // Moves a kept endpoint's publisher or subscriber; false when Fast DDS refuses.
+  bool move(Kept& k, const std::vector<std::string>& partitions);
+  // Parks `endpoint` when it is a kept one in use (true); false when it was not kept.
+  bool park(const eprosima::fastdds::dds::DomainEntity* endpoint);
 };
 
 }  // namespace pmu::dds
