@@ -69,6 +69,19 @@ pmu::test::Child start_agent(int domain, const std::string& socket, const std::s
   return agent;
 }
 
+// `pmuctl config set payload_voltage 23` to VEHICLE through the agent on `socket`, in the
+// background, its output in `out`.
+pmu::test::Child command_through(const std::string& socket, int domain, const std::string& vehicle,
+                                 const std::string& timeout, const std::string& out) {
+  pmu::test::ChildOptions o;
+  o.env = {"PMU_AGENT_SOCKET=" + socket};
+  o.stdout_path = out;
+  o.stderr_path = out;
+  return pmu::test::Child({PMUCTL_PATH, "--domain", std::to_string(domain), "--timeout", timeout, "--vehicle", vehicle,
+                           "config", "set", "payload_voltage", "23"},
+                          o);
+}
+
 bool wait_for_socket(const std::string& path) {
   for (int i = 0; i < 200; ++i) {
     struct stat st{};
@@ -207,15 +220,10 @@ TEST(PmuctlAgent, ACallThatWaitsForASilentAircraftHoldsUpNoOtherAndADeadWorkerIs
   ASSERT_TRUE(served) << read_file(log) << uav1.describe();
 
   // uav9 has no service: its command waits out its whole timeout inside one worker.
-  pmu::test::ChildOptions o;
-  o.env = {"PMU_AGENT_SOCKET=" + socket};
-  o.stdout_path = dir.path() + "/silent.out";
-  o.stderr_path = o.stdout_path;
-  pmu::test::Child silent({PMUCTL_PATH, "--domain", std::to_string(domain), "--timeout", "25", "--vehicle", "uav9",
-                           "config", "set", "payload_voltage", "23"},
-                          o);
+  const std::string silent_out = dir.path() + "/silent.out";
+  auto silent = command_through(socket, domain, "uav9", "25", silent_out);
   std::this_thread::sleep_for(1s);
-  ASSERT_TRUE(silent.running()) << read_file(o.stdout_path);
+  ASSERT_TRUE(silent.running()) << read_file(silent_out);
   // Meanwhile a command to uav1 goes through another worker and completes.
   auto r = sh(p + "--timeout 20 --vehicle uav1 --json config set payload_voltage 22");
   EXPECT_EQ(r.status, 0) << r.out;
@@ -223,7 +231,7 @@ TEST(PmuctlAgent, ACallThatWaitsForASilentAircraftHoldsUpNoOtherAndADeadWorkerIs
   EXPECT_TRUE(silent.running()) << "uav1's command waited for uav9's to end: " << read_file(log);
   const auto st = silent.wait_for(40s);
   ASSERT_TRUE(st);
-  EXPECT_TRUE(WIFEXITED(*st) && WEXITSTATUS(*st) == 2) << read_file(o.stdout_path);
+  EXPECT_TRUE(WIFEXITED(*st) && WEXITSTATUS(*st) == 2) << read_file(silent_out);
 
   // A worker that dies is replaced; calls go on being served by the agent.
   auto workers = workers_of(agent.pid());
@@ -296,25 +304,20 @@ TEST(PmuctlAgent, AnAgentThatEndsDuringACallLeavesNoAnswerAndNoSecondRun) {
   auto agent = start_agent(domain, socket, log);
   ASSERT_TRUE(wait_for_socket(socket)) << read_file(log);
   // No service on the domain: the call waits its whole timeout inside the agent.
-  pmu::test::ChildOptions o;
-  o.env = {"PMU_AGENT_SOCKET=" + socket};
-  o.stdout_path = dir.path() + "/call.out";
-  o.stderr_path = o.stdout_path;
-  pmu::test::Child call({PMUCTL_PATH, "--domain", std::to_string(domain), "--timeout", "20", "--vehicle", "uav1",
-                         "config", "set", "payload_voltage", "23"},
-                        o);
+  const std::string call_out = dir.path() + "/call.out";
+  auto call = command_through(socket, domain, "uav1", "20", call_out);
   std::this_thread::sleep_for(1500ms);
   ASSERT_TRUE(agent.signal(SIGKILL));
   const auto st = call.wait_for(15s);
   ASSERT_TRUE(st) << "the call did not end when its agent did";
-  EXPECT_TRUE(WIFEXITED(*st) && WEXITSTATUS(*st) == 3) << read_file(o.stdout_path);
+  EXPECT_TRUE(WIFEXITED(*st) && WEXITSTATUS(*st) == 3) << read_file(call_out);
   // Had it run the call again on its own, that run would have said there is no service.
-  EXPECT_EQ(read_file(o.stdout_path).find("no pmu-service"), std::string::npos) << read_file(o.stdout_path);
-  EXPECT_NE(read_file(o.stdout_path).find("pmuctl: the agent on " + socket +
+  EXPECT_EQ(read_file(call_out).find("no pmu-service"), std::string::npos) << read_file(call_out);
+  EXPECT_NE(read_file(call_out).find("pmuctl: the agent on " + socket +
                                            " ended during the call: it may have been carried out (see the agent's "
                                            "log), so it is not run again"),
             std::string::npos)
-      << read_file(o.stdout_path);
+      << read_file(call_out);
 }
 
 }  // namespace pmuctl_agent_test
