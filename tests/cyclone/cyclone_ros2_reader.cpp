@@ -4,7 +4,7 @@
 // partition. It reads a PMU's battery A, a BMS's battery and /diagnostics from pmu-service
 // (ros2: enabled) and prints, for each, one line of the values it decoded:
 //   battery_a voltage=24.6 current=2 temperature=25 present=1 status=1 health=1 location=battery_a serial=pmu 4321
-// Exit status: 0 each arrived within 30 s, 1 one did not, 2 bad usage or no DDS.
+// Exit status: 0 each arrived (/diagnostics: an OK status) within 30 s, 1 one did not, 2 bad usage or no DDS.
 //   cyclone_ros2_reader DOMAIN DEVICE_PREFIX   (e.g. 7 /test/uav1/sim)
 #include <dds/dds.h>
 
@@ -110,12 +110,14 @@ int main(int argc, char** argv) {
     ++missed;
   }
   using Array = diagnostic_msgs_msg_dds__DiagnosticArray_;
+  // A device's first status may be STALE "no frame yet", published before its first frame:
+  // every status is printed, and the wait ends at the first OK one.
   if (!wait_for<Array>(diag, [](const Array& a) {
         if (a.status._length != 1) return false;
         const auto& s = a.status._buffer[0];
         std::printf("diagnostics name=%s level=%u message=%s hardware_id=%s values=%u\n", s.name,
                     static_cast<unsigned>(s.level), s.message, s.hardware_id, s.values._length);
-        return true;
+        return s.level == 0;
       })) {
     std::printf("MISS diagnostics\n");
     ++missed;
