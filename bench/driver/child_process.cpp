@@ -6,6 +6,7 @@
 #include <sys/wait.h>
 
 #include <cerrno>
+#include <cstdio>
 #include <cstring>
 #include <deque>
 #include <fstream>
@@ -70,6 +71,9 @@ int ChildProcess::stop(std::chrono::milliseconds grace) {
   if (running()) ::kill(pid_, SIGTERM);
   int rc = wait(grace);
   if (!reaped_) {
+    // Said, because a DDS process killed this way leaves its shared-memory ports behind.
+    std::fprintf(stderr, "pmu_bench: process %d did not stop within %lld ms of SIGTERM: killed\n", pid_,
+                 static_cast<long long>(grace.count()));
     ::kill(pid_, SIGKILL);
     rc = wait(std::chrono::milliseconds(2000));
   }

@@ -82,7 +82,15 @@ std::optional<std::int64_t> ServiceRun::wait_ready(std::chrono::milliseconds tim
     const std::int64_t at = steady_ns();
     if (n <= 0) continue;
     buf[n] = '\0';
-    if (std::strstr(buf, "READY=1")) return at;
+    if (std::strstr(buf, "READY=1")) {
+      // The service reports its status every second, and a datagram socket nobody reads
+      // fills: its sd_notify then blocks its main loop, which no longer sees SIGTERM, and a
+      // SIGKILL later leaves its shared-memory ports behind to fail the next service's
+      // discovery in this domain. Without the socket, sd_notify fails at once.
+      notify_.reset();
+      ::unlink(notify_path_.c_str());
+      return at;
+    }
   }
 }
 

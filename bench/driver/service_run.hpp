@@ -44,6 +44,7 @@ class ServiceRun {
   SteadyTime spawned_at() const noexcept { return process_->spawned_at(); }
   FakePmu& pmu() noexcept { return *pmu_; }
   // steady_clock ns at which READY=1 arrived on the notify socket; nullopt after `timeout`.
+  // Once READY=1 is read, the socket is closed. Called once.
   std::optional<std::int64_t> wait_ready(std::chrono::milliseconds timeout);
   // Throws with the service log's tail when the service has exited.
   void check_alive();
