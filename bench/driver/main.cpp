@@ -9,8 +9,11 @@
 #include <CLI/CLI.hpp>
 #include <cstdio>
 #include <filesystem>
+#include <set>
+#include <string>
 
 #include "benchmarks.hpp"
+#include "domain_pick.hpp"
 #include "peers.hpp"
 #include "scale_peers.hpp"
 #include "pmu/dds/dds_context.hpp"
@@ -21,11 +24,13 @@ int main(int argc, char** argv) {
   app.require_subcommand(1);
   Settings s;
   s.qos_file = pmu::dds::default_qos_file();
-  s.domain_base = 150 + static_cast<int>(::getpid() % 20) * 4;
+  s.domain_base = -1;  // chosen below
   auto* run = app.add_subcommand("run", "run every service benchmark, print result rows (JSON lines)");
   run->add_option("--service", s.service_exe, "pmu-service binary")->required()->check(CLI::ExistingFile);
   run->add_flag("--quick", s.quick, "one short pass (smoke test)");
-  run->add_option("--domain-base", s.domain_base, "first of four DDS domains used")->check(CLI::Range(0, 228));
+  run->add_option("--domain-base", s.domain_base,
+                  "first of four DDS domains used (default: four of 150..229 with no shared-memory port in /dev/shm)")
+      ->check(CLI::Range(0, 228));
   run->add_option("--qos", s.qos_file, "QoS profiles (deploy/qos.xml)");
   run->add_option("--latency-seconds", s.latency_seconds, "length of each 7,634 frames/s run (default 10, quick 1)");
   run->add_option("--startups", s.startups, "starts of pmu-service for the start-up rows (default 5, quick 1)")
@@ -65,6 +70,24 @@ int main(int argc, char** argv) {
     if (*pong) return peer_pong();
     if (*telemetry) return peer_telemetry(p);
     if (*reader) return peer_reader(p);
+    const std::set<int> taken = domains_with_shm_ports("/dev/shm");
+    if (s.domain_base < 0) {
+      // The pid spreads runs at once over the range; each skips the domains the others hold.
+      s.domain_base = free_domain_base(kDomainFirst + static_cast<int>(::getpid() % 20) * kDomainsPerRun, taken);
+      if (s.domain_base < 0)
+        throw std::runtime_error("every four domains of " + std::to_string(kDomainFirst) + ".." +
+                                 std::to_string(kDomainLast) +
+                                 " have a Fast DDS shared-memory port in /dev/shm (fastrtps_port*): other runs, or "
+                                 "ports left by killed processes; name free ones with --domain-base");
+    } else {
+      for (int d = s.domain_base; d < s.domain_base + kDomainsPerRun; ++d)
+        if (taken.count(d))
+          std::fprintf(stderr,
+                       "pmu_bench: domain %d has a Fast DDS shared-memory port in /dev/shm (port %d..%d): another "
+                       "run, or one left by a killed process, which can keep SHM participants from matching\n",
+                       d, 7400 + 250 * d, 7400 + 250 * d + 249);
+    }
+    std::fprintf(stderr, "pmu_bench: DDS domains %d..%d\n", s.domain_base, s.domain_base + kDomainsPerRun - 1);
     s.self_exe = std::filesystem::read_symlink("/proc/self/exe").string();
     s.service_exe = std::filesystem::absolute(s.service_exe).string();
     char tmpl[] = "/tmp/pmu-bench-XXXXXX";

@@ -13,9 +13,9 @@
 // that does not lock) is skipped too.
 //
 // The range is kFirstDomain..kLastDomain without pmu_bench's 150..229 (bench/driver picks
-// those from its pid, without locks) and without 0 (the default domain, which scripts/run.sh
-// and people use): 1..149 and 230..232 (232 is the highest domain Fast DDS's default port
-// mapping allows).
+// four with no Fast DDS shared-memory port, without locks: bench/driver/domain_pick.hpp) and
+// without 0 (the default domain, which scripts/run.sh and people use): 1..149 and 230..232
+// (232 is the highest domain Fast DDS's default port mapping allows).
 //
 //   const int domain = pmu::test::exclusive_dds_domain();   // e.g. 37, the same on every call
 //   dds::DdsContext dds(domain, "", "my-test");
