@@ -111,13 +111,19 @@ class Uav1 : public pmu::test::ConfiguredService {
                                                 "    devices:\n      - address: 1\n        period: 0.5\n") {}
 };
 
-TEST(PmuctlAgent, CallsGoThroughItWithTheCallersOutputStatusAndDirectory) {
+// uav1 on a domain of its own, and an agent on that domain listening on its socket.
+class PmuctlAgentWithUav1 : public ::testing::Test {
+ protected:
+  void SetUp() override { ASSERT_TRUE(wait_for_socket(socket)) << read_file(log); }
+
   const int domain = pmu::test::exclusive_dds_domain();
-  Uav1 uav1(domain);
+  Uav1 uav1{domain};
   TempDir dir;
   const std::string socket = dir.path() + "/agent.sock", log = dir.path() + "/agent.log";
-  auto agent = start_agent(domain, socket, log);
-  ASSERT_TRUE(wait_for_socket(socket)) << read_file(log);
+  pmu::test::Child agent = start_agent(domain, socket, log);
+};
+
+TEST_F(PmuctlAgentWithUav1, CallsGoThroughItWithTheCallersOutputStatusAndDirectory) {
   EXPECT_EQ(fs::status(socket).permissions() & fs::perms::all, fs::perms::owner_read | fs::perms::owner_write)
       << "only the agent's user may call it";
   const std::string p = "cd " + dir.path() + " && PMU_AGENT_SOCKET=" + socket + " " + PMUCTL_PATH + " --domain " +
@@ -206,13 +212,7 @@ std::vector<pid_t> workers_of(pid_t agent) {
   return pids;
 }
 
-TEST(PmuctlAgent, ACallThatWaitsForASilentAircraftHoldsUpNoOtherAndADeadWorkerIsReplaced) {
-  const int domain = pmu::test::exclusive_dds_domain();
-  Uav1 uav1(domain);
-  TempDir dir;
-  const std::string socket = dir.path() + "/agent.sock", log = dir.path() + "/agent.log";
-  auto agent = start_agent(domain, socket, log);
-  ASSERT_TRUE(wait_for_socket(socket)) << read_file(log);
+TEST_F(PmuctlAgentWithUav1, ACallThatWaitsForASilentAircraftHoldsUpNoOtherAndADeadWorkerIsReplaced) {
   const std::string p = "PMU_AGENT_SOCKET=" + socket + " " + PMUCTL_PATH + " --domain " + std::to_string(domain) + " ";
   bool served = false;
   for (int attempt = 0; attempt < 10 && !served; ++attempt)
