@@ -68,6 +68,8 @@ diagnose() {
   log "diag: ground link: $(tc -s qdisc show dev "$(port_of gnd)" 2>&1 | tr '\n' ' ' | cut -c1-300)"
   log "diag: gnd side: $(on gnd /usr/sbin/tc -s qdisc show dev eth0 2>&1 | tr '\n' ' ' | cut -c1-300)"
   log "diag: processes: $(for p in $(cat "$WORK/pids" 2>/dev/null); do alive "$p" && printf '%s ' "$p:$(tr '\0' ' ' <"/proc/$p/cmdline" | cut -c1-50)"; done)"
+  # A capture's phases up to the failure.
+  [ -z "${CAPTURE_PID:-}" ] || { capture_mark failed "$(now)"; capture_report; }
 }
 
 # busy and total jiffies of the whole VM
@@ -801,8 +803,54 @@ check_gaps() {
 }
 
 # shellcheck disable=SC2046,SC2086 # `set -- $(...)` splits figures into fields on purpose
+# ---- a capture of the ground link (run_vm_tests.sh --capture, pmu.capture=1) -------------
+# tcpdump on the ground link's near end; the scenario marks its phases, and the report gives
+# each phase's bytes by direction and kind: "to-DS" (to the Discovery Server's port), "disc"
+# (other discovery: a participant's metatraffic ports, even offsets), "user" (user data, odd
+# offsets), "frag" (IP fragments after the first, which carry no port).
+capture_on() { grep -q 'pmu\.capture=1' /proc/cmdline; }
+capture_start() {
+  capture_on || return 0
+  : >"$WORK/$SCEN.marks"
+  # Wall-clock seconds of uptime 0: tcpdump stamps packets with the wall clock, the marks are
+  # uptimes (1 s resolution: busybox's date has no %N).
+  CAPTURE_EPOCH=$(calc "$(date +%s) - $(now)")
+  tcpdump -i "$(port_of gnd)" -nn -Z root -s 96 -w "$WORK/$SCEN.pcap" 2>"$WORK/$SCEN.tcpdump.err" &
+  CAPTURE_PID=$!
+  track "$CAPTURE_PID"
+}
+capture_mark() { ! capture_on || echo "$1 $(calc "$2 + $CAPTURE_EPOCH")" >>"$WORK/$SCEN.marks"; }
+capture_report() {
+  capture_on || return 0
+  kill "$CAPTURE_PID" 2>/dev/null; wait "$CAPTURE_PID" 2>/dev/null
+  tcpdump -r "$WORK/$SCEN.pcap" -Z root -nn -tt 2>"$WORK/$SCEN.tcpdump-r.err" | awk -v gnd="$(addr_of gnd)" -v ds="$DS_PORT" -v marks="$WORK/$SCEN.marks" '
+    BEGIN { while ((getline l < marks) > 0) { split(l, m, " "); n++; name[n] = m[1]; at[n] = m[2] } }
+    $2 == "IP" {
+      t = $1; for (i = n; i >= 1 && at[i] > t; i--) ; if (i < 1) next
+      dst = $5; sub(/:$/, "", dst)
+      nd = split(dst, d, "."); dip = d[1] "." d[2] "." d[3] "." d[4]
+      dir = (dip == gnd) ? "to-gnd" : "to-air"
+      len = ($NF ~ /^[0-9]+$/) ? $NF + 28 : 1500   # a fragment shows no length: taken as full
+      if (nd < 5) kind = "frag"
+      else if (d[5] == ds) kind = "to-DS"
+      else kind = ((d[5] - 7400) % 250) % 2 ? "user" : "disc"
+      k = i SUBSEP dir SUBSEP kind; bytes[k] += len; pkts[k]++
+    }
+    END {
+      for (i = 1; i < n; i++) {
+        dur = at[i + 1] - at[i]; if (dur <= 0) dur = 1
+        for (k in bytes) {
+          split(k, f, SUBSEP); if (f[1] != i) continue
+          printf "CAPTURE %s..%s %.0f s %s %s %d B %.1f kbit/s %d packets\n", name[i], name[i + 1], dur, f[2], f[3], bytes[k], bytes[k] * 8 / 1000 / dur, pkts[k]
+        }
+      }
+    }'
+}
+
 scenario_fleet8() {
   t_start=$(now)
+  capture_start
+  capture_mark start "$t_start"
   set -- $(vm_ticks); vb0=$1 vt0=$2; l0=$(link_bytes)
   multicast_flood off || fail "cannot stop multicast flooding on the bridge"
   $NETNS_EXEC gnd fast-discovery-server -i 0 -l "$(addr_of gnd)" -p "$DS_PORT" -x /etc/pmu-dds/discovery-server.xml \
@@ -819,12 +867,14 @@ scenario_fleet8() {
   for i in $FLEET_NUMS; do start_aircraft "$i"; done
   wait_until 60 fleet_ready || fail "not every service ready within 60 s of the start: $(for i in $FLEET_STARTED; do grep -q 'ready on DDS' "$(fleet_log "$i")" || printf 'uav%s ' "$i"; done)"
   t_ready=$(now)
+  capture_mark ready "$t_ready"
   detail "8 services (uav1-4 in mc1, uav5-8 in mc2), clients of the Discovery Server in gnd, multicast stopped; all ready $(calc "$t_ready - $t_start") s after the start"
 
   # Discovery: the ground's first call, and calls after it until one lists the eight.
   l1=$(link_bytes)
   list_all "$t_ready" "$FLEET_LIST_LIMIT" || fail "gnd: no pmuctl list showed all eight within $FLEET_LIST_LIMIT s of the first call ($LIST_CALLS calls; the last listed: '$SEEN'; $(tail -n1 "$WORK/$SCEN.list.err")); ground link: $(link_backlog) packets queued (toward gnd, toward the aircraft)"
   t_listed=$LISTED_AT
+  capture_mark listed "$t_listed"
   took=$(calc "$t_listed - $t_ready")
   set -- $l1 $(link_bytes)
   detail "gnd lists uav1..uav8 (sim0/1 each) $took s after its first pmuctl list ($LIST_CALLS calls; bound $FLEET_LIST_BOUND s); meanwhile the ground link carried $(calc "($3 - $1) * 8 / 1000 / $took") kbit/s to gnd, $(calc "($4 - $2) * 8 / 1000 / $took") kbit/s to the aircraft (cap 250)"
@@ -838,6 +888,7 @@ scenario_fleet8() {
   r_p50=$2 r_p99=$3 r_max=$4
   check_executed_once round
   t_round=$(now)
+  capture_mark round "$t_round"
   detail "command round, one pmuctl config set to each of the eight in turn: all COMPLETED, each executed once by its own vehicle (audit trails); pmuctl start to exit min $1 s, p50 $r_p50 s, p99 = max $r_p99 s (bound $FLEET_COMMAND_BOUND s); $(resends_answered) resends answered again, not executed"
   true_that "$r_p99 <= $FLEET_COMMAND_BOUND" || missed "command round p99 $r_p99 s (each: $(awk '{ printf "%s %.2f s, ", $1, $3 - $2 }' "$WORK/$SCEN.round.cmds" | sed 's/, $//'); bound $FLEET_COMMAND_BOUND s)"
 
@@ -845,6 +896,7 @@ scenario_fleet8() {
   # Server set-up's (clients 60 s, the server 90 s), which it must ride through.
   set_link_loss 100%
   T_CUT=$(now)
+  capture_mark cut "$T_CUT"
   restore_after "$CUT_SECONDS"
   sleep_until "$(calc "$T_CUT + 21")"
   o=$(ctl gnd --timeout 5 list 2>/dev/null | grep -c '"vehicle":"uav')
@@ -853,6 +905,8 @@ scenario_fleet8() {
   detail "ground link cut (netem loss 100 % both ways) for $(calc "$T_UP - $T_CUT") s; 21 s into it gnd listed no aircraft"
   list_all "$T_UP" "$FLEET_LIST_LIMIT" || fail "after the restore: no pmuctl list showed all eight within $FLEET_LIST_LIMIT s ($LIST_CALLS calls; the last listed: '$SEEN'); ground link: $(link_backlog) packets queued (toward gnd, toward the aircraft)"
   relisted=$(calc "$LISTED_AT - $T_UP")
+  capture_mark restored "$T_UP"
+  capture_mark relisted "$LISTED_AT"
   detail "after the restore: all eight listed again after $relisted s ($LIST_CALLS calls)"
   # Then a command to each at once: the operator checking the whole fleet is back.
   : >"$WORK/$SCEN.after.cmds"
@@ -862,6 +916,7 @@ scenario_fleet8() {
   check_round after
   last=$(awk '{ if ($3 > m) m = $3 } END { print m }' "$WORK/$SCEN.after.cmds")
   back=$(calc "$last - $T_UP")
+  capture_mark commanded "$last"
   set -- $(awk '{ print $3 - $2 }' "$WORK/$SCEN.after.cmds" | rank_stats)
   check_executed_once round after
   detail "after the restore: a command to each (all eight at once, after that list) COMPLETED by $back s (bound $FLEET_RESUME_BOUND s; each pmuctl p50 $2 s, max $4 s); no command of either round executed twice or by another vehicle"
@@ -873,6 +928,7 @@ scenario_fleet8() {
   # shellcheck disable=SC2086 # FLEET_NAMES is a word list
   wait_until 30 stream_has_all fleet "$tw" $FLEET_NAMES || fail "gnd: watch --low-rate got no sample of every aircraft within 30 s ($(stream_gaps fleet "$tw" "$(now)" $FLEET_NAMES | tr '\n' ';'))"
   t_join=$(now)
+  capture_mark join "$t_join"
   start_aircraft 9
   wait_until 40 stream_has_all fleet "$t_join" uav9 || fail "gnd: no telemetry of uav9 within 40 s of its start ($(tail -n1 "$(fleet_log 9)"))"
   t9=$(stream_between fleet "$t_join" | grep -m1 '"vehicle":"uav9"' | cut -d' ' -f1)
@@ -881,6 +937,7 @@ scenario_fleet8() {
   kill "$FLEET_PID_8"; wait "$FLEET_PID_8" 2>/dev/null
   sleep_until "$(calc "$t_leave + 15")"
   t_end=$(now)
+  capture_mark end "$t_end"
   check_gaps "while uav9 joined and uav8 left" fleet "$t_join" "$t_end" uav1 uav2 uav3 uav4 uav5 uav6 uav7
   others=$GAPS
   check_gaps "uav8 before it left" fleet "$t_join" "$t_leave" uav8
@@ -896,6 +953,7 @@ scenario_fleet8() {
   all=$(since "$t_start")
   set -- $l0 $l1
   detail "scenario $all s: start-up $(calc "$t_ready - $t_start"), discovery $took, command round $(calc "$t_round - $t_listed"), cut and recovery $(calc "$last - $t_round"), join and leave $(calc "$t_end - $last"), checks $(calc "$(now) - $t_end") s; VM CPUs $(calc "100 * ($vb1 - $vb0) / ($vt1 - $vt0)") % busy; ground link $(calc "($3 - $1) * 8 / 1000 / $all") kbit/s to gnd, $(calc "($4 - $2) * 8 / 1000 / $all") kbit/s to the aircraft on average (cap 250)"
+  capture_report
   [ -z "$MISSED" ] || fail "time bounds missed: $MISSED"
 }
 

@@ -10,6 +10,10 @@
 #
 #   run_vm_tests.sh [--suite system|lab] [--build-dir DIR] [--source-dir DIR] [--scenario NAME]...
 #                   [--list] [--timeout S] [--log FILE] [--keep] [--verbose] [--service-log-level L]
+#                   [--capture]
+# --capture (lab): tcpdump on the ground link during the fleet8 scenario, which then prints on
+# the console (lines "CAPTURE ...") the link's bytes in each of its phases, by direction and by
+# kind (discovery, user data, to the Discovery Server). Needs tcpdump on this machine.
 #
 # Exit status: 0 when every scenario passed (a SKIP is allowed only for a scenario that
 # waits for a pmuctl verb not written yet), 1 when a scenario failed or did not report,
@@ -29,6 +33,7 @@ log_file=""
 keep=0
 verbose=0
 service_log=""
+capture=0
 # Scenarios that may report SKIP without failing the run: they wait for a feature that is
 # still being written and turn on by themselves once it exists.
 skip_allowed=" commands_candump "
@@ -41,7 +46,7 @@ note() { echo "run_vm_tests: $*" >&2; }
 . "$(dirname "${BASH_SOURCE[0]}")/vm_host_lib.sh"
 
 usage() {
-  sed -n '2,16p' "${BASH_SOURCE[0]}" | sed 's/^# \{0,1\}//'
+  sed -n '2,20p' "${BASH_SOURCE[0]}" | sed 's/^# \{0,1\}//'
   exit "${1:-0}"
 }
 
@@ -56,6 +61,7 @@ while [ $# -gt 0 ]; do
     --keep) keep=1; shift ;;
     --verbose) verbose=1; shift ;;
     --service-log-level) service_log=$2; shift 2 ;;
+    --capture) capture=1; shift ;;
     --list) list_only=1; shift ;;
     -h|--help) usage 0 ;;
     *) echo "run_vm_tests: unknown argument '$1'" >&2; usage 2 ;;
@@ -136,6 +142,12 @@ if [ "$suite" = lab ]; then
   ds_bin=$(command -v fast-discovery-server || true)
   [ -n "$ds_bin" ] || die "the lab needs fast-discovery-server (scripts/setup.sh installs fastdds-tools)"
   command -v openssl >/dev/null || die "the lab needs openssl for its DDS-Security PKI (scripts/setup.sh installs it)"
+fi
+tcpdump_bin=""
+if [ "$capture" = 1 ]; then
+  [ "$suite" = lab ] || die "--capture is for the lab suite"
+  tcpdump_bin=$(command -v tcpdump || true)
+  [ -n "$tcpdump_bin" ] || die "--capture needs tcpdump (apt-get install tcpdump)"
 fi
 
 find_binary() {  # NAME EXPECTED-RELATIVE-PATH
@@ -327,6 +339,7 @@ else
   rm -f "$root/bin/tc"
   mkdir -p "$root/$tc_lib" && cp "$tc_lib"/*.dist "$root/$tc_lib/"
   copy_with_libs "$ds_bin" usr/bin/fast-discovery-server
+  [ -z "$tcpdump_bin" ] || copy_with_libs "$tcpdump_bin" usr/sbin/tcpdump
   # The security scenario's PKI, made fresh for every run (valid two days, every lab domain).
   "$source_dir/deploy/security/make_pki.sh" "$root/etc/pmu-dds/pki" --domain 0-232 --days 2 >"$work/pki.log" 2>&1 ||
     die "make_pki.sh failed: $(tail -n3 "$work/pki.log")"
@@ -403,6 +416,7 @@ mkdir -p "$(dirname "$log_file")"
 : >"$log_file"
 append="console=ttyS0 quiet panic=-1 pmu.scenarios=$(IFS=,; echo "${scenarios[*]}")"
 [ -n "$service_log" ] && append+=" pmu.service_log=$service_log"
+[ "$capture" = 1 ] && append+=" pmu.capture=1"
 note "booting qemu (TCG, timeout ${vm_timeout}s), console log: $log_file"
 boot_start=$(date +%s.%N)
 set +e
