@@ -192,8 +192,7 @@ DataWriter* DdsContext::make_writer(Publisher& publisher, Topic& topic, const st
   const DataWriterQos q = w->get_qos();
   if (const auto s = capacity_shortfall(profile, EndpointKind::Writer, q.resource_limits(), q.history()); !s.empty()) {
     publisher.delete_datawriter(w);
-    throw DdsError(qos_file_ + ": <data_writer profile_name=\"" + profile + "\"> (" + topic.get_name() + "): " + s +
-                   ": raise its <resourceLimitsQos> (deploy/qos.xml says how each number is derived)");
+    too_small(topic.get_name(), profile, true, s);
   }
   return w;
 }
@@ -211,8 +210,7 @@ DataReader* DdsContext::make_reader(Subscriber& subscriber, Topic& topic, const 
   const DataReaderQos q = r->get_qos();
   if (const auto s = capacity_shortfall(profile, EndpointKind::Reader, q.resource_limits(), q.history()); !s.empty()) {
     subscriber.delete_datareader(r);
-    throw DdsError(qos_file_ + ": <data_reader profile_name=\"" + profile + "\"> (" + topic.get_name() + "): " + s +
-                   ": raise its <resourceLimitsQos> (deploy/qos.xml says how each number is derived)");
+    too_small(topic.get_name(), profile, false, s);
   }
   return r;
 }
@@ -326,6 +324,13 @@ DataWriter& DdsContext::default_partition_writer(Topic& topic, const DataWriterQ
     throw DdsError(what + " (DDS-Security: this identity's permissions may not allow publishing it there)");
   }
   return *w;
+}
+
+void DdsContext::too_small(const std::string& topic, const std::string& profile, bool publish,
+                           const std::string& shortfall) const {
+  throw DdsError(qos_file_ + ": <" + (publish ? "data_writer" : "data_reader") + " profile_name=\"" + profile + "\"> (" +
+                 topic + "): " + shortfall +
+                 ": raise its <resourceLimitsQos> (deploy/qos.xml says how each number is derived)");
 }
 
 void DdsContext::refused(const std::string& topic, const std::string& profile, bool publish) const {

@@ -192,6 +192,10 @@ class DdsContext {
                                                   eprosima::fastdds::dds::DataReaderListener* listener);
   // Throws the DdsError for an endpoint Fast DDS refused ("cannot create a writer for ...").
   [[noreturn]] void refused(const std::string& topic, const std::string& profile, bool publish) const;
+  // Throws the DdsError for an endpoint whose profile cannot hold what its topic needs
+  // (`shortfall`, from capacity_shortfall), naming the profile in the QoS file.
+  [[noreturn]] void too_small(const std::string& topic, const std::string& profile, bool publish,
+                              const std::string& shortfall) const;
 
   int domain_;
   int contract_;
