@@ -2,6 +2,7 @@
 
 #include <cstdlib>
 #include <filesystem>
+#include <string_view>
 
 namespace pmu::bench {
 
@@ -15,17 +16,16 @@ std::set<int> domains_with_shm_ports(const std::string& shm_dir) {
     // fastrtps_port<N>, fastrtps_port<N>_el, fastrtps_port<N>_sl
     char* end = nullptr;
     const long port = std::strtol(name.c_str() + prefix.size(), &end, 10);
-    if (end == name.c_str() + prefix.size() || port < 7400) continue;
-    found.insert(static_cast<int>((port - 7400) / 250));
+    if (end == name.c_str() + prefix.size() || port < first_port(0)) continue;
+    found.insert(static_cast<int>((port - first_port(0)) / (first_port(1) - first_port(0))));
   }
   return found;
 }
 
-int free_domain_base(int start, const std::set<int>& taken) {
-  constexpr int bases = (kDomainLast - kDomainFirst + 1) / kDomainsPerRun;
-  const int first = start < kDomainFirst ? 0 : (start - kDomainFirst) / kDomainsPerRun;
-  for (int i = 0; i < bases; ++i) {
-    const int base = kDomainFirst + ((first + i) % bases) * kDomainsPerRun;
+int free_domain_base(unsigned spread, const std::set<int>& taken) {
+  constexpr unsigned bases = (kDomainLast - kDomainFirst + 1) / kDomainsPerRun;
+  for (unsigned i = 0; i < bases; ++i) {
+    const int base = kDomainFirst + static_cast<int>((spread + i) % bases) * kDomainsPerRun;
     bool free = true;
     for (int d = base; d < base + kDomainsPerRun; ++d) free = free && taken.count(d) == 0;
     if (free) return base;

@@ -13,11 +13,15 @@ inline constexpr int kDomainFirst = 150;  // pmu_bench's range, not handed to te
 inline constexpr int kDomainLast = 229;   // (tests/support/domain.hpp)
 inline constexpr int kDomainsPerRun = 4;
 
+// Fast DDS's default port mapping: a domain's ports are first_port .. first_port + 249.
+constexpr int first_port(int domain) { return 7400 + 250 * domain; }
+
 // The domains that have a Fast DDS shared-memory port file in `shm_dir`.
 std::set<int> domains_with_shm_ports(const std::string& shm_dir);
 
-// The first base, from `start` on and wrapping round the range, whose kDomainsPerRun domains
-// are none of `taken`; -1 when every base has one.
-int free_domain_base(int start, const std::set<int>& taken);
+// The first base whose kDomainsPerRun domains are none of `taken`, searching the range's bases
+// from the one `spread` (any number, e.g. the pid) picks and wrapping round; -1 when every
+// base has one. Runs at once with different spreads start at different bases.
+int free_domain_base(unsigned spread, const std::set<int>& taken);
 
 }  // namespace pmu::bench

@@ -73,7 +73,7 @@ int main(int argc, char** argv) {
     const std::set<int> taken = domains_with_shm_ports("/dev/shm");
     if (s.domain_base < 0) {
       // The pid spreads runs at once over the range; each skips the domains the others hold.
-      s.domain_base = free_domain_base(kDomainFirst + static_cast<int>(::getpid() % 20) * kDomainsPerRun, taken);
+      s.domain_base = free_domain_base(static_cast<unsigned>(::getpid()), taken);
       if (s.domain_base < 0)
         throw std::runtime_error("every four domains of " + std::to_string(kDomainFirst) + ".." +
                                  std::to_string(kDomainLast) +
@@ -85,7 +85,7 @@ int main(int argc, char** argv) {
           std::fprintf(stderr,
                        "pmu_bench: domain %d has a Fast DDS shared-memory port in /dev/shm (port %d..%d): another "
                        "run, or one left by a killed process, which can keep SHM participants from matching\n",
-                       d, 7400 + 250 * d, 7400 + 250 * d + 249);
+                       d, first_port(d), first_port(d + 1) - 1);
     }
     std::fprintf(stderr, "pmu_bench: DDS domains %d..%d\n", s.domain_base, s.domain_base + kDomainsPerRun - 1);
     s.self_exe = std::filesystem::read_symlink("/proc/self/exe").string();
