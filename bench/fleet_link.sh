@@ -4,7 +4,7 @@
 #
 #   bench/fleet_link.sh [--aircraft "1 4 8"] [--rate 250kbit] [--build-dir DIR] [--qos FILE]
 #                       [--pmuctl BIN] [--service BIN] [--discovery-server [--server-xml FILE|none]]
-#                       [--cut SECONDS] [--agent] [--json FILE] [--keep DIR [--capture]]
+#                       [--cut SECONDS] [--agent] [--loss PERCENT] [--json FILE] [--keep DIR [--capture]]
 #
 # Two network namespaces joined by one veth pair, shaped by tbf to RATE each way (a radio
 # modem's queue of about 2 s; no delay or loss: the VM lab adds those): in `air`, N pmu-service
@@ -30,6 +30,8 @@
 # --agent: the ground's pmuctl calls go through one `pmuctl agent`, started in `gnd` after the
 # idle step (so its first call, the list, pays for its participants' discovery); watch is
 # never served by an agent and runs on its own as before. Without it, calls run on their own.
+# --loss PERCENT: each namespace drops that share of the packets it sends on the veth, at
+# random (nftables; the VM lab's netem also delays, which a namespace here cannot).
 # --keep DIR: the run's logs (services, agent, calls) are copied to DIR at the end; with
 # --capture also a packet capture of the ground interface per fleet size (link-N.pcap, the
 # first 256 bytes of each packet) and when each step began (steps-N: its name, uptime and
@@ -52,6 +54,7 @@ cut_s=30
 agent=0
 keep=""
 capture=0
+loss=0
 while [ $# -gt 0 ]; do
   case "$1" in
     --aircraft) aircraft=$2; shift 2 ;;
@@ -65,6 +68,7 @@ while [ $# -gt 0 ]; do
     --server-xml) server_xml=$2; [ "$2" = none ] || server_xml=$(realpath "$2"); shift 2 ;;
     --cut) cut_s=$2; shift 2 ;;
     --agent) agent=1; shift ;;
+    --loss) loss=$2; shift 2 ;;
     --keep) keep=$2; shift 2 ;;
     --capture) capture=1; shift ;;
     -h|--help) sed -n '2,38p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
@@ -72,6 +76,8 @@ while [ $# -gt 0 ]; do
   esac
 done
 [ "$capture" = 0 ] || [ -n "$keep" ] || { echo "fleet_link.sh: --capture needs --keep DIR" >&2; exit 2; }
+case "$loss" in '' | *[!0-9]* ) echo "fleet_link.sh: --loss takes a whole percentage, 0..99 (got '$loss')" >&2; exit 2 ;; esac
+[ "$loss" -lt 100 ] || { echo "fleet_link.sh: --loss takes a whole percentage, 0..99 (got '$loss')" >&2; exit 2; }
 case "$cut_s" in '' | *[!0-9]* | 0) echo "fleet_link.sh: --cut takes whole seconds, at least 1 (got '$cut_s')" >&2; exit 2 ;; esac
 for n in $aircraft; do
   case "$n" in '' | *[!0-9]* | 0) echo "fleet_link.sh: --aircraft takes counts of at least 1 (got '$n')" >&2; exit 2 ;; esac
@@ -117,6 +123,12 @@ link_up() {
     ip -n "$ns" route add default dev "$dev"  # SPDP multicast leaves here
     # A radio modem's queue: about 2 s at 250 kbit/s.
     ip netns exec "$ns" tc qdisc add dev "$dev" root tbf rate "$rate" burst 3000 limit 64000
+    if [ "$loss" -gt 0 ]; then
+      ip netns exec "$ns" nft add table inet lossy &&
+        ip netns exec "$ns" nft add chain inet lossy out '{ type filter hook output priority 0; }' &&
+        ip netns exec "$ns" nft add rule inet lossy out oifname "$dev" numgen random mod 100 '<' "$loss" drop ||
+        { echo "fleet_link.sh: --loss needs nftables (nft) in this kernel" >&2; exit 2; }
+    fi
   done
   if [ "$capture" = 1 ]; then
     ip netns exec "$gnd" tcpdump -i gnd0 -s 256 -w "$work/link-$1.pcap" >/dev/null 2>&1 &
@@ -318,13 +330,13 @@ EOF
   wait 2>/dev/null || true
 done
 
-ROWS=$(printf '%s\n' "${rows[@]}") DS_ROWS=$(printf '%s\n' "${ds_rows[@]}") python3 - "$rate" "$json_out" "$qos" "$ctl" "$ds" "$svc" "$server_xml" "$cut_s" "$agent" <<'PY'
+ROWS=$(printf '%s\n' "${rows[@]}") DS_ROWS=$(printf '%s\n' "${ds_rows[@]}") python3 - "$rate" "$json_out" "$qos" "$ctl" "$ds" "$svc" "$server_xml" "$cut_s" "$agent" "$loss" <<'PY'
 import json, os, re, sys
-rate, json_out, qos, ctl, ds, svc, server_xml, cut_s, agent = sys.argv[1:10]
+rate, json_out, qos, ctl, ds, svc, server_xml, cut_s, agent, loss = sys.argv[1:11]
 m = re.match(r"(\d+)kbit", rate)
 cap = int(m.group(1)) * 1000 / 8 if m else None
 out = []
-print(f"fleet over a {rate} link (tbf each way){', Discovery Server on the ground (' + server_xml + ')' if ds == '1' else ''}{'; the calls through pmuctl agent' if agent == '1' else ''}; qos {qos}; pmuctl {ctl}; pmu-service {svc}")
+print(f"fleet over a {rate} link (tbf each way{', ' + loss + ' % loss' if loss != '0' else ''}){', Discovery Server on the ground (' + server_xml + ')' if ds == '1' else ''}{'; the calls through pmuctl agent' if agent == '1' else ''}; qos {qos}; pmuctl {ctl}; pmu-service {svc}")
 print("| aircraft | idle B/s | list: bytes, s, listed | command: bytes, s, result | watch --low-rate B/s (samples/s) | low-rate watch / one way's capacity | queue drops: from the list on / in the watch's 10 s |")
 print("|---|---|---|---|---|---|---|")
 for line in os.environ["ROWS"].splitlines():
@@ -358,7 +370,7 @@ if ds == "1":
                        executions=int(execs), commands=int(cmds), resends_answered=int(dupes), executed_wrongly=int(bad))
 if json_out:
     with open(json_out, "w") as fh:
-        json.dump({"rate": rate, "qos": qos, "pmuctl": ctl, "pmu_service": svc, "discovery_server": ds == "1",
+        json.dump({"rate": rate, "loss_percent": int(loss), "qos": qos, "pmuctl": ctl, "pmu_service": svc, "discovery_server": ds == "1",
                    "server_xml": server_xml if ds == "1" else None, "rows": out}, fh, indent=1)
 if failed:
     print(f"fleet_link.sh: {failed} command(s) executed twice or by another vehicle", file=sys.stderr)

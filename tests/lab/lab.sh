@@ -815,7 +815,7 @@ capture_start() {
   # Wall-clock seconds of uptime 0: tcpdump stamps packets with the wall clock, the marks are
   # uptimes (1 s resolution: busybox's date has no %N).
   CAPTURE_EPOCH=$(calc "$(date +%s) - $(now)")
-  tcpdump -i "$(port_of gnd)" -nn -Z root -s 96 -w "$WORK/$SCEN.pcap" 2>"$WORK/$SCEN.tcpdump.err" &
+  tcpdump -i "$(port_of gnd)" -nn -Z root -s 128 -w "$WORK/$SCEN.pcap" 2>"$WORK/$SCEN.tcpdump.err" &
   CAPTURE_PID=$!
   track "$CAPTURE_PID"
 }
@@ -842,6 +842,62 @@ capture_report() {
         for (k in bytes) {
           split(k, f, SUBSEP); if (f[1] != i) continue
           printf "CAPTURE %s..%s %.0f s %s %s %d B %.1f kbit/s %d packets\n", name[i], name[i + 1], dur, f[2], f[3], bytes[k], bytes[k] * 8 / 1000 / dur, pkts[k]
+        }
+      }
+    }'
+  capture_kinds
+}
+# The same capture by what the RTPS messages carry: who sent them (the Discovery Server,
+# whose GUID prefix is 44.53.00.5f..., or another participant) and the first DATA,
+# DATA_FRAG, HEARTBEAT, ACKNACK or GAP submessage's writer (builtin participant, endpoint or
+# liveliness discovery, or user data). One CAPTURE-KIND line per phase, direction and kind
+# among the six largest.
+capture_kinds() {
+  tcpdump -r "$WORK/$SCEN.pcap" -Z root -nn -tt -x 2>/dev/null | awk -v gnd="$(addr_of gnd)" -v marks="$WORK/$SCEN.marks" '
+    function hexval(h,   i, v) { v = 0; for (i = 1; i <= length(h); i++) v = v * 16 + index("0123456789abcdef", substr(h, i, 1)) - 1; return v }
+    function byte(o) { return substr(hx, o * 2 + 1, 2) }
+    function le16(o) { return hexval(byte(o + 1) byte(o)) }
+    function flush(   o, id, fl, len, w, ent, k, what, who) {
+      if (t == "") return
+      for (i = n; i >= 1 && at[i] > t; i--) ; if (i < 1) { t = ""; return }
+      who = (substr(hx, 73, 8) == "4453005f") ? "DS" : "peer"
+      what = "other"; o = 48
+      while (o + 4 <= length(hx) / 2) {
+        id = byte(o); fl = hexval(byte(o + 1)); len = (fl % 2) ? le16(o + 2) : hexval(byte(o + 2) byte(o + 3))
+        w = ""
+        if (id == "15" || id == "16") { w = byte(o + 12) byte(o + 13) byte(o + 14) byte(o + 15); what = (id == "15") ? "DATA" : "FRAG" }
+        else if (id == "07" || id == "06" || id == "08") { w = byte(o + 8) byte(o + 9) byte(o + 10) byte(o + 11); what = (id == "07") ? "HB" : (id == "06") ? "ACKNACK" : "GAP" }
+        if (what != "other") break
+        if (len == 0) break
+        o += 4 + len
+      }
+      ent = "user"
+      if (w ~ /^000100/) ent = "PDP"; else if (w ~ /^00000[34]/) ent = "EDP"; else if (w ~ /^000200/) ent = "WLP"; else if (w == "") ent = "?"
+      k = i SUBSEP dir SUBSEP who " " ent " " what; bytes[k] += len0; pkts[k]++
+      t = ""
+    }
+    BEGIN { while ((getline l < marks) > 0) { split(l, m, " "); n++; name[n] = m[1]; at[n] = m[2] } }
+    /^[0-9]/ {
+      flush()
+      if ($2 != "IP") next
+      t = $1; dst = $5; sub(/:$/, "", dst); split(dst, d, ".")
+      dir = (d[1] "." d[2] "." d[3] "." d[4] == gnd) ? "to-gnd" : "to-air"
+      len0 = ($NF ~ /^[0-9]+$/) ? $NF + 28 : 1500; hx = ""; next
+    }
+    /^[ \t]+0x/ { for (j = 2; j <= NF; j++) hx = hx $j }
+    END {
+      flush()
+      for (i = 1; i < n; i++) {
+        dur = at[i + 1] - at[i]; if (dur <= 0) dur = 1
+        for (dd = 1; dd <= 2; dd++) {
+          dn = (dd == 1) ? "to-gnd" : "to-air"; c = 0; delete seen
+          while (c < 6) {
+            best = ""; bb = -1
+            for (k in bytes) { split(k, f, SUBSEP); if (f[1] != i || f[2] != dn || (k in seen)) continue; if (bytes[k] > bb) { bb = bytes[k]; best = k } }
+            if (best == "") break
+            seen[best] = 1; c++; split(best, f, SUBSEP)
+            printf "CAPTURE-KIND %s..%s %.0f s %s %s: %d B %.1f kbit/s %d packets\n", name[i], name[i + 1], dur, dn, f[3], bytes[best], bytes[best] * 8 / 1000 / dur, pkts[best]
+          }
         }
       }
     }'
