@@ -77,14 +77,15 @@ DomainParticipantQos participant_qos(const std::string& name, Transport transpor
     throw NetworkError("more than " + std::to_string(kMaxServers) + " Discovery Servers (server ids are 0..255)");
   auto udp = std::make_shared<UDPv4TransportDescriptor>();
   udp->interfaceWhiteList = network.interface_addresses;
+  udp->maxMessageSize = kUdpMaxMessageSize;
   auto& t = qos.transport();
   switch (transport) {
     case Transport::Default:
-      if (allowlist) {
-        t.use_builtin_transports = false;
-        t.user_transports.push_back(std::make_shared<SharedMemTransportDescriptor>());
-        t.user_transports.push_back(udp);
-      }
+      // Fast DDS's builtin pair, but with the UDPv4 transport that has the allowlist and the
+      // datagram size.
+      t.use_builtin_transports = false;
+      t.user_transports.push_back(std::make_shared<SharedMemTransportDescriptor>());
+      t.user_transports.push_back(udp);
       break;
     case Transport::UdpOnly:
       t.use_builtin_transports = false;
@@ -97,6 +98,7 @@ DomainParticipantQos participant_qos(const std::string& name, Transport transpor
   }
 
   auto& builtin = qos.wire_protocol().builtin;
+  builtin.use_WriterLivelinessProtocol = false;
   switch (network.mode) {
     case DiscoveryMode::Multicast:
       break;

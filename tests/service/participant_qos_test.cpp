@@ -65,13 +65,12 @@ ResolvedNetwork server(std::vector<ResolvedServer> servers) {
   return n;
 }
 
-TEST(ParticipantQos, MulticastIsFastDdsDefaultUntouched) {
+TEST(ParticipantQos, MulticastIsFastDdsDefaultDiscoveryUntouched) {
   const DomainParticipantQos q = participant_qos("pmu-service", Transport::Default, {}, {});
   const DomainParticipantQos fast_dds_default;
   EXPECT_EQ(q.name().to_string(), "pmu-service");
-  EXPECT_TRUE(q.wire_protocol() == fast_dds_default.wire_protocol());
-  EXPECT_TRUE(q.transport().use_builtin_transports);
-  EXPECT_TRUE(q.transport().user_transports.empty());
+  EXPECT_TRUE(q.wire_protocol().builtin.discovery_config == fast_dds_default.wire_protocol().builtin.discovery_config);
+  EXPECT_TRUE(q.wire_protocol().builtin.initialPeersList == fast_dds_default.wire_protocol().builtin.initialPeersList);
   EXPECT_EQ(q.wire_protocol().builtin.discovery_config.discoveryProtocol, DiscoveryProtocol_t::SIMPLE);
   EXPECT_TRUE(q.wire_protocol().builtin.metatrafficMulticastLocatorList.empty()) << "Fast DDS fills in its defaults";
   EXPECT_TRUE(q.properties() == fast_dds_default.properties()) << "no security";
@@ -92,9 +91,35 @@ TEST(ParticipantQos, UnicastSendsOnlyToPeersAndListensOnlyOnUnicast) {
   ASSERT_EQ(q.transport().user_transports.size(), 1u);
   ASSERT_NE(udp_of(q), nullptr);
   EXPECT_TRUE(udp_of(q)->interfaceWhiteList.empty());
-  // Default transports stay Fast DDS's builtin ones in unicast mode.
-  const auto d = participant_qos("x", Transport::Default, unicast({{"127.0.0.1", 0}}), {});
-  EXPECT_TRUE(d.transport().use_builtin_transports);
+}
+
+// Every endpoint has AUTOMATIC liveliness with an infinite lease, which needs no liveliness
+// messages; Fast DDS's writer liveliness protocol would still match a builtin writer and
+// reader with every participant discovered, whose handshake crossed a radio link once per
+// ground participant and aircraft.
+TEST(ParticipantQos, NoParticipantRunsTheWriterLivelinessProtocol) {
+  ResolvedNetwork allowlist;
+  allowlist.interface_addresses = {"127.0.0.1"};
+  for (const auto& network : {ResolvedNetwork{}, unicast({{"127.0.0.1", 0}}), server({{{{"10.0.0.1", 11811}}}}), allowlist})
+    EXPECT_FALSE(participant_qos("x", Transport::Default, network, {}).wire_protocol().builtin.use_WriterLivelinessProtocol);
+  EXPECT_TRUE(DomainParticipantQos().wire_protocol().builtin.use_WriterLivelinessProtocol) << "Fast DDS's default";
+}
+
+// Fast DDS's builtin UDPv4 sends datagrams of up to 65,500 bytes, which cross a radio link
+// as IP fragments: every participant has its own UDPv4 transport with the smaller size, in
+// every transport choice and discovery mode.
+TEST(ParticipantQos, EveryUdpTransportSendsDatagramsThatFitOnePacket) {
+  ResolvedNetwork allowlist;
+  allowlist.interface_addresses = {"192.168.10.1", "127.0.0.1"};
+  for (const auto& network : {ResolvedNetwork{}, unicast({{"127.0.0.1", 0}}), server({{{{"10.0.0.1", 11811}}}}), allowlist})
+    for (const auto transport : {Transport::Default, Transport::UdpOnly}) {
+      const DomainParticipantQos q = participant_qos("x", transport, network, {});
+      EXPECT_FALSE(q.transport().use_builtin_transports);
+      ASSERT_NE(udp_of(q), nullptr);
+      EXPECT_EQ(udp_of(q)->maxMessageSize, 1400u);
+      EXPECT_LE(udp_of(q)->maxMessageSize, 1500u - 20u - 8u) << "one packet on a 1,500-byte MTU";
+      EXPECT_EQ(has_shm(q), transport == Transport::Default) << "same-host traffic keeps shared memory";
+    }
 }
 
 TEST(ParticipantQos, ServerModeIsAClientOfEachServerByPositionWithFastddsDiscoveryPrefixes) {

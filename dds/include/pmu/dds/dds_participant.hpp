@@ -18,12 +18,12 @@
 //              and its locators; metatraffic as in unicast (no multicast); its lease
 //              kClientLease, announced every kClientAnnouncementPeriod (the servers'
 //              own periods are deploy/discovery-server.xml's).
+// Transports: always explicit ones (use_builtin_transports = false), since Fast DDS's builtin
+// UDPv4 can be given neither an allowlist nor a datagram size. Transport Default is shared
+// memory beside UDPv4, as Fast DDS's builtin pair; UdpOnly is UDPv4 alone. The UDPv4
+// transport's maxMessageSize is kUdpMaxMessageSize.
 // Interfaces (allowlist): the UDPv4 transport's interfaceWhiteList = the addresses
-// (127.0.0.1 always among them, see resolve_network), and the builtin transports are
-// replaced by explicit ones (use_builtin_transports = false): left on, Fast DDS would add
-// its own UDPv4 transport without the allowlist and use every interface anyway. Transport
-// Default keeps shared memory beside the restricted UDPv4 (same-host traffic, which never
-// reaches a network interface); UdpOnly has UDPv4 alone.
+// (127.0.0.1 always among them, see resolve_network); without one it uses every interface.
 // Security: the DDS-Security plugin properties when `security` is not empty, with multicast
 // and unicast discovery and with an allowlist.
 // Statistics: property `fastdds.statistics` = the topics joined by ';' when `statistics` is
@@ -34,6 +34,7 @@
 // says why); the config and pmuctl refuse these first, naming the line or the option.
 
 #include <fastdds/dds/domain/qos/DomainParticipantQos.hpp>
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -49,6 +50,16 @@ namespace pmu::dds {
 // do not always exchange their endpoints again (deploy/discovery-server.xml says more).
 inline const eprosima::fastrtps::Duration_t kClientLease{60, 0};
 inline const eprosima::fastrtps::Duration_t kClientAnnouncementPeriod{20, 0};
+
+// The largest datagram a participant sends (Fast DDS sends up to 65,500 bytes by default).
+// A datagram larger than the path's MTU leaves as IP fragments, and losing any one fragment
+// loses the whole datagram: on a radio link with 10 % loss a 10 kB datagram (7 fragments)
+// is lost half the time, and the reliable writer resends all of it, again as fragments, into
+// the same link. Under this size every datagram is one packet on a 1,500-byte MTU with room
+// for a tunnel's headers, and a sample larger than it goes as RTPS fragments (DATA_FRAG),
+// each acknowledged and resent on its own. Fast DDS applies the smallest size of a
+// participant's transports to all of them, so same-host shared memory fragments too.
+inline constexpr std::uint32_t kUdpMaxMessageSize = 1400;
 
 eprosima::fastdds::dds::DomainParticipantQos participant_qos(const std::string& name, Transport transport,
                                                              const ResolvedNetwork& network,
