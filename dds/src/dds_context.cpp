@@ -187,7 +187,20 @@ DataWriter& DdsContext::writer(Topic& topic, const std::string& profile, DataWri
 
 DataWriter* DdsContext::make_writer(Publisher& publisher, Topic& topic, const std::string& profile,
                                     DataWriterListener* listener) {
-  DataWriter* w = publisher.create_datawriter_with_profile(&topic, profile, listener);
+  DataWriter* w = nullptr;
+  DataWriterQos qos;
+  if (heartbeat_floor_.count() > 0 &&
+      publisher.get_datawriter_qos_from_profile(profile, qos) == ReturnCode_t::RETCODE_OK &&
+      qos.reliability().kind == eprosima::fastdds::dds::RELIABLE_RELIABILITY_QOS) {
+    const auto ns = std::chrono::duration_cast<std::chrono::nanoseconds>(heartbeat_floor_).count();
+    const eprosima::fastrtps::Duration_t floor(static_cast<std::int32_t>(ns / 1000000000),
+                                               static_cast<std::uint32_t>(ns % 1000000000));
+    auto& period = qos.reliable_writer_qos().times.heartbeatPeriod;
+    if (period < floor) period = floor;
+    w = publisher.create_datawriter(&topic, qos, listener);
+  } else {
+    w = publisher.create_datawriter_with_profile(&topic, profile, listener);
+  }
   if (!w) refused(topic.get_name(), profile, true);
   const DataWriterQos q = w->get_qos();
   if (const auto s = capacity_shortfall(profile, EndpointKind::Writer, q.resource_limits(), q.history()); !s.empty()) {

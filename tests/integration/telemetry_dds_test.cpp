@@ -141,6 +141,38 @@ TEST(DdsTelemetry, EveryTopicArrivesWithTheSimulatorsValuesAndFrameTimestamps) {
   ASSERT_TRUE(wait_sample(lr.health, hl, si, 10s));
 }
 
+// `link: round_trip` (config.hpp): the reliable writers made after heartbeat_at_least
+// heartbeat no more often than that; best-effort writers have no heartbeat to change, and a
+// context without it keeps qos.xml's periods.
+TEST(DdsWriters, ReliableWritersHeartbeatNoMoreOftenThanTheLinkAllows) {
+  const auto period_of = [](DataWriter& w) { return w.get_qos().reliable_writer_qos().times.heartbeatPeriod; };
+  dds::DdsContext plain(pmu::test::exclusive_dds_domain(), "", "heartbeat-plain");
+  const auto shipped =
+      period_of(plain.writer(plain.topic(topics::kHealth, TypeSupport(new pmu::v4::HealthPubSubType())), qos_profiles::kState));
+  ASSERT_LT(shipped, eprosima::fastrtps::Duration_t(0, 900000000)) << "qos.xml's state period is not below the floor tested";
+
+  dds::DdsContext radio(pmu::test::exclusive_dds_domain(), "", "heartbeat-radio");
+  radio.heartbeat_at_least(900ms);
+  auto& health =
+      radio.writer(radio.topic(topics::kHealth, TypeSupport(new pmu::v4::HealthPubSubType())), qos_profiles::kState);
+  EXPECT_EQ(period_of(health), eprosima::fastrtps::Duration_t(0, 900000000));
+  auto& replies = radio.writer(
+      radio.topic(topics::kCommandReply, TypeSupport(new pmu::v4::CommandReplyPubSubType())), qos_profiles::kCommand);
+  EXPECT_EQ(period_of(replies), eprosima::fastrtps::Duration_t(0, 900000000));
+  // The rest of the profile is the profile's.
+  EXPECT_EQ(health.get_qos().durability().kind, TRANSIENT_LOCAL_DURABILITY_QOS);
+  EXPECT_EQ(health.get_qos().history().depth, 1);
+  EXPECT_EQ(replies.get_qos().history().depth, 4096);
+  auto& voltages =
+      radio.writer(radio.topic(topics::kVoltages, TypeSupport(new pmu::v4::VoltagesPubSubType())), qos_profiles::kTelemetry);
+  EXPECT_EQ(voltages.get_qos().reliability().kind, BEST_EFFORT_RELIABILITY_QOS);
+  // A floor below the profile's period leaves it.
+  dds::DdsContext lan(pmu::test::exclusive_dds_domain(), "", "heartbeat-lan");
+  lan.heartbeat_at_least(1ms);
+  EXPECT_EQ(period_of(lan.writer(lan.topic(topics::kHealth, TypeSupport(new pmu::v4::HealthPubSubType())), qos_profiles::kState)),
+            shipped);
+}
+
 TEST(DdsTelemetry, RateFollowsThePacketPeriod) {
   dds::DdsContext service_side(pmu::test::exclusive_dds_domain(), "", "pmu-service-rate");
   DdsPublisher publisher(service_side, 3s);

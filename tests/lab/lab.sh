@@ -691,6 +691,9 @@ FLEET_GAP_BOUND=5       # s without a low-rate sample (one per packet a second) 
 # and the scenario goes on to measure the rest; it fails at its end when any bound was missed.
 FLEET_LIST_LIMIT=90
 FLEET_DS="$(addr_of gnd):$DS_PORT"
+# The ground link's round trip as an integrator would write it in each service's `link:`:
+# 300 ms each way with 50 ms of jitter (netem on both ends).
+FLEET_ROUND_TRIP=0.7
 FLEET_NUMS="1 2 3 4 5 6 7 8"
 FLEET_NAMES="uav1 uav2 uav3 uav4 uav5 uav6 uav7 uav8"
 
@@ -702,7 +705,9 @@ start_aircraft() {
   start_service "$(fleet_host "$1")" "vehicle: uav$1
 discovery:
   mode: server
-  servers: [\"$FLEET_DS\"]"
+  servers: [\"$FLEET_DS\"]
+link:
+  round_trip: $FLEET_ROUND_TRIP"
   eval "FLEET_LOG_$1=\$SVC_LOG FLEET_PID_$1=\$SVC_PID"
   FLEET_STARTED="$FLEET_STARTED $1"
 }

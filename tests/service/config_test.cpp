@@ -123,7 +123,7 @@ const BadCase kBad[] = {
     {"domain: 0\n", "bad.yaml:1: no buses: the service needs at least one bus"},
     {"domian: 0\nbuses: []\n",
      "bad.yaml:1: unknown key 'domian' in the top level (known: domain, vehicle, low_rate_period, qos_file, dds_transport, log_level, "
-     "buses, timeouts, policy, security, discovery, interfaces, canopen_publish_period, dds_statistics, dds_type_objects, also_serve_contract, ros2)"},
+     "buses, timeouts, policy, security, discovery, interfaces, canopen_publish_period, dds_statistics, dds_type_objects, also_serve_contract, ros2, link)"},
     {"domain: 0\nvehicle: uav*\nbuses: []\n",
      "bad.yaml:2: vehicle 'uav*' contains '*'; a vehicle name is letters, digits, '_', '-' and '.' (it is also a DDS "
      "partition name, where other characters are patterns)"},
@@ -702,6 +702,26 @@ TEST(ConfigTypeObjects, OffUnlessTrueAndRefusedAtItsLineWhenNotABoolean) {
       {"dds_type_objects: [true]\n", "bad.yaml:1: dds_type_objects must be true or false"},
   };
   for (const auto& c : bad) expect_refused(c.yaml + std::string(kBus), c.message);
+}
+
+// link (interface.md 4): the round trip of the link to the ground, which sets how often the
+// reliable writers may heartbeat; unset by default (qos.xml's periods).
+TEST(ConfigLink, RoundTripInSecondsOrUnset) {
+  EXPECT_FALSE(parse_config(kBus, "s.yaml").link_round_trip);
+  const auto c = parse_config(std::string("link:\n  round_trip: 0.6\n") + kBus, "s.yaml");
+  ASSERT_TRUE(c.link_round_trip);
+  EXPECT_EQ(*c.link_round_trip, std::chrono::milliseconds(600));
+  EXPECT_EQ(*parse_config(std::string("link: {round_trip: 2}\n") + kBus, "s.yaml").link_round_trip,
+            std::chrono::milliseconds(2000));
+  const BadCase bad[] = {
+      {"link: 0.6\n", "bad.yaml:1: link must be a map: {round_trip: SECONDS}"},
+      {"domain: 3\nlink: {}\n", "bad.yaml:2: link needs round_trip: the link's round trip in seconds, 0.001..30"},
+      {"link:\n  round_trip: 31\n", "bad.yaml:2: link round_trip 31 out of range 0..30"},
+      {"link:\n  round_trip: 0\n", "bad.yaml:2: link round_trip 0 is below 0.001 s"},
+      {"link:\n  round_trip: fast\n", "bad.yaml:2: link round_trip must be a number, not 'fast'"},
+      {"link:\n  rtt: 0.6\n", "bad.yaml:2: unknown key 'rtt' in link (known: round_trip)"},
+  };
+  for (const auto& b : bad) expect_refused(b.yaml + std::string(kBus), b.message);
 }
 
 // also_serve_contract (interface.md 10.3): unset by default; only the contract before this

@@ -423,6 +423,16 @@ void parse_ros2(const Ctx& c, const YAML::Node& n, Ros2Settings& r) {
   }
 }
 
+void parse_link(const Ctx& c, const YAML::Node& n, std::optional<std::chrono::milliseconds>& round_trip) {
+  if (!n.IsMap()) c.fail(n, "link must be a map: {round_trip: SECONDS}");
+  c.only_keys(n, "link", {"round_trip"});
+  const auto v = n["round_trip"];
+  if (!v) c.fail(n, "link needs round_trip: the link's round trip in seconds, 0.001..30");
+  const double s = c.number(v, "link round_trip", 0, 30);
+  if (s < 0.001) c.fail(v, "link round_trip " + v.Scalar() + " is below 0.001 s");
+  round_trip = std::chrono::milliseconds(std::lround(s * 1000));
+}
+
 void parse_policy(const Ctx& c, const YAML::Node& n, PolicyConfig& p) {
   c.only_keys(n, "policy", {"confirm", "deny", "rate_limit", "burst", "command_lifetime",
                                 "max_command_lifetime"});
@@ -694,7 +704,7 @@ Config parse_config(const std::string& text, const std::string& source, const Co
   c.only_keys(root, "the top level", {"domain", "vehicle", "low_rate_period", "qos_file", "dds_transport", "log_level",
                                       "buses", "timeouts", "policy", "security", "discovery", "interfaces",
                                       "canopen_publish_period", "dds_statistics", "dds_type_objects",
-                                      "also_serve_contract", "ros2"});
+                                      "also_serve_contract", "ros2", "link"});
   if (const auto v = root["domain"]) cfg.domain = static_cast<int>(c.integer(v, "domain", 0, 232));
   if (const auto v = root["vehicle"]) {
     // `vehicle:` with nothing after it is YAML null: the unnamed vehicle, like no key.
@@ -757,6 +767,7 @@ Config parse_config(const std::string& text, const std::string& source, const Co
   }
   if (const auto v = root["timeouts"]) parse_timeouts(c, v, cfg.timeouts);
   if (const auto v = root["ros2"]) parse_ros2(c, v, cfg.ros2);
+  if (const auto v = root["link"]) parse_link(c, v, cfg.link_round_trip);
   if (const auto v = root["policy"]) parse_policy(c, v, cfg.policy);
   for (const auto& kv : root)
     if (kv.first.as<std::string>() == "security") parse_security(c, kv.first, kv.second, cfg.security);

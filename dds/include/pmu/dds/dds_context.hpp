@@ -31,6 +31,7 @@
 #include <fastdds/dds/subscriber/Subscriber.hpp>
 #include <fastdds/dds/topic/Topic.hpp>
 #include <fastdds/dds/topic/TypeSupport.hpp>
+#include <chrono>
 #include <cstddef>
 #include <map>
 #include <optional>
@@ -133,6 +134,11 @@ class DdsContext {
   eprosima::fastdds::dds::DataReader& reader(eprosima::fastdds::dds::Topic& topic, const std::string& profile,
                                              eprosima::fastdds::dds::DataReaderListener* listener = nullptr);
 
+  // From now on, reliable writers heartbeat at most this often (their profile's period when
+  // that is longer): the service's `link: round_trip` (config.hpp says why). Call before the
+  // writers are made (a writer's period cannot change once it exists); the writers' thread.
+  void heartbeat_at_least(std::chrono::milliseconds period) noexcept { heartbeat_floor_ = period; }
+
   // A writer in the default partition with `qos` as given, not from qos.xml: for ROS 2's
   // topics (ros2_publisher.hpp), whose partition and QoS are what ROS 2 subscribers expect
   // rather than a tuning of this service. Throws DdsError like writer().
@@ -226,6 +232,7 @@ class DdsContext {
   };
   bool reuse_ = false;
   std::vector<std::string> idle_matched_;
+  std::chrono::milliseconds heartbeat_floor_{0};
   std::vector<Kept> kept_;
   eprosima::fastdds::dds::DataWriter* kept_writer(eprosima::fastdds::dds::Topic& topic, const std::string& profile);
   eprosima::fastdds::dds::DataReader* kept_reader(eprosima::fastdds::dds::Topic& topic, const std::string& profile);
