@@ -3,6 +3,7 @@
 #include <fcntl.h>
 #include <poll.h>
 #include <sys/file.h>
+#include <sys/mman.h>
 #include <sys/prctl.h>
 #include <sys/socket.h>
 #include <sys/stat.h>
@@ -10,7 +11,10 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <atomic>
+#include <cstdint>
+#include <new>
 #include <cerrno>
 #include <chrono>
 #include <csignal>
@@ -175,10 +179,38 @@ UniqueFd listen_at(const std::string& path, UniqueFd& lock) {
   return fd;
 }
 
+// When each worker began the call it is serving (steady clock, ns; 0: idle), in memory the
+// agent shares with its workers.
+using BusySince = std::atomic<std::int64_t>;
+static_assert(BusySince::is_always_lock_free, "shared between processes");
+BusySince* g_busy = nullptr;  // kMaxWorkers of them, mapped before the workers are forked
+constexpr int kMaxWorkers = 64;
+
+std::int64_t steady_ns() {
+  return std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now().time_since_epoch())
+      .count();
+}
+
+// Worker `index` takes a call only when every worker before it has been on its current call
+// for kSpillAfter: calls go to the first worker while it keeps up, so its endpoints, already
+// matched at the aircraft and holding the fleet's state (ContextPool), serve them, and each
+// further worker, whose first calls announce endpoints of its own to every aircraft, only
+// takes over from workers held up by an aircraft that does not answer.
+constexpr auto kSpillAfter = std::chrono::seconds(5);
+bool my_turn(int index) {
+  if (!g_busy) return true;
+  const std::int64_t now = steady_ns();
+  for (int j = 0; j < index; ++j) {
+    const std::int64_t since = g_busy[j].load();
+    if (since == 0 || now - since < std::chrono::nanoseconds(kSpillAfter).count()) return false;
+  }
+  return true;
+}
+
 // One worker: takes calls from the shared listening socket until a stop signal, one at a time,
 // with participants of its own. The socket is non-blocking: every idle worker wakes for a new
-// connection and the one whose accept() gets it serves it.
-void serve_calls(int listener, const GlobalOptions& settings, const AgentCallRunner& run) {
+// connection, and the one whose turn it is (my_turn) and whose accept() gets it serves it.
+void serve_calls(int listener, const GlobalOptions& settings, const AgentCallRunner& run, int index) {
   ContextPool pool(settings);
   // The participant from the start rather than at the worker's first call: the aircraft then
   // discover every worker's participant at once, and no call waits for that.
@@ -191,22 +223,29 @@ void serve_calls(int listener, const GlobalOptions& settings, const AgentCallRun
   while (!g_stop) {
     pollfd p{listener, POLLIN, 0};
     const int ready = ::poll(&p, 1, 200);  // the signal flag is looked at between waits
+    pool.expire_lingering();
     if (ready <= 0) continue;
+    if (!my_turn(index)) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(50));
+      continue;
+    }
     UniqueFd connection(::accept4(listener, nullptr, nullptr, SOCK_CLOEXEC));
     if (!connection) continue;  // another worker took it
+    if (g_busy) g_busy[index].store(steady_ns());
     serve(connection.get(), pool, run);
+    if (g_busy) g_busy[index].store(0);
   }
 }
 
 // A worker process, forked before any DDS thread exists. It dies with the agent: a caller
 // whose agent was killed must get no answer rather than one from an orphan.
-pid_t start_worker(int listener, const GlobalOptions& settings, const AgentCallRunner& run) {
+pid_t start_worker(int listener, const GlobalOptions& settings, const AgentCallRunner& run, int index) {
   const pid_t agent = ::getpid();
   const pid_t pid = ::fork();
   if (pid != 0) return pid;
   (void)::prctl(PR_SET_PDEATHSIG, SIGKILL);
   if (::getppid() != agent) std::_Exit(1);  // the agent ended before the line above
-  serve_calls(listener, settings, run);
+  serve_calls(listener, settings, run, index);
   std::fflush(nullptr);
   std::exit(0);  // the participants are gone (serve_calls' pool); Fast DDS's own statics follow
 }
@@ -232,13 +271,17 @@ int run_agent(const GlobalOptions& settings, const std::string& socket, int work
                settings.network.summary.empty() ? "multicast discovery" : settings.network.summary.c_str(),
                socket.c_str(), workers, workers == 1 ? "" : "s");
   if (workers <= 1) {
-    serve_calls(listener.get(), settings, run);
+    serve_calls(listener.get(), settings, run, 0);
   } else {
+    workers = std::min(workers, kMaxWorkers);
+    void* shared = ::mmap(nullptr, sizeof(BusySince) * kMaxWorkers, PROT_READ | PROT_WRITE, MAP_SHARED | MAP_ANONYMOUS, -1, 0);
+    if (shared != MAP_FAILED) g_busy = new (shared) BusySince[kMaxWorkers]{};  // else every worker takes calls as they come
     std::vector<pid_t> pids;
-    for (int i = 0; i < workers; ++i) pids.push_back(start_worker(listener.get(), settings, run));
+    for (int i = 0; i < workers; ++i) pids.push_back(start_worker(listener.get(), settings, run, i));
     while (!g_stop) {
       std::this_thread::sleep_for(std::chrono::milliseconds(200));
-      for (auto& pid : pids) {
+      for (std::size_t i = 0; i < pids.size(); ++i) {
+        pid_t& pid = pids[i];
         int status = 0;
         if (pid > 0 && ::waitpid(pid, &status, WNOHANG) != pid) continue;
         // A worker that failed or was killed: the others serve on, and a new one takes its place.
@@ -246,7 +289,8 @@ int run_agent(const GlobalOptions& settings, const std::string& socket, int work
           std::fprintf(stderr, "pmuctl agent: worker pid %d ended (%s %d); a new one takes its place\n",
                        static_cast<int>(pid), WIFSIGNALED(status) ? "signal" : "exit",
                        WIFSIGNALED(status) ? WTERMSIG(status) : WEXITSTATUS(status));
-        pid = g_stop ? -1 : start_worker(listener.get(), settings, run);
+        if (g_busy) g_busy[i].store(0);  // a call it was serving ended with it
+        pid = g_stop ? -1 : start_worker(listener.get(), settings, run, static_cast<int>(i));
       }
     }
     // Each worker ends after the call it is serving.
