@@ -205,7 +205,7 @@ int run_cli(int argc, char** argv, const AgentCall* served) {
   agent->add_option("--workers", agent_workers,
                     "Calls served at once, each by a process with its own DDS participant (default 4). Calls go to "
                     "the first while it keeps up; the next takes one when all before it have been on theirs for "
-                    "5 s, so a call that waits for a silent aircraft holds up no other for longer")
+                    "3 s, so a call that waits for a silent aircraft holds up no other for longer")
       ->check(CLI::Range(1, 16));
 
   auto* watch = app.add_subcommand("watch", "Live telemetry with each device's alarm marker: a refreshing table, or one JSON object per sample");

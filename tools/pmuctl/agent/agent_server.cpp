@@ -196,7 +196,7 @@ std::int64_t steady_ns() {
 // matched at the aircraft and holding the fleet's state (ContextPool), serve them, and each
 // further worker, whose first calls announce endpoints of its own to every aircraft, only
 // takes over from workers held up by an aircraft that does not answer.
-constexpr auto kSpillAfter = std::chrono::seconds(5);
+constexpr auto kSpillAfter = std::chrono::seconds(3);
 bool my_turn(int index) {
   if (!g_busy) return true;
   const std::int64_t now = steady_ns();

@@ -6,7 +6,7 @@
 // call at a time with the caller's working directory, environment and standard streams
 // (which are per process), answering its exit status. Calls go to the first worker while it
 // keeps up, so its endpoints, matched at the aircraft, serve them; the next takes a call only
-// when every worker before it has been on its own for 5 s. A call to an aircraft that does
+// when every worker before it has been on its own for 3 s. A call to an aircraft that does
 // not answer then holds one worker, not the ground station. Only the caller's own user may call
 // (the socket is 0600 and the peer's uid is checked). It ends on SIGINT or SIGTERM, after
 // each worker's current call, removing its socket; a worker that dies is replaced, and the

@@ -32,7 +32,6 @@
 #include "pmu/mcap/output_file.hpp"
 #include "pmuctl/verbs/command_channel.hpp"
 #include "pmuctl/verbs/exit_status.hpp"
-#include "pmuctl/verbs/state_samples.hpp"
 #include "pmuctl/verbs/service_presence.hpp"
 #include "pmuctl/verbs/context_lease.hpp"
 
@@ -71,9 +70,9 @@ class DeviceReader {
     pmu::v4::Config c;
     while (config_.take_next_sample(&c, &si) == ReturnCode_t::RETCODE_OK)
       if (si.valid_data && c.vehicle().to_string() == vehicle_) configs_[{c.bus().to_string(), c.address()}] = c;
-    info_samples_.poll(info_, [&](const pmu::v4::DeviceInfo& i, const SampleInfo& s) {
-      if (s.valid_data && i.vehicle().to_string() == vehicle_) infos_[{i.bus().to_string(), i.address()}] = i;
-    });
+    pmu::v4::DeviceInfo i;
+    while (info_.take_next_sample(&i, &si) == ReturnCode_t::RETCODE_OK)
+      if (si.valid_data && i.vehicle().to_string() == vehicle_) infos_[{i.bus().to_string(), i.address()}] = i;
     pmu::v4::Baseline b;
     while (baseline_.take_next_sample(&b, &si) == ReturnCode_t::RETCODE_OK) {
       if (si.valid_data) {
@@ -134,7 +133,6 @@ class DeviceReader {
   std::string vehicle_;
   DataReader& config_;
   DataReader& info_;
-  StateSamples<pmu::v4::DeviceInfo> info_samples_;  // an agent's lingers (state_samples.hpp)
   DataReader& baseline_;
   std::map<std::pair<std::string, std::uint16_t>, pmu::v4::Config> configs_;
   std::map<std::pair<std::string, std::uint16_t>, pmu::v4::Baseline> baselines_;

@@ -35,15 +35,15 @@ pmu::dds::DdsContext& ContextPool::context(const std::string& participant_name,
     try {
       slot = make_context(settings_, participant_name, partitions);
       // Command endpoints carry only a call's requests and the replies to them: left matched
-      // in their vehicle's partitions, the next command to it finds them matched. The readers
-      // of health and device info, which every list and every command's choice of PMU read,
-      // linger a while: the calls of an operator at work find them matched with the fleet's
-      // current state, instead of each call announcing them again to every aircraft and
-      // waiting for the state to cross the link. Health comes every second, so a lingering
-      // reader costs the link that stream, which ends `kStateLinger` after the last call.
+      // in their vehicle's partitions, the next command to it finds them matched. The reader
+      // of health, which every list and every command's choice of PMU read, lingers a while:
+      // the calls of an operator at work find it matched and the fleet's health coming
+      // (every second), instead of each call announcing it again to every aircraft and
+      // waiting for the state to cross the link. It costs the link that stream, which ends
+      // `kStateLinger` after the last call.
       pmu::dds::DdsContext::ReuseRules rules;
       rules.idle_matched = {qos_profiles::kCommand};
-      rules.lingering_topics = {topics::kHealth, topics::kInfo};
+      rules.lingering_topics = {topics::kHealth};
       rules.linger = kStateLinger;
       slot->reuse_endpoints(std::move(rules));
     } catch (...) {

@@ -25,7 +25,7 @@ namespace pmu::tools {
 // participant of this name.
 inline constexpr const char* kPmuctlParticipant = "pmuctl";
 
-// How long the readers of health and device info stay matched after a call
+// How long the reader of health stays matched after a call
 // (ContextPool::context says why).
 inline constexpr std::chrono::seconds kStateLinger{30};
 

@@ -1,32 +1,27 @@
 #pragma once
-// Reads a state reader's samples without taking them. An agent's readers of health and device
-// info linger matched between calls (ContextPool), holding the fleet's current state, which
-// their writers (TRANSIENT_LOCAL) sent once: a call that took the samples would leave the
-// next one nothing of the devices whose state did not change since.
+// Takes a state reader's samples, passing over health that is not recent. An agent's reader
+// of health lingers matched between calls (ContextPool) and goes on receiving while no call
+// runs; what it received long ago says nothing of now: during a radio dropout it still holds
+// the last sample of every aircraft. A call on its own would not have heard from them.
 //
-//   StateSamples<pmu::v4::Health> s;
+//   StateSamples<pmu::v4::Health> s(kHealthFresh);
 //   s.poll(reader, [&](const pmu::v4::Health& h, const SampleInfo& info) { ... });
 //
-// The first poll gives every sample the reader holds, later ones those received since.
-// With a `max_age`, a sample received longer ago than that is passed over: the reader may
-// have lingered through a radio dropout, and health the service publishes every second
-// that stopped coming says the aircraft is out of reach, not how it is.
+// Taken, not read: Fast DDS 2.9.1 aborts (an assertion in StatefulReader::NotifyChanges)
+// when a sample that arrived before a lost one was read and the lost one's repair then
+// comes, which a lossy link makes common; a reader keeps nothing read.
 // A plain value; the verb's thread, with a reader that outlives it.
 
 #include <chrono>
-#include <fastdds/dds/core/LoanableSequence.hpp>
-#include <functional>
-#include <optional>
 #include <fastdds/dds/subscriber/DataReader.hpp>
 #include <fastdds/dds/subscriber/SampleInfo.hpp>
-#include <fastdds/dds/subscriber/InstanceState.hpp>
-#include <fastdds/dds/subscriber/SampleState.hpp>
-#include <fastdds/dds/subscriber/ViewState.hpp>
+#include <functional>
+#include <optional>
 
 namespace pmu::tools {
 
 // How recent a pmu/health sample must be to count (the service publishes one a second; a
-// lossy link's repair of a lost one takes another heartbeat period, 1 s).
+// lossy link's repair of a lost one takes another heartbeat period).
 inline constexpr std::chrono::seconds kHealthFresh{5};
 
 template <class T>
@@ -39,24 +34,10 @@ class StateSamples {
 
   template <class F>
   void poll(eprosima::fastdds::dds::DataReader& reader, F&& on_sample) {
-    using namespace eprosima::fastdds::dds;
-    const SampleStateMask states = first_ ? SampleStateMask{ANY_SAMPLE_STATE} : SampleStateMask{NOT_READ_SAMPLE_STATE};
-    first_ = false;
-    // Instance by instance: one read() lends at most max_samples_per_read samples, and
-    // reading the first ones again would never reach the others.
-    InstanceHandle_t previous = HANDLE_NIL;
-    for (;;) {
-      LoanableSequence<T> samples;
-      SampleInfoSeq infos;
-      if (reader.read_next_instance(samples, infos, LENGTH_UNLIMITED, previous, states, ANY_VIEW_STATE,
-                                    ANY_INSTANCE_STATE) != ReturnCode_t::RETCODE_OK)
-        return;  // no further instance with samples (new ones, after the first poll)
-      for (LoanableCollection::size_type i = 0; i < infos.length(); ++i) {
-        previous = infos[i].instance_handle;
-        if (!too_old(infos[i])) on_sample(samples[i], infos[i]);
-      }
-      (void)reader.return_loan(samples, infos);
-    }
+    T sample;
+    eprosima::fastdds::dds::SampleInfo info;
+    while (reader.take_next_sample(&sample, &info) == ReturnCode_t::RETCODE_OK)
+      if (!too_old(info)) on_sample(sample, info);
   }
 
  private:
@@ -70,7 +51,6 @@ class StateSamples {
 
   std::optional<std::chrono::system_clock::duration> max_age_;
   WallClock clock_;
-  bool first_ = true;
 };
 
 }  // namespace pmu::tools

@@ -196,11 +196,10 @@ class DdsContext {
 
   struct ReuseRules {
     std::vector<std::string> idle_matched;  // profiles, as above
-    // Readers of these topics stay matched for `linger` after their job, holding what they
-    // received: a job soon after in the same partitions takes one up with the current
-    // state already in it and costs the link no announcement (each move of an endpoint is
-    // one, which a Discovery Server hands to every client whose writers share the topic).
-    // A lingering reader's samples are left in it: its jobs read them (read, not take).
+    // Readers of these topics stay matched for `linger` after their job, and what they
+    // receive meanwhile is kept: a job soon after in the same partitions takes one up, not
+    // emptied, and costs the link no announcement (each move of an endpoint is one, which a
+    // Discovery Server hands to every client whose writers share the topic).
     std::vector<std::string> lingering_topics;
     std::chrono::steady_clock::duration linger{};
     std::function<std::chrono::steady_clock::time_point()> clock = [] { return std::chrono::steady_clock::now(); };
