@@ -211,16 +211,7 @@ DataWriter* DdsContext::make_writer(Publisher& publisher, Topic& topic, const st
 }
 
 DataReader& DdsContext::reader(Topic& topic, const std::string& profile, DataReaderListener* listener) {
-  DataReader* r = reuse_ && !listener ? kept_reader(topic, profile, partitions_.subscriber)
-                                      : make_reader(*subscriber_, topic, profile, listener);
-  readers_.push_back(r);
-  return *r;
-}
-
-DataReader& DdsContext::reader(Topic& topic, const std::string& profile,
-                               const std::vector<std::string>& subscriber_partitions) {
-  if (!reuse_) return reader(topic, profile);
-  DataReader* r = kept_reader(topic, profile, subscriber_partitions);
+  DataReader* r = reuse_ && !listener ? kept_reader(topic, profile) : make_reader(*subscriber_, topic, profile, listener);
   readers_.push_back(r);
   return *r;
 }
@@ -257,12 +248,10 @@ DdsContext::Kept* DdsContext::take_up(const std::string& topic, const std::strin
       if (!k.in_use && (k.writer != nullptr) == writer && k.topic == topic && k.profile == profile &&
           (k.partitions == partitions) == same_partitions) {
         // What a reader holds is an earlier job's (one left matched may also hold replies to
-        // other clients since), except a lingering one's in the same partitions: the current
-        // state of what it reads.
-        if (k.reader && !(same_partitions && k.lingering_since)) drain(*k.reader);
+        // other clients since).
+        if (k.reader) drain(*k.reader);
         if (!same_partitions && !move(k, partitions)) continue;
         k.in_use = true;
-        k.lingering_since.reset();
         return &k;
       }
   return nullptr;
@@ -279,22 +268,22 @@ DataWriter* DdsContext::kept_writer(Topic& topic, const std::string& profile) {
     if (publisher) participant_->delete_publisher(publisher);
     throw;
   }
-  kept_.push_back({topic.get_name(), profile, partitions_.publisher, publisher, w, nullptr, nullptr, true, std::nullopt});
+  kept_.push_back({topic.get_name(), profile, partitions_.publisher, publisher, w, nullptr, nullptr, true});
   return w;
 }
 
-DataReader* DdsContext::kept_reader(Topic& topic, const std::string& profile, const std::vector<std::string>& partitions) {
-  if (Kept* k = take_up(topic.get_name(), profile, false, partitions)) return k->reader;
+DataReader* DdsContext::kept_reader(Topic& topic, const std::string& profile) {
+  if (Kept* k = take_up(topic.get_name(), profile, false, partitions_.subscriber)) return k->reader;
   Subscriber* subscriber = participant_->create_subscriber(SUBSCRIBER_QOS_DEFAULT);
   DataReader* r = nullptr;
   try {
-    if (!subscriber || !move_to(*subscriber, partitions)) refused(topic.get_name(), profile, false);
+    if (!subscriber || !move_to(*subscriber, partitions_.subscriber)) refused(topic.get_name(), profile, false);
     r = make_reader(*subscriber, topic, profile, nullptr);
   } catch (...) {
     if (subscriber) participant_->delete_subscriber(subscriber);
     throw;
   }
-  kept_.push_back({topic.get_name(), profile, partitions, nullptr, nullptr, subscriber, r, true, std::nullopt});
+  kept_.push_back({topic.get_name(), profile, partitions_.subscriber, nullptr, nullptr, subscriber, r, true});
   return r;
 }
 
@@ -302,30 +291,14 @@ bool DdsContext::park(const DomainEntity* endpoint) {
   for (auto& k : kept_)
     if (k.in_use && (k.writer == endpoint || k.reader == endpoint)) {
       k.in_use = false;
-      // Left matched while idle (reuse_endpoints' `idle_matched` profiles), lingering, or
-      // moved away so that nothing its remote writers publish comes to it.
-      const auto& idle = rules_.idle_matched;
-      if (std::find(idle.begin(), idle.end(), k.profile) != idle.end()) return true;
-      const auto& lingering = rules_.lingering_topics;
-      if (k.reader && std::find(lingering.begin(), lingering.end(), k.topic) != lingering.end()) {
-        k.lingering_since = rules_.clock();
-        return true;
-      }
+      // Left matched while idle (reuse_endpoints' `idle_matched` profiles), or moved away so
+      // that nothing its remote writers publish comes to it.
+      if (std::find(idle_matched_.begin(), idle_matched_.end(), k.profile) != idle_matched_.end()) return true;
       (void)move(k, {kClosingPartition});
       if (k.reader) drain(*k.reader);
       return true;
     }
   return false;
-}
-
-void DdsContext::expire_lingering() {
-  const auto now = rules_.clock();
-  for (auto& k : kept_)
-    if (!k.in_use && k.lingering_since && now - *k.lingering_since >= rules_.linger) {
-      k.lingering_since.reset();
-      (void)move(k, {kClosingPartition});
-      if (k.reader) drain(*k.reader);
-    }
 }
 
 void DdsContext::delete_endpoints_since(EndpointMark mark) {

@@ -31,7 +31,6 @@
 #include "pmu/config/network_settings.hpp"
 #include "pmu/dds/dds_context.hpp"
 #include "pmu/idl/commandPubSubTypes.h"
-#include "pmu/idl/statePubSubTypes.h"
 #include "pmu/idl/telemetryPubSubTypes.h"
 #include "pmu/idl/topics.hpp"
 #include "support/domain.hpp"
@@ -277,54 +276,6 @@ TEST(DiscoveryServer, ALongLivedClientsEndedReadersAreUnmatchedAtTheOtherClients
   reply_reader->get_subscription_matched_status(s);
   EXPECT_EQ(s.current_count, 1) << "the next job's reply reader is not matched at once";
   agent.delete_endpoints_since(mark);
-}
-
-// An agent's reader of a lingering topic (ReuseRules::lingering_topics) stays matched after
-// its job, keeping what it receives: the next job in the same partitions takes it up with
-// the service's state already in it, announcing nothing. Once it has been idle for the
-// linger time, expire_lingering parks it like any other, and the service unmatches it.
-TEST(DiscoveryServer, ALingeringReaderKeepsItsStateForTheNextJobAndIsParkedWhenItsTimeIsUp) {
-  if (::access(kDiscoveryServer, X_OK) != 0)
-    GTEST_SKIP() << kDiscoveryServer << " is missing: install Debian's fastdds-tools (scripts/setup.sh does)";
-  const std::uint16_t port = pmu::test::free_udp_port();
-  Server server(0, port);
-  DdsContext service(pmu::test::exclusive_dds_domain(), "", "ds-service", {}, Transport::UdpOnly, client_of(port));
-  DataWriter& health = service.writer(
-      service.topic(topics::kHealth, TypeSupport(new pmu::v4::HealthPubSubType())), qos_profiles::kState);
-  pmu::v4::Health sample;
-  sample.bus("sim0");
-  sample.address(1);
-  ASSERT_TRUE(health.write(&sample));
-
-  DdsContext agent(pmu::test::exclusive_dds_domain(), "", "ds-agent", {}, Transport::UdpOnly, client_of(port));
-  auto now = std::chrono::steady_clock::now();
-  DdsContext::ReuseRules rules;
-  rules.idle_matched = {qos_profiles::kCommand};
-  rules.lingering_topics = {topics::kHealth};
-  rules.linger = 30s;
-  rules.clock = [&now] { return now; };
-  agent.reuse_endpoints(rules);
-  Topic& topic = agent.topic(topics::kHealth, TypeSupport(new pmu::v4::HealthPubSubType()));
-  const auto held = [](DataReader& r) { return r.get_unread_count(); };
-
-  auto mark = agent.endpoint_mark();
-  DataReader* reader = &agent.reader(topic, qos_profiles::kState);
-  ASSERT_TRUE(pmu::test::wait_until([&] { return held(*reader) == 1u; }, 20s, 20ms)) << "the state never came";
-  agent.delete_endpoints_since(mark);
-  now += 29s;
-  agent.expire_lingering();
-  std::this_thread::sleep_for(2s);
-  EXPECT_EQ(matched_readers(health), 1) << "a lingering reader was unmatched before its time";
-
-  mark = agent.endpoint_mark();
-  EXPECT_EQ(&agent.reader(topic, qos_profiles::kState), reader) << "the next job made a new reader";
-  EXPECT_EQ(held(*reader), 1u) << "the next job's reader came back emptied of the state it had received";
-  agent.delete_endpoints_since(mark);
-
-  now += 30s;
-  agent.expire_lingering();
-  EXPECT_TRUE(pmu::test::wait_until([&] { return matched_readers(health) == 0; }, 20s, 20ms))
-      << "a reader idle for its linger time is still matched";
 }
 
 // ---- the interface allowlist ---------------------------------------------------------------

@@ -193,7 +193,7 @@ std::int64_t steady_ns() {
 
 // Worker `index` takes a call only when every worker before it has been on its current call
 // for kSpillAfter: calls go to the first worker while it keeps up, so its endpoints, already
-// matched at the aircraft and holding the fleet's state (ContextPool), serve them, and each
+// matched at the aircraft (command endpoints stay matched, ContextPool), serve them, and each
 // further worker, whose first calls announce endpoints of its own to every aircraft, only
 // takes over from workers held up by an aircraft that does not answer.
 constexpr auto kSpillAfter = std::chrono::seconds(3);
@@ -223,7 +223,6 @@ void serve_calls(int listener, const GlobalOptions& settings, const AgentCallRun
   while (!g_stop) {
     pollfd p{listener, POLLIN, 0};
     const int ready = ::poll(&p, 1, 200);  // the signal flag is looked at between waits
-    pool.expire_lingering();
     if (ready <= 0) continue;
     if (!my_turn(index)) {
       std::this_thread::sleep_for(std::chrono::milliseconds(50));

@@ -13,7 +13,6 @@
 #include <thread>
 
 #include "pmu/command/command.hpp"
-#include "pmu/config/vehicle.hpp"
 #include "pmu/idl/commandPubSubTypes.h"
 #include "pmu/idl/guarded_type.hpp"
 #include "pmu/idl/state.h"
@@ -21,7 +20,6 @@
 #include "pmu/idl/topics.hpp"
 #include "pmuctl/verbs/exit_status.hpp"
 #include "pmuctl/verbs/service_presence.hpp"
-#include "pmuctl/verbs/state_samples.hpp"
 
 namespace pmu::tools {
 namespace {
@@ -55,25 +53,22 @@ std::optional<int> resolve_target(const GlobalOptions& o, const std::string& veh
     address = *o.address;
     return std::nullopt;
   }
-  // Through an agent, the reader of every vehicle that `list` uses too: it lingers matched
-  // between calls with the fleet's health in it (ContextPool), so a command announces no
-  // reader of its own. The vehicle is chosen below, by the samples' key.
-  Topic& health = dds.topic(topics::kHealth, TypeSupport(new idl::Guarded<pmu::v4::HealthPubSubType>()));
-  DataReader& r = o.pool ? dds.reader(health, qos_profiles::kState, service::every_vehicle_partitions())
-                         : dds.reader(health, qos_profiles::kState);
-  StateSamples<pmu::v4::Health> samples(kHealthFresh);
+  DataReader& r = dds.reader(dds.topic(topics::kHealth, TypeSupport(new idl::Guarded<pmu::v4::HealthPubSubType>())),
+                             qos_profiles::kState);
   std::set<std::pair<std::string, std::uint16_t>> seen;
   std::set<std::string> vehicles_seen;
   bool own_vehicle_seen = false;
   std::map<InstanceHandle_t, std::pair<std::string, std::uint16_t>> handles;
   std::optional<Clock::time_point> settle;
   while (Clock::now() < deadline) {
-    samples.poll(r, [&](const pmu::v4::Health& h, const SampleInfo& info) {
-      if (!info.valid_data || info.instance_state != ALIVE_INSTANCE_STATE) {
-        // Disposed: a PMU that moved to another address is not a second PMU; nor is one
-        // whose service is gone (a lingering reader still holds its last health).
-        if (auto it = handles.find(info.instance_handle); it != handles.end()) seen.erase(it->second);
-        return;
+    pmu::v4::Health h;
+    SampleInfo info;
+    while (r.take_next_sample(&h, &info) == ReturnCode_t::RETCODE_OK) {
+      if (!info.valid_data) {
+        // Disposed: a PMU that moved to another address is not a second PMU.
+        if (auto it = handles.find(info.instance_handle); it != handles.end() && info.instance_state != ALIVE_INSTANCE_STATE)
+          seen.erase(it->second);
+        continue;
       }
       vehicles_seen.insert(h.vehicle().to_string());
       own_vehicle_seen = own_vehicle_seen || h.vehicle().to_string() == vehicle;
@@ -82,7 +77,7 @@ std::optional<int> resolve_target(const GlobalOptions& o, const std::string& veh
         seen.insert({h.bus().to_string(), h.address()});
         handles[info.instance_handle] = {h.bus().to_string(), h.address()};
       }
-    });
+    }
     // The service's health is TRANSIENT_LOCAL: all of it comes in one burst once matched, so
     // the settle time starts with its first sample, of the wanted PMU or not. Other
     // vehicles' samples do not start it: on a slow link their services are discovered one

@@ -35,17 +35,8 @@ pmu::dds::DdsContext& ContextPool::context(const std::string& participant_name,
     try {
       slot = make_context(settings_, participant_name, partitions);
       // Command endpoints carry only a call's requests and the replies to them: left matched
-      // in their vehicle's partitions, the next command to it finds them matched. The reader
-      // of health, which every list and every command's choice of PMU read, lingers a while:
-      // the calls of an operator at work find it matched and the fleet's health coming
-      // (every second), instead of each call announcing it again to every aircraft and
-      // waiting for the state to cross the link. It costs the link that stream, which ends
-      // `kStateLinger` after the last call.
-      pmu::dds::DdsContext::ReuseRules rules;
-      rules.idle_matched = {qos_profiles::kCommand};
-      rules.lingering_topics = {topics::kHealth};
-      rules.linger = kStateLinger;
-      slot->reuse_endpoints(std::move(rules));
+      // in their vehicle's partitions, the next command to it finds them matched.
+      slot->reuse_endpoints({qos_profiles::kCommand});
     } catch (...) {
       contexts_.erase(participant_name);
       throw;
@@ -54,10 +45,6 @@ pmu::dds::DdsContext& ContextPool::context(const std::string& participant_name,
     throw pmu::dds::DdsError("the agent's participant cannot move to this call's partitions");
   }
   return *slot;
-}
-
-void ContextPool::expire_lingering() {
-  for (auto& [name, context] : contexts_) context->expire_lingering();
 }
 
 std::string effective_qos_file(const std::string& qos_file) {

@@ -10,7 +10,6 @@
 // whole run); a lease outlives every reference the verb took from its context.
 // Threads: the verb's thread only; each of the agent's workers serves one call at a time.
 
-#include <chrono>
 #include <map>
 #include <memory>
 #include <string>
@@ -25,10 +24,6 @@ namespace pmu::tools {
 // participant of this name.
 inline constexpr const char* kPmuctlParticipant = "pmuctl";
 
-// How long the reader of health stays matched after a call
-// (ContextPool::context says why).
-inline constexpr std::chrono::seconds kStateLinger{30};
-
 class ContextPool {
  public:
   // `settings`: the domain, QoS file, security files and network of every participant made.
@@ -41,10 +36,6 @@ class ContextPool {
   // one participant of the agent, once. Throws DdsError like DdsContext's constructor, and
   // when the partitions cannot be set.
   pmu::dds::DdsContext& context(const std::string& participant_name, const pmu::dds::Partitions& partitions);
-
-  // Parks the readers that lingered matched for kStateLinger since their call
-  // (DdsContext::expire_lingering). Between calls, on the calls' thread.
-  void expire_lingering();
 
  private:
   GlobalOptions settings_;

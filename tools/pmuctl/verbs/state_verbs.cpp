@@ -28,7 +28,6 @@
 #include "pmuctl/verbs/alarm_sample.hpp"
 #include "pmuctl/verbs/exit_status.hpp"
 #include "pmuctl/verbs/service_presence.hpp"
-#include "pmuctl/verbs/state_samples.hpp"
 #include "pmuctl/verbs/state_settle.hpp"
 #include "pmuctl/view/alarm_marker.hpp"
 #include "pmuctl/view/sample_fields.hpp"
@@ -122,26 +121,23 @@ const char* number_key(pmu::v4::DeviceKind k) {
 template <class T, class PubSub>
 class StateCollector {
  public:
-  // Health counts only while it keeps coming (state_samples.hpp).
   StateCollector(pmu::dds::DdsContext& dds, const char* topic)
-      : topic_(topic),
-        reader_(dds.reader(dds.topic(topic, TypeSupport(new idl::Guarded<PubSub>())), qos_profiles::kState)),
-        samples_(std::string(topic) == topics::kHealth ? std::optional<std::chrono::system_clock::duration>(kHealthFresh)
-                                                        : std::nullopt) {}
+      : topic_(topic), reader_(dds.reader(dds.topic(topic, TypeSupport(new idl::Guarded<PubSub>())), qos_profiles::kState)) {}
 
   void poll(const GlobalOptions& o) {
-    samples_.poll(reader_, [&](const T& sample, const SampleInfo& info) {
+    T sample;
+    SampleInfo info;
+    while (reader_.take_next_sample(&sample, &info) == ReturnCode_t::RETCODE_OK) {
       writers_heard_.insert(info.publication_handle);
-      // Disposed (a PMU that moved to another address), or its service gone (a lingering
-      // reader still holds its last state): that device is not there any more.
-      if (!info.valid_data || info.instance_state != ALIVE_INSTANCE_STATE) {
-        forget(info.instance_handle);
-        return;
+      if (!info.valid_data) {
+        // Disposed (a PMU that moved to another address): that device is not there any more.
+        if (info.instance_state != ALIVE_INSTANCE_STATE) forget(info.instance_handle);
+        continue;
       }
-      if (!selected(o, id_of(sample))) return;
+      if (!selected(o, id_of(sample))) continue;
       latest_[id_of(sample)] = sample;
       handles_[info.instance_handle] = id_of(sample);
-    });
+    }
   }
   bool matched() { return matched_writers() > 0; }
   std::size_t matched_writers() {
@@ -163,7 +159,6 @@ class StateCollector {
   }
   std::string topic_;
   DataReader& reader_;
-  StateSamples<T> samples_;
   std::map<DeviceId, T> latest_;
   std::map<InstanceHandle_t, DeviceId> handles_;
   std::set<InstanceHandle_t> writers_heard_;

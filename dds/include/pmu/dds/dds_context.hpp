@@ -33,7 +33,6 @@
 #include <fastdds/dds/topic/TypeSupport.hpp>
 #include <chrono>
 #include <cstddef>
-#include <functional>
 #include <map>
 #include <optional>
 #include <stdexcept>
@@ -134,16 +133,11 @@ class DdsContext {
                                              eprosima::fastdds::dds::DataWriterListener* listener = nullptr);
   eprosima::fastdds::dds::DataReader& reader(eprosima::fastdds::dds::Topic& topic, const std::string& profile,
                                              eprosima::fastdds::dds::DataReaderListener* listener = nullptr);
+
   // From now on, reliable writers heartbeat at most this often (their profile's period when
   // that is longer): the service's `link: round_trip` (config.hpp says why). Call before the
   // writers are made (a writer's period cannot change once it exists); the writers' thread.
   void heartbeat_at_least(std::chrono::milliseconds period) noexcept { heartbeat_floor_ = period; }
-
-  // A reader as above, but in `subscriber_partitions` rather than the job's, in a context
-  // that reuses endpoints (each kept reader has a subscriber of its own); a context that does
-  // not has one subscriber, so its reader is in the job's partitions.
-  eprosima::fastdds::dds::DataReader& reader(eprosima::fastdds::dds::Topic& topic, const std::string& profile,
-                                             const std::vector<std::string>& subscriber_partitions);
 
   // A writer in the default partition with `qos` as given, not from qos.xml: for ROS 2's
   // topics (ros2_publisher.hpp), whose partition and QoS are what ROS 2 subscribers expect
@@ -189,28 +183,9 @@ class DdsContext {
   // (nothing flows to them unasked, so a later job in the same partitions finds them matched
   // at no cost to the link); the others are parked.
   void reuse_endpoints(std::vector<std::string> idle_matched) {
-    ReuseRules rules;
-    rules.idle_matched = std::move(idle_matched);
-    reuse_endpoints(std::move(rules));
-  }
-
-  struct ReuseRules {
-    std::vector<std::string> idle_matched;  // profiles, as above
-    // Readers of these topics stay matched for `linger` after their job, and what they
-    // receive meanwhile is kept: a job soon after in the same partitions takes one up, not
-    // emptied, and costs the link no announcement (each move of an endpoint is one, which a
-    // Discovery Server hands to every client whose writers share the topic).
-    std::vector<std::string> lingering_topics;
-    std::chrono::steady_clock::duration linger{};
-    std::function<std::chrono::steady_clock::time_point()> clock = [] { return std::chrono::steady_clock::now(); };
-  };
-  void reuse_endpoints(ReuseRules rules) {
     reuse_ = true;
-    rules_ = std::move(rules);
+    idle_matched_ = std::move(idle_matched);
   }
-  // Parks the lingering readers idle for `linger` or longer. The owner calls it between jobs,
-  // on the jobs' thread.
-  void expire_lingering();
 
  private:
   // An endpoint of `publisher` or `subscriber` with the named profile, its capacity checked;
@@ -254,16 +229,13 @@ class DdsContext {
     eprosima::fastdds::dds::Subscriber* subscriber = nullptr;  // a reader's
     eprosima::fastdds::dds::DataReader* reader = nullptr;
     bool in_use = false;
-    // Since when it lingers matched in `partitions` (ReuseRules::lingering_topics).
-    std::optional<std::chrono::steady_clock::time_point> lingering_since;
   };
   bool reuse_ = false;
-  ReuseRules rules_;
+  std::vector<std::string> idle_matched_;
   std::chrono::milliseconds heartbeat_floor_{0};
   std::vector<Kept> kept_;
   eprosima::fastdds::dds::DataWriter* kept_writer(eprosima::fastdds::dds::Topic& topic, const std::string& profile);
-  eprosima::fastdds::dds::DataReader* kept_reader(eprosima::fastdds::dds::Topic& topic, const std::string& profile,
-                                                  const std::vector<std::string>& partitions);
+  eprosima::fastdds::dds::DataReader* kept_reader(eprosima::fastdds::dds::Topic& topic, const std::string& profile);
   // An idle kept writer (`writer`) or reader of this topic and profile, in `partitions` (one
   // already there first), marked in use; a reader emptied. Null when there is none.
   Kept* take_up(const std::string& topic, const std::string& profile, bool writer,
