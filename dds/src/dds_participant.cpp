@@ -77,7 +77,9 @@ DomainParticipantQos participant_qos(const std::string& name, Transport transpor
     throw NetworkError("more than " + std::to_string(kMaxServers) + " Discovery Servers (server ids are 0..255)");
   auto udp = std::make_shared<UDPv4TransportDescriptor>();
   udp->interfaceWhiteList = network.interface_addresses;
-  udp->maxMessageSize = kUdpMaxMessageSize;
+  // Fast DDS 2.9 serialises a DDS-Security handshake message, which carries certificates,
+  // into one buffer of this size and fails the handshake when it does not fit.
+  if (security.empty()) udp->maxMessageSize = kUdpMaxMessageSize;
   auto& t = qos.transport();
   switch (transport) {
     case Transport::Default:

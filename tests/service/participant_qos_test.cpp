@@ -120,6 +120,12 @@ TEST(ParticipantQos, EveryUdpTransportSendsDatagramsThatFitOnePacket) {
       EXPECT_LE(udp_of(q)->maxMessageSize, 1500u - 20u - 8u) << "one packet on a 1,500-byte MTU";
       EXPECT_EQ(has_shm(q), transport == Transport::Default) << "same-host traffic keeps shared memory";
     }
+  // A DDS-Security handshake (certificates) must fit one of Fast DDS's messages.
+  SecurityFiles files;
+  files.identity_ca = files.identity_certificate = files.private_key = "x.pem";
+  files.permissions_ca = files.governance = files.permissions = "x.p7s";
+  EXPECT_EQ(udp_of(participant_qos("x", Transport::UdpOnly, {}, files))->maxMessageSize,
+            UDPv4TransportDescriptor().maxMessageSize);
 }
 
 TEST(ParticipantQos, ServerModeIsAClientOfEachServerByPositionWithFastddsDiscoveryPrefixes) {

@@ -21,7 +21,9 @@
 // Transports: always explicit ones (use_builtin_transports = false), since Fast DDS's builtin
 // UDPv4 can be given neither an allowlist nor a datagram size. Transport Default is shared
 // memory beside UDPv4, as Fast DDS's builtin pair; UdpOnly is UDPv4 alone. The UDPv4
-// transport's maxMessageSize is kUdpMaxMessageSize.
+// transport's maxMessageSize is kUdpMaxMessageSize, except with DDS-Security: Fast DDS 2.9
+// serialises a handshake message (certificates) into a buffer of that size, and a handshake
+// that does not fit fails ("Cannot serialize ParticipantGenericMessage").
 // Interfaces (allowlist): the UDPv4 transport's interfaceWhiteList = the addresses
 // (127.0.0.1 always among them, see resolve_network); without one it uses every interface.
 // Security: the DDS-Security plugin properties when `security` is not empty, with multicast
