@@ -212,6 +212,44 @@ std::vector<pid_t> workers_of(pid_t agent) {
   return pids;
 }
 
+// The agent's worker sends a vehicle's later commands to the PMU it found for the first
+// (target_memory.hpp); when that PMU has moved, the service's "not seen" (nothing executed)
+// makes the call find it again and send the command there, once.
+TEST_F(PmuctlAgentWithUav1, ACommandFollowsTheRememberedPmuWhenItMoved) {
+  const std::string p = "PMU_AGENT_SOCKET=" + socket + " " + PMUCTL_PATH + " --domain " + std::to_string(domain) +
+                        " --vehicle uav1 ";
+  bool listed = false;
+  for (int attempt = 0; attempt < 10 && !listed; ++attempt) {
+    const auto r = sh(p + "--timeout 10 --json list");
+    for (const auto& j : pmu::test::json_lines(r.out))
+      listed = listed || (!j.is_discarded() && j.contains("address") && j["address"] == 1);
+  }
+  ASSERT_TRUE(listed) << read_file(log) << uav1.describe();
+  const auto reply_of = [](const std::string& out) {
+    for (const auto& j : pmu::test::json_lines(out))
+      if (!j.is_discarded() && j.contains("result")) return j;
+    return nlohmann::json();
+  };
+
+  auto r = sh(p + "--timeout 30 --json config set payload_voltage 23");
+  auto j = reply_of(r.out);
+  ASSERT_EQ(r.status, 0) << r.out;
+  EXPECT_EQ(j["address"], 1) << r.out;
+  r = sh(p + "--timeout 30 --confirm config set can_address 7");
+  ASSERT_EQ(r.status, 0) << r.out << uav1.describe();
+
+  r = sh(p + "--timeout 30 --json config set payload_voltage 24");
+  j = reply_of(r.out);
+  EXPECT_EQ(r.status, 0) << r.out << uav1.describe();
+  EXPECT_EQ(j["result"], "COMPLETED") << r.out;
+  EXPECT_EQ(j["address"], 7) << r.out;
+  const std::string service_log = uav1.describe();
+  // The remembered PMU was tried first: the service said it has no device 1 and did nothing.
+  EXPECT_EQ(count(service_log, "-> REJECTED: device 1 not seen on can0"), 1u) << service_log;
+  ASSERT_TRUE(j.contains("request_id")) << r.out;
+  EXPECT_EQ(count(service_log, "audit: command " + j["request_id"].get<std::string>()), 1u) << service_log;
+}
+
 TEST_F(PmuctlAgentWithUav1, ACallThatWaitsForASilentAircraftHoldsUpNoOtherAndADeadWorkerIsReplaced) {
   const std::string p = "PMU_AGENT_SOCKET=" + socket + " " + PMUCTL_PATH + " --domain " + std::to_string(domain) + " ";
   bool served = false;

@@ -147,10 +147,32 @@ CommandChannel::CommandChannel(const GlobalOptions& o)
                           qos_profiles::kCommand)) {}
 
 std::optional<int> CommandChannel::open(Clock::time_point deadline, std::string& bus, std::uint16_t& address,
-                                        bool broadcast) {
-  if (!broadcast)
-    if (const auto failed = resolve_target(options_, vehicle_, dds_, deadline, bus, address)) return failed;
+                                        Find find) {
+  recalled_ = false;
+  if (find != Find::Broadcast) {
+    TargetMemory* memory = options_.pool ? &options_.pool->targets() : nullptr;
+    const bool named = !options_.bus.empty() && options_.address;  // nothing to find
+    if (memory && find == Find::MayRecall && !named)
+      if (const auto t = memory->recall(query(), Clock::now())) {
+        bus = t->bus;
+        address = t->address;
+        recalled_ = true;
+      }
+    if (!recalled_) {
+      if (const auto failed = resolve_target(options_, vehicle_, dds_, deadline, bus, address)) return failed;
+      if (memory && !named) memory->remember(query(), {bus, address}, Clock::now());
+    }
+  }
   return wait_for_match(options_, dds_, writer_, replies_, vehicle_, deadline, "accepts commands");
+}
+
+bool CommandChannel::recalled_target_gone(const Outcome& out, const std::string& bus, std::uint16_t address) {
+  if (!recalled_ || !options_.pool || !out.reply || out.reply->result() != pmu::v4::REJECTED ||
+      !says_target_gone(out.reply->reason().to_string(), {bus, address}))
+    return false;
+  options_.pool->targets().forget(query());
+  recalled_ = false;
+  return true;
 }
 
 CommandChannel::Outcome CommandChannel::send(const CommandSpec& spec, const std::string& bus, std::uint16_t address,

@@ -50,10 +50,14 @@ class CommandChannel {
   pmu::dds::DdsContext& dds() { return dds_; }
   const std::string& vehicle() const { return vehicle_; }
 
-  // The PMU (resolve_target; skipped when `broadcast`) and the matched endpoints. nullopt
-  // when ready to send; else the exit status, after saying why.
+  // How open() finds the PMU: resolve_target; or, in a call `pmuctl agent` serves, first the
+  // PMU its worker found for the same vehicle and options before (TargetMemory), which a
+  // caller that reads nothing more of the device takes; or none, for a broadcast.
+  enum class Find { Resolve, MayRecall, Broadcast };
+  // The PMU and the matched endpoints. nullopt when ready to send; else the exit status,
+  // after saying why.
   std::optional<int> open(Clock::time_point deadline, std::string& bus, std::uint16_t& address,
-                          bool broadcast = false);
+                          Find find = Find::Resolve);
 
   struct Outcome {
     std::string request_id;
@@ -65,9 +69,16 @@ class CommandChannel {
   // printed on stderr and keeps the wait open 3 s more than `timeout` would.
   Outcome send(const CommandSpec& spec, const std::string& bus, std::uint16_t address, double timeout);
 
+  // True when open() took a remembered PMU and `out` is the service's answer that it has no
+  // such device (not executed): the PMU is forgotten, and open() finds it afresh.
+  bool recalled_target_gone(const Outcome& out, const std::string& bus, std::uint16_t address);
+
  private:
+  TargetQuery query() const { return {vehicle_, options_.bus, options_.address}; }
+
   const GlobalOptions& options_;
   std::string vehicle_;
+  bool recalled_ = false;  // open() took the PMU from the agent's TargetMemory
   ContextLease lease_;
   pmu::dds::DdsContext& dds_;
   eprosima::fastdds::dds::DataReader& replies_;

@@ -179,10 +179,21 @@ int run_command(const GlobalOptions& o, const CommandSpec& spec) {
   const bool broadcast = spec.kind == pmu::v4::ENGINE_STOP && o.address && *o.address == codec::kBroadcastAddress;
   std::string bus = broadcast ? o.bus : std::string();
   std::uint16_t address = broadcast ? codec::kBroadcastAddress : 0;
-  if (const auto failed = channel.open(deadline, bus, address, broadcast)) return *failed;
+  using Find = CommandChannel::Find;
+  if (const auto failed = channel.open(deadline, bus, address, broadcast ? Find::Broadcast : Find::MayRecall))
+    return *failed;
 
-  const auto timeout_left = std::max(0.0, std::chrono::duration<double>(deadline - Clock::now()).count());
-  const auto out = channel.send(spec, bus, address, timeout_left);
+  const auto timeout_left = [&deadline] {
+    return std::max(0.0, std::chrono::duration<double>(deadline - Clock::now()).count());
+  };
+  auto out = channel.send(spec, bus, address, timeout_left());
+  // The PMU this agent's worker commanded before is no longer there (it moved, or its service
+  // restarted without it); the service executed nothing, so the command goes, under a new
+  // request id, to the PMU found now.
+  if (channel.recalled_target_gone(out, bus, address)) {
+    if (const auto failed = channel.open(deadline, bus, address)) return *failed;
+    out = channel.send(spec, bus, address, timeout_left());
+  }
   if (!out.written) return fail(o, ExitStatus::NotDone, "the command could not be written to DDS");
   if (const auto& r = out.reply) {
     if (o.json) {

@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "pmu/dds/dds_context.hpp"
+#include "pmuctl/agent/target_memory.hpp"
 #include "pmuctl/verbs/state_verbs.hpp"
 
 namespace pmu::tools {
@@ -37,8 +38,12 @@ class ContextPool {
   // when the partitions cannot be set.
   pmu::dds::DdsContext& context(const std::string& participant_name, const pmu::dds::Partitions& partitions);
 
+  // The PMU each vehicle's commands went to (command_channel.hpp says when it is used).
+  TargetMemory& targets() noexcept { return targets_; }
+
  private:
   GlobalOptions settings_;
+  TargetMemory targets_;
   std::map<std::string, std::unique_ptr<pmu::dds::DdsContext>> contexts_;
 };
 
