@@ -250,6 +250,31 @@ TEST_F(PmuctlAgentWithUav1, ACommandFollowsTheRememberedPmuWhenItMoved) {
   EXPECT_EQ(count(service_log, "audit: command " + j["request_id"].get<std::string>()), 1u) << service_log;
 }
 
+// A list through the agent tells its worker each vehicle's one PMU: the next command goes
+// there without reading the health again. Moved meanwhile by a call of its own, the PMU is
+// found again.
+TEST_F(PmuctlAgentWithUav1, AListTellsTheWorkerEachVehiclesOnePmu) {
+  const std::string p = "PMU_AGENT_SOCKET=" + socket + " " + PMUCTL_PATH + " --domain " + std::to_string(domain) +
+                        " --vehicle uav1 ";
+  bool listed = false;
+  for (int attempt = 0; attempt < 10 && !listed; ++attempt) {
+    const auto r = sh(p + "--timeout 10 --json list");
+    for (const auto& j : pmu::test::json_lines(r.out))
+      listed = listed || (!j.is_discarded() && j.contains("address") && j["address"] == 1);
+  }
+  ASSERT_TRUE(listed) << read_file(log) << uav1.describe();
+  auto r = sh(p + "--no-agent --timeout 30 --confirm config set can_address 7");
+  ASSERT_EQ(r.status, 0) << r.out << uav1.describe();
+
+  r = sh(p + "--timeout 30 --json config set payload_voltage 24");
+  EXPECT_EQ(r.status, 0) << r.out << uav1.describe();
+  EXPECT_NE(r.out.find("\"address\":7,"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("\"result\":\"COMPLETED\""), std::string::npos) << r.out;
+  const std::string service_log = uav1.describe();
+  EXPECT_EQ(count(service_log, "-> REJECTED: device 1 not seen on can0"), 1u)
+      << "the listed PMU was tried first\n" << service_log;
+}
+
 TEST_F(PmuctlAgentWithUav1, ACallThatWaitsForASilentAircraftHoldsUpNoOtherAndADeadWorkerIsReplaced) {
   const std::string p = "PMU_AGENT_SOCKET=" + socket + " " + PMUCTL_PATH + " --domain " + std::to_string(domain) + " ";
   bool served = false;

@@ -424,6 +424,24 @@ std::string contracts_cell(const std::set<int>& contracts) {
   return cell;
 }
 
+// In a call `pmuctl agent` serves: each listed vehicle's one PMU, which that worker's later
+// commands to the vehicle then take without reading its health again (target_memory.hpp); a
+// vehicle listed with several is forgotten, so its commands find out which.
+template <typename Latest>
+void remember_only_pmus(const Latest& latest, TargetMemory& memory) {
+  std::map<std::string, std::vector<Target>> pmus;
+  for (const auto& entry : latest)
+    if (entry.first.kind == pmu::v4::KIND_PMU) pmus[entry.first.vehicle].push_back({entry.first.bus, entry.first.address});
+  const auto now = TargetMemory::Clock::now();
+  for (const auto& [vehicle, found] : pmus) {
+    const TargetQuery query{vehicle, "", std::nullopt};
+    if (found.size() == 1)
+      memory.remember(query, found.front(), now);
+    else
+      memory.forget(query);
+  }
+}
+
 int run_list(const GlobalOptions& o) {
   ContextLease lease(o, kPmuctlParticipant);
   pmu::dds::DdsContext& dds = *lease;
@@ -431,6 +449,7 @@ int run_list(const GlobalOptions& o) {
   StateCollector<pmu::v4::DeviceInfo, pmu::v4::DeviceInfoPubSubType> info(dds, topics::kInfo);
   if (int rc = collect(o, dds, health, 3.0)) return rc;
   info.poll(o);
+  if (o.pool && o.bus.empty() && !o.address) remember_only_pmus(health.latest(), o.pool->targets());
   // Every contract each vehicle's services serve; those of other contracts only discovery sees.
   std::map<std::string, std::set<int>> contracts;
   for (const auto& v : vehicles_on_domain(dds)) contracts[v].insert(pmu::dds::contract_major());
