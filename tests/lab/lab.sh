@@ -774,6 +774,13 @@ check_executed_once() {  # ROUND...
 # A time bound missed: recorded, the scenario fails at its end naming all of them.
 MISSED=""
 missed() { MISSED="$MISSED${MISSED:+; }$*"; detail "TARGET MISSED: $*"; }
+# The agent's log of the calls that set payload_voltage to VALUE-PREFIX (12. the round, 13.
+# after the cut): "uavN by worker W in S s; ..." (W from 0: which worker, so spills show).
+agent_calls() {
+  grep "config set payload_voltage $1" "$WORK/$SCEN.agent.log" |
+    sed -n 's/.*worker \([0-9]*\): .*--vehicle \(uav[0-9]*\) .*: exit [0-9]* in \([0-9.]*\) s$/\2 by worker \1 in \3 s/p' |
+    tr '\n' ';' | sed 's/;$//; s/;/; /g'
+}
 resends_answered() { _n=0; for _j in $FLEET_STARTED; do _n=$((_n + $(duplicate_lines pmuctl- "$(fleet_log "$_j")" | wc -l))); done; echo "$_n"; }
 
 # The longest time without a sample of each VEHICLE in stream NAME between uptimes A and B
@@ -951,6 +958,7 @@ scenario_fleet8() {
   t_round=$(now)
   capture_mark round "$t_round"
   detail "command round, one pmuctl config set to each of the eight in turn: all COMPLETED, each executed once by its own vehicle (audit trails); pmuctl start to exit min $1 s, p50 $r_p50 s, p99 = max $r_p99 s (bound $FLEET_COMMAND_BOUND s); $(resends_answered) resends answered again, not executed"
+  detail "the round in gnd's agent: $(agent_calls '12\.')"
   true_that "$r_p99 <= $FLEET_COMMAND_BOUND" || missed "command round p99 $r_p99 s (each: $(awk '{ printf "%s %.2f s, ", $1, $3 - $2 }' "$WORK/$SCEN.round.cmds" | sed 's/, $//'); bound $FLEET_COMMAND_BOUND s)"
 
   # A cut of 30 s: longer than Fast DDS's default lease (20 s), shorter than the Discovery
@@ -981,6 +989,7 @@ scenario_fleet8() {
   set -- $(awk '{ print $3 - $2 }' "$WORK/$SCEN.after.cmds" | rank_stats)
   check_executed_once round after
   detail "after the restore: a command to each (all eight at once, after that list) COMPLETED by $back s (bound $FLEET_RESUME_BOUND s; each pmuctl p50 $2 s, max $4 s); no command of either round executed twice or by another vehicle"
+  detail "the eight at once in gnd's agent: $(agent_calls '13\.')"
   true_that "$back <= $FLEET_RESUME_BOUND" || missed "after the link's return, every aircraft listed after $relisted s and commanded by $back s (bound $FLEET_RESUME_BOUND s)"
 
   # A ninth aircraft joins, then uav8 leaves, while gnd watches the fleet's low-rate topics.

@@ -86,8 +86,9 @@ std::string words(const std::vector<std::string>& arguments) {
   return s;
 }
 
-// Runs one accepted connection's call. Every outcome is one line of the agent's log.
-void serve(int connection, ContextPool& pool, const AgentCallRunner& run) {
+// Runs one accepted connection's call. Every outcome is one line of the agent's log, which
+// names the worker (0 first): whether calls spilled over to further workers shows there.
+void serve(int connection, ContextPool& pool, const AgentCallRunner& run, int worker) {
   ucred peer{};
   socklen_t len = sizeof peer;
   if (::getsockopt(connection, SOL_SOCKET, SO_PEERCRED, &peer, &len) != 0 || peer.uid != ::geteuid()) {
@@ -124,11 +125,11 @@ void serve(int connection, ContextPool& pool, const AgentCallRunner& run) {
   }
   const double secs = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   if (reply.ran)
-    std::fprintf(stderr, "pmuctl agent: pid %d: %s: exit %d in %.2f s\n", static_cast<int>(peer.pid),
-                 words(request->arguments).c_str(), reply.status, secs);
+    std::fprintf(stderr, "pmuctl agent: worker %d: pid %d: %s: exit %d in %.2f s\n", worker,
+                 static_cast<int>(peer.pid), words(request->arguments).c_str(), reply.status, secs);
   else
-    std::fprintf(stderr, "pmuctl agent: pid %d: %s: declined (%s)\n", static_cast<int>(peer.pid),
-                 words(request->arguments).c_str(), reply.declined.c_str());
+    std::fprintf(stderr, "pmuctl agent: worker %d: pid %d: %s: declined (%s)\n", worker,
+                 static_cast<int>(peer.pid), words(request->arguments).c_str(), reply.declined.c_str());
   if (!send_with_fds(connection, encode_reply(reply), {}))
     std::fprintf(stderr, "pmuctl agent: pid %d: its caller left before the answer\n", static_cast<int>(peer.pid));
 }
@@ -195,8 +196,11 @@ std::int64_t steady_ns() {
 // for kSpillAfter: calls go to the first worker while it keeps up, so its endpoints, already
 // matched at the aircraft (command endpoints stay matched, ContextPool), serve them, and each
 // further worker, whose first calls announce endpoints of its own to every aircraft, only
-// takes over from workers held up by an aircraft that does not answer.
-constexpr auto kSpillAfter = std::chrono::seconds(3);
+// takes over from workers held up by an aircraft that does not answer. Over a radio link
+// (700 ms round trip, 10 % loss) a call to an aircraft that answers takes 1 to 3.5 s, one
+// that repairs a loss twice up to 5 s; a spilled call costs the link a worker's new
+// endpoints and takes twice as long, so only a call past that waits for another worker.
+constexpr auto kSpillAfter = std::chrono::seconds(5);
 bool my_turn(int index) {
   if (!g_busy) return true;
   const std::int64_t now = steady_ns();
@@ -231,7 +235,7 @@ void serve_calls(int listener, const GlobalOptions& settings, const AgentCallRun
     UniqueFd connection(::accept4(listener, nullptr, nullptr, SOCK_CLOEXEC));
     if (!connection) continue;  // another worker took it
     if (g_busy) g_busy[index].store(steady_ns());
-    serve(connection.get(), pool, run);
+    serve(connection.get(), pool, run, index);
     if (g_busy) g_busy[index].store(0);
   }
 }
