@@ -119,6 +119,7 @@ DomainParticipantQos participant_qos(const std::string& name, Transport transpor
       builtin.discovery_config.leaseDuration_announcementperiod = kClientAnnouncementPeriod;
       builtin.discovery_config.m_DiscoveryServers.clear();
       for (std::size_t id = 0; id < network.servers.size(); ++id) {
+        if (network.servers[id].locators.empty()) continue;  // an id left unused
         RemoteServerAttributes server;
         // The prefix `fastdds discovery -i ID` gives its server; ROS_DISCOVERY_SERVER's convention.
         get_server_client_default_guidPrefix(static_cast<int>(id), server.guidPrefix);

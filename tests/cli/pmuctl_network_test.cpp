@@ -49,6 +49,10 @@ const BadCase kBad[] = {
      "here): give an IPv4 address or a host name\n"},
     {"PMU_DISCOVERY_SERVER=10.0.0.1:x pmuctl list",
      "pmuctl: PMU_DISCOVERY_SERVER '10.0.0.1:x': port 'x' is not a number\n"},
+    {"pmuctl --discovery-server , list",
+     "pmuctl: --discovery-server names no server (an empty entry only leaves its id unused)\n"},
+    {"PMU_DISCOVERY_SERVER=' , ' pmuctl list",
+     "pmuctl: PMU_DISCOVERY_SERVER names no server (an empty entry only leaves its id unused)\n"},
     {"pmuctl --interface eth1/x list",
      "pmuctl: --interface 'eth1/x': 'eth1/x' is not an interface name (1..15 characters, no '/', ':' or space) or an "
      "IPv4 address\n"},

@@ -415,6 +415,22 @@ TEST(DiscoveryEndToEnd, ServiceAndPmuctlAsClientsOfADiscoveryServer) {
   EXPECT_TRUE(service.running());
 }
 
+// A Discovery Server on each host, each host's participants clients of their own and the
+// ground station a client of all: the service names only server 1 (an empty first entry),
+// as pmuctl does.
+TEST(DiscoveryEndToEnd, AClientOfTheServerWithId1Alone) {
+  if (::access(kDiscoveryServer, X_OK) != 0)
+    GTEST_SKIP() << kDiscoveryServer << " is missing: install Debian's fastdds-tools (scripts/setup.sh does)";
+  const std::string domain = std::to_string(pmu::test::exclusive_dds_domain());
+  const std::string port = std::to_string(pmu::test::free_udp_port());
+  Server server(1, static_cast<std::uint16_t>(std::stoi(port)));
+  ConfigFile config("domain: " + domain + "\ndds_transport: udp\ndiscovery:\n  mode: server\n  servers: [\"\", \"127.0.0.1:" +
+                    port + "\"]\n");
+  pmu::test::Child service({PMU_SERVICE_PATH, "--config", config.path, "--bus", "sim", "--log-level", "warn"});
+  expect_watch("", "--discovery-server ,127.0.0.1:" + port, domain);
+  EXPECT_TRUE(service.running());
+}
+
 TEST(DiscoveryEndToEnd, PmuctlOptionsWinOverTheEnvironment) {
   // A bad PMU_DDS_PEERS is not even read when --discovery-server is given, nor a bad
   // PMU_DDS_INTERFACES with --interface: pmuctl gets as far as looking for the service.

@@ -323,6 +323,9 @@ const BadCase kBadNetwork[] = {
      "bad.yaml:6: peer 'gcs.local' appears twice in peers"},
     {"discovery:\n  mode: server\n  servers: [\"10.0.0.1:11811\", \"10.0.0.1:11811\"]\n",
      "bad.yaml:6: server '10.0.0.1:11811' appears twice in servers"},
+    {"discovery:\n  mode: server\n  servers: [\"\", \"\"]\n",
+     "bad.yaml:6: servers must name at least one server (an empty entry only leaves its id unused), e.g. "
+     "[\"10.0.0.1:11811\"]"},
     {"discovery:\n  mode: server\n  servers: [\"10.0.0.1:0\"]\n",
      "bad.yaml:6: server '10.0.0.1:0': port 0 out of range 1..65535"},
     {"dds_transport: shm\ndiscovery:\n  mode: unicast\n  peers: [10.0.0.1]\n",
@@ -421,6 +424,16 @@ TEST(ConfigNetwork, ServersInIdOrder) {
   EXPECT_EQ(c.network.servers[1].host, "ds2.local");
   EXPECT_EQ(c.network.servers[1].port, 0) << "11811 is filled in when resolved";
   EXPECT_EQ(c.network.servers[1].where, "s.yaml:8");
+}
+
+// A client of the server with id 1 alone (a Discovery Server on each mission computer, the
+// ground station a client of all of them in id order).
+TEST(ConfigNetwork, AnEmptyServerEntryLeavesItsIdUnused) {
+  const Config c = parse_config(std::string(kBus) + "discovery:\n  mode: server\n  servers: [\"\", \"10.0.0.2\"]\n",
+                                "s.yaml");
+  ASSERT_EQ(c.network.servers.size(), 2u);
+  EXPECT_EQ(c.network.servers[0].host, "");
+  EXPECT_EQ(c.network.servers[1].host, "10.0.0.2");
 }
 
 TEST(ConfigNetwork, AtMost256ServersTheIdsOfAGuidPrefixByte) {

@@ -118,6 +118,22 @@ TEST(NetworkResolve, ServersKeepTheirPositionAndGetTheDefaultPort) {
             "192.168.11.20:14520");
 }
 
+TEST(NetworkResolve, AnEmptyServerEntryKeepsItsIdAndHasNoLocator) {
+  NetworkConfig c;
+  c.mode = DiscoveryMode::Server;
+  Address unused;
+  unused.where = "f.yaml:3";
+  c.servers = {unused, address("10.0.0.2")};
+  NetworkLookup none;  // nothing to look up
+  none.local_addresses = [] { return std::vector<LocalAddress>{}; };
+  const ResolvedNetwork r = resolve_network(c, none);
+  ASSERT_EQ(r.servers.size(), 2u);
+  EXPECT_TRUE(r.servers[0].locators.empty());
+  ASSERT_EQ(r.servers[1].locators.size(), 1u);
+  EXPECT_EQ(r.servers[1].locators[0], (Ipv4Endpoint{"10.0.0.2", kDefaultServerPort}));
+  EXPECT_EQ(r.summary, "server discovery through Discovery Server id 1 at 10.0.0.2:11811");
+}
+
 TEST(NetworkResolve, InterfaceNamesBecomeTheirAddresses) {
   NetworkConfig c;
   c.interfaces = {interface("eth1"), interface("10.1.1.5"), interface("lo"), interface("127.0.0.1")};

@@ -152,6 +152,18 @@ TEST(ParticipantQos, ServerModeIsAClientOfEachServerByPositionWithFastddsDiscove
   EXPECT_TRUE(b.initialPeersList.empty());
 }
 
+// An entry left empty keeps its id unused: a client of server 1 alone has that server only.
+TEST(ParticipantQos, AServerIdLeftUnusedIsNoServer) {
+  const DomainParticipantQos q =
+      participant_qos("pmu-service", Transport::Default, server({{}, {{{"10.0.0.2", 11811}}}}), {});
+  const auto& servers = q.wire_protocol().builtin.discovery_config.m_DiscoveryServers;
+  ASSERT_EQ(servers.size(), 1u);
+  std::ostringstream p;
+  p << servers.begin()->guidPrefix;
+  EXPECT_EQ(p.str(), "44.53.01.5f.45.50.52.4f.53.49.4d.41") << "fastdds discovery -i 1";
+  EXPECT_EQ(texts(servers.begin()->metatrafficUnicastLocatorList), (std::vector<std::string>{"10.0.0.2:11811"}));
+}
+
 // A client's announcements cross the radio link to the server: three per lease, not
 // Fast DDS's every 3 s, and a lease longer than a 30 s dropout; the other modes keep Fast DDS's periods (a multicast participant that
 // announced less often would be found later after a lost first announcement).

@@ -528,8 +528,11 @@ void parse_security(const Ctx& c, const YAML::Node& key, const YAML::Node& n, Se
 // discovery: and interfaces: (interface.md 7.2). Each entry is read by dds::parse_address or
 // dds::parse_interface, which pmuctl uses too, so both say the same about the same text.
 // Names are only checked for form here; they are looked up at start (dds::resolve_network).
+// `empty_keeps_position`: an empty string is an entry of its own (a server id left unused),
+// kept with an empty host; at least one entry must name something.
 std::vector<dds::Address> parse_address_list(const Ctx& c, const YAML::Node& n, const std::string& key,
-                                             const std::string& what, const std::string& example) {
+                                             const std::string& what, const std::string& example,
+                                             bool empty_keeps_position = false) {
   if (!n.IsSequence()) c.fail(n, key + " must be a list, e.g. " + example);
   if (n.size() == 0) c.fail(n, key + " must name at least one " + what + ", e.g. " + example);
   std::vector<dds::Address> out;
@@ -539,6 +542,10 @@ std::vector<dds::Address> parse_address_list(const Ctx& c, const YAML::Node& n, 
     dds::Address a;
     a.text = item.Scalar();
     a.where = c.line_of(item);
+    if (empty_keeps_position && a.text.empty()) {
+      out.push_back(std::move(a));
+      continue;
+    }
     const std::string why = what == "interface" ? dds::parse_interface(a.text, a) : dds::parse_address(a.text, a);
     if (!why.empty()) c.fail(item, what + " " + quoted(a.text) + ": " + why);
     std::string host = a.host;  // host names are case-insensitive
@@ -546,6 +553,9 @@ std::vector<dds::Address> parse_address_list(const Ctx& c, const YAML::Node& n, 
     if (!seen.insert({host, a.port}).second) c.fail(item, what + " " + quoted(a.text) + " appears twice in " + key);
     out.push_back(std::move(a));
   }
+  if (std::all_of(out.begin(), out.end(), [](const dds::Address& a) { return a.host.empty(); }))
+    c.fail(n, key + " must name at least one " + what + " (an empty entry only leaves its id unused), e.g. " +
+                  example);
   return out;
 }
 
@@ -584,7 +594,7 @@ void parse_discovery(const Ctx& c, const YAML::Node& key, const YAML::Node& n, d
     const YAML::Node& s = *v;
     if (net.mode != dds::DiscoveryMode::Server)
       c.fail(s, "servers are for discovery mode server, not " + mode_name + " (set mode: server, or remove servers)");
-    net.servers = parse_address_list(c, s, "servers", "server", "[\"10.0.0.1:11811\"]");
+    net.servers = parse_address_list(c, s, "servers", "server", "[\"10.0.0.1:11811\"]", true);
     if (net.servers.size() > dds::kMaxServers)
       c.fail(s[dds::kMaxServers], "more than " + std::to_string(dds::kMaxServers) + " servers (server ids are 0..255)");
   }

@@ -213,6 +213,10 @@ ResolvedNetwork resolve_network(const NetworkConfig& config, const NetworkLookup
   } else if (config.mode == DiscoveryMode::Server) {
     for (const auto& s : config.servers) {
       ResolvedServer rs;
+      if (s.host.empty()) {  // an id left unused
+        r.servers.push_back(std::move(rs));
+        continue;
+      }
       const std::uint16_t port = s.port ? s.port : kDefaultServerPort;
       for (const auto& ip : addresses_of(s, "server")) rs.locators.push_back({ip, port});
       std::vector<std::string> l;

@@ -35,14 +35,20 @@ std::vector<std::string> split_commas(const std::string& s) {
 }
 
 // Reads each entry with the config's functions; `where` names the option or variable.
+// `empty_keeps_position`: an empty entry (",10.0.0.2") is a server id left unused; at least
+// one must name a server.
 std::optional<std::vector<dds::Address>> addresses(const std::vector<std::string>& texts, const std::string& where,
-                                                   bool interface) {
+                                                   bool interface, bool empty_keeps_position = false) {
   std::vector<dds::Address> out;
   std::set<std::pair<std::string, std::uint16_t>> seen;
   for (const auto& text : texts) {
     dds::Address a;
     a.text = text;
     a.where = where;
+    if (empty_keeps_position && text.empty()) {
+      out.push_back(std::move(a));
+      continue;
+    }
     const std::string why = interface ? dds::parse_interface(text, a) : dds::parse_address(text, a);
     if (!why.empty()) {
       std::fprintf(stderr, "pmuctl: %s '%s': %s\n", where.c_str(), text.c_str(), why.c_str());
@@ -55,6 +61,10 @@ std::optional<std::vector<dds::Address>> addresses(const std::vector<std::string
       return std::nullopt;
     }
     out.push_back(std::move(a));
+  }
+  if (empty_keeps_position && std::all_of(out.begin(), out.end(), [](const dds::Address& a) { return a.host.empty(); })) {
+    std::fprintf(stderr, "pmuctl: %s names no server (an empty entry only leaves its id unused)\n", where.c_str());
+    return std::nullopt;
   }
   return out;
 }
@@ -95,7 +105,7 @@ bool resolve_network_options(const NetworkOptions& o, const dds::NetworkLookup& 
     config.mode = dds::DiscoveryMode::Unicast;
     config.peers = std::move(*a);
   } else if (!servers.empty()) {
-    auto a = addresses(servers, servers_from, false);
+    auto a = addresses(servers, servers_from, false, true);
     if (!a) return false;
     if (a->size() > dds::kMaxServers) {
       std::fprintf(stderr, "pmuctl: %s: more than %zu servers (server ids are 0..255)\n", servers_from.c_str(),

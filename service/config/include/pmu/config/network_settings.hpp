@@ -59,7 +59,9 @@ struct Address {
 struct NetworkConfig {
   DiscoveryMode mode = DiscoveryMode::Multicast;
   std::vector<Address> peers;       // Unicast: at least one
-  std::vector<Address> servers;     // Server: at least one; the position is the server id
+  // Server: the position is the server id; an entry with an empty host leaves its id unused
+  // (a server of id 1 alone: ["", "10.0.0.2"]), and at least one names a server.
+  std::vector<Address> servers;
   std::vector<Address> interfaces;  // empty: every interface; host = a name or an IPv4 address
 };
 
@@ -109,7 +111,7 @@ struct Ipv4Endpoint {
 
 // A server and every address its host name resolved to.
 struct ResolvedServer {
-  std::vector<Ipv4Endpoint> locators;  // each with the server's port (11811 if none given)
+  std::vector<Ipv4Endpoint> locators;  // each with the server's port (11811 if none given); empty: an id left unused
 };
 
 // NetworkConfig with every name replaced by its addresses: what the participant QoS needs.
