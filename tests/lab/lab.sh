@@ -16,9 +16,9 @@
 #   sh /lab.sh one NAME     a single scenario (what `all` runs for each)
 
 ALL_SCENARIOS="topology consumers commands cut cut_lifespan fleet unicast discovery_server security"
-# Run by name only (`one fleet8`), not in `all`: it asserts a fleet's targets that are not met
-# yet (tests/lab/README.md), so in `all` it would fail every run of the suite.
-NAMED_SCENARIOS="fleet8"
+# Run by name only (`one fleet8`), not in `all`: they assert a fleet's targets that are not
+# all met yet (tests/lab/README.md), so in `all` they would fail every run of the suite.
+NAMED_SCENARIOS="fleet8 fleet8_ground_server"
 
 export PATH=/opt/pmu/bin:/usr/sbin:/usr/bin:/sbin:/bin
 export PMU_QOS_FILE=/etc/pmu-dds/qos.xml
@@ -675,13 +675,18 @@ discovery:
   ground_served "discovery server in mc2"
 }
 
-# Eight aircraft over the ground link, each a client of a Discovery Server on the ground
-# host (deploy/README.md, "A fleet on one ground link": with multicast discovery every new
-# ground participant makes each aircraft send it all its endpoints, about 17 kB, which
-# eight aircraft cannot fit through 250 kbit/s). Multicast is stopped at the bridge; the
-# server in gnd runs with the shipped radio periods. The lab has two mission computers, so
-# each runs four services (uav1..4 in mc1, uav5..8 in mc2): a vehicle is a service, whatever
-# host it runs on, and each service has its own participant, ports and audit trail.
+# Eight aircraft over the ground link, with Fast DDS Discovery Servers (deploy/README.md, "A
+# fleet on one ground link": with multicast discovery every new ground participant makes
+# each aircraft send it all its endpoints, about 17 kB, which eight aircraft cannot fit
+# through 250 kbit/s). Multicast is stopped at the bridge; the servers run with the shipped
+# radio periods. The lab has two mission computers, so each runs four services (uav1..4 in
+# mc1, uav5..8 in mc2): a vehicle is a service, whatever host it runs on, and each service
+# has its own participant, ports and audit trail.
+# FLEET_SERVERS=aircraft (`fleet8`, the set-up deploy/README.md recommends): a server on each
+# mission computer (id 0 in mc1, id 1 in mc2), its own services its clients, so their
+# registration never crosses the link; the ground a client of both. FLEET_SERVERS=ground
+# (`fleet8_ground_server`): one server in gnd, every participant its client, so the eight
+# services register with it across the link.
 FLEET_SIZE=8
 FLEET_LIST_BOUND=30     # s from the ground's first `pmuctl list` to the return of one listing every aircraft
 FLEET_COMMAND_BOUND=5   # s one `pmuctl config set` may take, start to exit (p99 of a round)
@@ -690,7 +695,15 @@ FLEET_GAP_BOUND=5       # s without a low-rate sample (one per packet a second) 
 # How long discovery is waited for at all: a missed bound is measured to the end and named,
 # and the scenario goes on to measure the rest; it fails at its end when any bound was missed.
 FLEET_LIST_LIMIT=90
-FLEET_DS="$(addr_of gnd):$DS_PORT"
+FLEET_SERVERS=aircraft
+# The server of host H, as its clients write it.
+fleet_ds() { echo "$(addr_of "$1"):$DS_PORT"; }
+# A service's `servers:` on host H: its own host's server, at that server's id.
+fleet_servers_of() {
+  if [ "$FLEET_SERVERS" = ground ]; then echo "[\"$(fleet_ds gnd)\"]"
+  elif [ "$1" = mc1 ]; then echo "[\"$(fleet_ds mc1)\"]"
+  else echo "[\"\", \"$(fleet_ds mc2)\"]"; fi
+}
 # The ground link's round trip as an integrator would write it in each service's `link:`:
 # 300 ms each way with 50 ms of jitter (netem on both ends).
 FLEET_ROUND_TRIP=0.7
@@ -705,7 +718,7 @@ start_aircraft() {
   start_service "$(fleet_host "$1")" "vehicle: uav$1
 discovery:
   mode: server
-  servers: [\"$FLEET_DS\"]
+  servers: $(fleet_servers_of "$(fleet_host "$1")")
 link:
   round_trip: $FLEET_ROUND_TRIP"
   eval "FLEET_LOG_$1=\$SVC_LOG FLEET_PID_$1=\$SVC_PID"
@@ -859,8 +872,8 @@ capture_report() {
     }'
   capture_kinds
 }
-# The same capture by what the RTPS messages carry: who sent them (the Discovery Server,
-# whose GUID prefix is 44.53.00.5f..., or another participant) and the first DATA,
+# The same capture by what the RTPS messages carry: who sent them (a Discovery Server, whose
+# GUID prefix is 44.53.ID.5f..., or another participant) and the first DATA,
 # DATA_FRAG, HEARTBEAT, ACKNACK or GAP submessage's writer (builtin participant, endpoint or
 # liveliness discovery, or user data). One CAPTURE-KIND line per phase, direction and kind
 # among the six largest.
@@ -872,7 +885,7 @@ capture_kinds() {
     function flush(   o, id, fl, len, w, ent, k, what, who) {
       if (t == "") return
       for (i = n; i >= 1 && at[i] > t; i--) ; if (i < 1) { t = ""; return }
-      who = (substr(hx, 73, 8) == "4453005f") ? "DS" : "peer"
+      who = (substr(hx, 73, 4) == "4453" && substr(hx, 79, 2) == "5f") ? "DS" : "peer"
       what = "other"; o = 48
       while (o + 4 <= length(hx) / 2) {
         id = byte(o); fl = hexval(byte(o + 1)); len = (fl % 2) ? le16(o + 2) : hexval(byte(o + 2) byte(o + 3))
@@ -915,16 +928,34 @@ capture_kinds() {
     }'
 }
 
+scenario_fleet8_ground_server() {
+  FLEET_SERVERS=ground
+  scenario_fleet8
+}
+
 scenario_fleet8() {
   t_start=$(now)
   capture_start
   capture_mark start "$t_start"
   set -- $(vm_ticks); vb0=$1 vt0=$2; l0=$(link_bytes)
   multicast_flood off || fail "cannot stop multicast flooding on the bridge"
-  $NETNS_EXEC gnd fast-discovery-server -i 0 -l "$(addr_of gnd)" -p "$DS_PORT" -x /etc/pmu-dds/discovery-server.xml \
-    >"$WORK/$SCEN.ds.log" 2>&1 &
-  track $!
-  CTL_EXTRA="--discovery-server $FLEET_DS"
+  if [ "$FLEET_SERVERS" = ground ]; then
+    $NETNS_EXEC gnd fast-discovery-server -i 0 -l "$(addr_of gnd)" -p "$DS_PORT" -x /etc/pmu-dds/discovery-server.xml \
+      >"$WORK/$SCEN.ds.log" 2>&1 &
+    track $!
+    CTL_EXTRA="--discovery-server $(fleet_ds gnd)"
+    servers_said="clients of the Discovery Server in gnd"
+  else
+    _id=0
+    for _h in mc1 mc2; do
+      $NETNS_EXEC "$_h" fast-discovery-server -i "$_id" -l "$(addr_of "$_h")" -p "$DS_PORT" -x /etc/pmu-dds/discovery-server.xml \
+        >"$WORK/$SCEN.ds-$_h.log" 2>&1 &
+      track $!
+      _id=$((_id + 1))
+    done
+    CTL_EXTRA="--discovery-server $(fleet_ds mc1),$(fleet_ds mc2)"
+    servers_said="each a client of the Discovery Server of its mission computer (gnd of both)"
+  fi
   # The ground station a radio link wants: one pmuctl agent, through which every pmuctl call
   # in gnd goes (interface.md 7.3); watch keeps a participant of its own.
   export PMU_AGENT_SOCKET="$WORK/$SCEN.agent.sock"
@@ -936,7 +967,7 @@ scenario_fleet8() {
   wait_until 60 fleet_ready || fail "not every service ready within 60 s of the start: $(for i in $FLEET_STARTED; do grep -q 'ready on DDS' "$(fleet_log "$i")" || printf 'uav%s ' "$i"; done)"
   t_ready=$(now)
   capture_mark ready "$t_ready"
-  detail "8 services (uav1-4 in mc1, uav5-8 in mc2), clients of the Discovery Server in gnd, multicast stopped; all ready $(calc "$t_ready - $t_start") s after the start"
+  detail "8 services (uav1-4 in mc1, uav5-8 in mc2), $servers_said, multicast stopped; all ready $(calc "$t_ready - $t_start") s after the start"
 
   # Discovery: the ground's first call, and calls after it until one lists the eight.
   l1=$(link_bytes)
@@ -1063,7 +1094,7 @@ security:
 scenario_limit() {  # seconds a scenario may take in the (slow, emulated) VM
   case "$1" in
     commands) echo 300 ;;
-    fleet8) echo 420 ;;
+    fleet8 | fleet8_ground_server) echo 420 ;;
     cut | cut_lifespan | fleet | security) echo 200 ;;
     topology) echo 60 ;;
     *) echo 150 ;;
@@ -1114,7 +1145,7 @@ before_scenario() {
   fi
   detail "started on an idle ground link ($_q packets queued, $_moved bytes in 1 s)"
 }
-FAIL_LOGS="service*.log ground.out.err *.err ds.log agent.log"
+FAIL_LOGS="service*.log ground.out.err *.err ds.log ds-*.log agent.log"
 DOMAIN_BASE=40
 
 case "${1:-all}" in
