@@ -121,6 +121,11 @@ class PmuctlAgentWithUav1 : public ::testing::Test {
   TempDir dir;
   const std::string socket = dir.path() + "/agent.sock", log = dir.path() + "/agent.log";
   pmu::test::Child agent = start_agent(domain, socket, log);
+
+  // The start of a pmuctl call to uav1 through the agent, ready for its options and verb.
+  std::string uav1_calls() const {
+    return "PMU_AGENT_SOCKET=" + socket + " " + PMUCTL_PATH + " --domain " + std::to_string(domain) + " --vehicle uav1 ";
+  }
 };
 
 TEST_F(PmuctlAgentWithUav1, CallsGoThroughItWithTheCallersOutputStatusAndDirectory) {
@@ -212,19 +217,21 @@ std::vector<pid_t> workers_of(pid_t agent) {
   return pids;
 }
 
+// `pmuctl list` of uav1 through the agent until it shows uav1's PMU at address 1 (the first
+// calls wait for the service as long as a loaded run needs); `p` as uav1_calls() gives it.
+bool listed_through_agent(const std::string& p) {
+  for (int attempt = 0; attempt < 10; ++attempt)
+    for (const auto& j : pmu::test::json_lines(sh(p + "--timeout 10 --json list").out))
+      if (!j.is_discarded() && j.contains("address") && j["address"] == 1) return true;
+  return false;
+}
+
 // The agent's worker sends a vehicle's later commands to the PMU it found for the first
 // (target_memory.hpp); when that PMU has moved, the service's "not seen" (nothing executed)
 // makes the call find it again and send the command there, once.
 TEST_F(PmuctlAgentWithUav1, ACommandFollowsTheRememberedPmuWhenItMoved) {
-  const std::string p = "PMU_AGENT_SOCKET=" + socket + " " + PMUCTL_PATH + " --domain " + std::to_string(domain) +
-                        " --vehicle uav1 ";
-  bool listed = false;
-  for (int attempt = 0; attempt < 10 && !listed; ++attempt) {
-    const auto r = sh(p + "--timeout 10 --json list");
-    for (const auto& j : pmu::test::json_lines(r.out))
-      listed = listed || (!j.is_discarded() && j.contains("address") && j["address"] == 1);
-  }
-  ASSERT_TRUE(listed) << read_file(log) << uav1.describe();
+  const std::string p = uav1_calls();
+  ASSERT_TRUE(listed_through_agent(p)) << read_file(log) << uav1.describe();
   const auto reply_of = [](const std::string& out) {
     for (const auto& j : pmu::test::json_lines(out))
       if (!j.is_discarded() && j.contains("result")) return j;
@@ -254,15 +261,8 @@ TEST_F(PmuctlAgentWithUav1, ACommandFollowsTheRememberedPmuWhenItMoved) {
 // there without reading the health again. Moved meanwhile by a call of its own, the PMU is
 // found again.
 TEST_F(PmuctlAgentWithUav1, AListTellsTheWorkerEachVehiclesOnePmu) {
-  const std::string p = "PMU_AGENT_SOCKET=" + socket + " " + PMUCTL_PATH + " --domain " + std::to_string(domain) +
-                        " --vehicle uav1 ";
-  bool listed = false;
-  for (int attempt = 0; attempt < 10 && !listed; ++attempt) {
-    const auto r = sh(p + "--timeout 10 --json list");
-    for (const auto& j : pmu::test::json_lines(r.out))
-      listed = listed || (!j.is_discarded() && j.contains("address") && j["address"] == 1);
-  }
-  ASSERT_TRUE(listed) << read_file(log) << uav1.describe();
+  const std::string p = uav1_calls();
+  ASSERT_TRUE(listed_through_agent(p)) << read_file(log) << uav1.describe();
   auto r = sh(p + "--no-agent --timeout 30 --confirm config set can_address 7");
   ASSERT_EQ(r.status, 0) << r.out << uav1.describe();
 
