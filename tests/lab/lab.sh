@@ -1136,12 +1136,29 @@ after_scenario() {
 # more and a left-over backlog is hundreds of packets.
 IDLE_PACKETS=10
 IDLE_BYTES=2000
+# Who keeps a link busy that should be idle: each host's bytes sent in 1 s, and every
+# process in its namespace (none should be left between scenarios).
+idle_senders() {
+  _t0=""; for _h in $HOSTS; do _t0="$_t0 $(on "$_h" cat /sys/class/net/eth0/statistics/tx_bytes)"; done
+  sleep 1
+  _i=0; _out="sent in 1 s:"
+  for _h in $HOSTS; do
+    _i=$((_i + 1)); _b=$(echo "$_t0" | awk -v i="$_i" '{ print $i }')
+    _out="$_out $_h $(( $(on "$_h" cat /sys/class/net/eth0/statistics/tx_bytes) - _b )) B"
+  done
+  for _h in $HOSTS; do
+    for _p in $(ip netns pids "$_h" 2>/dev/null); do
+      _out="$_out; in $_h: $_p $(tr '\0' ' ' <"/proc/$_p/cmdline" 2>/dev/null | cut -c1-60)"
+    done
+  done
+  echo "$_out"
+}
 before_scenario() {
   _q=$(link_backlog); _b0=$(link_bytes); sleep 1; _b1=$(link_bytes)
   _moved=$(echo "$_b0 $_b1" | awk '{ a = $3 - $1; b = $4 - $2; print (a > b ? a : b) }')
   _most=$(echo "$_q" | awk '{ print ($1 > $2 ? $1 : $2) }')
   if [ "$_most" -gt "$IDLE_PACKETS" ] || [ "$_moved" -gt "$IDLE_BYTES" ]; then
-    fail "the ground link was not idle at the start: packets queued (toward gnd, toward the aircraft) $_q, up to $_moved bytes sent in 1 s"
+    fail "the ground link was not idle at the start: packets queued (toward gnd, toward the aircraft) $_q, up to $_moved bytes sent in 1 s; $(idle_senders)"
   fi
   detail "started on an idle ground link ($_q packets queued, $_moved bytes in 1 s)"
 }
