@@ -121,6 +121,10 @@ std::optional<CommandKind> command_kind_from_name(std::string_view name) noexcep
   return std::nullopt;
 }
 
+std::string device_not_seen_reason(std::uint16_t address, std::string_view bus) {
+  return "device " + std::to_string(address) + " not seen on " + std::string(bus);
+}
+
 std::string_view to_string(CommandResult r) noexcept {
   switch (r) {
     case CommandResult::Completed: return "COMPLETED";

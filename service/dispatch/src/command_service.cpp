@@ -244,7 +244,7 @@ void CommandService::broadcast_on_every_bus(const CommandRequest& r) {
 std::optional<CommandService::Refusal> CommandService::check_device(BusWorker& worker, const DeviceSession* session,
                                                                   const CommandRequest& r) {
   const std::string device = "device " + std::to_string(r.address);
-  if (!session) return Refusal{CommandResult::Rejected, device + " not seen on " + r.bus};
+  if (!session) return Refusal{CommandResult::Rejected, device_not_seen_reason(r.address, r.bus)};
   // Firmware decides what a command may do; a stop needs nothing read.
   if (!session->info() && r.kind() != CommandKind::EngineStop)
     return Refusal{CommandResult::Rejected,

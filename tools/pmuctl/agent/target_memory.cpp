@@ -1,5 +1,7 @@
 #include "pmuctl/agent/target_memory.hpp"
 
+#include "pmu/command/command.hpp"
+
 namespace pmu::tools {
 
 TargetMemory::Key TargetMemory::key_of(const TargetQuery& query) {
@@ -19,8 +21,7 @@ void TargetMemory::remember(const TargetQuery& query, const Target& target, Cloc
 void TargetMemory::forget(const TargetQuery& query) { found_.erase(key_of(query)); }
 
 bool says_target_gone(const std::string& reason, const Target& target) {
-  // The service's words (CommandService::check_device); its audit line says the same.
-  return reason == "device " + std::to_string(target.address) + " not seen on " + target.bus;
+  return reason == pmu::service::device_not_seen_reason(target.address, target.bus);
 }
 
 }  // namespace pmu::tools

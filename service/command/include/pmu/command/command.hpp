@@ -49,6 +49,9 @@ std::optional<CommandKind> command_kind_from_name(std::string_view name) noexcep
 enum class CommandResult : std::uint8_t { Completed, Rejected, Denied, Unsupported, Timeout, Failed, InProgress };
 std::string_view to_string(CommandResult r) noexcept;  // "COMPLETED", ...
 inline bool is_final(CommandResult r) noexcept { return r != CommandResult::InProgress; }
+// The reason of a command REJECTED because its service has no device at `address` on `bus`:
+// nothing was executed. pmuctl's agent compares a reply with it (target_memory.hpp).
+std::string device_not_seen_reason(std::uint16_t address, std::string_view bus);
 
 // The IDL's string bounds (idl/command.idl): longer strings are rejected, not truncated.
 inline constexpr std::size_t kMaxRequestIdLength = 63;
