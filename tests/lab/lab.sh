@@ -134,6 +134,7 @@ lab_up() {
   rm -f "$WORK/tc-air" "$WORK/tc-gnd"; mkfifo "$WORK/tc-air" "$WORK/tc-gnd"
   /usr/sbin/tc -force -batch - <"$WORK/tc-air" >>"$WORK/tc.log" 2>&1 &
   $NETNS_EXEC gnd /usr/sbin/tc -force -batch - <"$WORK/tc-gnd" >>"$WORK/tc.log" 2>&1 &
+  echo $! >"$WORK/tc-gnd.pid"   # the one process a host's namespace keeps between scenarios
 }
 
 # ---- the programs ----------------------------------------------------------------------
@@ -1124,9 +1125,58 @@ link_backlog() {
   echo "$(tc -s qdisc show dev "$(port_of gnd)" | sed -n 's/.*backlog [^ ]* \([0-9]*\)p.*/\1/p' | head -n1)" \
     "$(on gnd /usr/sbin/tc -s qdisc show dev eth0 | sed -n 's/.*backlog [^ ]* \([0-9]*\)p.*/\1/p' | head -n1)"
 }
+# The hand-over to the next scenario. kill_started has stopped what the scenario tracked;
+# what it did not track (a process still in a host's namespace) is stopped here and named.
+# Then the link is reset only once no host's own stack sends any more: a process's last
+# words (a participant's goodbyes to every peer, repairs to a reader already gone) and the
+# kernel's answers to them (port unreachable) must land in the queue the reset drops, not in
+# the next scenario's first second, where they read as a link that is not idle.
 after_scenario() {
+  _left=$(lab_processes)
+  if [ -n "$_left" ]; then
+    _left=$(echo "$_left" | tr '\n' ';' | sed 's/;$//')
+    echo "[$SCEN] hand-over: left running, now stopped:$_left"
+    echo "$_left" | tr ';' '\n' | sed -n 's/.* pid \([0-9]*\):.*/\1/p' >"$WORK/pids"
+    kill_started
+    echo " the previous scenario left running:$_left" >"$WORK/handover"
+  else
+    : >"$WORK/handover"
+  fi
+  _t0=$(now)
+  if wait_until "$HANDOVER_QUIET" hosts_quiet; then
+    echo " the hosts fell quiet $(since "$_t0") s after the previous scenario ended" >>"$WORK/handover"
+  else
+    echo " the hosts still sent after $HANDOVER_QUIET s (packets in 1 s:$QUIET_SAID)" >>"$WORK/handover"
+  fi
   multicast_flood on
   reset_link || echo "[$SCEN] could not reset the ground link's netem"
+}
+# Every process in a host's namespace but the ground end's tc (lab_up's), each as
+# " HOST pid N: COMMAND".
+lab_processes() {
+  _keep=$(cat "$WORK/tc-gnd.pid" 2>/dev/null)
+  for _h in $HOSTS; do
+    for _p in $(ip netns pids "$_h" 2>/dev/null); do
+      [ "$_p" = "$_keep" ] && continue
+      printf ' %s pid %s: %s\n' "$_h" "$_p" "$(tr '\0' ' ' <"/proc/$_p/cmdline" 2>/dev/null | cut -c1-60)"
+    done
+  done
+}
+# The IP packets each host's own stack has sent ("N N N" in the order of HOSTS): counted
+# before any queue, so the ground end's netem draining what it holds is not a host sending.
+host_packets() {
+  for _h in $HOSTS; do
+    on "$_h" cat /proc/net/snmp | awk '/^Ip:/ { if (!n) { for (i = 2; i <= NF; i++) if ($i == "OutRequests") n = i; next } print $n }'
+  done | tr '\n' ' '
+}
+HANDOVER_QUIET=20  # s the hand-over waits for quiet hosts
+QUIET_PACKETS=4    # packets a quiet host may send in 1 s (IGMP leaves of closed sockets, ARP)
+# True when no host sent more than QUIET_PACKETS in 1 s; QUIET_SAID names those that did.
+hosts_quiet() {
+  _a=$(host_packets); sleep 1; _b=$(host_packets)
+  QUIET_SAID=$(echo "$_a $_b" | awk -v hosts="$HOSTS" -v most="$QUIET_PACKETS" '
+    { n = split(hosts, h, " "); for (i = 1; i <= n; i++) if ($(i + n) - $i > most) printf " %s %d", h[i], $(i + n) - $i }')
+  [ -z "$QUIET_SAID" ]
 }
 # Each scenario says that it starts on an idle link that nobody loads (every process of the
 # previous one has been killed), so a failure names its own cause. netem's delay line always
@@ -1137,7 +1187,7 @@ after_scenario() {
 IDLE_PACKETS=10
 IDLE_BYTES=2000
 # Who keeps a link busy that should be idle: each host's bytes sent in 1 s, and every
-# process in its namespace (none should be left between scenarios).
+# process in its namespace (none but lab_up's tc should be left between scenarios).
 idle_senders() {
   _t0=""; for _h in $HOSTS; do _t0="$_t0 $(on "$_h" cat /sys/class/net/eth0/statistics/tx_bytes)"; done
   sleep 1
@@ -1146,21 +1196,17 @@ idle_senders() {
     _i=$((_i + 1)); _b=$(echo "$_t0" | awk -v i="$_i" '{ print $i }')
     _out="$_out $_h $(( $(on "$_h" cat /sys/class/net/eth0/statistics/tx_bytes) - _b )) B"
   done
-  for _h in $HOSTS; do
-    for _p in $(ip netns pids "$_h" 2>/dev/null); do
-      _out="$_out; in $_h: $_p $(tr '\0' ' ' <"/proc/$_p/cmdline" 2>/dev/null | cut -c1-60)"
-    done
-  done
-  echo "$_out"
+  echo "$_out; processes:$(lab_processes | tr '\n' ';' | sed 's/;$//')"
 }
 before_scenario() {
   _q=$(link_backlog); _b0=$(link_bytes); sleep 1; _b1=$(link_bytes)
   _moved=$(echo "$_b0 $_b1" | awk '{ a = $3 - $1; b = $4 - $2; print (a > b ? a : b) }')
   _most=$(echo "$_q" | awk '{ print ($1 > $2 ? $1 : $2) }')
   if [ "$_most" -gt "$IDLE_PACKETS" ] || [ "$_moved" -gt "$IDLE_BYTES" ]; then
-    fail "the ground link was not idle at the start: packets queued (toward gnd, toward the aircraft) $_q, up to $_moved bytes sent in 1 s; $(idle_senders)"
+    fail "the ground link was not idle at the start: packets queued (toward gnd, toward the aircraft) $_q, up to $_moved bytes sent in 1 s; $(idle_senders);$(cat "$WORK/handover" 2>/dev/null | tr '\n' ';' | sed 's/;$//')"
   fi
-  detail "started on an idle ground link ($_q packets queued, $_moved bytes in 1 s)"
+  _ho=$(cat "$WORK/handover" 2>/dev/null | tr '\n' ';' | sed 's/;$//')
+  detail "started on an idle ground link ($_q packets queued, $_moved bytes in 1 s${_ho:+;$_ho})"
 }
 FAIL_LOGS="service*.log ground.out.err *.err ds.log ds-*.log agent.log"
 DOMAIN_BASE=40
