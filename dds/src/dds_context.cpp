@@ -242,19 +242,32 @@ bool DdsContext::move(Kept& k, const std::vector<std::string>& partitions) {
 
 DdsContext::Kept* DdsContext::take_up(const std::string& topic, const std::string& profile, bool writer,
                                       const std::vector<std::string>& partitions) {
-  // One still in this job's partitions first: taking it up costs the link nothing.
-  for (const bool same_partitions : {true, false})
-    for (auto& k : kept_)
-      if (!k.in_use && (k.writer != nullptr) == writer && k.topic == topic && k.profile == profile &&
-          (k.partitions == partitions) == same_partitions) {
-        // What a reader holds is an earlier job's (one left matched may also hold replies to
-        // other clients since).
-        if (k.reader) drain(*k.reader);
-        if (!same_partitions && !move(k, partitions)) continue;
-        k.in_use = true;
-        return &k;
-      }
-  return nullptr;
+  std::size_t alike = 0;
+  Kept* here = nullptr;   // idle, in these partitions: taking it up costs the link nothing
+  Kept* oldest = nullptr; // idle elsewhere, the least recently taken up
+  for (auto& k : kept_) {
+    if ((k.writer != nullptr) != writer || k.topic != topic || k.profile != profile) continue;
+    ++alike;
+    if (k.in_use) continue;
+    if (k.partitions == partitions) {
+      if (!here) here = &k;
+    } else if (!oldest || k.taken_up < oldest->taken_up) {
+      oldest = &k;
+    }
+  }
+  // One left matched in another vehicle's partitions serves that vehicle's next command
+  // there; moved, it would be announced again across the link twice.
+  const bool idle_matched = std::find(idle_matched_.begin(), idle_matched_.end(), profile) != idle_matched_.end();
+  if (!here && oldest && idle_matched && alike < kMostIdleMatched) oldest = nullptr;
+  Kept* k = here ? here : oldest;
+  if (!k) return nullptr;
+  // What a reader holds is an earlier job's (one left matched may also hold replies to
+  // other clients since).
+  if (k->reader) drain(*k->reader);
+  if (k != here && !move(*k, partitions)) return nullptr;
+  k->in_use = true;
+  k->taken_up = ++take_ups_;
+  return k;
 }
 
 DataWriter* DdsContext::kept_writer(Topic& topic, const std::string& profile) {
@@ -268,7 +281,7 @@ DataWriter* DdsContext::kept_writer(Topic& topic, const std::string& profile) {
     if (publisher) participant_->delete_publisher(publisher);
     throw;
   }
-  kept_.push_back({topic.get_name(), profile, partitions_.publisher, publisher, w, nullptr, nullptr, true});
+  kept_.push_back({topic.get_name(), profile, partitions_.publisher, publisher, w, nullptr, nullptr, true, ++take_ups_});
   return w;
 }
 
@@ -283,7 +296,7 @@ DataReader* DdsContext::kept_reader(Topic& topic, const std::string& profile) {
     if (subscriber) participant_->delete_subscriber(subscriber);
     throw;
   }
-  kept_.push_back({topic.get_name(), profile, partitions_.subscriber, nullptr, nullptr, subscriber, r, true});
+  kept_.push_back({topic.get_name(), profile, partitions_.subscriber, nullptr, nullptr, subscriber, r, true, ++take_ups_});
   return r;
 }
 

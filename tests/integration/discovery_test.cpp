@@ -27,6 +27,7 @@
 #include <sstream>
 #include <string>
 #include <thread>
+#include <vector>
 
 #include "pmu/config/network_settings.hpp"
 #include "pmu/dds/dds_context.hpp"
@@ -276,6 +277,61 @@ TEST(DiscoveryServer, ALongLivedClientsEndedReadersAreUnmatchedAtTheOtherClients
   reply_reader->get_subscription_matched_status(s);
   EXPECT_EQ(s.current_count, 1) << "the next job's reply reader is not matched at once";
   agent.delete_endpoints_since(mark);
+}
+
+// One job of a long-lived participant that reuses endpoints, in `vehicle`'s partitions: the
+// command reply reader it takes up or makes, parked again when the job ends.
+DataReader* reply_reader_of_a_job(DdsContext& agent, Topic& topic, const std::string& vehicle) {
+  EXPECT_TRUE(agent.set_partitions({{vehicle}, {vehicle}}));
+  const auto mark = agent.endpoint_mark();
+  DataReader* r = &agent.reader(topic, qos_profiles::kCommand);
+  agent.delete_endpoints_since(mark);
+  return r;
+}
+
+// A ground station's long-lived participant commands one vehicle after another. The command
+// endpoints it left matched in one vehicle's partitions stay there while another vehicle is
+// commanded: moved, each would be announced again across the link, there and back, and the
+// first vehicle's next command would wait for that discovery once more.
+TEST(EndpointReuse, ACommandEndpointLeftMatchedForOneVehicleStaysThereWhileAnotherIsCommanded) {
+  const auto domain = pmu::test::exclusive_dds_domain();
+  const ResolvedNetwork network = unicast_to_loopback();
+  DdsContext uav1(domain, "", "reuse-uav1", {}, Transport::UdpOnly, network, Partitions{{"uav1"}, {"uav1"}});
+  DdsContext uav2(domain, "", "reuse-uav2", {}, Transport::UdpOnly, network, Partitions{{"uav2"}, {"uav2"}});
+  auto replies_of = [](DdsContext& dds) -> DataWriter& {
+    return dds.writer(dds.topic(topics::kCommandReply, TypeSupport(new pmu::v4::CommandReplyPubSubType())),
+                      qos_profiles::kCommand);
+  };
+  DataWriter& replies1 = replies_of(uav1);
+  DataWriter& replies2 = replies_of(uav2);
+
+  DdsContext agent(domain, "", "reuse-agent", {}, Transport::UdpOnly, network);
+  agent.reuse_endpoints({qos_profiles::kCommand});
+  Topic& topic = agent.topic(topics::kCommandReply, TypeSupport(new pmu::v4::CommandReplyPubSubType()));
+  auto job = [&](const std::string& vehicle) { return reply_reader_of_a_job(agent, topic, vehicle); };
+  DataReader* for_uav1 = job("uav1");
+  ASSERT_TRUE(pmu::test::wait_until([&] { return matched_readers(replies1) == 1; }, 20s, 20ms));
+  DataReader* for_uav2 = job("uav2");
+  EXPECT_NE(for_uav2, for_uav1) << "uav1's reply reader was moved to uav2";
+  ASSERT_TRUE(pmu::test::wait_until([&] { return matched_readers(replies2) == 1; }, 20s, 20ms));
+  std::this_thread::sleep_for(1s);  // a move, had there been one, would have unmatched it by now
+  EXPECT_EQ(matched_readers(replies1), 1) << "uav1's reply reader was unmatched while uav2 was commanded";
+  EXPECT_EQ(job("uav1"), for_uav1) << "uav1's next command did not take up its own reader";
+  EXPECT_EQ(job("uav2"), for_uav2) << "uav2's next command did not take up its own reader";
+}
+
+// Left matched, they are bounded: beyond kMostIdleMatched vehicles, the least recently
+// used one moves to the next vehicle.
+TEST(EndpointReuse, BeyondTheMostLeftMatchedTheLeastRecentlyUsedMoves) {
+  DdsContext agent(pmu::test::exclusive_dds_domain(), "", "reuse-bound", {}, Transport::UdpOnly, unicast_to_loopback());
+  agent.reuse_endpoints({qos_profiles::kCommand});
+  Topic& topic = agent.topic(topics::kCommandReply, TypeSupport(new pmu::v4::CommandReplyPubSubType()));
+  auto job = [&](const std::string& vehicle) { return reply_reader_of_a_job(agent, topic, vehicle); };
+  std::vector<DataReader*> made;
+  for (std::size_t i = 0; i < DdsContext::kMostIdleMatched; ++i) made.push_back(job("uav" + std::to_string(i)));
+  EXPECT_EQ(std::set<DataReader*>(made.begin(), made.end()).size(), made.size()) << "a vehicle's reader was moved";
+  EXPECT_EQ(job("uav0"), made[0]);  // uav0 is now the most recently used, uav1 the least
+  EXPECT_EQ(job("one-more"), made[1]) << "not the least recently used one was moved";
 }
 
 // ---- the interface allowlist ---------------------------------------------------------------

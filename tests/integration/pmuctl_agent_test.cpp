@@ -21,10 +21,13 @@
 #include <thread>
 #include <vector>
 
+#include "pmu/dds/dds_context.hpp"
+#include "pmu/idl/topics.hpp"
 #include "support/configured_service.hpp"
 #include "support/domain.hpp"
 #include "support/json_lines.hpp"
 #include "support/process.hpp"
+#include "support/wait.hpp"
 
 namespace pmuctl_agent_test {  // named: the unity build joins this file with others that have an `sh`
 
@@ -273,6 +276,22 @@ TEST_F(PmuctlAgentWithUav1, AListTellsTheWorkerEachVehiclesOnePmu) {
   const std::string service_log = uav1.describe();
   EXPECT_EQ(count(service_log, "-> REJECTED: device 1 not seen on can0"), 1u)
       << "the listed PMU was tried first\n" << service_log;
+}
+
+// After a list through the agent, its worker has made the command writer of each vehicle it
+// showed, so the first command there finds it matched: over a radio link its discovery
+// would otherwise cost the command seconds. Seen by another participant, before any command.
+TEST_F(PmuctlAgentWithUav1, AListMakesTheCommandWriterOfEachVehicleItShowed) {
+  pmu::dds::DdsContext probe(domain, PMU_QOS_FILE, "agent-test-probe");
+  ASSERT_TRUE(listed_through_agent(uav1_calls())) << read_file(log) << uav1.describe();
+  const auto uav1_command_writer = [&] {
+    for (const auto& w : probe.remote_writers().writers_of(pmu::topics::kCommand))
+      for (const auto& partition : w.partitions)
+        if (partition.find("uav1") != std::string::npos) return true;
+    return false;
+  };
+  EXPECT_TRUE(pmu::test::wait_until(uav1_command_writer, 20s, 50ms))
+      << "no command writer of uav1 after the list\n" << read_file(log);
 }
 
 TEST_F(PmuctlAgentWithUav1, ACallThatWaitsForASilentAircraftHoldsUpNoOtherAndADeadWorkerIsReplaced) {

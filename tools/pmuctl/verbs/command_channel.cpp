@@ -146,6 +146,20 @@ CommandChannel::CommandChannel(const GlobalOptions& o)
       writer_(dds_.writer(dds_.topic(topics::kCommand, TypeSupport(new pmu::v4::CommandPubSubType())),
                           qos_profiles::kCommand)) {}
 
+void open_command_channels(const GlobalOptions& o, const std::vector<std::string>& vehicles) {
+  if (!o.pool || o.pool->commands_refused()) return;
+  for (const auto& vehicle : vehicles) {
+    GlobalOptions one = o;
+    one.vehicle = vehicle;
+    try {
+      const CommandChannel channel(one);  // its lease parks the endpoints, matched
+    } catch (const pmu::dds::DdsError&) {
+      o.pool->refuse_commands();  // tried once: each try would have Fast DDS log its refusal
+      return;
+    }
+  }
+}
+
 std::optional<int> CommandChannel::open(Clock::time_point deadline, std::string& bus, std::uint16_t& address,
                                         Find find) {
   recalled_ = false;

@@ -10,6 +10,7 @@
 #include <cstdint>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "pmu/dds/dds_context.hpp"
 #include "pmu/idl/command.h"
@@ -38,6 +39,15 @@ std::optional<int> wait_for_match(const GlobalOptions& o, pmu::dds::DdsContext& 
                                   eprosima::fastdds::dds::DataWriter& writer,
                                   eprosima::fastdds::dds::DataReader& replies, const std::string& vehicle,
                                   std::chrono::steady_clock::time_point deadline, const char* accepts);
+
+// In a call `pmuctl agent` serves (o.pool): makes each vehicle's command writer and reply
+// reader, which stay matched in its partitions while idle (DdsContext::reuse_endpoints), so
+// the first command to a vehicle a `list` has shown waits for no discovery across the link:
+// over a radio link each lost announcement of that discovery costs a second. Their matching
+// goes on after the call. Endpoints DDS refuses (an identity not allowed to command) are
+// left to a command to report, and the worker does not try again. Nothing for a call of
+// its own.
+void open_command_channels(const GlobalOptions& o, const std::vector<std::string>& vehicles);
 
 // The time `seconds` from now as ns since the Unix epoch (a request's expires_at).
 std::uint64_t epoch_ns_after(double seconds);

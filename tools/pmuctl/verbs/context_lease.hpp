@@ -41,9 +41,15 @@ class ContextPool {
   // The PMU each vehicle's commands went to (command_channel.hpp says when it is used).
   TargetMemory& targets() noexcept { return targets_; }
 
+  // Whether DDS refused this pool's command endpoints once (an identity not allowed to
+  // command): a list then no longer makes them ahead of a command (open_command_channels).
+  bool commands_refused() const noexcept { return commands_refused_; }
+  void refuse_commands() noexcept { commands_refused_ = true; }
+
  private:
   GlobalOptions settings_;
   TargetMemory targets_;
+  bool commands_refused_ = false;
   std::map<std::string, std::unique_ptr<pmu::dds::DdsContext>> contexts_;
 };
 

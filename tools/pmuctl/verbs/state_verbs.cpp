@@ -26,6 +26,7 @@
 #include "pmu/idl/topics.hpp"
 #include "pmu/transport/stop_signals.hpp"
 #include "pmuctl/verbs/alarm_sample.hpp"
+#include "pmuctl/verbs/command_channel.hpp"
 #include "pmuctl/verbs/exit_status.hpp"
 #include "pmuctl/verbs/service_presence.hpp"
 #include "pmuctl/verbs/state_settle.hpp"
@@ -427,29 +428,45 @@ std::string contracts_cell(const std::set<int>& contracts) {
 // In a call `pmuctl agent` serves: each listed vehicle's one PMU, which that worker's later
 // commands to the vehicle then take without reading its health again (target_memory.hpp); a
 // vehicle listed with several is forgotten, so its commands find out which.
+// Returns the vehicles remembered.
 template <typename Latest>
-void remember_only_pmus(const Latest& latest, TargetMemory& memory) {
+std::vector<std::string> remember_only_pmus(const Latest& latest, TargetMemory& memory) {
   std::map<std::string, std::vector<Target>> pmus;
   for (const auto& entry : latest)
     if (entry.first.kind == pmu::v4::KIND_PMU) pmus[entry.first.vehicle].push_back({entry.first.bus, entry.first.address});
   const auto now = TargetMemory::Clock::now();
+  std::vector<std::string> remembered;
   for (const auto& [vehicle, found] : pmus) {
     const TargetQuery query{vehicle, "", std::nullopt};
-    if (found.size() == 1)
+    if (found.size() == 1) {
       memory.remember(query, found.front(), now);
-    else
+      remembered.push_back(vehicle);
+    } else {
       memory.forget(query);
+    }
   }
+  return remembered;
 }
 
+// The list itself; `one_pmu`: the vehicles it found one PMU of, in a call the agent serves.
+static int list_once(const GlobalOptions& o, std::vector<std::string>& one_pmu);
+
 int run_list(const GlobalOptions& o) {
+  std::vector<std::string> one_pmu;
+  const int rc = list_once(o, one_pmu);
+  // After its lease: the channels borrow the same participant.
+  if (rc == 0) open_command_channels(o, one_pmu);
+  return rc;
+}
+
+static int list_once(const GlobalOptions& o, std::vector<std::string>& one_pmu) {
   ContextLease lease(o, kPmuctlParticipant);
   pmu::dds::DdsContext& dds = *lease;
   StateCollector<pmu::v4::Health, pmu::v4::HealthPubSubType> health(dds, topics::kHealth);
   StateCollector<pmu::v4::DeviceInfo, pmu::v4::DeviceInfoPubSubType> info(dds, topics::kInfo);
   if (int rc = collect(o, dds, health, 3.0)) return rc;
   info.poll(o);
-  if (o.pool && o.bus.empty() && !o.address) remember_only_pmus(health.latest(), o.pool->targets());
+  if (o.pool && o.bus.empty() && !o.address) one_pmu = remember_only_pmus(health.latest(), o.pool->targets());
   // Every contract each vehicle's services serve; those of other contracts only discovery sees.
   std::map<std::string, std::set<int>> contracts;
   for (const auto& v : vehicles_on_domain(dds)) contracts[v].insert(pmu::dds::contract_major());

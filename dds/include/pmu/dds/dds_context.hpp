@@ -33,6 +33,7 @@
 #include <fastdds/dds/topic/TypeSupport.hpp>
 #include <chrono>
 #include <cstddef>
+#include <cstdint>
 #include <map>
 #include <optional>
 #include <stdexcept>
@@ -181,7 +182,10 @@ class DdsContext {
   // job uses at once, per topic and profile. Same thread rule as writer() and reader().
   // `idle_matched`: profiles whose endpoints stay matched in their partitions while idle
   // (nothing flows to them unasked, so a later job in the same partitions finds them matched
-  // at no cost to the link); the others are parked.
+  // at no cost to the link); the others are parked. A job in other partitions gets a new one
+  // of these rather than one moved from the partitions it serves, up to kMostIdleMatched of
+  // a topic and profile (a ground station's fleet); beyond, the least recently used moves.
+  static constexpr std::size_t kMostIdleMatched = 16;
   void reuse_endpoints(std::vector<std::string> idle_matched) {
     reuse_ = true;
     idle_matched_ = std::move(idle_matched);
@@ -229,7 +233,9 @@ class DdsContext {
     eprosima::fastdds::dds::Subscriber* subscriber = nullptr;  // a reader's
     eprosima::fastdds::dds::DataReader* reader = nullptr;
     bool in_use = false;
+    std::uint64_t taken_up = 0;  // when last taken up, in take_ups_
   };
+  std::uint64_t take_ups_ = 0;
   bool reuse_ = false;
   std::vector<std::string> idle_matched_;
   std::chrono::milliseconds heartbeat_floor_{0};
@@ -237,7 +243,9 @@ class DdsContext {
   eprosima::fastdds::dds::DataWriter* kept_writer(eprosima::fastdds::dds::Topic& topic, const std::string& profile);
   eprosima::fastdds::dds::DataReader* kept_reader(eprosima::fastdds::dds::Topic& topic, const std::string& profile);
   // An idle kept writer (`writer`) or reader of this topic and profile, in `partitions` (one
-  // already there first), marked in use; a reader emptied. Null when there is none.
+  // already there first, else the least recently used moved there, but not an idle-matched
+  // one while fewer than kMostIdleMatched exist), marked in use; a reader emptied. Null
+  // when there is none to take: the caller makes one.
   Kept* take_up(const std::string& topic, const std::string& profile, bool writer,
                 const std::vector<std::string>& partitions);
   // Moves a kept endpoint's publisher or subscriber; false when Fast DDS refuses.
