@@ -693,6 +693,7 @@ FLEET_LIST_BOUND=30     # s from the ground's first `pmuctl list` to the return 
 FLEET_COMMAND_BOUND=5   # s one `pmuctl config set` may take, start to exit (p99 of a round)
 FLEET_RESUME_BOUND=20   # s from the link's return to every aircraft listed and a command to each COMPLETED
 FLEET_GAP_BOUND=5       # s without a low-rate sample (one per packet a second) that count as stopped telemetry
+FLEET_STEADY=10         # s the watch runs without such a pause before uav9 joins
 # How long discovery is waited for at all: a missed bound is measured to the end and named,
 # and the scenario goes on to measure the rest; it fails at its end when any bound was missed.
 FLEET_LIST_LIMIT=90
@@ -811,6 +812,14 @@ stream_gaps() {  # NAME A B VEHICLE...
       last[v] = $1; c[v]++ }
     END { for (i = 1; i <= n; i++) { v = w[i]; if (b - last[v] > gap[v]) { gap[v] = b - last[v]; from[v] = last[v] }
                                      printf "%s %.1f %d %.2f\n", v, gap[v], c[v], from[v] } }'
+}
+# True when over the last FLEET_STEADY s (all after the watch's start, tw) every aircraft of
+# the fleet's watch gave samples with no pause over FLEET_GAP_BOUND s.
+watch_steady() {
+  _to=$(now); _from=$(calc "$_to - $FLEET_STEADY")
+  true_that "$_from >= $tw" || return 1
+  # shellcheck disable=SC2086 # FLEET_NAMES is a word list
+  stream_gaps fleet "$_from" "$_to" $FLEET_NAMES | awk -v m="$FLEET_GAP_BOUND" '$2 > m || $3 == 0 { bad = 1 } END { exit bad }'
 }
 stream_has_all() {  # NAME T VEHICLE...: a sample of each since T
   _n=$1 _t=$2; shift 2
@@ -1029,6 +1038,15 @@ scenario_fleet8() {
   tw=$(now)
   # shellcheck disable=SC2086 # FLEET_NAMES is a word list
   wait_until 30 stream_has_all fleet "$tw" $FLEET_NAMES || fail "gnd: watch --low-rate got no sample of every aircraft within 30 s ($(stream_gaps fleet "$tw" "$(now)" $FLEET_NAMES | tr '\n' ';'))"
+  t_all=$(now)
+  # Premise: the others' telemetry flows steadily before anyone joins. A new ground
+  # participant (this watch) is handed every aircraft's endpoints across the link, which
+  # fills it for seconds after its first samples; a join measured from then would be charged
+  # with the watch's own start.
+  capture_mark watch "$tw"
+  # shellcheck disable=SC2086 # FLEET_NAMES is a word list
+  wait_until 90 watch_steady || fail "premise: gnd's watch never ran $FLEET_STEADY s without a pause over $FLEET_GAP_BOUND s within 90 s of its start (the last $FLEET_STEADY s: $(stream_gaps fleet "$(calc "$(now) - $FLEET_STEADY")" "$(now)" $FLEET_NAMES | tr '\n' ';'))"
+  detail "gnd's watch --low-rate: a sample of every aircraft $(calc "$t_all - $tw") s after its start, steady ($FLEET_STEADY s without a pause over $FLEET_GAP_BOUND s) $(calc "$(now) - $tw") s after its start"
   t_join=$(now)
   capture_mark join "$t_join"
   start_aircraft 9
