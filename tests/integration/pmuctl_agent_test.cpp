@@ -329,7 +329,7 @@ TEST_F(PmuctlAgentWithUav1, ACallThatWaitsForASilentAircraftHoldsUpNoOtherAndADe
   EXPECT_TRUE(replaced) << read_file(log);
   for (int i = 0; i < 4; ++i) {
     r = sh(p + "--timeout 20 --vehicle uav1 config get payload_voltage");
-    EXPECT_EQ(r.status, 0) << r.out;
+    EXPECT_EQ(r.status, 0) << r.out << "the agent's log:\n" << read_file(log) << uav1.describe();
     EXPECT_NE(r.out.find("uav1/can0/1 payload_voltage = 22.0"), std::string::npos) << r.out;
   }
 
