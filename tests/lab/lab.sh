@@ -1152,9 +1152,9 @@ link_backlog() {
 after_scenario() {
   _left=$(lab_processes)
   if [ -n "$_left" ]; then
+    echo "$_left" | sed -n 's/.* pid \([0-9]*\):.*/\1/p' >"$WORK/pids"
     _left=$(echo "$_left" | tr '\n' ';' | sed 's/;$//')
     echo "[$SCEN] hand-over: left running, now stopped:$_left"
-    echo "$_left" | tr ';' '\n' | sed -n 's/.* pid \([0-9]*\):.*/\1/p' >"$WORK/pids"
     kill_started
     echo " the previous scenario left running:$_left" >"$WORK/handover"
   else
@@ -1189,11 +1189,13 @@ host_packets() {
 }
 HANDOVER_QUIET=20  # s the hand-over waits for quiet hosts
 QUIET_PACKETS=4    # packets a quiet host may send in 1 s (IGMP leaves of closed sockets, ARP)
-# True when no host sent more than QUIET_PACKETS in 1 s; QUIET_SAID names those that did.
+# True when no host sent more than QUIET_PACKETS in 1 s; QUIET_SAID names those that did,
+# QUIET_COUNTS gives every host's count.
 hosts_quiet() {
   _a=$(host_packets); sleep 1; _b=$(host_packets)
-  QUIET_SAID=$(echo "$_a $_b" | awk -v hosts="$HOSTS" -v most="$QUIET_PACKETS" '
-    { n = split(hosts, h, " "); for (i = 1; i <= n; i++) if ($(i + n) - $i > most) printf " %s %d", h[i], $(i + n) - $i }')
+  QUIET_COUNTS=$(echo "$_a $_b" | awk -v hosts="$HOSTS" '
+    { n = split(hosts, h, " "); for (i = 1; i <= n; i++) printf " %s %d", h[i], $(i + n) - $i }')
+  QUIET_SAID=$(echo "$QUIET_COUNTS" | awk -v most="$QUIET_PACKETS" '{ for (i = 1; i < NF; i += 2) if ($(i + 1) > most) printf " %s %d", $i, $(i + 1) }')
   [ -z "$QUIET_SAID" ]
 }
 # Each scenario says that it starts on an idle link that nobody loads (every process of the
@@ -1204,26 +1206,20 @@ hosts_quiet() {
 # more and a left-over backlog is hundreds of packets.
 IDLE_PACKETS=10
 IDLE_BYTES=2000
-# Who keeps a link busy that should be idle: each host's bytes sent in 1 s, and every
+# Who keeps a link busy that should be idle: the packets each host sent in 1 s, and every
 # process in its namespace (none but lab_up's tc should be left between scenarios).
 idle_senders() {
-  _t0=""; for _h in $HOSTS; do _t0="$_t0 $(on "$_h" cat /sys/class/net/eth0/statistics/tx_bytes)"; done
-  sleep 1
-  _i=0; _out="sent in 1 s:"
-  for _h in $HOSTS; do
-    _i=$((_i + 1)); _b=$(echo "$_t0" | awk -v i="$_i" '{ print $i }')
-    _out="$_out $_h $(( $(on "$_h" cat /sys/class/net/eth0/statistics/tx_bytes) - _b )) B"
-  done
-  echo "$_out; processes:$(lab_processes | tr '\n' ';' | sed 's/;$//')"
+  hosts_quiet
+  echo "packets sent in 1 s:$QUIET_COUNTS; processes:$(lab_processes | tr '\n' ';' | sed 's/;$//')"
 }
 before_scenario() {
   _q=$(link_backlog); _b0=$(link_bytes); sleep 1; _b1=$(link_bytes)
   _moved=$(echo "$_b0 $_b1" | awk '{ a = $3 - $1; b = $4 - $2; print (a > b ? a : b) }')
   _most=$(echo "$_q" | awk '{ print ($1 > $2 ? $1 : $2) }')
-  if [ "$_most" -gt "$IDLE_PACKETS" ] || [ "$_moved" -gt "$IDLE_BYTES" ]; then
-    fail "the ground link was not idle at the start: packets queued (toward gnd, toward the aircraft) $_q, up to $_moved bytes sent in 1 s; $(idle_senders);$(cat "$WORK/handover" 2>/dev/null | tr '\n' ';' | sed 's/;$//')"
-  fi
   _ho=$(cat "$WORK/handover" 2>/dev/null | tr '\n' ';' | sed 's/;$//')
+  if [ "$_most" -gt "$IDLE_PACKETS" ] || [ "$_moved" -gt "$IDLE_BYTES" ]; then
+    fail "the ground link was not idle at the start: packets queued (toward gnd, toward the aircraft) $_q, up to $_moved bytes sent in 1 s; $(idle_senders)${_ho:+;$_ho}"
+  fi
   detail "started on an idle ground link ($_q packets queued, $_moved bytes in 1 s${_ho:+;$_ho})"
 }
 FAIL_LOGS="service*.log ground.out.err *.err ds.log ds-*.log agent.log"
