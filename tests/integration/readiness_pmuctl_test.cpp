@@ -78,6 +78,25 @@ TEST(ReadinessOverDds, AHotPmuRaisesItsAlarmAndMakesTheVehicleNotReady) {
   EXPECT_NE(r.out.find("CRITICAL thermal_shutdown"), std::string::npos) << r.out;
 }
 
+// Polled for voltages and currents only, a PMU at 95 degC (in thermal shutdown over its T_U
+// of 80) raises no alarm: neither the flag nor the temperature reaches the service. The
+// vehicle is not ready for want of them (input_missing, docs/safety.md H6).
+TEST(ReadinessOverDds, APmuWhoseAlarmsSeeNothingIsNotReady) {
+  const std::string domain = std::to_string(pmu::test::exclusive_dds_domain());
+  pmu::test::ConfiguredService service(
+      PMU_SERVICE_PATH, config(domain, "        mode: polling\n        packets: [voltages, currents]\n"
+                                       "        sim: {internal_temperature: 95}\n"));
+  const std::string p = std::string(PMUCTL_PATH) + " --domain " + domain + " ";
+  const auto r = until(
+      p + "--timeout 10 preflight",
+      [](const auto& x) { return x.out.find("temperatures not monitored") != std::string::npos; }, 30s);
+  EXPECT_EQ(r.status, 1) << r.out << service.describe();
+  EXPECT_NE(r.out.find("NOT READY"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("CRITICAL input_missing"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("PMU 1 temperatures not monitored"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("PMU 1 status not monitored"), std::string::npos) << r.out;
+}
+
 // watch shows the alarm with the device's telemetry: a marker on its lines, and with --json
 // the alarm's own line, as `pmuctl alarms --json` prints it.
 TEST(ReadinessOverDds, WatchMarksTheHotPmusLinesWithItsAlarm) {

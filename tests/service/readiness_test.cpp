@@ -120,6 +120,99 @@ TEST(ReadinessRules, MessagesNameTheDeviceAndFitAnAutopilotsPrearmText) {
   EXPECT_EQ(reasons[1].source, alarms::DeviceKind::Mppt);
 }
 
+// ---- the inputs the rules read ----------------------------------------------------------------
+
+constexpr std::uint8_t V = codec::group_bit::Voltages, C = codec::group_bit::Currents,
+                       T = codec::group_bit::Temperatures, S = codec::group_bit::Status;
+const auto t0 = std::chrono::steady_clock::time_point{} + 100s;
+
+// An ONLINE PMU whose alarms read voltages, temperatures and status, monitoring `monitored`,
+// with each packet of `received` last come at t0 - `age`; stale after 3 s.
+DeviceView fed(std::uint8_t monitored, std::uint8_t received, std::chrono::milliseconds age = 0ms,
+               bool streaming = true) {
+  DeviceView d = online();
+  d.packets_needed = V | T | S;
+  d.packets_monitored = monitored;
+  d.streaming = streaming;
+  d.max_age = 3s;
+  for (std::size_t i = 0; i < 5; ++i)
+    if (received & (1u << i)) d.received[i] = t0 - age;
+  return d;
+}
+
+// Unknown is never OK: an alarm with no input holds NORMAL, so a packet the rules read that
+// is not monitored, not received or stale is a critical reason of its own (docs/safety.md H6,
+// H3).
+TEST(ReadinessRules, APacketTheRulesReadThatIsNotFreshIsNotReady) {
+  struct Case {
+    const char* what;
+    DeviceView device;
+    DeviceKind kind;
+    std::vector<std::string> messages;  // the reasons', in order
+  };
+  const auto with_state = [](DeviceView d, HealthState s) {
+    d.state = s;
+    return d;
+  };
+  const Case cases[] = {
+      {"everything the rules read, fresh", fed(V | C | T | S, V | C | T | S), DeviceKind::Pmu, {}},
+      {"fresh at the limit of its age", fed(V | T | S, V | T | S, 3000ms), DeviceKind::Pmu, {}},
+      {"polled for voltages and currents only", fed(V | C, V | C, 0ms, false), DeviceKind::Pmu,
+       {"PMU 1 status not monitored", "PMU 1 temperatures not monitored"}},
+      {"streaming voltages only", fed(V, V), DeviceKind::Pmu,
+       {"PMU 1 status not monitored", "PMU 1 temperatures not monitored"}},
+      {"temperatures never came", fed(V | T | S, V | S), DeviceKind::Pmu, {"PMU 1 temperatures not received"}},
+      {"status stale", [] {
+         auto d = fed(V | T | S, V | T);
+         d.received[4] = t0 - 3001ms;
+         return d;
+       }(), DeviceKind::Pmu, {"PMU 1 status stale"}},
+      {"nothing came", fed(V | T | S, 0), DeviceKind::Pmu,
+       {"PMU 1 status not received", "PMU 1 temperatures not received", "PMU 1 voltages not received"}},
+      {"currents are read by no rule", fed(V | T | S, V | T | S), DeviceKind::Pmu, {}},
+      {"a PMU not online says that alone", with_state(fed(V, V), HealthState::Stale), DeviceKind::Pmu,
+       {"PMU 1 on can0 STALE"}},
+      {"a battery reads no PMU packet", online(std::nullopt), DeviceKind::Battery, {}},
+  };
+  for (const auto& c : cases) {
+    SCOPED_TRACE(c.what);
+    ReadinessInput in;
+    in.now = t0;
+    in.devices[Key{"can0", c.kind, 1}] = c.device;
+    const auto reasons = readiness_reasons(in);
+    std::vector<std::string> messages;
+    for (const auto& r : reasons) {
+      messages.push_back(r.message);
+      EXPECT_EQ(r.severity, Severity::Critical);
+      EXPECT_LE(r.message.size(), 42u) << r.message;
+      EXPECT_LE(r.description.size(), 127u) << r.description;
+      if (r.code == "input_missing") {
+        EXPECT_NE(r.description.find("alarms cannot be judged"), std::string::npos);
+      }
+    }
+    EXPECT_EQ(messages, c.messages);
+  }
+}
+
+TEST(ReadinessRules, AMissingInputSaysWhatToDoForHowTheServiceGetsIt) {
+  ReadinessInput in;
+  in.now = t0;
+  in.devices[Key{"can0", DeviceKind::Pmu, 65534}] = fed(V | S, V | S);
+  in.devices[Key{"can0", DeviceKind::Pmu, 2}] = fed(V | S, V | S, 0ms, false);
+  const auto reasons = readiness_reasons(in);
+  ASSERT_EQ(reasons.size(), 2u);
+  EXPECT_EQ(reasons[0].code, "input_missing");
+  EXPECT_EQ(reasons[0].device, 2);
+  EXPECT_EQ(reasons[0].message, "PMU 2 temperatures not monitored");
+  EXPECT_EQ(reasons[0].description,
+            "The service does not poll it, so its alarms cannot be judged: add it to the device's packets: in the "
+            "service's config.");
+  EXPECT_EQ(reasons[1].message, "PMU 65534 temperatures not monitored");
+  EXPECT_EQ(reasons[1].description,
+            "The PMU does not stream it, so its alarms cannot be judged: add it to packets_streamed (pmuctl config "
+            "set).");
+}
+
 // ---- drift from a baseline file ---------------------------------------------------------------
 
 baseline::ConfigFile baseline_text(const std::string& text) {
@@ -272,11 +365,30 @@ InfoState info(std::uint8_t minor) {
   return i;
 }
 
+// A PMU's packets as its session hands them on; the tracker reads only which packet it is.
+void feed(ReadinessTracker& t, const DeviceKey& key, std::initializer_list<codec::PacketId> packets) {
+  for (const auto p : packets) {
+    codec::PmuMessage m;
+    m.packet = p;
+    t.on_telemetry(key, m, {});
+  }
+}
+constexpr auto kVoltages = codec::PacketId::Voltages, kCurrents = codec::PacketId::Currents,
+               kTemperatures = codec::PacketId::Temperatures, kStatus = codec::PacketId::Status;
+
+std::vector<std::string> messages_of(const ReadinessReport& r, std::uint16_t device) {
+  std::vector<std::string> out;
+  for (const auto& x : r.reasons)
+    if (x.device == device) out.push_back(x.message);
+  return out;
+}
+
 TEST(ReadinessTracker, ReportsEveryChangeAndOnceASecondAndPassesEverythingOn) {
   transport::ManualClock clock;
   RecordingSink next;
-  ReadinessTracker t({bus_with_min_firmware()}, next, clock);
+  ReadinessTracker t({bus_with_min_firmware()}, Timeouts{}.stale_periods, next, clock);
   const DeviceKey pmu1{"can0", 1, DeviceKind::Pmu};
+  const DeviceKey found{"can0", 7, DeviceKind::Pmu};  // discovered: the bus's discover: minimum, 1.14
   t.on_health(pmu1, health(HealthState::Unknown));
   ASSERT_EQ(next.readiness.size(), 1u);
   EXPECT_FALSE(next.readiness.back().ready);
@@ -289,6 +401,10 @@ TEST(ReadinessTracker, ReportsEveryChangeAndOnceASecondAndPassesEverythingOn) {
   EXPECT_EQ(next.readiness.size(), 2u) << "unchanged, but a second has passed";
 
   clock.advance(100ms);
+  // Its packets come (fresh for 3 s at the default 1 s period, longer than the rest of this
+  // test); while it is not ONLINE they change nothing.
+  feed(t, pmu1, {kVoltages, kTemperatures, kStatus});
+  EXPECT_EQ(next.readiness.size(), 2u);
   t.on_health(pmu1, health(HealthState::Online));
   ASSERT_EQ(next.readiness.size(), 3u) << "a change: at once";
   EXPECT_TRUE(next.readiness.back().ready);
@@ -300,7 +416,7 @@ TEST(ReadinessTracker, ReportsEveryChangeAndOnceASecondAndPassesEverythingOn) {
   EXPECT_EQ(next.readiness.back().reasons.at(0).code, "firmware_below_minimum");
   EXPECT_EQ(next.infos.size(), 1u);
 
-  const DeviceKey found{"can0", 7, DeviceKind::Pmu};  // discovered: the bus's discover: minimum, 1.14
+  feed(t, found, {kVoltages, kTemperatures, kStatus});
   t.on_health(found, health(HealthState::Online));
   t.on_info(found, info(14));
   EXPECT_EQ(t.current().reasons.size(), 1u) << "1.14 meets the discovered minimum";
@@ -331,6 +447,66 @@ TEST(ReadinessTracker, ReportsEveryChangeAndOnceASecondAndPassesEverythingOn) {
   t.on_gone(found);  // it moved to another address: the old key is no reason any more
   EXPECT_TRUE(next.readiness.back().ready);
   EXPECT_EQ(next.gone.size(), 1u);
+}
+
+// The scenario of a PMU polled for voltages and currents only, and of one whose PS is set to
+// voltages at run time: neither is READY while its alarms cannot see what they read
+// (docs/safety.md H6, H3).
+TEST(ReadinessTracker, APmuIsReadyOnlyWhileThePacketsItsAlarmsReadComeFresh) {
+  transport::ManualClock clock;
+  RecordingSink next;
+  BusConfig b;
+  b.name = "can0";
+  DeviceConfig streamed;  // streaming every packet at 1 s, the defaults
+  streamed.address = 1;
+  DeviceConfig polled;
+  polled.address = 2;
+  polled.mode = TelemetryMode::Polling;
+  polled.groups = codec::group_bit::Voltages | codec::group_bit::Currents;
+  b.devices = {streamed, polled};
+  ReadinessTracker t({b}, 3, next, clock);
+  const DeviceKey pmu1{"can0", 1, DeviceKind::Pmu}, pmu2{"can0", 2, DeviceKind::Pmu};
+  t.on_health(pmu1, health(HealthState::Online));
+  t.on_health(pmu2, health(HealthState::Online));
+  EXPECT_FALSE(t.current().ready);
+  EXPECT_EQ(messages_of(t.current(), 1), (std::vector<std::string>{"PMU 1 status not received",
+                                                                   "PMU 1 temperatures not received",
+                                                                   "PMU 1 voltages not received"}));
+
+  feed(t, pmu1, {kVoltages, kCurrents, kTemperatures, kStatus});
+  feed(t, pmu2, {kVoltages, kCurrents});
+  EXPECT_TRUE(messages_of(t.current(), 1).empty());
+  EXPECT_EQ(messages_of(t.current(), 2),
+            (std::vector<std::string>{"PMU 2 status not monitored", "PMU 2 temperatures not monitored"}));
+  EXPECT_FALSE(next.readiness.back().ready) << "polled for voltages and currents only";
+
+  // A verified set of PS to voltages (the session reports the configuration read back): at once.
+  ConfigState c;
+  c.raw[static_cast<std::size_t>(codec::Parameter::PacketsStreamed)] = codec::group_bit::Voltages;
+  t.on_config(pmu1, c);
+  EXPECT_EQ(messages_of(next.readiness.back(), 1),
+            (std::vector<std::string>{"PMU 1 status not monitored", "PMU 1 temperatures not monitored"}));
+  c.raw[static_cast<std::size_t>(codec::Parameter::PacketsStreamed)] = 0xFF;  // bits 5-7 mean nothing
+  t.on_config(pmu1, c);
+  EXPECT_TRUE(messages_of(next.readiness.back(), 1).empty());
+
+  // Three periods without a packet: stale; it coming again clears that at once.
+  clock.advance(3001ms);
+  feed(t, pmu1, {kVoltages, kStatus});
+  EXPECT_EQ(messages_of(next.readiness.back(), 1), (std::vector<std::string>{"PMU 1 temperatures stale"}));
+  feed(t, pmu1, {kTemperatures});
+  EXPECT_TRUE(messages_of(next.readiness.back(), 1).empty());
+
+  // PP read as 5 s: three of those before a packet is stale.
+  c.raw[static_cast<std::size_t>(codec::Parameter::PacketPeriod)] = 50;
+  t.on_config(pmu1, c);
+  clock.advance(14s);
+  t.on_health(pmu1, health(HealthState::Online));
+  EXPECT_TRUE(messages_of(t.current(), 1).empty());
+  clock.advance(1001ms);
+  t.on_health(pmu1, health(HealthState::Online));
+  EXPECT_EQ(messages_of(t.current(), 1), (std::vector<std::string>{"PMU 1 status stale", "PMU 1 temperatures stale",
+                                                                   "PMU 1 voltages stale"}));
 }
 
 }  // namespace

@@ -87,4 +87,16 @@ codec::Result<std::vector<AlarmConfig>, std::string> resolve(DeviceKind kind, co
   return out;
 }
 
+std::uint8_t packets_read(const DeviceSettings& settings) {
+  const auto rows = resolve(DeviceKind::Pmu, settings);
+  std::uint8_t packets = 0;
+  for (const auto& row : alarm_table())
+    if (applies_to(row, DeviceKind::Pmu)) packets = static_cast<std::uint8_t>(packets | row.packets);
+  if (!rows.ok()) return packets;
+  packets = 0;
+  for (const auto& a : *rows)
+    if (a.enabled) packets = static_cast<std::uint8_t>(packets | a.spec().packets);
+  return packets;
+}
+
 }  // namespace pmu::alarms

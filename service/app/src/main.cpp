@@ -165,7 +165,7 @@ int run(const service::Config& cfg, const pmu::dds::ResolvedNetwork& network) {
   }
   service::StateFanout fanout(sinks);
   // In front of the publishers: pmu/readiness from what the sessions report.
-  service::ReadinessTracker readiness(cfg.buses, fanout, clock);
+  service::ReadinessTracker readiness(cfg.buses, cfg.timeouts.stale_periods, fanout, clock);
   // In front of readiness: pmu/energy from each PMU's voltages and currents.
   service::EnergyTracker state_sink(cfg.buses, cfg.timeouts.stale_periods, readiness);
 

@@ -5,6 +5,8 @@
 #include <set>
 #include <string>
 
+#include "pmu/codec/messages.hpp"
+
 namespace pmu::service {
 namespace {
 
@@ -70,6 +72,39 @@ std::string drift_description(const std::vector<baseline::Difference>& diffs, co
   return bounded(items + fix, kDescription);
 }
 
+// "PMU 1 temperatures not received": one reason for each packet the PMU's alarms read that
+// the service does not have fresh. An alarm without its input neither raises nor clears, so
+// it would stay NORMAL and look like all clear (docs/safety.md H6, H3).
+void missing_inputs(const std::string& bus, DeviceKind kind, std::uint16_t address, const std::string& name,
+                    const DeviceView& d, std::chrono::steady_clock::time_point now,
+                    std::vector<ReadinessReason>& out) {
+  for (std::size_t i = 0; i < codec::kGroupNames.size(); ++i) {
+    const auto& packet = codec::kGroupNames[i];
+    if (!(d.packets_needed & packet.bit)) continue;
+    const auto& at = d.received[i];
+    const char* what = nullptr;
+    std::string description;
+    if (!(d.packets_monitored & packet.bit)) {
+      what = "not monitored";
+      description = d.streaming ? "The PMU does not stream it, so its alarms cannot be judged: add it to packets_streamed "
+                                  "(pmuctl config set)."
+                                : "The service does not poll it, so its alarms cannot be judged: add it to the "
+                                  "device's packets: in the service's config.";
+    } else if (!at || now - *at > d.max_age) {
+      what = at ? "stale" : "not received";
+      description = d.streaming ? "Its alarms cannot be judged without it: check packet_period and packets_streamed "
+                                  "(pmuctl config get)."
+                                : "Its alarms cannot be judged without it: the PMU does not answer the service's "
+                                  "polls for it.";
+    } else {
+      continue;
+    }
+    out.push_back({"input_missing", alarms::Severity::Critical, bus, source_of(kind), address,
+                   bounded(name + " " + std::string(packet.name) + " " + what, kMessage),
+                   bounded(std::move(description), kDescription)});
+  }
+}
+
 }  // namespace
 
 baseline::Settings settings_of(const ConfigState& config) {
@@ -110,6 +145,8 @@ std::vector<ReadinessReason> readiness_reasons(const ReadinessInput& in) {
       out.push_back({"device_not_online", Severity::Critical, bus, source_of(kind), address,
                      bounded(name + " on " + bus + " " + to_string(d.state), 42),
                      "No recent frame from it: check its power and CAN wiring (pmuctl health)."});
+    else
+      missing_inputs(bus, kind, address, name, d, in.now, out);
     if (d.bus_state != transport::BusState::Up && buses_reported.insert(bus).second) {
       const bool warning = d.bus_state == transport::BusState::ErrorWarning;
       out.push_back({"bus_not_up", warning ? Severity::Warning : Severity::Critical, bus, alarms::DeviceKind::Bus, 0,
@@ -146,7 +183,9 @@ std::vector<ReadinessReason> readiness_reasons(const ReadinessInput& in) {
   }
   std::sort(out.begin(), out.end(), [](const ReadinessReason& x, const ReadinessReason& y) {
     const int cx = x.severity == Severity::Critical ? 0 : 1, cy = y.severity == Severity::Critical ? 0 : 1;
-    return std::tie(cx, x.bus, x.source, x.device, x.code) < std::tie(cy, y.bus, y.source, y.device, y.code);
+    // The message last: one device's input_missing reasons differ only in it.
+    return std::tie(cx, x.bus, x.source, x.device, x.code, x.message) <
+           std::tie(cy, y.bus, y.source, y.device, y.code, y.message);
   });
   return out;
 }

@@ -2,6 +2,8 @@
 
 #include <spdlog/spdlog.h>
 
+#include "pmu/alarms/settings.hpp"
+
 namespace pmu::service {
 namespace {
 
@@ -17,9 +19,9 @@ bool same(const std::vector<ReadinessReason>& a, const std::vector<ReadinessReas
 
 }  // namespace
 
-ReadinessTracker::ReadinessTracker(const std::vector<BusConfig>& buses, StateSink& next,
+ReadinessTracker::ReadinessTracker(const std::vector<BusConfig>& buses, double stale_periods, StateSink& next,
                                    const transport::Clock& clock)
-    : next_(next), clock_(clock) {
+    : stale_periods_(stale_periods), next_(next), clock_(clock) {
   for (const auto& b : buses) buses_[b.name] = b;
   report_.since = clock_.system_now();
 }
@@ -27,17 +29,61 @@ ReadinessTracker::ReadinessTracker(const std::vector<BusConfig>& buses, StateSin
 DeviceView& ReadinessTracker::view_of(const DeviceKey& key) {
   auto [it, added] = input_.devices.try_emplace(Key{key.bus, key.kind, key.address});
   if (added && key.kind == DeviceKind::Pmu) {
+    const DeviceConfig* config = nullptr;
     if (auto b = buses_.find(key.bus); b != buses_.end()) {
+      config = &b->second.discovered_defaults;
       it->second.min_firmware = b->second.discovered_defaults.min_firmware;
       for (const auto& d : b->second.devices)
         if (d.address == key.address) {
+          config = &d;
           it->second.min_firmware = d.min_firmware;
           it->second.baseline = d.baseline;
           it->second.baseline_file = d.baseline_path;
         }
     }
+    // A PMU the config does not name (no such bus): the table's alarms, and every packet
+    // taken as not monitored until its PS is read; the side on which readiness says less.
+    Expected e{true, 0, std::chrono::milliseconds(1000)};
+    alarms::DeviceSettings alarm_settings;
+    if (config) {
+      e = {config->mode == TelemetryMode::Streaming, config->groups, config->period};
+      alarm_settings = config->alarms;
+    }
+    it->second.packets_needed = alarms::packets_read(alarm_settings);
+    expected_[Key{key.bus, key.kind, key.address}] = e;
+    refresh_inputs(Key{key.bus, key.kind, key.address}, it->second);
   }
   return it->second;
+}
+
+void ReadinessTracker::refresh_inputs(const Key& key, DeviceView& v) {
+  const auto e = expected_.find(key);
+  if (e == expected_.end()) return;
+  v.streaming = e->second.streaming;
+  const auto& ps = v.settings.raw[static_cast<std::size_t>(codec::Parameter::PacketsStreamed)];
+  const auto& pp = v.settings.raw[static_cast<std::size_t>(codec::Parameter::PacketPeriod)];
+  // Streaming: what the PMU's PS selects (v1.9 table 13; bits 5-7 mean nothing), every PP.
+  v.packets_monitored = v.streaming && ps ? static_cast<std::uint8_t>(*ps & codec::group_bit::All) : e->second.groups;
+  auto period = e->second.period;
+  if (v.streaming && pp && *pp > 0) period = codec::duration_of(codec::Parameter::PacketPeriod, *pp);
+  v.max_age = std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+      std::chrono::duration<double, std::milli>(period) * stale_periods_);
+}
+
+void ReadinessTracker::on_telemetry(const DeviceKey& key, const codec::PmuMessage& message,
+                                    std::chrono::system_clock::time_point received) {
+  next_.on_telemetry(key, message, received);
+  const auto index = static_cast<std::size_t>(message.packet);
+  if (key.kind != DeviceKind::Pmu || index >= DeviceView{}.received.size()) return;
+  std::lock_guard<std::mutex> lock(mutex_);
+  auto& v = view_of(key);
+  const auto now = clock_.steady_now();
+  auto& at = v.received[index];
+  // A packet that was missing or stale comes back: the report changes now, not at the next
+  // health report. Otherwise nothing changes: the frame rate need not drive the rules.
+  const bool was_missing = !at || now - *at > v.max_age;
+  at = now;
+  if (was_missing) update(false);
 }
 
 void ReadinessTracker::on_config(const DeviceKey& key, const ConfigState& config) {
@@ -45,6 +91,7 @@ void ReadinessTracker::on_config(const DeviceKey& key, const ConfigState& config
   std::lock_guard<std::mutex> lock(mutex_);
   auto& v = view_of(key);
   v.settings = settings_of(config);
+  refresh_inputs(Key{key.bus, key.kind, key.address}, v);
   log_drift(key, v);
   update(false);
 }
@@ -108,6 +155,7 @@ void ReadinessTracker::on_gone(const DeviceKey& key) {
   // A unit that moved to another address: its new key reports on its own.
   input_.devices.erase(Key{key.bus, key.kind, key.address});
   drift_logged_.erase(Key{key.bus, key.kind, key.address});
+  expected_.erase(Key{key.bus, key.kind, key.address});
   update(true);
 }
 
@@ -130,6 +178,7 @@ ReadinessReport ReadinessTracker::current() const {
 }
 
 void ReadinessTracker::update(bool force) {
+  input_.now = clock_.steady_now();
   auto reasons = readiness_reasons(input_);
   bool ready = true;
   for (const auto& r : reasons) ready = ready && r.severity != alarms::Severity::Critical;

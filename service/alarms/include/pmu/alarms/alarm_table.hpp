@@ -67,6 +67,12 @@ struct AlarmSpec {
   std::chrono::milliseconds on_delay;   // the condition must hold this long to raise
   std::chrono::milliseconds off_delay;  // ... and be gone this long to clear
   Basis basis;
+  // The PMU packets the row reads (codec::group_bit: 0x00 voltages, 0x03 temperatures, 0x04
+  // status), so that a packet not received, stale or not monitored is a readiness reason of
+  // its own (input_missing, interface.md 1.7) instead of an alarm that silently holds, and a
+  // change of packets_streamed that drops one needs confirm (blind_monitoring, 2.2). 0 for
+  // rows fed by the session's health, the bus, or CANopen frames.
+  std::uint8_t packets;
 };
 
 const std::array<AlarmSpec, kCodeCount>& alarm_table() noexcept;

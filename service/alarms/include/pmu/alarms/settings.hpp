@@ -65,4 +65,9 @@ codec::Result<AlarmConfig, std::string> resolve(Code code, const AlarmOverride& 
 // does not apply to `kind` ("cell_low: not an alarm of a pmu").
 codec::Result<std::vector<AlarmConfig>, std::string> resolve(DeviceKind kind, const DeviceSettings& settings);
 
+// The PMU packets (codec::group_bit) the enabled rows of a PMU with `settings` read: what the
+// service must receive from it for its alarms to judge anything. Settings resolve() refuses
+// count as the table's defaults, as AlarmFeed runs them.
+std::uint8_t packets_read(const DeviceSettings& settings);
+
 }  // namespace pmu::alarms

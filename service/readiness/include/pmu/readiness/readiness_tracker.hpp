@@ -7,6 +7,9 @@
 // A PMU with a `baseline:` is compared with it after every reading of its configuration
 // (start, a reconnect's re-read, a verified set) and identity; each change of what differs
 // (which settings, the serial) is logged once, and so is the match that follows.
+// Each PMU's telemetry is noted by packet, so a packet its alarms read that is not monitored,
+// not received or stale is a reason (input_missing): what it streams follows its PS as read,
+// so a verified set of packets_streamed changes the report at once.
 //
 // Lifetime: `next` and `clock` must outlive the tracker, which keeps references to both
 // (main.cpp makes the publisher and the clock first and the bus workers, which write through
@@ -29,14 +32,15 @@ namespace pmu::service {
 
 class ReadinessTracker final : public StateSink {
  public:
-  // `buses`: the config's, for each PMU's min_firmware and baseline (a discovered PMU takes
-  // its bus's discover: settings, and has no baseline).
-  ReadinessTracker(const std::vector<BusConfig>& buses, StateSink& next, const transport::Clock& clock);
+  // `buses`: the config's, for each PMU's min_firmware, baseline, mode, packets, period and
+  // alarms (a discovered PMU takes its bus's discover: settings, and has no baseline).
+  // `stale_periods`: the config's; a packet older than this many of its periods is stale, as
+  // a device is for its health.
+  ReadinessTracker(const std::vector<BusConfig>& buses, double stale_periods, StateSink& next,
+                   const transport::Clock& clock);
 
   void on_telemetry(const DeviceKey& key, const codec::PmuMessage& message,
-                    std::chrono::system_clock::time_point received) override {
-    next_.on_telemetry(key, message, received);
-  }
+                    std::chrono::system_clock::time_point received) override;
   void on_config(const DeviceKey& key, const ConfigState& config) override;
   void on_info(const DeviceKey& key, const InfoState& info) override;
   void on_health(const DeviceKey& key, const HealthReport& health) override;
@@ -80,8 +84,20 @@ class ReadinessTracker final : public StateSink {
     bool serial = false;
   };
   void log_drift(const DeviceKey& key, const DeviceView& view);
+  // What the service gets of a PMU's packets, and how old one may be, from its config and the
+  // PS and PP last read (mutex_ held).
+  void refresh_inputs(const Key& key, DeviceView& view);
+
+  // A PMU's config: how the service gets its packets.
+  struct Expected {
+    bool streaming = true;
+    std::uint8_t groups = 0;
+    std::chrono::milliseconds period{1000};
+  };
 
   std::map<std::string, BusConfig> buses_;  // by bus name
+  double stale_periods_;
+  std::map<Key, Expected> expected_;  // PMUs
   StateSink& next_;
   const transport::Clock& clock_;
   mutable std::mutex mutex_;
