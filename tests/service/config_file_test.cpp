@@ -238,13 +238,19 @@ TEST(ApplyPlan, SafeOrderAndTheConfirmRules) {
   EXPECT_EQ(rule("power_up_state"), service::ConfirmRule::PowerUpAvionicsOff);
   EXPECT_EQ(rule("outputs"), service::ConfirmRule::DisableAvionics);
   EXPECT_EQ(rule("avionics_voltage"), std::nullopt);
-  EXPECT_EQ(rule("packets_streamed"), std::nullopt);  // not 0
+  // Not 0, but without temperatures and status: the alarms that read them go blind.
+  EXPECT_EQ(rule("packets_streamed"), service::ConfirmRule::BlindMonitoring);
   for (const auto& c : plan) EXPECT_EQ(c.from, *device[c.setting]) << setting_name(c.setting);
 
   const auto silent = read_config_file("parameters:\n  packets_streamed: none\n");
+  const auto streaming_or_not = [](bool streaming) {
+    service::DeviceUse u;
+    u.streaming = streaming;
+    return u;
+  };
   ASSERT_TRUE(silent.ok());
-  EXPECT_EQ(apply_plan(differences(device, *silent), true)[0].confirm, service::ConfirmRule::StopStreaming);
-  EXPECT_EQ(apply_plan(differences(device, *silent), false)[0].confirm, std::nullopt);
+  EXPECT_EQ(apply_plan(differences(device, *silent), streaming_or_not(true))[0].confirm, service::ConfirmRule::StopStreaming);
+  EXPECT_EQ(apply_plan(differences(device, *silent), streaming_or_not(false))[0].confirm, std::nullopt);
 }
 
 TEST(ApplyPlan, EachChangeIsTheCommandThatSetsIt) {

@@ -35,7 +35,9 @@ TEST(Policy, ConfirmRulesByDefault) {
       {"engine stop", make(CommandKind::EngineStop), false},
       {"can address", make(CommandKind::SetParameter, 0, "can_address", 3), true},
       {"T_U 0", make(CommandKind::SetParameter, 0, "upper_temperature_limit", 0), true},
-      {"T_U 80", make(CommandKind::SetParameter, 0, "upper_temperature_limit", 80), false},
+      // Nothing known of the unit: its internal temperature may be anything up to 127 degC.
+      {"T_U 80, temperature unknown", make(CommandKind::SetParameter, 0, "upper_temperature_limit", 80), true},
+      {"T_U 128, temperature unknown", make(CommandKind::SetParameter, 0, "upper_temperature_limit", 128), false},
       // Judged on what the wire will carry: these round to 0.
       {"T_U 0.0005", make(CommandKind::SetParameter, 0, "upper_temperature_limit", 0.0005), true},
       {"T_U -0.0009", make(CommandKind::SetParameter, 0, "upper_temperature_limit", -0.0009), true},
@@ -47,7 +49,8 @@ TEST(Policy, ConfirmRulesByDefault) {
       // PS = 0 silences a streaming PMU (v1.9 table 13: PS selects the packets streamed).
       {"PS 0", make(CommandKind::SetParameter, 0, "packets_streamed", 0), true},
       {"PS 0.0004", make(CommandKind::SetParameter, 0, "packets_streamed", 0.0004), true},
-      {"PS voltages only", make(CommandKind::SetParameter, 0, "packets_streamed", 1), false},
+      // Without temperatures and status the alarms that read them go blind.
+      {"PS voltages only", make(CommandKind::SetParameter, 0, "packets_streamed", 1), true},
       {"PS every packet", make(CommandKind::SetParameter, 0, "packets_streamed", 0x1F), false},
       {"PP 0.1 s", make(CommandKind::SetParameter, 0, "packet_period", 0.1), false},
       {"generation off", make(CommandKind::SetGeneration), false},
@@ -66,23 +69,132 @@ TEST(Policy, ConfirmRulesByDefault) {
   }
 }
 
+DeviceUse streaming_or_not(bool streaming) {
+  DeviceUse u;
+  u.streaming = streaming;
+  return u;
+}
+
 // The service asks a polled device for its packets: PS = 0 takes nothing from it.
 TEST(Policy, StopStreamingOnlyForADeviceTheServiceListensTo) {
   const PolicyConfig p;
   const auto ps0 = make(CommandKind::SetParameter, 0, "packets_streamed", 0);
-  const auto streaming = check_policy(ps0, p, DeviceUse{true});
+  const auto streaming = check_policy(ps0, p, streaming_or_not(true));
   EXPECT_EQ(streaming.result, CommandResult::Denied);
   EXPECT_EQ(streaming.reason,
             "set_parameter sets packets_streamed to 0: the PMU stops the telemetry this service listens for, and "
             "goes OFFLINE: it needs confirm (pmuctl --confirm); rule stop_streaming");
-  EXPECT_TRUE(check_policy(ps0, p, DeviceUse{false}).allowed());
+  EXPECT_TRUE(check_policy(ps0, p, streaming_or_not(false)).allowed());
   PolicyConfig off;
   off.confirm[static_cast<std::size_t>(ConfirmRule::StopStreaming)] = false;
-  EXPECT_TRUE(check_policy(ps0, off, DeviceUse{true}).allowed());
+  EXPECT_TRUE(check_policy(ps0, off, streaming_or_not(true)).allowed());
   EXPECT_EQ(parse_config("policy:\n  confirm: [stop_streaming]\nbuses:\n  - interface: can0\n    discover: true\n",
                          "p.yaml")
                 .policy.confirm,
-            (std::array<bool, kConfirmRuleCount>{false, false, false, false, false, false, true}));
+            (std::array<bool, kConfirmRuleCount>{false, false, false, false, false, false, true, false}));
+  EXPECT_EQ(parse_config("policy:\n  confirm: [blind_monitoring]\nbuses:\n  - interface: can0\n    discover: true\n",
+                         "p.yaml")
+                .policy.confirm,
+            (std::array<bool, kConfirmRuleCount>{false, false, false, false, false, false, false, true}));
+}
+
+// A unit's internal temperature and what its rules read, as the dispatcher fills them.
+DeviceUse at(std::optional<double> internal, bool streaming = true, std::uint8_t needed = kRulePackets) {
+  DeviceUse u;
+  u.streaming = streaming;
+  u.packets_needed = needed;
+  u.internal_temperature = internal;
+  return u;
+}
+
+struct EffectCase {
+  const char* what;
+  CommandRequest request;
+  DeviceUse device;
+  std::optional<ConfirmRule> rule;
+};
+
+// The rules judged by effect: what the set does with the values the unit has now (v1.9 5.14:
+// T_U at or below the internal temperature shuts it down; table 13: PS selects what is
+// streamed). docs/safety.md H2, H3, H6.
+TEST(Policy, RulesJudgedByWhatTheSetDoesToTheUnitNow) {
+  const auto tu = [](double v) { return make(CommandKind::SetParameter, 0, "upper_temperature_limit", v); };
+  const auto ps = [](double v) { return make(CommandKind::SetParameter, 0, "packets_streamed", v); };
+  using G = std::uint8_t;
+  constexpr G V = codec::group_bit::Voltages, C = codec::group_bit::Currents, E = codec::group_bit::BatteryEnergy,
+              T = codec::group_bit::Temperatures, S = codec::group_bit::Status;
+  const EffectCase cases[] = {
+      {"T_U 1 at 35 degC", tu(1), at(35), ConfirmRule::ThermalShutdown},
+      {"T_U 35 at 35 degC", tu(35), at(35), ConfirmRule::ThermalShutdown},
+      {"T_U 36 at 35 degC", tu(36), at(35), std::nullopt},
+      {"T_U 90 at 95 degC", tu(90), at(95), ConfirmRule::ThermalShutdown},
+      {"T_U 85 at 35 degC", tu(85), at(35), std::nullopt},
+      {"T_U 0 at -20 degC", tu(0), at(-20), ConfirmRule::ThermalShutdown},
+      {"T_U 1 at -20 degC", tu(1), at(-20), std::nullopt},
+      {"T_U 255 at 127 degC", tu(255), at(127), std::nullopt},
+      {"T_U 1, temperature unknown", tu(1), at(std::nullopt), ConfirmRule::ThermalShutdown},
+      {"T_U 127, temperature unknown", tu(127), at(std::nullopt), ConfirmRule::ThermalShutdown},
+      {"T_U 128, temperature unknown", tu(128), at(std::nullopt), std::nullopt},
+      {"T_U 255, temperature unknown", tu(255), at(std::nullopt), std::nullopt},
+      {"PS voltages, streaming", ps(V), at(35), ConfirmRule::BlindMonitoring},
+      {"PS without status, streaming", ps(V | C | E | T), at(35), ConfirmRule::BlindMonitoring},
+      {"PS without temperatures, streaming", ps(V | S), at(35), ConfirmRule::BlindMonitoring},
+      {"PS what the rules read", ps(V | T | S), at(35), std::nullopt},
+      {"PS everything", ps(V | C | E | T | S), at(35), std::nullopt},
+      {"PS voltages, polled", ps(V), at(35, false), std::nullopt},
+      {"PS 0, streaming", ps(0), at(35), ConfirmRule::StopStreaming},
+      {"PS 0, polled", ps(0), at(35, false), std::nullopt},
+      // Set-points within their ranges switch nothing off, whatever their bits look like.
+      {"V_B 25.2 V", make(CommandKind::SetParameter, 0, "battery_voltage", 25.2), at(35), std::nullopt},
+      {"V_S 5.0 V", make(CommandKind::SetParameter, 0, "servo_voltage", 5.0), at(std::nullopt), std::nullopt},
+      // A unit whose temperature alarms are all off needs no temperatures.
+      {"PS without temperatures, none needed", ps(V | S), at(35, true, V | S), std::nullopt},
+      {"PS without status, status needed", ps(V | T), at(35, true, S), ConfirmRule::BlindMonitoring},
+  };
+  PolicyConfig p;
+  for (const auto& c : cases) {
+    SCOPED_TRACE(c.what);
+    EXPECT_EQ(confirm_rule_for(c.request, c.device), c.rule);
+    const auto v = check_policy(c.request, p, c.device);
+    EXPECT_EQ(v.allowed(), !c.rule) << v.reason;
+    if (c.rule) {
+      EXPECT_NE(v.reason.find("rule " + std::string(to_string(*c.rule))), std::string::npos) << v.reason;
+      CommandRequest confirmed = c.request;
+      confirmed.confirm = true;
+      EXPECT_TRUE(check_policy(confirmed, p, c.device).allowed());
+      PolicyConfig off;
+      off.confirm[static_cast<std::size_t>(*c.rule)] = false;
+      EXPECT_TRUE(check_policy(c.request, off, c.device).allowed()) << "the rule can be switched off";
+    }
+  }
+}
+
+// The DENIED reason says the values the rule was judged on.
+TEST(Policy, AReasonJudgedByEffectNamesTheValues) {
+  const PolicyConfig p;
+  const auto tu1 = make(CommandKind::SetParameter, 0, "upper_temperature_limit", 1);
+  EXPECT_EQ(check_policy(tu1, p, at(35)).reason,
+            "set_parameter sets the upper temperature limit to 1 degC, at or below the unit's internal temperature "
+            "35 degC: it forces thermal shutdown, which stops charging: it needs confirm (pmuctl --confirm); rule "
+            "thermal_shutdown");
+  EXPECT_EQ(check_policy(tu1, p, at(std::nullopt)).reason,
+            "set_parameter sets the upper temperature limit to 1 degC while the unit's internal temperature is unknown "
+            "(safe from 128 degC): it may force thermal shutdown, which stops charging: it needs confirm (pmuctl "
+            "--confirm); rule thermal_shutdown");
+  EXPECT_EQ(check_policy(make(CommandKind::SetParameter, 0, "packets_streamed", 1), p, at(35)).reason,
+            "set_parameter drops temperatures, status from packets_streamed: the readiness and alarm rules that read "
+            "them go blind: it needs confirm (pmuctl --confirm); rule blind_monitoring");
+}
+
+// DeviceUse's worst case is what the alarm table's PMU rows read.
+TEST(Policy, TheRulePacketsAreWhatTheAlarmTableReads) {
+  EXPECT_EQ(alarms::packets_read(alarms::DeviceSettings{}), kRulePackets);
+  alarms::DeviceSettings no_temperatures;
+  for (const auto c : {alarms::Code::InternalOverTemperature, alarms::Code::StarterOverTemperature,
+                       alarms::Code::GeneratorOverTemperature, alarms::Code::BatteryAOverTemperature,
+                       alarms::Code::BatteryBOverTemperature})
+    no_temperatures[c].enabled = false;
+  EXPECT_EQ(alarms::packets_read(no_temperatures), codec::group_bit::Voltages | codec::group_bit::Status);
 }
 
 TEST(Policy, RulesCanBeSwitchedOffAndKindsDenied) {

@@ -31,13 +31,13 @@ service::CommandAction action_for(Setting setting, std::uint32_t raw) {
   return service::action::SetParameter{*parameter_of(setting), raw};
 }
 
-std::vector<Change> apply_plan(const std::vector<Difference>& diffs, bool streaming) {
+std::vector<Change> apply_plan(const std::vector<Difference>& diffs, const service::DeviceUse& device) {
   std::vector<Change> out;
   for (const auto& d : diffs) {
     service::CommandRequest r;
     r.action = action_for(d.setting, d.file);
     out.push_back({d.setting, d.device.value_or(0), d.file, d.line,
-                   service::confirm_rule_for(r, service::DeviceUse{streaming})});
+                   service::confirm_rule_for(r, device)});
   }
   std::stable_sort(out.begin(), out.end(),
                    [](const Change& a, const Change& b) { return apply_rank(a.setting) < apply_rank(b.setting); });

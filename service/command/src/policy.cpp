@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <array>
+#include <cstdio>
 
 #include "pmu/codec/messages.hpp"
 
@@ -10,7 +11,7 @@ namespace {
 
 constexpr std::array<std::string_view, kConfirmRuleCount> kRuleNames{
     "disable_avionics", "reset", "engine_start", "set_can_address", "thermal_shutdown", "power_up_avionics_off",
-    "stop_streaming"};
+    "stop_streaming", "blind_monitoring"};
 
 // What each rule protects against, for the DENIED reason.
 constexpr std::array<std::string_view, kConfirmRuleCount> kRuleWhy{
@@ -18,10 +19,46 @@ constexpr std::array<std::string_view, kConfirmRuleCount> kRuleWhy{
     "resets the PMU (outputs to their power-up state)",
     "cranks the engine",
     "moves the PMU to another CAN address",
-    "sets the upper temperature limit to 0, which forces thermal shutdown",
+    "sets the upper temperature limit to 0, or at or below the unit's internal temperature (below 128 degC while "
+    "it is unknown), which forces thermal shutdown",
     "leaves the avionics/servo output off at the next power-up or reset",
     "sets packets_streamed to 0: the PMU stops the telemetry this service listens for, and goes OFFLINE",
+    "drops from packets_streamed a packet the readiness and alarm rules read: they go blind",
 };
+
+// T_U at or below the internal temperature shuts the unit down (v1.9 5.14: all battery
+// charging ceases); 0 forces it whatever the temperature (table 15). docs/safety.md H2.
+bool forces_thermal_shutdown(std::uint32_t t_u, const DeviceUse& device) {
+  if (t_u == 0) return true;
+  if (!device.internal_temperature) return t_u < kSafeUpperTemperatureLimit;
+  return static_cast<double>(t_u) <= *device.internal_temperature;
+}
+
+std::string degrees(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.0f degC", v);
+  return buf;
+}
+
+// What `r` would do, for the DENIED reason: the rule's text, or for a rule judged by effect,
+// the values it was judged on.
+std::string effect(ConfirmRule rule, const CommandRequest& r, const DeviceUse& device) {
+  const auto* set = std::get_if<action::SetParameter>(&r.action);
+  if (rule == ConfirmRule::ThermalShutdown && set && set->raw != 0) {
+    const std::string limit = "sets the upper temperature limit to " + degrees(set->raw);
+    if (!device.internal_temperature)
+      return limit + " while the unit's internal temperature is unknown (safe from " +
+             degrees(kSafeUpperTemperatureLimit) + "): it may force thermal shutdown, which stops charging";
+    return limit + ", at or below the unit's internal temperature " + degrees(*device.internal_temperature) +
+           ": it forces thermal shutdown, which stops charging";
+  }
+  if (rule == ConfirmRule::BlindMonitoring && set) {
+    const auto dropped = static_cast<std::uint8_t>(device.packets_needed & ~set->raw);
+    return "drops " + codec::names_of(codec::kGroupNames, dropped, ", ") +
+           " from packets_streamed: the readiness and alarm rules that read them go blind";
+  }
+  return std::string(kRuleWhy[static_cast<std::size_t>(rule)]);
+}
 
 }  // namespace
 
@@ -39,15 +76,20 @@ std::optional<ConfirmRule> confirm_rule_for(const CommandRequest& r, const Devic
     switch (p->parameter) {
       case codec::Parameter::CanAddress: return ConfirmRule::SetCanAddress;
       case codec::Parameter::UpperTemperatureLimit:
-        return p->raw == 0 ? std::optional(ConfirmRule::ThermalShutdown) : std::nullopt;
+        return forces_thermal_shutdown(p->raw, device) ? std::optional(ConfirmRule::ThermalShutdown) : std::nullopt;
       case codec::Parameter::PowerUpState:
         return p->raw & AvionicsServo ? std::nullopt : std::optional(ConfirmRule::PowerUpAvionicsOff);
+      // Set-points within their ranges (v1.9 tables 8 to 11): none switches an output off.
       case codec::Parameter::AvionicsVoltage:
       case codec::Parameter::PayloadVoltage:
       case codec::Parameter::ServoVoltage:
-      case codec::Parameter::BatteryVoltage:
+      case codec::Parameter::BatteryVoltage: return std::nullopt;
       case codec::Parameter::PacketsStreamed:
-        return p->raw == 0 && device.streaming ? std::optional(ConfirmRule::StopStreaming) : std::nullopt;
+        // A polled device is asked for its packets: what it streams takes nothing from the
+        // service (docs/safety.md H3).
+        if (!device.streaming) return std::nullopt;
+        if (p->raw == 0) return ConfirmRule::StopStreaming;
+        return device.packets_needed & ~p->raw ? std::optional(ConfirmRule::BlindMonitoring) : std::nullopt;
       case codec::Parameter::PacketPeriod:
       case codec::Parameter::TemperatureOffset:
       case codec::Parameter::CrankingTime: return std::nullopt;
@@ -78,8 +120,7 @@ PolicyVerdict check_policy(const CommandRequest& r, const PolicyConfig& p, const
   if (p.deny[static_cast<std::size_t>(r.kind())])
     return {CommandResult::Denied, std::string(to_string(r.kind())) + " is denied by the service's policy"};
   if (const auto rule = confirm_rule_for(r, device); rule && p.confirm[static_cast<std::size_t>(*rule)] && !r.confirm) {
-    return {CommandResult::Denied, std::string(to_string(r.kind())) + " " +
-                                       std::string(kRuleWhy[static_cast<std::size_t>(*rule)]) +
+    return {CommandResult::Denied, std::string(to_string(r.kind())) + " " + effect(*rule, r, device) +
                                        ": it needs confirm (pmuctl --confirm); rule " + std::string(to_string(*rule))};
   }
   return {};

@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <memory>
 
+#include "pmu/alarms/settings.hpp"
 #include "pmu/codec/encode.hpp"
 #include "pmu/codec/ids.hpp"
 #include "sender_key.hpp"
@@ -113,7 +114,6 @@ void CommandService::submit(const CommandSample& s) {
   if (r.bus.empty() && r.address == codec::kBroadcastAddress) return broadcast_on_every_bus(r);
   BusWorker* worker = worker_for(r.bus);
   if (!worker) return refuse(r, not_served(r));
-  if (auto no = judge(r)) return refuse(r, *no);
   if (auto no = limit_rate(r)) return refuse(r, *no);
   worker->post([this, worker, r] { run_on_worker(*worker, r); });
 }
@@ -149,17 +149,15 @@ bool CommandService::first_time(const std::string& key, const CommandSample& s) 
   return false;
 }
 
-// From the config alone (immutable, so any thread may read it): a device the config does
-// not name is taken to stream, the side on which the policy asks for more.
-DeviceUse CommandService::device_use(const CommandRequest& r) const {
-  for (const auto* w : workers_) {
-    const BusConfig& bus = w->config();
-    if (bus.name != r.bus) continue;
-    for (const auto& d : bus.devices)
-      if (d.address == r.address) return {d.mode == TelemetryMode::Streaming};
-    if (bus.discover) return {bus.discovered_defaults.mode == TelemetryMode::Streaming};
-  }
-  return {};
+// From the session, on its worker's thread: how the service gets the device's packets, which
+// of them its alarms read, and its internal temperature while fresh. What is not known is
+// left at DeviceUse's worst case.
+DeviceUse CommandService::device_use(const DeviceSession& session, SteadyTime now) {
+  DeviceUse use;
+  use.streaming = session.settings().mode == TelemetryMode::Streaming;
+  use.packets_needed = alarms::packets_read(session.settings().alarms);
+  use.internal_temperature = session.internal_temperature(now);
+  return use;
 }
 
 CommandService::Refusal CommandService::not_served(const CommandRequest& r) const {
@@ -168,8 +166,8 @@ CommandService::Refusal CommandService::not_served(const CommandRequest& r) cons
   return {CommandResult::Rejected, "bus '" + printable(r.bus) + "' is not served here (buses: " + served + ")"};
 }
 
-std::optional<CommandService::Refusal> CommandService::judge(const CommandRequest& r) const {
-  PolicyVerdict verdict = check_policy(r, policy_, device_use(r));
+std::optional<CommandService::Refusal> CommandService::judge(const CommandRequest& r, const DeviceUse& use) const {
+  PolicyVerdict verdict = check_policy(r, policy_, use);
   if (verdict.allowed()) return std::nullopt;
   return Refusal{verdict.result, std::move(verdict.reason)};
 }
@@ -191,6 +189,7 @@ void CommandService::run_on_worker(BusWorker& worker, const CommandRequest& r) {
   if (r.address == codec::kBroadcastAddress) return broadcast(worker, r);
   DeviceSession* session = worker.session(r.address);
   if (auto no = check_device(worker, session, r)) return refuse(r, *no);
+  if (auto no = judge(r, device_use(*session, clock_.steady_now()))) return refuse(r, *no);
   execute_command(*session, r, clock_.steady_now(), timeouts_,
                   [this, key = sender_key(r.sender, r.request_id), sender = r.sender,
                    what = describe(r)](const CommandReplyData& d) { finish(key, sender, what, d); });

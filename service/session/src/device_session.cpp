@@ -54,6 +54,13 @@ std::chrono::milliseconds DeviceSession::period() const noexcept {
   return settings_.period;
 }
 
+std::optional<double> DeviceSession::internal_temperature(SteadyTime now) const noexcept {
+  if (!internal_temperature_ || std::isnan(internal_temperature_->value)) return std::nullopt;
+  const auto max_age = std::chrono::duration<double, std::milli>(period()) * timeouts_.stale_periods;
+  if (now - internal_temperature_->at > max_age) return std::nullopt;
+  return internal_temperature_->value;
+}
+
 void DeviceSession::start_reading(SteadyTime now) {
   now_ = now;
   const std::uint64_t round = reading_.start();
@@ -278,6 +285,7 @@ void DeviceSession::feed_alarms(const codec::PmuMessage& m, SteadyTime now, Wall
     engine_.generator_volts = v->generator;
     feed_engine_alarms(now, wall);
   } else if (const auto* t = std::get_if<codec::Temperatures>(&m.payload)) {
+    internal_temperature_ = Latest{t->internal, now};
     alarms_.observe(Code::InternalOverTemperature, t->internal, now, wall);
     alarms_.observe(Code::StarterOverTemperature, t->starter, now, wall);
     alarms_.observe(Code::GeneratorOverTemperature, t->generator, now, wall);

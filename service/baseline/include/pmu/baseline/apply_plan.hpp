@@ -32,8 +32,10 @@ struct Change {
 
 // The changes for `diffs`, in the order above. Every difference must have its device value
 // (the caller refuses to apply to a device not fully read: it could not be undone).
-// `streaming`: the service listens for this PMU's streamed packets (stop_streaming rule).
-std::vector<Change> apply_plan(const std::vector<Difference>& diffs, bool streaming = true);
+// `device`: what the caller knows of the PMU for the rules judged by effect; by default
+// nothing, so each such rule asks for confirm whenever the service might (pmuctl sends a
+// change confirmed only where the plan says it needs it).
+std::vector<Change> apply_plan(const std::vector<Difference>& diffs, const service::DeviceUse& device = {});
 
 // The command that sets `setting` to `raw`.
 service::CommandAction action_for(Setting setting, std::uint32_t raw);

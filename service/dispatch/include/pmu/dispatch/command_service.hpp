@@ -7,8 +7,10 @@
 //     resend with the same content is answered again with the first one's result, never
 //     executed twice (while the first still runs, the answer is owed and sent when it ends);
 //     the same id with other content is REJECTED, never answered with the other's reply;
-//   * expired, unroutable, denied or rate-limited requests are answered at once, with
-//     nothing sent to a bus;
+//   * expired, unroutable or rate-limited requests are answered at once, with nothing sent
+//     to a bus; the deny list and confirm rules judge a request on its bus worker's thread,
+//     after the device check, since the rules judged by effect read what the device reports
+//     now (policy.hpp's DeviceUse), which lives on that thread; a DENIED one sends nothing;
 //   * valid ones run on their bus worker's thread (command_executor.hpp), serialised per
 //     device by the device session, in parallel across devices and buses.
 // Replies are handed to `reply` outside the service's lock. Every command and its result is
@@ -81,9 +83,10 @@ class CommandService {
   Seen remember(const std::string& key, const CommandSample& s, std::optional<CommandReplyData>& again);
   // Routing: the bus is not one of this service's (when worker_for found none).
   Refusal not_served(const CommandRequest& r) const;
-  // The deny list and confirm rules (policy.hpp).
-  std::optional<Refusal> judge(const CommandRequest& r) const;
-  DeviceUse device_use(const CommandRequest& r) const;
+  // The deny list and confirm rules (policy.hpp), on the worker's thread: `use` is what the
+  // session knows of the device now.
+  std::optional<Refusal> judge(const CommandRequest& r, const DeviceUse& use) const;
+  static DeviceUse device_use(const DeviceSession& session, SteadyTime now);
   // The per-device token bucket; never for engine stop.
   std::optional<Refusal> limit_rate(const CommandRequest& r);
   // ...and on the bus worker's thread:

@@ -147,6 +147,10 @@ class DeviceSession {
     return alarms_.acknowledge(code, now, wall);
   }
   bool ready() const noexcept { return reading_.running(); }
+  // The internal temperature (v1.9 table 5) of the latest temperatures packet, while that is
+  // not stale (stale_periods x the period, as the health counts); nullopt when none came or
+  // it is stale. The confirm rules judged by effect read it (policy.hpp's DeviceUse).
+  std::optional<double> internal_temperature(SteadyTime now) const noexcept;
   std::size_t queued() const noexcept { return queue_.size(); }
 
  private:
@@ -199,6 +203,11 @@ class DeviceSession {
     bool stopped_by_itself = false;        // it fell below running speed with no stop sent
   };
   EngineView engine_;
+  struct Latest {
+    double value = 0;
+    SteadyTime at{};
+  };
+  std::optional<Latest> internal_temperature_;  // from the latest 0x03
   SteadyTime now_{};  // the latest time any call brought
   SteadyTime next_poll_{};
 };
