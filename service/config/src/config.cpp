@@ -26,6 +26,7 @@
 #include "pmu/config/quoted.hpp"
 #include "pmu/config/statistics_settings.hpp"
 #include "pmu/config/vehicle.hpp"
+#include "pmu/files/bounded_file.hpp"
 #include "pmu/version.hpp"
 #include "alarm_settings.hpp"
 #include "baseline_setting.hpp"
@@ -829,22 +830,13 @@ std::string SecurityConfig::line_of(const std::string& key) const {
 }
 
 Config load_config(const std::string& path) {
-  const auto reason = [&](const char* what) {
-    return ConfigError(path + ": " + what + " the config file: " + std::strerror(errno));
-  };
-  // A directory opens and reads as nothing; it is not an empty file.
-  struct stat st {};
-  if (::stat(path.c_str(), &st) != 0) throw reason("cannot open");
-  if (S_ISDIR(st.st_mode)) throw ConfigError(path + ": is a directory, not a config file");
-  const std::unique_ptr<std::FILE, int (*)(std::FILE*)> f(std::fopen(path.c_str(), "rb"), &std::fclose);
-  if (!f) throw reason("cannot open");
-  std::string text;
-  char buf[4096];
-  for (std::size_t n; (n = std::fread(buf, 1, sizeof buf, f.get())) > 0;) text.append(buf, n);
-  if (std::ferror(f.get())) throw reason("cannot read");
+  // Bounded and regular only: a device or FIFO named as the config must not hang or exhaust
+  // the start (docs/safety.md H12).
+  auto file = files::read_bounded_file(path, kMaxConfigFileBytes);
+  if (!file.ok()) throw ConfigError(path + ": cannot read the config file: " + file.error);
   ConfigEnvironment env;
   if (const char* dir = std::getenv("CREDENTIALS_DIRECTORY"); dir != nullptr) env.credentials_directory = dir;
-  return parse_config(text, path, env);
+  return parse_config(file.text, path, env);
 }
 
 Config default_sim_config() {

@@ -11,7 +11,6 @@
 #include <fastdds/dds/core/status/SubscriptionMatchedStatus.hpp>
 #include <fastdds/dds/subscriber/InstanceState.hpp>
 #include <fastdds/dds/subscriber/SampleInfo.hpp>
-#include <fstream>
 #include <map>
 #include <nlohmann/json.hpp>
 #include <set>
@@ -25,6 +24,7 @@
 #include "pmu/command/command.hpp"
 #include "pmu/dds/baseline_sample.hpp"
 #include "pmu/dds/dds_context.hpp"
+#include "pmu/files/bounded_file.hpp"
 #include "pmu/idl/guarded_type.hpp"
 #include "pmu/idl/state.h"
 #include "pmu/idl/statePubSubTypes.h"
@@ -143,15 +143,15 @@ class DeviceReader {
 codec::FirmwareVersion firmware_of(const pmu::v4::DeviceInfo& i) { return {i.firmware_major(), i.firmware_minor()}; }
 
 // The file's text, or the exit status after saying why it cannot be read.
+// Regular and bounded only (the reader the service uses): `config diff /dev/zero` or a FIFO
+// is refused at once, never read without end (docs/safety.md H12).
 std::optional<std::string> read_text(const GlobalOptions& o, const std::string& path, int& status) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) {
-    status = fail(o, ExitStatus::BadUsage, path + ": cannot be read: " + std::strerror(errno));
+  auto file = files::read_bounded_file(path, baseline::kMaxConfigFileBytes);
+  if (!file.ok()) {
+    status = fail(o, ExitStatus::BadUsage, path + ": cannot be read: " + file.error);
     return std::nullopt;
   }
-  std::ostringstream text;
-  text << in.rdbuf();
-  return text.str();
+  return std::move(file.text);
 }
 
 // The file read and checked, or the exit status (2) after saying FILE:LINE: what.
