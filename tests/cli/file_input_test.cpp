@@ -2,7 +2,8 @@
 // docs/safety.md H12): pmu-service, its --check-config and pmuctl's config verbs refuse a
 // device, a FIFO or a huge file at once, exit status 2, naming the file and, for a file a
 // config names, the config's line. Before the fix /dev/zero ended them with std::bad_alloc
-// (status 134) and a FIFO kept them waiting for ever.
+// (status 134) and a FIFO kept them waiting for ever. Also the firmware a simulated PMU may
+// be, which --check-config judges as the start does (interface.md 4.4).
 #include <gtest/gtest.h>
 #include <sys/stat.h>
 #include <unistd.h>
@@ -77,6 +78,19 @@ TEST(FileInput, PmuServiceRefusesADeviceOrAFifoAsItsConfigOrABaseline) {
        fifo + ": cannot read the config file: it is a FIFO, not a regular file"},
   };
   for (const auto& c : cases) expect_refused(c);
+}
+
+TEST(FileInput, CheckConfigRefusesAFirmwareTheSimulatorCannotBe) {
+  Folder dir;
+  for (const char* firmware : {"9.9", "1.11"}) {
+    const std::string config = dir.write("sim.yaml", kSimBus + "        sim: {firmware: \"" + firmware + "\"}\n");
+    expect_refused({std::string("sim firmware ") + firmware,
+                    std::string(PMU_SERVICE_PATH) + " --check-config --config " + config,
+                    config + ":5: firmware '" + firmware + "': the simulator is firmware 1.12..1.17"});
+  }
+  const std::string good = dir.write("good.yaml", kSimBus + "        sim: {firmware: \"1.12\"}\n");
+  const auto r = pmu::test::run_capture(std::string(PMU_SERVICE_PATH) + " --check-config --config " + good + " 2>&1");
+  EXPECT_EQ(r.status, 0) << r.out;
 }
 
 // pmuctl reads its file before it joins the domain: no service is needed to refuse it.

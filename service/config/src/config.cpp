@@ -212,7 +212,15 @@ PmuSimSettings parse_pmu_sim(const Ctx& c, const YAML::Node& n) {
   if (const auto v = n["silent"]) s.silent = sim_bool(c, v, "silent");
   if (const auto v = n["soa_shutdown"]) s.soa_shutdown = sim_bool(c, v, "soa_shutdown");
   if (const auto v = n["payload_shed"]) s.payload_shed = sim_bool(c, v, "payload_shed");
-  if (const auto v = n["firmware"]) s.firmware = firmware_of(c, v, "firmware");
+  if (const auto v = n["firmware"]) {
+    s.firmware = firmware_of(c, v, "firmware");
+    // The simulator behaves as a documented firmware only; refused here, at check time,
+    // rather than by the model when the service starts (interface.md 4.4).
+    if (!codec::is_described(*s.firmware))
+      c.fail(v, "firmware " + quoted(v.Scalar()) + ": the simulator is firmware " +
+                    codec::to_string(codec::kOldestDescribedFirmware) + ".." + codec::to_string(codec::kCurrentFirmware) +
+                    " (the versions the protocol documents describe)");
+  }
   if (const auto v = n["serial"]) s.serial = static_cast<std::uint16_t>(c.integer(v, "serial", 0, 65535));
   if (const auto v = n["ignores_set"]) {
     const auto name = c.scalar<std::string>(v, "ignores_set", "a stored parameter's name");
