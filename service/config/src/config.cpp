@@ -20,6 +20,7 @@
 #include <string_view>
 #include <utility>
 
+#include "pmu/codec/decimal_text.hpp"
 #include "pmu/codec/firmware.hpp"
 #include "pmu/codec/messages.hpp"
 #include "pmu/codec/telemetry.hpp"
@@ -35,15 +36,6 @@ namespace pmu::service {
 namespace {
 
 constexpr std::size_t kMaxBusName = 15;  // the IDL key is string<15>; IFNAMSIZ - 1 too
-
-// -?(0|[1-9][0-9]*): the one spelling of an integer that YAML 1.1 and a reader agree on.
-bool is_plain_decimal(const std::string& s) {
-  const std::size_t start = !s.empty() && s[0] == '-' ? 1 : 0;
-  if (s.size() == start) return false;
-  if (s[start] == '0' && s.size() > start + 1) return false;
-  return std::all_of(s.begin() + static_cast<std::ptrdiff_t>(start), s.end(),
-                     [](unsigned char ch) { return ch >= '0' && ch <= '9'; });
-}
 
 struct Ctx {
   std::string source;
@@ -90,7 +82,7 @@ struct Ctx {
   long integer(const YAML::Node& n, const char* name, long lo, long hi) const {
     // yaml-cpp reads 010 as octal 8 and 0x10 as 16 (YAML 1.1), so an address written with
     // a leading zero would silently name another device: only plain decimal is taken.
-    if (n.IsScalar() && !is_plain_decimal(n.Scalar()))
+    if (n.IsScalar() && !codec::is_plain_decimal(n.Scalar()))
       fail(n, std::string(name) + " must be a decimal integer (digits, optionally after '-'; no leading 0, '+', "
                                   "0x, 0o, exponent or fraction), not " + quoted(n.Scalar()));
     const auto v = scalar<long>(n, name, "an integer");
