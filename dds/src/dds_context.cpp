@@ -4,9 +4,10 @@
 
 #include <fastdds/dds/subscriber/SampleInfo.hpp>
 
+#include <unistd.h>
+
 #include <algorithm>
 #include <cstdlib>
-#include <fstream>
 #include <memory>
 #include <mutex>
 #include <spdlog/spdlog.h>
@@ -23,7 +24,9 @@ namespace {
 
 using namespace eprosima::fastdds::dds;
 
-bool readable(const std::string& path) { return std::ifstream(path).good(); }
+// Whether the file is there to be read; opening it to see would block on a FIFO. A file that
+// is there but no regular one is refused with its reason when the profiles are loaded.
+bool readable(const std::string& path) { return ::access(path.c_str(), R_OK) == 0; }
 
 // Fast DDS 2.9.1 (Debian bookworm's) can hang forever deleting a reliable writer whose readers
 // have not acknowledged everything. Its destructor (RTPSWriter::deinit) returns the history's

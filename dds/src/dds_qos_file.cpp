@@ -4,7 +4,6 @@
 #include <fastrtps/attributes/PublisherAttributes.h>
 #include <fastrtps/attributes/SubscriberAttributes.h>
 #include <fastrtps/xmlparser/XMLProfileManager.h>
-#include <sys/stat.h>
 #include <tinyxml2.h>
 
 #include <cerrno>
@@ -13,6 +12,7 @@
 #include <mutex>
 
 #include "pmu/dds/dds_context.hpp"
+#include "pmu/files/bounded_file.hpp"
 
 namespace pmu::dds {
 namespace {
@@ -20,17 +20,12 @@ namespace {
 using eprosima::fastrtps::xmlparser::XMLP_ret;
 using eprosima::fastrtps::xmlparser::XMLProfileManager;
 
-// "" when `file` can be opened for reading, else why not.
-std::string unreadable(const std::string& file) {
-  struct stat st {};
-  if (::stat(file.c_str(), &st) != 0) return std::string("cannot open: ") + std::strerror(errno);
-  if (S_ISDIR(st.st_mode)) return "is a directory, not a QoS profile file";
-  if (std::FILE* f = std::fopen(file.c_str(), "rb")) {
-    std::fclose(f);
-    return {};
-  }
-  return std::string("cannot open: ") + std::strerror(errno);
-}
+// Far above any profile file; a bound, so a device named as the QoS file is refused.
+constexpr std::size_t kMaxQosFileBytes = std::size_t{1} << 20;
+
+// The file's text, or why it cannot be read: regular and bounded only, through the one
+// reader, because a FIFO or /dev/zero named here would stop the start (docs/safety.md H12).
+files::FileText qos_text(const std::string& file) { return files::read_bounded_file(file, kMaxQosFileBytes); }
 
 // The line of <data_writer|data_reader profile_name="..."> anywhere in the document, or 0.
 int profile_line(const tinyxml2::XMLElement* e, const char* tag, const char* profile) {
@@ -49,7 +44,10 @@ void load_qos_profiles(const std::string& file) {
   static std::map<std::string, bool> loaded;
   std::lock_guard<std::mutex> lock(mutex);
   if (loaded[file]) return;
-  if (const auto why = unreadable(file); !why.empty()) throw DdsError("QoS profile file " + file + ": " + why);
+  // Fast DDS reads the file itself, by its path: it is handed only a file just found to be
+  // regular and within the bound.
+  if (const auto text = qos_text(file); !text.ok())
+    throw DdsError("QoS profile file " + file + ": cannot be read: " + text.error);
   using eprosima::fastdds::dds::DomainParticipantFactory;
   if (DomainParticipantFactory::get_instance()->load_XML_profiles_file(file) != ReturnCode_t::RETCODE_OK)
     throw DdsError("cannot load QoS profiles from " + file + " (see the Fast DDS XML error above)");
@@ -57,10 +55,11 @@ void load_qos_profiles(const std::string& file) {
 }
 
 std::vector<std::string> qos_file_problems(const std::string& file, const std::vector<ProfileUse>& uses) {
-  if (const auto why = unreadable(file); !why.empty()) return {file + ": " + why};
+  const auto text = qos_text(file);
+  if (!text.ok()) return {file + ": cannot be read: " + text.error};
   // Fast DDS only logs where its XML parser stopped; tinyxml2 (its parser too) gives the line.
   tinyxml2::XMLDocument doc;
-  if (doc.LoadFile(file.c_str()) != tinyxml2::XML_SUCCESS)
+  if (doc.Parse(text.text.data(), text.text.size()) != tinyxml2::XML_SUCCESS)
     return {file + ":" + std::to_string(doc.ErrorLineNum()) + ": not well-formed XML: " + doc.ErrorStr()};
   try {
     load_qos_profiles(file);

@@ -58,6 +58,10 @@ const BadCase kBad[] = {
     {"--mppt 0 --panels 5", "--panels: Value 5 not in range 0 to 4"},
     {"--mppt 0 --mppt-garble [none]", "--mppt-garble: [none] not in {none,wrong_length,unknown_subindex}"},
     {"--mppt-silent", "--mppt-silent requires --mppt"},
+    // Only a firmware the documents describe (interface.md 3.3, 4.4).
+    {"--firmware 1.11", "pmu-sim: --firmware 1.11: the simulator is firmware 1.12..1.17"},
+    {"--firmware 9.9", "pmu-sim: --firmware 9.9: the simulator is firmware 1.12..1.17"},
+    {"--firmware 1.x", "pmu-sim: --firmware '1.x' is not a version like 1.16"},
 };
 
 TEST(PmuSimOptions, BadValuesAreRefusedBeforeTheBusIsOpened) {
@@ -80,6 +84,8 @@ TEST(PmuSimOptions, GoodWorldOptionsAreAccepted) {
       "--no-pmu --battery 2 --state-of-charge 35 --cell-voltages 3.9,3.9,3.9,3.55 --battery-garble wrong_length "
       "--battery-silent --mppt 0 --panels 2 --mppt-garble unknown_subindex --mppt-silent",
       "--battery 2 --cells 3 --cell-voltages 3.9,4.25,3.1",
+      "--firmware 1.12 --serial 7",
+      "--firmware 1.17",
   };
   for (const char* args : good) {
     SCOPED_TRACE(args);

@@ -284,6 +284,15 @@ TEST(PmuctlView, ConfigSetReadsMaskNamesAndNumbers) {
       {"avionics_voltage", "12V", 0, "'12V' is not a number"},
       {"avionics_voltage", "nan", 0, "is not a number"},
       {"avionics_voltage", "", 0, "'' is not a number"},
+      // The spec's range, step and mask, before anything is sent (interface.md 3.2: exit 2).
+      {"packets_streamed", "0x20", 0, "packets_streamed 32 has bits outside the defined mask 0x1F"},
+      {"packets_streamed", "32", 0, "packets_streamed 32 has bits outside the defined mask 0x1F"},
+      {"power_up_state", "0x80", 0, "power_up_state 128 has bits outside the defined mask 0x7F"},
+      {"avionics_voltage", "99", 0, "value 99.0 V out of range 12.0..24.0 V for avionics_voltage"},
+      {"can_address", "65535", 0, "out of range"},
+      {"cranking_time", "2.55", 0, "is not a multiple of 0.1 s"},
+      {"packets_streamed", "0x1F", 0x1F, nullptr},
+      {"can_address", "65534", 65534, nullptr},
   };
   for (const auto& r : rows) {
     const auto v = parse_config_value(r.parameter, r.text);

@@ -234,13 +234,75 @@ TEST(ConfigFilesOverDds, DiffWithoutAFileUsesTheServicesBaseline) {
   const auto equal = pmu::test::run_capture(p + "--address 1 config diff 2>&1");
   EXPECT_EQ(equal.status, 0) << equal.out;
 
+  // Another unit than the baseline's differs, whatever its settings: never "matches".
   const auto other_unit = pmu::test::run_capture(p + "--address 2 config diff 2>&1");
   EXPECT_EQ(other_unit.status, 1) << other_unit.out;
-  EXPECT_NE(other_unit.out.find("serial: device 1002, baseline 4242"), std::string::npos) << other_unit.out;
+  EXPECT_NE(other_unit.out.find(pinned + ": serial: device 1002, baseline 4242: another unit than the baseline's"),
+            std::string::npos)
+      << other_unit.out;
+  EXPECT_NE(other_unit.out.find("sim/2 differs from " + pinned + ": it is another unit (serial 1002, the baseline's "
+                                "4242); its 1 settings match"),
+            std::string::npos)
+      << other_unit.out;
+  EXPECT_EQ(other_unit.out.find("matches"), std::string::npos) << other_unit.out;
+  const auto other_json = pmu::test::run_capture(p + "--address 2 --json config diff");
+  EXPECT_EQ(other_json.status, 1) << other_json.out;
+  const auto j = Json::parse(other_json.out);
+  EXPECT_EQ(j["equal"], false) << other_json.out;
+  ASSERT_EQ(j["differences"].size(), 1u) << other_json.out;
+  EXPECT_EQ(j["differences"][0]["name"], "serial");
+  EXPECT_EQ(j["differences"][0]["device"], "1002");
+  EXPECT_EQ(j["differences"][0]["file"], "4242");
 
   const auto none = pmu::test::run_capture(p + "--address 3 config diff 2>&1");
   EXPECT_EQ(none.status, 2) << none.out;
   EXPECT_NE(none.out.find("no baseline configured for PMU sim/3"), std::string::npos) << none.out;
+}
+
+// apply judges the unit and the new address before the first frame, and its dry run refuses
+// what it would: a file read from another serial needs --other-unit, and a can_address that
+// another PMU of the service has is refused as the service would refuse it (interface.md 2.6).
+TEST(ConfigFilesOverDds, ApplyJudgesTheUnitAndTheNewAddressBeforeSending) {
+  Files files;
+  const std::string domain = std::to_string(pmu::test::exclusive_dds_domain());
+  pmu::test::ConfiguredService service(PMU_SERVICE_PATH, "domain: " + domain + "\nqos_file: " PMU_QOS_FILE
+                                                         "\nbuses:\n  - interface: sim\n    devices:\n"
+                                                         "      - address: 1\n        period: 0.5\n"
+                                                         "      - address: 2\n        period: 0.5\n");
+  const std::string p = std::string(PMUCTL_PATH) + " --domain " + domain + " --bus sim ";
+  ASSERT_EQ(pmu::test::run_capture(p + "--timeout 30 --address 2 config get can_address").status, 0)
+      << service.describe();
+  const std::string from_1 = files.write("from-1.yaml", "device:\n  serial: 1001\nparameters:\n  avionics_voltage: 22.0\n");
+  const std::string to_1 = files.write("to-1.yaml", "parameters:\n  can_address: 1\n");
+  const std::string to_5 = files.write("to-5.yaml", "parameters:\n  can_address: 5\n");
+  struct Case {
+    std::string args;
+    int status;
+    std::string says;
+  };
+  const Case refused[] = {
+      {"config apply " + from_1, 2,
+       from_1 + ":2: the file was read from serial 1001, and sim/2 is serial 1002: another unit; nothing was sent "
+                "(--other-unit applies it to this unit)"},
+      {"config apply --dry-run " + from_1, 2, from_1 + ":2: the file was read from serial 1001"},
+      {"--confirm config apply " + to_1, 2,
+       to_1 + ":2: can_address 1: address 1 is already in use on sim (a PMU the service serves); nothing was sent"},
+      {"config apply --dry-run " + to_1, 2, to_1 + ":2: can_address 1: address 1 is already in use on sim"},
+      {"config apply --dry-run " + to_5, 0, "1. " + to_5 + ":2: can_address: 2 -> 5 (needs --confirm"},
+      {"config apply --dry-run --other-unit " + from_1, 0, "1. " + from_1 + ":4: avionics_voltage: 12.0 V -> 22.0 V"},
+  };
+  const auto audits = count_of(service.describe(), "audit: command");
+  for (const auto& c : refused) {
+    SCOPED_TRACE(c.args);
+    const auto r = pmu::test::run_capture(p + "--timeout 10 --address 2 " + c.args + " 2>&1");
+    EXPECT_EQ(r.status, c.status) << r.out;
+    EXPECT_NE(r.out.find(c.says), std::string::npos) << r.out;
+  }
+  EXPECT_EQ(count_of(service.describe(), "audit: command"), audits) << "a refused or dry-run apply sent a command";
+  // Said so, it is applied to this unit.
+  const auto applied = pmu::test::run_capture(p + "--timeout 10 --address 2 config apply --other-unit " + from_1 + " 2>&1");
+  EXPECT_EQ(applied.status, 0) << applied.out << service.describe();
+  EXPECT_NE(applied.out.find("sim/2: avionics_voltage 12.0 V -> 22.0 V: COMPLETED"), std::string::npos) << applied.out;
 }
 
 }  // namespace

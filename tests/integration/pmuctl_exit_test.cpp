@@ -82,7 +82,8 @@ const Case kDemo[] = {
     {"--timeout 10 --confirm engine start", 1, "DENIED: engine already running: 6000 rpm"},
     {"--timeout 10 --address 65535 engine stop", 0, "stop sent to every PMU (broadcast) on sim0"},
     {"--timeout 10 --bus sim0 --address 65535 engine stop", 0, "stop sent to every PMU (broadcast)"},
-    {"--timeout 10 config set avionics_voltage 99", 1, "REJECTED"},
+    // A value the spec refuses is bad usage, refused before anything is sent (interface.md 3.2).
+    {"--timeout 10 config set avionics_voltage 99", 2, "value 99.0 V out of range 12.0..24.0 V for avionics_voltage"},
     // Broadcast is for the stop alone.
     {"--address 65535 outputs get", 2, "--address 65535 (broadcast) is only for `engine stop`"},
     {"--address 65535 engine start", 2, "--address 65535 (broadcast) is only for `engine stop`"},
@@ -94,6 +95,11 @@ const Case kDemo[] = {
     {"--timeout 30 --address 9 config get", 2, "PMU 9 not seen"},
     {"--timeout 30 --address 9 outputs get", 2, "PMU 9 not seen"},
     {"--timeout 30 --bus nope list", 2, "no device seen on bus nope"},
+    // Named whole, a target is not looked up first (an engine stop waits for nothing): the
+    // service's refusal says it is not there, which is no such target too.
+    {"--timeout 10 --bus nope --address 1 engine stop", 2, "REJECTED: bus 'nope' is not served here (buses: sim0)"},
+    {"--timeout 10 --bus nope --address 65535 engine stop", 2, "REJECTED: bus 'nope' is not served here"},
+    {"--timeout 10 --bus sim0 --address 9 engine stop", 2, "REJECTED: device 9 not seen on sim0"},
     {"config get no_such_parameter", 2, "unknown parameter 'no_such_parameter' (parameters: avionics_voltage"},
     {"config set outputs 15", 2, "switch them with `pmuctl outputs set|enable|disable NAME...`"},
     {"config set generation_enabled 1", 2, "`pmuctl generation on|off`"},
@@ -101,7 +107,8 @@ const Case kDemo[] = {
     {"config set avionics_voltage -inf", 2, "'-inf' is not a finite number"},
     {"config set avionics_voltage nan", 2, "avionics_voltage: 'nan' is not a number"},
     {"config set packets_streamed -1", 2, "packets_streamed: '-1' is not a mask"},
-    {"--timeout 10 config set packets_streamed 32", 1, "packets_streamed 32 has bits outside the defined mask 0x1F"},
+    {"--timeout 10 config set packets_streamed 32", 2, "packets_streamed 32 has bits outside the defined mask 0x1F"},
+    {"--timeout 10 config set packets_streamed 0x20", 2, "packets_streamed 32 has bits outside the defined mask 0x1F"},
     // Option values.
     {"--timeout 1e10 list", 2, "--timeout '1e10' is not a number of seconds"},
     {"--timeout nan list", 2, "--timeout 'nan' is not a number of seconds"},

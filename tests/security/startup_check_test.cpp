@@ -136,7 +136,11 @@ TEST(StartupCheck, MissingOrIncompleteFiles) {
   expect_error(check(f), "permissions", "nowhere/permissions.p7s: does not exist");
   f = Pki::get().files("pmu-service");
   f.governance = Pki::get().dir();  // a folder
-  expect_error(check(f), "governance", ": is not a regular file");
+  expect_error(check(f), "governance", ": cannot be read: it is a directory, not a regular file");
+  // A device is never read: /dev/zero would never end (docs/safety.md H12).
+  f = Pki::get().files("pmu-service");
+  f.governance = "/dev/zero";
+  expect_error(check(f), "governance", "/dev/zero: cannot be read: it is a character device, not a regular file");
   f = Pki::get().files("pmu-service");
   f.private_key.clear();
   expect_error(check(f), "private_key", "private_key is not set");

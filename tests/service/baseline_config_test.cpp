@@ -137,6 +137,26 @@ TEST(BaselineConfig, AFileThatCannotServeIsRefusedAtTheConfigsLine) {
   }
 }
 
+// What is not a regular file within 64 KiB is refused at the config's line without being
+// read (docs/safety.md H12): /dev/zero would exhaust memory, a FIFO block the start.
+TEST(BaselineConfig, ADeviceAFifoOrAHugeFileIsRefusedNotRead) {
+  Folder dir;
+  const std::string source = dir.path() + "/pmu-service.yaml";
+  const std::string fifo = dir.path() + "/pmu1.fifo";
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+  const std::string huge = dir.write("huge.yaml", "# " + std::string(64 * 1024, 'x') + "\noutputs: []\n");
+  const std::pair<std::string, std::string> cases[] = {
+      {"/dev/zero", source + ":5: baseline /dev/zero cannot be read: it is a character device, not a regular file"},
+      {fifo, source + ":5: baseline " + fifo + " cannot be read: it is a FIFO, not a regular file"},
+      {huge, source + ":5: baseline " + huge + " cannot be read: it is 65551 bytes, larger than the 64 KiB bound"},
+  };
+  for (const auto& [path, message] : cases) {
+    SCOPED_TRACE(path);
+    EXPECT_EQ(refusal(config_with("        baseline: " + path + "\n"), source), message);
+  }
+  ::unlink(fifo.c_str());
+}
+
 TEST(BaselineConfig, AnUnreadableFileSaysWhy) {
   if (::geteuid() == 0) GTEST_SKIP() << "root reads a file of mode 000: no EACCES to see";
   Folder dir;

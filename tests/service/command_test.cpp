@@ -317,6 +317,38 @@ TEST(Commands, InvalidRequestsAreRefusedWithAReasonAndNothingIsSent) {
   }
 }
 
+// pmuctl exits 2 (no such target) for a refusal that says the bus or the device is not there,
+// 1 for any other (interface.md 3.2): says_no_such_target tells them apart on the service's
+// own reasons.
+TEST(Commands, ARefusalSaysWhenItsTargetIsNotThere) {
+  struct Case {
+    const char* what;
+    std::string bus;
+    std::uint16_t address;
+    CommandKind kind;
+    bool not_there;
+  };
+  const Case cases[] = {
+      {"a bus not served", "can9", 1, CommandKind::EngineStop, true},
+      {"a broadcast stop on a bus not served", "can9", 0xFFFF, CommandKind::EngineStop, true},
+      {"a device not seen", "sim0", 7, CommandKind::EngineStop, true},
+      {"a refusal by the policy", "sim0", 1, CommandKind::Reset, false},
+  };
+  for (const auto& tc : cases) {
+    SCOPED_TRACE(tc.what);
+    Commands c({pmu(1)});
+    auto r = c.req(tc.kind, tc.address);
+    r.bus = tc.bus;
+    const auto reply = c.run(r);
+    EXPECT_NE(reply.result, CommandResult::Completed) << reply.reason;
+    EXPECT_EQ(says_no_such_target(reply.reason, tc.bus, tc.address), tc.not_there) << reply.reason;
+  }
+  // Another bus's or device's refusal is not this target's.
+  EXPECT_FALSE(says_no_such_target(device_not_seen_reason(7, "sim0"), "sim0", 8));
+  EXPECT_FALSE(says_no_such_target(bus_not_served_reason("can9", "sim0"), "can1", 1));
+  EXPECT_FALSE(says_no_such_target("rate limit: more than 5 commands/s", "sim0", 1));
+}
+
 TEST(Commands, FeaturesTheFirmwareLacksAreUnsupported) {
   Commands c({pmu(1, codec::FirmwareVersion{1, 12})});
   auto m = c.req(CommandKind::RequestMeasurements);

@@ -182,10 +182,22 @@ const Malformed kMalformed[] = {
     {"YAML syntax", "parameters:\n  avionics_voltage: [24.0\n", 3, "YAML syntax error"},
     {"two documents", "outputs: [payload]\n---\noutputs: []\n", 3, "second YAML document"},
     {"vehicle too long", "device:\n  vehicle: a-vehicle-name-too-long\noutputs: []\n", 2, "longer than 15"},
+    // Numbers in plain decimal only, as the service's config (interface.md 4.1): an integer
+    // setting takes no fraction, and no setting another base.
+    {"a fraction for an address", "parameters:\n  can_address: 1.5\n", 2, "'1.5' is not a whole number"},
+    {"a whole limit written with a fraction", "parameters:\n  upper_temperature_limit: 80.0\n", 2,
+     "is not a whole number"},
+    {"an address with a leading 0", "parameters:\n  can_address: 010\n", 2, "is not a whole number"},
+    {"hex for a voltage", "parameters:\n  avionics_voltage: 0x18\n", 2, "'0x18' is not a decimal number"},
+    {"an exponent", "parameters:\n  packet_period: 5e-1\n", 2, "is not a decimal number"},
+    {"a plus sign", "parameters:\n  payload_voltage: +22.0\n", 2, "is not a decimal number"},
+    {"a fraction without its 0", "parameters:\n  cranking_time: .5\n", 2, "is not a decimal number"},
+    {"hex for the header's address", "device:\n  address: 0x10\noutputs: []\n", 2, "is not a whole number"},
+    {"a leading 0 for the serial", "device:\n  serial: 01001\n", 2, "is not a whole number"},
 };
 
 TEST(ConfigFile, MalformedFilesAreRefusedAtTheirLine) {
-  static_assert(std::size(kMalformed) >= 25);
+  static_assert(std::size(kMalformed) >= 34);
   for (const auto& m : kMalformed) {
     const auto f = read_config_file(m.text);
     ASSERT_FALSE(f.ok()) << m.what;

@@ -3,6 +3,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <cstdio>
 #include <cstdlib>
 #include <optional>
 #include <string>
@@ -578,7 +579,7 @@ TEST(ConfigFile, MissingFileSaysWhy) {
     (void)load_config("/nonexistent/pmu.yaml");
     ADD_FAILURE() << "accepted";
   } catch (const ConfigError& e) {
-    EXPECT_EQ(std::string(e.what()), "/nonexistent/pmu.yaml: cannot open the config file: No such file or directory");
+    EXPECT_EQ(std::string(e.what()), "/nonexistent/pmu.yaml: cannot read the config file: No such file or directory");
   }
 }
 
@@ -593,7 +594,7 @@ TEST(ConfigFile, UnreadableFileSaysWhy) {
     (void)load_config(path);
     ADD_FAILURE() << "accepted";
   } catch (const ConfigError& e) {
-    EXPECT_EQ(std::string(e.what()), std::string(path) + ": cannot open the config file: Permission denied");
+    EXPECT_EQ(std::string(e.what()), std::string(path) + ": cannot read the config file: Permission denied");
   }
   ::unlink(path);
 }
@@ -603,8 +604,42 @@ TEST(ConfigFile, DirectoryIsNotAnEmptyFile) {
     (void)load_config("/tmp");
     ADD_FAILURE() << "accepted";
   } catch (const ConfigError& e) {
-    EXPECT_EQ(std::string(e.what()), "/tmp: is a directory, not a config file");
+    EXPECT_EQ(std::string(e.what()), "/tmp: cannot read the config file: it is a directory, not a regular file");
   }
+}
+
+// Only a regular file within its bound is read (docs/safety.md H12): /dev/zero never ends, a
+// FIFO's open waits for a writer that never comes; each is refused at once, saying why.
+TEST(ConfigFile, ADeviceAFifoOrAHugeFileIsRefusedNotRead) {
+  char dir[] = "/tmp/pmu-config-XXXXXX";
+  ASSERT_NE(::mkdtemp(dir), nullptr);
+  const std::string fifo = std::string(dir) + "/fifo.yaml";
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+  const std::string huge = std::string(dir) + "/huge.yaml";
+  {
+    std::FILE* f = std::fopen(huge.c_str(), "w");
+    ASSERT_NE(f, nullptr);
+    const std::string line = "# " + std::string(1021, 'x') + "\n";  // 1 KiB a line
+    for (int i = 0; i <= 1024; ++i) std::fputs(line.c_str(), f);
+    std::fclose(f);
+  }
+  const std::pair<std::string, std::string> cases[] = {
+      {"/dev/zero", "/dev/zero: cannot read the config file: it is a character device, not a regular file"},
+      {fifo, fifo + ": cannot read the config file: it is a FIFO, not a regular file"},
+      {huge, huge + ": cannot read the config file: it is 1025 KiB, larger than the 1 MiB bound"},
+  };
+  for (const auto& [path, message] : cases) {
+    SCOPED_TRACE(path);
+    try {
+      (void)load_config(path);
+      ADD_FAILURE() << "accepted";
+    } catch (const ConfigError& e) {
+      EXPECT_EQ(std::string(e.what()), message);
+    }
+  }
+  ::unlink(fifo.c_str());
+  ::unlink(huge.c_str());
+  ::rmdir(dir);
 }
 
 // A key given twice, at any depth, is refused at its second line (yaml-cpp keeps both and

@@ -3,6 +3,7 @@
 #include "pmu/session/moved_addresses.hpp"
 
 #include <gtest/gtest.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <cstdio>
@@ -65,6 +66,27 @@ TEST(MovedAddresses, MissingFileIsNoMoves) {
   const auto r = read_moved_addresses("/nonexistent-dir/moved-addresses");
   EXPECT_TRUE(r.moves.empty());
   EXPECT_TRUE(r.errors.empty());
+}
+
+// A state file that is no regular file is reported and taken as no moves, never read or
+// waited on (docs/safety.md H12): the start goes on.
+TEST(MovedAddresses, ADeviceOrAFifoIsAnErrorNotARead) {
+  char dir[] = "/tmp/pmu-moved-XXXXXX";
+  ASSERT_NE(::mkdtemp(dir), nullptr);
+  const std::string fifo = std::string(dir) + "/moved-addresses";
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+  const std::pair<std::string, std::string> cases[] = {
+      {"/dev/zero", "/dev/zero: cannot read: it is a character device, not a regular file"},
+      {fifo, fifo + ": cannot read: it is a FIFO, not a regular file"},
+  };
+  for (const auto& [path, error] : cases) {
+    SCOPED_TRACE(path);
+    const auto r = read_moved_addresses(path);
+    EXPECT_TRUE(r.moves.empty());
+    EXPECT_EQ(r.errors, std::vector<std::string>{error});
+  }
+  ::unlink(fifo.c_str());
+  ::rmdir(dir);
 }
 
 const char* kConfig =

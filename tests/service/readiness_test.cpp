@@ -336,6 +336,29 @@ TEST(ReadinessRules, DriftTextsFitTheirBoundsAndSayHowToFix) {
   ASSERT_EQ(one.size(), 1u);
   EXPECT_EQ(one[0].description,
             "outputs avionics_servo,payload,charger_a,charger_b (0x0F)->payload (0x02). pmuctl config diff / apply pmu1.yaml");
+
+  // A mask whose names do not fit is said by its numbers: the values are always shown.
+  struct Case {
+    const char* what;
+    std::string file;
+    std::string description;
+  };
+  const Case masks[] = {
+      {"outputs alone", "outputs: [avionics_servo, payload, charger_a]\n",
+       "outputs 0x0F->0x07. pmuctl config diff / apply pmu1.yaml"},
+      {"power_up_state alone", "parameters:\n  power_up_state: [avionics_servo, payload, charger_a, "
+       "battery_disconnect_detect, payload_shedding, soa_management]\n",
+       "power_up_state 0x0F->0x77. pmuctl config diff / apply pmu1.yaml"},
+      {"a mask after a value", "parameters:\n  avionics_voltage: 22.0\noutputs: [avionics_servo, payload, charger_a]\n",
+       "avionics_voltage 12.0 V->22.0 V; outputs 0x0F->0x07. pmuctl config diff / apply pmu1.yaml"},
+  };
+  for (const auto& c : masks) {
+    SCOPED_TRACE(c.what);
+    in.devices[Key{"can0", DeviceKind::Pmu, 1}] = pinned_pmu(c.file);
+    const auto r = readiness_reasons(in);
+    ASSERT_EQ(r.size(), 1u);
+    EXPECT_EQ(r[0].description, c.description);
+  }
 }
 
 // ---- the tracker ----------------------------------------------------------------------------

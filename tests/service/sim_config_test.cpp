@@ -152,6 +152,15 @@ const BadCase kBadPmu[] = {
     {"          soa_shutdown: yes please\n", "bad.yaml:6: soa_shutdown must be true or false, not 'yes please'"},
     {"          payload_shed: []\n", "bad.yaml:6: payload_shed must be true or false"},
     {"          firmware: 1.x\n", "bad.yaml:6: firmware '1.x' is not MAJOR.MINOR (each 0..255, e.g. \"1.14\")"},
+    {"          firmware: \"9.9\"\n",
+     "bad.yaml:6: firmware '9.9': the simulator is firmware 1.12..1.17 (the versions the protocol documents "
+     "describe)"},
+    {"          firmware: \"1.11\"\n",
+     "bad.yaml:6: firmware '1.11': the simulator is firmware 1.12..1.17 (the versions the protocol documents "
+     "describe)"},
+    {"          firmware: \"1.18\"\n",
+     "bad.yaml:6: firmware '1.18': the simulator is firmware 1.12..1.17 (the versions the protocol documents "
+     "describe)"},
     {"          serial: 65536\n", "bad.yaml:6: serial 65536 out of range 0..65535"},
     {"          serial: 0x10\n",
      "bad.yaml:6: serial must be a decimal integer (digits, optionally after '-'; no leading 0, '+', 0x, 0o, "

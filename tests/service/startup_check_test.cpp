@@ -3,6 +3,7 @@
 // with FILE:LINE. Fast DDS keeps loaded profiles for the process, and each test here runs in
 // a process of its own (gtest_discover_tests), so each loads at most one file.
 #include <gtest/gtest.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <cstdlib>
@@ -57,14 +58,32 @@ TEST(StartupCheck, MissingQosFileIsNamedAtTheConfigLine) {
   const auto c = check(std::string(kBus) + "qos_file: /nonexistent/qos.xml\n", "/etc/pmu-dds/pmu-service.yaml");
   ASSERT_EQ(c.errors.size(), 1u);
   EXPECT_EQ(c.errors[0],
-            "/etc/pmu-dds/pmu-service.yaml:4: qos_file: /nonexistent/qos.xml: cannot open: No such file or directory");
+            "/etc/pmu-dds/pmu-service.yaml:4: qos_file: /nonexistent/qos.xml: cannot be read: No such file or directory");
 }
 
 TEST(StartupCheck, QosFileThatIsADirectory) {
   const std::string dir = scratch("dir");
   const auto c = check("qos_file: " + dir + "\n" + kBus, "a.yaml");
   ASSERT_EQ(c.errors.size(), 1u);
-  EXPECT_EQ(c.errors[0], "a.yaml:1: qos_file: " + dir + ": is a directory, not a QoS profile file");
+  EXPECT_EQ(c.errors[0], "a.yaml:1: qos_file: " + dir + ": cannot be read: it is a directory, not a regular file");
+}
+
+// A device or FIFO named as the QoS file is refused, never handed to Fast DDS or tinyxml2 to
+// read without end or wait on (docs/safety.md H12).
+TEST(StartupCheck, QosFileThatIsADeviceOrAFifo) {
+  const std::string fifo = scratch("fifo") + "/qos.xml";
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+  const std::pair<std::string, std::string> cases[] = {
+      {"/dev/zero", "a.yaml:1: qos_file: /dev/zero: cannot be read: it is a character device, not a regular file"},
+      {fifo, "a.yaml:1: qos_file: " + fifo + ": cannot be read: it is a FIFO, not a regular file"},
+  };
+  for (const auto& [path, error] : cases) {
+    SCOPED_TRACE(path);
+    const auto c = check("qos_file: " + path + "\n" + kBus, "a.yaml");
+    ASSERT_EQ(c.errors.size(), 1u);
+    EXPECT_EQ(c.errors[0], error);
+  }
+  ::unlink(fifo.c_str());
 }
 
 TEST(StartupCheck, MalformedQosFileIsNamedAtItsOwnLine) {
@@ -104,7 +123,7 @@ TEST(StartupCheck, PmuQosFileIsNamedWhenItIsTheOneUsed) {
   const auto c = check(kBus, "a.yaml");
   ::unsetenv("PMU_QOS_FILE");
   ASSERT_EQ(c.errors.size(), 1u);
-  EXPECT_EQ(c.errors[0], "$PMU_QOS_FILE: /nonexistent/env-qos.xml: cannot open: No such file or directory");
+  EXPECT_EQ(c.errors[0], "$PMU_QOS_FILE: /nonexistent/env-qos.xml: cannot be read: No such file or directory");
 }
 
 TEST(StartupCheck, NoQosFileAnywhere) {
@@ -123,7 +142,7 @@ TEST(StartupCheck, CheckConfigAndTheStartRefuseTheSameQosFileTheSameWay) {
   const std::string dir = scratch("program");
   const std::string cfg = write(dir + "/pmu-service.yaml",
                                 "domain: 170\nqos_file: /nonexistent/qos.xml\n" + std::string(kBus));
-  const std::string expected = cfg + ":2: qos_file: /nonexistent/qos.xml: cannot open: No such file or directory";
+  const std::string expected = cfg + ":2: qos_file: /nonexistent/qos.xml: cannot be read: No such file or directory";
   for (const std::string extra : {" --check-config", ""}) {
     SCOPED_TRACE(extra);
     const auto r = pmu::test::run_capture("timeout 30 " PMU_SERVICE_PATH " --config " + cfg + extra + " 2>&1");

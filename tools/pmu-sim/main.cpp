@@ -84,7 +84,7 @@ int main(int argc, char** argv) {
   app.add_option("iface", iface, "SocketCAN interface, e.g. vcan0")->required();
   app.add_option("--address", addresses, "CAN address (repeat for several units; default 1)")
       ->check(CLI::Range(0, int{pmu::codec::kMaxDeviceAddress}));
-  app.add_option("--firmware", firmware, "Firmware version to behave as: 1.12, 1.14, 1.16 or 1.17");
+  app.add_option("--firmware", firmware, "Firmware version to behave as, 1.12..1.17 (default 1.17)");
   app.add_option("--serial", serial, "Serial number of the first unit (the next get +1)")->check(CLI::Range(0, 65535));
   std::string engine = "running";
   auto* engine_opt = app.add_option("--engine", engine, "The engine at power-up: running (default) or stopped")
@@ -187,6 +187,15 @@ int main(int argc, char** argv) {
   const auto fw = pmu::codec::parse_firmware(firmware);
   if (!fw) {
     std::fprintf(stderr, "pmu-sim: --firmware '%s' is not a version like 1.16\n", firmware.c_str());
+    return 2;
+  }
+  // Every argument is checked before the bus is opened (interface.md 3.3): the model would
+  // refuse this firmware only once the bus is open.
+  if (!pmu::codec::is_described(*fw)) {
+    std::fprintf(stderr, "pmu-sim: --firmware %s: the simulator is firmware %s..%s (the versions the protocol "
+                         "documents describe)\n",
+                 firmware.c_str(), pmu::codec::to_string(pmu::codec::kOldestDescribedFirmware).c_str(),
+                 pmu::codec::to_string(pmu::codec::kCurrentFirmware).c_str());
     return 2;
   }
   if (engine_stopped || engine == "stopped") engine_running = false;

@@ -257,6 +257,10 @@ int run_cli(int argc, char** argv, const AgentCall* served) {
   bool dry_run = false;
   config_apply->add_option("file", config_file, "A file written by `config snapshot` or by hand")->required();
   config_apply->add_flag("--dry-run", dry_run, "Check the file and print the changes in order; send nothing");
+  bool other_unit = false;
+  config_apply->add_flag("--other-unit", other_unit,
+                         "Apply a file read from another unit (its device.serial is not this PMU's); refused "
+                         "without it");
 
   bool confirm = false;
   app.add_flag("--confirm", confirm, "Confirm a command the safety policy guards (avionics off, reset, engine start...)");
@@ -449,7 +453,7 @@ int run_cli(int argc, char** argv, const AgentCall* served) {
     if (*config_get) return pmu::tools::run_config_get(g, parameter);
     if (*config_snapshot) return pmu::tools::run_config_snapshot(g, config_file, force);
     if (*config_diff) return pmu::tools::run_config_diff(g, config_file);
-    if (*config_apply) return pmu::tools::run_config_apply(g, config_file, dry_run, confirm);
+    if (*config_apply) return pmu::tools::run_config_apply(g, config_file, dry_run, confirm, other_unit);
     pmu::tools::CommandSpec spec;
     spec.confirm = confirm;
     if (*config_set) {

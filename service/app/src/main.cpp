@@ -11,7 +11,6 @@
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
-#include <fstream>
 #include <memory>
 #include <optional>
 #include <spdlog/spdlog.h>
@@ -324,7 +323,7 @@ int main(int argc, char** argv) {
   try {
     if (!config_path.empty()) {
       cfg = service::load_config(config_path);
-    } else if (bus_spec.empty() || std::ifstream(kDefaultConfig).good()) {
+    } else if (bus_spec.empty() || ::access(kDefaultConfig, R_OK) == 0) {  // no open: a FIFO would block; load_config refuses one
       cfg = service::load_config(kDefaultConfig);
     } else {
       cfg = service::default_sim_config();

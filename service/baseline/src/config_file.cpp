@@ -8,6 +8,7 @@
 #include <initializer_list>
 #include <set>
 
+#include "pmu/codec/decimal_text.hpp"
 #include "pmu/codec/encode.hpp"
 #include "pmu/codec/messages.hpp"
 #include "pmu/command/command.hpp"
@@ -45,26 +46,38 @@ void check_keys(const YAML::Node& map, std::string_view where, std::initializer_
   }
 }
 
-// The whole scalar as a finite number; a unit or anything else after it is refused, so "24 V"
-// never reads as 24.
-double number(const YAML::Node& n, std::string_view name) {
+// The whole scalar as a finite number in plain decimal (codec/decimal_text.hpp), as the
+// service's config takes numbers: a unit or anything else after it is refused, so "24 V" never
+// reads as 24, and "0x18" never as 24 V.
+double number(const YAML::Node& n, std::string_view name, bool integer = false) {
   if (!n.IsScalar()) bad(n, std::string(name) + " must be a number");
   const std::string& s = n.Scalar();
   char* end = nullptr;
   const double v = s.empty() ? std::nan("") : std::strtod(s.c_str(), &end);
   if (s.empty() || *end != '\0' || !std::isfinite(v) || s.find_first_of(" \t") != std::string::npos)
     bad(n, std::string(name) + ": " + shown(n) + " is not a number");
+  if (integer && !codec::is_plain_decimal(s))
+    bad(n, std::string(name) + ": " + shown(n) +
+               " is not a whole number (digits, optionally after '-'; no fraction, leading 0, '+', 0x or exponent)");
+  if (!codec::is_plain_decimal_number(s))
+    bad(n, std::string(name) + ": " + shown(n) +
+               " is not a decimal number (digits, optionally after '-' and with a fraction after '.'; no leading 0, "
+               "'+', 0x, exponent, or '.' without digits on both sides)");
   return v;
 }
 
-std::uint32_t whole(const YAML::Node& n, std::string_view name, std::uint32_t max) {
+// A whole number 0..max in plain decimal; or, where `hex` (a mask: interface.md 4.6), 0x hex.
+std::uint32_t whole(const YAML::Node& n, std::string_view name, std::uint32_t max, bool hex_too = false) {
   if (!n.IsScalar()) bad(n, std::string(name) + " must be a whole number");
   const std::string& s = n.Scalar();
-  const bool hex = s.size() > 2 && s[0] == '0' && (s[1] == 'x' || s[1] == 'X');
+  const bool hex = hex_too && s.size() > 2 && s[0] == '0' && (s[1] == 'x' || s[1] == 'X');
+  const bool spelled = hex ? s.find_first_not_of("0123456789abcdefABCDEF", 2) == std::string::npos
+                           : codec::is_plain_decimal(s) && s[0] != '-';
   char* end = nullptr;
-  const unsigned long long v = std::strtoull(s.c_str(), &end, hex ? 16 : 10);
-  if (s.empty() || *end != '\0' || s[0] == '-' || s[0] == '+' || s[0] == ' ' || v > max)
-    bad(n, std::string(name) + ": " + shown(n) + " is not a whole number 0.." + std::to_string(max));
+  const unsigned long long v = spelled ? std::strtoull(s.c_str(), &end, hex ? 16 : 10) : 0;
+  if (!spelled || *end != '\0' || v > max)
+    bad(n, std::string(name) + ": " + shown(n) + " is not a whole number 0.." + std::to_string(max) +
+               (hex_too ? " (decimal, or hex after 0x)" : " (decimal: no fraction, exponent, 0x, '+' or leading 0)"));
   return static_cast<std::uint32_t>(v);
 }
 
@@ -90,7 +103,7 @@ std::uint32_t mask(const YAML::Node& n, std::string_view name, const std::array<
   if (n.IsScalar()) {
     if (n.Scalar() == "none") return 0;
     if (!n.Scalar().empty() && std::isdigit(static_cast<unsigned char>(n.Scalar()[0])))
-      return whole(n, name, 0xFF);
+      return whole(n, name, 0xFF, true);
     bad(n, std::string(name) + ": " + shown(n) + " is not a mask (" + valid + ")");
   }
   if (!n.IsSequence()) bad(n, std::string(name) + " must be " + valid);
@@ -112,6 +125,8 @@ std::uint32_t parameter(const YAML::Node& n, codec::Parameter p, std::optional<c
     v = mask(n, spec.name, codec::kGroupNames);
   else if (p == codec::Parameter::PowerUpState)
     v = mask(n, spec.name, codec::kPowerUpNames);
+  else if (spec.kind == codec::ParameterKind::Integer)  // can_address 1.5 is no address
+    v = number(n, spec.name, true);
   else  // Compared as the wire carries it: a value between two steps is the step the device
         // would store (12.04 V is 12.0 V with 0.1 V steps).
     v = std::round(number(n, spec.name) * spec.divisor) / spec.divisor;

@@ -125,6 +125,19 @@ std::string device_not_seen_reason(std::uint16_t address, std::string_view bus) 
   return "device " + std::to_string(address) + " not seen on " + std::string(bus);
 }
 
+namespace {
+std::string not_served_lead(std::string_view bus) { return "bus '" + printable(bus) + "' is not served here"; }
+}  // namespace
+
+std::string bus_not_served_reason(std::string_view bus, std::string_view served) {
+  return not_served_lead(bus) + " (buses: " + std::string(served) + ")";
+}
+
+bool says_no_such_target(std::string_view reason, std::string_view bus, std::uint16_t address) {
+  const std::string lead = not_served_lead(bus) + " (";
+  return reason == device_not_seen_reason(address, bus) || reason.substr(0, lead.size()) == lead;
+}
+
 std::string_view to_string(CommandResult r) noexcept {
   switch (r) {
     case CommandResult::Completed: return "COMPLETED";

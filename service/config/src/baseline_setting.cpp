@@ -1,11 +1,6 @@
 #include "baseline_setting.hpp"
 
-#include <sys/stat.h>
-
-#include <cerrno>
-#include <cstdio>
-#include <cstring>
-#include <memory>
+#include "pmu/files/bounded_file.hpp"
 
 namespace pmu::service {
 namespace {
@@ -13,19 +8,6 @@ namespace {
 [[noreturn]] void refuse(const YAML::Node& at, const std::string& source, const std::string& what) {
   const int line = at.IsDefined() && at.Mark().line >= 0 ? at.Mark().line + 1 : 1;
   throw ConfigError(source + ":" + std::to_string(line) + ": " + what);
-}
-
-// The file's text, or why not (a directory opens and reads as nothing: it is no empty file).
-bool baseline_text(const std::string& path, std::string& text, std::string& why) {
-  struct stat st {};
-  if (::stat(path.c_str(), &st) != 0) return why = std::strerror(errno), false;
-  if (S_ISDIR(st.st_mode)) return why = "it is a directory", false;
-  const std::unique_ptr<std::FILE, int (*)(std::FILE*)> f(std::fopen(path.c_str(), "rb"), &std::fclose);
-  if (!f) return why = std::strerror(errno), false;
-  char buf[4096];
-  for (std::size_t n; (n = std::fread(buf, 1, sizeof buf, f.get())) > 0;) text.append(buf, n);
-  if (std::ferror(f.get())) return why = std::strerror(errno), false;
-  return true;
 }
 
 std::string folder_of(const std::string& source) {
@@ -43,10 +25,10 @@ void read_baseline(const YAML::Node& n, const std::string& source, DeviceConfig&
                           std::to_string(kMaxBaselinePath) + " (pmu/baseline carries it)");
   // Relative to the config file, as qos_file: systemd runs the service in /.
   d.baseline_path = d.baseline_file.front() == '/' ? d.baseline_file : folder_of(source) + d.baseline_file;
-  std::string text, why;
-  if (!baseline_text(d.baseline_path, text, why))
-    refuse(n, source, "baseline " + d.baseline_path + " cannot be read: " + why);
-  auto file = baseline::read_config_file(text);
+  // Regular and bounded: /dev/zero or a FIFO named here must not stop the start (docs/safety.md H12).
+  const auto text = files::read_bounded_file(d.baseline_path, baseline::kMaxConfigFileBytes);
+  if (!text.ok()) refuse(n, source, "baseline " + d.baseline_path + " cannot be read: " + text.error);
+  auto file = baseline::read_config_file(text.text);
   if (!file) refuse(n, source, "baseline refused: " + baseline::describe(file.error(), d.baseline_path));
   // The unit is at least the higher of the two minimums, so every value must fit that
   // firmware; with neither, read_config_file has checked them for the file's own firmware.

@@ -20,12 +20,14 @@
 #include <string_view>
 #include <utility>
 
+#include "pmu/codec/decimal_text.hpp"
 #include "pmu/codec/firmware.hpp"
 #include "pmu/codec/messages.hpp"
 #include "pmu/codec/telemetry.hpp"
 #include "pmu/config/quoted.hpp"
 #include "pmu/config/statistics_settings.hpp"
 #include "pmu/config/vehicle.hpp"
+#include "pmu/files/bounded_file.hpp"
 #include "pmu/version.hpp"
 #include "alarm_settings.hpp"
 #include "baseline_setting.hpp"
@@ -34,15 +36,6 @@ namespace pmu::service {
 namespace {
 
 constexpr std::size_t kMaxBusName = 15;  // the IDL key is string<15>; IFNAMSIZ - 1 too
-
-// -?(0|[1-9][0-9]*): the one spelling of an integer that YAML 1.1 and a reader agree on.
-bool is_plain_decimal(const std::string& s) {
-  const std::size_t start = !s.empty() && s[0] == '-' ? 1 : 0;
-  if (s.size() == start) return false;
-  if (s[start] == '0' && s.size() > start + 1) return false;
-  return std::all_of(s.begin() + static_cast<std::ptrdiff_t>(start), s.end(),
-                     [](unsigned char ch) { return ch >= '0' && ch <= '9'; });
-}
 
 struct Ctx {
   std::string source;
@@ -89,7 +82,7 @@ struct Ctx {
   long integer(const YAML::Node& n, const char* name, long lo, long hi) const {
     // yaml-cpp reads 010 as octal 8 and 0x10 as 16 (YAML 1.1), so an address written with
     // a leading zero would silently name another device: only plain decimal is taken.
-    if (n.IsScalar() && !is_plain_decimal(n.Scalar()))
+    if (n.IsScalar() && !codec::is_plain_decimal(n.Scalar()))
       fail(n, std::string(name) + " must be a decimal integer (digits, optionally after '-'; no leading 0, '+', "
                                   "0x, 0o, exponent or fraction), not " + quoted(n.Scalar()));
     const auto v = scalar<long>(n, name, "an integer");
@@ -211,7 +204,15 @@ PmuSimSettings parse_pmu_sim(const Ctx& c, const YAML::Node& n) {
   if (const auto v = n["silent"]) s.silent = sim_bool(c, v, "silent");
   if (const auto v = n["soa_shutdown"]) s.soa_shutdown = sim_bool(c, v, "soa_shutdown");
   if (const auto v = n["payload_shed"]) s.payload_shed = sim_bool(c, v, "payload_shed");
-  if (const auto v = n["firmware"]) s.firmware = firmware_of(c, v, "firmware");
+  if (const auto v = n["firmware"]) {
+    s.firmware = firmware_of(c, v, "firmware");
+    // The simulator behaves as a documented firmware only; refused here, at check time,
+    // rather than by the model when the service starts (interface.md 4.4).
+    if (!codec::is_described(*s.firmware))
+      c.fail(v, "firmware " + quoted(v.Scalar()) + ": the simulator is firmware " +
+                    codec::to_string(codec::kOldestDescribedFirmware) + ".." + codec::to_string(codec::kCurrentFirmware) +
+                    " (the versions the protocol documents describe)");
+  }
   if (const auto v = n["serial"]) s.serial = static_cast<std::uint16_t>(c.integer(v, "serial", 0, 65535));
   if (const auto v = n["ignores_set"]) {
     const auto name = c.scalar<std::string>(v, "ignores_set", "a stored parameter's name");
@@ -829,22 +830,13 @@ std::string SecurityConfig::line_of(const std::string& key) const {
 }
 
 Config load_config(const std::string& path) {
-  const auto reason = [&](const char* what) {
-    return ConfigError(path + ": " + what + " the config file: " + std::strerror(errno));
-  };
-  // A directory opens and reads as nothing; it is not an empty file.
-  struct stat st {};
-  if (::stat(path.c_str(), &st) != 0) throw reason("cannot open");
-  if (S_ISDIR(st.st_mode)) throw ConfigError(path + ": is a directory, not a config file");
-  const std::unique_ptr<std::FILE, int (*)(std::FILE*)> f(std::fopen(path.c_str(), "rb"), &std::fclose);
-  if (!f) throw reason("cannot open");
-  std::string text;
-  char buf[4096];
-  for (std::size_t n; (n = std::fread(buf, 1, sizeof buf, f.get())) > 0;) text.append(buf, n);
-  if (std::ferror(f.get())) throw reason("cannot read");
+  // Bounded and regular only: a device or FIFO named as the config must not hang or exhaust
+  // the start (docs/safety.md H12).
+  auto file = files::read_bounded_file(path, kMaxConfigFileBytes);
+  if (!file.ok()) throw ConfigError(path + ": cannot read the config file: " + file.error);
   ConfigEnvironment env;
   if (const char* dir = std::getenv("CREDENTIALS_DIRECTORY"); dir != nullptr) env.credentials_directory = dir;
-  return parse_config(text, path, env);
+  return parse_config(file.text, path, env);
 }
 
 Config default_sim_config() {

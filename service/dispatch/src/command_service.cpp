@@ -163,7 +163,7 @@ DeviceUse CommandService::device_use(const DeviceSession& session, SteadyTime no
 CommandService::Refusal CommandService::not_served(const CommandRequest& r) const {
   std::string served;
   for (auto* w : workers_) served += (served.empty() ? "" : ", ") + w->config().name;
-  return {CommandResult::Rejected, "bus '" + printable(r.bus) + "' is not served here (buses: " + served + ")"};
+  return {CommandResult::Rejected, bus_not_served_reason(r.bus, served)};
 }
 
 std::optional<CommandService::Refusal> CommandService::judge(const CommandRequest& r, const DeviceUse& use) const {

@@ -1,6 +1,7 @@
 #include "pmu/readiness/readiness_rules.hpp"
 
 #include <algorithm>
+#include <cstdio>
 #include <initializer_list>
 #include <set>
 #include <string>
@@ -49,8 +50,20 @@ std::string drift_message(const std::vector<baseline::Difference>& diffs) {
   return bounded("config differs: " + std::to_string(diffs.size()) + " settings", kMessage);
 }
 
+// A mask's value as its number alone ("0x0F"), when its names do not fit; any other value as
+// value_text gives it, which is short.
+std::string compact_value(baseline::Setting s, std::uint32_t raw) {
+  using baseline::Setting;
+  if (s != Setting::Outputs && s != Setting::PacketsStreamed && s != Setting::PowerUpState)
+    return baseline::value_text(s, raw);
+  char hex[8];
+  std::snprintf(hex, sizeof hex, "0x%02X", static_cast<unsigned>(raw & 0xFF));
+  return hex;
+}
+
 // "avionics_voltage 24.0 V->22.0 V; outputs ... . pmuctl config diff / apply pmu1.yaml": each
-// item device->baseline while they fit, then the way to fix it.
+// item device->baseline while they fit, a mask by its number when its names do not, then the
+// way to fix it.
 std::string drift_description(const std::vector<baseline::Difference>& diffs, const std::string& file) {
   const auto slash = file.rfind('/');
   std::string name = slash == std::string::npos ? file : file.substr(slash + 1);
@@ -59,16 +72,24 @@ std::string drift_description(const std::vector<baseline::Difference>& diffs, co
   std::string items;
   std::size_t shown = 0;
   for (const auto& d : diffs) {
-    const std::string item = std::string(baseline::setting_name(d.setting)) + " " + baseline::value_text(d.setting, *d.device) +
-                             "->" + baseline::value_text(d.setting, d.file);
+    const std::string setting(baseline::setting_name(d.setting));
     const std::size_t left = diffs.size() - shown - 1;
     const std::string more = left ? "; +" + std::to_string(left) + " more" : "";
-    if ((items.empty() ? 0 : items.size() + 2) + item.size() + more.size() + fix.size() > kDescription) break;
+    const std::size_t used = (items.empty() ? 0 : items.size() + 2) + more.size() + fix.size();
+    const std::size_t room = used < kDescription ? kDescription - used : 0;
+    std::string item = setting + " " + baseline::value_text(d.setting, *d.device) + "->" +
+                       baseline::value_text(d.setting, d.file);
+    if (item.size() > room)
+      item = setting + " " + compact_value(d.setting, *d.device) + "->" + compact_value(d.setting, d.file);
+    if (item.size() > room) break;
     items += (items.empty() ? "" : "; ") + item;
     ++shown;
   }
-  if (shown == 0) items = std::to_string(diffs.size()) + " settings differ from the baseline";
-  else if (shown < diffs.size()) items += "; +" + std::to_string(diffs.size() - shown) + " more";
+  if (shown == 0)
+    items = std::to_string(diffs.size()) + (diffs.size() == 1 ? " setting differs" : " settings differ") +
+            " from the baseline";
+  else if (shown < diffs.size())
+    items += "; +" + std::to_string(diffs.size() - shown) + " more";
   return bounded(items + fix, kDescription);
 }
 

@@ -13,6 +13,8 @@
 #include <sys/stat.h>
 #include <tinyxml2.h>
 
+#include "pmu/files/bounded_file.hpp"
+
 #include <algorithm>
 #include <cerrno>
 #include <cstring>
@@ -56,6 +58,10 @@ bool has_errors(const std::vector<SecurityIssue>& issues) noexcept {
 }
 
 namespace {
+
+// A certificate, key, governance or permissions file is a few KiB; permissions for a large
+// fleet stay far below this.
+constexpr std::size_t kMaxSecurityFileBytes = std::size_t{1} << 20;
 
 template <class T, void (*Free)(T*)>
 struct Deleter {
@@ -202,30 +208,35 @@ class Checker {
   }
 
   bool check_readable(const char* key, const std::string& path) {
-    struct stat st{};
-    if (::stat(path.c_str(), &st) != 0) {
-      error(key, path + ": " + (errno == ENOENT ? std::string("does not exist") : std::strerror(errno)));
+    // Through the one bounded reader: a device or FIFO named as a security file must not
+    // stop the start (docs/safety.md H12).
+    const auto file = files::read_bounded_file(path, kMaxSecurityFileBytes);
+    if (!file.ok()) {
+      error(key, path + ": " + (file.system_error == ENOENT ? "does not exist" : "cannot be read: " + file.error));
       return false;
     }
-    if (!S_ISREG(st.st_mode)) {
-      error(key, path + ": is not a regular file");
-      return false;
-    }
-    std::ifstream in(path, std::ios::binary);
-    if (!in) {
-      error(key, path + ": cannot be read: " + std::strerror(errno));
-      return false;
-    }
-    if (st.st_size == 0) {
+    if (file.text.empty()) {
       error(key, path + ": is empty");
       return false;
     }
-    if (std::string(key) == "private_key" && (st.st_mode & (S_IRWXG | S_IRWXO)) != 0)
+    struct stat st {};
+    if (std::string(key) == "private_key" && ::stat(path.c_str(), &st) == 0 && (st.st_mode & (S_IRWXG | S_IRWXO)) != 0)
       warning(key, path + ": is accessible by group or others (chmod 600 it)");
     return true;
   }
 
-  static Bio open(const std::string& path) { return Bio(BIO_new_file(path.c_str(), "r")); }
+  // The file's text in a memory BIO, read by the bounded reader; null when it cannot be read.
+  static Bio open(const std::string& path) {
+    auto file = files::read_bounded_file(path, kMaxSecurityFileBytes);
+    if (!file.ok()) return Bio(nullptr);
+    // BIO_new_mem_buf keeps a pointer only: the BIO gets its own copy.
+    Bio bio(BIO_new(BIO_s_mem()));
+    if (bio && BIO_write(bio.get(), file.text.data(), static_cast<int>(file.text.size())) != static_cast<int>(file.text.size()))
+      bio.reset();
+    // Its end is the end of the file, as a file BIO's: S/MIME's reader stops at it, not retries.
+    if (bio) BIO_set_mem_eof_return(bio.get(), 0);
+    return bio;
+  }
 
   Cert load_cert(const char* key, const std::string& path) {
     Bio in = open(path);

@@ -11,12 +11,15 @@
 #include <sstream>
 
 #include "pmu/codec/ids.hpp"
+#include "pmu/files/bounded_file.hpp"
 
 namespace pmu::service {
 namespace {
 
 constexpr const char* kDefaultStateDirectory = "/var/lib/pmu-dds";
 constexpr const char* kFileName = "moved-addresses";
+// A line per moved PMU, under 40 bytes: far more than a service's PMUs ever fill.
+constexpr std::size_t kMaxMovedAddressesBytes = std::size_t{64} << 10;
 
 std::optional<std::uint16_t> number(const std::string& word, std::uint32_t max) {
   std::uint32_t v = 0;
@@ -91,14 +94,14 @@ std::string format_moved_addresses(const std::vector<MovedAddress>& moves) {
 }
 
 MovedAddresses read_moved_addresses(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) {
-    if (errno == ENOENT) return {};
-    return {{}, {path + ": cannot read: " + std::strerror(errno)}};
+  // Bounded and regular: a state file replaced by a device or FIFO must not stop the start
+  // (docs/safety.md H12); it is then reported and no moves are taken from it.
+  const auto file = files::read_bounded_file(path, kMaxMovedAddressesBytes);
+  if (!file.ok()) {
+    if (file.system_error == ENOENT) return {};
+    return {{}, {path + ": cannot read: " + file.error}};
   }
-  std::stringstream text;
-  text << in.rdbuf();
-  return parse_moved_addresses(text.str(), path);
+  return parse_moved_addresses(file.text, path);
 }
 
 std::vector<std::string> stale_addresses(const Config& config, const std::vector<MovedAddress>& moves) {

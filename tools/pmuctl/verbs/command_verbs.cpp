@@ -213,7 +213,12 @@ int run_command(const GlobalOptions& o, const CommandSpec& spec) {
         std::printf("%g\n", r->value());
     }
     std::fprintf(stderr, "%s%s%s\n", result_name(r->result()), (r->reason().size() == 0) ? "" : ": ", r->reason().c_str());
-    return static_cast<int>(r->result() == pmu::v4::COMPLETED ? ExitStatus::Ok : ExitStatus::NotDone);
+    if (r->result() == pmu::v4::COMPLETED) return static_cast<int>(ExitStatus::Ok);
+    // A bus the service does not serve, or no such device on it, is no such target (2), as
+    // when pmuctl finds that out itself; the service executed nothing (interface.md 3.2).
+    if (r->result() == pmu::v4::REJECTED && pmu::service::says_no_such_target(r->reason().to_string(), bus, address))
+      return static_cast<int>(ExitStatus::BadUsage);
+    return static_cast<int>(ExitStatus::NotDone);
   }
   char waited[96];
   std::snprintf(waited, sizeof waited, "no reply from pmu-service within %.1f s (request ", timeout);

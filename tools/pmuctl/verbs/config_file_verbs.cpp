@@ -11,7 +11,6 @@
 #include <fastdds/dds/core/status/SubscriptionMatchedStatus.hpp>
 #include <fastdds/dds/subscriber/InstanceState.hpp>
 #include <fastdds/dds/subscriber/SampleInfo.hpp>
-#include <fstream>
 #include <map>
 #include <nlohmann/json.hpp>
 #include <set>
@@ -25,6 +24,7 @@
 #include "pmu/command/command.hpp"
 #include "pmu/dds/baseline_sample.hpp"
 #include "pmu/dds/dds_context.hpp"
+#include "pmu/files/bounded_file.hpp"
 #include "pmu/idl/guarded_type.hpp"
 #include "pmu/idl/state.h"
 #include "pmu/idl/statePubSubTypes.h"
@@ -63,7 +63,9 @@ class DeviceReader {
         info_(dds.reader(dds.topic(topics::kInfo, TypeSupport(new idl::Guarded<pmu::v4::DeviceInfoPubSubType>())),
                          qos_profiles::kState)),
         baseline_(dds.reader(dds.topic(topics::kBaseline, TypeSupport(new idl::Guarded<pmu::v4::BaselinePubSubType>())),
-                             qos_profiles::kState)) {}
+                             qos_profiles::kState)),
+        health_(dds.reader(dds.topic(topics::kHealth, TypeSupport(new idl::Guarded<pmu::v4::HealthPubSubType>())),
+                           qos_profiles::kState)) {}
 
   void poll() {
     SampleInfo si;
@@ -73,6 +75,14 @@ class DeviceReader {
     pmu::v4::DeviceInfo i;
     while (info_.take_next_sample(&i, &si) == ReturnCode_t::RETCODE_OK)
       if (si.valid_data && i.vehicle().to_string() == vehicle_) infos_[{i.bus().to_string(), i.address()}] = i;
+    pmu::v4::Health h;
+    while (health_.take_next_sample(&h, &si) == ReturnCode_t::RETCODE_OK) {
+      if (si.valid_data && h.vehicle().to_string() == vehicle_ && h.kind() == pmu::v4::KIND_PMU) {
+        pmus_[si.instance_handle] = {h.bus().to_string(), h.address()};
+      } else if (!si.valid_data && si.instance_state != ALIVE_INSTANCE_STATE) {
+        pmus_.erase(si.instance_handle);  // disposed: a PMU that moved is no longer at its old address
+      }
+    }
     pmu::v4::Baseline b;
     while (baseline_.take_next_sample(&b, &si) == ReturnCode_t::RETCODE_OK) {
       if (si.valid_data) {
@@ -113,6 +123,19 @@ class DeviceReader {
     const auto it = infos_.find({bus, address});
     return it == infos_.end() ? nullptr : &it->second;
   }
+  // Whether the service serves a PMU at `address` on `bus` (a pmu/health instance: the
+  // service's sessions, configured or discovered, read or not), as it judges an address
+  // change (interface.md 2.6). Its health is TRANSIENT_LOCAL and comes in one burst: once
+  // `own`'s has come, so have the others.
+  bool pmu_served(const std::string& bus, std::uint16_t address, std::uint16_t own, Clock::time_point deadline) {
+    const auto seen = [&](std::uint16_t a) {
+      for (const auto& [handle, pmu] : pmus_)
+        if (pmu.first == bus && pmu.second == a) return true;
+      return false;
+    };
+    poll_until([&] { return seen(own); }, deadline);
+    return seen(address);
+  }
   // Both read, or the deadline passed.
   bool wait(const std::string& bus, std::uint16_t address, Clock::time_point deadline) {
     return poll_until([&] { return config(bus, address) && info(bus, address); }, deadline);
@@ -134,6 +157,8 @@ class DeviceReader {
   DataReader& config_;
   DataReader& info_;
   DataReader& baseline_;
+  DataReader& health_;
+  std::map<InstanceHandle_t, std::pair<std::string, std::uint16_t>> pmus_;  // pmu/health of PMUs
   std::map<std::pair<std::string, std::uint16_t>, pmu::v4::Config> configs_;
   std::map<std::pair<std::string, std::uint16_t>, pmu::v4::Baseline> baselines_;
   std::set<InstanceHandle_t> disposed_;  // pmu/baseline instances of PMUs without one
@@ -143,15 +168,15 @@ class DeviceReader {
 codec::FirmwareVersion firmware_of(const pmu::v4::DeviceInfo& i) { return {i.firmware_major(), i.firmware_minor()}; }
 
 // The file's text, or the exit status after saying why it cannot be read.
+// Regular and bounded only (the reader the service uses): `config diff /dev/zero` or a FIFO
+// is refused at once, never read without end (docs/safety.md H12).
 std::optional<std::string> read_text(const GlobalOptions& o, const std::string& path, int& status) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) {
-    status = fail(o, ExitStatus::BadUsage, path + ": cannot be read: " + std::strerror(errno));
+  auto file = files::read_bounded_file(path, baseline::kMaxConfigFileBytes);
+  if (!file.ok()) {
+    status = fail(o, ExitStatus::BadUsage, path + ": cannot be read: " + file.error);
     return std::nullopt;
   }
-  std::ostringstream text;
-  text << in.rdbuf();
-  return text.str();
+  return std::move(file.text);
 }
 
 // The file read and checked, or the exit status (2) after saying FILE:LINE: what.
@@ -354,45 +379,55 @@ int diff(const GlobalOptions& o, const std::string& path) {
   const auto missing = baseline::not_in_file(have, *f);
   const std::size_t compared = baseline::kSettingCount - missing.size();
   const std::string label = device_label(vehicle, t->bus, t->address);
+  const auto& info = *device.info(t->bus, t->address);
+  const bool other_unit = f->header.serial && *f->header.serial != info.serial_number();
+  // A baseline's serial pins it to one unit (serial_differs, interface.md 1.7): another unit
+  // is a difference of its own, so it is never "matches" (exit 1). A file named here was
+  // only read from a unit, which the summary mentions.
+  const bool serial_differs = other_unit && path.empty();
+  const bool equal = diffs.empty() && !serial_differs;
   if (o.json) {
-    Json j{{"vehicle", vehicle},       {"bus", t->bus},          {"address", t->address}, {"file", file},
-           {"equal", diffs.empty()},  {"compared", compared},  {"differences", Json::array()},
+    Json j{{"vehicle", vehicle},  {"bus", t->bus},         {"address", t->address}, {"file", file},
+           {"equal", equal},      {"compared", compared},  {"differences", Json::array()},
            {"not_in_file", Json::array()}};
+    if (serial_differs)
+      j["differences"].push_back({{"name", "serial"},
+                                  {"line", 0},
+                                  {"device", std::to_string(info.serial_number())},
+                                  {"file", std::to_string(*f->header.serial)}});
     for (const auto& d : diffs) j["differences"].push_back(difference_json(d));
     for (const auto s : missing) j["not_in_file"].push_back(std::string(baseline::setting_name(s)));
     std::printf("%s\n", j.dump(-1, ' ', false, Json::error_handler_t::replace).c_str());
   } else {
+    if (serial_differs)
+      std::printf("%s: serial: device %u, baseline %u: another unit than the baseline's\n", file.c_str(),
+                  unsigned{info.serial_number()}, unsigned{*f->header.serial});
     for (const auto& d : diffs)
       if (d.line > 0)
         std::printf("%s:%d: %s\n", file.c_str(), d.line, baseline::describe(d).c_str());
       else  // the service's baseline: its lines are not published
         std::printf("%s: %s\n", file.c_str(), baseline::describe(d).c_str());
   }
-  if (diffs.empty())
+  if (equal)
     std::fprintf(stderr, "%s matches %s (%zu settings)\n", label.c_str(), file.c_str(), compared);
+  else if (diffs.empty())
+    std::fprintf(stderr, "%s differs from %s: it is another unit (serial %u, the baseline's %u); its %zu settings match\n",
+                 label.c_str(), file.c_str(), unsigned{info.serial_number()}, unsigned{*f->header.serial}, compared);
   else
-    std::fprintf(stderr, "%s differs from %s in %zu of %zu settings\n", label.c_str(), file.c_str(), diffs.size(),
-                 compared);
+    std::fprintf(stderr, "%s differs from %s in %zu of %zu settings%s\n", label.c_str(), file.c_str(), diffs.size(),
+                 compared, serial_differs ? ", and is another unit than the baseline's" : "");
   if (!missing.empty()) {
     std::string names;
     for (const auto s : missing) names += (names.empty() ? "" : ", ") + std::string(baseline::setting_name(s));
     std::fprintf(stderr, "not in the file, so not compared: %s\n", names.c_str());
   }
-  const auto& info = *device.info(t->bus, t->address);
-  const bool other_unit = f->header.serial && *f->header.serial != info.serial_number();
-  if (other_unit && path.empty()) {
-    // A baseline's serial pins it to one unit (serial_differs, interface.md 1.7).
-    std::fprintf(stderr, "%s: serial: device %u, baseline %u: another unit than the baseline's\n", file.c_str(),
-                 unsigned{info.serial_number()}, unsigned{*f->header.serial});
-    return static_cast<int>(ExitStatus::NotDone);
-  }
-  if (other_unit)
+  if (other_unit && !path.empty())
     std::fprintf(stderr, "the file was read from serial %u; this PMU is serial %u\n", unsigned{*f->header.serial},
                  unsigned{info.serial_number()});
-  return static_cast<int>(diffs.empty() ? ExitStatus::Ok : ExitStatus::NotDone);
+  return static_cast<int>(equal ? ExitStatus::Ok : ExitStatus::NotDone);
 }
 
-int apply(const GlobalOptions& o, const std::string& file, bool dry_run, bool confirm) {
+int apply(const GlobalOptions& o, const std::string& file, bool dry_run, bool confirm, bool other_unit) {
   int status = 0;
   const auto f = read_file(o, file, status);
   if (!f) return status;
@@ -417,7 +452,24 @@ int apply(const GlobalOptions& o, const std::string& file, bool dry_run, bool co
                 file + ":" + std::to_string(f->min_firmware_line) + ": " + label + " has firmware " +
                     codec::to_string(firmware) + ", older than min_firmware " +
                     codec::to_string(*f->header.min_firmware));
+  // A file read from another unit is that unit's configuration: applied only when the
+  // operator says so (interface.md 3.2), as a diff says it of another serial.
+  const auto serial = device.info(bus, address)->serial_number();
+  if (f->header.serial && *f->header.serial != serial && !other_unit)
+    return fail(o, ExitStatus::BadUsage,
+                file + ":" + std::to_string(f->serial_line) + ": the file was read from serial " +
+                    std::to_string(*f->header.serial) + ", and " + label + " is serial " + std::to_string(serial) +
+                    ": another unit; nothing was sent (--other-unit applies it to this unit)");
   const auto plan = baseline::apply_plan(baseline::differences(settings_of(*device.config(bus, address)), *f));
+  // The service refuses a can_address another PMU it serves has (interface.md 2.6); judged
+  // here too, so that the dry run says what the apply would meet and the apply sends nothing.
+  for (const auto& c : plan)
+    if (c.setting == Setting::CanAddress && c.to != address &&
+        device.pmu_served(bus, static_cast<std::uint16_t>(c.to), address, deadline_after(timeout)))
+      return fail(o, ExitStatus::BadUsage,
+                  file + ":" + std::to_string(c.line) + ": can_address " + std::to_string(c.to) + ": address " +
+                      std::to_string(c.to) + " is already in use on " + bus + " (a PMU the service serves); " +
+                      "nothing was sent");
   if (plan.empty()) {
     std::fprintf(stderr, "%s already matches %s: nothing to apply\n", label.c_str(), file.c_str());
     return 0;
@@ -534,8 +586,8 @@ int run_config_snapshot(const GlobalOptions& o, const std::string& file, bool fo
   return config_file_verbs::snapshot(o, file, force);
 }
 int run_config_diff(const GlobalOptions& o, const std::string& file) { return config_file_verbs::diff(o, file); }
-int run_config_apply(const GlobalOptions& o, const std::string& file, bool dry_run, bool confirm) {
-  return config_file_verbs::apply(o, file, dry_run, confirm);
+int run_config_apply(const GlobalOptions& o, const std::string& file, bool dry_run, bool confirm, bool other_unit) {
+  return config_file_verbs::apply(o, file, dry_run, confirm, other_unit);
 }
 
 }  // namespace pmu::tools

@@ -23,7 +23,9 @@ int run_config_diff(const GlobalOptions& o, const std::string& file);
 // Validates the whole file first, then applies what differs in pmu::baseline's order, each
 // change verified by the service's read-back; on a failure restores what it changed. Exit 0
 // only when the final diff is clean; 1 a change failed (and what was restored), 2 a bad file
-// or a change that needs --confirm (nothing sent), 3 nothing answers.
-int run_config_apply(const GlobalOptions& o, const std::string& file, bool dry_run, bool confirm);
+// or a change that needs --confirm, a file read from another serial without `other_unit`, or a
+// can_address another served PMU has (nothing sent), 3 nothing answers. The dry run refuses
+// what the apply would.
+int run_config_apply(const GlobalOptions& o, const std::string& file, bool dry_run, bool confirm, bool other_unit);
 
 }  // namespace pmu::tools

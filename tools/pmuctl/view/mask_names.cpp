@@ -5,6 +5,9 @@
 #include <cstdio>
 #include <cstdlib>
 
+#include "pmu/codec/encode.hpp"
+#include "pmu/codec/parameters.hpp"
+
 namespace pmu::tools {
 namespace {
 
@@ -15,7 +18,9 @@ const MaskNames kMasks[] = {
 };
 
 // The range said is the mask the names cover (0x1F for packets_streamed), never the byte's
-// 0..255: a number with other bits is refused by the codec with the firmware's own reason.
+// 0..255. A number with other bits is refused by the spec's own check (parse_config_value),
+// before anything is sent; a bit the names cover but the unit's firmware lacks only the
+// service can judge.
 std::string valid_names(const MaskNames& m) {
   std::string s;
   unsigned defined = 0;
@@ -77,10 +82,20 @@ const MaskNames* mask_names(std::string_view field) noexcept {
 }
 
 ConfigValue parse_config_value(std::string_view parameter, std::string_view text) {
-  if (const auto* m = mask_names(parameter)) return parse_mask(*m, text);
-  const auto v = number(text);
-  if (!v || !std::isfinite(*v)) return refused(std::string(parameter) + ": '" + std::string(text) + "' is not a number");
-  return {*v, {}};
+  ConfigValue out;
+  if (const auto* m = mask_names(parameter)) {
+    out = parse_mask(*m, text);
+  } else {
+    const auto v = number(text);
+    if (!v || !std::isfinite(*v)) return refused(std::string(parameter) + ": '" + std::string(text) + "' is not a number");
+    out = {*v, {}};
+  }
+  // The spec's range, step and mask, as the service would judge them, so a value out of
+  // range is bad usage (exit 2, interface.md 3.2) and never sent. The firmware is the newest:
+  // the power_up_state bits an older unit lacks are the service's to refuse, knowing the unit.
+  if (const auto p = codec::parameter_from_name(parameter); p && out.value)
+    if (const auto raw = codec::to_raw(*p, *out.value); !raw) return refused(raw.error().describe());
+  return out;
 }
 
 }  // namespace pmu::tools

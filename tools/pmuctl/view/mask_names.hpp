@@ -23,8 +23,10 @@ const MaskNames* mask_names(std::string_view field) noexcept;
 
 // `config set PARAM VALUE`'s value, from the command line: the number to send, or why not
 // (naming the bad token and what is valid). A mask parameter takes a comma list of its
-// names, `none`, or a whole number 0..255 (decimal or 0x hex); any other parameter a finite
-// number in its unit. Ranges and the firmware's bits are the service's to check.
+// names, `none`, or a whole number (decimal or 0x hex); any other parameter a finite number in
+// its unit. A stored parameter's value is then checked as the spec says (range, step, the
+// bits the mask defines): only whether the unit's firmware has a power_up_state bit is left
+// to the service, which knows the unit.
 struct ConfigValue {
   std::optional<double> value;
   std::string error;  // set when value is empty

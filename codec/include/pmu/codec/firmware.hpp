@@ -40,6 +40,14 @@ std::string to_string(FirmwareVersion v);
 
 // The newest firmware the v1.9 document describes; assumed when the version is unknown.
 inline constexpr FirmwareVersion kCurrentFirmware{1, 17};
+// The oldest firmware the documents name (v1.9 6.1: 1.12 added the external temperatures and
+// the starter-ready flag). What a unit before it did beyond that, and after kCurrentFirmware,
+// no document says: a simulated PMU is only ever one of 1.12..1.17.
+inline constexpr FirmwareVersion kOldestDescribedFirmware{1, 12};
+// Whether `fw` is one the documents describe, kOldestDescribedFirmware..kCurrentFirmware.
+constexpr bool is_described(FirmwareVersion fw) noexcept {
+  return fw >= kOldestDescribedFirmware && !(kCurrentFirmware < fw);
+}
 
 enum class Feature : std::uint8_t {
   ExternalTemperatures,

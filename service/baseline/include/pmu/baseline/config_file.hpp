@@ -30,6 +30,9 @@
 
 namespace pmu::baseline {
 
+// The largest PMU configuration file read (interface.md 4.6): a full one is under 1 KiB.
+inline constexpr std::size_t kMaxConfigFileBytes = std::size_t{64} << 10;
+
 struct Header {
   std::string vehicle;
   std::string bus;

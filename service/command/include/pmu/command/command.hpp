@@ -52,6 +52,13 @@ inline bool is_final(CommandResult r) noexcept { return r != CommandResult::InPr
 // The reason of a command REJECTED because its service has no device at `address` on `bus`:
 // nothing was executed. pmuctl's agent compares a reply with it (target_memory.hpp).
 std::string device_not_seen_reason(std::uint16_t address, std::string_view bus);
+// The reason of a command REJECTED because its service serves no bus `bus` (`served`: the
+// buses it does serve): nothing was executed.
+std::string bus_not_served_reason(std::string_view bus, std::string_view served);
+// Whether a REJECTED command's reason says its target is not there: no such bus, or no such
+// device on it. pmuctl exits 2 for that (no such target), 1 for any other refusal
+// (interface.md 3.2).
+bool says_no_such_target(std::string_view reason, std::string_view bus, std::uint16_t address);
 
 // The IDL's string bounds (idl/command.idl): longer strings are rejected, not truncated.
 inline constexpr std::size_t kMaxRequestIdLength = 63;

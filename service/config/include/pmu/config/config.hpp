@@ -27,6 +27,9 @@ namespace pmu::service {
 
 // The longest `baseline:` path: pmu/baseline's `file` is a string<255>.
 inline constexpr std::size_t kMaxBaselinePath = 255;
+// The largest config file read (interface.md 4.1): far above any real one, and a bound, so a
+// device or a runaway file named as the config is refused (docs/safety.md H12).
+inline constexpr std::size_t kMaxConfigFileBytes = std::size_t{1} << 20;
 
 class ConfigError : public std::runtime_error {
  public:
