@@ -8,15 +8,20 @@
 
 #include <chrono>
 #include <fastdds/dds/core/status/PublicationMatchedStatus.hpp>
+#include <fastdds/dds/core/status/SubscriptionMatchedStatus.hpp>
 #include <string>
+#include <sys/wait.h>
 #include <thread>
+#include <vector>
 
 #include "pmu/dds/dds_context.hpp"
+#include "pmu/idl/alarmsPubSubTypes.h"
 #include "pmu/idl/commandPubSubTypes.h"
 #include "pmu/idl/topics.hpp"
 #include "support/domain.hpp"
 #include "support/json_lines.hpp"
 #include "support/process.hpp"
+#include "support/wait.hpp"
 
 namespace {
 
@@ -180,6 +185,80 @@ TEST(PmuctlExit, NoReplyIsExitThreeWithOneJsonLine) {
   EXPECT_EQ(lines[0]["exit_status"], 3) << r.out;
   EXPECT_NE(lines[0]["reason"].get<std::string>().find("no reply from pmu-service within 8.0 s"), std::string::npos)
       << r.out;
+}
+
+
+std::uint64_t epoch_ns(std::chrono::system_clock::time_point t) {
+  return static_cast<std::uint64_t>(std::chrono::duration_cast<std::chrono::nanoseconds>(t.time_since_epoch()).count());
+}
+
+// A service whose request reader pmuctl matches at once and whose reply writer it meets only
+// after a slow discovery (3 s), and which never answers: pmuctl sends its request with part of
+// its --timeout used up. The request's expires_at (interface.md 2.3) is the end of pmuctl's
+// wait, whatever the finding cost, so the service sends nothing of it once pmuctl has given up
+// (docs/safety.md H9); a resend keeps it.
+template <class RequestType, class ReplyType, class Request>
+void expect_expiry_at_the_end_of_the_wait(const char* request_topic, const char* reply_topic,
+                                          const std::vector<std::string>& verb) {
+  using namespace eprosima::fastdds::dds;
+  const int domain = pmu::test::exclusive_dds_domain();
+  pmu::dds::DdsContext service(domain, PMU_QOS_FILE, "late-service");
+  DataReader& requests =
+      service.reader(service.topic(request_topic, TypeSupport(new RequestType())), pmu::qos_profiles::kCommand);
+  std::vector<std::string> argv{PMUCTL_PATH, "--domain", std::to_string(domain), "--timeout", "15", "--json"};
+  argv.insert(argv.end(), verb.begin(), verb.end());
+  pmu::test::ChildOptions o;
+  o.stdout_path = o.stderr_path = "/dev/null";
+  const auto started = std::chrono::system_clock::now();
+  pmu::test::Child pmuctl(argv, o);
+  ASSERT_TRUE(pmu::test::wait_until(
+      [&] {
+        SubscriptionMatchedStatus st;
+        requests.get_subscription_matched_status(st);
+        return st.current_count > 0;
+      },
+      15s))
+      << "pmuctl's request writer never matched";
+  std::this_thread::sleep_for(3s);  // the slow part of the discovery: pmuctl's wait goes on
+  (void)service.writer(service.topic(reply_topic, TypeSupport(new ReplyType())), pmu::qos_profiles::kCommand);
+  // Taken while pmuctl runs: what its writer sent goes with it.
+  std::vector<std::uint64_t> expiries;
+  const auto take = [&] {
+    Request r;
+    SampleInfo info;
+    while (requests.take_next_sample(&r, &info) == ReturnCode_t::RETCODE_OK)
+      if (info.valid_data) expiries.push_back(r.expires_at());
+  };
+  ASSERT_TRUE(pmu::test::wait_until(
+      [&] {
+        take();
+        return !pmuctl.running();
+      },
+      60s))
+      << "pmuctl did not end";
+  const auto gave_up = std::chrono::system_clock::now();
+  const auto status = pmuctl.status();
+  ASSERT_TRUE(status && WIFEXITED(*status));
+  EXPECT_EQ(WEXITSTATUS(*status), 3) << "no reply";
+  ASSERT_FALSE(expiries.empty()) << "pmuctl sent nothing";
+  for (const auto e : expiries) {
+    EXPECT_EQ(e, expiries.front()) << "a resend keeps the request's expiry";
+    EXPECT_GT(e, epoch_ns(started));
+    EXPECT_LE(e, epoch_ns(gave_up)) << "the request outlives pmuctl's wait by "
+                                     << (static_cast<double>(e) - static_cast<double>(epoch_ns(gave_up))) / 1e9
+                                     << " s";
+  }
+}
+
+TEST(PmuctlExpiry, ACommandExpiresWhenPmuctlStopsWaiting) {
+  expect_expiry_at_the_end_of_the_wait<pmu::v4::CommandPubSubType, pmu::v4::CommandReplyPubSubType, pmu::v4::Command>(
+      pmu::topics::kCommand, pmu::topics::kCommandReply, {"--bus", "can0", "--address", "1", "outputs", "get"});
+}
+
+TEST(PmuctlExpiry, AnAlarmAcknowledgementExpiresWhenPmuctlStopsWaiting) {
+  expect_expiry_at_the_end_of_the_wait<pmu::v4::AlarmAckPubSubType, pmu::v4::AlarmAckReplyPubSubType,
+                                       pmu::v4::AlarmAck>(pmu::topics::kAlarmAck, pmu::topics::kAlarmAckReply,
+                                                          {"--bus", "can0", "alarms", "ack", "bus_off", "--kind", "bus"});
 }
 
 }  // namespace

@@ -148,6 +148,57 @@ TEST(AddressChange, CommandsGoToTheNewAddressAtOnceAndTheOldOneIsNotSeen) {
   EXPECT_NE(old.reason.find("device 1 not seen"), std::string::npos) << old.reason;
 }
 
+std::size_t stops_to(const Harness& h, std::uint16_t address) {
+  std::size_t n = 0;
+  for (const auto& f : h.sent_frames()) n += f.id == codec::make_id(codec::PacketId::EngineStop, address);
+  return n;
+}
+
+// docs/safety.md H4: a stop sent to the address the unit has just left, by someone who had
+// not yet read the move's reply, reaches the unit where it is now; other commands to that
+// address are still not seen.
+TEST(AddressChange, AnEngineStopToTheAddressTheUnitLeftFollowsIt) {
+  Moves m;
+  ASSERT_EQ(m.move(1, 7).result, CommandResult::Completed);
+  m.h.clear_sent();
+  const auto stop = m.command(CommandKind::EngineStop, 1);
+  EXPECT_EQ(stop.result, CommandResult::Completed) << stop.reason;
+  EXPECT_EQ(stop.reason, "stop sent to address 7, where the unit is now (it was 1)");
+  EXPECT_EQ(stops_to(m.h, 7), 1u);
+  EXPECT_EQ(stops_to(m.h, 1), 0u);
+  EXPECT_EQ(m.command(CommandKind::GetSerial, 1).result, CommandResult::Rejected);
+  // Moved on again: the stop still finds it.
+  ASSERT_EQ(m.move(7, 9).result, CommandResult::Completed);
+  m.h.clear_sent();
+  EXPECT_EQ(m.command(CommandKind::EngineStop, 1).result, CommandResult::Completed);
+  EXPECT_EQ(stops_to(m.h, 9), 1u);
+}
+
+// While our own address change waits for its read-back, the unit answers at one of the two
+// addresses: a stop goes to both (docs/safety.md H4).
+TEST(AddressChange, AnEngineStopDuringAnAddressChangeGoesToBothAddresses) {
+  Moves m;
+  m.h.recording_bus().drop_data_of = 0x1B;  // the set is lost: the read-back at 7 waits, unanswered
+  CommandSample set;
+  set.request_id = "move";
+  set.sender = "test";
+  set.bus = "sim0";
+  set.address = 1;
+  set.kind = static_cast<std::uint32_t>(CommandKind::SetParameter);
+  set.parameter = "can_address";
+  set.value = 7;
+  set.confirm = true;
+  m.service.submit(set);
+  m.h.run_for(100ms);
+  ASSERT_TRUE(m.replies.empty()) << "the read-back is still waiting";
+  m.h.clear_sent();
+  const auto stop = m.command(CommandKind::EngineStop, 1);
+  EXPECT_EQ(stop.result, CommandResult::Completed) << stop.reason;
+  EXPECT_EQ(stop.reason, "stop sent to addresses 1 and 7: its CAN address is being changed");
+  EXPECT_EQ(stops_to(m.h, 1), 1u);
+  EXPECT_EQ(stops_to(m.h, 7), 1u);
+}
+
 TEST(AddressChange, MovingBackAndForthLeavesNoGhostAtEitherAddress) {
   Moves m;
   const std::pair<std::uint16_t, std::uint16_t> steps[] = {{1, 7}, {7, 1}, {1, 7}, {7, 1}};

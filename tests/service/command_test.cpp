@@ -495,20 +495,70 @@ TEST(Commands, OneDeviceIsSerialisedTwoDevicesProceedInParallel) {
   EXPECT_EQ(c.sent().back(), hex(pmu_frame(0x31, 1, {})));
 }
 
-TEST(Commands, EngineStopJumpsTheQueue) {
-  auto slow = pmu(1);
-  Commands c({slow});
-  c.h.pmus().with_model(1, [](sim::PmuModel& m) {
+// docs/safety.md H4: an engine stop waits behind nothing the unit is asked: not behind the
+// requests queued for it, nor behind the one in flight, however long that one waits for its
+// answer. It goes out in the worker's next turn, with no time passing.
+struct BusyCase {
+  const char* what;
+  std::function<void(Commands&)> busy;  // leaves a request in flight to unit 1
+};
+
+void with_faults(Commands& c, std::function<void(sim::Faults&)> change) {
+  c.h.pmus().with_model(1, [&](sim::PmuModel& m) {
     auto f = m.faults();
-    f.delay = std::chrono::milliseconds(100);
+    change(f);
     m.set_faults(f);
   });
-  for (int i = 0; i < 5; ++i) c.service.submit(c.req(CommandKind::GetSerial));
-  c.service.submit(c.req(CommandKind::EngineStop));
-  c.h.run_for(150ms);
+}
+
+TEST(Commands, EngineStopGoesOutAtOnceWhateverTheUnitIsAsked) {
+  const BusyCase cases[] = {
+      {"gets queued, the first answered late",
+       [](Commands& c) {
+         with_faults(c, [](sim::Faults& f) { f.delay = std::chrono::milliseconds(200); });
+         for (int i = 0; i < 5; ++i) c.service.submit(c.req(CommandKind::GetSerial));
+         c.h.run_for(50ms);
+       }},
+      {"a silent unit asked again (a get's retries)",
+       [](Commands& c) {
+         with_faults(c, [](sim::Faults& f) { f.silent = true; });
+         c.service.submit(c.req(CommandKind::GetFirmware));
+         c.h.run_for(300ms);  // past the first reply timeout: the second try is in flight
+       }},
+      {"a set waiting for its read-back",
+       [](Commands& c) {
+         with_faults(c, [](sim::Faults& f) { f.delay = std::chrono::milliseconds(200); });
+         c.service.submit(set_param(c, "avionics_voltage", 24.0));
+         c.h.run_for(50ms);
+       }},
+  };
+  for (const auto& k : cases) {
+    SCOPED_TRACE(k.what);
+    Commands c({pmu(1)});
+    k.busy(c);
+    ASSERT_GT(c.h.worker().session(1)->queued(), 0u) << "the unit is busy";
+    const auto replies = c.replies.size();
+    c.h.clear_sent();
+    auto stop = c.req(CommandKind::EngineStop);
+    c.service.submit(stop);
+    c.h.settle();  // the worker's next turn; no time passes
+    EXPECT_EQ(c.sent(), (std::vector<std::string>{hex(pmu_frame(0x25, 1, {}))}));
+    ASSERT_EQ(c.replies.size(), replies + 1);
+    EXPECT_EQ(c.replies.back().request_id, stop.request_id);
+    EXPECT_EQ(c.replies.back().result, CommandResult::Completed);
+    EXPECT_EQ(c.replies.back().reason, "stop sent");
+  }
+}
+
+TEST(Commands, EngineStopRunsBeforeCommandsPostedToTheWorkerBeforeIt) {
+  Commands c({pmu(1), pmu(2)}, {}, {}, {device(1), device(2)});
+  c.service.submit(c.req(CommandKind::GetSerial, 2));
+  c.service.submit(c.req(CommandKind::GetFirmware, 1));
+  c.service.submit(c.req(CommandKind::EngineStop, 1));
+  c.h.worker().run_once(0ms);  // one turn runs what was posted
   const auto s = c.sent();
-  ASSERT_GE(s.size(), 2u);
-  EXPECT_EQ(s[1], hex(pmu_frame(0x25, 1, {}))) << "sent right after the get already in flight";
+  ASSERT_FALSE(s.empty());
+  EXPECT_EQ(s.front(), hex(pmu_frame(0x25, 1, {}))) << "docs/safety.md H4: the stop first";
 }
 
 TEST(Commands, BurstOf1000MixedCommandsFromTwoSendersGetsExactly1000Replies) {

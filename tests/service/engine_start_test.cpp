@@ -5,6 +5,8 @@
 #include <gtest/gtest.h>
 
 #include "harness.hpp"
+#include "pmu/codec/encode.hpp"
+#include "pmu/codec/ids.hpp"
 #include "pmu/dispatch/command_service.hpp"
 #include "pmu/dispatch/engine_start.hpp"
 
@@ -158,8 +160,9 @@ TEST(EngineStartRefusal, FromTheFlagsOfPacket0x04AsTheFirmwareDefinesThem) {
 
 class Start {
  public:
-  explicit Start(std::function<void(sim::Plant&)> plant = {}, codec::FirmwareVersion fw = codec::kCurrentFirmware)
-      : h(sim_bus({device(1)}), {pmu(1, fw)}),
+  explicit Start(std::function<void(sim::Plant&)> plant = {}, codec::FirmwareVersion fw = codec::kCurrentFirmware,
+                 std::optional<std::uint32_t> cranking_time_raw = std::nullopt)
+      : h(sim_bus({device(1)}), {unit(fw, cranking_time_raw)}),
         service({&h.worker()}, PolicyConfig{}, Timeouts{}, h.clock(),
                 [this](const CommandReplyData& r) { replies.push_back(r); }) {
     h.pmus().with_model(1, [&](sim::PmuModel& m) {
@@ -170,6 +173,12 @@ class Start {
     });
     h.run_for(300ms);  // start-up reading done
     h.clear_sent();
+  }
+
+  static sim::DeviceConfig unit(codec::FirmwareVersion fw, std::optional<std::uint32_t> cranking_time_raw) {
+    auto d = pmu(1, fw);
+    if (cranking_time_raw) d.parameters.set_raw(codec::Parameter::CrankingTime, *cranking_time_raw);
+    return d;
   }
 
   CommandSample command(CommandKind kind, const std::string& id) const {
@@ -199,6 +208,12 @@ class Start {
   std::size_t frames(std::uint8_t packet, bool with_data) const {
     std::size_t n = 0;
     for (const auto& f : h.sent_frames()) n += ((f.id >> 16) & 0xFF) == packet && (f.length > 0) == with_data;
+    return n;
+  }
+  // Zero-length frames (gets, starts, stops) of `packet` sent to `address`.
+  std::size_t frames_to(codec::PacketId packet, std::uint16_t address) const {
+    std::size_t n = 0;
+    for (const auto& f : h.sent_frames()) n += f.id == codec::make_id(packet, address) && f.length == 0;
     return n;
   }
   sim::EngineState engine() {
@@ -362,6 +377,87 @@ TEST(EngineStart, AUnitThatFallsSilentWhileStartingTimesOut) {
   EXPECT_EQ(final->result, CommandResult::Timeout);
   EXPECT_NE(final->reason.find("stopped answering while its engine was starting"), std::string::npos);
   EXPECT_EQ(s.frames(0x25, false), 1u);
+}
+
+// A CT of 0: the unit never lets go of the starter by itself, so only a stop that reaches
+// it ends the cranking (docs/safety.md H5).
+constexpr std::uint32_t kNoCrankingTimeout = 0;
+
+// docs/safety.md H4, H10: our own address change while the start is verified. The start goes
+// on reading the speed of this unit at its new address, and its stop goes there.
+TEST(EngineStart, AUnitMovedByCommandWhileCrankingIsStillTheOneWatchedAndItsStopFollowsIt) {
+  Start s([](sim::Plant& p) { p.engine_starts_after.reset(); }, codec::kCurrentFirmware, kNoCrankingTimeout);
+  s.service.submit(s.command(CommandKind::EngineStart, "start-1"));
+  s.h.run_for(1s);
+  ASSERT_EQ(s.engine(), sim::EngineState::Cranking);
+  auto move = s.command(CommandKind::SetParameter, "move-1");
+  move.parameter = "can_address";
+  move.value = 7;
+  move.confirm = true;
+  s.service.submit(move);
+  s.run_until_final("move-1", 5s);
+  ASSERT_TRUE(s.final_of("move-1"));
+  ASSERT_EQ(s.final_of("move-1")->result, CommandResult::Completed) << s.final_of("move-1")->reason;
+  s.h.clear_sent();
+
+  s.run_until_final("start-1");
+  const auto final = s.final_of("start-1");
+  ASSERT_TRUE(final);
+  EXPECT_EQ(final->result, CommandResult::Failed) << final->reason;
+  EXPECT_NE(final->reason.find("no start: rpm 300 after 27.5 s"), std::string::npos)
+      << "the cranking speed read at the new address: " << final->reason;
+  EXPECT_GE(s.frames_to(codec::PacketId::Status, 7), 10u) << "the speed polled where the unit is";
+  EXPECT_EQ(s.frames_to(codec::PacketId::Status, 1), 0u) << "nothing to the address it left";
+  EXPECT_EQ(s.frames_to(codec::PacketId::EngineStop, 7), 1u);
+  EXPECT_EQ(s.frames_to(codec::PacketId::EngineStop, 1), 0u);
+  EXPECT_EQ(s.engine(), sim::EngineState::Stopped) << "the stop reached the unit";
+}
+
+// docs/safety.md H4, H5: another tool moves the unit while it cranks. It falls silent at its
+// address, so the start ends and its stop goes there, where the unit no longer is; once the
+// service finds the unit at its new address, the stop is sent again there.
+TEST(EngineStart, AUnitThatMovesByItselfWhileCrankingIsSentTheStopAgainWhereItIsFound) {
+  Start s([](sim::Plant& p) { p.engine_starts_after.reset(); }, codec::kCurrentFirmware, kNoCrankingTimeout);
+  s.service.submit(s.command(CommandKind::EngineStart, "start-1"));
+  s.h.run_for(1s);
+  ASSERT_EQ(s.engine(), sim::EngineState::Cranking);
+  auto tool = s.h.network().attach("other-tool");
+  ASSERT_TRUE(tool->send(*codec::encode_parameter_reply(codec::Parameter::CanAddress, 9, 1), 100ms).ok());
+  s.run_until_final("start-1", 5s);
+  const auto final = s.final_of("start-1");
+  ASSERT_TRUE(final);
+  EXPECT_EQ(final->result, CommandResult::Timeout) << final->reason;
+  EXPECT_EQ(s.frames_to(codec::PacketId::EngineStop, 1), 1u);
+  EXPECT_EQ(s.engine(), sim::EngineState::Cranking) << "a stop to address 1 does not reach it";
+
+  s.h.run_for(10s);
+  ASSERT_EQ(s.h.worker().addresses(), (std::vector<std::uint16_t>{9})) << "found by its serial";
+  EXPECT_EQ(s.frames_to(codec::PacketId::EngineStop, 9), 1u);
+  EXPECT_EQ(s.engine(), sim::EngineState::Stopped);
+}
+
+// docs/safety.md H5, H9: the start frame is bound by the request's expiry like the check
+// before it. A check answered only after the expiry (its first answer late, past the reply
+// timeout) must not crank an engine whose caller has given up.
+TEST(EngineStart, NoStartFrameAfterTheExpiryEvenWhenTheCheckIsAnsweredLate) {
+  Start s;
+  s.h.pmus().with_model(1, [](sim::PmuModel& m) {
+    auto f = m.faults();
+    f.delay = std::chrono::milliseconds(300);  // past the 250 ms reply timeout
+    m.set_faults(f);
+  });
+  auto start = s.command(CommandKind::EngineStart, "start-1");
+  start.expires_at = static_cast<std::uint64_t>(
+      std::chrono::duration_cast<std::chrono::nanoseconds>((s.h.clock().system_now() + 200ms).time_since_epoch())
+          .count());
+  s.service.submit(start);
+  s.run_until_final("start-1", 5s);
+  const auto final = s.final_of("start-1");
+  ASSERT_TRUE(final);
+  EXPECT_EQ(final->result, CommandResult::Rejected) << final->reason;
+  EXPECT_EQ(final->reason, "expired before it could be sent");
+  EXPECT_EQ(s.frames(0x24, false), 0u) << "no start frame";
+  EXPECT_EQ(s.engine(), sim::EngineState::Stopped);
 }
 
 }  // namespace

@@ -206,5 +206,27 @@ TEST(RequestQueue, ARoundAppendedTogetherCanBeDroppedByItsFirstFailure) {
   EXPECT_EQ(q.size(), 0u);
 }
 
+// A unit that moved (interface.md 2.6): the request in flight is resent, and those waiting
+// are sent, at its new address; a frame to another address is left as it is.
+TEST(RequestQueue, ReaddressMovesTheFramesToTheAddressTheUnitLeft) {
+  Wire wire;
+  RequestQueue q(wire.fn(), 100ms);
+  std::vector<std::string> log;
+  q.push_back(get(PacketId::Status, log, 1, "in flight"), t0);
+  q.push_back(get(PacketId::Serial, log, 0, "waiting"), t0);
+  Request elsewhere = logged(codec::encode_get(PacketId::Firmware, 3), log, "elsewhere");
+  elsewhere.reply = PacketId::Firmware;
+  q.push_back(std::move(elsewhere), t0);
+  q.readdress(1, 7);
+  q.tick(t0 + 100ms);  // the resend of the one in flight
+  q.on_answer(data_of(PacketId::Status), t0 + 110ms);
+  q.on_answer(data_of(PacketId::Serial), t0 + 120ms);
+  ASSERT_EQ(wire.sent.size(), 4u);
+  EXPECT_EQ(wire.sent[0].id, codec::make_id(PacketId::Status, 1)) << "sent before the move";
+  EXPECT_EQ(wire.sent[1].id, codec::make_id(PacketId::Status, 7));
+  EXPECT_EQ(wire.sent[2].id, codec::make_id(PacketId::Serial, 7));
+  EXPECT_EQ(wire.sent[3].id, codec::make_id(PacketId::Firmware, 3));
+}
+
 }  // namespace
 }  // namespace pmu::service::request_queue_test

@@ -191,6 +191,39 @@ TEST_F(Loop, PostedWorkRunsOnTheLoopThreadInPostingOrder) {
   EXPECT_NE(ran_on, std::this_thread::get_id());
 }
 
+TEST_F(Loop, UrgentWorkRunsBeforeTheTurnsFdsAndBeforeWorkPostedEarlier) {
+  Signal s;
+  s.raise();
+  std::vector<std::string> order;
+  ASSERT_EQ(loop_.watch(s.fd(), EventLoop::kReadable,
+                        [&](std::uint32_t) {
+                          order.push_back("fd");
+                          s.consume();
+                        }),
+            0);
+  loop_.post([&] { order.push_back("work 1"); });
+  loop_.post([&] { order.push_back("work 2"); });
+  loop_.post_urgent([&] { order.push_back("urgent 1"); });
+  loop_.post_urgent([&] { order.push_back("urgent 2"); });
+  EXPECT_EQ(loop_.run_once(0ms), 5u);
+  EXPECT_EQ(order, (std::vector<std::string>{"urgent 1", "urgent 2", "fd", "work 1", "work 2"}));
+}
+
+TEST_F(Loop, UrgentWorkPostedByAnFdCallbackRunsThatTurnBeforeTheOtherWork) {
+  Signal s;
+  s.raise();
+  std::vector<std::string> order;
+  ASSERT_EQ(loop_.watch(s.fd(), EventLoop::kReadable,
+                        [&](std::uint32_t) {
+                          s.consume();
+                          loop_.post_urgent([&] { order.push_back("urgent"); });
+                        }),
+            0);
+  loop_.post([&] { order.push_back("work"); });
+  loop_.run_once(0ms);
+  EXPECT_EQ(order, (std::vector<std::string>{"urgent", "work"}));
+}
+
 TEST_F(Loop, PostFromAnotherThreadEndsAWaitWithoutBound) {
   std::atomic<bool> returned{false};
   std::atomic<std::size_t> called{0};

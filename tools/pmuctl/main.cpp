@@ -165,7 +165,7 @@ int run_cli(int argc, char** argv, const AgentCall* served) {
       "read every vehicle, command the unnamed one)");
   app.add_option("--bus", g.bus, "Only this bus (the service's name for it, e.g. can0)");
   app.add_option("--address", address,
-                 "Only the PMU at this CAN address (0..65534); 65535 (broadcast) with `engine stop` alone: every "
+                 "Only the PMU at this CAN address (0..65534); 65535 (broadcast) with `engine stop` alone: to every "
                  "PMU of the bus (--bus) or of the vehicle")
       ->check(CLI::Range(0, int{pmu::codec::kBroadcastAddress}));
   app.add_flag("--json", g.json, "Machine-readable output: one JSON object per line");
@@ -278,9 +278,16 @@ int run_cli(int argc, char** argv, const AgentCall* served) {
   auto* generation = app.add_subcommand("generation", "Electrical power generation on|off");
   std::string on_off;
   generation->add_option("state", on_off, "on or off")->required()->check(CLI::IsMember({"on", "off"}));
-  auto* engine = app.add_subcommand("engine", "Engine start|stop");
+  auto* engine = app.add_subcommand(
+      "engine",
+      "Engine start (verified by the generator speed) | stop (0x25: stops the starter cranking; a running engine "
+      "keeps running, no PMU command stops it)");
   std::string start_stop;
-  engine->add_option("action", start_stop, "start or stop")->required()->check(CLI::IsMember({"start", "stop"}));
+  engine
+      ->add_option("action", start_stop,
+                   "start: crank until the engine runs; stop: stop the starter cranking (not a running engine)")
+      ->required()
+      ->check(CLI::IsMember({"start", "stop"}));
   auto* reset = app.add_subcommand("reset", "Restart the PMU (outputs to power-up state, energies to zero)");
   auto* measure = app.add_subcommand("measure", "Ask for measurements now (0x0F; firmware 1.14+)");
   std::vector<std::string> groups;

@@ -66,6 +66,14 @@ void EventLoop::post(Work work) {
   wake();
 }
 
+void EventLoop::post_urgent(Work work) {
+  {
+    std::lock_guard<std::mutex> lock(posted_mutex_);
+    urgent_.push_back(std::move(work));
+  }
+  wake();
+}
+
 void EventLoop::wake() noexcept { detail::signal_eventfd(wake_.get()); }
 
 EventLoop::TimerId EventLoop::add_timer(TimePoint deadline, std::chrono::nanoseconds period,
@@ -142,27 +150,40 @@ std::size_t EventLoop::run_once(std::chrono::milliseconds max_wait) {
       loop.erase_removed();
     }
   } end_dispatch{*this};
+  for (int i = 0; i < ready; ++i) woken = woken || ready_[static_cast<std::size_t>(i)].data.ptr == nullptr;
+  // Reset before running the work, so a post() made by that work wakes the next turn.
+  if (woken) {
+    detail::clear_eventfd(wake_.get());
+    called += run_urgent();
+  }
   for (int i = 0; i < ready; ++i) {
     const struct epoll_event& event = ready_[static_cast<std::size_t>(i)];
-    if (event.data.ptr == nullptr) {
-      woken = true;
-      continue;
-    }
+    if (event.data.ptr == nullptr) continue;
     Watch& w = *static_cast<Watch*>(event.data.ptr);
     if (w.removed || !w.callback) continue;
     w.callback(event.events);
     ++called;
   }
-  // Reset before running the work, so a post() made by that work wakes the next turn.
-  if (woken) {
-    detail::clear_eventfd(wake_.get());
-    called += run_posted();
-  }
+  if (woken) called += run_posted();
   called += fire_due_timers();
   return called;
 }
 
+std::size_t EventLoop::run_urgent() {
+  {
+    std::lock_guard<std::mutex> lock(posted_mutex_);
+    if (urgent_.empty()) return 0;
+    running_.swap(urgent_);
+  }
+  const std::size_t count = running_.size();
+  for (auto& work : running_) work();
+  running_.clear();
+  return count;
+}
+
 std::size_t EventLoop::run_posted() {
+  // Urgent work posted since step 2 (by an fd callback) still goes first.
+  const std::size_t urgent = run_urgent();
   {
     std::lock_guard<std::mutex> lock(posted_mutex_);
     running_.swap(posted_);
@@ -170,7 +191,7 @@ std::size_t EventLoop::run_posted() {
   const std::size_t count = running_.size();
   for (auto& work : running_) work();
   running_.clear();
-  return count;
+  return urgent + count;
 }
 
 std::size_t EventLoop::fire_due_timers() {

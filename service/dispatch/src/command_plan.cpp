@@ -115,7 +115,7 @@ struct Table {
     CommandPlan p;
     p.frame = *codec::encode_engine_stop(a);
     p.what = "engine stop";
-    p.urgent = true;  // safety first: ahead of whatever the device has queued, and never expired
+    p.urgent = true;  // safety first: not behind whatever the device has queued or in flight, never expired
     p.check = done("stop sent");
     return p;
   }

@@ -3,6 +3,8 @@
 // submits the next step, so the Run lives exactly as long as a step is outstanding and
 // nothing refers to itself.
 #include <memory>
+#include <string>
+#include <vector>
 
 #include "pmu/codec/encode.hpp"
 #include "pmu/dispatch/command_plan.hpp"
@@ -19,6 +21,7 @@ class Run : public std::enable_shared_from_this<Run> {
 
   // Step 0: the command's own frame.
   void start(SteadyTime now) {
+    if (plan_.urgent) return send_urgent(now);
     if (plan_.alias) session_.set_alias(plan_.alias);
     Request r;
     r.frame = plan_.frame;
@@ -26,13 +29,35 @@ class Run : public std::enable_shared_from_this<Run> {
     r.retries = plan_.idempotent ? retries_ : 0;
     if (!plan_.urgent) r.expires = request_.expires;
     r.done = [self = shared_from_this()](const RequestOutcome& o) { self->on_command(o); };
-    if (plan_.urgent)
-      session_.submit_front(std::move(r), now);
-    else
-      session_.submit(std::move(r), now);
+    session_.submit(std::move(r), now);
   }
 
  private:
+  // An engine stop: out at once, to where the unit is now (DeviceSession::send_urgent;
+  // docs/safety.md H4). Nothing answers it, so sending it is the whole command.
+  void send_urgent(SteadyTime now) {
+    const auto sent = session_.send_urgent(plan_.frame, now);
+    RequestOutcome o;
+    o.status = sent.result.ok() ? RequestStatus::Sent : RequestStatus::SendFailed;
+    o.send = sent.result;
+    if (!succeeded(o, plan_.what)) return;
+    Verdict v = plan_.check(nullptr);
+    v.reason += where(sent.addresses);
+    conclude(std::move(v));
+  }
+
+  // Where an urgent frame went, when that is not simply the address the request named.
+  std::string where(const std::vector<std::uint16_t>& addresses) const {
+    if (addresses.empty() || (addresses.size() == 1 && addresses[0] == request_.address)) return {};
+    if (addresses.size() == 1)
+      return " to address " + std::to_string(addresses[0]) + ", where the unit is now (it was " +
+             std::to_string(request_.address) + ")";
+    std::string list;
+    for (std::size_t i = 0; i < addresses.size(); ++i)
+      list += (i == 0 ? "" : i + 1 == addresses.size() ? " and " : ", ") + std::to_string(addresses[i]);
+    return " to addresses " + list + ": its CAN address is being changed";
+  }
+
   void on_command(const RequestOutcome& o) {
     if (!succeeded(o, plan_.what)) return;
     if (plan_.read_back) return read_back(false);
@@ -42,7 +67,9 @@ class Run : public std::enable_shared_from_this<Run> {
   // Steps 1 and 2: the verification get, ahead of anything queued since.
   void read_back(bool last) {
     Request r;
-    r.frame = *codec::encode_get(plan_.read_back->packet, plan_.read_back->address);
+    // At the address the unit answers at now, unless the command itself moves it.
+    const std::uint16_t address = plan_.alias ? plan_.read_back->address : session_.key().address;
+    r.frame = *codec::encode_get(plan_.read_back->packet, address);
     r.reply = plan_.read_back->packet;
     r.retries = retries_;
     r.done = [self = shared_from_this(), last](const RequestOutcome& o) { self->on_read_back(o, last); };

@@ -115,6 +115,9 @@ void CommandService::submit(const CommandSample& s) {
   BusWorker* worker = worker_for(r.bus);
   if (!worker) return refuse(r, not_served(r));
   if (auto no = limit_rate(r)) return refuse(r, *no);
+  // A stop waits behind no other command posted to the worker, nor behind the frames of its
+  // turn (docs/safety.md H4).
+  if (r.kind() == CommandKind::EngineStop) return worker->post_urgent([this, worker, r] { run_on_worker(*worker, r); });
   worker->post([this, worker, r] { run_on_worker(*worker, r); });
 }
 
@@ -188,6 +191,9 @@ std::optional<CommandService::Refusal> CommandService::limit_rate(const CommandR
 void CommandService::run_on_worker(BusWorker& worker, const CommandRequest& r) {
   if (r.address == codec::kBroadcastAddress) return broadcast(worker, r);
   DeviceSession* session = worker.session(r.address);
+  // A stop to the address a unit has just left follows the unit (interface.md 2.6): whoever
+  // sent it meant that unit, and the address it left reaches nothing (docs/safety.md H4).
+  if (!session && r.kind() == CommandKind::EngineStop) session = worker.session_moved_from(r.address);
   if (auto no = check_device(worker, session, r)) return refuse(r, *no);
   if (auto no = judge(r, device_use(*session, clock_.steady_now()))) return refuse(r, *no);
   execute_command(*session, r, clock_.steady_now(), timeouts_,
@@ -221,7 +227,7 @@ void CommandService::broadcast_on_every_bus(const CommandRequest& r) {
   auto round = std::make_shared<Round>();
   round->left = workers_.size();
   for (auto* w : workers_)
-    w->post([this, w, r, round] {
+    w->post_urgent([this, w, r, round] {
       stop_engine_starts(*w, r.request_id);
       const auto sent = w->bus().send(*codec::encode_engine_stop(codec::kBroadcastAddress), timeouts_.send);
       std::string done, failed;

@@ -114,8 +114,10 @@ class StartRun : public std::enable_shared_from_this<StartRun> {
           if (auto self = weak.lock()) self->on_stop(stop_id, at);
         }});
     // Step 0, the check: a fresh 0x04, behind the device's queue and bound by the expiry.
+    // Every frame of the start goes to the unit's address when it is made (a move readdresses
+    // those queued): the start verifies this unit wherever it answers (docs/safety.md H10).
     Request r;
-    r.frame = *codec::encode_get(codec::PacketId::Status, request_.address);
+    r.frame = *codec::encode_get(codec::PacketId::Status, session_.key().address);
     r.reply = codec::PacketId::Status;
     r.retries = retries_;
     r.expires = request_.expires;
@@ -130,8 +132,11 @@ class StartRun : public std::enable_shared_from_this<StartRun> {
     if (!status) return conclude({CommandResult::Failed, "the status answer carries no status", {}, ""});
     if (auto why = refuse_start(*status, device_.firmware, session_.settings().engine))
       return conclude({CommandResult::Denied, *why, {}, ""});
+    // Bound by the expiry too: the check's answer may come after it (a resent get), and a
+    // start its caller gave up on must not crank (docs/safety.md H5, H9).
     Request r;
-    r.frame = *codec::encode_engine_start(request_.address);
+    r.frame = *codec::encode_engine_start(session_.key().address);
+    r.expires = request_.expires;
     r.done = [self = shared_from_this()](const RequestOutcome& sent) { self->on_sent(sent); };
     session_.submit_front(std::move(r), session_.now());
   }
@@ -153,7 +158,7 @@ class StartRun : public std::enable_shared_from_this<StartRun> {
     if (done_) return;
     // Ahead of the queue: the speed must be read on time whatever else waits for the unit.
     Request r;
-    r.frame = *codec::encode_get(codec::PacketId::Status, request_.address);
+    r.frame = *codec::encode_get(codec::PacketId::Status, session_.key().address);
     r.reply = codec::PacketId::Status;
     r.retries = retries_;
     r.done = [self = shared_from_this()](const RequestOutcome& o) { self->on_poll(o); };
@@ -166,7 +171,7 @@ class StartRun : public std::enable_shared_from_this<StartRun> {
     if (o.status != RequestStatus::Answered) {
       stop_cranking();
       return conclude({CommandResult::Timeout,
-                       "device " + std::to_string(request_.address) +
+                       "device " + std::to_string(session_.key().address) +
                            " stopped answering while its engine was starting; stop sent in case it still cranks",
                        {},
                        ""});
@@ -199,13 +204,9 @@ class StartRun : public std::enable_shared_from_this<StartRun> {
   }
 
   // The unit's CT should have ended the cranking; a CT of 0 never does, and a starter left
-  // turning an engine that will not fire is what the stop exists for (v1.9 5.23).
-  void stop_cranking() {
-    Request r;
-    r.frame = *codec::encode_engine_stop(request_.address);
-    r.done = [](const RequestOutcome&) {};
-    session_.submit_front(std::move(r), session_.now());
-  }
+  // turning an engine that will not fire is what the stop exists for (v1.9 5.23). Sent at
+  // once to where the unit is now, as an ENGINE_STOP is (docs/safety.md H4, H5).
+  void stop_cranking() { (void)session_.send_urgent(*codec::encode_engine_stop(session_.key().address), session_.now()); }
 
   void report_progress(SteadyTime now) {
     if (auto v = watch_->progress(now)) send(*v);
@@ -224,7 +225,7 @@ class StartRun : public std::enable_shared_from_this<StartRun> {
         break;
       case RequestStatus::Timeout:
         conclude({CommandResult::Timeout,
-                  "device " + std::to_string(request_.address) + " did not answer the " + what + " after " +
+                  "device " + std::to_string(session_.key().address) + " did not answer the " + what + " after " +
                       std::to_string(retries_ + 1) + " tries",
                   {},
                   ""});

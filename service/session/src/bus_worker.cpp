@@ -122,6 +122,12 @@ DeviceSession* BusWorker::session(std::uint16_t address) {
   return nullptr;
 }
 
+DeviceSession* BusWorker::session_moved_from(std::uint16_t address) {
+  if (session(address)) return nullptr;
+  const auto it = left_.find(address);
+  return it == left_.end() ? nullptr : session(it->second);
+}
+
 std::vector<std::uint16_t> BusWorker::addresses() const {
   std::vector<std::uint16_t> v;
   for (const auto& [a, s] : sessions_) v.push_back(a);
@@ -258,6 +264,8 @@ void BusWorker::discover() {
 
 void BusWorker::post(std::function<void()> fn) { loop_.post(std::move(fn)); }
 
+void BusWorker::post_urgent(std::function<void()> fn) { loop_.post_urgent(std::move(fn)); }
+
 std::size_t BusWorker::run_once(milliseconds max_wait) {
   turn_frames_ = 0;
   loop_.run_once(std::min(max_wait, kTick));
@@ -318,6 +326,12 @@ void BusWorker::rekey_moved_sessions() {
     m.config_line = moved->settings().source_line;
     // A move onto an address that had a session of its own leaves one session fewer.
     sessions_[address] = std::move(moved);
+    // Who left where: a unit that left an address another unit left before is where both
+    // went; one that is back where it left is no longer away from it.
+    for (auto& [left, now_at] : left_)
+      if (now_at == from) now_at = address;
+    left_[from] = address;
+    left_.erase(address);
     device_count_.store(sessions_.size(), std::memory_order_relaxed);
     log_move(m);
     if (moved_) moved_(m);

@@ -8,6 +8,7 @@
 #include <variant>
 
 #include "pmu/codec/encode.hpp"
+#include "pmu/codec/ids.hpp"
 
 namespace pmu::service {
 namespace {
@@ -35,13 +36,7 @@ DeviceSession::DeviceSession(DeviceKey key, DeviceConfig device, const Timeouts&
                              SendFn send, SteadyTime now)
     : key_(std::move(key)), settings_(device), timeouts_(timeouts), sink_(sink), send_(std::move(send)),
       health_(now, timeouts),
-      queue_(
-          [this](const codec::CanFrame& f) {
-            const auto sent = send_(f);
-            if (sent.ok()) health_.on_sent();
-            return sent;
-          },
-          timeouts.reply),
+      queue_([this](const codec::CanFrame& f) { return send_one(f); }, timeouts.reply),
       alarms_(key_.bus, alarms::DeviceKind::Pmu, key_.address, device.alarms, sink) {
   start_reading(now);
 }
@@ -129,9 +124,36 @@ void DeviceSession::submit_front(Request request, SteadyTime now) {
   queue_.push_front(std::move(request), now);
 }
 
+transport::SendResult DeviceSession::send_one(const codec::CanFrame& frame) {
+  const auto sent = send_(frame);
+  if (sent.ok()) health_.on_sent();
+  return sent;
+}
+
+DeviceSession::UrgentSent DeviceSession::send_urgent(const codec::CanFrame& frame, SteadyTime now) {
+  now_ = now;
+  UrgentSent out;
+  const auto id = codec::parse_id(frame.id, frame.extended);
+  if (!id.id) {  // not a PMU frame: nothing to address
+    out.result = send_one(frame);
+    return out;
+  }
+  out.addresses.push_back(key_.address);
+  if (alias_ && *alias_ != key_.address) out.addresses.push_back(*alias_);
+  for (const auto address : out.addresses) {
+    codec::CanFrame to = frame;
+    to.id = codec::make_id(id.id->packet, address);
+    const auto sent = send_one(to);
+    if (!sent.ok() && out.result.ok()) out.result = sent;
+  }
+  if (id.id->packet == codec::PacketId::EngineStop) last_stop_ = now;
+  return out;
+}
+
 void DeviceSession::on_frame(const codec::PmuId& id, const codec::CanFrame& frame, SteadyTime now,
                              WallTime received) {
   now_ = now;
+  last_heard_ = now;
   const bool was_offline = health_.offline();
   health_.on_frame(now);
   const auto m = codec::decode(frame, id, firmware());
@@ -180,9 +202,22 @@ void DeviceSession::move_to(std::uint16_t address, MoveCause cause, SteadyTime n
   alarms_.move_to(address);
   alias_.reset();
   reading_.set_address(address);
+  // Whatever waits for the unit follows it: an engine start's speed polls go on reading this
+  // unit, and nothing meant for it goes to the address it left (docs/safety.md H4, H10).
+  queue_.readdress(old.address, address);
   if (cause == MoveCause::ByItself) {
+    // A stop sent since it was last heard at the old address went where it no longer was.
+    const bool stop_missed = last_stop_ && (!last_heard_ || *last_stop_ >= *last_heard_) &&
+                             now - *last_stop_ <= kStopFollowsFor;
     if (health_.offline()) health_.on_reconnect();
     health_.on_frame(now);  // its serial answer, which the bus worker took as the evidence
+    last_heard_ = now;
+    if (stop_missed) {
+      const auto sent = send_urgent(*codec::encode_engine_stop(address), now);
+      spdlog::warn("{}/{}: an engine stop was sent to address {} after the unit was last heard there: sent again "
+                   "at its new address ({})",
+                   key_.bus, address, old.address, transport::to_string(sent.result.status));
+    }
     start_reading(now);
   }
   if (reading_.info()) sink_.on_info(key_, *reading_.info());

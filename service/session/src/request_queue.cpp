@@ -1,5 +1,7 @@
 #include "pmu/session/request_queue.hpp"
 
+#include "pmu/codec/ids.hpp"
+
 namespace pmu::service {
 
 RequestQueue::RequestQueue(SendFn send, std::chrono::milliseconds reply_timeout)
@@ -79,6 +81,15 @@ bool RequestQueue::tick(SteadyTime now) {
 
 void RequestQueue::drop(int tag) {
   for (auto it = queue_.begin(); it != queue_.end();) it = it->tag == tag ? queue_.erase(it) : std::next(it);
+}
+
+void RequestQueue::readdress(std::uint16_t from, std::uint16_t to) {
+  const auto move = [from, to](Request& r) {
+    const auto id = codec::parse_id(r.frame.id, r.frame.extended);
+    if (id.id && id.id->address == from) r.frame.id = codec::make_id(id.id->packet, to);
+  };
+  if (in_flight_) move(*in_flight_);
+  for (auto& r : queue_) move(r);
 }
 
 bool RequestQueue::waiting(int tag) const noexcept {

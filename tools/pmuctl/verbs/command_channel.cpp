@@ -129,9 +129,9 @@ std::optional<int> wait_for_match(const GlobalOptions& o, pmu::dds::DdsContext& 
   }
 }
 
-std::uint64_t epoch_ns_after(double seconds) {
-  const auto t = std::chrono::system_clock::now() +
-                 std::chrono::duration_cast<std::chrono::system_clock::duration>(std::chrono::duration<double>(seconds));
+std::uint64_t epoch_ns_at(std::chrono::steady_clock::time_point deadline) {
+  const auto left = std::chrono::duration_cast<std::chrono::system_clock::duration>(deadline - Clock::now());
+  const auto t = std::chrono::system_clock::now() + left;
   return static_cast<std::uint64_t>(std::chrono::duration_cast<std::chrono::nanoseconds>(t.time_since_epoch()).count());
 }
 
@@ -205,7 +205,7 @@ CommandChannel::Outcome CommandChannel::send(const CommandSpec& spec, const std:
   c.outputs(spec.outputs);
   c.enable(spec.enable);
   c.groups(spec.groups);
-  c.expires_at(epoch_ns_after(timeout));
+  c.expires_at(epoch_ns_at(deadline));
   c.confirm(spec.confirm);
   if (!writer_.write(&c)) {  // bool in Fast DDS 2.x
     out.written = false;

@@ -49,8 +49,10 @@ std::optional<int> wait_for_match(const GlobalOptions& o, pmu::dds::DdsContext& 
 // its own.
 void open_command_channels(const GlobalOptions& o, const std::vector<std::string>& vehicles);
 
-// The time `seconds` from now as ns since the Unix epoch (a request's expires_at).
-std::uint64_t epoch_ns_after(double seconds);
+// `deadline`, the end of pmuctl's own wait, as ns since the Unix epoch: a request's
+// expires_at (interface.md 2.3). The service sends nothing of a request after it, so nothing
+// is carried out once pmuctl has given up on it (docs/safety.md H9).
+std::uint64_t epoch_ns_at(std::chrono::steady_clock::time_point deadline);
 
 class CommandChannel {
  public:

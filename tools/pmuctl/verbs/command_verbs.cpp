@@ -82,7 +82,9 @@ int run_alarm_ack(const GlobalOptions& o, const std::string& code, const std::st
   a.kind(source);
   a.device(device);
   a.code(code);
-  a.expires_at(epoch_ns_after(timeout));
+  // The end of this wait, which finding the PMU and the match have used part of: an
+  // acknowledgement pmuctl gave up on is never applied (docs/safety.md H9).
+  a.expires_at(epoch_ns_at(deadline));
   if (!writer.write(&a)) return fail(o, ExitStatus::NotDone, "the acknowledgement could not be written to DDS");
 
   // Unanswered after 1 s: sent again with the same id, which the service answers again and

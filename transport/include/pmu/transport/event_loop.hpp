@@ -7,8 +7,10 @@
 //   by the injected Clock, one turn at a time. A turn is:
 //     1. wait until a watched fd is ready, work is posted, wake()/stop() is called, or the
 //        earliest armed timer is due, but never longer than the turn's max_wait;
-//     2. call the callback of every ready fd (in the order epoll reports them);
-//     3. run the work posted before this turn's wait ended, in posting order;
+//     2. run the work posted urgent (post_urgent) before this turn's wait ended, in posting
+//        order: ahead of the fds, which may have a flood to deliver, and of other work;
+//     3. call the callback of every ready fd (in the order epoll reports them), then run
+//        the work posted before this turn's wait ended (urgent first), in posting order;
 //     4. fire every armed timer that is due by the clock, earliest deadline first (ties in
 //        the order the timers were added).
 //   run_once() is one turn (tests drive a loop with a ManualClock this way); run() turns
@@ -112,6 +114,9 @@ class EventLoop {
   // --- posted work and wake-ups (any thread) ---
   // Runs `work` on the loop thread in step 3 of the next turn, waking the loop if it waits.
   void post(Work work);
+  // As post(), but in step 2: before the turn's fd callbacks and before all work posted
+  // with post() (a command that must not wait behind others: the service's engine stop).
+  void post_urgent(Work work);
   // Ends the current (or next) turn's wait without work. Nothing allocates.
   void wake() noexcept;
 
@@ -162,6 +167,7 @@ class EventLoop {
   // The wait of this turn, in epoll_wait's milliseconds (-1: forever).
   int wait_ms(std::chrono::milliseconds max_wait) const noexcept;
   std::size_t run_posted();
+  std::size_t run_urgent();
   std::size_t fire_due_timers();
   void erase_removed() noexcept;
 
@@ -181,6 +187,7 @@ class EventLoop {
 
   std::mutex posted_mutex_;
   std::vector<Work> posted_;   // guarded by posted_mutex_
+  std::vector<Work> urgent_;   // guarded by posted_mutex_: post_urgent()'s
   std::vector<Work> running_;  // loop thread: this turn's posted work, capacity kept
   std::atomic<bool> stop_{false};
 

@@ -13,13 +13,14 @@
 //   SetGeneration  0x23; read back 0x23                                    check: the state
 //   RequestMeasurements  0x0F, done when the first requested packet arrives
 //   Reset / EngineStop  sent, nothing to read; a reset then re-reads the device; the stop
-//                  goes ahead of the device's queue and never expires
+//                  is not queued at all: out at once, to where the unit is when it is sent
+//                  (DeviceSession::send_urgent), and never expires
 //   EngineStart    its frame only: the start is verified by the generator speed, a run of
 //                  its own (engine_start.hpp), not by one answer
 //
 // Steps of a run, each one Request on the session (device_session.hpp):
-//   0  `frame` (behind the device's queue, with the command's expiry; ahead and without
-//      one when `urgent`)
+//   0  `frame` (behind the device's queue, with the command's expiry; when `urgent`, not
+//      queued: sent at once, with no expiry)
 //   1  the read-back get, ahead of the queue so nothing changes the value in between
 //   2  the read-back once more when step 1's answer fails the check: the protocol has no
 //      sequence numbers, so a late answer to an earlier get of the packet can come first
@@ -53,7 +54,7 @@ struct CommandPlan {
   std::string what = "command";           // names step 0 in failure reasons ("did not answer the get")
   std::optional<codec::PacketId> answer;  // the packet that answers `frame` (gets, 0x0F); none for sets
   bool idempotent = false;                // `frame` is a get: retried when the device is silent
-  bool urgent = false;                    // ahead of the device's queue, never expired (engine stop)
+  bool urgent = false;                    // sent at once, not queued, never expired (engine stop)
 
   struct ReadBack {
     codec::PacketId packet;

@@ -78,6 +78,9 @@ class BusWorker final : private transport::BusHandler {
 
   // Runs `fn` on the worker's thread at its next turn. Thread-safe.
   void post(std::function<void()> fn);
+  // As post(), ahead of the turn's frames and of all work posted with post(): an engine stop
+  // waits behind no other command (docs/safety.md H4). Thread-safe.
+  void post_urgent(std::function<void()> fn);
 
   // A PMU session moved from one address to another (after the move; worker thread). Also,
   // with from == to == first, a session expecting a recorded serial that read its unit at its
@@ -95,6 +98,9 @@ class BusWorker final : private transport::BusHandler {
   // Worker thread only (or before run()):
   // The session serving `address` now (a session that moved this turn included).
   DeviceSession* session(std::uint16_t address);
+  // The session of the unit that last left `address` for another, while no session serves
+  // `address`: where a stop addressed to a unit that just moved must go (interface.md 2.6).
+  DeviceSession* session_moved_from(std::uint16_t address);
   std::vector<std::uint16_t> addresses() const;
   // The battery (node) or MPPT (device id) session, or null.
   CanOpenSession* canopen_session(DeviceKind kind, std::uint16_t id);
@@ -142,6 +148,7 @@ class BusWorker final : private transport::BusHandler {
   std::map<std::uint16_t, std::unique_ptr<DeviceSession>> sessions_;
   std::map<std::pair<DeviceKind, std::uint16_t>, std::unique_ptr<CanOpenSession>> canopen_;
   std::map<std::uint16_t, std::chrono::steady_clock::time_point> asked_;  // stranger -> next serial get allowed
+  std::map<std::uint16_t, std::uint16_t> left_;  // an address a unit moved away from -> where it is now
   std::function<void(const Moved&)> moved_;
   AlarmFeed bus_alarms_;
 

@@ -78,8 +78,25 @@ class DeviceSession {
 
   // Queues a request behind those already waiting.
   void submit(Request request, SteadyTime now);
-  // Queues a request ahead of everything waiting (ENGINE_STOP must not wait behind a queue).
+  // Queues a request ahead of everything waiting (a read-back, an engine start's speed poll).
   void submit_front(Request request, SteadyTime now);
+
+  // Sends `frame`, a frame for this unit that nothing answers (an engine stop), at once: not
+  // queued, neither behind the requests waiting nor behind the one in flight, which goes on
+  // waiting for its answer (docs/safety.md H4). It goes to the address the unit is at now,
+  // whatever address `frame` names; while an address change of ours is under way (alias),
+  // to both addresses, as the unit answers at one of them (interface.md 2.6).
+  struct UrgentSent {
+    transport::SendResult result;          // the first refusal, else Sent
+    std::vector<std::uint16_t> addresses;  // where it went, this unit's address first
+  };
+  UrgentSent send_urgent(const codec::CanFrame& frame, SteadyTime now);
+  // An engine stop sent after the unit was last heard at its address may never have reached
+  // it: the unit may have moved by itself (interface.md 2.6). Found at a new address within
+  // this time of that stop, it is sent the stop again there (docs/safety.md H4, H5): longer
+  // than the longest cranking time (25.5 s, v1.9 5.16) plus the time to find a moved unit
+  // with the default settings (3 periods of silence, then its serial).
+  static constexpr std::chrono::seconds kStopFollowsFor{30};
   // Reads identity and every stored value again (after a reset).
   void reread(SteadyTime now) { start_reading(now); }
 
@@ -157,6 +174,7 @@ class DeviceSession {
   static constexpr int kReadingTag = 1;
   static constexpr int kPollTag = 2;
 
+  transport::SendResult send_one(const codec::CanFrame& frame);  // counted in the health when sent
   void start_reading(SteadyTime now);
   void on_reading_done(const RequestOutcome& outcome, std::uint64_t round);
   void configure_streaming();
@@ -192,6 +210,8 @@ class DeviceSession {
   };
   std::vector<Timer> timers_;  // at(); run by tick()
   std::optional<EngineStartInProgress> engine_start_;
+  std::optional<SteadyTime> last_heard_;  // the last frame from the unit's address (or alias)
+  std::optional<SteadyTime> last_stop_;   // the last engine stop sent to it (send_urgent)
 
   AlarmFeed alarms_;
   // What the alarms derived from more than one packet last heard; forgotten at OFFLINE.

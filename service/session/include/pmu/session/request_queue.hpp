@@ -80,6 +80,11 @@ class RequestQueue {
 
   // Forgets the waiting requests with `tag` without ending them (their round is over).
   void drop(int tag);
+  // The device answers at `to` now, no longer at `from`: every request waiting or in flight
+  // whose frame goes to `from` goes to `to` from its next send on. They were made for this
+  // device, and a frame to the address it left reaches nothing, or another unit
+  // (interface.md 2.6; docs/safety.md H4, H10).
+  void readdress(std::uint16_t from, std::uint16_t to);
   // A request with `tag` waits (the one in flight does not count).
   bool waiting(int tag) const noexcept;
   // Waiting plus in flight.
