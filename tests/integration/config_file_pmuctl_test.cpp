@@ -1,18 +1,25 @@
 // A PMU's configuration as a file, as an operator uses it (docs/interface.md 3.2, 4.6):
 // pmuctl config snapshot, diff and apply against pmu-service on the built-in simulator, with
 // one simulated PMU for each firmware the documents describe.
+#include <fcntl.h>
 #include <gtest/gtest.h>
+#include <sys/stat.h>
+#include <sys/wait.h>
+#include <unistd.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <fstream>
 #include <regex>
 #include <sstream>
+#include <stdexcept>
 #include <string>
 
 #include "support/configured_service.hpp"
 #include "support/domain.hpp"
 #include "support/json_lines.hpp"
 #include "support/process.hpp"
+#include "support/wait.hpp"
 
 // A namespace of its own: the unity builds put this file in one translation unit with the
 // other integration tests, whose helpers have the same names.
@@ -53,6 +60,57 @@ class Files {
  private:
   std::string dir_;
 };
+
+// A FIFO a child writes its stderr to, kept full until the test reads it: the child's first
+// line on stderr stops it right there. pmuctl's apply writes its first line once its first
+// change is made, under its hold, so a test can act while an apply holds a PMU mid-way.
+class StderrGate {
+ public:
+  explicit StderrGate(const std::string& path) : path_(path) {
+    if (::mkfifo(path.c_str(), 0600) != 0) throw std::runtime_error("mkfifo " + path);
+    read_ = ::open(path.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC);
+    const int w = ::open(path.c_str(), O_WRONLY | O_NONBLOCK | O_CLOEXEC);
+    if (read_ < 0 || w < 0) throw std::runtime_error("open " + path);
+    const std::string page(4096, '.');
+    for (ssize_t n; (n = ::write(w, page.data(), page.size())) > 0;) filler_ += static_cast<std::size_t>(n);
+    for (ssize_t n; (n = ::write(w, ".", 1)) > 0;) filler_ += static_cast<std::size_t>(n);
+    ::close(w);
+  }
+  ~StderrGate() { ::close(read_); }
+  StderrGate(const StderrGate&) = delete;
+  StderrGate& operator=(const StderrGate&) = delete;
+
+  const std::string& path() const { return path_; }
+  // Takes what is in the FIFO without waiting; the child goes on once there is room.
+  void drain() {
+    char buf[4096];
+    for (ssize_t n; (n = ::read(read_, buf, sizeof buf)) > 0;) {
+      std::size_t skip = std::min(filler_, static_cast<std::size_t>(n));
+      filler_ -= skip;
+      text_.append(buf + skip, static_cast<std::size_t>(n) - skip);
+    }
+  }
+  const std::string& text() const { return text_; }
+
+ private:
+  std::string path_;
+  int read_ = -1;
+  std::size_t filler_ = 0;
+  std::string text_;
+};
+
+// Lets `child` (stopped on `gate`) go on to its end; its exit status, -1 when it did not exit.
+int run_to_end(pmu::test::Child& child, StderrGate& gate) {
+  const bool ended = pmu::test::wait_until(
+      [&] {
+        gate.drain();
+        return !child.running();
+      },
+      std::chrono::seconds(120));
+  gate.drain();
+  if (!ended || !child.status() || !WIFEXITED(*child.status())) return -1;
+  return WEXITSTATUS(*child.status());
+}
 
 std::size_t count_of(const std::string& text, const std::string& what) {
   std::size_t n = 0;
@@ -171,6 +229,95 @@ TEST(ConfigFilesOverDds, AFailedChangeRestoresWhatWasApplied) {
   EXPECT_EQ(j["restored"].size(), 1u);
   EXPECT_EQ(j["exit_status"], 1);
   EXPECT_EQ(pmu::test::run_capture(p + "config diff " + factory).status, 0) << "the device is as it was";
+}
+
+// Two applies at once (docs/safety.md H11): the first holds the PMU from its first command to
+// its last. The second, run while the first is stopped mid-way with a change made, is refused
+// with the holder named and changes nothing; the first goes on to its end, and the PMU holds
+// exactly the first file's values.
+TEST(ConfigFilesOverDds, TwoAppliesAtOnceTheSecondIsRefusedNamingTheHolder) {
+  const std::string domain = std::to_string(pmu::test::exclusive_dds_domain());
+  pmu::test::ConfiguredService service(PMU_SERVICE_PATH, config(domain));
+  const std::string p = std::string(PMUCTL_PATH) + " --domain " + domain + " --bus sim --address 17 ";
+  Files files;
+  ASSERT_EQ(pmu::test::run_capture(p + "--timeout 30 config get can_address").status, 0) << service.describe();
+  const std::string first = files.write(
+      "first.yaml", "parameters:\n  avionics_voltage: 22.0\n  payload_voltage: 13.5\n  cranking_time: 3.5\n");
+  const std::string second = files.write(
+      "second.yaml", "parameters:\n  avionics_voltage: 20.0\n  payload_voltage: 15.0\n  cranking_time: 4.0\n");
+
+  StderrGate gate(files.path("first.stderr"));
+  pmu::test::ChildOptions stopped;
+  stopped.stderr_path = gate.path();
+  stopped.stdout_path = files.path("first.stdout");
+  pmu::test::Child a({PMUCTL_PATH, "--domain", domain, "--bus", "sim", "--address", "17", "--timeout", "60", "config",
+                      "apply", first},
+                     stopped);
+  // Its first change (cranking_time, section 4.6's order) is made; it stops at its line.
+  const std::regex changed(R"(set_parameter cranking_time=3.5 to sim/17[^\n]* -> COMPLETED)");
+  ASSERT_TRUE(pmu::test::wait_until([&] { return std::regex_search(service.describe(), changed); },
+                                    std::chrono::seconds(60)))
+      << service.describe();
+
+  const auto b = pmu::test::run_capture(p + "--timeout 20 config apply " + second + " 2>&1");
+  EXPECT_EQ(b.status, 1) << b.out;
+  EXPECT_NE(b.out.find(second + " not applied: reading "), std::string::npos) << b.out;
+  EXPECT_NE(b.out.find("DENIED: configuration of sim/17 held by an apply from "), std::string::npos) << b.out;
+  // The holder's request id, pmuctl-HOST-PID-NANOSECONDS#N: the first apply's process.
+  EXPECT_TRUE(std::regex_search(b.out, std::regex("\\(request id pmuctl-[^ ]*-" + std::to_string(a.pid()) +
+                                                  "-[0-9]+#1\\) for another [0-9.]+ s")))
+      << b.out;
+  EXPECT_NE(b.out.find("; nothing was changed"), std::string::npos) << b.out;
+  EXPECT_EQ(b.out.find("-> 20.0 V"), std::string::npos) << "the second apply changed something";
+
+  EXPECT_EQ(run_to_end(a, gate), 0) << gate.text() << service.describe();
+  EXPECT_NE(gate.text().find("3 change(s) applied; it matches " + first), std::string::npos) << gate.text();
+  EXPECT_EQ(pmu::test::run_capture(p + "config diff " + first).status, 0) << "exactly the first file's values";
+  EXPECT_EQ(pmu::test::run_capture(p + "config diff " + second).status, 1);
+}
+
+// A restore puts back only what the apply changed (docs/safety.md H11): a setting another
+// writer changed after the apply did (here once the hold of an apply stopped mid-way ran out
+// by itself) keeps that writer's value, reported and not counted as restored.
+TEST(ConfigFilesOverDds, ARestoreLeavesWhatAnotherWriterChangedMeanwhile) {
+  const std::string domain = std::to_string(pmu::test::exclusive_dds_domain());
+  pmu::test::ConfiguredService service(PMU_SERVICE_PATH, config(domain));
+  const std::string p = std::string(PMUCTL_PATH) + " --domain " + domain + " --bus sim --address 20 ";
+  Files files;
+  ASSERT_EQ(pmu::test::run_capture(p + "--timeout 30 config get can_address").status, 0) << service.describe();
+  // Applied in the order temperature_offset, cranking_time (this unit does not take it).
+  const std::string file =
+      files.write("bad-memory.yaml", "parameters:\n  cranking_time: 3.5\n  temperature_offset: 100\n");
+  StderrGate gate(files.path("apply.stderr"));
+  pmu::test::ChildOptions stopped;
+  stopped.stderr_path = gate.path();
+  stopped.stdout_path = files.path("apply.stdout");
+  pmu::test::Child a({PMUCTL_PATH, "--domain", domain, "--bus", "sim", "--address", "20", "--timeout", "10", "config",
+                      "apply", file},
+                     stopped);
+  const std::regex changed(R"(set_parameter temperature_offset=100 to sim/20[^\n]* -> COMPLETED)");
+  ASSERT_TRUE(pmu::test::wait_until([&] { return std::regex_search(service.describe(), changed); },
+                                    std::chrono::seconds(60)))
+      << service.describe();
+  // The hold ends 10 s after the apply's latest command; until then the set is DENIED.
+  ASSERT_TRUE(pmu::test::wait_until(
+      [&] { return pmu::test::run_capture(p + "config set temperature_offset 90").status == 0; },
+      std::chrono::seconds(60), std::chrono::milliseconds(200)))
+      << service.describe();
+
+  EXPECT_EQ(run_to_end(a, gate), 1) << gate.text() << service.describe();
+  const std::string& out = gate.text();
+  EXPECT_NE(out.find("cranking_time 5.0 s -> 3.5 s: FAILED"), std::string::npos) << out;
+  EXPECT_NE(out.find("temperature_offset NOT RESTORED: the device holds 90, not the 100 this apply set: another "
+                     "writer changed it since; left as it is"),
+            std::string::npos)
+      << out;
+  EXPECT_EQ(out.find("restored temperature_offset"), std::string::npos) << out;
+  EXPECT_NE(out.find("0 of 1 applied change(s) restored; 1 changed by another writer since, left as they are"),
+            std::string::npos)
+      << out;
+  const std::string theirs = files.write("theirs.yaml", "parameters:\n  temperature_offset: 90\n");
+  EXPECT_EQ(pmu::test::run_capture(p + "config diff " + theirs).status, 0) << "the other writer's value stays";
 }
 
 // A bad file is exit 2 with FILE:LINE and no frame; a file for a newer firmware is refused for

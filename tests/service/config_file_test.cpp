@@ -273,5 +273,23 @@ TEST(ApplyPlan, EachChangeIsTheCommandThatSetsIt) {
   EXPECT_EQ(p.raw, 45u);
 }
 
+// A restore puts back only what the apply changed (docs/safety.md H11): a change whose value
+// the device no longer holds was someone else's since, and is left as it is.
+TEST(ApplyPlan, AnUndoRestoresOnlyWhereTheDeviceStillHoldsTheAppliedValue) {
+  const Change c{Setting::AvionicsVoltage, 120, 220, 3, std::nullopt};
+  struct Case {
+    const char* what;
+    std::optional<std::uint32_t> device_now;
+    Undo undo;
+  };
+  const Case cases[] = {
+      {"still the applied value", 220u, Undo::Restore},
+      {"another writer's value", 180u, Undo::ChangedByAnother},
+      {"put back by another writer already", 120u, Undo::ChangedByAnother},
+      {"not read", std::nullopt, Undo::NotRead},
+  };
+  for (const auto& k : cases) EXPECT_EQ(undo_of(c, k.device_now), k.undo) << k.what;
+}
+
 }  // namespace
 }  // namespace pmu::baseline

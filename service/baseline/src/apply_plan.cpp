@@ -31,6 +31,11 @@ service::CommandAction action_for(Setting setting, std::uint32_t raw) {
   return service::action::SetParameter{*parameter_of(setting), raw};
 }
 
+Undo undo_of(const Change& c, std::optional<std::uint32_t> device_now) noexcept {
+  if (!device_now) return Undo::NotRead;
+  return *device_now == c.to ? Undo::Restore : Undo::ChangedByAnother;
+}
+
 std::vector<Change> apply_plan(const std::vector<Difference>& diffs, const service::DeviceUse& device) {
   std::vector<Change> out;
   for (const auto& d : diffs) {

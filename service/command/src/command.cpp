@@ -91,6 +91,21 @@ codec::Result<CommandAction, std::string> parse_action(CommandKind kind, const C
   return Reject{std::string("unknown command kind")};
 }
 
+// The hold bits of `groups` for a kind that may hold (the header says why there).
+codec::Result<std::optional<ConfigHold>, std::string> parse_hold(const CommandSample& s) {
+  const bool hold = (s.groups & hold_bit::Hold) != 0;
+  const bool release = (s.groups & hold_bit::Release) != 0;
+  if (!hold) {
+    if (release) return Reject{std::string("groups bit 0x40 (release a hold) needs bit 0x80 (hold)")};
+    return std::optional<ConfigHold>{};
+  }
+  const auto mark = s.request_id.rfind('#');
+  if (mark == std::string::npos || mark == 0 || mark + 1 == s.request_id.size())
+    return Reject{"a command that holds the configuration (groups bit 0x80) has a request id APPLY#N, not " +
+                  quoted(s.request_id)};
+  return std::optional<ConfigHold>{ConfigHold{s.request_id.substr(0, mark), release}};
+}
+
 codec::Result<bool, std::string> within(const std::string& text, std::size_t max, const char* field) {
   if (text.size() <= max) return true;
   return Reject{std::string(field) + " is " + std::to_string(text.size()) + " bytes long; at most " +
@@ -112,6 +127,13 @@ codec::Result<std::chrono::steady_clock::time_point, std::string> deadline(std::
   return now.steady + std::chrono::duration_cast<std::chrono::steady_clock::duration>(ahead);
 }
 
+
+bool changes_configuration(CommandKind k) noexcept {
+  return k == CommandKind::SetParameter || k == CommandKind::SetOutputs || k == CommandKind::EnableOutputs ||
+         k == CommandKind::DisableOutputs || k == CommandKind::SetGeneration || k == CommandKind::Reset;
+}
+
+bool may_hold(CommandKind k) noexcept { return k == CommandKind::Get || changes_configuration(k); }
 
 std::string_view to_string(CommandKind k) noexcept { return kKindNames[static_cast<std::size_t>(k)]; }
 
@@ -195,6 +217,12 @@ codec::Result<CommandRequest, std::string> parse_command(const CommandSample& s,
   if (!expires) return Reject{expires.error()};
   auto act = parse_action(kind, s, *enable);
   if (!act) return Reject{act.error()};
+  std::optional<ConfigHold> hold;
+  if (may_hold(kind)) {
+    auto h = parse_hold(s);
+    if (!h) return Reject{h.error()};
+    hold = std::move(*h);
+  }
 
   CommandRequest r;
   r.request_id = s.request_id;
@@ -205,6 +233,7 @@ codec::Result<CommandRequest, std::string> parse_command(const CommandSample& s,
   r.action = *act;
   r.expires = *expires;
   r.confirm = *confirm;
+  r.hold = std::move(hold);
   return r;
 }
 
@@ -243,6 +272,7 @@ std::string describe(const CommandRequest& r) {
            ? " to every PMU on every bus" + (r.vehicle.empty() ? std::string() : " of " + printable(r.vehicle))
            : " to " + device_path(r.vehicle, r.bus, r.address);
   if (r.confirm) s += " (confirmed)";
+  if (r.hold) s += r.hold->release ? " (apply's last: releases its hold)" : " (under an apply's hold)";
   return s;
 }
 

@@ -196,6 +196,7 @@ void CommandService::run_on_worker(BusWorker& worker, const CommandRequest& r) {
   if (!session && r.kind() == CommandKind::EngineStop) session = worker.session_moved_from(r.address);
   if (auto no = check_device(worker, session, r)) return refuse(r, *no);
   if (auto no = judge(r, device_use(*session, clock_.steady_now()))) return refuse(r, *no);
+  if (auto no = check_hold(r)) return refuse(r, *no);
   execute_command(*session, r, clock_.steady_now(), timeouts_,
                   [this, key = sender_key(r.sender, r.request_id), sender = r.sender,
                    what = describe(r)](const CommandReplyData& d) { finish(key, sender, what, d); });
@@ -244,6 +245,16 @@ void CommandService::broadcast_on_every_bus(const CommandRequest& r) {
       answer(r, CommandResult::Failed,
              "bus refused the engine stop: " + failed + (done.empty() ? std::string() : "; sent on " + done));
     });
+}
+
+std::optional<CommandService::Refusal> CommandService::check_hold(const CommandRequest& r) {
+  std::optional<std::string> held;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    held = holds_.admit(r, clock_.steady_now());
+  }
+  if (!held) return std::nullopt;
+  return Refusal{CommandResult::Denied, std::move(*held)};
 }
 
 std::optional<CommandService::Refusal> CommandService::check_device(BusWorker& worker, const DeviceSession* session,

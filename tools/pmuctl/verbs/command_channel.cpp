@@ -194,7 +194,7 @@ CommandChannel::Outcome CommandChannel::send(const CommandSpec& spec, const std:
   const auto deadline = Clock::now() + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(timeout));
   pmu::v4::Command c;
   Outcome out;
-  out.request_id = request_id();
+  out.request_id = spec.request_id.empty() ? request_id() : spec.request_id;
   c.request_id(out.request_id);
   c.vehicle(vehicle_);
   c.bus(bus);

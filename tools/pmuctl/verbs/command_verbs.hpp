@@ -19,6 +19,7 @@ struct CommandSpec {
   bool enable = false;
   std::uint8_t groups = 0;
   bool confirm = false;
+  std::string request_id;  // empty: a new one (request_id()); an apply names its commands APPLY#N
 };
 
 int run_command(const GlobalOptions& o, const CommandSpec& spec);

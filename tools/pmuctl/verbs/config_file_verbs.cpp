@@ -297,6 +297,73 @@ bool completed(const CommandChannel::Outcome& out) {
   return out.written && out.reply && out.reply->result() == pmu::v4::COMPLETED;
 }
 
+// A GET of one setting, under the name `config get` takes.
+CommandSpec read_spec(Setting s) {
+  CommandSpec spec;
+  spec.kind = pmu::v4::GET;
+  spec.parameter = std::string(baseline::setting_name(s));
+  return spec;
+}
+
+// The raw value a GET of `s` read, from the reply's value in its unit (a mask or 0/1 for
+// the switched states); nullopt when it read nothing.
+std::optional<std::uint32_t> raw_value(Setting s, const CommandChannel::Outcome& out) {
+  if (!completed(out) || !out.reply->has_value()) return std::nullopt;
+  const auto p = baseline::parameter_of(s);
+  const double raw = p ? out.reply->value() * codec::spec_of(*p).divisor : out.reply->value();
+  if (!std::isfinite(raw) || raw < 0 || raw > 65535) return std::nullopt;
+  return static_cast<std::uint32_t>(std::llround(raw));
+}
+
+// The commands of one apply (interface.md 2.8, docs/safety.md H11): each holds the device's
+// configuration for this apply (groups bit 0x80, request ids APPLY#N, APPLY a request id of
+// its own: "pmuctl-HOST-PID-NANOSECONDS", so a refusal names the holder's host and process),
+// so another writer's change cannot land between them; the last gives the hold back. A
+// service that knows no hold ignores the bits.
+class HeldCommands {
+ public:
+  HeldCommands(CommandChannel& channel, std::string bus, double timeout)
+      : channel_(channel), bus_(std::move(bus)), timeout_(timeout), apply_(request_id()) {}
+
+  CommandChannel::Outcome send(CommandSpec spec, std::uint16_t address) {
+    return send_with(std::move(spec), address, service::hold_bit::Hold);
+  }
+  // The apply's last command: a read of the outputs that releases the hold. Without its
+  // reply the hold ends by itself at the expiry of the apply's latest command.
+  void release(std::uint16_t address) {
+    (void)send_with(read_spec(Setting::Outputs), address, service::hold_bit::Hold | service::hold_bit::Release);
+  }
+
+ private:
+  CommandChannel::Outcome send_with(CommandSpec spec, std::uint16_t address, std::uint8_t bits) {
+    spec.groups = bits;
+    spec.request_id = apply_ + "#" + std::to_string(++sent_);
+    return channel_.send(spec, bus_, address, timeout_);
+  }
+
+  CommandChannel& channel_;
+  std::string bus_;
+  double timeout_;
+  std::string apply_;
+  unsigned sent_ = 0;
+};
+
+// The plan's changes that need --confirm and do not have it, one message each.
+std::vector<std::string> unconfirmed_in(const std::vector<baseline::Change>& plan, const std::string& file,
+                                        bool confirm) {
+  std::vector<std::string> out;
+  for (const auto& c : plan)
+    if (c.confirm && !confirm)
+      out.push_back(file + ":" + std::to_string(c.line) + ": " + std::string(baseline::setting_name(c.setting)) + " " +
+                    baseline::value_text(c.setting, c.to) + " " + std::string(service::rule_why(*c.confirm)) +
+                    ": it needs --confirm (rule " + std::string(service::to_string(*c.confirm)) + ")");
+  return out;
+}
+int refuse_unconfirmed(const GlobalOptions& o, const std::vector<std::string>& unconfirmed, const char* nothing) {
+  for (std::size_t i = 0; i + 1 < unconfirmed.size(); ++i) std::fprintf(stderr, "pmuctl: %s\n", unconfirmed[i].c_str());
+  return fail(o, ExitStatus::BadUsage, unconfirmed.back() + "; " + nothing);
+}
+
 }  // namespace
 
 int snapshot(const GlobalOptions& o, const std::string& file, bool force) {
@@ -460,23 +527,25 @@ int apply(const GlobalOptions& o, const std::string& file, bool dry_run, bool co
                 file + ":" + std::to_string(f->serial_line) + ": the file was read from serial " +
                     std::to_string(*f->header.serial) + ", and " + label + " is serial " + std::to_string(serial) +
                     ": another unit; nothing was sent (--other-unit applies it to this unit)");
-  const auto plan = baseline::apply_plan(baseline::differences(settings_of(*device.config(bus, address)), *f));
+  // Judged first on the configuration the service publishes: a file with nothing to change,
+  // or with a change that lacks --confirm, sends nothing at all.
+  const auto seen = baseline::apply_plan(baseline::differences(settings_of(*device.config(bus, address)), *f));
   // The service refuses a can_address another PMU it serves has (interface.md 2.6); judged
   // here too, so that the dry run says what the apply would meet and the apply sends nothing.
-  for (const auto& c : plan)
+  for (const auto& c : seen)
     if (c.setting == Setting::CanAddress && c.to != address &&
         device.pmu_served(bus, static_cast<std::uint16_t>(c.to), address, deadline_after(timeout)))
       return fail(o, ExitStatus::BadUsage,
                   file + ":" + std::to_string(c.line) + ": can_address " + std::to_string(c.to) + ": address " +
                       std::to_string(c.to) + " is already in use on " + bus + " (a PMU the service serves); " +
                       "nothing was sent");
-  if (plan.empty()) {
+  if (seen.empty()) {
     std::fprintf(stderr, "%s already matches %s: nothing to apply\n", label.c_str(), file.c_str());
     return 0;
   }
   if (dry_run) {
-    for (std::size_t i = 0; i < plan.size(); ++i) {
-      const auto& c = plan[i];
+    for (std::size_t i = 0; i < seen.size(); ++i) {
+      const auto& c = seen[i];
       const std::string rule =
           c.confirm ? " (needs --confirm: " + std::string(service::to_string(*c.confirm)) + ")" : std::string();
       std::printf("%zu. %s:%d: %s: %s -> %s%s\n", i + 1, file.c_str(), c.line,
@@ -485,19 +554,39 @@ int apply(const GlobalOptions& o, const std::string& file, bool dry_run, bool co
                   rule.c_str());
     }
     std::fprintf(stderr, "%s: %zu change(s) to apply from %s; nothing was sent (--dry-run)\n", label.c_str(),
-                 plan.size(), file.c_str());
+                 seen.size(), file.c_str());
     return 0;
   }
-  std::vector<std::string> unconfirmed;
-  for (const auto& c : plan)
-    if (c.confirm && !confirm)
-      unconfirmed.push_back(file + ":" + std::to_string(c.line) + ": " + std::string(baseline::setting_name(c.setting)) +
-                            " " + baseline::value_text(c.setting, c.to) + " " +
-                            std::string(service::rule_why(*c.confirm)) + ": it needs --confirm (rule " +
-                            std::string(service::to_string(*c.confirm)) + ")");
-  if (!unconfirmed.empty()) {
-    for (std::size_t i = 0; i + 1 < unconfirmed.size(); ++i) std::fprintf(stderr, "pmuctl: %s\n", unconfirmed[i].c_str());
-    return fail(o, ExitStatus::BadUsage, unconfirmed.back() + "; nothing was sent");
+  if (const auto unconfirmed = unconfirmed_in(seen, file, confirm); !unconfirmed.empty())
+    return refuse_unconfirmed(o, unconfirmed, "nothing was sent");
+
+  // Then under the apply's hold (interface.md 2.8, docs/safety.md H11), from the device
+  // itself: pmu/config may not yet show another writer's last change, and each change's
+  // undo must know the value it replaces. A hold another apply has is refused here, before
+  // anything changed.
+  HeldCommands held(channel, bus, timeout);
+  baseline::Settings read;
+  for (std::size_t i = 0; i < baseline::kSettingCount; ++i) {
+    const auto s = static_cast<Setting>(i);
+    if (!f->settings[s]) continue;
+    const auto out = held.send(read_spec(s), address);
+    read[s] = raw_value(s, out);
+    if (read[s]) continue;
+    const bool denied = out.reply && out.reply->result() == pmu::v4::DENIED;
+    if (!denied) held.release(address);
+    return fail(o, ExitStatus::NotDone,
+                label + ": " + file + " not applied: reading " + std::string(baseline::setting_name(s)) + ": " +
+                    outcome_text(out, timeout) + "; nothing was changed");
+  }
+  const auto plan = baseline::apply_plan(baseline::differences(read, *f));
+  if (plan.empty()) {
+    held.release(address);
+    std::fprintf(stderr, "%s already matches %s: nothing to apply\n", label.c_str(), file.c_str());
+    return 0;
+  }
+  if (const auto unconfirmed = unconfirmed_in(plan, file, confirm); !unconfirmed.empty()) {
+    held.release(address);
+    return refuse_unconfirmed(o, unconfirmed, "nothing was changed");
   }
 
   Json changes = Json::array();
@@ -505,7 +594,7 @@ int apply(const GlobalOptions& o, const std::string& file, bool dry_run, bool co
   std::string failure;
   std::uint16_t at = address;  // the unit's address now: can_address, applied last, moves it
   for (const auto& c : plan) {
-    const auto out = channel.send(command_for(c.setting, c.to, confirm && c.confirm), bus, at, timeout);
+    const auto out = held.send(command_for(c.setting, c.to, confirm && c.confirm), at);
     const std::string result = outcome_text(out, timeout);
     // One line per change, like the service's audit line for the command.
     std::fprintf(stderr, "%s: %s %s -> %s: %s\n", label.c_str(), std::string(baseline::setting_name(c.setting)).c_str(),
@@ -524,25 +613,48 @@ int apply(const GlobalOptions& o, const std::string& file, bool dry_run, bool co
   }
 
   if (!failure.empty()) {
-    // Undo, newest first, to the values read before: the device goes back to the state it
-    // was in, so each restore is sent confirmed.
+    // Undo, newest first, what this apply changed and nothing else: each setting goes back to
+    // the value it replaced only while the device still holds the value the apply set
+    // (compare, then set, under the hold: docs/safety.md H11). A value someone else wrote
+    // since is theirs and stays. Each restore is sent confirmed: it returns the device to a
+    // state it was in.
     Json restored = Json::array();
-    std::size_t ok = 0;
+    std::size_t ok = 0, others = 0;
     for (auto it = applied.rbegin(); it != applied.rend(); ++it) {
       const auto& c = **it;
-      const auto out = channel.send(command_for(c.setting, c.from, true), bus, at, timeout);
-      const std::string result = outcome_text(out, timeout);
-      std::fprintf(stderr, "%s: restored %s to %s: %s\n", label.c_str(), std::string(baseline::setting_name(c.setting)).c_str(),
-                   baseline::value_text(c.setting, c.from).c_str(), result.c_str());
-      restored.push_back({{"name", std::string(baseline::setting_name(c.setting))},
-                          {"to", baseline::value_text(c.setting, c.from)},
-                          {"result", result}});
-      if (completed(out)) ++ok;
-      if (c.setting == Setting::CanAddress && completed(out)) at = static_cast<std::uint16_t>(c.from);
+      const std::string name(baseline::setting_name(c.setting));
+      const auto now_out = held.send(read_spec(c.setting), at);
+      const auto now = raw_value(c.setting, now_out);
+      std::string result;
+      switch (baseline::undo_of(c, now)) {
+        case baseline::Undo::Restore: {
+          const auto out = held.send(command_for(c.setting, c.from, true), at);
+          result = outcome_text(out, timeout);
+          std::fprintf(stderr, "%s: restored %s to %s: %s\n", label.c_str(), name.c_str(),
+                       baseline::value_text(c.setting, c.from).c_str(), result.c_str());
+          if (completed(out)) ++ok;
+          if (c.setting == Setting::CanAddress && completed(out)) at = static_cast<std::uint16_t>(c.from);
+          break;
+        }
+        case baseline::Undo::ChangedByAnother:
+          ++others;
+          result = "NOT RESTORED: the device holds " + baseline::value_text(c.setting, *now) + ", not the " +
+                   baseline::value_text(c.setting, c.to) + " this apply set: another writer changed it since";
+          std::fprintf(stderr, "%s: %s %s; left as it is\n", label.c_str(), name.c_str(), result.c_str());
+          break;
+        case baseline::Undo::NotRead:
+          result = "NOT RESTORED: its value could not be read (" + outcome_text(now_out, timeout) + ")";
+          std::fprintf(stderr, "%s: %s %s; left as it is\n", label.c_str(), name.c_str(), result.c_str());
+          break;
+      }
+      restored.push_back({{"name", name}, {"to", baseline::value_text(c.setting, c.from)}, {"result", result}});
     }
-    const std::string summary = "apply stopped at " + failure + "; " + std::to_string(ok) + " of " +
-                                std::to_string(applied.size()) + " applied change(s) restored" +
-                                (ok == applied.size() ? "" : ": THE DEVICE IS PARTLY CHANGED, see the lines above");
+    held.release(at);
+    const std::string summary =
+        "apply stopped at " + failure + "; " + std::to_string(ok) + " of " + std::to_string(applied.size()) +
+        " applied change(s) restored" +
+        (others ? "; " + std::to_string(others) + " changed by another writer since, left as they are" : "") +
+        (ok == applied.size() ? "" : ": THE DEVICE IS PARTLY CHANGED, see the lines above");
     std::fprintf(stderr, "%s: %s\n", label.c_str(), summary.c_str());
     if (o.json) {
       Json j{{"vehicle", channel.vehicle()}, {"bus", bus},          {"address", address}, {"file", file},
@@ -552,6 +664,7 @@ int apply(const GlobalOptions& o, const std::string& file, bool dry_run, bool co
     }
     return static_cast<int>(ExitStatus::NotDone);
   }
+  held.release(at);
 
   // Each change was read back by the service; the final diff is the file against the whole
   // configuration as the service now publishes it (at the unit's address now).

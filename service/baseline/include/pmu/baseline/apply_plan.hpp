@@ -1,7 +1,8 @@
 #pragma once
 // How a configuration file is applied to a device (interface.md 4.6): only what differs, one
 // command per setting, in an order that is safe, each judged by the confirm rules before
-// anything is sent. Undoing runs the applied changes backwards with their old values.
+// anything is sent. Undoing runs the applied changes backwards with their old values, each
+// only where the device still holds what the apply set (undo_of).
 //
 // The order, by what a change does to a flying aircraft:
 //   1. what acts only later or on faults: temperature_offset, upper_temperature_limit,
@@ -39,6 +40,15 @@ std::vector<Change> apply_plan(const std::vector<Difference>& diffs, const servi
 
 // The command that sets `setting` to `raw`.
 service::CommandAction action_for(Setting setting, std::uint32_t raw);
+
+// What undoing one applied change does, given the value the device holds when the undo
+// comes (docs/safety.md H11): a restore puts back only what the apply itself changed. The
+// device still holds `c.to`: set it back to `c.from`. It holds anything else: another writer
+// (a tool on the bus, the unit's panel, a client of a service that knows no hold) changed it
+// since, and that value is theirs: left as it is, and said. Not read: left as it is too,
+// since an undo that cannot be checked could overwrite someone else's value.
+enum class Undo { Restore, ChangedByAnother, NotRead };
+Undo undo_of(const Change& c, std::optional<std::uint32_t> device_now) noexcept;
 
 // Where `s` comes in the order above (0 first).
 int apply_rank(Setting s) noexcept;

@@ -115,6 +115,25 @@ using CommandAction =
                  action::Reset, action::GetSerial, action::GetFirmware>;
 static_assert(std::variant_size_v<CommandAction> == kCommandKindCount);
 
+// An apply's hold on a device's configuration (interface.md 2.8, docs/safety.md H11). It rides
+// in `groups`, which no kind but REQUEST_MEASUREMENTS reads, on bits outside its group mask
+// (so a request that has none of them means what it always meant), and names its apply in
+// the request id, `APPLY#N`: every command of one apply, whatever its kind, carries the same
+// APPLY. The service admits it in command_service.cpp (config_holds.hpp).
+namespace hold_bit {
+inline constexpr std::uint8_t Hold = 0x80;     // the command is one of an apply's: it takes or renews the hold
+inline constexpr std::uint8_t Release = 0x40;  // with Hold: the apply's last; the hold ends with it
+}  // namespace hold_bit
+struct ConfigHold {
+  std::string apply;  // the request id before its last '#'
+  bool release = false;
+};
+// The kinds a hold rides on: a GET, and every kind that changes a stored setting, an output
+// or generation. The others ignore the bits, so nothing can make an engine stop refused.
+bool may_hold(CommandKind k) noexcept;
+// The kinds another writer's hold refuses: they change what an apply sets.
+bool changes_configuration(CommandKind k) noexcept;
+
 struct CommandRequest {
   std::string request_id;
   std::string sender;
@@ -126,6 +145,7 @@ struct CommandRequest {
   CommandAction action;
   std::chrono::steady_clock::time_point expires;  // the first frame is not sent after this
   bool confirm = false;
+  std::optional<ConfigHold> hold;  // set only for a kind that may_hold()
 
   CommandKind kind() const noexcept { return static_cast<CommandKind>(action.index()); }
 };

@@ -11,6 +11,8 @@
 //     to a bus; the deny list and confirm rules judge a request on its bus worker's thread,
 //     after the device check, since the rules judged by effect read what the device reports
 //     now (policy.hpp's DeviceUse), which lives on that thread; a DENIED one sends nothing;
+//   * while an apply holds a device's configuration (interface.md 2.8), another writer's
+//     change to it is DENIED, naming the holder; a stop and a plain GET never are;
 //   * valid ones run on their bus worker's thread (command_executor.hpp), serialised per
 //     device by the device session, in parallel across devices and buses.
 // Replies are handed to `reply` outside the service's lock. Every command and its result is
@@ -39,6 +41,7 @@
 #include <vector>
 
 #include "pmu/command/command.hpp"
+#include "pmu/command/config_holds.hpp"
 #include "pmu/command/policy.hpp"
 #include "pmu/dispatch/command_executor.hpp"
 #include "pmu/session/bus_worker.hpp"
@@ -98,6 +101,9 @@ class CommandService {
   void stop_engine_starts(BusWorker& worker, const std::string& request_id);
   // Known, read (firmware known) and, for an address change, the new address free.
   std::optional<Refusal> check_device(BusWorker& worker, const DeviceSession* session, const CommandRequest& r);
+  // An apply's hold on the device (config_holds.hpp): checked on the worker's thread, in the
+  // order the device's commands are queued, so nothing admitted before a hold lands after it.
+  std::optional<Refusal> check_hold(const CommandRequest& r);
 
   // Records the final reply under `key`, logs it and publishes it (and the owed copies).
   void finish(const std::string& key, const std::string& sender, const std::string& what,
@@ -116,6 +122,7 @@ class CommandService {
   std::unordered_map<std::string, Entry> seen_;  // by sender_key(sender, request_id)
   std::deque<std::string> order_;                // oldest first, to bound seen_
   std::map<std::pair<std::string, std::uint16_t>, RateLimiter> limiters_;
+  ConfigHolds holds_;
   Counters counters_;
 };
 
