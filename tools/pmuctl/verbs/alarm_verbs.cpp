@@ -57,7 +57,7 @@ int run_alarms(const GlobalOptions& o) {
   pmu::dds::DdsContext& dds = *lease;
   DataReader& reader = dds.reader(
       dds.topic(topics::kAlarms, TypeSupport(new idl::Guarded<pmu::v4::AlarmPubSubType>())), qos_profiles::kAlarms);
-  const auto deadline = Clock::now() + std::chrono::duration<double>(o.timeout.value_or(3.0));
+  const auto deadline = wait_end(o, 3.0);
   // A service with no alarm that ever left NORMAL has nothing in its history, so the wait
   // cannot end on a sample: it ends once every service discovered has matched and nothing
   // new came for the quiet time (a matched writer sends what it holds at once).

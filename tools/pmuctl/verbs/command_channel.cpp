@@ -190,7 +190,7 @@ bool CommandChannel::recalled_target_gone(const Outcome& out, const std::string&
 }
 
 CommandChannel::Outcome CommandChannel::send(const CommandSpec& spec, const std::string& bus, std::uint16_t address,
-                                             double timeout) {
+                                             double timeout, std::uint64_t expires_at_ns) {
   const auto deadline = Clock::now() + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(timeout));
   pmu::v4::Command c;
   Outcome out;
@@ -205,7 +205,7 @@ CommandChannel::Outcome CommandChannel::send(const CommandSpec& spec, const std:
   c.outputs(spec.outputs);
   c.enable(spec.enable);
   c.groups(spec.groups);
-  c.expires_at(epoch_ns_after(timeout));
+  c.expires_at(expires_at_ns ? expires_at_ns : epoch_ns_after(timeout));
   c.confirm(spec.confirm);
   if (!writer_.write(&c)) {  // bool in Fast DDS 2.x
     out.written = false;
