@@ -300,6 +300,34 @@ TEST_F(PmuctlAgentWithUav1, AListMakesTheCommandWriterOfEachVehicleItShowed) {
       << "no command writer of uav1 after the list\n" << read_file(log);
 }
 
+// docs/safety.md H6: uav1's service stops answering (SIGSTOP: as killed, but it can be let go
+// at the end). The agent's workers still hold it, matched, until its DDS lease ends; a call
+// on its own never finds it. Each verb's answer through the agent is the answer of the
+// same call on its own: the same output and exit status, never an all-clear.
+TEST_F(PmuctlAgentWithUav1, ADeadServiceGetsTheAnswersOfACallOnItsOwn) {
+  const std::string p = uav1_calls();
+  ASSERT_TRUE(listed_through_agent(p)) << read_file(log) << uav1.describe();
+  const char* verbs[] = {"alarms", "--json alarms", "list", "energy", "preflight", "config snapshot -",
+                         "config get payload_voltage", "--json list"};
+  // Every verb once while the service answers, so the workers know its writers.
+  for (const char* verb : verbs) (void)sh(p + "--timeout 10 " + verb);
+
+  ASSERT_EQ(::kill(uav1.pid(), SIGSTOP), 0);
+  struct LetGo {
+    pid_t pid;
+    ~LetGo() { ::kill(pid, SIGCONT); }
+  } let_go{uav1.pid()};
+  for (const char* verb : verbs) {
+    SCOPED_TRACE(verb);
+    const auto through_agent = sh(p + "--timeout 2 " + std::string(verb));
+    const auto on_its_own = sh(p + "--no-agent --timeout 2 " + std::string(verb));
+    EXPECT_EQ(on_its_own.status, 3) << on_its_own.out;
+    EXPECT_EQ(through_agent.status, on_its_own.status) << through_agent.out << "\non its own:\n" << on_its_own.out;
+    EXPECT_EQ(through_agent.out, on_its_own.out);
+  }
+  EXPECT_EQ(read_file(log).find("--timeout 2 alarms: exit 0"), std::string::npos) << read_file(log);
+}
+
 // Agent workers use no Fast DDS shared-memory port: one a killed worker leaves behind, with
 // a reader slot nobody empties, would be given to its replacement, which then heard nothing
 // a service on this host sent it and said "no pmu-service" while uav1 ran (docs/safety.md H6).

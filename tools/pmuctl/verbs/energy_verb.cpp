@@ -99,6 +99,7 @@ int run(const GlobalOptions& o) {
   }
   if (pmu_figures.by_key.empty() && bms_figures.by_key.empty()) {
     if (matched(pmus) == 0 && matched(batteries) == 0) return no_service(o, dds);
+    if (pmu_figures.writers.empty() && bms_figures.writers.empty()) return nothing_heard(o);
     return fail(o, ExitStatus::BadUsage,
                 std::string("no energy figures from ") +
                     (o.address ? "PMU " + std::to_string(*o.address) : std::string("any PMU or battery")) +

@@ -99,6 +99,7 @@ int run_preflight(const GlobalOptions& o) {
     SubscriptionMatchedStatus st;
     reader.get_subscription_matched_status(st);
     if (st.current_count == 0) return no_service(o, dds);
+    if (writers.empty()) return nothing_heard(o);
     return fail(o, ExitStatus::NoAnswer,
                 "no readiness from " + (o.vehicle ? vehicle_text(*o.vehicle) : std::string("any vehicle")) +
                     " within the timeout");

@@ -192,6 +192,7 @@ int collect(const GlobalOptions& o, const pmu::dds::DdsContext& dds, Collector& 
   }
   if (!c.latest().empty()) return 0;
   if (!c.matched()) return no_service(o, dds);
+  if (c.writers_heard() == 0) return nothing_heard(o);
   return fail(o, ExitStatus::BadUsage, not_seen(o));
 }
 
