@@ -329,8 +329,9 @@ TEST_F(PmuctlAgentWithUav1, ADeadServiceGetsTheAnswersOfACallOnItsOwn) {
 }
 
 // Agent workers use no Fast DDS shared-memory port: one a killed worker leaves behind, with
-// a reader slot nobody empties, would be given to its replacement, which then heard nothing
-// a service on this host sent it and said "no pmu-service" while uav1 ran (docs/safety.md H6).
+// a reader slot nobody empties, would be given to its replacement, which would then hear
+// nothing a service on this host sends it and say "no pmu-service" while uav1 runs
+// (docs/safety.md H6).
 TEST_F(PmuctlAgentWithUav1, NoWorkerHoldsASharedMemoryPortAKilledOneWouldLeave) {
   ASSERT_TRUE(listed_through_agent(uav1_calls())) << read_file(log) << uav1.describe();
   const auto workers = workers_of(agent.pid());

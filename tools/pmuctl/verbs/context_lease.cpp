@@ -36,10 +36,10 @@ pmu::dds::DdsContext& ContextPool::context(const std::string& participant_name,
     try {
       // UDP alone, no shared memory: a worker killed (and replaced) leaves its shared-memory
       // port behind, with a reader slot nobody empties, and Fast DDS 2.9 gives a replacement
-      // that port again (the same participant id once the dead one's UDP port is free):
-      // whatever a service on this host sent it there never arrived, and the replacement
-      // answered "no pmu-service" while the service ran (docs/safety.md H6). The aircraft
-      // are on other hosts anyway.
+      // that port again (the same participant id once the dead one's UDP port is free): what
+      // a service on this host sends it there would never arrive, and the replacement would
+      // answer "no pmu-service" while the service runs (docs/safety.md H6). The aircraft are
+      // on other hosts anyway.
       slot = make_context(settings_, participant_name, partitions, pmu::dds::Transport::UdpOnly);
       // Command endpoints carry only a call's requests and the replies to them: left matched
       // in their vehicle's partitions, the next command to it finds them matched.
