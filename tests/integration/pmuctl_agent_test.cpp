@@ -2,11 +2,15 @@
 // caller's arguments, environment, directory, output and exit status; a command through it
 // is executed once; calls it must not serve (another domain, watch, --no-agent) run on their
 // own; one agent per socket, a stale socket is taken over, and an agent that ends during a
-// call leaves the caller with "no answer", never a second run.
+// call leaves the caller with "no answer", never a second run. An engine stop never waits
+// behind another call (docs/safety.md H4); a call whose caller left or whose wait ended
+// while it waited for a worker is never run (H9); a call trusts no agent another user could
+// have put on its socket path (H6).
 #include <gtest/gtest.h>
 #include <sys/stat.h>
 #include <sys/socket.h>
 #include <sys/un.h>
+#include <sys/wait.h>
 #include <unistd.h>
 
 #include <chrono>
@@ -64,11 +68,13 @@ class TempDir {
 };
 
 // An agent on `socket`, its log in `log`; started from the test's main thread.
-pmu::test::Child start_agent(int domain, const std::string& socket, const std::string& log) {
+pmu::test::Child start_agent(int domain, const std::string& socket, const std::string& log,
+                             const std::string& workers = "4") {
   pmu::test::ChildOptions o;
   o.stderr_path = log;
   o.stdout_path = log;
-  pmu::test::Child agent({PMUCTL_PATH, "--domain", std::to_string(domain), "agent", "--socket", socket}, o);
+  pmu::test::Child agent(
+      {PMUCTL_PATH, "--domain", std::to_string(domain), "agent", "--socket", socket, "--workers", workers}, o);
   return agent;
 }
 
@@ -294,6 +300,49 @@ TEST_F(PmuctlAgentWithUav1, AListMakesTheCommandWriterOfEachVehicleItShowed) {
       << "no command writer of uav1 after the list\n" << read_file(log);
 }
 
+// docs/safety.md H6: uav1's service stops answering (SIGSTOP: as killed, but it can be let go
+// at the end). The agent's workers still hold it, matched, until its DDS lease ends; a call
+// on its own never finds it. Each verb's answer through the agent is the answer of the
+// same call on its own: the same output and exit status, never an all-clear.
+TEST_F(PmuctlAgentWithUav1, ADeadServiceGetsTheAnswersOfACallOnItsOwn) {
+  const std::string p = uav1_calls();
+  ASSERT_TRUE(listed_through_agent(p)) << read_file(log) << uav1.describe();
+  const char* verbs[] = {"alarms", "--json alarms", "list", "energy", "preflight", "config snapshot -",
+                         "config get payload_voltage", "--json list"};
+  // Every verb once while the service answers, so the workers know its writers.
+  for (const char* verb : verbs) (void)sh(p + "--timeout 10 " + verb);
+
+  ASSERT_EQ(::kill(uav1.pid(), SIGSTOP), 0);
+  struct LetGo {
+    pid_t pid;
+    ~LetGo() { ::kill(pid, SIGCONT); }
+  } let_go{uav1.pid()};
+  for (const char* verb : verbs) {
+    SCOPED_TRACE(verb);
+    const auto through_agent = sh(p + "--timeout 2 " + std::string(verb));
+    const auto on_its_own = sh(p + "--no-agent --timeout 2 " + std::string(verb));
+    EXPECT_EQ(on_its_own.status, 3) << on_its_own.out;
+    EXPECT_EQ(through_agent.status, on_its_own.status) << through_agent.out << "\non its own:\n" << on_its_own.out;
+    EXPECT_EQ(through_agent.out, on_its_own.out);
+  }
+  EXPECT_EQ(read_file(log).find("--timeout 2 alarms: exit 0"), std::string::npos) << read_file(log);
+}
+
+// Agent workers use no Fast DDS shared-memory port: one a killed worker leaves behind, with
+// a reader slot nobody empties, would be given to its replacement, which would then hear
+// nothing a service on this host sends it and say "no pmu-service" while uav1 runs
+// (docs/safety.md H6).
+TEST_F(PmuctlAgentWithUav1, NoWorkerHoldsASharedMemoryPortAKilledOneWouldLeave) {
+  ASSERT_TRUE(listed_through_agent(uav1_calls())) << read_file(log) << uav1.describe();
+  const auto workers = workers_of(agent.pid());
+  ASSERT_FALSE(workers.empty()) << read_file(log);
+  for (const pid_t w : workers) {
+    const std::string maps = read_file("/proc/" + std::to_string(w) + "/maps");
+    ASSERT_FALSE(maps.empty()) << "worker " << w;
+    EXPECT_EQ(maps.find("fastrtps_port"), std::string::npos) << "worker " << w << " maps a shared-memory port";
+  }
+}
+
 TEST_F(PmuctlAgentWithUav1, ACallThatWaitsForASilentAircraftHoldsUpNoOtherAndADeadWorkerIsReplaced) {
   const std::string p = "PMU_AGENT_SOCKET=" + socket + " " + PMUCTL_PATH + " --domain " + std::to_string(domain) + " ";
   bool served = false;
@@ -317,14 +366,14 @@ TEST_F(PmuctlAgentWithUav1, ACallThatWaitsForASilentAircraftHoldsUpNoOtherAndADe
 
   // A worker that dies is replaced; calls go on being served by the agent.
   auto workers = workers_of(agent.pid());
-  ASSERT_EQ(workers.size(), 4u) << "the default is four workers: " << read_file(log);
+  ASSERT_EQ(workers.size(), 5u) << "four workers and the stop lane: " << read_file(log);
   ASSERT_EQ(::kill(workers.front(), SIGKILL), 0);
   bool replaced = false;
   for (int i = 0; i < 100 && !replaced; ++i) {
     std::this_thread::sleep_for(100ms);
     replaced = read_file(log).find("worker pid " + std::to_string(workers.front()) +
                                    " ended (signal 9); a new one takes its place") != std::string::npos &&
-               workers_of(agent.pid()).size() == 4u;
+               workers_of(agent.pid()).size() == 5u;
   }
   EXPECT_TRUE(replaced) << read_file(log);
   for (int i = 0; i < 4; ++i) {
@@ -339,6 +388,142 @@ TEST_F(PmuctlAgentWithUav1, ACallThatWaitsForASilentAircraftHoldsUpNoOtherAndADe
   ASSERT_TRUE(agent.wait_for(20s));
   for (const pid_t w : workers) EXPECT_NE(::kill(w, 0), 0) << "worker " << w << " outlived its agent";
   EXPECT_FALSE(fs::exists(socket));
+}
+
+// uav1 on a domain of its own, and an agent with one worker for calls on that domain.
+class PmuctlAgentWithOneWorker : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    ASSERT_TRUE(wait_for_socket(socket)) << read_file(log);
+    bool served = false;
+    for (int attempt = 0; attempt < 10 && !served; ++attempt)
+      served = sh(calls() + "--timeout 10 --vehicle uav1 config set payload_voltage 22").status == 0;
+    ASSERT_TRUE(served) << read_file(log) << uav1.describe();
+  }
+
+  // The start of a pmuctl call through the agent, ready for its options and verb.
+  std::string calls() const {
+    return "PMU_AGENT_SOCKET=" + socket + " " + PMUCTL_PATH + " --domain " + std::to_string(domain) + " ";
+  }
+
+  const int domain = pmu::test::exclusive_dds_domain();
+  Uav1 uav1{domain};
+  TempDir dir;
+  const std::string socket = dir.path() + "/agent.sock", log = dir.path() + "/agent.log";
+  pmu::test::Child agent = start_agent(domain, socket, log, "1");
+};
+
+// docs/safety.md H4: the only worker for calls waits for an aircraft that does not answer;
+// an engine stop meanwhile goes out on the stop lane, and completes while that call still waits.
+TEST_F(PmuctlAgentWithOneWorker, AnEngineStopNeverWaitsBehindAnotherCall) {
+  const std::string silent_out = dir.path() + "/silent.out";
+  auto silent = command_through(socket, domain, "uav9", "60", silent_out);
+  std::this_thread::sleep_for(1s);
+  ASSERT_TRUE(silent.running()) << read_file(silent_out);
+
+  const auto r = sh(calls() + "--timeout 20 --vehicle uav1 engine stop");
+  EXPECT_EQ(r.status, 0) << r.out << read_file(log);
+  EXPECT_NE(r.out.find("COMPLETED"), std::string::npos) << r.out;
+  EXPECT_TRUE(silent.running()) << "the stop waited for the call before it:\n" << read_file(log);
+  EXPECT_NE(read_file(log).find("worker stop: pid "), std::string::npos) << read_file(log);
+  EXPECT_NE(read_file(log).find("--vehicle uav1 engine stop: exit 0"), std::string::npos) << read_file(log);
+}
+
+// docs/safety.md H9: calls queued behind a call that holds the only worker. One whose caller
+// gave up (killed by `timeout`) and one whose wait ended are never run, and the log says so;
+// the second caller hears that it was not run (exit 3).
+TEST_F(PmuctlAgentWithOneWorker, ACallWhoseCallerGaveUpIsNeverRun) {
+  const std::string silent_out = dir.path() + "/silent.out";
+  auto silent = command_through(socket, domain, "uav9", "15", silent_out);
+  std::this_thread::sleep_for(1s);
+  ASSERT_TRUE(silent.running()) << read_file(silent_out);
+
+  auto r = sh("timeout -s INT 2 env " + calls() + "--timeout 30 --vehicle uav1 config set payload_voltage 21");
+  EXPECT_EQ(r.status, 124) << r.out;
+  r = sh(calls() + "--timeout 2 --vehicle uav1 config set payload_voltage 20");
+  EXPECT_EQ(r.status, 3) << r.out;
+  EXPECT_NE(r.out.find("pmuctl: the agent on " + socket + " did not run the call: its wait (--timeout) ended before "
+                       "one of the agent's workers was free"),
+            std::string::npos)
+      << r.out;
+  EXPECT_TRUE(silent.running()) << read_file(log);
+  const auto st = silent.wait_for(40s);
+  ASSERT_TRUE(st);
+
+  // Neither ran: the value is the one set before.
+  r = sh(calls() + "--timeout 20 --vehicle uav1 config get payload_voltage");
+  EXPECT_EQ(r.status, 0) << r.out;
+  EXPECT_NE(r.out.find("uav1/can0/1 payload_voltage = 22.0"), std::string::npos) << r.out << uav1.describe();
+  const std::string agent_log = read_file(log);
+  EXPECT_NE(agent_log.find("config set payload_voltage 21: dropped: its caller left before a worker was free"),
+            std::string::npos)
+      << agent_log;
+  EXPECT_NE(agent_log.find("config set payload_voltage 20: dropped: its caller's wait ended before a worker was free"),
+            std::string::npos)
+      << agent_log;
+  EXPECT_EQ(count(agent_log, "payload_voltage 21: exit"), 0u) << agent_log;
+  EXPECT_EQ(count(agent_log, "payload_voltage 20: exit"), 0u) << agent_log;
+}
+
+// docs/safety.md H6: a process of another user listening on the socket path, in a folder
+// every user may write to, gets nothing of root's call, and cannot answer it: the call runs
+// on its own and says why (no service here: exit 3, never the fake's READY).
+TEST(PmuctlAgent, ACallTrustsNoAgentOfAnotherUser) {
+  if (::geteuid() != 0) GTEST_SKIP() << "a listener of another user needs root to start";
+  const int domain = pmu::test::exclusive_dds_domain();
+  TempDir dir;
+  ASSERT_EQ(::chmod(dir.path().c_str(), 01777), 0);  // a shared folder, as /tmp
+  const std::string socket = dir.path() + "/agent.sock";
+  const pid_t fake = ::fork();
+  ASSERT_GE(fake, 0);
+  if (fake == 0) {
+    // nobody's fake agent: prints READY on the caller's stdout and answers exit 0.
+    if (::setgid(65534) != 0 || ::setuid(65534) != 0) ::_exit(1);
+    const int fd = ::socket(AF_UNIX, SOCK_SEQPACKET, 0);
+    sockaddr_un addr{};
+    addr.sun_family = AF_UNIX;
+    std::strncpy(addr.sun_path, socket.c_str(), sizeof addr.sun_path - 1);
+    if (::bind(fd, reinterpret_cast<const sockaddr*>(&addr), sizeof addr) != 0 || ::listen(fd, 4) != 0) ::_exit(1);
+    ::chmod(socket.c_str(), 0777);
+    for (;;) {
+      const int c = ::accept(fd, nullptr, nullptr);
+      char buf[65536];
+      char control[CMSG_SPACE(sizeof(int) * 3)];
+      iovec iov{buf, sizeof buf};
+      msghdr msg{};
+      msg.msg_iov = &iov;
+      msg.msg_iovlen = 1;
+      msg.msg_control = control;
+      msg.msg_controllen = sizeof control;
+      if (::recvmsg(c, &msg, 0) > 0)
+        if (cmsghdr* h = CMSG_FIRSTHDR(&msg)) {
+          int fds[3];
+          std::memcpy(fds, CMSG_DATA(h), sizeof fds);
+          (void)!::write(fds[1], "uav1: READY\n", 12);
+          for (const int f : fds) ::close(f);  // the caller's output ends with the call
+        }
+      (void)!::send(c, "exit 0", 6, 0);
+      ::close(c);
+    }
+  }
+  struct Reap {
+    pid_t pid;
+    ~Reap() {
+      ::kill(pid, SIGKILL);
+      ::waitpid(pid, nullptr, 0);
+    }
+  } reap{fake};
+  ASSERT_TRUE(wait_for_socket(socket));
+  ASSERT_TRUE(pmu::test::wait_until([&] { return connects(socket); }, 10s, 20ms));
+
+  const auto r = sh("PMU_AGENT_SOCKET=" + socket + " " + PMUCTL_PATH + " --domain " + std::to_string(domain) +
+                    " --timeout 1 preflight");
+  EXPECT_EQ(r.status, 3) << r.out;
+  EXPECT_EQ(r.out.find("READY"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("pmuctl: not using the agent on " + socket + ": its folder " + dir.path() +
+                       " is writable by other users (mode 1777); the call runs on its own"),
+            std::string::npos)
+      << r.out;
 }
 
 TEST(PmuctlAgent, OneAgentPerSocketAndAStaleSocketIsTakenOver) {

@@ -24,6 +24,8 @@ class ConfiguredService {
   ConfiguredService& operator=(const ConfiguredService&) = delete;
 
   std::string describe();
+  // The service's process (to stop or kill it as a test's fault).
+  pid_t pid() const { return process_.pid(); }
 
  private:
   std::string dir_, config_, log_;

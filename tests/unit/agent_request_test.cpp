@@ -1,6 +1,7 @@
 // What a pmuctl call sends `pmuctl agent` (tools/pmuctl/agent/agent_request.hpp): a request
-// survives its encoding, and every malformed one is refused whole with a reason, never
-// half-read; replies likewise; and the socket's default path.
+// survives its encoding, its caller's deadline and lane included, and every malformed one is
+// refused whole with a reason, never half-read; replies likewise; and the socket's default
+// path.
 #include <gtest/gtest.h>
 #include <stdlib.h>
 #include <sys/socket.h>
@@ -24,12 +25,16 @@ std::string nul(std::initializer_list<std::string> parts) {
 
 TEST(AgentRequest, SurvivesItsEncoding) {
   AgentRequest r;
+  r.deadline_ns = 1790000000123456789ull;
+  r.engine_stop = true;
   r.directory = "/home/op/fleet";
   r.environment = {{"PMU_VEHICLE", "uav1"}, {"PMU_DISCOVERY_SERVER", "10.0.0.1"}};
   r.arguments = {"--json", "config", "set", "payload_voltage", "13.5", ""};  // an empty argument too
   std::string error;
   const auto back = pmu::tools::decode_request(pmu::tools::encode_request(r), error);
   ASSERT_TRUE(back) << error;
+  EXPECT_EQ(back->deadline_ns, r.deadline_ns);
+  EXPECT_TRUE(back->engine_stop);
   EXPECT_EQ(back->directory, r.directory);
   EXPECT_EQ(back->environment, r.environment);
   EXPECT_EQ(back->arguments, r.arguments);
@@ -42,22 +47,28 @@ struct Bad {
 };
 
 TEST(AgentRequest, EveryMalformedRequestIsRefusedWithItsReason) {
+  const std::string not_ours = "not a pmuctl agent request (it does not begin with \"pmuctl-agent-2\")";
   const Bad cases[] = {
-      {"empty", "", "not a pmuctl agent request (it does not begin with \"pmuctl-agent-1\")"},
-      {"another program", nul({"GET / HTTP/1.1", "/", "0"}),
-       "not a pmuctl agent request (it does not begin with \"pmuctl-agent-1\")"},
-      {"a newer version", nul({"pmuctl-agent-2", "/", "0", "list"}),
-       "not a pmuctl agent request (it does not begin with \"pmuctl-agent-1\")"},
-      {"no terminating NUL", nul({"pmuctl-agent-1", "/", "0"}) + "list", "a request's last string has no terminating NUL"},
-      {"a relative directory", nul({"pmuctl-agent-1", "fleet", "0", "list"}),
+      {"empty", "", not_ours.c_str()},
+      {"another program", nul({"GET / HTTP/1.1", "/", "0"}), not_ours.c_str()},
+      {"an older version, without deadline nor lane", nul({"pmuctl-agent-1", "/", "0", "list"}), not_ours.c_str()},
+      {"no terminating NUL", nul({"pmuctl-agent-2", "1", "call", "/", "0"}) + "list",
+       "a request's last string has no terminating NUL"},
+      {"a deadline that is not a number", nul({"pmuctl-agent-2", "soon", "call", "/", "0", "list"}),
+       "the deadline 'soon' is not a time in ns since the epoch"},
+      {"no deadline", nul({"pmuctl-agent-2", "0", "call", "/", "0", "list"}),
+       "the deadline '0' is not a time in ns since the epoch"},
+      {"an unknown lane", nul({"pmuctl-agent-2", "1", "fast", "/", "0", "list"}),
+       "the lane 'fast' is neither stop nor call"},
+      {"a relative directory", nul({"pmuctl-agent-2", "1", "call", "fleet", "0", "list"}),
        "the working directory is not an absolute path"},
-      {"a count that is not a number", nul({"pmuctl-agent-1", "/", "x", "list"}),
+      {"a count that is not a number", nul({"pmuctl-agent-2", "1", "call", "/", "x", "list"}),
        "the count of environment variables 'x' is not a number of the strings that follow"},
-      {"a count beyond the strings", nul({"pmuctl-agent-1", "/", "2", "PMU_VEHICLE=a"}),
+      {"a count beyond the strings", nul({"pmuctl-agent-2", "1", "call", "/", "2", "PMU_VEHICLE=a"}),
        "the count of environment variables '2' is not a number of the strings that follow"},
-      {"a variable pmuctl does not read", nul({"pmuctl-agent-1", "/", "1", "LD_PRELOAD=/tmp/x.so", "list"}),
+      {"a variable pmuctl does not read", nul({"pmuctl-agent-2", "1", "call", "/", "1", "LD_PRELOAD=/tmp/x.so", "list"}),
        "environment entry 1 is not NAME=VALUE of a variable pmuctl reads"},
-      {"an entry without =", nul({"pmuctl-agent-1", "/", "1", "PMU_VEHICLE", "list"}),
+      {"an entry without =", nul({"pmuctl-agent-2", "1", "call", "/", "1", "PMU_VEHICLE", "list"}),
        "environment entry 1 is not NAME=VALUE of a variable pmuctl reads"},
   };
   for (const auto& c : cases) {
@@ -69,7 +80,7 @@ TEST(AgentRequest, EveryMalformedRequestIsRefusedWithItsReason) {
 }
 
 TEST(AgentRequest, TooManyStringsAreRefused) {
-  std::string bytes = nul({"pmuctl-agent-1", "/", "0"});
+  std::string bytes = nul({"pmuctl-agent-2", "1", "call", "/", "0"});
   for (int i = 0; i < 5000; ++i) bytes += nul({"x"});
   std::string error;
   EXPECT_FALSE(pmu::tools::decode_request(bytes, error));
@@ -77,12 +88,16 @@ TEST(AgentRequest, TooManyStringsAreRefused) {
 }
 
 TEST(AgentReply, SurvivesItsEncodingAndAnythingElseIsNotAReply) {
-  for (const AgentReply& r : {AgentReply{true, 0, ""}, AgentReply{true, 3, ""}, AgentReply{false, 0, "why not"}}) {
+  for (const AgentReply& r : {AgentReply{true, 0, "", false, ""}, AgentReply{true, 3, "", false, ""},
+                              AgentReply{false, 0, "why not", false, ""},
+                              AgentReply{false, 0, "", true, "its wait ended first"}}) {
     const auto back = pmu::tools::decode_reply(pmu::tools::encode_reply(r));
     ASSERT_TRUE(back);
     EXPECT_EQ(back->ran, r.ran);
     EXPECT_EQ(back->status, r.status);
     EXPECT_EQ(back->declined, r.declined);
+    EXPECT_EQ(back->expired, r.expired);
+    EXPECT_EQ(back->why_expired, r.why_expired);
   }
   for (const char* bad : {"", "exit", "exit ", "exit -1", "exit 256", "exit 3x", "ok 0", "declined"})
     EXPECT_FALSE(pmu::tools::decode_reply(bad)) << bad;

@@ -6,6 +6,8 @@
 #include <CLI/CLI.hpp>
 #include <algorithm>
 #include <cctype>
+#include <chrono>
+#include <cstdint>
 #include <cerrno>
 #include <cmath>
 #include <cstdio>
@@ -141,15 +143,27 @@ bool setup_vehicle(pmu::tools::GlobalOptions& g, const CLI::Option* option, cons
   return true;
 }
 
-// Set when `pmuctl agent` runs a call: its participants, its DDS settings, and why it
-// declined the call (left empty when it ran it).
+// Set when `pmuctl agent` runs a call: its participants, its DDS settings, the call's
+// request (its caller's deadline and lane), and why it declined the call (left empty when it
+// ran it).
 struct AgentCall {
   pmu::tools::ContextPool& pool;
   const pmu::tools::GlobalOptions& settings;
+  const pmu::tools::AgentRequest& request;
   std::string& declined;
 };
 
+std::uint64_t epoch_ns_now() {
+  return static_cast<std::uint64_t>(std::chrono::duration_cast<std::chrono::nanoseconds>(
+                                        std::chrono::system_clock::now().time_since_epoch())
+                                        .count());
+}
+
 int run_cli(int argc, char** argv, const AgentCall* served) {
+  // The moment the call was made: its caller's wait is counted from here, also through the
+  // agent, however long the call waits there (docs/safety.md H9).
+  const auto began = std::chrono::steady_clock::now();
+  const std::uint64_t began_ns = epoch_ns_now();
   CLI::App app{"pmuctl: operate and inspect Millswood 250W PMUs served by pmu-service"};
   app.require_subcommand(1);
   app.fallthrough();  // global options may follow the verb: `pmuctl decode --json`
@@ -203,9 +217,10 @@ int run_cli(int argc, char** argv, const AgentCall* served) {
       ->type_name("PATH");
   int agent_workers = 4;
   agent->add_option("--workers", agent_workers,
-                    "Calls served at once, each by a process with its own DDS participant (default 4). Calls go to "
-                    "the first while it keeps up; the next takes one when all before it have been on theirs for "
-                    "3 s, so a call that waits for a silent aircraft holds up no other for longer")
+                    "Calls served at once, each by a process with its own DDS participant (default 4), besides one "
+                    "for engine stops, which never wait. Calls go to the first while it keeps up; the next takes "
+                    "one when all before it have been on theirs for 5 s, so a call that waits for a silent "
+                    "aircraft holds up no other for longer")
       ->check(CLI::Range(1, 16));
 
   auto* watch = app.add_subcommand("watch", "Live telemetry with each device's alarm marker: a refreshing table, or one JSON object per sample");
@@ -415,9 +430,22 @@ int run_cli(int argc, char** argv, const AgentCall* served) {
   // Calls that end by themselves go through the agent; those that run until stopped keep a
   // participant of their own anyway.
   const bool agent_serves = !*agent && !*watch && !*record && !*serve;
+  const bool engine_stop = *engine && start_stop == "stop";
+  // The caller's wait: --timeout, else the verb's default (pmuctl(1)), from the call's start.
+  const bool reads_state = app.got_subcommand("list") || app.got_subcommand("info") ||
+                           app.got_subcommand("health") || (*alarms && !*alarms_ack) ||
+                           app.got_subcommand("preflight") || app.got_subcommand("energy") || *config_get;
+  const double wait = g.timeout.value_or(reads_state ? 3.0 : 5.0);
+  g.deadline = began + std::chrono::duration_cast<std::chrono::steady_clock::duration>(std::chrono::duration<double>(wait));
+  g.deadline_ns = began_ns + static_cast<std::uint64_t>(wait * 1e9);
   if (served) {
     if (!agent_serves) {
       served->declined = "an agent serves calls that end by themselves, not watch, record, serve or agent";
+      return 2;
+    }
+    if (served->request.engine_stop != engine_stop) {
+      served->declined = served->request.engine_stop ? "it came on the stop lane and is not an engine stop"
+                                                     : "it is an engine stop that did not come on the stop lane";
       return 2;
     }
     if (!pmu::tools::same_dds_settings(g, served->settings)) {
@@ -425,9 +453,18 @@ int run_cli(int argc, char** argv, const AgentCall* served) {
       return 2;
     }
     g.pool = &served->pool;
+    // The caller's deadline, not one counted from now: the call may have waited for a worker.
+    const std::uint64_t now_ns = epoch_ns_now();
+    g.deadline_ns = served->request.deadline_ns;
+    const auto left = std::chrono::nanoseconds(g.deadline_ns > now_ns ? g.deadline_ns - now_ns : 0);
+    g.deadline = std::chrono::steady_clock::now() + std::chrono::duration_cast<std::chrono::steady_clock::duration>(left);
+    if (left.count() == 0)
+      return pmu::tools::fail(g, pmu::tools::ExitStatus::NoAnswer,
+                              "the call's wait (--timeout) ended before the agent could run it: not run");
   } else if (agent_serves && !g.no_agent) {
-    if (const auto status =
-            pmu::tools::call_agent(pmu::tools::agent_socket_path(g.domain), std::vector<std::string>(argv + 1, argv + argc), g.json))
+    if (const auto status = pmu::tools::call_agent(pmu::tools::agent_socket_path(g.domain),
+                                                   std::vector<std::string>(argv + 1, argv + argc), g.json,
+                                                   {g.deadline_ns, engine_stop}))
       return *status;
   }
   try {
@@ -437,13 +474,13 @@ int run_cli(int argc, char** argv, const AgentCall* served) {
       const std::string socket = agent_socket.empty() ? pmu::tools::agent_socket_path(g.domain) : agent_socket;
       return pmu::tools::run_agent(
           g, socket, agent_workers,
-          [&g](const std::vector<std::string>& arguments, pmu::tools::ContextPool& pool, std::string& declined) {
+          [&g](const pmu::tools::AgentRequest& request, pmu::tools::ContextPool& pool, std::string& declined) {
             std::vector<std::string> words{"pmuctl"};
-            words.insert(words.end(), arguments.begin(), arguments.end());
+            words.insert(words.end(), request.arguments.begin(), request.arguments.end());
             std::vector<char*> args;
             for (auto& w : words) args.push_back(w.data());
             args.push_back(nullptr);
-            const AgentCall call{pool, g, declined};
+            const AgentCall call{pool, g, request, declined};
             return run_cli(static_cast<int>(words.size()), args.data(), &call);
           });
     }

@@ -8,16 +8,33 @@
 #include <cstring>
 
 #include "pmuctl/agent/agent_request.hpp"
+#include "pmuctl/agent/agent_trust.hpp"
 #include "pmuctl/agent/unix_socket.hpp"
 #include "pmuctl/verbs/exit_status.hpp"
 
 namespace pmu::tools {
+namespace {
 
-std::optional<int> call_agent(const std::string& socket, const std::vector<std::string>& arguments, bool json) {
+std::nullopt_t not_trusted(const std::string& socket, const std::string& why) {
+  std::fprintf(stderr, "pmuctl: not using the agent on %s: %s; the call runs on its own\n", socket.c_str(),
+               why.c_str());
+  return std::nullopt;
+}
+
+}  // namespace
+
+std::optional<int> call_agent(const std::string& socket, const std::vector<std::string>& arguments, bool json,
+                              const AgentCallInfo& call) {
+  // The path before connecting, the listener once connected: nothing of the call (arguments,
+  // environment, terminal) reaches a process this user did not start.
+  if (const auto why = untrusted_socket_path(socket, ::getuid()); !why.empty()) return not_trusted(socket, why);
   UniqueFd fd = connect_unix(socket);
   if (!fd) return std::nullopt;  // no agent: the common case, said nowhere
+  if (const auto why = untrusted_peer(fd.get(), ::getuid()); !why.empty()) return not_trusted(socket, why);
 
   AgentRequest request;
+  request.deadline_ns = call.deadline_ns;
+  request.engine_stop = call.engine_stop;
   char cwd[4096];
   if (!::getcwd(cwd, sizeof cwd)) return std::nullopt;  // the agent could not find relative paths
   request.directory = cwd;
@@ -41,6 +58,8 @@ std::optional<int> call_agent(const std::string& socket, const std::vector<std::
   if (!reply)
     return fail(json, ExitStatus::NoAnswer, "the agent on " + socket + " answered something that is not a result");
   if (reply->ran) return reply->status;
+  if (reply->expired)
+    return fail(json, ExitStatus::NoAnswer, "the agent on " + socket + " did not run the call: " + reply->why_expired);
   std::fprintf(stderr, "pmuctl: the agent on %s does not serve this call (%s); it runs on its own\n", socket.c_str(),
                reply->declined.c_str());
   return std::nullopt;

@@ -1,15 +1,18 @@
 #pragma once
 // What a pmuctl call sends `pmuctl agent` over its socket, and what comes back: one
-// SOCK_SEQPACKET message each way. The request carries the call's working directory, the
-// environment variables that change what pmuctl does, and its arguments; its standard
-// input, output and error go along as file descriptors (SCM_RIGHTS), so the agent writes
-// straight to the caller's terminal or pipe. The reply is the call's exit status, or why
-// the agent did not run it (the caller then runs it on its own).
+// SOCK_SEQPACKET message each way. The request carries the end of the caller's wait, whether
+// it is an engine stop, the call's working directory, the environment variables that change
+// what pmuctl does, and its arguments; its standard input, output and error go along as file
+// descriptors (SCM_RIGHTS), so the agent writes straight to the caller's terminal or pipe.
+// The reply is the call's exit status, why the agent did not run it (the caller then runs it
+// on its own), or that its caller's wait ended before a worker was free (not run).
 //
-// Encoding: NUL-terminated strings: "pmuctl-agent-1", the directory, the number of
-// variables, NAME=VALUE for each, then the arguments (without argv[0]). Decoding is total:
-// anything else is an error naming what was wrong, never a partial request.
+// Encoding: NUL-terminated strings: "pmuctl-agent-2", the deadline (ns since the Unix epoch,
+// UTC), the lane ("stop" or "call"), the directory, the number of variables, NAME=VALUE for
+// each, then the arguments (without argv[0]). Decoding is total: anything else is an error
+// naming what was wrong, never a partial request.
 
+#include <cstdint>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -26,6 +29,12 @@ inline constexpr const char* kAgentEnvironment[] = {
 };
 
 struct AgentRequest {
+  // When the caller stops waiting (ns since the Unix epoch, UTC: the clock of expires_at,
+  // interface.md 2.3), fixed when the call began. A call still queued then is not run, and
+  // every command it sends expires then (docs/safety.md H9).
+  std::uint64_t deadline_ns = 0;
+  // An engine stop: served on the agent's stop lane, never behind another call (docs/safety.md H4).
+  bool engine_stop = false;
   std::string directory;
   std::vector<std::pair<std::string, std::string>> environment;
   std::vector<std::string> arguments;
@@ -35,11 +44,14 @@ std::string encode_request(const AgentRequest& request);
 // The request, or nullopt with `error` saying what is wrong with `bytes`.
 std::optional<AgentRequest> decode_request(std::string_view bytes, std::string& error);
 
-// The agent's answer: "exit N" (the call ran; N its exit status), "declined WHY" (not run).
+// The agent's answer: "exit N" (the call ran; N its exit status), "declined WHY" (not run;
+// the caller runs it on its own), "expired WHY" (not run, and its caller's wait is over).
 struct AgentReply {
   bool ran = false;
   int status = 0;
-  std::string declined;  // why, when !ran
+  std::string declined;  // why, when !ran and !expired
+  bool expired = false;
+  std::string why_expired;
 };
 std::string encode_reply(const AgentReply& reply);
 std::optional<AgentReply> decode_reply(std::string_view bytes);

@@ -3,7 +3,6 @@
 #include <fcntl.h>
 #include <poll.h>
 #include <sys/file.h>
-#include <sys/mman.h>
 #include <sys/prctl.h>
 #include <sys/socket.h>
 #include <sys/stat.h>
@@ -14,7 +13,7 @@
 #include <algorithm>
 #include <atomic>
 #include <cstdint>
-#include <new>
+#include <iterator>
 #include <cerrno>
 #include <chrono>
 #include <csignal>
@@ -22,7 +21,6 @@
 #include <cstdlib>
 #include <cstring>
 #include <optional>
-#include <thread>
 #include <vector>
 
 #include "pmuctl/agent/agent_request.hpp"
@@ -33,6 +31,8 @@ namespace {
 
 std::atomic<bool> g_stop{false};
 extern "C" void on_stop_signal(int) { g_stop = true; }
+
+constexpr int kMaxWorkers = 16;
 
 // The caller's standard streams, working directory and environment for the length of one
 // call, and the agent's own back afterwards (also when the call throws).
@@ -86,38 +86,29 @@ std::string words(const std::vector<std::string>& arguments) {
   return s;
 }
 
-// Runs one accepted connection's call. Every outcome is one line of the agent's log, which
-// names the worker (0 first): whether calls spilled over to further workers shows there.
-void serve(int connection, ContextPool& pool, const AgentCallRunner& run, int worker) {
+std::uint64_t epoch_ns_now() {
+  return static_cast<std::uint64_t>(
+      std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::system_clock::now().time_since_epoch()).count());
+}
+
+// A worker's name in the log: its index (0 first), or "stop" for the stop lane.
+std::string worker_name(int index) { return index < 0 ? "stop" : std::to_string(index); }
+
+// Runs one call a worker was handed: the request the agent read, and its connection and the
+// caller's three streams. Every outcome is one line of the agent's log, which names the
+// worker: whether calls spilled over to further workers shows there.
+void serve(int connection, const AgentRequest& request, const std::vector<UniqueFd>& streams, ContextPool& pool,
+           const AgentCallRunner& run, int worker) {
   ucred peer{};
   socklen_t len = sizeof peer;
-  if (::getsockopt(connection, SOL_SOCKET, SO_PEERCRED, &peer, &len) != 0 || peer.uid != ::geteuid()) {
-    (void)send_with_fds(connection, encode_reply({false, 0, "it belongs to another user"}), {});
-    std::fprintf(stderr, "pmuctl agent: refused a call from uid %u (not this agent's user)\n",
-                 static_cast<unsigned>(peer.uid));
-    return;
-  }
-  std::string bytes;
-  std::vector<UniqueFd> fds;
-  if (!receive(connection, bytes, &fds)) {
-    std::fprintf(stderr, "pmuctl agent: pid %d: no whole request (%s)\n", static_cast<int>(peer.pid),
-                 std::strerror(errno));
-    return;
-  }
-  std::string error;
-  const auto request = decode_request(bytes, error);
-  if (!request || fds.size() != 3) {
-    if (request) error = "it came with " + std::to_string(fds.size()) + " file descriptors, not 3";
-    (void)send_with_fds(connection, encode_reply({false, 0, "a bad request: " + error}), {});
-    std::fprintf(stderr, "pmuctl agent: pid %d: a bad request: %s\n", static_cast<int>(peer.pid), error.c_str());
-    return;
-  }
+  (void)::getsockopt(connection, SOL_SOCKET, SO_PEERCRED, &peer, &len);
   const auto start = std::chrono::steady_clock::now();
   AgentReply reply;
+  std::string error;
   {
-    CallerScope scope(*request, fds, error);
+    CallerScope scope(request, streams, error);
     if (error.empty()) {
-      reply.status = run(request->arguments, pool, reply.declined);
+      reply.status = run(request, pool, reply.declined);
       reply.ran = reply.declined.empty();
     } else {
       reply.declined = error;
@@ -125,11 +116,11 @@ void serve(int connection, ContextPool& pool, const AgentCallRunner& run, int wo
   }
   const double secs = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   if (reply.ran)
-    std::fprintf(stderr, "pmuctl agent: worker %d: pid %d: %s: exit %d in %.2f s\n", worker,
-                 static_cast<int>(peer.pid), words(request->arguments).c_str(), reply.status, secs);
+    std::fprintf(stderr, "pmuctl agent: worker %s: pid %d: %s: exit %d in %.2f s\n", worker_name(worker).c_str(),
+                 static_cast<int>(peer.pid), words(request.arguments).c_str(), reply.status, secs);
   else
-    std::fprintf(stderr, "pmuctl agent: worker %d: pid %d: %s: declined (%s)\n", worker,
-                 static_cast<int>(peer.pid), words(request->arguments).c_str(), reply.declined.c_str());
+    std::fprintf(stderr, "pmuctl agent: worker %s: pid %d: %s: declined (%s)\n", worker_name(worker).c_str(),
+                 static_cast<int>(peer.pid), words(request.arguments).c_str(), reply.declined.c_str());
   if (!send_with_fds(connection, encode_reply(reply), {}))
     std::fprintf(stderr, "pmuctl agent: pid %d: its caller left before the answer\n", static_cast<int>(peer.pid));
 }
@@ -180,18 +171,6 @@ UniqueFd listen_at(const std::string& path, UniqueFd& lock) {
   return fd;
 }
 
-// When each worker began the call it is serving (steady clock, ns; 0: idle), in memory the
-// agent shares with its workers.
-using BusySince = std::atomic<std::int64_t>;
-static_assert(BusySince::is_always_lock_free, "shared between processes");
-BusySince* g_busy = nullptr;  // kMaxWorkers of them, mapped before the workers are forked
-constexpr int kMaxWorkers = 64;
-
-std::int64_t steady_ns() {
-  return std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now().time_since_epoch())
-      .count();
-}
-
 // Worker `index` takes a call only when every worker before it has been on its current call
 // for kSpillAfter: calls go to the first worker while it keeps up, so its endpoints, already
 // matched at the aircraft (command endpoints stay matched, ContextPool), serve them, and each
@@ -200,21 +179,13 @@ std::int64_t steady_ns() {
 // (700 ms round trip, 10 % loss) a call to an aircraft that answers takes 1 to 3.5 s, one
 // that repairs a loss twice up to 5 s; a spilled call costs the link a worker's new
 // endpoints and takes twice as long, so only a call past that waits for another worker.
+// An engine stop never waits for this (the stop lane, below).
 constexpr auto kSpillAfter = std::chrono::seconds(5);
-bool my_turn(int index) {
-  if (!g_busy) return true;
-  const std::int64_t now = steady_ns();
-  for (int j = 0; j < index; ++j) {
-    const std::int64_t since = g_busy[j].load();
-    if (since == 0 || now - since < std::chrono::nanoseconds(kSpillAfter).count()) return false;
-  }
-  return true;
-}
 
-// One worker: takes calls from the shared listening socket until a stop signal, one at a time,
-// with participants of its own. The socket is non-blocking: every idle worker wakes for a new
-// connection, and the one whose turn it is (my_turn) and whose accept() gets it serves it.
-void serve_calls(int listener, const GlobalOptions& settings, const AgentCallRunner& run, int index) {
+// One worker process's loop: takes each call the agent hands it over `channel` (the request,
+// then its connection and the caller's three streams), serves it with participants of its
+// own, and says "done" on the channel, until a stop signal or the agent's end.
+void serve_calls(int channel, const GlobalOptions& settings, const AgentCallRunner& run, int index) {
   ContextPool pool(settings);
   // The participant from the start rather than at the worker's first call: the aircraft then
   // discover every worker's participant at once, and no call waits for that.
@@ -225,33 +196,266 @@ void serve_calls(int listener, const GlobalOptions& settings, const AgentCallRun
                  e.what());
   }
   while (!g_stop) {
-    pollfd p{listener, POLLIN, 0};
-    const int ready = ::poll(&p, 1, 200);  // the signal flag is looked at between waits
-    if (ready <= 0) continue;
-    if (!my_turn(index)) {
-      std::this_thread::sleep_for(std::chrono::milliseconds(50));
-      continue;
+    pollfd p{channel, POLLIN, 0};
+    if (::poll(&p, 1, 200) <= 0) continue;  // the signal flag is looked at between waits
+    std::string bytes;
+    std::vector<UniqueFd> fds;
+    if (!receive(channel, bytes, &fds)) return;  // the agent ended
+    std::string error;
+    const auto request = decode_request(bytes, error);
+    if (request && fds.size() == 4) {
+      const std::vector<UniqueFd> streams(std::make_move_iterator(fds.begin() + 1), std::make_move_iterator(fds.end()));
+      serve(fds[0].get(), *request, streams, pool, run, index);
     }
-    UniqueFd connection(::accept4(listener, nullptr, nullptr, SOCK_CLOEXEC));
-    if (!connection) continue;  // another worker took it
-    if (g_busy) g_busy[index].store(steady_ns());
-    serve(connection.get(), pool, run, index);
-    if (g_busy) g_busy[index].store(0);
+    fds.clear();  // the caller's connection closes here, after the answer
+    std::fflush(nullptr);
+    if (!send_with_fds(channel, "done", {})) return;
   }
 }
 
-// A worker process, forked before any DDS thread exists. It dies with the agent: a caller
-// whose agent was killed must get no answer rather than one from an orphan.
-pid_t start_worker(int listener, const GlobalOptions& settings, const AgentCallRunner& run, int index) {
+// A call accepted and read by the agent, waiting for a worker.
+struct Waiting {
+  UniqueFd connection;
+  std::string bytes;            // the request as it came, handed on to the worker
+  std::vector<UniqueFd> fds;    // the caller's stdin, stdout, stderr
+  AgentRequest request;
+  pid_t pid = 0;
+};
+
+struct Worker {
+  pid_t pid = -1;
+  UniqueFd channel;                                   // the agent's end of the worker's socketpair
+  std::optional<std::chrono::steady_clock::time_point> busy_since;  // on a call since
+};
+
+// A worker process, forked before any DDS thread exists (the agent itself never makes one).
+// It dies with the agent: a caller whose agent was killed must get no answer rather than one
+// from an orphan. `others` are the agent's descriptors the worker must not keep (the other
+// workers' channels, the listener, waiting callers' connections).
+Worker start_worker(const GlobalOptions& settings, const AgentCallRunner& run, int index,
+                    const std::vector<int>& others) {
+  Worker w;
+  int pair[2];
+  if (::socketpair(AF_UNIX, SOCK_SEQPACKET | SOCK_CLOEXEC, 0, pair) != 0) {
+    std::fprintf(stderr, "pmuctl agent: cannot make a worker's channel: %s\n", std::strerror(errno));
+    return w;
+  }
+  UniqueFd mine(pair[0]), its(pair[1]);
   const pid_t agent = ::getpid();
   const pid_t pid = ::fork();
-  if (pid != 0) return pid;
-  (void)::prctl(PR_SET_PDEATHSIG, SIGKILL);
-  if (::getppid() != agent) std::_Exit(1);  // the agent ended before the line above
-  serve_calls(listener, settings, run, index);
-  std::fflush(nullptr);
-  std::exit(0);  // the participants are gone (serve_calls' pool); Fast DDS's own statics follow
+  if (pid < 0) {
+    std::fprintf(stderr, "pmuctl agent: cannot start a worker: %s\n", std::strerror(errno));
+    return w;
+  }
+  if (pid == 0) {
+    (void)::prctl(PR_SET_PDEATHSIG, SIGKILL);
+    if (::getppid() != agent) std::_Exit(1);  // the agent ended before the line above
+    mine.reset();
+    for (const int fd : others) (void)::close(fd);
+    serve_calls(its.get(), settings, run, index);
+    std::fflush(nullptr);
+    std::exit(0);  // the participants are gone (serve_calls' pool); Fast DDS's own statics follow
+  }
+  w.pid = pid;
+  w.channel = std::move(mine);
+  return w;
 }
+
+// The agent: accepts each call, checks its caller, reads its request, and hands it to a
+// worker (serve_calls) as the lanes allow; drops a waiting call whose caller left or whose
+// wait ended. Never makes a DDS participant nor a thread, so it may fork workers at any time.
+class Dispatcher {
+ public:
+  Dispatcher(int listener, const GlobalOptions& settings, const AgentCallRunner& run, int workers)
+      : listener_(listener), settings_(settings), run_(run), workers_(static_cast<std::size_t>(workers)) {
+    for (std::size_t i = 0; i < workers_.size(); ++i) replace(static_cast<int>(i));
+    replace(kStop);
+  }
+
+  void run() {
+    while (!g_stop) {
+      std::vector<pollfd> polled{{listener_, POLLIN, 0}};
+      for (const auto& w : workers_) polled.push_back({w.channel.get(), POLLIN, 0});
+      polled.push_back({stop_.channel.get(), POLLIN, 0});
+      for (const auto& c : waiting_) polled.push_back({c.connection.get(), 0, 0});  // POLLHUP: its caller left
+      (void)::poll(polled.data(), polled.size(), 100);
+      const auto now = std::chrono::steady_clock::now();
+      for (std::size_t i = 0; i < workers_.size(); ++i)
+        if (polled[1 + i].revents) heard_from(workers_[i]);
+      if (polled[1 + workers_.size()].revents) heard_from(stop_);
+      drop_waiting(polled, 2 + workers_.size());
+      if (polled[0].revents & POLLIN) accept_calls();
+      reap();
+      hand_out(now);
+    }
+    // Each worker ends after the call it is serving; waiting calls get no answer (their
+    // callers see the agent end, not run).
+    waiting_.clear();
+    for (auto* w : all())
+      if (w->pid > 0) (void)::kill(w->pid, SIGTERM);
+    for (auto* w : all())
+      if (w->pid > 0) (void)::waitpid(w->pid, nullptr, 0);
+  }
+
+ private:
+  static constexpr int kStop = -1;
+
+  std::vector<Worker*> all() {
+    std::vector<Worker*> v;
+    for (auto& w : workers_) v.push_back(&w);
+    v.push_back(&stop_);
+    return v;
+  }
+  Worker& worker(int index) { return index == kStop ? stop_ : workers_[static_cast<std::size_t>(index)]; }
+
+  // The agent's descriptors a new worker closes.
+  std::vector<int> inherited() {
+    std::vector<int> fds{listener_};
+    for (auto* w : all())
+      if (w->channel) fds.push_back(w->channel.get());
+    for (const auto& c : waiting_) {
+      fds.push_back(c.connection.get());
+      for (const auto& f : c.fds) fds.push_back(f.get());
+    }
+    return fds;
+  }
+
+  void replace(int index) {
+    Worker& w = worker(index);
+    w.channel.reset();
+    w.busy_since.reset();
+    w = start_worker(settings_, run_, index, inherited());
+  }
+
+  // A worker said "done", or its channel closed (it died: reap() replaces it).
+  void heard_from(Worker& w) {
+    std::string bytes;
+    if (receive(w.channel.get(), bytes)) w.busy_since.reset();
+  }
+
+  // Workers that died: replaced; a call one was serving ended with it (its caller sees the
+  // connection close: "ended during the call", not run again).
+  void reap() {
+    for (int index = kStop; index < static_cast<int>(workers_.size()); ++index) {
+      Worker& w = worker(index);
+      int status = 0;
+      if (w.pid > 0 && ::waitpid(w.pid, &status, WNOHANG) != w.pid) continue;
+      if (w.pid > 0)
+        std::fprintf(stderr, "pmuctl agent: worker pid %d ended (%s %d); a new one takes its place\n",
+                     static_cast<int>(w.pid), WIFSIGNALED(status) ? "signal" : "exit",
+                     WIFSIGNALED(status) ? WTERMSIG(status) : WEXITSTATUS(status));
+      replace(index);
+    }
+  }
+
+  void accept_calls() {
+    for (;;) {
+      UniqueFd connection(::accept4(listener_, nullptr, nullptr, SOCK_CLOEXEC));
+      if (!connection) return;
+      ucred peer{};
+      socklen_t len = sizeof peer;
+      if (::getsockopt(connection.get(), SOL_SOCKET, SO_PEERCRED, &peer, &len) != 0 || peer.uid != ::geteuid()) {
+        (void)send_with_fds(connection.get(), encode_reply({false, 0, "it belongs to another user", false, ""}), {});
+        std::fprintf(stderr, "pmuctl agent: refused a call from uid %u (not this agent's user)\n",
+                     static_cast<unsigned>(peer.uid));
+        continue;
+      }
+      // The caller sends its request right after connecting; a caller that does not within
+      // a moment is not waited for (the agent serves the others meanwhile).
+      pollfd p{connection.get(), POLLIN, 0};
+      Waiting c;
+      if (::poll(&p, 1, 1000) <= 0 || !receive(connection.get(), c.bytes, &c.fds)) {
+        std::fprintf(stderr, "pmuctl agent: pid %d: no whole request (%s)\n", static_cast<int>(peer.pid),
+                     std::strerror(errno));
+        continue;
+      }
+      std::string error;
+      const auto request = decode_request(c.bytes, error);
+      if (!request || c.fds.size() != 3) {
+        if (request) error = "it came with " + std::to_string(c.fds.size()) + " file descriptors, not 3";
+        (void)send_with_fds(connection.get(), encode_reply({false, 0, "a bad request: " + error, false, ""}), {});
+        std::fprintf(stderr, "pmuctl agent: pid %d: a bad request: %s\n", static_cast<int>(peer.pid), error.c_str());
+        continue;
+      }
+      c.connection = std::move(connection);
+      c.request = *request;
+      c.pid = peer.pid;
+      waiting_.push_back(std::move(c));
+    }
+  }
+
+  // Waiting calls whose caller left (its connection closed: Ctrl-C, `timeout`) or whose
+  // caller's wait ended are not run, and the log says so (docs/safety.md H9).
+  void drop_waiting(const std::vector<pollfd>& polled, std::size_t first) {
+    const std::uint64_t now = epoch_ns_now();
+    std::vector<Waiting> kept;
+    for (std::size_t i = 0; i < waiting_.size(); ++i) {
+      Waiting& c = waiting_[i];
+      const bool left = i + first < polled.size() && (polled[i + first].revents & (POLLHUP | POLLERR));
+      if (left) {
+        std::fprintf(stderr, "pmuctl agent: pid %d: %s: dropped: its caller left before a worker was free\n",
+                     static_cast<int>(c.pid), words(c.request.arguments).c_str());
+      } else if (c.request.deadline_ns <= now) {
+        AgentReply reply;
+        reply.expired = true;
+        reply.why_expired = "its wait (--timeout) ended before one of the agent's workers was free";
+        (void)send_with_fds(c.connection.get(), encode_reply(reply), {});
+        std::fprintf(stderr, "pmuctl agent: pid %d: %s: dropped: its caller's wait ended before a worker was free\n",
+                     static_cast<int>(c.pid), words(c.request.arguments).c_str());
+      } else {
+        kept.push_back(std::move(c));
+      }
+    }
+    waiting_ = std::move(kept);
+  }
+
+  bool free(const Worker& w) const { return w.pid > 0 && !w.busy_since; }
+
+  // The worker for `c` now, or null. An engine stop goes to the stop lane, else to any free
+  // worker, at once (docs/safety.md H4); another call to the first free worker all of whose
+  // predecessors have been on their calls for kSpillAfter.
+  Worker* worker_for(const Waiting& c, std::chrono::steady_clock::time_point now) {
+    if (c.request.engine_stop) {
+      if (free(stop_)) return &stop_;
+      for (auto& w : workers_)
+        if (free(w)) return &w;
+      return nullptr;
+    }
+    for (auto& w : workers_) {
+      if (free(w)) return &w;
+      if (!w.busy_since || now - *w.busy_since < kSpillAfter) return nullptr;
+    }
+    return nullptr;
+  }
+
+  void hand_out(std::chrono::steady_clock::time_point now) {
+    // Engine stops first, then the others in the order they came.
+    std::stable_partition(waiting_.begin(), waiting_.end(), [](const Waiting& c) { return c.request.engine_stop; });
+    std::vector<Waiting> kept;
+    for (auto& c : waiting_) {
+      Worker* w = worker_for(c, now);
+      if (!w) {
+        kept.push_back(std::move(c));
+        continue;
+      }
+      const std::vector<int> fds{c.connection.get(), c.fds[0].get(), c.fds[1].get(), c.fds[2].get()};
+      if (!send_with_fds(w->channel.get(), c.bytes, fds)) {
+        kept.push_back(std::move(c));  // the worker died: its replacement takes the call
+        continue;
+      }
+      w->busy_since = now;
+      // The agent's copies close here: the worker holds the call's connection now.
+    }
+    waiting_ = std::move(kept);
+  }
+
+  int listener_;
+  const GlobalOptions& settings_;
+  const AgentCallRunner& run_;
+  std::vector<Worker> workers_;
+  Worker stop_;
+  std::vector<Waiting> waiting_;
+};
 
 }  // namespace
 
@@ -270,37 +474,14 @@ int run_agent(const GlobalOptions& settings, const std::string& socket, int work
   // Line by line, as on a terminal: a caller's output and messages then interleave as they
   // would in a call on its own (stdout's buffering is chosen once, for the agent's own fd 1).
   std::setvbuf(stdout, nullptr, _IOLBF, 0);
-  std::fprintf(stderr, "pmuctl agent: serving domain %d (%s) on %s, up to %d call%s at once\n", settings.domain,
+  workers = std::clamp(workers, 1, kMaxWorkers);
+  std::fprintf(stderr, "pmuctl agent: serving domain %d (%s) on %s, up to %d call%s at once and an engine stop\n",
+               settings.domain,
                settings.network.summary.empty() ? "multicast discovery" : settings.network.summary.c_str(),
                socket.c_str(), workers, workers == 1 ? "" : "s");
-  if (workers <= 1) {
-    serve_calls(listener.get(), settings, run, 0);
-  } else {
-    workers = std::min(workers, kMaxWorkers);
-    void* shared = ::mmap(nullptr, sizeof(BusySince) * kMaxWorkers, PROT_READ | PROT_WRITE, MAP_SHARED | MAP_ANONYMOUS, -1, 0);
-    if (shared != MAP_FAILED) g_busy = new (shared) BusySince[kMaxWorkers]{};  // else every worker takes calls as they come
-    std::vector<pid_t> pids;
-    for (int i = 0; i < workers; ++i) pids.push_back(start_worker(listener.get(), settings, run, i));
-    while (!g_stop) {
-      std::this_thread::sleep_for(std::chrono::milliseconds(200));
-      for (std::size_t i = 0; i < pids.size(); ++i) {
-        pid_t& pid = pids[i];
-        int status = 0;
-        if (pid > 0 && ::waitpid(pid, &status, WNOHANG) != pid) continue;
-        // A worker that failed or was killed: the others serve on, and a new one takes its place.
-        if (pid > 0)
-          std::fprintf(stderr, "pmuctl agent: worker pid %d ended (%s %d); a new one takes its place\n",
-                       static_cast<int>(pid), WIFSIGNALED(status) ? "signal" : "exit",
-                       WIFSIGNALED(status) ? WTERMSIG(status) : WEXITSTATUS(status));
-        if (g_busy) g_busy[i].store(0);  // a call it was serving ended with it
-        pid = g_stop ? -1 : start_worker(listener.get(), settings, run, static_cast<int>(i));
-      }
-    }
-    // Each worker ends after the call it is serving.
-    for (const pid_t pid : pids)
-      if (pid > 0) (void)::kill(pid, SIGTERM);
-    for (const pid_t pid : pids)
-      if (pid > 0) (void)::waitpid(pid, nullptr, 0);
+  {
+    Dispatcher dispatcher(listener.get(), settings, run, workers);
+    dispatcher.run();
   }
   (void)::unlink(socket.c_str());
   std::fprintf(stderr, "pmuctl agent: stopped\n");

@@ -5,13 +5,16 @@
 #include <ctime>
 #include <fastdds/dds/core/status/SubscriptionMatchedStatus.hpp>
 #include <fastdds/dds/subscriber/SampleInfo.hpp>
+#include <algorithm>
 #include <map>
+#include <set>
 #include <nlohmann/json.hpp>
 #include <thread>
 #include <tuple>
 
 #include "pmu/dds/contract_names.hpp"
 #include "pmu/idl/alarmsPubSubTypes.h"
+#include "pmu/idl/alarms.h"
 #include "pmu/idl/guarded_type.hpp"
 #include "pmu/idl/topics.hpp"
 #include "pmuctl/verbs/alarm_sample.hpp"
@@ -57,7 +60,15 @@ int run_alarms(const GlobalOptions& o) {
   pmu::dds::DdsContext& dds = *lease;
   DataReader& reader = dds.reader(
       dds.topic(topics::kAlarms, TypeSupport(new idl::Guarded<pmu::v4::AlarmPubSubType>())), qos_profiles::kAlarms);
-  const auto deadline = Clock::now() + std::chrono::duration<double>(o.timeout.value_or(3.0));
+  // A service with no alarm sends nothing on pmu/alarms, nor does one that is dead but still
+  // matched (a participant that knew it holds it until its lease ends): its pmu/readiness,
+  // which a live service sends a reader at once, tells them apart. No all-clear is said
+  // unless a service answered (docs/safety.md H6).
+  DataReader& readiness = dds.reader(
+      dds.topic(topics::kReadiness, TypeSupport(new idl::Guarded<pmu::v4::ReadinessPubSubType>())),
+      qos_profiles::kState);
+  std::set<InstanceHandle_t> answered;  // readiness writers heard
+  const auto deadline = wait_end(o, 3.0);
   // A service with no alarm that ever left NORMAL has nothing in its history, so the wait
   // cannot end on a sample: it ends once every service discovered has matched and nothing
   // new came for the quiet time (a matched writer sends what it holds at once).
@@ -75,17 +86,24 @@ int run_alarms(const GlobalOptions& o) {
       const AlarmEntry e = alarm_entry_of(a);
       if (selected(o, e)) latest[key_of(a)] = e;
     }
+    pmu::v4::Readiness r;
+    while (readiness.take_next_sample(&r, &info) == ReturnCode_t::RETCODE_OK)
+      if (answered.insert(info.publication_handle).second) last_change = Clock::now();
     SubscriptionMatchedStatus st;
     reader.get_subscription_matched_status(st);
+    SubscriptionMatchedStatus ready_st;
+    readiness.get_subscription_matched_status(ready_st);
     const auto now_coming =
         dds.remote_writers().participants_without_writer(pmu::dds::kServiceParticipantName, topics::kAlarms);
     if (st.current_count != matched || now_coming != coming) last_change = Clock::now();
     matched = st.current_count;
     coming = now_coming;
-    if (matched > 0 && coming == 0 && Clock::now() - last_change >= kQuiet) break;
+    const bool all_answered = answered.size() >= static_cast<std::size_t>(std::max(ready_st.current_count, 1));
+    if (matched > 0 && coming == 0 && all_answered && Clock::now() - last_change >= kQuiet) break;
     std::this_thread::sleep_for(std::chrono::milliseconds(20));
   }
   if (matched == 0) return no_service(o, dds);
+  if (answered.empty()) return nothing_heard(o);
   std::size_t shown = 0;
   for (const auto& [key, a] : latest) {
     if (a.state == AlarmStatus::Normal) continue;

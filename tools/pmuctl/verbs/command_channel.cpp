@@ -60,10 +60,12 @@ std::optional<int> resolve_target(const GlobalOptions& o, const std::string& veh
   bool own_vehicle_seen = false;
   std::map<InstanceHandle_t, std::pair<std::string, std::uint16_t>> handles;
   std::optional<Clock::time_point> settle;
+  bool heard = false;
   while (Clock::now() < deadline) {
     pmu::v4::Health h;
     SampleInfo info;
     while (r.take_next_sample(&h, &info) == ReturnCode_t::RETCODE_OK) {
+      heard = true;
       if (!info.valid_data) {
         // Disposed: a PMU that moved to another address is not a second PMU.
         if (auto it = handles.find(info.instance_handle); it != handles.end() && info.instance_state != ALIVE_INSTANCE_STATE)
@@ -89,6 +91,7 @@ std::optional<int> resolve_target(const GlobalOptions& o, const std::string& veh
   SubscriptionMatchedStatus st;
   r.get_subscription_matched_status(st);
   if (st.current_count == 0) return no_service(o, dds);
+  if (!heard) return nothing_heard(o);
   if (seen.empty() && !vehicles_seen.count(vehicle))
     return fail(o, ExitStatus::BadUsage,
                 "no pmu-service of " + vehicle_text(vehicle) + " on domain " + std::to_string(o.domain) +
@@ -190,7 +193,7 @@ bool CommandChannel::recalled_target_gone(const Outcome& out, const std::string&
 }
 
 CommandChannel::Outcome CommandChannel::send(const CommandSpec& spec, const std::string& bus, std::uint16_t address,
-                                             double timeout) {
+                                             double timeout, std::uint64_t expires_at_ns) {
   const auto deadline = Clock::now() + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(timeout));
   pmu::v4::Command c;
   Outcome out;
@@ -205,7 +208,7 @@ CommandChannel::Outcome CommandChannel::send(const CommandSpec& spec, const std:
   c.outputs(spec.outputs);
   c.enable(spec.enable);
   c.groups(spec.groups);
-  c.expires_at(epoch_ns_at(deadline));
+  c.expires_at(expires_at_ns ? expires_at_ns : epoch_ns_at(deadline));
   c.confirm(spec.confirm);
   if (!writer_.write(&c)) {  // bool in Fast DDS 2.x
     out.written = false;

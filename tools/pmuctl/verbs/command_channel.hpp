@@ -78,8 +78,11 @@ class CommandChannel {
   };
   // Sends one command and waits for its final reply, resending with the same id after 1 s
   // without a reply (never executed twice: interface.md 2.4). Each IN_PROGRESS reply is
-  // printed on stderr and keeps the wait open 3 s more than `timeout` would.
-  Outcome send(const CommandSpec& spec, const std::string& bus, std::uint16_t address, double timeout);
+  // printed on stderr and keeps the wait open 3 s more than `timeout` would. The command's
+  // expires_at is `expires_at_ns` when not 0 (the end of its caller's wait), else `timeout`
+  // from now.
+  Outcome send(const CommandSpec& spec, const std::string& bus, std::uint16_t address, double timeout,
+               std::uint64_t expires_at_ns = 0);
 
   // True when open() took a remembered PMU and `out` is the service's answer that it has no
   // such device (not executed): the PMU is forgotten, and open() finds it afresh.

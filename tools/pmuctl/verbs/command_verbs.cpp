@@ -43,7 +43,7 @@ using Clock = std::chrono::steady_clock;
 
 int run_alarm_ack(const GlobalOptions& o, const std::string& code, const std::string& kind) {
   const double timeout = o.timeout.value_or(5.0);
-  const auto deadline = Clock::now() + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(timeout));
+  const auto deadline = wait_end(o, timeout);
   const std::string vehicle = o.vehicle.value_or(std::string());
   pmu::v4::AlarmSource source = pmu::v4::SOURCE_PMU;
   if (kind == "battery")
@@ -84,7 +84,7 @@ int run_alarm_ack(const GlobalOptions& o, const std::string& code, const std::st
   a.code(code);
   // The end of this wait, which finding the PMU and the match have used part of: an
   // acknowledgement pmuctl gave up on is never applied (docs/safety.md H9).
-  a.expires_at(epoch_ns_at(deadline));
+  a.expires_at(o.deadline_ns ? o.deadline_ns : epoch_ns_at(deadline));
   if (!writer.write(&a)) return fail(o, ExitStatus::NotDone, "the acknowledgement could not be written to DDS");
 
   // Unanswered after 1 s: sent again with the same id, which the service answers again and
@@ -173,7 +173,7 @@ std::string broadcast_refusal(const GlobalOptions& o, int kind) {
 
 int run_command(const GlobalOptions& o, const CommandSpec& spec) {
   const double timeout = o.timeout.value_or(5.0);
-  const auto deadline = Clock::now() + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(timeout));
+  const auto deadline = wait_end(o, timeout);
   CommandChannel channel(o);
   // A stop to the broadcast address needs no PMU seen: with --bus it goes to that bus, without
   // to every bus of the service (bus ""), so an engine can be stopped whatever the service
@@ -188,13 +188,14 @@ int run_command(const GlobalOptions& o, const CommandSpec& spec) {
   const auto timeout_left = [&deadline] {
     return std::max(0.0, std::chrono::duration<double>(deadline - Clock::now()).count());
   };
-  auto out = channel.send(spec, bus, address, timeout_left());
+  // Expires when its caller stops waiting (docs/safety.md H9).
+  auto out = channel.send(spec, bus, address, timeout_left(), o.deadline_ns);
   // The PMU this agent's worker commanded before is no longer there (it moved, or its service
   // restarted without it); the service executed nothing, so the command goes, under a new
   // request id, to the PMU found now.
   if (channel.recalled_target_gone(out, bus, address)) {
     if (const auto failed = channel.open(deadline, bus, address)) return *failed;
-    out = channel.send(spec, bus, address, timeout_left());
+    out = channel.send(spec, bus, address, timeout_left(), o.deadline_ns);
   }
   if (!out.written) return fail(o, ExitStatus::NotDone, "the command could not be written to DDS");
   if (const auto& r = out.reply) {

@@ -242,7 +242,7 @@ class ReadOnlyView {
   ContextLease lease_;
   pmu::dds::DdsContext& dds_;
   DeviceReader device_;
-  Clock::time_point deadline_ = deadline_after(o_.timeout.value_or(5.0));
+  Clock::time_point deadline_ = wait_end(o_, 5.0);
 };
 
 std::string utc_now() {

@@ -8,9 +8,10 @@ namespace pmu::tools {
 namespace {
 
 std::unique_ptr<pmu::dds::DdsContext> make_context(const GlobalOptions& o, const std::string& name,
-                                                   const pmu::dds::Partitions& partitions) {
-  return std::make_unique<pmu::dds::DdsContext>(o.domain, o.qos_file, name, o.security, pmu::dds::Transport::Default,
-                                                o.network, partitions);
+                                                   const pmu::dds::Partitions& partitions,
+                                                   pmu::dds::Transport transport = pmu::dds::Transport::Default) {
+  return std::make_unique<pmu::dds::DdsContext>(o.domain, o.qos_file, name, o.security, transport, o.network,
+                                                partitions);
 }
 
 bool same_security(const pmu::dds::SecurityFiles& a, const pmu::dds::SecurityFiles& b) {
@@ -33,7 +34,13 @@ pmu::dds::DdsContext& ContextPool::context(const std::string& participant_name,
   auto& slot = contexts_[participant_name];
   if (!slot) {
     try {
-      slot = make_context(settings_, participant_name, partitions);
+      // UDP alone, no shared memory: a worker killed (and replaced) leaves its shared-memory
+      // port behind, with a reader slot nobody empties, and Fast DDS 2.9 gives a replacement
+      // that port again (the same participant id once the dead one's UDP port is free): what
+      // a service on this host sends it there would never arrive, and the replacement would
+      // answer "no pmu-service" while the service runs (docs/safety.md H6). The aircraft are
+      // on other hosts anyway.
+      slot = make_context(settings_, participant_name, partitions, pmu::dds::Transport::UdpOnly);
       // Command endpoints carry only a call's requests and the replies to them: left matched
       // in their vehicle's partitions, the next command to it finds them matched.
       slot->reuse_endpoints({qos_profiles::kCommand});

@@ -83,7 +83,7 @@ int run(const GlobalOptions& o) {
   DataReader& batteries =
       dds.reader(dds.topic(topics::kBmsEnergy, TypeSupport(new idl::Guarded<pmu::v4::BmsEnergyPubSubType>())),
                  qos_profiles::kState);
-  const auto deadline = Clock::now() + std::chrono::duration<double>(o.timeout.value_or(3.0));
+  const auto deadline = wait_end(o, 3.0);
   StateSettle settle(std::chrono::milliseconds(300));
   Latest<pmu::v4::Energy> pmu_figures;
   Latest<pmu::v4::BmsEnergy> bms_figures;
@@ -99,6 +99,7 @@ int run(const GlobalOptions& o) {
   }
   if (pmu_figures.by_key.empty() && bms_figures.by_key.empty()) {
     if (matched(pmus) == 0 && matched(batteries) == 0) return no_service(o, dds);
+    if (pmu_figures.writers.empty() && bms_figures.writers.empty()) return nothing_heard(o);
     return fail(o, ExitStatus::BadUsage,
                 std::string("no energy figures from ") +
                     (o.address ? "PMU " + std::to_string(*o.address) : std::string("any PMU or battery")) +

@@ -80,7 +80,7 @@ int run_preflight(const GlobalOptions& o) {
   DataReader& reader =
       dds.reader(dds.topic(topics::kReadiness, TypeSupport(new idl::Guarded<pmu::v4::ReadinessPubSubType>())),
                  qos_profiles::kState);
-  const auto deadline = Clock::now() + std::chrono::duration<double>(o.timeout.value_or(3.0));
+  const auto deadline = wait_end(o, 3.0);
   StateSettle settle(std::chrono::milliseconds(300));
   std::map<std::string, pmu::v4::Readiness> latest;
   std::set<InstanceHandle_t> writers;
@@ -99,6 +99,7 @@ int run_preflight(const GlobalOptions& o) {
     SubscriptionMatchedStatus st;
     reader.get_subscription_matched_status(st);
     if (st.current_count == 0) return no_service(o, dds);
+    if (writers.empty()) return nothing_heard(o);
     return fail(o, ExitStatus::NoAnswer,
                 "no readiness from " + (o.vehicle ? vehicle_text(*o.vehicle) : std::string("any vehicle")) +
                     " within the timeout");

@@ -80,6 +80,12 @@ int no_service(const GlobalOptions& o, const pmu::dds::DdsContext& dds) {
               "no pmu-service of " + vehicle_text(*o.vehicle) + domain + vehicles_seen_text(vehicles));
 }
 
+int nothing_heard(const GlobalOptions& o) {
+  return fail(o, ExitStatus::NoAnswer,
+              "no pmu-service" + (o.vehicle ? " of " + vehicle_text(*o.vehicle) : std::string()) + " on domain " +
+                  std::to_string(o.domain));
+}
+
 std::size_t writers_expected(const pmu::dds::DdsContext& dds, eprosima::fastdds::dds::DataReader& reader,
                              const std::string& topic) {
   eprosima::fastdds::dds::SubscriptionMatchedStatus st;

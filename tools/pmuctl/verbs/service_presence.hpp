@@ -48,4 +48,13 @@ std::string vehicle_text(const std::string& vehicle);
 // of other vehicles than the one asked for are there.
 int no_service(const GlobalOptions& o, const pmu::dds::DdsContext& dds);
 
+// Ends a verb whose readers matched pmu-service writers none of which sent anything during
+// the call: exit 3, "no pmu-service [of VEHICLE] on domain N", what a call on its own says
+// when no service is there. A live service's state writers answer a reader that matches
+// them at once (TRANSIENT_LOCAL), and its pmu/readiness at least once a second; a service
+// killed or stopped answers nothing, yet a participant that knew it (the agent's workers)
+// still matches its writers until its DDS lease ends, and must not take that silence for
+// an empty state, no alarm or no device (docs/safety.md H6).
+int nothing_heard(const GlobalOptions& o);
+
 }  // namespace pmu::tools

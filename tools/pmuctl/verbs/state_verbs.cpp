@@ -165,11 +165,21 @@ class StateCollector {
   std::set<InstanceHandle_t> writers_heard_;
 };
 
+}  // namespace
+
+Clock::time_point wait_end(const GlobalOptions& o, double default_timeout) {
+  if (o.deadline) return *o.deadline;
+  return Clock::now() + std::chrono::duration_cast<Clock::duration>(
+                            std::chrono::duration<double>(o.timeout.value_or(default_timeout)));
+}
+
+namespace {
+
 // Waits for the state of the selected devices: returns once every service discovered has sent
 // its state and nothing new came for a short quiet time (state_settle.hpp), or at the timeout.
 template <class Collector>
 int collect(const GlobalOptions& o, const pmu::dds::DdsContext& dds, Collector& c, double default_timeout) {
-  const auto deadline = Clock::now() + std::chrono::duration<double>(o.timeout.value_or(default_timeout));
+  const auto deadline = wait_end(o, default_timeout);
   StateSettle settle(std::chrono::milliseconds(300));
   while (Clock::now() < deadline) {
     c.poll(o);
@@ -182,6 +192,7 @@ int collect(const GlobalOptions& o, const pmu::dds::DdsContext& dds, Collector& 
   }
   if (!c.latest().empty()) return 0;
   if (!c.matched()) return no_service(o, dds);
+  if (c.writers_heard() == 0) return nothing_heard(o);
   return fail(o, ExitStatus::BadUsage, not_seen(o));
 }
 

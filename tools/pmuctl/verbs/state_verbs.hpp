@@ -3,6 +3,7 @@
 // Each returns the process exit status; messages a person can act on go to stderr
 // ("no pmu-service on domain 0", "device 7 not seen on can0").
 
+#include <chrono>
 #include <cstdint>
 #include <optional>
 #include <string>
@@ -29,10 +30,19 @@ struct GlobalOptions {
   pmu::dds::SecurityFiles security;     // empty: no DDS-Security (--security-dir/--identity)
   pmu::dds::ResolvedNetwork network;    // discovery and interfaces (--peer, --discovery-server, --interface)
   bool no_agent = false;                // --no-agent: never through `pmuctl agent`
+  // The end of the caller's wait, fixed when the call began (--timeout or the verb's default
+  // from then): a verb waits for the service until then, a command sent expires then
+  // (interface.md 2.3 expires_at), and a call `pmuctl agent` serves keeps its caller's,
+  // however long it waited for a worker (docs/safety.md H9). Unset: from the verb's start.
+  std::optional<std::chrono::steady_clock::time_point> deadline;
+  std::uint64_t deadline_ns = 0;        // the same, in ns since the Unix epoch (0: unset)
   // Set while `pmuctl agent` serves the call: the verbs borrow its participants
   // (context_lease.hpp). Null for a call of its own.
   ContextPool* pool = nullptr;
 };
+
+// The end of the call's wait: o.deadline, else --timeout or `default_timeout` s from now.
+std::chrono::steady_clock::time_point wait_end(const GlobalOptions& o, double default_timeout);
 
 // The partitions of pmuctl's participant for these options (service/vehicle.hpp).
 pmu::dds::Partitions partitions_for(const GlobalOptions& o);
