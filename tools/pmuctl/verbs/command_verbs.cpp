@@ -199,6 +199,13 @@ int run_command(const GlobalOptions& o, const CommandSpec& spec) {
   }
   if (!out.written) return fail(o, ExitStatus::NotDone, "the command could not be written to DDS");
   if (const auto& r = out.reply) {
+    // A bus the service does not serve, or no such device on it, is no such target (2), as
+    // when pmuctl finds that out itself; the service executed nothing (interface.md 3.2).
+    const ExitStatus status =
+        r->result() == pmu::v4::COMPLETED ? ExitStatus::Ok
+        : r->result() == pmu::v4::REJECTED && pmu::service::says_no_such_target(r->reason().to_string(), bus, address)
+            ? ExitStatus::BadUsage
+            : ExitStatus::NotDone;
     if (o.json) {
       Json j{{"request_id", out.request_id},
              {"vehicle", r->vehicle().to_string()},
@@ -208,6 +215,8 @@ int run_command(const GlobalOptions& o, const CommandSpec& spec) {
              {"reason", r->reason().to_string()}};
       if (r->has_value()) j["value"] = r->value();
       if (!(r->value_text().size() == 0)) j["value_text"] = r->value_text().to_string();
+      // A failure of status 2 or 3 carries its status on its line (interface.md 3.2).
+      if (status == ExitStatus::BadUsage) j["exit_status"] = static_cast<int>(status);
       std::printf("%s\n", j.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace).c_str());
     } else if (r->has_value() || !(r->value_text().size() == 0)) {
       if (!(r->value_text().size() == 0))
@@ -216,12 +225,7 @@ int run_command(const GlobalOptions& o, const CommandSpec& spec) {
         std::printf("%g\n", r->value());
     }
     std::fprintf(stderr, "%s%s%s\n", result_name(r->result()), (r->reason().size() == 0) ? "" : ": ", r->reason().c_str());
-    if (r->result() == pmu::v4::COMPLETED) return static_cast<int>(ExitStatus::Ok);
-    // A bus the service does not serve, or no such device on it, is no such target (2), as
-    // when pmuctl finds that out itself; the service executed nothing (interface.md 3.2).
-    if (r->result() == pmu::v4::REJECTED && pmu::service::says_no_such_target(r->reason().to_string(), bus, address))
-      return static_cast<int>(ExitStatus::BadUsage);
-    return static_cast<int>(ExitStatus::NotDone);
+    return static_cast<int>(status);
   }
   char waited[96];
   std::snprintf(waited, sizeof waited, "no reply from pmu-service within %.1f s (request ", timeout);
