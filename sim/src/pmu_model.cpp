@@ -4,8 +4,6 @@
 #include <stdexcept>
 #include <utility>
 
-#include "pmu/codec/firmware.hpp"
-
 #include "model_state.hpp"
 
 namespace pmu::sim {
@@ -19,10 +17,6 @@ struct PmuModel::Impl : ModelState {
 PmuModel::PmuModel(const DeviceConfig& config, FrameSink sink, TimePoint now) {
   if (config.address == codec::kBroadcastAddress)
     throw std::invalid_argument("PMU address 65535 is the broadcast address (v1.9 4.3); use 0..65534");
-  if (!codec::is_described(config.firmware))
-    throw std::invalid_argument("PMU firmware " + codec::to_string(config.firmware) + ": the simulator is firmware " +
-                                codec::to_string(codec::kOldestDescribedFirmware) + ".." +
-                                codec::to_string(codec::kCurrentFirmware));
   impl_ = std::make_unique<Impl>(config, std::move(sink), now);
 }
 

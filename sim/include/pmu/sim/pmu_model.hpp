@@ -77,9 +77,8 @@ struct Telemetry {
 class PmuModel {
  public:
   // `now` is the power-up time: streaming starts one packet period later and energies
-  // integrate from here. Throws std::invalid_argument for a broadcast address, or a firmware
-  // the documents do not describe (codec::is_described: the model cannot behave as it);
-  // start-up configuration is the only place this class throws.
+  // integrate from here. Throws std::invalid_argument for a broadcast address (start-up
+  // configuration is the only place this class throws).
   PmuModel(const DeviceConfig& config, FrameSink sink, TimePoint now);
   ~PmuModel();
   PmuModel(const PmuModel&) = delete;
