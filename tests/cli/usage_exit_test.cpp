@@ -48,6 +48,19 @@ TEST(Usage, HelpExitsZero) {
 
 // --version names the program, the release of CMakeLists.txt (and debian/changelog, which
 // the configure step holds to it) and the contract version of docs/interface.md's head.
+// The help says what the protocol's stop does: 0x25 stops the starter cranking, and no PMU
+// command stops a running engine (v1.9 5.23; docs/safety.md H4). The agent's help gives the
+// spill-over the agent waits (interface.md 3.2).
+TEST(Usage, TheHelpSaysWhatAStopAndTheAgentDo) {
+  const auto engine = pmu::test::run_capture(std::string(PMUCTL_PATH) + " engine --help");
+  EXPECT_EQ(engine.status, 0);
+  EXPECT_NE(engine.out.find("stops the starter cranking; a running engine keeps running"), std::string::npos)
+      << engine.out;
+  const auto agent = pmu::test::run_capture(std::string(PMUCTL_PATH) + " agent --help");
+  EXPECT_EQ(agent.status, 0);
+  EXPECT_NE(agent.out.find("have been on theirs for 5 s"), std::string::npos) << agent.out;
+}
+
 TEST(Usage, VersionNamesTheReleaseAndTheContract) {
   const struct {
     const char* path;
