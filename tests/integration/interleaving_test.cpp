@@ -18,7 +18,6 @@
 #include <csignal>
 #include <cstdlib>
 #include <ctime>
-#include <filesystem>
 #include <fstream>
 #include <iostream>
 #include <iterator>
@@ -36,11 +35,11 @@
 #include "support/json_lines.hpp"
 #include "support/process.hpp"
 #include "support/wait.hpp"
+#include "support/temp_dir.hpp"
 
 namespace interleaving_test {  // named: the unity build joins this file with others
 
 using namespace std::chrono_literals;
-namespace fs = std::filesystem;
 using Json = nlohmann::json;
 using Clock = std::chrono::steady_clock;
 
@@ -81,22 +80,6 @@ std::optional<double> log_line_time(const std::string& line) {
 double wall_now() {
   return std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count();
 }
-
-class TempDir {
- public:
-  TempDir() {
-    char tmpl[] = "/tmp/pmu-interleaving.XXXXXX";
-    path_ = ::mkdtemp(tmpl);
-  }
-  ~TempDir() {
-    std::error_code ec;
-    fs::remove_all(path_, ec);
-  }
-  const std::string& path() const { return path_; }
-
- private:
-  std::string path_;
-};
 
 // pmu-service on this test's config, started again after a kill; each start logs to a file of
 // its own, and log() is all of them. Start and kill it from the test's main thread.
@@ -544,7 +527,7 @@ class Interleavings : public ::testing::Test {
   int seconds_ = kDefaultSeconds;
   std::mt19937_64 rng_;
   int domain_ = 0;
-  TempDir dir_;
+  pmu::test::TempDir dir_{"pmu-interleaving"};
   std::string socket_;
   std::unique_ptr<Service> service_;
   int step_ = 0;

@@ -32,6 +32,7 @@
 #include "support/json_lines.hpp"
 #include "support/process.hpp"
 #include "support/wait.hpp"
+#include "support/temp_dir.hpp"
 
 namespace pmuctl_agent_test {  // named: the unity build joins this file with others that have an `sh`
 
@@ -50,22 +51,6 @@ std::size_t count(const std::string& text, const std::string& what) {
   for (auto at = text.find(what); at != std::string::npos; at = text.find(what, at + 1)) ++n;
   return n;
 }
-
-class TempDir {
- public:
-  TempDir() {
-    char tmpl[] = "/tmp/pmu-agent-test.XXXXXX";
-    path_ = ::mkdtemp(tmpl);
-  }
-  ~TempDir() {
-    std::error_code ec;
-    fs::remove_all(path_, ec);
-  }
-  const std::string& path() const { return path_; }
-
- private:
-  std::string path_;
-};
 
 // An agent on `socket`, its log in `log`; started from the test's main thread.
 pmu::test::Child start_agent(int domain, const std::string& socket, const std::string& log,
@@ -127,7 +112,7 @@ class PmuctlAgentWithUav1 : public ::testing::Test {
 
   const int domain = pmu::test::exclusive_dds_domain();
   Uav1 uav1{domain};
-  TempDir dir;
+  pmu::test::TempDir dir{"pmu-agent-test"};
   const std::string socket = dir.path() + "/agent.sock", log = dir.path() + "/agent.log";
   pmu::test::Child agent = start_agent(domain, socket, log);
 
@@ -408,7 +393,7 @@ class PmuctlAgentWithOneWorker : public ::testing::Test {
 
   const int domain = pmu::test::exclusive_dds_domain();
   Uav1 uav1{domain};
-  TempDir dir;
+  pmu::test::TempDir dir{"pmu-agent-test"};
   const std::string socket = dir.path() + "/agent.sock", log = dir.path() + "/agent.log";
   pmu::test::Child agent = start_agent(domain, socket, log, "1");
 };
@@ -471,7 +456,7 @@ TEST_F(PmuctlAgentWithOneWorker, ACallWhoseCallerGaveUpIsNeverRun) {
 TEST(PmuctlAgent, ACallTrustsNoAgentOfAnotherUser) {
   if (::geteuid() != 0) GTEST_SKIP() << "a listener of another user needs root to start";
   const int domain = pmu::test::exclusive_dds_domain();
-  TempDir dir;
+  pmu::test::TempDir dir{"pmu-agent-test"};
   ASSERT_EQ(::chmod(dir.path().c_str(), 01777), 0);  // a shared folder, as /tmp
   const std::string socket = dir.path() + "/agent.sock";
   const pid_t fake = ::fork();
@@ -528,7 +513,7 @@ TEST(PmuctlAgent, ACallTrustsNoAgentOfAnotherUser) {
 
 TEST(PmuctlAgent, OneAgentPerSocketAndAStaleSocketIsTakenOver) {
   const int domain = pmu::test::exclusive_dds_domain();
-  TempDir dir;
+  pmu::test::TempDir dir{"pmu-agent-test"};
   const std::string socket = dir.path() + "/agent.sock";
   {
     // What a killed agent leaves: a socket file nobody listens on.
@@ -566,7 +551,7 @@ TEST(PmuctlAgent, OneAgentPerSocketAndAStaleSocketIsTakenOver) {
 
 TEST(PmuctlAgent, AnAgentThatEndsDuringACallLeavesNoAnswerAndNoSecondRun) {
   const int domain = pmu::test::exclusive_dds_domain();
-  TempDir dir;
+  pmu::test::TempDir dir{"pmu-agent-test"};
   const std::string socket = dir.path() + "/agent.sock", log = dir.path() + "/agent.log";
   auto agent = start_agent(domain, socket, log);
   ASSERT_TRUE(wait_for_socket(socket)) << read_file(log);

@@ -15,10 +15,6 @@ namespace {
 using alarms::AlarmState;
 using alarms::Code;
 
-std::uint64_t epoch_ns(std::chrono::system_clock::time_point t) {
-  return static_cast<std::uint64_t>(std::chrono::duration_cast<std::chrono::nanoseconds>(t.time_since_epoch()).count());
-}
-
 AlarmAckSample ack(const std::string& id, const char* code = "thermal_shutdown", std::int64_t kind = 0,
                    std::uint16_t device = 1) {
   AlarmAckSample s;

@@ -12,35 +12,10 @@
 
 #include "pmu/config/config.hpp"
 
+#include "support/temp_dir.hpp"
+
 namespace pmu::service::baseline_config_test {
 namespace {
-
-// A folder of its own under /tmp, removed with what the test wrote into it.
-class Folder {
- public:
-  Folder() {
-    char templ[] = "/tmp/pmu-baseline-XXXXXX";
-    if (::mkdtemp(templ) != nullptr) path_ = templ;
-  }
-  ~Folder() {
-    for (const auto& f : files_) std::remove(f.c_str());
-    ::rmdir(path_.c_str());
-  }
-  Folder(const Folder&) = delete;
-  Folder& operator=(const Folder&) = delete;
-  const std::string& path() const { return path_; }
-  // Writes `text` to NAME in the folder; returns its path.
-  std::string write(const std::string& name, const std::string& text) {
-    const std::string p = path_ + "/" + name;
-    std::ofstream(p) << text;
-    files_.push_back(p);
-    return p;
-  }
-
- private:
-  std::string path_;
-  std::vector<std::string> files_;
-};
 
 const char* const kBaseline = R"(device:
   serial: 1001
@@ -66,7 +41,7 @@ std::string refusal(const std::string& text, const std::string& source) {
 }
 
 TEST(BaselineConfig, ARelativePathIsReadFromTheConfigsFolder) {
-  Folder dir;
+  pmu::test::TempDir dir{"pmu-baseline"};
   dir.write("pmu1.yaml", kBaseline);
   const std::string source = dir.path() + "/pmu-service.yaml";
   const Config c = parse_config(config_with("        baseline: pmu1.yaml\n"), source);
@@ -82,7 +57,7 @@ TEST(BaselineConfig, ARelativePathIsReadFromTheConfigsFolder) {
 }
 
 TEST(BaselineConfig, AnAbsolutePathIsTakenAsItIs) {
-  Folder dir;
+  pmu::test::TempDir dir{"pmu-baseline"};
   const std::string file = dir.write("pmu1.yaml", kBaseline);
   const Config c = parse_config(config_with("        baseline: " + file + "\n"), "/elsewhere/pmu-service.yaml");
   EXPECT_EQ(c.buses.at(0).devices.at(0).baseline_path, file);
@@ -102,7 +77,7 @@ TEST(BaselineConfig, NoBaselineUnlessConfigured) {
 // Each refusal names the config's line and, for a file that reads but is wrong, quotes the
 // baseline's own FILE:LINE, so the operator knows which of the two files to open.
 TEST(BaselineConfig, AFileThatCannotServeIsRefusedAtTheConfigsLine) {
-  Folder dir;
+  pmu::test::TempDir dir{"pmu-baseline"};
   const std::string source = dir.path() + "/pmu-service.yaml";
   dir.write("bad.yaml", "parameters:\n  avionics_voltage: 22.0\n  payload_voltage: 99\n");
   dir.write("s0.yaml", "parameters:\n  power_up_state: [avionics_servo, soa_management]\n");
@@ -140,7 +115,7 @@ TEST(BaselineConfig, AFileThatCannotServeIsRefusedAtTheConfigsLine) {
 // What is not a regular file within 64 KiB is refused at the config's line without being
 // read (docs/safety.md H12): /dev/zero would exhaust memory, a FIFO block the start.
 TEST(BaselineConfig, ADeviceAFifoOrAHugeFileIsRefusedNotRead) {
-  Folder dir;
+  pmu::test::TempDir dir{"pmu-baseline"};
   const std::string source = dir.path() + "/pmu-service.yaml";
   const std::string fifo = dir.path() + "/pmu1.fifo";
   ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
@@ -159,7 +134,7 @@ TEST(BaselineConfig, ADeviceAFifoOrAHugeFileIsRefusedNotRead) {
 
 TEST(BaselineConfig, AnUnreadableFileSaysWhy) {
   if (::geteuid() == 0) GTEST_SKIP() << "root reads a file of mode 000: no EACCES to see";
-  Folder dir;
+  pmu::test::TempDir dir{"pmu-baseline"};
   const std::string file = dir.write("locked.yaml", kBaseline);
   ASSERT_EQ(::chmod(file.c_str(), 0), 0);
   EXPECT_EQ(refusal(config_with("        baseline: locked.yaml\n"), dir.path() + "/c.yaml"),

@@ -14,44 +14,19 @@
 #include <vector>
 
 #include "pmu/files/bounded_file.hpp"
+#include "support/temp_dir.hpp"
 
 namespace pmu::files::bounded_file_test {
 namespace {
 
-class Folder {
- public:
-  Folder() {
-    char templ[] = "/tmp/pmu-files-XXXXXX";
-    if (::mkdtemp(templ) != nullptr) path_ = templ;
-  }
-  ~Folder() {
-    for (const auto& f : made_) std::remove(f.c_str());
-    ::rmdir(path_.c_str());
-  }
-  Folder(const Folder&) = delete;
-  Folder& operator=(const Folder&) = delete;
-  const std::string& path() const { return path_; }
-  std::string write(const std::string& name, const std::string& text) {
-    const std::string p = path_ + "/" + name;
-    std::ofstream(p, std::ios::binary) << text;
-    made_.push_back(p);
-    return p;
-  }
-  // A FIFO nobody writes to: opening it for reading the usual way waits for ever.
-  std::string fifo(const std::string& name) {
-    const std::string p = path_ + "/" + name;
-    if (::mkfifo(p.c_str(), 0600) != 0) return {};
-    made_.push_back(p);
-    return p;
-  }
-
- private:
-  std::string path_;
-  std::vector<std::string> made_;
-};
+// A FIFO in `dir` nobody writes to: opening it for reading the usual way waits for ever.
+std::string fifo_in(const pmu::test::TempDir& dir, const std::string& name) {
+  const std::string p = dir.path() + "/" + name;
+  return ::mkfifo(p.c_str(), 0600) == 0 ? p : std::string();
+}
 
 TEST(BoundedFile, ARegularFileUpToItsBoundIsReadWhole) {
-  Folder dir;
+  pmu::test::TempDir dir{"pmu-files"};
   const std::string text = "a: 1\nb: [x, y]\n";
   struct Case {
     const char* what;
@@ -75,8 +50,8 @@ TEST(BoundedFile, ARegularFileUpToItsBoundIsReadWhole) {
 }
 
 TEST(BoundedFile, WhatIsNotARegularFileWithinItsBoundIsRefusedWithItsReason) {
-  Folder dir;
-  const std::string fifo = dir.fifo("pipe");
+  pmu::test::TempDir dir{"pmu-files"};
+  const std::string fifo = fifo_in(dir, "pipe");
   ASSERT_FALSE(fifo.empty()) << "mkfifo: " << std::strerror(errno);
   struct Case {
     const char* what;
@@ -109,7 +84,7 @@ TEST(BoundedFile, WhatIsNotARegularFileWithinItsBoundIsRefusedWithItsReason) {
 
 TEST(BoundedFile, AFileThatCannotBeOpenedSaysWhy) {
   if (::geteuid() == 0) GTEST_SKIP() << "root opens a file of mode 000: no EACCES to see";
-  Folder dir;
+  pmu::test::TempDir dir{"pmu-files"};
   const std::string file = dir.write("locked", "x");
   ASSERT_EQ(::chmod(file.c_str(), 0), 0);
   const auto got = read_bounded_file(file, 1024);

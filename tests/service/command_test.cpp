@@ -23,10 +23,6 @@ using codec::test::pmu_frame;
 
 std::uint32_t wire(CommandKind k) { return static_cast<std::uint32_t>(k); }
 
-std::uint64_t epoch_ns(std::chrono::system_clock::time_point t) {
-  return static_cast<std::uint64_t>(std::chrono::duration_cast<std::chrono::nanoseconds>(t.time_since_epoch()).count());
-}
-
 // A harness plus a CommandService whose replies are collected.
 class Commands {
  public:

@@ -17,10 +17,6 @@ namespace {
 
 using codec::test::pmu_frame;
 
-std::uint64_t epoch_ns(std::chrono::system_clock::time_point t) {
-  return static_cast<std::uint64_t>(std::chrono::duration_cast<std::chrono::nanoseconds>(t.time_since_epoch()).count());
-}
-
 // A harness plus a CommandService whose replies are collected.
 class Service {
  public:

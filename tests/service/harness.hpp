@@ -46,6 +46,11 @@ class RecordingBus final : public transport::CanBus {
   std::unique_ptr<transport::CanBus> inner_;
 };
 
+// A system-clock time as a request's expires_at carries it (ns since the Unix epoch).
+inline std::uint64_t epoch_ns(std::chrono::system_clock::time_point t) {
+  return static_cast<std::uint64_t>(std::chrono::duration_cast<std::chrono::nanoseconds>(t.time_since_epoch()).count());
+}
+
 inline BusConfig sim_bus(std::vector<DeviceConfig> devices, bool discover = false) {
   BusConfig b;
   b.name = "sim0";

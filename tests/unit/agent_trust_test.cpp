@@ -13,7 +13,6 @@
 
 #include <chrono>
 #include <cstring>
-#include <filesystem>
 #include <fstream>
 #include <string>
 #include <thread>
@@ -21,26 +20,11 @@
 #include "pmuctl/agent/agent_trust.hpp"
 #include "pmuctl/agent/unix_socket.hpp"
 
+#include "support/temp_dir.hpp"
+
 namespace {
 
-namespace fs = std::filesystem;
 constexpr uid_t kOther = 65534;  // nobody
-
-class TempDir {
- public:
-  TempDir() {
-    char tmpl[] = "/tmp/pmu-agent-trust.XXXXXX";
-    path_ = ::mkdtemp(tmpl);
-  }
-  ~TempDir() {
-    std::error_code ec;
-    fs::remove_all(path_, ec);
-  }
-  const std::string& path() const { return path_; }
-
- private:
-  std::string path_;
-};
 
 // A socket bound (not listened on) at `path`, by this process.
 bool bind_socket(const std::string& path) {
@@ -79,7 +63,7 @@ TEST(AgentTrust, OnlyAFolderAndSocketOfTheCallerOrRootAreTrusted) {
   for (const auto& c : cases) {
     SCOPED_TRACE(c.what);
     if (c.needs_root && me != 0) continue;  // said below
-    TempDir dir;
+    pmu::test::TempDir dir{"pmu-agent-trust"};
     const std::string folder = dir.path() + "/pmu-dds", path = folder + "/agent.sock";
     ASSERT_EQ(::mkdir(folder.c_str(), 0700), 0);
     if (std::string(c.at_path) == "socket") {
@@ -143,7 +127,7 @@ struct Listener {
 };
 
 TEST(AgentTrust, AListenerOfTheCallerOrRootIsTrustedOfAnotherUserNot) {
-  TempDir dir;
+  pmu::test::TempDir dir{"pmu-agent-trust"};
   const std::string mine = dir.path() + "/mine.sock";
   const Listener own{listen_as(mine, ::geteuid())};
   auto fd = connect_when_listened(mine);
