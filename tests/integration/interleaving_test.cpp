@@ -131,7 +131,6 @@ struct Call {
   // What the step learns when it ends.
   pmu::test::Child child;
   std::string out_path;
-  Clock::time_point started;
   double wall_started = 0;
   std::optional<int> status;  // exit status; nullopt when a signal ended it
   bool gave_up = false;
@@ -208,7 +207,6 @@ class Interleavings : public ::testing::Test {
       std::this_thread::sleep_until(t0 + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(e.at)));
       Call& c = calls[e.call];
       if (!e.give_up) {
-        c.started = Clock::now();
         c.wall_started = wall_now();
         c.child = launch(c, static_cast<int>(e.call));
       } else if (c.child.running()) {
@@ -292,6 +290,24 @@ class Interleavings : public ::testing::Test {
 
   // ---- steps ---------------------------------------------------------------------------
 
+  // A confirmed engine start, waited for as long as a start that never fires runs.
+  static Call engine_start(Via v) {
+    Call c;
+    c.what = "engine start";
+    c.via = v;
+    c.args = {"--confirm", "engine", "start"};
+    c.timeout = kCrankingTime + 6;
+    return c;
+  }
+  static Call engine_stop(Via v, double at) {
+    Call c;
+    c.what = "engine stop";
+    c.via = v;
+    c.at = at;
+    c.args = {"engine", "stop"};
+    return c;
+  }
+
   // Sets an operator might make in a hurry, none of them confirmed: each either is harmless or
   // must be refused (I3, I4, I2), and the harmless ones put things back.
   std::vector<Call> step_sets() {
@@ -326,20 +342,11 @@ class Interleavings : public ::testing::Test {
   // change while it cranks, or a start left to run to its end.
   std::vector<Call> step_engine() {
     std::vector<Call> calls;
-    Call start;
-    start.what = "engine start";
-    start.via = via();
-    start.args = {"--confirm", "engine", "start"};
-    start.timeout = kCrankingTime + 6;
-    calls.push_back(std::move(start));
+    calls.push_back(engine_start(via()));
     const int how = integer(0, 3);
     if (how <= 1) {
-      Call stop;
-      stop.what = "engine stop";
-      stop.via = via();
-      stop.at = uniform(0.3, 4.0);
-      stop.args = {"engine", "stop"};
-      calls.push_back(std::move(stop));
+      const Via v = via();
+      calls.push_back(engine_stop(v, uniform(0.3, 4.0)));
     } else if (how == 2) {
       Call move;
       move.what = "address change";
@@ -356,12 +363,7 @@ class Interleavings : public ::testing::Test {
   // call's wait has ended. A call on its own is given up too, midway.
   std::vector<Call> step_given_up() {
     std::vector<Call> calls;
-    Call start;
-    start.what = "engine start";
-    start.via = Via::Agent;
-    start.args = {"--confirm", "engine", "start"};
-    start.timeout = kCrankingTime + 6;
-    calls.push_back(std::move(start));
+    calls.push_back(engine_start(Via::Agent));
     for (const Via v : {Via::Agent, Via::Own}) {
       if (markers_.size() >= 60) break;
       Call late;
@@ -375,12 +377,7 @@ class Interleavings : public ::testing::Test {
       markers_.push_back(tenths(marker));
       calls.push_back(std::move(late));
     }
-    Call stop;
-    stop.what = "engine stop";
-    stop.via = Via::Own;
-    stop.at = 4.0;
-    stop.args = {"engine", "stop"};
-    calls.push_back(std::move(stop));
+    calls.push_back(engine_stop(Via::Own, 4.0));
     return calls;
   }
 
