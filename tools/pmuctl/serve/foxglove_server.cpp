@@ -255,7 +255,8 @@ struct Endpoint final : FoxgloveServer::Impl {
     for (const auto& r : replies) con->send(r, websocketpp::frame::opcode::text);
     // A new subscription to a state channel gets the current state at once, stamped with the
     // server's clock where the sample is older (state published hours ago would otherwise
-    // stretch a player's timeline back to then).
+    // stretch a player's timeline back to then). It is the current state; whether a device is
+    // live is pmu/health's state, not this time (docs/safety.md H7).
     for (const auto& [key, sample] : last_state)
       if (!had[key.first]) send_to(client, con, sample, std::max(sample.time_ns, clock));
   }
