@@ -13,6 +13,10 @@
 //     capability time: a Time message before the first message, none going back, no live
 //     message stamped after the last Time, state sent at subscribe stamped no earlier than it
 //     (a player's timeline is not stretched back to when that state was published).
+//   node serve_client.mjs URL first SECONDS
+//     subscribes to pmu/voltages and ends at the first message that decodes, with its values on
+//     stdout; exit status 1 if none came within SECONDS (a bound that only turns "never"
+//     into a failure: when the first sample comes is up to DDS discovery).
 //   node serve_client.mjs URL count SECONDS OUT.json
 //     subscribes to pmu/voltages and writes {"messages": N, "per_second": [...]} to OUT.json
 //     (the slow-client test's reader that must keep receiving).
@@ -87,6 +91,17 @@ client.on("message", ({ subscriptionId, timestamp, data }) => {
   const channel = subscriptions.get(subscriptionId);
   if (!channel) return problem(`message for unknown subscription ${subscriptionId}`);
   perSecond[perSecond.length - 1]++;
+  if (mode === "first") {
+    try {
+      const bytes = new Uint8Array(data.buffer, data.byteOffset, data.byteLength);
+      const v = channel.reader.readMessage(bytes);
+      if (!(v.avionics > 5 && v.avionics < 40)) problem(`voltages avionics ${v.avionics}`);
+      finish(() => console.log(`serve_client first: ${channel.topic} of ${v.bus}/${v.address}, avionics ${v.avionics}`));
+    } catch (e) {
+      problem(`${channel.topic}: message does not decode: ${e.message}`);
+    }
+    return;
+  }
   if (mode !== "check") return;
   try {
     const bytes = new Uint8Array(data.buffer, data.byteOffset, data.byteLength);
@@ -121,6 +136,12 @@ function start() {
     ws.send(JSON.stringify({ op: "subscribe", subscriptions: [{ id: -1, channelId: 0 }] }));
     ws.send(new Uint8Array([1, 0, 0, 0, 0]));
     setTimeout(finishCheck, Number(rest[1]) * 1000);
+  } else if (mode === "first") {
+    subscribe("pmu/voltages");
+    setTimeout(() => {
+      problem(`no pmu/voltages message within ${rest[0]} s`);
+      finish();
+    }, Number(rest[0]) * 1000);
   } else {
     subscribe("pmu/voltages");
     const tick = setInterval(() => perSecond.push(0), 1000);
