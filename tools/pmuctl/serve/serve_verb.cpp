@@ -3,8 +3,8 @@
 #include <unistd.h>
 
 #include <cstdio>
-#include <tuple>
 #include <string_view>
+#include <tuple>
 
 #include "pmu/dds/dds_context.hpp"
 #include "pmu/files/bounded_file.hpp"
