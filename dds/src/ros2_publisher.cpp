@@ -6,6 +6,7 @@
 
 #include "diagnostic_msgs/msg/DiagnosticArrayPubSubTypes.h"
 #include "pmu/dds/ros2_messages.hpp"
+#include "pmu/dds/zero_padded_type.hpp"
 #include "pmu/session/log_throttle.hpp"
 #include "sensor_msgs/msg/BatteryStatePubSubTypes.h"
 
@@ -95,7 +96,7 @@ struct Ros2Publisher::State {
     const std::string ros_name =
         service::ros2_device_namespace(settings.name_space, vehicle, k.bus, ros2_publisher::ros2_kind(k.kind), k.address) + "/" + leaf;
     try {
-      auto& topic = dds.topic(service::ros2_dds_topic(ros_name), eprosima::fastdds::dds::TypeSupport(new sensor_msgs::msg::BatteryStatePubSubType()));
+      auto& topic = dds.topic(service::ros2_dds_topic(ros_name), zero_padded<sensor_msgs::msg::BatteryStatePubSubType>());
       return &dds.default_partition_writer(topic, ros2_writer_qos());
     } catch (const DdsError& e) {
       failed(ros_name.c_str(), e.what());
@@ -162,7 +163,7 @@ Ros2Publisher::Ros2Publisher(DdsContext& dds, const service::Ros2Settings& setti
   for (const auto& b : buses)
     for (const auto& battery : b.batteries)
       if (battery.capacity_ah) s_->capacity_ah[{b.name, battery.node}] = *battery.capacity_ah;
-  auto& topic = dds.topic("rt/diagnostics", eprosima::fastdds::dds::TypeSupport(new diagnostic_msgs::msg::DiagnosticArrayPubSubType()));
+  auto& topic = dds.topic("rt/diagnostics", zero_padded<diagnostic_msgs::msg::DiagnosticArrayPubSubType>());
   s_->diagnostics = &dds.default_partition_writer(topic, ros2_writer_qos());
 }
 
