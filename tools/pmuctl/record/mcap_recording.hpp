@@ -8,6 +8,7 @@
 // No DDS: samples arrive as CDR bytes. Not thread-safe (record serialises calls).
 
 #include <cstdint>
+#include <map>
 #include <memory>
 #include <string>
 #include <vector>
@@ -25,7 +26,12 @@ class McapRecording {
   // output was refused (nothing made) or failed once written to (disk full).
   std::string open(const std::string& path, const std::vector<const RecordedTopic*>& topics);
 
-  // `topic`: index into open()'s list. `time_ns`: since the Unix epoch, the message's log and
+  // One more topic, while recording (a ROS 2 topic discovery found): its schema (unless a
+  // topic of its type has it) and channel go into the chunk being filled, before its first
+  // message. Its index for write() is the number of topics before it.
+  std::size_t add_topic(const RecordedTopic* topic);
+
+  // `topic`: index into open()'s list, then add_topic()'s. `time_ns`: since the Unix epoch, the message's log and
   // publish time. False once the file cannot be written (error()).
   bool write(std::size_t topic, std::uint64_t time_ns, const std::uint8_t* data, std::size_t size);
   // The chunk so far to the file, so a crash keeps it.
@@ -57,6 +63,7 @@ class McapRecording {
   std::vector<const RecordedTopic*> topics_;
   std::vector<std::uint16_t> channels_;
   std::vector<std::uint64_t> counts_;
+  std::map<std::string, std::uint16_t> schemas_;  // by schema name: topics of one type share it
 };
 
 // "56.7 kB"

@@ -82,6 +82,7 @@ struct FoxgloveServer::Impl {
 
   std::mutex pending_mutex;  // publish() and the drain
   std::deque<Pending> pending;
+  std::vector<std::pair<foxglove::Channel, bool>> added;  // add_channel(), before the samples pending
   std::size_t pending_bytes = 0;
   bool drain_posted = false;
 
@@ -167,12 +168,25 @@ struct FoxgloveServer::Impl {
 
   void drain() {
     std::deque<Pending> batch;
+    std::vector<std::pair<foxglove::Channel, bool>> new_channels;
     {
       std::lock_guard<std::mutex> lock(pending_mutex);
       batch.swap(pending);
+      new_channels.swap(added);
       pending_bytes = 0;
       drain_posted = false;
     }
+    for (auto& [channel, state] : new_channels) {
+      const std::string one = foxglove::advertise_json({channel});
+      channels.push_back(std::move(channel));
+      latched.push_back(state);
+      for (auto& [h, client] : clients) {
+        client.subscriptions.add_channel();
+        if (const auto con = connection(h); con && con->get_state() == websocketpp::session::state::open)
+          con->send(one, websocketpp::frame::opcode::text);
+      }
+    }
+    if (!new_channels.empty()) advertise = foxglove::advertise_json(channels);
     for (auto& p : batch) {
       for (auto& [h, client] : clients)
         if (const auto con = connection(h)) send_to(client, con, p);
@@ -272,6 +286,18 @@ void FoxgloveServer::publish(std::uint32_t channel, std::uint64_t time_ns, const
     }
     m.pending_bytes += payload.size();
     m.pending.push_back(Pending{channel, time_ns, instance, std::move(payload)});
+    post = !m.drain_posted;
+    m.drain_posted = true;
+  }
+  if (post) asio::post(m.server.get_io_service(), [&m] { m.drain(); });
+}
+
+void FoxgloveServer::add_channel(foxglove::Channel channel, bool latched) {
+  Impl& m = *impl_;
+  bool post = false;
+  {
+    std::lock_guard<std::mutex> lock(m.pending_mutex);
+    m.added.emplace_back(std::move(channel), latched);
     post = !m.drain_posted;
     m.drain_posted = true;
   }
