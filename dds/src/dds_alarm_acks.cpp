@@ -8,6 +8,7 @@
 #include <mutex>
 
 #include "pmu/config/vehicle.hpp"
+#include "pmu/dds/zero_padded_type.hpp"
 #include "pmu/idl/alarms.h"
 #include "pmu/idl/alarmsPubSubTypes.h"
 #include "pmu/idl/guarded_type.hpp"
@@ -115,7 +116,7 @@ struct DdsAlarmAckEndpoint::Impl final : public DataReaderListener {
 DdsAlarmAckEndpoint::DdsAlarmAckEndpoint(dds::DdsContext& dds, std::string vehicle)
     : impl_(std::make_unique<Impl>(dds, std::move(vehicle))) {
   try {
-    impl_->writer = &dds.writer(dds.topic(topics::kAlarmAckReply, TypeSupport(new pmu::v4::AlarmAckReplyPubSubType())),
+    impl_->writer = &dds.writer(dds.topic(topics::kAlarmAckReply, dds::zero_padded<pmu::v4::AlarmAckReplyPubSubType>()),
                                 qos_profiles::kCommand);
   } catch (const dds::DdsError& e) {
     if (!dds.secure()) throw;

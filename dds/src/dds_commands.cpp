@@ -14,6 +14,7 @@
 #include "pmu/config/vehicle.hpp"
 #include "pmu/dds/command_cdr.hpp"
 #include "pmu/dds/dds_publisher.hpp"
+#include "pmu/dds/zero_padded_type.hpp"
 #include "pmu/dispatch/command_service.hpp"
 #include "pmu/idl/command.h"
 #include "pmu/idl/commandPubSubTypes.h"
@@ -138,7 +139,7 @@ struct DdsCommandEndpoint::Impl final : public DataReaderListener {
 
 DdsCommandEndpoint::DdsCommandEndpoint(dds::DdsContext& dds, DdsPublisher* failures, std::string vehicle)
     : impl_(std::make_unique<Impl>(dds, failures, std::move(vehicle))) {
-  impl_->writer = &dds.writer(dds.topic(topics::kCommandReply, TypeSupport(new pmu::v4::CommandReplyPubSubType())),
+  impl_->writer = &dds.writer(dds.topic(topics::kCommandReply, dds::zero_padded<pmu::v4::CommandReplyPubSubType>()),
                               qos_profiles::kCommand);
 }
 

@@ -355,6 +355,19 @@ DataWriter& DdsContext::default_partition_writer(Topic& topic, const DataWriterQ
   return *w;
 }
 
+DataReader& DdsContext::default_partition_reader(Topic& topic, const DataReaderQos& qos, DataReaderListener* listener) {
+  if (!default_subscriber_) default_subscriber_ = participant_->create_subscriber(SUBSCRIBER_QOS_DEFAULT);
+  if (!default_subscriber_)
+    throw DdsError("cannot create a DDS subscriber in the default partition for " + topic.get_name());
+  DataReader* r = default_subscriber_->create_datareader(&topic, qos, listener);
+  if (!r) {
+    const std::string what = "cannot create a reader for " + topic.get_name() + " in the default partition";
+    if (!secure_) throw DdsError(what);
+    throw DdsError(what + " (DDS-Security: this identity's permissions may not allow subscribing to it there)");
+  }
+  return *r;
+}
+
 void DdsContext::too_small(const std::string& topic, const std::string& profile, bool publish,
                            const std::string& shortfall) const {
   throw DdsError(qos_file_ + ": <" + (publish ? "data_writer" : "data_reader") + " profile_name=\"" + profile + "\"> (" +

@@ -16,6 +16,7 @@
 #include "pmu/config/low_rate.hpp"
 #include "pmu/dds/baseline_sample.hpp"
 #include "pmu/dds/telemetry_samples.hpp"
+#include "pmu/dds/zero_padded_type.hpp"
 #include "pmu/idl/alarms.h"
 #include "pmu/idl/alarmsPubSubTypes.h"
 #include "pmu/idl/canopen.h"
@@ -144,29 +145,29 @@ DdsPublisher::DdsPublisher(dds::DdsContext& dds, std::chrono::milliseconds telem
     return &dds.writer(dds.topic(name, type), qos_profiles::kState);
   };
   const auto d = telemetry_deadline;
-  w_->voltages = telemetry(topics::kVoltages, TypeSupport(new pmu::v4::VoltagesPubSubType()), d);
-  w_->currents = telemetry(topics::kCurrents, TypeSupport(new pmu::v4::CurrentsPubSubType()), d);
-  w_->energy = telemetry(topics::kBatteryEnergy, TypeSupport(new pmu::v4::BatteryEnergyPubSubType()), d);
-  w_->temperatures = telemetry(topics::kTemperatures, TypeSupport(new pmu::v4::TemperaturesPubSubType()), d);
-  w_->status = telemetry(topics::kStatus, TypeSupport(new pmu::v4::StatusPubSubType()), d);
+  w_->voltages = telemetry(topics::kVoltages, dds::zero_padded<pmu::v4::VoltagesPubSubType>(), d);
+  w_->currents = telemetry(topics::kCurrents, dds::zero_padded<pmu::v4::CurrentsPubSubType>(), d);
+  w_->energy = telemetry(topics::kBatteryEnergy, dds::zero_padded<pmu::v4::BatteryEnergyPubSubType>(), d);
+  w_->temperatures = telemetry(topics::kTemperatures, dds::zero_padded<pmu::v4::TemperaturesPubSubType>(), d);
+  w_->status = telemetry(topics::kStatus, dds::zero_padded<pmu::v4::StatusPubSubType>(), d);
   if (w_->low_rate.enabled()) {
     // The same types on topics of their own: a reader of one never matches the other's writer.
     const auto low = std::max(telemetry_deadline, 3 * low_rate_period);
-    w_->low[0] = telemetry(topics::kLowRateVoltages, TypeSupport(new pmu::v4::VoltagesPubSubType()), low);
-    w_->low[1] = telemetry(topics::kLowRateCurrents, TypeSupport(new pmu::v4::CurrentsPubSubType()), low);
-    w_->low[2] = telemetry(topics::kLowRateBatteryEnergy, TypeSupport(new pmu::v4::BatteryEnergyPubSubType()), low);
-    w_->low[3] = telemetry(topics::kLowRateTemperatures, TypeSupport(new pmu::v4::TemperaturesPubSubType()), low);
-    w_->low[4] = telemetry(topics::kLowRateStatus, TypeSupport(new pmu::v4::StatusPubSubType()), low);
+    w_->low[0] = telemetry(topics::kLowRateVoltages, dds::zero_padded<pmu::v4::VoltagesPubSubType>(), low);
+    w_->low[1] = telemetry(topics::kLowRateCurrents, dds::zero_padded<pmu::v4::CurrentsPubSubType>(), low);
+    w_->low[2] = telemetry(topics::kLowRateBatteryEnergy, dds::zero_padded<pmu::v4::BatteryEnergyPubSubType>(), low);
+    w_->low[3] = telemetry(topics::kLowRateTemperatures, dds::zero_padded<pmu::v4::TemperaturesPubSubType>(), low);
+    w_->low[4] = telemetry(topics::kLowRateStatus, dds::zero_padded<pmu::v4::StatusPubSubType>(), low);
   }
   if (canopen_deadline) {
     const auto cd = *canopen_deadline;
-    w_->battery = telemetry(topics::kBattery, TypeSupport(new pmu::v4::BatteryPubSubType()), cd);
-    w_->battery_cells = telemetry(topics::kBatteryCells, TypeSupport(new pmu::v4::BatteryCellsPubSubType()), cd);
-    w_->mppt = telemetry(topics::kMppt, TypeSupport(new pmu::v4::MpptPubSubType()), cd);
+    w_->battery = telemetry(topics::kBattery, dds::zero_padded<pmu::v4::BatteryPubSubType>(), cd);
+    w_->battery_cells = telemetry(topics::kBatteryCells, dds::zero_padded<pmu::v4::BatteryCellsPubSubType>(), cd);
+    w_->mppt = telemetry(topics::kMppt, dds::zero_padded<pmu::v4::MpptPubSubType>(), cd);
   }
-  w_->config = state(topics::kConfig, TypeSupport(new pmu::v4::ConfigPubSubType()));
-  w_->info = state(topics::kInfo, TypeSupport(new pmu::v4::DeviceInfoPubSubType()));
-  w_->health = state(topics::kHealth, TypeSupport(new pmu::v4::HealthPubSubType()));
+  w_->config = state(topics::kConfig, dds::zero_padded<pmu::v4::ConfigPubSubType>());
+  w_->info = state(topics::kInfo, dds::zero_padded<pmu::v4::DeviceInfoPubSubType>());
+  w_->health = state(topics::kHealth, dds::zero_padded<pmu::v4::HealthPubSubType>());
   // Topics newer than the DDS-Security permissions a service may have been given: without a
   // grant the service runs without them rather than not at all.
   auto newer = [&](const char* name, TypeSupport type, const char* profile) -> DataWriter* {
@@ -180,12 +181,12 @@ DdsPublisher::DdsPublisher(dds::DdsContext& dds, std::chrono::milliseconds telem
       return nullptr;
     }
   };
-  w_->alarms = newer(topics::kAlarms, TypeSupport(new pmu::v4::AlarmPubSubType()), qos_profiles::kAlarms);
-  w_->readiness = newer(topics::kReadiness, TypeSupport(new pmu::v4::ReadinessPubSubType()), qos_profiles::kState);
-  w_->derived_energy = newer(topics::kEnergy, TypeSupport(new pmu::v4::EnergyPubSubType()), qos_profiles::kState);
-  w_->baseline = newer(topics::kBaseline, TypeSupport(new pmu::v4::BaselinePubSubType()), qos_profiles::kState);
+  w_->alarms = newer(topics::kAlarms, dds::zero_padded<pmu::v4::AlarmPubSubType>(), qos_profiles::kAlarms);
+  w_->readiness = newer(topics::kReadiness, dds::zero_padded<pmu::v4::ReadinessPubSubType>(), qos_profiles::kState);
+  w_->derived_energy = newer(topics::kEnergy, dds::zero_padded<pmu::v4::EnergyPubSubType>(), qos_profiles::kState);
+  w_->baseline = newer(topics::kBaseline, dds::zero_padded<pmu::v4::BaselinePubSubType>(), qos_profiles::kState);
   if (canopen_deadline)
-    w_->bms_energy = newer(topics::kBmsEnergy, TypeSupport(new pmu::v4::BmsEnergyPubSubType()), qos_profiles::kState);
+    w_->bms_energy = newer(topics::kBmsEnergy, dds::zero_padded<pmu::v4::BmsEnergyPubSubType>(), qos_profiles::kState);
 }
 
 DdsPublisher::~DdsPublisher() = default;

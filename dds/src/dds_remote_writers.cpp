@@ -2,6 +2,7 @@
 
 #include <fastdds/rtps/common/InstanceHandle.h>
 
+#include <set>
 #include <sstream>
 
 namespace pmu::dds {
@@ -72,6 +73,14 @@ std::vector<RemoteWriters::Seen> RemoteWriters::writers_of(const std::string& to
   for (const auto& [guid, w] : writers_)
     if (w.topic == topic) out.push_back(Seen{w.partitions, w.type_name});
   return out;
+}
+
+std::vector<std::string> RemoteWriters::topics_of_type(const std::string& type_name) const {
+  std::set<std::string> topics;
+  std::lock_guard<std::mutex> lock(mutex_);
+  for (const auto& [guid, w] : writers_)
+    if (w.type_name == type_name) topics.insert(w.topic);
+  return {topics.begin(), topics.end()};
 }
 
 }  // namespace pmu::dds

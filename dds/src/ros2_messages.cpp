@@ -24,10 +24,11 @@ std::uint8_t supply_status(double current, double soc_percent) {
 
 // What the battery's own alarms say of its health, the worst first: over-temperature, then a
 // critical low (voltage or charge: the battery is spent), then any other fault of the pack.
-std::uint8_t supply_health(service::HealthState health, const std::vector<service::AlarmReport>& active,
+// Nothing is known of the health of a battery that is not there.
+std::uint8_t supply_health(bool present, service::HealthState health, const std::vector<service::AlarmReport>& active,
                            const std::vector<Code>& overheat, const std::vector<Code>& dead,
                            const std::vector<Code>& failure) {
-  if (health != service::HealthState::Online) return Bs::POWER_SUPPLY_HEALTH_UNKNOWN;
+  if (!present || health != service::HealthState::Online) return Bs::POWER_SUPPLY_HEALTH_UNKNOWN;
   auto any = [&](const std::vector<Code>& codes) {
     return std::any_of(active.begin(), active.end(), [&](const service::AlarmReport& a) {
       return alarm_active(a) && std::find(codes.begin(), codes.end(), a.code) != codes.end();
@@ -52,7 +53,7 @@ void add(diagnostic_msgs::msg::DiagnosticStatus& s, std::string key, std::string
 }
 
 std::string seconds_text(double s) {
-  if (s < 0) return "none";
+  if (!(s >= 0)) return "never";
   char buf[32];
   std::snprintf(buf, sizeof buf, "%.1f", s);
   return buf;
@@ -87,12 +88,13 @@ sensor_msgs::msg::BatteryState pmu_battery_message(const PmuBatteryView& v) {
   m.percentage(as_float(kUnknown));
   m.power_supply_status(supply_status(v.current, kUnknown));
   const bool a = v.input != 'B';
-  m.power_supply_health(supply_health(v.health, v.active,
+  // An input with no battery reads about 0 V.
+  const bool present = !std::isnan(v.voltage) && v.voltage >= 1.0;
+  m.power_supply_health(supply_health(present, v.health, v.active,
                                       {a ? Code::BatteryAOverTemperature : Code::BatteryBOverTemperature},
                                       {a ? Code::BatteryACriticalVoltage : Code::BatteryBCriticalVoltage}, {}));
   m.power_supply_technology(Bs::POWER_SUPPLY_TECHNOLOGY_UNKNOWN);
-  // An input with no battery reads about 0 V.
-  m.present(!std::isnan(v.voltage) && v.voltage >= 1.0);
+  m.present(present);
   m.location(a ? "battery_a" : "battery_b");
   // The battery has no serial on the bus; the PMU that measures it has.
   m.serial_number(v.pmu_serial ? "pmu " + std::to_string(*v.pmu_serial) : "");
@@ -116,7 +118,7 @@ sensor_msgs::msg::BatteryState bms_battery_message(const BmsView& v) {
   m.design_capacity(as_float(design));
   m.percentage(as_float(soc / 100.0));
   m.power_supply_status(supply_status(current, soc));
-  m.power_supply_health(supply_health(v.health, v.active, {Code::BmsOverTemperature},
+  m.power_supply_health(supply_health(!std::isnan(voltage), v.health, v.active, {Code::BmsOverTemperature},
                                       {Code::BmsCriticalSoc}, {Code::CellLow, Code::CellImbalance}));
   m.power_supply_technology(Bs::POWER_SUPPLY_TECHNOLOGY_UNKNOWN);
   m.present(!std::isnan(voltage));
@@ -154,11 +156,11 @@ diagnostic_msgs::msg::DiagnosticStatus device_status(const DeviceDiagnosticsView
       break;
     case service::HealthState::Stale:
       s.level(Ds::STALE);
-      s.message("stale: last frame " + seconds_text(v.health.last_frame_age) + " s ago");
+      s.message("stale: " + service::last_frame_text(v.health.last_frame_age));
       break;
     case service::HealthState::Offline:
       s.level(Ds::ERROR);
-      s.message("offline: last frame " + seconds_text(v.health.last_frame_age) + " s ago");
+      s.message("offline: " + service::last_frame_text(v.health.last_frame_age));
       break;
     case service::HealthState::Online:
       if (active.empty()) {

@@ -6,6 +6,7 @@
 
 #include "diagnostic_msgs/msg/DiagnosticArrayPubSubTypes.h"
 #include "pmu/dds/ros2_messages.hpp"
+#include "pmu/dds/zero_padded_type.hpp"
 #include "pmu/session/log_throttle.hpp"
 #include "sensor_msgs/msg/BatteryStatePubSubTypes.h"
 
@@ -79,6 +80,10 @@ struct Ros2Publisher::State {
   std::mutex mutex;
   std::map<ros2_publisher::Key, ros2_publisher::Device> devices;
   DataWriter* diagnostics = nullptr;
+  // Each device's newest status: every /diagnostics message carries them all (as ROS 2's
+  // diagnostic_updater does), so the one message a KEEP_LAST 1 writer keeps for a late
+  // subscriber holds every device's current status.
+  std::map<ros2_publisher::Key, diagnostic_msgs::msg::DiagnosticStatus> statuses;
   std::uint64_t failures = 0;
   service::LogThrottle failure_reports{std::chrono::seconds(5)};
 
@@ -91,7 +96,7 @@ struct Ros2Publisher::State {
     const std::string ros_name =
         service::ros2_device_namespace(settings.name_space, vehicle, k.bus, ros2_publisher::ros2_kind(k.kind), k.address) + "/" + leaf;
     try {
-      auto& topic = dds.topic(service::ros2_dds_topic(ros_name), eprosima::fastdds::dds::TypeSupport(new sensor_msgs::msg::BatteryStatePubSubType()));
+      auto& topic = dds.topic(service::ros2_dds_topic(ros_name), zero_padded<sensor_msgs::msg::BatteryStatePubSubType>());
       return &dds.default_partition_writer(topic, ros2_writer_qos());
     } catch (const DdsError& e) {
       failed(ros_name.c_str(), e.what());
@@ -106,6 +111,12 @@ struct Ros2Publisher::State {
     ++failures;
     if (failure_reports.allow(service::LogThrottle::Clock::now()))
       spdlog::warn("ROS 2: {}: {} ({} failure(s) so far)", what, why, failures);
+  }
+  void write_diagnostics() {
+    diagnostic_msgs::msg::DiagnosticArray array;
+    set_stamp(array.header(), std::chrono::system_clock::now());
+    for (const auto& [key, status] : statuses) array.status().push_back(status);
+    write(diagnostics, &array, "/diagnostics");
   }
   void write_pmu_batteries(const DeviceKey& k, ros2_publisher::Device& d, std::chrono::system_clock::time_point at) {
     if (!d.refused && !d.battery_a) d.battery_a = battery_writer(k, "battery_a");
@@ -152,7 +163,7 @@ Ros2Publisher::Ros2Publisher(DdsContext& dds, const service::Ros2Settings& setti
   for (const auto& b : buses)
     for (const auto& battery : b.batteries)
       if (battery.capacity_ah) s_->capacity_ah[{b.name, battery.node}] = *battery.capacity_ah;
-  auto& topic = dds.topic("rt/diagnostics", eprosima::fastdds::dds::TypeSupport(new diagnostic_msgs::msg::DiagnosticArrayPubSubType()));
+  auto& topic = dds.topic("rt/diagnostics", zero_padded<diagnostic_msgs::msg::DiagnosticArrayPubSubType>());
   s_->diagnostics = &dds.default_partition_writer(topic, ros2_writer_qos());
 }
 
@@ -206,16 +217,16 @@ void Ros2Publisher::on_health(const DeviceKey& key, const service::HealthReport&
   v.extra.emplace(v.extra.begin(), "bus", key.bus);
   v.health = health;
   v.active = d.active();
-  diagnostic_msgs::msg::DiagnosticArray array;
-  set_stamp(array.header(), std::chrono::system_clock::now());
-  array.status().push_back(device_status(v));
-  s_->write(s_->diagnostics, &array, "/diagnostics");
+  s_->statuses[ros2_publisher::key_of(key)] = device_status(v);
+  s_->write_diagnostics();
 }
 
 void Ros2Publisher::on_gone(const DeviceKey& key) {
   // A ROS 2 topic has no instance to dispose, and its writer keeps the last message for late
   // joiners: the last one says that nothing is there (not present, nothing measured).
   std::lock_guard<std::mutex> lock(s_->mutex);
+  // Its status leaves /diagnostics: the address is no device any more.
+  if (s_->statuses.erase(ros2_publisher::key_of(key))) s_->write_diagnostics();
   auto it = s_->devices.find(ros2_publisher::key_of(key));
   if (it == s_->devices.end()) return;
   ros2_publisher::Device fresh;

@@ -4,7 +4,9 @@
 // reader: magic, footer, summary, chunk indexes, CRCs; with --stream the stream reader,
 // which is what a viewer falls back to for a file without a summary, e.g. after a crash),
 // each channel's schema is parsed by @foxglove/omgidl-parser and every message decoded by
-// @foxglove/omgidl-serialization's MessageReader, as Foxglove and Lichtblick do.
+// @foxglove/omgidl-serialization's MessageReader, as Foxglove and Lichtblick do; a `ros2msg`
+// schema (the ROS 2 topics) by @foxglove/rosmsg's parser and @foxglove/rosmsg2-serialization's
+// MessageReader, as Foxglove reads ROS 2 channels.
 //
 //   node read_mcap.mjs FILE.mcap [--stream]
 // FILE "-" is standard input, read to its end (`pmuctl record - | node read_mcap.mjs - --stream`).
@@ -13,6 +15,8 @@ import { readFile, open } from "node:fs/promises";
 import { McapIndexedReader, McapStreamReader } from "@mcap/core";
 import { parseIDL } from "@foxglove/omgidl-parser";
 import { MessageReader } from "@foxglove/omgidl-serialization";
+import { parse as parseRosmsg } from "@foxglove/rosmsg";
+import { MessageReader as Ros2MessageReader } from "@foxglove/rosmsg2-serialization";
 
 const args = process.argv.slice(2);
 const stream = args.includes("--stream");
@@ -39,10 +43,14 @@ function readerFor(channelId) {
   if (!channel) throw new Error(`message on unknown channel ${channelId}`);
   const schema = schemas.get(channel.schemaId);
   if (!schema) throw new Error(`channel ${channel.topic} names unknown schema ${channel.schemaId}`);
-  if (channel.messageEncoding !== "cdr" || schema.encoding !== "omgidl")
-    throw new Error(`channel ${channel.topic}: encodings ${channel.messageEncoding}/${schema.encoding}, not cdr/omgidl`);
+  if (channel.messageEncoding !== "cdr" || (schema.encoding !== "omgidl" && schema.encoding !== "ros2msg"))
+    throw new Error(`channel ${channel.topic}: encodings ${channel.messageEncoding}/${schema.encoding}, not cdr/omgidl or cdr/ros2msg`);
   const text = new TextDecoder().decode(schema.data);
-  const r = { topic: channel.topic, schema: schema.name, reader: new MessageReader(schema.name, parseIDL(text)) };
+  const reader =
+    schema.encoding === "ros2msg"
+      ? new Ros2MessageReader(parseRosmsg(text, { ros2: true }))
+      : new MessageReader(schema.name, parseIDL(text));
+  const r = { topic: channel.topic, schema: schema.name, reader };
   readers.set(channelId, r);
   return r;
 }
@@ -117,6 +125,7 @@ try {
       ? { message_count: st.messageCount.toString(), channel_count: st.channelCount, chunk_count: st.chunkCount }
       : null;
     end.topics = [...reader.channelsById.values()].map((c) => c.topic);
+    end.schemas = [...reader.schemasById.values()].map((x) => ({ name: x.name, encoding: x.encoding }));
     if (handle) await handle.close();
   }
   end.messages = count;

@@ -51,7 +51,11 @@ TEST(Ros2Messages, PmuBatteryStatusHealthAndPresence) {
       {'B', 24.6, 0.0, HealthState::Online, {}, Bs::POWER_SUPPLY_STATUS_NOT_CHARGING, Bs::POWER_SUPPLY_HEALTH_GOOD, true},
       {'B', 24.6, 0.05, HealthState::Online, {}, Bs::POWER_SUPPLY_STATUS_NOT_CHARGING, Bs::POWER_SUPPLY_HEALTH_GOOD, true},
       {'A', 24.6, kUnknown, HealthState::Online, {}, Bs::POWER_SUPPLY_STATUS_UNKNOWN, Bs::POWER_SUPPLY_HEALTH_GOOD, true},
-      {'B', 0.0, 0.0, HealthState::Online, {}, Bs::POWER_SUPPLY_STATUS_NOT_CHARGING, Bs::POWER_SUPPLY_HEALTH_GOOD, false},
+      // No battery on the input: nothing is known of its health.
+      {'B', 0.0, 0.0, HealthState::Online, {}, Bs::POWER_SUPPLY_STATUS_NOT_CHARGING, Bs::POWER_SUPPLY_HEALTH_UNKNOWN, false},
+      {'A', 0.4, 0.0, HealthState::Online, {alarm(Code::BatteryACriticalVoltage)}, Bs::POWER_SUPPLY_STATUS_NOT_CHARGING,
+       Bs::POWER_SUPPLY_HEALTH_UNKNOWN, false},
+      {'A', kUnknown, kUnknown, HealthState::Online, {}, Bs::POWER_SUPPLY_STATUS_UNKNOWN, Bs::POWER_SUPPLY_HEALTH_UNKNOWN, false},
       {'A', kUnknown, kUnknown, HealthState::Unknown, {}, Bs::POWER_SUPPLY_STATUS_UNKNOWN, Bs::POWER_SUPPLY_HEALTH_UNKNOWN, false},
       {'A', 24.6, -1, HealthState::Stale, {}, Bs::POWER_SUPPLY_STATUS_DISCHARGING, Bs::POWER_SUPPLY_HEALTH_UNKNOWN, true},
       {'A', 19.0, -1, HealthState::Online, {alarm(Code::BatteryACriticalVoltage)}, Bs::POWER_SUPPLY_STATUS_DISCHARGING,
@@ -200,6 +204,13 @@ TEST(Ros2Messages, BmsStatusAndHealth) {
     EXPECT_EQ(m.power_supply_status(), c.status);
     EXPECT_EQ(m.power_supply_health(), c.supply_health);
   }
+  // Online, but its voltage not received: not present, health unknown.
+  BmsView v;
+  v.values = bms_values(kUnknown, kUnknown, kUnknown);
+  v.health = HealthState::Online;
+  const auto m = bms_battery_message(v);
+  EXPECT_FALSE(m.present());
+  EXPECT_EQ(m.power_supply_health(), Bs::POWER_SUPPLY_HEALTH_UNKNOWN);
 }
 
 TEST(Ros2Messages, DiagnosticLevelFromHealthAndAlarms) {
@@ -244,6 +255,32 @@ TEST(Ros2Messages, DiagnosticLevelFromHealthAndAlarms) {
   const auto s = device_status(v);
   EXPECT_EQ(key_value(s, "active_alarms"), "thermal_shutdown,battery_a_low_voltage") << "critical first";
   EXPECT_EQ(key_value(s, "alarm thermal_shutdown"), "critical, ACTIVE_UNACKNOWLEDGED: thermal_shutdown message");
+}
+
+// A device never heard (last_frame_age -1) has no age to print: its status says so as
+// pmuctl does (`never`), in the message and in `last_frame_age_s`.
+TEST(Ros2Messages, DiagnosticOfADeviceNeverHeard) {
+  struct Case {
+    HealthState health;
+    double age;
+    std::string message, age_value;
+  };
+  const Case cases[] = {
+      {HealthState::Unknown, -1, "no frame yet", "never"},
+      {HealthState::Offline, -1, "offline: no frame yet", "never"},
+      {HealthState::Stale, -1, "stale: no frame yet", "never"},
+      {HealthState::Offline, 12.3, "offline: last frame 12.3 s ago", "12.3"},
+      {HealthState::Online, 0.0, "online", "0.0"},
+  };
+  for (const auto& c : cases) {
+    SCOPED_TRACE(c.message);
+    DeviceDiagnosticsView v;
+    v.health.state = c.health;
+    v.health.last_frame_age = c.age;
+    const auto s = device_status(v);
+    EXPECT_EQ(s.message(), c.message);
+    EXPECT_EQ(key_value(s, "last_frame_age_s"), c.age_value);
+  }
 }
 
 }  // namespace

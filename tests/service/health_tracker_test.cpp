@@ -99,5 +99,12 @@ TEST(HealthTracker, CountersAndBusStateTravelInTheReport) {
   EXPECT_EQ(r.bus_state, transport::BusState::Down);
 }
 
+// The log's words for the age: a device never heard (age -1) has none to print.
+TEST(HealthTracker, TheLastFrameInWords) {
+  const std::pair<double, const char*> cases[] = {
+      {-1, "no frame yet"}, {0.04, "last frame 0.0 s ago"}, {3.5, "last frame 3.5 s ago"}, {61.26, "last frame 61.3 s ago"}};
+  for (const auto& [age, text] : cases) EXPECT_EQ(last_frame_text(age), text) << age;
+}
+
 }  // namespace
 }  // namespace pmu::service::health_tracker_test

@@ -301,8 +301,8 @@ void DeviceSession::update_health(SteadyTime now, bool force) {
   const auto& report = health_.report();
   if (u.changed && report.state != HealthState::Unknown)
     spdlog::log(report.state == HealthState::Online ? spdlog::level::info : spdlog::level::warn,
-                "{}/{}: {} (last frame {:.1f} s ago)", key_.bus, key_.address, to_string(report.state),
-                report.last_frame_age);
+                "{}/{}: {} ({})", key_.bus, key_.address, to_string(report.state),
+                last_frame_text(report.last_frame_age));
   if (u.publish) sink_.on_health(key_, report);
 }
 

@@ -1,5 +1,7 @@
 #include "pmu/session/health_tracker.hpp"
 
+#include <cstdio>
+
 namespace pmu::service {
 namespace {
 
@@ -15,6 +17,13 @@ const char* to_string(HealthState s) noexcept {
     case HealthState::Offline: return "OFFLINE";
   }
   return "UNKNOWN";
+}
+
+std::string last_frame_text(double age_s) {
+  if (!(age_s >= 0)) return "no frame yet";
+  char buf[48];
+  std::snprintf(buf, sizeof buf, "last frame %.1f s ago", age_s);
+  return buf;
 }
 
 const char* to_string(DeviceKind k) noexcept {

@@ -3,7 +3,6 @@
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
-#include <map>
 
 namespace pmu::tools {
 
@@ -19,18 +18,20 @@ std::string McapRecording::open(const std::string& path, const std::vector<const
   if (auto why = out_.open(path); !why.empty()) return why;
   writer_ = std::make_unique<pmu::mcap::Writer>(out_.sink(), pmu::mcap::WriterOptions{"", "pmuctl (pmu-dds)", 256 * 1024});
   if (!writer_->open()) return error();
-  std::map<std::string, std::uint16_t> schemas;  // by type name: topics of one type share it
-  for (const auto* t : topics) {
-    auto it = schemas.find(t->type_name);
-    if (it == schemas.end())
-      it = schemas.emplace(t->type_name, writer_->add_schema(t->type_name, "omgidl", std::string(t->idl))).first;
-    channels_.push_back(writer_->add_channel(it->second, t->topic, "cdr"));
-  }
-  topics_ = topics;
-  counts_.assign(topics.size(), 0);
+  for (const auto* t : topics) add_topic(t);
   // The schemas and channels reach the file at once: a recording stopped before its first
   // chunk still says what it would have held.
   return writer_->flush() ? std::string() : error();
+}
+
+std::size_t McapRecording::add_topic(const RecordedTopic* t) {
+  auto it = schemas_.find(t->schema());
+  if (it == schemas_.end())
+    it = schemas_.emplace(t->schema(), writer_->add_schema(t->schema(), t->schema_encoding(), std::string(t->idl))).first;
+  channels_.push_back(writer_->add_channel(it->second, t->channel_name(), "cdr"));
+  topics_.push_back(t);
+  counts_.push_back(0);
+  return topics_.size() - 1;
 }
 
 bool McapRecording::write(std::size_t topic, std::uint64_t time_ns, const std::uint8_t* data, std::size_t size) {
@@ -73,7 +74,7 @@ std::string McapRecording::progress() const {
   std::string per;
   for (std::size_t i = 0; i < topics_.size(); ++i) {
     if (counts_[i] == 0) continue;
-    std::string_view name = topics_[i]->topic;
+    std::string_view name = topics_[i]->channel_name();
     if (name.substr(0, 4) == "pmu/") name.remove_prefix(4);
     per += (per.empty() ? "" : ", ") + std::string(name) + " " + std::to_string(counts_[i]);
   }

@@ -8,6 +8,7 @@
 // No DDS: samples arrive as CDR bytes. Not thread-safe (record serialises calls).
 
 #include <cstdint>
+#include <map>
 #include <memory>
 #include <string>
 #include <vector>
@@ -30,7 +31,12 @@ class McapRecording {
   // player's timeline starts with the recording, not hours before; its publish time stays its
   // own. Without it (decode --mcap) log time = publish time.
   void start_log_times_at(std::uint64_t start_ns) { log_start_ns_ = start_ns; }
-  // `topic`: index into open()'s list. `time_ns`: since the Unix epoch, the message's publish
+  // One more topic, while recording (a ROS 2 topic discovery found): its schema (unless a
+  // topic of its type has it) and channel go into the chunk being filled, before its first
+  // message. Its index for write() is the number of topics before it.
+  std::size_t add_topic(const RecordedTopic* topic);
+
+  // `topic`: index into open()'s list, then add_topic()'s. `time_ns`: since the Unix epoch, the message's publish
   // time (its source time), and its log time unless before start_log_times_at's. False once
   // the file cannot be written (error()).
   bool write(std::size_t topic, std::uint64_t time_ns, const std::uint8_t* data, std::size_t size);
@@ -64,6 +70,7 @@ class McapRecording {
   std::vector<std::uint16_t> channels_;
   std::vector<std::uint64_t> counts_;
   std::uint64_t log_start_ns_ = 0;
+  std::map<std::string, std::uint16_t> schemas_;  // by schema name: topics of one type share it
 };
 
 // "56.7 kB"

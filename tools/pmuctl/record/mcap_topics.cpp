@@ -58,7 +58,8 @@ std::vector<const RecordedTopic*> select_topics(const std::vector<std::string>& 
     if (!t) {
       std::string known;
       for (const auto& k : recorded_topics()) known += (known.empty() ? "" : ", ") + std::string(k.topic);
-      error = "--topic " + n + " is not a topic of the contract (" + known + ")";
+      error = "--topic " + n + " is not a topic of the contract (" + known +
+              ") nor a ROS 2 topic of the service (/diagnostics, /<vehicle>/<bus>/pmu_<a>/battery_a, ...)";
       return {};
     }
     if (std::find(topics.begin(), topics.end(), t) == topics.end()) topics.push_back(t);

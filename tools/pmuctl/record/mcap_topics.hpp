@@ -16,6 +16,16 @@ struct RecordedTopic {
   std::string_view idl;     // the schema text
   const char* qos_profile;  // deploy/qos.xml's reader profile
   bool by_default;          // recorded when no --topic is given
+  // A ROS 2 topic pmu-service writes (ros2_topics.hpp, docs/interface.md 11): read in the
+  // default partition with a ROS 2 subscriber's QoS (qos_profile unused); its channel is named
+  // as ROS 2 names the topic and its schema is the ros2msg definition.
+  bool ros2 = false;
+  const char* channel = nullptr;      // the MCAP/Foxglove topic ("/diagnostics"); nullptr: `topic`
+  const char* schema_name = nullptr;  // "diagnostic_msgs/msg/DiagnosticArray"; nullptr: `type_name`
+
+  const char* channel_name() const { return channel ? channel : topic; }
+  const char* schema() const { return schema_name ? schema_name : type_name; }
+  const char* schema_encoding() const { return ros2 ? "ros2msg" : "omgidl"; }
 };
 
 // Every topic `record` knows, in the contract's order.

@@ -1,16 +1,19 @@
 #include "pmuctl/record/raw_topic_readers.hpp"
 
+#include <algorithm>
 #include <cstdio>
 
 #include <fastdds/dds/subscriber/DataReader.hpp>
 #include <fastdds/dds/subscriber/SampleInfo.hpp>
 
+#include "diagnostic_msgs/msg/DiagnosticArrayPubSubTypes.h"
 #include "pmu/idl/alarmsPubSubTypes.h"
 #include "pmu/idl/canopenPubSubTypes.h"
 #include "pmu/idl/commandPubSubTypes.h"
 #include "pmu/idl/energyPubSubTypes.h"
 #include "pmu/idl/statePubSubTypes.h"
 #include "pmu/idl/telemetryPubSubTypes.h"
+#include "sensor_msgs/msg/BatteryStatePubSubTypes.h"
 
 namespace pmu::tools {
 namespace {
@@ -61,15 +64,30 @@ TypeSupport raw_type_support(const std::string& type_name) {
   if (type_name == "pmu::v4::Command") return TypeSupport(new RawSampleType<pmu::v4::CommandPubSubType>());
   if (type_name == "pmu::v4::AlarmAck") return TypeSupport(new RawSampleType<pmu::v4::AlarmAckPubSubType>());
   if (type_name == "pmu::v4::AlarmAckReply") return TypeSupport(new RawSampleType<pmu::v4::AlarmAckReplyPubSubType>());
+  if (type_name == kRos2BatteryType) return TypeSupport(new RawSampleType<sensor_msgs::msg::BatteryStatePubSubType>());
+  if (type_name == kRos2DiagnosticsType)
+    return TypeSupport(new RawSampleType<diagnostic_msgs::msg::DiagnosticArrayPubSubType>());
   return TypeSupport(new RawSampleType<pmu::v4::CommandReplyPubSubType>());
 }
 
 void RawTopicReaders::open(pmu::dds::DdsContext& dds, const std::vector<const RecordedTopic*>& topics) {
-  for (std::size_t i = 0; i < topics.size(); ++i) {
-    listeners_.push_back(std::make_unique<TopicListener>(sink_, i));
-    dds.reader(dds.topic(topics[i]->topic, raw_type_support(topics[i]->type_name)), topics[i]->qos_profile,
-               listeners_.back().get());
+  for (std::size_t i = 0; i < topics.size(); ++i) open_one(dds, *topics[i], i);
+}
+
+void RawTopicReaders::open_one(pmu::dds::DdsContext& dds, const RecordedTopic& topic, std::size_t index) {
+  auto listener = std::make_unique<TopicListener>(sink_, index);
+  auto& t = dds.topic(topic.topic, raw_type_support(topic.type_name));
+  if (topic.ros2) {
+    DataReaderQos q = DATAREADER_QOS_DEFAULT;
+    q.reliability().kind = RELIABLE_RELIABILITY_QOS;
+    q.durability().kind = TRANSIENT_LOCAL_DURABILITY_QOS;
+    q.history().kind = KEEP_LAST_HISTORY_QOS;
+    q.history().depth = 16;
+    dds.default_partition_reader(t, q, listener.get());
+  } else {
+    dds.reader(t, topic.qos_profile, listener.get());
   }
+  listeners_.push_back(std::move(listener));
 }
 
 bool forwarded_topics(const GlobalOptions& o, const std::vector<std::string>& names, const char* verb,
@@ -84,6 +102,50 @@ bool forwarded_topics(const GlobalOptions& o, const std::vector<std::string>& na
   topics = select_topics(names, unknown);
   if (topics.empty()) std::fprintf(stderr, "pmuctl %s: %s\n", verb, unknown.c_str());
   return !topics.empty();
+}
+
+bool forwarded_topics(const GlobalOptions& o, const std::vector<std::string>& names, const char* verb,
+                      std::vector<const RecordedTopic*>& topics, Ros2Selection& ros2) {
+  std::vector<std::string> contract;
+  for (const auto& n : names) {
+    if (auto r = ros2_topic_named(n)) {
+      if (std::none_of(ros2.named.begin(), ros2.named.end(), [&](const auto& x) { return x.dds_topic == r->dds_topic; }))
+        ros2.named.push_back(*r);
+    } else {
+      contract.push_back(n);
+    }
+  }
+  ros2.discover = names.empty();
+  // Only ROS 2 topics named: no contract topic, but --bus and --address refused alike.
+  if (contract.empty() && !names.empty() && o.bus.empty() && !o.address) {
+    topics.clear();
+    return true;
+  }
+  return forwarded_topics(o, contract, verb, topics);
+}
+
+void Ros2Readers::update(pmu::dds::DdsContext& dds, RawTopicReaders& readers,
+                         const std::function<std::size_t(const RecordedTopic&)>& add) {
+  for (const auto& n : selection_.named) open(dds, readers, add, n);
+  if (!selection_.discover) return;
+  for (const char* type : {kRos2DiagnosticsType, kRos2BatteryType})
+    for (const auto& topic : dds.remote_writers().topics_of_type(type)) {
+      const auto name = ros2_topic_named(topic);
+      if (!name || std::string_view(name->type_name) != type) continue;  // not a topic of the service's
+      if (vehicle_ && !ros2_topic_of_vehicle(topic, *vehicle_)) continue;
+      open(dds, readers, add, *name);
+    }
+}
+
+void Ros2Readers::open(pmu::dds::DdsContext& dds, RawTopicReaders& readers,
+                       const std::function<std::size_t(const RecordedTopic&)>& add, const Ros2TopicName& name) {
+  if (!opened_.insert(name.dds_topic).second) return;
+  const RecordedTopic* t = topics_.get(name);
+  try {
+    readers.open_one(dds, *t, add(*t));
+  } catch (const pmu::dds::DdsError& e) {
+    std::fprintf(stderr, "pmuctl %s: %s: %s\n", verb_, t->channel_name(), e.what());
+  }
 }
 
 }  // namespace pmu::tools

@@ -27,7 +27,8 @@ struct Shared {
 
 int run_record(const GlobalOptions& o, const std::string& path, const std::vector<std::string>& names) {
   std::vector<const RecordedTopic*> topics;
-  if (!forwarded_topics(o, names, "record", topics)) return 2;
+  Ros2Selection ros2;
+  if (!forwarded_topics(o, names, "record", topics, ros2)) return 2;
 
   pmu::transport::StopSignals stop;
   // A reader of a pipe or FIFO that goes away gives EPIPE, said and exit status 1, instead
@@ -57,12 +58,20 @@ int run_record(const GlobalOptions& o, const std::string& path, const std::vecto
     pmu::dds::DdsContext dds(o.domain, o.qos_file, "pmuctl-record", o.security, pmu::dds::Transport::Default,
                              o.network, partitions_for(o));
     readers.open(dds, topics);
+    // A ROS 2 topic's channel is added before its reader exists, so before its first message.
+    Ros2Readers ros2_readers(std::move(ros2), o.vehicle, "record");
+    const auto add_channel = [&s](const RecordedTopic& t) {
+      std::lock_guard<std::mutex> lock(s.mutex);
+      return s.rec.add_topic(&t);
+    };
+    ros2_readers.update(dds, readers, add_channel);
     std::fprintf(stderr, "pmuctl record: recording %zu topics on domain %d into %s; Ctrl-C stops\n", topics.size(),
                  o.domain, shared->rec.name().c_str());
     const bool tty = ::isatty(STDERR_FILENO) == 1;
     int ticks = 0;
     for (;;) {
       const bool signalled = stop.wait_for(std::chrono::seconds(1)) != 0;
+      if (!signalled) ros2_readers.update(dds, readers, add_channel);
       std::lock_guard<std::mutex> lock(shared->mutex);
       if (signalled) break;
       if (!shared->rec.flush() || shared->rec.failed()) break;

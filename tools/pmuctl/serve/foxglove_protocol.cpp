@@ -111,7 +111,7 @@ std::string advertise_json(const std::vector<Channel>& channels) {
                     {"encoding", "cdr"},
                     {"schemaName", c.schema_name},
                     {"schema", std::string(c.schema)},
-                    {"schemaEncoding", "omgidl"}});
+                    {"schemaEncoding", std::string(c.schema_encoding)}});
   return json{{"op", "advertise"}, {"channels", std::move(list)}}.dump();
 }
 

@@ -43,6 +43,7 @@ struct Channel {
   std::string topic;        // the DDS topic name, "pmu/voltages"
   std::string schema_name;  // the DDS type name, "pmu::v4::Voltages"
   std::string_view schema;  // the IDL text (static storage: pmu::idl_text)
+  std::string_view schema_encoding = "omgidl";  // "ros2msg" for a ROS 2 topic (pmu::ros2_msg_text)
 };
 
 enum class StatusLevel : int { Info = 0, Warning = 1, Error = 2 };
@@ -97,6 +98,8 @@ class ClientSubscriptions {
     return channel < by_channel_.size() ? by_channel_[channel] : std::nullopt;
   }
   std::size_t count() const { return by_id_.size(); }
+  // A channel advertised after the client connected: the next id.
+  void add_channel() { by_channel_.emplace_back(); }
 
  private:
   std::map<std::uint32_t, std::uint32_t> by_id_;             // subscription id -> channel

@@ -120,6 +120,7 @@ struct FoxgloveServer::Impl {
   virtual std::string start() = 0;
   virtual void publish(std::uint32_t channel, std::uint64_t time_ns, const Instance& instance,
                        std::vector<std::uint8_t>&& payload) = 0;
+  virtual void add_channel(foxglove::Channel channel, bool latched) = 0;
   virtual Counters counters() const = 0;
   virtual void stop() = 0;
 };
@@ -158,6 +159,7 @@ struct Endpoint final : FoxgloveServer::Impl {
 
   std::mutex pending_mutex;  // publish() and the drain
   std::deque<Pending> pending;
+  std::vector<std::pair<foxglove::Channel, bool>> added;  // add_channel(), before the samples pending
   std::size_t pending_bytes = 0;
   bool drain_posted = false;
 
@@ -263,12 +265,25 @@ struct Endpoint final : FoxgloveServer::Impl {
 
   void drain() {
     std::deque<Pending> batch;
+    std::vector<std::pair<foxglove::Channel, bool>> new_channels;
     {
       std::lock_guard<std::mutex> lock(pending_mutex);
       batch.swap(pending);
+      new_channels.swap(added);
       pending_bytes = 0;
       drain_posted = false;
     }
+    for (auto& [channel, state] : new_channels) {
+      const std::string one = foxglove::advertise_json({channel});
+      channels.push_back(std::move(channel));
+      latched.push_back(state);
+      for (auto& [h, client] : clients) {
+        client.subscriptions.add_channel();
+        if (const auto con = connection(h); con && con->get_state() == websocketpp::session::state::open)
+          con->send(one, websocketpp::frame::opcode::text);
+      }
+    }
+    if (!new_channels.empty()) advertise = foxglove::advertise_json(channels);
     // The batch's newest source time is the clock; each client hears it (send_time) before
     // the batch's first message it gets.
     for (const auto& p : batch) clock = std::max(clock, p.time_ns);
@@ -318,6 +333,7 @@ struct Endpoint final : FoxgloveServer::Impl {
   std::string start() override;
   void publish(std::uint32_t channel, std::uint64_t time_ns, const Instance& instance,
                std::vector<std::uint8_t>&& payload) override;
+  void add_channel(foxglove::Channel channel, bool state) override;
   Counters counters() const override {
     return Counters{client_count.load(), forwarded.load(), dropped.load()};
   }
@@ -409,6 +425,19 @@ void Endpoint<Config>::publish(std::uint32_t channel, std::uint64_t time_ns, con
 }
 
 template <class Config>
+void Endpoint<Config>::add_channel(foxglove::Channel channel, bool state) {
+  Endpoint& m = *this;
+  bool post = false;
+  {
+    std::lock_guard<std::mutex> lock(m.pending_mutex);
+    m.added.emplace_back(std::move(channel), state);
+    post = !m.drain_posted;
+    m.drain_posted = true;
+  }
+  if (post) asio::post(m.server.get_io_service(), [&m] { m.drain(); });
+}
+
+template <class Config>
 void Endpoint<Config>::stop() {
   Endpoint& m = *this;
   if (!m.thread.joinable()) return;
@@ -445,6 +474,10 @@ std::string FoxgloveServer::start() { return impl_->start(); }
 void FoxgloveServer::publish(std::uint32_t channel, std::uint64_t time_ns, const std::array<std::uint8_t, 16>& instance,
                              std::vector<std::uint8_t>&& payload) {
   impl_->publish(channel, time_ns, instance, std::move(payload));
+}
+
+void FoxgloveServer::add_channel(foxglove::Channel channel, bool latched) {
+  impl_->add_channel(std::move(channel), latched);
 }
 
 FoxgloveServer::Counters FoxgloveServer::counters() const { return impl_->counters(); }

@@ -66,6 +66,10 @@ class FoxgloveServer {
   // `instance`: the DDS instance (for latched channels).
   void publish(std::uint32_t channel, std::uint64_t time_ns, const std::array<std::uint8_t, 16>& instance,
                std::vector<std::uint8_t>&& payload);
+  // Any thread. One more channel (a ROS 2 topic discovery found), its id the number of
+  // channels before it: advertised to the clients connected and to those that connect later.
+  // Samples published for it after this call reach the server thread after the channel.
+  void add_channel(foxglove::Channel channel, bool latched);
   Counters counters() const;
   // Closes every connection (going away), waits for them briefly, ends the server thread.
   void stop();

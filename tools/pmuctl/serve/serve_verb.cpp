@@ -41,12 +41,14 @@ std::string load_tls(const ServeOptions& serve, TlsPem& pem) {
 
 int run_serve(const GlobalOptions& o, const ServeOptions& serve, const std::vector<std::string>& names) {
   std::vector<const RecordedTopic*> topics;
-  if (!forwarded_topics(o, names, "serve", topics)) return 2;
+  Ros2Selection ros2;
+  if (!forwarded_topics(o, names, "serve", topics, ros2)) return 2;
   // Channel id = index into `topics`, which is also the readers' topic index.
   std::vector<foxglove::Channel> channels;
   std::vector<bool> latched;
   for (std::uint32_t i = 0; i < topics.size(); ++i) {
-    channels.push_back(foxglove::Channel{i, topics[i]->topic, topics[i]->type_name, topics[i]->idl});
+    channels.push_back(foxglove::Channel{i, topics[i]->channel_name(), topics[i]->schema(), topics[i]->idl,
+                                         topics[i]->schema_encoding()});
     const std::string_view profile = topics[i]->qos_profile;
     latched.push_back(profile == pmu::qos_profiles::kState || profile == pmu::qos_profiles::kAlarms);
   }
@@ -80,6 +82,17 @@ int run_serve(const GlobalOptions& o, const ServeOptions& serve, const std::vect
     pmu::dds::DdsContext dds(o.domain, o.qos_file, "pmuctl-serve", o.security, pmu::dds::Transport::Default,
                              o.network, partitions_for(o));
     readers.open(dds, topics);
+    // A ROS 2 topic, found in discovery, becomes a channel advertised to every client. Its
+    // writer keeps its last message (TRANSIENT_LOCAL, keyless): latched, as the state topics,
+    // with the sample's source timestamp, so an old message does not look new (docs/safety.md H7).
+    Ros2Readers ros2_readers(std::move(ros2), o.vehicle, "serve");
+    auto next_id = static_cast<std::uint32_t>(topics.size());
+    const auto add_channel = [&server, &next_id](const RecordedTopic& t) {
+      const std::uint32_t id = next_id++;
+      server.add_channel(foxglove::Channel{id, t.channel_name(), t.schema(), t.idl, t.schema_encoding()}, true);
+      return std::size_t{id};
+    };
+    ros2_readers.update(dds, readers, add_channel);
     std::fprintf(stderr,
                  "pmuctl serve: serving %zu topics of domain %d on %s://%s (Foxglove WebSocket, subprotocol %s); "
                  "Ctrl-C stops\n",
@@ -87,6 +100,7 @@ int run_serve(const GlobalOptions& o, const ServeOptions& serve, const std::vect
                  std::string(foxglove::kSubprotocols).c_str());
     const bool tty = ::isatty(STDERR_FILENO) == 1;
     for (int ticks = 1; stop.wait_for(std::chrono::seconds(1)) == 0; ++ticks) {
+      ros2_readers.update(dds, readers, add_channel);
       if (tty)
         std::fprintf(stderr, "\r\033[Kpmuctl serve: %s", progress(server.counters()).c_str());
       else if (ticks % 10 == 0)

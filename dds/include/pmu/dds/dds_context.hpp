@@ -146,6 +146,13 @@ class DdsContext {
   eprosima::fastdds::dds::DataWriter& default_partition_writer(eprosima::fastdds::dds::Topic& topic,
                                                                const eprosima::fastdds::dds::DataWriterQos& qos);
 
+  // A reader in the default partition with `qos` as given, not from qos.xml: for ROS 2's
+  // topics read as a ROS 2 subscriber reads them (pmuctl record and serve). Throws DdsError
+  // like reader(); `listener` as for reader().
+  eprosima::fastdds::dds::DataReader& default_partition_reader(eprosima::fastdds::dds::Topic& topic,
+                                                               const eprosima::fastdds::dds::DataReaderQos& qos,
+                                                               eprosima::fastdds::dds::DataReaderListener* listener);
+
   // The writers and readers made by writer() and reader() so far. A long-lived context that
   // serves one job after another (`pmuctl agent`) deletes each job's endpoints when it ends
   // (delete_endpoints_since), so its participant does not grow with every job. Deleting
@@ -218,6 +225,7 @@ class DdsContext {
   eprosima::fastdds::dds::DomainParticipant* participant_ = nullptr;
   eprosima::fastdds::dds::Publisher* publisher_ = nullptr;
   eprosima::fastdds::dds::Publisher* default_publisher_ = nullptr;  // made by the first default_partition_writer()
+  eprosima::fastdds::dds::Subscriber* default_subscriber_ = nullptr;  // made by the first default_partition_reader()
   eprosima::fastdds::dds::Subscriber* subscriber_ = nullptr;
   std::map<std::string, eprosima::fastdds::dds::Topic*> topics_;
   std::vector<eprosima::fastdds::dds::DataWriter*> writers_;  // made by writer(), in order

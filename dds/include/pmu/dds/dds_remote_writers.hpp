@@ -35,6 +35,11 @@ class RemoteWriters final : public eprosima::fastdds::dds::DomainParticipantList
   // (which it can never match) learns that they are there.
   std::vector<Seen> writers_of(const std::string& topic) const;
 
+  // The topics of every remote writer of type `type_name` discovery reported, each once, in
+  // name order: a reader of ROS 2 topics (pmuctl record, serve) finds a service's battery
+  // topics, which are named for its devices.
+  std::vector<std::string> topics_of_type(const std::string& type_name) const;
+
   void on_participant_discovery(eprosima::fastdds::dds::DomainParticipant*,
                                 eprosima::fastrtps::rtps::ParticipantDiscoveryInfo&& info) override;
 

@@ -61,6 +61,10 @@ struct InfoState {
 enum class HealthState : std::uint8_t { Unknown, Online, Stale, Offline };
 const char* to_string(HealthState s) noexcept;
 
+// For people reading a log or a status: `last frame 3.5 s ago`, or `no frame yet` for an age
+// below 0 (HealthReport's "never"), which is no age to print.
+std::string last_frame_text(double age_s);
+
 struct HealthReport {
   HealthState state = HealthState::Unknown;
   transport::BusState bus_state = transport::BusState::Up;
