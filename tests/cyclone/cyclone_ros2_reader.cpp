@@ -110,14 +110,19 @@ int main(int argc, char** argv) {
     ++missed;
   }
   using Array = diagnostic_msgs_msg_dds__DiagnosticArray_;
-  // A device's first status may be STALE "no frame yet", published before its first frame:
-  // every status is printed, and the wait ends at the first OK one.
+  // Each array holds every device's newest status (interface.md 11.3). A device's first status
+  // may be STALE "no frame yet", published before its first frame: every status is printed,
+  // and the wait ends at the first array whose statuses are all OK.
   if (!wait_for<Array>(diag, [](const Array& a) {
-        if (a.status._length != 1) return false;
-        const auto& s = a.status._buffer[0];
-        std::printf("diagnostics name=%s level=%u message=%s hardware_id=%s values=%u\n", s.name,
-                    static_cast<unsigned>(s.level), s.message, s.hardware_id, s.values._length);
-        return s.level == 0;
+        if (a.status._length == 0) return false;
+        bool all_ok = true;
+        for (uint32_t i = 0; i < a.status._length; ++i) {
+          const auto& s = a.status._buffer[i];
+          std::printf("diagnostics name=%s level=%u message=%s hardware_id=%s values=%u\n", s.name,
+                      static_cast<unsigned>(s.level), s.message, s.hardware_id, s.values._length);
+          all_ok = all_ok && s.level == 0;
+        }
+        return all_ok;
       })) {
     std::printf("MISS diagnostics\n");
     ++missed;
