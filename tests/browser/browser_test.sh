@@ -5,10 +5,13 @@
 # a voltage against the player's time axis (page.mjs; judged by drive.mjs). The server runs
 # against pmu-service on the simulated power system.
 #   browser_test.sh PMU-SERVICE PMUCTL SOURCE-DIR SCREENSHOT.png MODE
-# MODE: http-websocket  http page, ws://, subprotocol foxglove.websocket.v1
-#       http-sdk        http page, ws://, subprotocol foxglove.sdk.v1
-#       https-sdk       https page (a certificate made here), wss:// (serve --tls-cert/--tls-key),
-#                       foxglove.sdk.v1; the page's origin given to serve --allow-origin
+# MODE: http-websocket  http page on 127.0.0.1, ws://, subprotocol foxglove.websocket.v1
+#       http-sdk        http page on 127.0.0.1, ws://, subprotocol foxglove.sdk.v1
+#       https-sdk       https page of a site of its own (https://viz.test:PORT, a certificate
+#                       made here), wss:// (serve --tls-cert/--tls-key --allow-origin that site),
+#                       foxglove.sdk.v1
+# In every mode a page of another site (other.test, an origin serve does not allow) is then
+# refused. *.test names this host for Chromium (drive.mjs).
 # Skipped (exit 77) with the reason when Chromium, Node.js or tests/browser's npm packages
 # (scripts/setup.sh: npm ci there) are missing.
 set -uo pipefail
@@ -58,14 +61,17 @@ cp "$here/index.html" "$work/site/"
 
 tls=()
 if [ "$scheme" = https ]; then
-  openssl req -x509 -newkey rsa:2048 -nodes -days 1 -subj "/CN=127.0.0.1" -addext "subjectAltName=IP:127.0.0.1" \
+  openssl req -x509 -newkey rsa:2048 -nodes -days 1 -subj "/CN=viz.test" \
+    -addext "subjectAltName=DNS:viz.test,DNS:other.test,IP:127.0.0.1" \
     -keyout "$work/key.pem" -out "$work/cert.pem" 2>"$work/openssl.err" || fail "openssl: $(cat "$work/openssl.err")"
   tls=("$work/cert.pem" "$work/key.pem")
 fi
 node "$here/static_server.mjs" "$work/site" "${tls[@]}" >"$work/site.out" 2>&1 &
 pids+=($!)
 wait_for "$work/site.out" $! "^$scheme://" || fail "the web server did not start: $(cat "$work/site.out")"
-page_origin=$(head -n 1 "$work/site.out")
+site_port=$(head -n 1 "$work/site.out" | sed 's/.*://')
+page_origin="$scheme://127.0.0.1:$site_port"
+[ "$scheme" = https ] && page_origin="https://viz.test:$site_port"
 
 "$svc" --config "$src/deploy/examples/sim-power-system.yaml" --domain "$domain" >"$work/service.log" 2>&1 &
 pids+=($!)
@@ -83,4 +89,7 @@ sleep 2  # discovery: the samples flow before the page comes
 
 node "$here/drive.mjs" "$chromium" "$page_origin" "$ws_url" "$subprotocol" 6 "$screenshot" || fail "the page's view of $ws_url from $page_origin"
 grep -q "client 127.0.0.1:[0-9]* connected" "$work/serve.err" || fail "no connect line"
+other="$scheme://other.test:$site_port"
+node "$here/drive.mjs" "$chromium" "$other" "$ws_url" "$subprotocol" 2 "$work/refused.png" --refused || fail "a page from $other"
+grep -q "refused 127.0.0.1:[0-9]*: .*$other" "$work/serve.err" || fail "no line saying the page from $other was refused"
 echo "browser $mode: PASS (plot: $screenshot)"

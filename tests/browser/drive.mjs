@@ -1,12 +1,16 @@
 // Drives headless Chromium (puppeteer-core) to the test page and judges what the page saw of
 // `pmuctl serve` (docs/interface.md section 9.2) against pmu-service on the simulated power
 // system (deploy/examples/sim-power-system.yaml).
-//   node drive.mjs CHROMIUM PAGE-URL WS-URL SUBPROTOCOL SECONDS SCREENSHOT.png
-// The page's plot is saved to SCREENSHOT.png whatever the verdict. Exit status 0 when every
-// check passed; 1 with the problems on stderr.
+//   node drive.mjs CHROMIUM PAGE-URL WS-URL SUBPROTOCOL SECONDS SCREENSHOT.png [--refused]
+// The page's plot is saved to SCREENSHOT.png whatever the verdict. With --refused the page's
+// origin is one the server must refuse: the page must get no connection and nothing from it.
+// Host names ending in .test are this host (Chromium's resolver is told so), so a page can
+// have an origin other than a local one. Exit status 0 when every check passed; 1 with the
+// problems on stderr.
 import puppeteer from "puppeteer-core";
 
-const [chromium, pageUrl, wsUrl, subprotocol, seconds, screenshot] = process.argv.slice(2);
+const [chromium, pageUrl, wsUrl, subprotocol, seconds, screenshot, expect] = process.argv.slice(2);
+const refused = expect === "--refused";
 const problems = [];
 const problem = (p) => problems.push(p);
 
@@ -14,7 +18,11 @@ const browser = await puppeteer.launch({
   executablePath: chromium,
   headless: true,
   // The https page and wss:// use a certificate made for this run; root has no sandbox.
-  args: ["--ignore-certificate-errors", ...(process.getuid?.() === 0 ? ["--no-sandbox"] : [])],
+  args: [
+    "--ignore-certificate-errors",
+    "--host-resolver-rules=MAP *.test 127.0.0.1",
+    ...(process.getuid?.() === 0 ? ["--no-sandbox"] : []),
+  ],
 });
 let result;
 try {
@@ -30,14 +38,27 @@ try {
   const canvas = await page.$("#plot");
   await canvas.screenshot({ path: screenshot });
   console.log(`screenshot: ${screenshot}`);
-  if (consoleLines.some((l) => l.startsWith("error"))) problem(`console: ${consoleLines.join("; ")}`);
+  // A refused WebSocket is an error on the console; anything else there is a problem.
+  if (!refused && consoleLines.some((l) => l.startsWith("error"))) problem(`console: ${consoleLines.join("; ")}`);
 } finally {
   await browser.close();
 }
 
-for (const e of result.errors) problem(`page: ${e}`);
 const origin = new URL(pageUrl).origin;
 if (result.origin !== origin) problem(`page origin ${result.origin}, not ${origin}`);
+if (refused) {
+  // The handshake fails: no subprotocol, no serverInfo, no message, an abnormal close.
+  if (result.negotiated !== "" || result.serverInfo || result.times.length || result.messages["pmu/voltages"].length)
+    problem(`a page from ${origin} was served: ${JSON.stringify({ negotiated: result.negotiated, serverInfo: result.serverInfo })}`);
+  if (result.closeCode !== 1006) problem(`a page from ${origin}: close code ${result.closeCode}, not 1006 (handshake refused)`);
+  if (problems.length) {
+    console.error(problems.join("\n"));
+    process.exit(1);
+  }
+  console.log(`browser ${origin} -> ${result.url}: refused (${result.errors.join("; ")})`);
+  process.exit(0);
+}
+for (const e of result.errors) problem(`page: ${e}`);
 if (result.negotiated !== subprotocol) problem(`offered ${subprotocol}, negotiated "${result.negotiated}"`);
 
 // serverInfo: pmuctl's, with the `time` capability.
