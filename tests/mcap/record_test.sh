@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # pmuctl record against pmu-service on the simulated power system: stopped by SIGINT the
 # file has a summary, @mcap/core reads it and each schema is its type's own; killed with
-# SIGKILL the stream reader still reads its complete chunks; an unwritable path and a full
+# SIGKILL the stream reader still reads its complete chunks; a recorder started late logs the
+# state published before it at its start (publish time kept); an unwritable path and a full
 # disk are refused with what and where; onto each kind of path (interface.md section 9.1,
 # "Where the file goes") nothing record did not create is removed, renamed over or
 # truncated; `record -` pipes the file into a reader.
@@ -60,6 +61,45 @@ if read_mcap "$work/rec.mcap" >"$work/rec.jsonl"; then
   node "$MCAP_TESTS_DIR/check_schemas.mjs" "$work/rec.mcap" --max-total 20000 || fail "schemas of the recording"
 else
   fail "@mcap/core's indexed reader refused the file"
+fi
+
+# 1b. A recording started long after the service published its state: pmu/config and pmu/info
+# (TRANSIENT_LOCAL, published at the service's start) come first with that old source time as
+# their publish time, but no message is logged before the recording started, so a player's
+# timeline begins with the recording.
+start_ns=$(date +%s%N)
+"$ctl" --domain "$domain" record --topic config --topic info --topic voltages "$work/late.mcap" 2>"$work/late.err" &
+rec=$!
+late_holds() {
+  local f
+  f=$(ls "$work"/late.mcap.partial-* 2>/dev/null) && [ -n "$f" ] && read_mcap --stream "$f" >"$work/late_poll.jsonl" 2>/dev/null &&
+    grep -q '"pmu/voltages"' "$work/late_poll.jsonl" && grep -q '"pmu/info"' "$work/late_poll.jsonl"
+}
+within 30 late_holds || fail "after 30 s the late recording holds no voltages and info"
+kill -INT "$rec"
+wait "$rec" || fail "late record: $(cat "$work/late.err")"
+if read_mcap "$work/late.mcap" >"$work/late.jsonl"; then
+  node -e '
+    const [file, start] = [process.argv[1], BigInt(process.argv[2])];
+    const lines = require("fs").readFileSync(file, "utf8").split("\n").filter((l) => l.trim()).map((l) => JSON.parse(l));
+    const messages = lines.filter((l) => !l.end);
+    const problems = [];
+    for (const m of messages) {
+      const [log, pub] = [BigInt(m.log_time), BigInt(m.publish_time)];
+      if (log < start) problems.push(`${m.topic}: logged at ${log}, before the recording started (${start})`);
+      if (pub > log) problems.push(`${m.topic}: published at ${pub}, after its log time ${log}`);
+      if (pub < log && log - start > 5000000000n) problems.push(`${m.topic}: log time ${log} is neither its publish time nor the start`);
+    }
+    for (const topic of ["pmu/config", "pmu/info"]) {
+      const state = messages.filter((m) => m.topic === topic);
+      if (!state.length) problems.push(`no ${topic}`);
+      for (const m of state)
+        if (BigInt(m.publish_time) >= start) problems.push(`${topic}: published at ${m.publish_time}, not before the recording`);
+    }
+    if (problems.length) { console.error(problems.slice(0, 10).join("\n")); process.exit(1); }' \
+    "$work/late.jsonl" "$start_ns" || fail "late recording times"
+else
+  fail "@mcap/core refused the late recording"
 fi
 
 # 2. SIGKILL: what a crash leaves is read up to the last complete chunk. It is the temporary

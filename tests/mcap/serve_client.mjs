@@ -9,10 +9,18 @@
 //     their messages (the state topics', published once long before this client came, must
 //     arrive at once, as DDS gives a late joiner the current state):
 //     keys and field names as `pmuctl watch --json` prints them (WATCH.jsonl, recorded over
-//     the same seconds), the same values for the same samples, timestamps of now.
+//     the same seconds), the same values for the same samples, timestamps of now; the
+//     capability time: a Time message before the first message, none going back, no live
+//     message stamped after the last Time, state sent at subscribe stamped no earlier than it
+//     (a player's timeline is not stretched back to when that state was published).
+//   node serve_client.mjs URL first SECONDS
+//     subscribes to pmu/voltages and ends at the first message that decodes, with its values on
+//     stdout; exit status 1 if none came within SECONDS (a bound that only turns "never"
+//     into a failure: when the first sample comes is up to DDS discovery).
 //   node serve_client.mjs URL count SECONDS OUT.json
 //     subscribes to pmu/voltages and writes {"messages": N, "per_second": [...]} to OUT.json
 //     (the slow-client test's reader that must keep receiving).
+// A wss:// URL is verified against the certificate in $SERVE_TLS_CA (a self-signed one).
 // Exit status 0 when every check passed; 1 with the problems on stderr.
 import { readFileSync, writeFileSync } from "node:fs";
 import wsProtocol from "@foxglove/ws-protocol"; // CommonJS: no named exports
@@ -49,7 +57,11 @@ const defaultTopics = {
 const f32 = (v) => (typeof v === "number" && Number.isFinite(v) && !Number.isInteger(v) ? Number(Math.fround(v).toPrecision(7)) : v);
 const sameNumber = (a, b) => a === b || (typeof a === "number" && typeof b === "number" && Math.abs(a - b) <= 1e-6 * Math.max(1, Math.abs(a)));
 
-const ws = new WebSocket(url, [FoxgloveClient.SUPPORTED_SUBPROTOCOL]);
+const ws = new WebSocket(
+  url,
+  [FoxgloveClient.SUPPORTED_SUBPROTOCOL],
+  process.env.SERVE_TLS_CA ? { ca: readFileSync(process.env.SERVE_TLS_CA) } : {},
+);
 const client = new FoxgloveClient({ ws });
 const channels = new Map(); // id -> {topic, schemaName, reader}
 const subscriptions = new Map(); // subscription id -> channel
@@ -57,10 +69,12 @@ const received = new Map(); // topic -> [{time (bigint ns), values}]
 const statuses = [];
 let serverInfo;
 let perSecond = [0];
+const times = []; // the Time messages' timestamps (bigint ns)
 
 client.on("error", (e) => problem(`client error: ${e.message ?? e}`));
 client.on("serverInfo", (info) => (serverInfo = info));
 client.on("status", (s) => statuses.push(s));
+client.on("time", ({ timestamp }) => times.push(timestamp));
 client.on("advertise", (list) => {
   for (const c of list) {
     try {
@@ -77,12 +91,23 @@ client.on("message", ({ subscriptionId, timestamp, data }) => {
   const channel = subscriptions.get(subscriptionId);
   if (!channel) return problem(`message for unknown subscription ${subscriptionId}`);
   perSecond[perSecond.length - 1]++;
+  if (mode === "first") {
+    try {
+      const bytes = new Uint8Array(data.buffer, data.byteOffset, data.byteLength);
+      const v = channel.reader.readMessage(bytes);
+      if (!(v.avionics > 5 && v.avionics < 40)) problem(`voltages avionics ${v.avionics}`);
+      finish(() => console.log(`serve_client first: ${channel.topic} of ${v.bus}/${v.address}, avionics ${v.avionics}`));
+    } catch (e) {
+      problem(`${channel.topic}: message does not decode: ${e.message}`);
+    }
+    return;
+  }
   if (mode !== "check") return;
   try {
     const bytes = new Uint8Array(data.buffer, data.byteOffset, data.byteLength);
     const values = channel.reader.readMessage(bytes);
     if (!received.has(channel.topic)) received.set(channel.topic, []);
-    received.get(channel.topic).push({ time: timestamp, values });
+    received.get(channel.topic).push({ time: timestamp, values, clock: times.at(-1) });
   } catch (e) {
     problem(`${channel.topic}: message does not decode: ${e.message}`);
   }
@@ -111,6 +136,12 @@ function start() {
     ws.send(JSON.stringify({ op: "subscribe", subscriptions: [{ id: -1, channelId: 0 }] }));
     ws.send(new Uint8Array([1, 0, 0, 0, 0]));
     setTimeout(finishCheck, Number(rest[1]) * 1000);
+  } else if (mode === "first") {
+    subscribe("pmu/voltages");
+    setTimeout(() => {
+      problem(`no pmu/voltages message within ${rest[0]} s`);
+      finish();
+    }, Number(rest[0]) * 1000);
   } else {
     subscribe("pmu/voltages");
     const tick = setInterval(() => perSecond.push(0), 1000);
@@ -141,8 +172,23 @@ function finishCheck() {
   if (!serverInfo) problem("no serverInfo");
   else {
     if (!/pmuctl/.test(serverInfo.name)) problem(`serverInfo name ${serverInfo.name}`);
-    if (!Array.isArray(serverInfo.capabilities)) problem("serverInfo capabilities is not an array");
+    if (JSON.stringify(serverInfo.capabilities) !== JSON.stringify(["time"]))
+      problem(`serverInfo capabilities ${JSON.stringify(serverInfo.capabilities)}, not ["time"]`);
   }
+  // The capability time: the server's clock is the source time of what it forwards.
+  if (!times.length) problem("no Time message");
+  if (times.some((t, i) => i > 0 && t < times[i - 1])) problem(`the server's time went back: ${times.slice(0, 10)}`);
+  const stateTopics = ["pmu/info", "pmu/config", "pmu/health"];
+  for (const [topic, list] of received)
+    for (const m of list) {
+      if (m.clock === undefined) problem(`${topic}: a message before any Time message`);
+      else if (!stateTopics.includes(topic) && m.time > m.clock)
+        problem(`${topic}: stamped ${m.time}, after the server's time ${m.clock}`);
+    }
+  // pmu/info was published once, when the service started: what the late subscriber gets is
+  // stamped with the server's time then, not that old source time.
+  for (const m of received.get("pmu/info") ?? [])
+    if (m.clock !== undefined && m.time < m.clock) problem(`pmu/info stamped ${m.time}, before the server's time ${m.clock}`);
   if (ws.protocol !== FoxgloveClient.SUPPORTED_SUBPROTOCOL) problem(`negotiated subprotocol "${ws.protocol}"`);
 
   // advertise: record's default topics, named as the DDS topics, cdr + omgidl

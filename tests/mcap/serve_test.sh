@@ -1,13 +1,18 @@
 #!/usr/bin/env bash
 # pmuctl serve (docs/interface.md section 9.2) against pmu-service on the simulated bus.
-#   serve_test.sh PMU-SERVICE PMUCTL SOURCE-DIR foxglove|slow|cli
+#   serve_test.sh PMU-SERVICE PMUCTL SOURCE-DIR foxglove|slow|tls|cli
 # foxglove: Foxglove's own client (serve_client.mjs check) reads serverInfo, the channels and
 #           their schemas, and pmu/voltages, pmu/health, pmu/battery equal to `pmuctl watch
-#           --json`; a client without the subprotocol is refused; SIGINT stops it with 0.
+#           --json`, on the server's clock (capability time); a client offering only
+#           foxglove.sdk.v1 is served; a client without the subprotocol is refused (400), and
+#           pages of origins not allowed (403); SIGINT stops it with 0.
 # slow:     a client that never reads (ws_raw.py slow) has its messages dropped, named on
 #           stderr, while a normal client keeps receiving at the full rate.
-# cli:      a port in use (exit 1, address:port named), bad --port/--listen/--client-queue
-#           (exit 2). Needs no Node.js.
+# tls:      wss:// with a self-signed certificate made now: Foxglove's client, verifying it,
+#           reads live messages; plain ws:// on every interface warns about https pages.
+# cli:      a port in use (exit 1, address:port named), bad --port/--listen/--client-queue/
+#           --allow-origin, TLS files missing, not PEM or not matching (exit 2). Needs no
+#           Node.js.
 set -uo pipefail
 svc=$1 ctl=$2 src=$3 mode=$4
 here="$(cd "$(dirname "$0")" && pwd)"
@@ -30,7 +35,7 @@ free_port() { python3 -c 'import socket; s=socket.socket(); s.bind(("127.0.0.1",
 # Waits until the server's stderr says it serves (or it exited); false after 20 s.
 wait_serving() {
   for _ in $(seq 200); do
-    grep -q "serving .* on ws://" "$1" && return 0
+    grep -q "serving .* on wss\?://" "$1" && return 0
     kill -0 "$2" 2>/dev/null || return 1
     sleep 0.1
   done
@@ -49,9 +54,29 @@ foxglove)
   "$svc" --config "$src/deploy/examples/sim-power-system.yaml" --domain "$domain" >"$work/service.log" 2>&1 &
   pids+=($!)
   port=$(free_port)
-  "$ctl" --domain "$domain" serve --port "$port" 2>"$work/serve.err" &
+  "$ctl" --domain "$domain" serve --port "$port" --allow-origin https://viz.example.com:8443 2>"$work/serve.err" &
   server=$!; pids+=($server)
   wait_serving "$work/serve.err" "$server" || { fail "serve did not start: $(cat "$work/serve.err")"; exit 1; }
+
+  # Pages: the defaults and --allow-origin's are let in, others refused with 403 and a line
+  # that says how to allow them.
+  for origin in https://app.foxglove.dev file:// http://localhost:8080 http://127.0.0.1 "http://[::1]:5173" \
+                https://viz.example.com:8443; do
+    line=$(python3 "$here/ws_raw.py" "$port" origin "$origin")
+    [[ "$line" == "HTTP/1.1 101 "* ]] || fail "a page of $origin got: $line"
+  done
+  for origin in https://evil.example null https://viz.example.com http://192.168.1.10:8080; do
+    line=$(python3 "$here/ws_raw.py" "$port" origin "$origin")
+    [[ "$line" == "HTTP/1.1 403 "* ]] || fail "a page of $origin got: $line"
+  done
+  grep -q "refused 127.0.0.1:[0-9]*: origin https://evil.example is not allowed (pmuctl serve --allow-origin https://evil.example allows it)" "$work/serve.err" ||
+    fail "no origin refusal line: $(cat "$work/serve.err")"
+  grep -q "refused 127.0.0.1:[0-9]*: origin null is not allowed (it is no scheme://host\[:port\] origin; only --allow-origin '\*' allows it)" "$work/serve.err" ||
+    fail "no refusal line for origin null: $(cat "$work/serve.err")"
+
+  # The Foxglove SDK's name of the protocol, offered alone.
+  python3 "$here/ws_raw.py" "$port" sdk || fail "a client offering foxglove.sdk.v1"
+  grep -q "client 127.0.0.1:[0-9]* connected (foxglove.sdk.v1)" "$work/serve.err" || fail "no sdk connect line"
 
   line=$(python3 "$here/ws_raw.py" "$port" no-subprotocol)
   [[ "$line" == "HTTP/1.1 400 "* ]] || fail "a client without the subprotocol got: $line"
@@ -64,7 +89,7 @@ foxglove)
   sleep 2  # serve has pmu/info and pmu/config by now: the client is a late joiner
   node "$here/serve_client.mjs" "ws://127.0.0.1:$port" check "$work/watch.jsonl" 6 || fail "serve_client check"
   wait "$watcher"
-  grep -q "client 127.0.0.1:[0-9]* connected" "$work/serve.err" || fail "no connect line"
+  grep -q "client 127.0.0.1:[0-9]* connected (foxglove.websocket.v1)" "$work/serve.err" || fail "no connect line"
   grep -q "client 127.0.0.1:[0-9]* disconnected" "$work/serve.err" || fail "no disconnect line"
   stop_server "$server" "$work/serve.err"
   ;;
@@ -115,6 +140,32 @@ slow)
   grep -q "publish_failures\|refused" "$work/service.log" && fail "the service could not publish: $(grep -m3 "refused" "$work/service.log")"
   ;;
 
+tls)
+  "$svc" --config "$src/deploy/examples/sim-power-system.yaml" --domain "$domain" >"$work/service.log" 2>&1 &
+  pids+=($!)
+  openssl req -x509 -newkey rsa:2048 -nodes -days 1 -subj /CN=127.0.0.1 -addext subjectAltName=IP:127.0.0.1 \
+    -keyout "$work/key.pem" -out "$work/cert.pem" 2>/dev/null || { fail "openssl req"; exit 1; }
+  port=$(free_port)
+  "$ctl" --domain "$domain" serve --port "$port" --tls-cert "$work/cert.pem" --tls-key "$work/key.pem" 2>"$work/serve.err" &
+  server=$!; pids+=($server)
+  wait_serving "$work/serve.err" "$server" || { fail "serve did not start: $(cat "$work/serve.err")"; exit 1; }
+  grep -q "serving .* on wss://127.0.0.1:$port " "$work/serve.err" || fail "start line: $(cat "$work/serve.err")"
+  SERVE_TLS_CA="$work/cert.pem" node "$here/serve_client.mjs" "wss://127.0.0.1:$port" first 30 || fail "wss client"
+  # A plain ws:// client gets no WebSocket from a wss:// server.
+  line=$(python3 "$here/ws_raw.py" "$port" origin http://localhost 2>&1 | head -1)
+  [[ "$line" == "HTTP/1.1 101 "* ]] && fail "a plain client was served on wss://"
+  stop_server "$server" "$work/serve.err"
+  # Plain ws:// on every interface: https pages cannot connect, said at start.
+  port=$(free_port)
+  "$ctl" --domain "$domain" serve --listen 0.0.0.0 --port "$port" 2>"$work/plain.err" &
+  server=$!; pids+=($server)
+  wait_serving "$work/plain.err" "$server" || { fail "serve did not start: $(cat "$work/plain.err")"; exit 1; }
+  grep -q "warning: ws://0.0.0.0:$port is plain WebSocket: a page served over https (the Foxglove web app) may not connect to it (mixed content).*--tls-cert and --tls-key" "$work/plain.err" ||
+    fail "no mixed-content warning: $(cat "$work/plain.err")"
+  stop_server "$server" "$work/plain.err"
+  grep -q "warning" "$work/serve.err" && fail "a warning with TLS: $(cat "$work/serve.err")"
+  ;;
+
 cli)
   # A listener holds a port (it picks a free one and says which).
   python3 -c 'import socket,time; s=socket.socket(); s.bind(("127.0.0.1",0)); s.listen(); print(s.getsockname()[1], flush=True); time.sleep(60)' >"$work/held" &
@@ -134,11 +185,29 @@ cli)
   check_refused "--listen 'localhost' is not an IP address" --listen localhost
   check_refused "--client-queue '1' is not a size in kB 64..1048576" --client-queue 1
   check_refused "--topic nonsense is not a topic of the contract" --topic nonsense
+  check_refused "--allow-origin 'viz.example.com' is not an origin scheme://host[:port]" --allow-origin viz.example.com
+  check_refused "--allow-origin 'https://viz.example.com/' is not an origin" --allow-origin https://viz.example.com/
+  check_refused "--tls-cert and --tls-key go together" --tls-cert "$work/none.pem"
+  # TLS files: missing, not PEM, a key that is not the certificate's; refused before listening.
+  check_refused "--tls-cert $work/none.pem cannot be read: No such file or directory" \
+    --tls-cert "$work/none.pem" --tls-key "$work/none.pem"
+  if command -v openssl >/dev/null; then
+    openssl req -x509 -newkey rsa:2048 -nodes -days 1 -subj /CN=127.0.0.1 -keyout "$work/key.pem" -out "$work/cert.pem" 2>/dev/null
+    openssl genpkey -algorithm RSA -pkeyopt rsa_keygen_bits:2048 -out "$work/other.pem" 2>/dev/null
+    echo "not a certificate" >"$work/junk.pem"
+    check_refused "--tls-cert $work/junk.pem: not a PEM certificate (chain): " --tls-cert "$work/junk.pem" --tls-key "$work/key.pem"
+    check_refused "--tls-key $work/cert.pem: not a PEM private key: " --tls-cert "$work/cert.pem" --tls-key "$work/cert.pem"
+    check_refused "--tls-key $work/other.pem is not the private key of the certificate in --tls-cert $work/cert.pem" \
+      --tls-cert "$work/cert.pem" --tls-key "$work/other.pem"
+    check_refused "--tls-key $work cannot be read: " --tls-cert "$work/cert.pem" --tls-key "$work"
+  else
+    fail "openssl is not installed (scripts/setup.sh test)"
+  fi
   timeout 20 "$ctl" --domain "$domain" --bus sim0 serve 2>"$work/err"; status=$?
   [ $status -eq 2 ] && grep -q "bus and --address do not apply" "$work/err" || fail "--bus: $status $(cat "$work/err")"
   ;;
 *)
-  echo "usage: serve_test.sh PMU-SERVICE PMUCTL SOURCE-DIR foxglove|slow|cli" >&2; exit 2 ;;
+  echo "usage: serve_test.sh PMU-SERVICE PMUCTL SOURCE-DIR foxglove|slow|tls|cli" >&2; exit 2 ;;
 esac
 if [ $failures -ne 0 ]; then
   echo "--- serve stderr" >&2; tail -n 30 "$work/serve.err" 2>/dev/null >&2

@@ -28,12 +28,32 @@ json only_status(const std::vector<std::string>& replies) {
   return j;
 }
 
-TEST(FoxgloveProtocol, ServerInfoHasNameAndNoCapabilities) {
+TEST(FoxgloveProtocol, ServerInfoHasNameAndTheTimeCapability) {
   const json j = parsed(server_info_json("pmuctl serve (pmu-dds)"));
   EXPECT_EQ(j["op"], "serverInfo");
   EXPECT_EQ(j["name"], "pmuctl serve (pmu-dds)");
-  ASSERT_TRUE(j["capabilities"].is_array());
-  EXPECT_TRUE(j["capabilities"].empty());
+  EXPECT_EQ(j["capabilities"], json::array({"time"}));
+}
+
+TEST(FoxgloveProtocol, TimeIsOpcodeTwoAndNanosecondsLittleEndian) {
+  const std::string t = time_message(1700000000123456789ull);
+  const std::string want("\x02\x15\xCD\x85\x3D\xFE\x9C\x97\x17", 9);
+  EXPECT_EQ(t, want);
+  EXPECT_EQ(time_message(0), std::string(9, '\0').replace(0, 1, "\x02"));
+}
+
+TEST(FoxgloveProtocol, SubprotocolIsTheFirstOfferedThatTheServerSpeaks) {
+  struct Case { std::vector<std::string> offered; std::string_view chosen; };
+  const Case cases[] = {
+      {{"foxglove.websocket.v1"}, "foxglove.websocket.v1"},
+      {{"foxglove.sdk.v1"}, "foxglove.sdk.v1"},
+      {{"foxglove.sdk.v1", "foxglove.websocket.v1"}, "foxglove.sdk.v1"},
+      {{"foxglove.websocket.v1", "foxglove.sdk.v1"}, "foxglove.websocket.v1"},
+      {{"chat", "foxglove.sdk.v1"}, "foxglove.sdk.v1"},
+      {{"foxglove.websocket.v2", "FOXGLOVE.SDK.V1"}, ""},
+      {{}, ""},
+  };
+  for (const auto& c : cases) EXPECT_EQ(choose_subprotocol(c.offered), c.chosen) << c.offered.size();
 }
 
 TEST(FoxgloveProtocol, AdvertiseListsEveryChannelAsCdrWithOmgIdlSchema) {

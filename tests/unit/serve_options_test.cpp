@@ -1,5 +1,5 @@
-// `pmuctl serve`'s --listen, --port and --client-queue (serve_options.hpp): every text gives
-// a value or a message naming the option.
+// `pmuctl serve`'s --listen, --port, --client-queue, --allow-origin, --tls-cert and --tls-key
+// (serve_options.hpp): every text gives a value or a message naming the option.
 #include <gtest/gtest.h>
 
 #include "pmuctl/serve/serve_options.hpp"
@@ -46,6 +46,40 @@ TEST(ServeOptions, RefusedWithTheOptionNamed) {
     const auto why = parse_serve_options(c.listen, c.port, c.queue, o);
     EXPECT_NE(why.find(c.says), std::string::npos) << why;
     EXPECT_EQ(o.port, 8765) << "left as it was";
+  }
+}
+
+TEST(ServeOptions, AccessOptions) {
+  struct Case { std::vector<std::string> origins; const char *cert, *key, *says; };
+  const Case cases[] = {
+      {{}, "", "", ""},
+      {{"https://viz.example.com", "*"}, "c.pem", "k.pem", ""},
+      {{"viz.example.com"}, "", "", "--allow-origin 'viz.example.com' is not an origin"},
+      {{}, "c.pem", "", "--tls-cert and --tls-key go together (the certificate chain and its private key, PEM): "
+                        "--tls-key is missing"},
+      {{}, "", "k.pem", "--tls-cert is missing"},
+  };
+  for (const auto& c : cases) {
+    ServeOptions o;
+    const auto why = parse_serve_access(c.origins, c.cert, c.key, o);
+    if (*c.says == '\0') {
+      EXPECT_EQ(why, "");
+      EXPECT_EQ(o.tls(), *c.cert != '\0');
+      EXPECT_EQ(o.origins.exact.size() + (o.origins.any ? 1u : 0u), c.origins.size());
+    } else {
+      EXPECT_NE(why.find(c.says), std::string::npos) << why;
+      EXPECT_FALSE(o.tls()) << "left as it was";
+    }
+  }
+}
+
+TEST(ServeOptions, LoopbackAddresses) {
+  struct Case { const char* listen; bool loopback; };
+  for (const Case c : {Case{"127.0.0.1", true}, Case{"127.1.2.3", true}, Case{"::1", true}, Case{"0.0.0.0", false},
+                       Case{"::", false}, Case{"192.168.1.5", false}, Case{"::ffff:127.0.0.1", false}}) {
+    ServeOptions o;
+    ASSERT_EQ(parse_serve_options(c.listen, "8765", "1024", o), "");
+    EXPECT_EQ(listens_on_loopback(o), c.loopback) << c.listen;
   }
 }
 

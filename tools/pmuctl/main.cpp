@@ -339,7 +339,8 @@ int run_cli(int argc, char** argv, const AgentCall* served) {
       "serve", "Serve the topics live to Foxglove or Lichtblick (Foxglove WebSocket protocol) until Ctrl-C or SIGTERM");
   std::string serve_listen = "127.0.0.1", serve_port = "8765", serve_queue = "1024";
   serve->add_option("--listen", serve_listen,
-                    "IP address to listen on (0.0.0.0: every interface; there is no TLS nor authentication)")
+                    "IP address to listen on (0.0.0.0: every interface; there is no authentication; a web page "
+                    "served over https needs --tls-cert for a remote address)")
       ->type_name("ADDR")
       ->capture_default_str();
   serve->add_option("--port", serve_port, "TCP port (Foxglove's default)")->type_name("N")->capture_default_str();
@@ -351,6 +352,18 @@ int run_cli(int argc, char** argv, const AgentCall* served) {
   serve->add_option("--topic", serve_topics, "Only this topic, as for record; repeat for more (default: record's)")
       ->type_name("NAME")
       ->allow_extra_args(false);
+  std::vector<std::string> serve_origins;
+  serve->add_option("--allow-origin", serve_origins,
+                    "Also let pages of this origin connect (scheme://host[:port], exactly; '*': every page); "
+                    "repeat for more (default: the Foxglove app, the Foxglove and Lichtblick desktop apps, pages "
+                    "on localhost, and clients that send no Origin)")
+      ->type_name("ORIGIN")
+      ->allow_extra_args(false);
+  std::string serve_cert, serve_key;
+  serve->add_option("--tls-cert", serve_cert, "Serve wss:// with this certificate (chain), PEM; with --tls-key")
+      ->type_name("FILE");
+  serve->add_option("--tls-key", serve_key, "The certificate's private key, PEM, without a passphrase")
+      ->type_name("FILE");
 
   // CLI11 reads "-inf" or "-nan" as short options (-i...), so `config set avionics_voltage -inf`
   // would say "value is required". No option of pmuctl looks like that, and no value can be
@@ -417,8 +430,9 @@ int run_cli(int argc, char** argv, const AgentCall* served) {
   }
   pmu::tools::ServeOptions serve_options;
   if (*serve) {
-    if (const auto why = pmu::tools::parse_serve_options(serve_listen, serve_port, serve_queue, serve_options);
-        !why.empty()) {
+    auto why = pmu::tools::parse_serve_options(serve_listen, serve_port, serve_queue, serve_options);
+    if (why.empty()) why = pmu::tools::parse_serve_access(serve_origins, serve_cert, serve_key, serve_options);
+    if (!why.empty()) {
       std::fprintf(stderr, "pmuctl serve: %s\n", why.c_str());
       return 2;
     }

@@ -35,7 +35,8 @@ std::string McapRecording::open(const std::string& path, const std::vector<const
 
 bool McapRecording::write(std::size_t topic, std::uint64_t time_ns, const std::uint8_t* data, std::size_t size) {
   if (!writer_ || topic >= channels_.size()) return false;
-  if (!writer_->write(channels_[topic], time_ns, time_ns, data, size)) return false;
+  const std::uint64_t log_ns = time_ns < log_start_ns_ ? log_start_ns_ : time_ns;
+  if (!writer_->write(channels_[topic], log_ns, time_ns, data, size)) return false;
   ++counts_[topic];
   return true;
 }

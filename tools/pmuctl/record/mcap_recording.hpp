@@ -25,8 +25,14 @@ class McapRecording {
   // output was refused (nothing made) or failed once written to (disk full).
   std::string open(const std::string& path, const std::vector<const RecordedTopic*>& topics);
 
-  // `topic`: index into open()'s list. `time_ns`: since the Unix epoch, the message's log and
-  // publish time. False once the file cannot be written (error()).
+  // Log times from `start_ns` on (record: when the recording started). A message older than
+  // that (state published before, which DDS gives a late reader) is logged at `start_ns`, so a
+  // player's timeline starts with the recording, not hours before; its publish time stays its
+  // own. Without it (decode --mcap) log time = publish time.
+  void start_log_times_at(std::uint64_t start_ns) { log_start_ns_ = start_ns; }
+  // `topic`: index into open()'s list. `time_ns`: since the Unix epoch, the message's publish
+  // time (its source time), and its log time unless before start_log_times_at's. False once
+  // the file cannot be written (error()).
   bool write(std::size_t topic, std::uint64_t time_ns, const std::uint8_t* data, std::size_t size);
   // The chunk so far to the file, so a crash keeps it.
   bool flush();
@@ -57,6 +63,7 @@ class McapRecording {
   std::vector<const RecordedTopic*> topics_;
   std::vector<std::uint16_t> channels_;
   std::vector<std::uint64_t> counts_;
+  std::uint64_t log_start_ns_ = 0;
 };
 
 // "56.7 kB"

@@ -2,6 +2,7 @@
 
 #include <unistd.h>
 
+#include <chrono>
 #include <csignal>
 #include <cstdio>
 #include <memory>
@@ -41,6 +42,11 @@ int run_record(const GlobalOptions& o, const std::string& path, const std::vecto
     shared->rec.discard();  // nothing recorded: no file that looks like a recording (only its own)
     return created ? 1 : 2;
   }
+  // The recording starts now: before this no message is logged (state that DDS gives the late
+  // reader keeps its own time as publish time).
+  shared->rec.start_log_times_at(static_cast<std::uint64_t>(
+      std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::system_clock::now().time_since_epoch())
+          .count()));
   Shared& s = *shared;
   RawTopicReaders readers([&s](const RawSampleInfo& info, RawSample& sample) {
     std::lock_guard<std::mutex> lock(s.mutex);

@@ -42,7 +42,7 @@ bool u32_field(const json& object, const char* name, const std::string& where, s
   return true;
 }
 
-// Ops of the spec this server does not offer (its capabilities are []): named, so a client
+// Ops of the spec this server does not offer (its only capability is time): named, so a client
 // hears that they exist but are not served, rather than "unknown".
 bool is_spec_op(std::string_view op) {
   for (const char* known : {"advertise", "unadvertise", "getParameters", "setParameters", "subscribeParameterUpdates",
@@ -90,10 +90,17 @@ void put_le(std::string& out, std::uint64_t value, int bytes) {
 
 }  // namespace
 
+std::string_view choose_subprotocol(const std::vector<std::string>& offered) {
+  for (const auto& o : offered) {
+    if (o == kSubprotocol) return kSubprotocol;
+    if (o == kSdkSubprotocol) return kSdkSubprotocol;
+  }
+  return {};
+}
+
 std::string server_info_json(std::string_view name) {
-  // No capabilities: the server only publishes; `supportedEncodings` concerns client
-  // publishing and is left out.
-  return json{{"op", "serverInfo"}, {"name", std::string(name)}, {"capabilities", json::array()}}.dump();
+  // The server only publishes: `supportedEncodings` concerns client publishing and is left out.
+  return json{{"op", "serverInfo"}, {"name", std::string(name)}, {"capabilities", json::array({"time"})}}.dump();
 }
 
 std::string advertise_json(const std::vector<Channel>& channels) {
@@ -124,6 +131,14 @@ std::string message_data(std::uint32_t subscription, std::uint64_t time_ns, cons
   return out;
 }
 
+std::string time_message(std::uint64_t time_ns) {
+  std::string out;
+  out.reserve(9);
+  out.push_back('\x02');
+  put_le(out, time_ns, 8);
+  return out;
+}
+
 ClientRequest parse_client_text(std::string_view text) {
   const json message = json::parse(text.begin(), text.end(), nullptr, /*allow_exceptions=*/false);
   if (message.is_discarded()) return BadRequest{"not JSON: " + quote_text(text)};
@@ -134,14 +149,14 @@ ClientRequest parse_client_text(std::string_view text) {
   if (name == "subscribe") return parse_subscribe(message);
   if (name == "unsubscribe") return parse_unsubscribe(message);
   if (is_spec_op(name))
-    return BadRequest{"op \"" + name + "\" is not supported: this server only publishes (capabilities [])"};
+    return BadRequest{"op \"" + name + "\" is not supported: this server only publishes (capabilities [\"time\"])"};
   return BadRequest{"unknown op " + quote_text(name) + " (this server takes subscribe and unsubscribe)"};
 }
 
 BadRequest parse_client_binary(const std::uint8_t* data, std::size_t size) {
   if (size == 0) return BadRequest{"empty binary message"};
   return BadRequest{"binary message with opcode " + std::to_string(data[0]) +
-                    " is not supported: this server takes no client data (capabilities [])"};
+                    " is not supported: this server takes no client data (capabilities [\"time\"])"};
 }
 
 std::vector<std::string> ClientSubscriptions::on_text(std::string_view text) {

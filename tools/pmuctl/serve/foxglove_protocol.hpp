@@ -1,13 +1,16 @@
 #pragma once
-// The Foxglove WebSocket protocol (subprotocol `foxglove.websocket.v1`,
-// github.com/foxglove/ws-protocol docs/spec.md) as far as `pmuctl serve` speaks it: the
-// server's JSON messages and binary MessageData frames, and the client's subscribe and
-// unsubscribe requests turned into typed values. Pure: no sockets, threads or clock, so every
+// The Foxglove WebSocket protocol (subprotocols `foxglove.websocket.v1` and
+// `foxglove.sdk.v1`, github.com/foxglove/ws-protocol docs/spec.md) as far as `pmuctl serve`
+// speaks it: the server's JSON messages, binary MessageData and Time frames, the choice of
+// subprotocol, and the client's subscribe and unsubscribe requests turned into typed values. Pure: no sockets, threads or clock, so every
 // byte is checked by tests/unit/foxglove_protocol_test.cpp.
 //
 //   message_data(7, 1700000000123456789, {0x00,0x01,0x00,0x00})
 //     -> 01 | 07 00 00 00 | 15 CD 85 3D FE 9C 97 17 | 00 01 00 00
 //        op   subscription   timestamp (ns, u64 LE)   payload (the CDR bytes)
+//   time_message(1700000000123456789)
+//     -> 02 | 15 CD 85 3D FE 9C 97 17      (capability `time`: the server's clock, ns)
+//   choose_subprotocol({"foxglove.sdk.v1", "foxglove.websocket.v1"}) -> "foxglove.sdk.v1"
 //   parse_client_text(R"({"op":"subscribe","subscriptions":[{"id":0,"channelId":3}]})")
 //     -> SubscribeRequest{{{0, 3}}}
 //   parse_client_text("{\"op\":\"fly\"}") -> BadRequest{"unknown op \"fly\" ..."}
@@ -25,7 +28,14 @@
 
 namespace pmu::tools::foxglove {
 
+// What the spec names the protocol, and what the Foxglove SDK (foxglove_bridge 3) names the
+// same messages; this server speaks the part both share, so it accepts either.
 inline constexpr std::string_view kSubprotocol = "foxglove.websocket.v1";
+inline constexpr std::string_view kSdkSubprotocol = "foxglove.sdk.v1";
+inline constexpr std::string_view kSubprotocols = "foxglove.websocket.v1 or foxglove.sdk.v1";  // for messages
+
+// The first subprotocol the client lists that this server speaks, or "" when it offers none.
+std::string_view choose_subprotocol(const std::vector<std::string>& offered);
 
 // What the server advertises: encoding `cdr`, schema encoding `omgidl` for every channel.
 struct Channel {
@@ -37,6 +47,8 @@ struct Channel {
 
 enum class StatusLevel : int { Info = 0, Warning = 1, Error = 2 };
 
+// Capabilities ["time"]: the server's clock is the source time of what it forwards (Time
+// messages), and each MessageData's timestamp is the time a player shows it at.
 std::string server_info_json(std::string_view name);
 std::string advertise_json(const std::vector<Channel>& channels);
 std::string status_json(StatusLevel level, std::string_view message);
@@ -45,6 +57,8 @@ std::string status_json(StatusLevel level, std::string_view message);
 inline constexpr std::size_t kMessageDataHeaderSize = 13;
 std::string message_data(std::uint32_t subscription, std::uint64_t time_ns, const std::uint8_t* payload,
                          std::size_t size);
+// Binary Time: opcode 0x02, u64 LE timestamp (ns).
+std::string time_message(std::uint64_t time_ns);
 
 // A client's request, or what is wrong with it.
 struct Subscription {

@@ -1,7 +1,8 @@
 #pragma once
-// The WebSocket side of `pmuctl serve`: websocketpp on standalone asio, one server thread,
-// speaking the Foxglove protocol (foxglove_protocol.hpp) with the drop policy of
-// client_backlog.hpp. websocketpp stays inside foxglove_server.cpp.
+// The WebSocket side of `pmuctl serve`: websocketpp on standalone asio (ws://, or wss://
+// through OpenSSL), one server thread, speaking the Foxglove protocol (foxglove_protocol.hpp)
+// with the drop policy of client_backlog.hpp and the origins of origin_policy.hpp. websocketpp
+// stays inside foxglove_server.cpp.
 //
 // Threads: publish() is called by Fast DDS's listener threads. It only appends the sample to
 // a bounded hand-over queue and, when that queue was empty, posts one drain to the server
@@ -12,7 +13,11 @@
 // Error handling: start() returns what went wrong ("cannot listen on 127.0.0.1:8765:
 // Address already in use"); after it nothing throws. Client mistakes are answered with
 // status messages; a client that fails or vanishes is just removed.
-// Security: no TLS and no authentication; it listens on 127.0.0.1 unless told otherwise.
+// Time (capability `time`): the server's clock is the newest source time it has forwarded,
+// told to each client in a Time message before the first message that advances it; a state
+// sample sent to a new subscriber is stamped max(its source time, that clock).
+// Security: pages of origins the options do not allow are refused (HTTP 403); TLS when
+// given a certificate; no authentication; it listens on 127.0.0.1 unless told otherwise.
 
 #include <array>
 #include <cstddef>
@@ -26,6 +31,17 @@
 
 namespace pmu::tools {
 
+// --tls-cert's and --tls-key's files as read, PEM; the names are for messages.
+struct TlsPem {
+  std::string cert_file, cert;
+  std::string key_file, key;
+};
+
+// Whether the certificate chain and key parse and belong together: "" or what is wrong,
+// naming the option and file ("--tls-key k.pem is not the private key of the certificate in
+// --tls-cert c.pem").
+std::string check_tls(const TlsPem& pem);
+
 class FoxgloveServer {
  public:
   struct Counters {
@@ -36,9 +52,10 @@ class FoxgloveServer {
 
   // `latched[i]`: channel i carries state (TRANSIENT_LOCAL in DDS): the server keeps the last
   // message of each instance and sends those to a client when it subscribes, as DDS gives a
-  // late-joining reader the current state. `name`: serverInfo's name.
+  // late-joining reader the current state. `name`: serverInfo's name. `tls`: used when
+  // options.tls(), checked by check_tls() beforehand.
   FoxgloveServer(std::vector<foxglove::Channel> channels, std::vector<bool> latched, ServeOptions options,
-                 std::string name);
+                 std::string name, TlsPem tls = {});
   ~FoxgloveServer();  // stop()
   FoxgloveServer(const FoxgloveServer&) = delete;
   FoxgloveServer& operator=(const FoxgloveServer&) = delete;
@@ -53,8 +70,9 @@ class FoxgloveServer {
   // Closes every connection (going away), waits for them briefly, ends the server thread.
   void stop();
 
+  struct Impl;  // opaque: foxglove_server.cpp's ws:// and wss:// endpoints implement it
+
  private:
-  struct Impl;
   std::unique_ptr<Impl> impl_;
 };
 

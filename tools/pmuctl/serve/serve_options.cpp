@@ -3,6 +3,7 @@
 #include <arpa/inet.h>
 
 #include <cstdlib>
+#include <utility>
 
 namespace pmu::tools {
 namespace {
@@ -39,6 +40,27 @@ std::string parse_serve_options(const std::string& listen, const std::string& po
   out.port = static_cast<std::uint16_t>(p);
   out.client_queue = static_cast<std::size_t>(kb) * 1024;
   return {};
+}
+
+std::string parse_serve_access(const std::vector<std::string>& allow_origins, const std::string& tls_cert,
+                               const std::string& tls_key, ServeOptions& out) {
+  OriginPolicy origins;
+  for (const auto& a : allow_origins)
+    if (auto why = add_allowed_origin(a, origins); !why.empty()) return why;
+  if (tls_cert.empty() != tls_key.empty())
+    return std::string("--tls-cert and --tls-key go together (the certificate chain and its private key, PEM): ") +
+           (tls_cert.empty() ? "--tls-cert" : "--tls-key") + " is missing";
+  out.origins = std::move(origins);
+  out.tls_cert = tls_cert;
+  out.tls_key = tls_key;
+  return {};
+}
+
+bool listens_on_loopback(const ServeOptions& o) {
+  in_addr a4{};
+  if (::inet_pton(AF_INET, o.address.c_str(), &a4) == 1) return (ntohl(a4.s_addr) >> 24) == 127;
+  in6_addr a6{};
+  return ::inet_pton(AF_INET6, o.address.c_str(), &a6) == 1 && IN6_IS_ADDR_LOOPBACK(&a6);
 }
 
 std::string endpoint_label(const ServeOptions& o) {

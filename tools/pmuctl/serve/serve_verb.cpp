@@ -4,8 +4,10 @@
 
 #include <cstdio>
 #include <string_view>
+#include <tuple>
 
 #include "pmu/dds/dds_context.hpp"
+#include "pmu/files/bounded_file.hpp"
 #include "pmu/idl/topics.hpp"
 #include "pmuctl/record/raw_topic_readers.hpp"
 #include "pmuctl/serve/foxglove_server.hpp"
@@ -17,6 +19,22 @@ namespace {
 std::string progress(const FoxgloveServer::Counters& c) {
   return std::to_string(c.clients) + (c.clients == 1 ? " client, " : " clients, ") + std::to_string(c.forwarded) +
          " messages forwarded, " + std::to_string(c.dropped) + " dropped";
+}
+
+// A certificate chain or key is a few kB; the bound keeps a wrong path (a log, a device) out.
+constexpr std::size_t kMaxPemBytes = 1024 * 1024;
+
+// --tls-cert's and --tls-key's files read and checked; "" or what is wrong and which file.
+std::string load_tls(const ServeOptions& serve, TlsPem& pem) {
+  for (const auto& [option, path, text] : {std::tuple{"--tls-cert", &serve.tls_cert, &pem.cert},
+                                           std::tuple{"--tls-key", &serve.tls_key, &pem.key}}) {
+    auto file = pmu::files::read_bounded_file(*path, kMaxPemBytes);
+    if (!file.ok()) return std::string(option) + " " + *path + " cannot be read: " + file.error;
+    *text = std::move(file.text);
+  }
+  pem.cert_file = serve.tls_cert;
+  pem.key_file = serve.tls_key;
+  return check_tls(pem);
 }
 
 }  // namespace
@@ -33,8 +51,22 @@ int run_serve(const GlobalOptions& o, const ServeOptions& serve, const std::vect
     latched.push_back(profile == pmu::qos_profiles::kState || profile == pmu::qos_profiles::kAlarms);
   }
 
+  TlsPem pem;
+  if (serve.tls()) {
+    if (const auto why = load_tls(serve, pem); !why.empty()) {
+      std::fprintf(stderr, "pmuctl serve: %s\n", why.c_str());
+      return 2;
+    }
+  } else if (!listens_on_loopback(serve)) {
+    std::fprintf(stderr,
+                 "pmuctl serve: warning: ws://%s is plain WebSocket: a page served over https (the Foxglove web "
+                 "app) may not connect to it (mixed content), only the desktop apps and pages of http:// can; "
+                 "give --tls-cert and --tls-key to serve wss://, or put a TLS proxy in front\n",
+                 endpoint_label(serve).c_str());
+  }
+
   pmu::transport::StopSignals stop;  // before the server's and Fast DDS's threads
-  FoxgloveServer server(std::move(channels), std::move(latched), serve, "pmuctl serve (pmu-dds)");
+  FoxgloveServer server(std::move(channels), std::move(latched), serve, "pmuctl serve (pmu-dds)", std::move(pem));
   if (const auto why = server.start(); !why.empty()) {
     std::fprintf(stderr, "pmuctl serve: %s\n", why.c_str());
     return 1;
@@ -49,9 +81,10 @@ int run_serve(const GlobalOptions& o, const ServeOptions& serve, const std::vect
                              o.network, partitions_for(o));
     readers.open(dds, topics);
     std::fprintf(stderr,
-                 "pmuctl serve: serving %zu topics of domain %d on ws://%s (Foxglove WebSocket, subprotocol %s); "
+                 "pmuctl serve: serving %zu topics of domain %d on %s://%s (Foxglove WebSocket, subprotocol %s); "
                  "Ctrl-C stops\n",
-                 topics.size(), o.domain, endpoint_label(serve).c_str(), std::string(foxglove::kSubprotocol).c_str());
+                 topics.size(), o.domain, serve.tls() ? "wss" : "ws", endpoint_label(serve).c_str(),
+                 std::string(foxglove::kSubprotocols).c_str());
     const bool tty = ::isatty(STDERR_FILENO) == 1;
     for (int ticks = 1; stop.wait_for(std::chrono::seconds(1)) == 0; ++ticks) {
       if (tty)
