@@ -85,11 +85,9 @@ fi
 "$ctl" --domain "$domain" serve "${serve_args[@]}" 2>"$work/serve.err" &
 server=$!; pids+=($server)
 wait_for "$work/serve.err" "$server" "serving .* on wss\?://" || fail "serve did not start: $(cat "$work/serve.err")"
-sleep 2  # discovery: the samples flow before the page comes
-
-node "$here/drive.mjs" "$chromium" "$page_origin" "$ws_url" "$subprotocol" 6 "$screenshot" || fail "the page's view of $ws_url from $page_origin"
+node "$here/drive.mjs" "$chromium" "$page_origin" "$ws_url" "$subprotocol" 10 "$screenshot" || fail "the page's view of $ws_url from $page_origin"
 grep -q "client 127.0.0.1:[0-9]* connected" "$work/serve.err" || fail "no connect line"
 other="$scheme://other.test:$site_port"
-node "$here/drive.mjs" "$chromium" "$other" "$ws_url" "$subprotocol" 2 "$work/refused.png" --refused || fail "a page from $other"
+node "$here/drive.mjs" "$chromium" "$other" "$ws_url" "$subprotocol" 10 "$work/refused.png" --refused || fail "a page from $other"
 grep -q "refused 127.0.0.1:[0-9]*: origin $other is not allowed" "$work/serve.err" || fail "no line saying the page from $other was refused"
 echo "browser $mode: PASS (plot: $screenshot)"

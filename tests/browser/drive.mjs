@@ -1,7 +1,8 @@
 // Drives headless Chromium (puppeteer-core) to the test page and judges what the page saw of
 // `pmuctl serve` (docs/interface.md section 9.2) against pmu-service on the simulated power
 // system (deploy/examples/sim-power-system.yaml).
-//   node drive.mjs CHROMIUM PAGE-URL WS-URL SUBPROTOCOL SECONDS SCREENSHOT.png [--refused]
+//   node drive.mjs CHROMIUM PAGE-URL WS-URL SUBPROTOCOL VOLTAGES SCREENSHOT.png [--refused]
+// The page reads until it has VOLTAGES pmu/voltages messages (page.mjs).
 // The page's plot is saved to SCREENSHOT.png whatever the verdict. With --refused the page's
 // origin is one the server must refuse: the page must get no connection and nothing from it.
 // Host names ending in .test are this host (Chromium's resolver is told so), so a page can
@@ -9,7 +10,7 @@
 // problems on stderr.
 import puppeteer from "puppeteer-core";
 
-const [chromium, pageUrl, wsUrl, subprotocol, seconds, screenshot, expect] = process.argv.slice(2);
+const [chromium, pageUrl, wsUrl, subprotocol, voltages, screenshot, expect] = process.argv.slice(2);
 const refused = expect === "--refused";
 const problems = [];
 const problem = (p) => problems.push(p);
@@ -30,10 +31,11 @@ try {
   const consoleLines = [];
   page.on("console", (m) => consoleLines.push(`${m.type()}: ${m.text()}`));
   page.on("pageerror", (e) => problem(`page error: ${e.message}`));
-  const query = new URLSearchParams({ ws: wsUrl, protocol: subprotocol, seconds });
+  const query = new URLSearchParams({ ws: wsUrl, protocol: subprotocol, voltages });
   await page.goto(`${pageUrl}/index.html?${query}`);
-  // The page hands its result over after SECONDS; the bound only turns "never" into a FAIL.
-  await page.waitForFunction(() => window.pmuResult !== undefined, { timeout: (Number(seconds) + 30) * 1000 });
+  // The page hands its result over once it has what it waits for (DDS discovery first);
+  // the bound only turns "never" into a FAIL.
+  await page.waitForFunction(() => window.pmuResult !== undefined, { timeout: 60000 });
   result = await page.evaluate(() => window.pmuResult);
   const canvas = await page.$("#plot");
   await canvas.screenshot({ path: screenshot });
@@ -81,8 +83,8 @@ for (let i = 1; i < times.length; i++) if (times[i] < times[i - 1]) problem(`Tim
 // server's clock as its Time messages give it: within a few seconds of the last Time before it.
 const volts = result.messages["pmu/voltages"];
 const battery = result.messages["pmu/battery"];
-if (volts.length < 3) problem(`${volts.length} pmu/voltages messages`);
-if (battery.length < 1) problem(`${battery.length} pmu/battery messages`);
+if (volts.length < Number(voltages)) problem(`${volts.length} pmu/voltages messages`);
+if (battery.length < 2) problem(`${battery.length} pmu/battery messages`);
 for (const m of volts) {
   const v = m.values;
   if (v.bus !== "sim0" || v.address !== 1 || typeof v.vehicle !== "string") problem(`voltages keys ${v.vehicle}/${v.bus}/${v.address}`);

@@ -1,9 +1,10 @@
 // The page of the browser test (bundled for the browser by esbuild at test time): what an
 // integrator's Foxglove web app does with `pmuctl serve` (docs/interface.md section 9.2), with
 // the browser's own WebSocket and Foxglove's omgidl parser and CDR decoder.
-//   index.html?ws=URL&protocol=SUBPROTOCOL&seconds=N
+//   index.html?ws=URL&protocol=SUBPROTOCOL&voltages=N
 // Connects offering SUBPROTOCOL, subscribes to pmu/voltages and pmu/battery, decodes their
-// messages, keeps the server's Time messages (opcode 0x02), then draws pmu/voltages' avionics
+// messages and keeps the server's Time messages (opcode 0x02) until it has N pmu/voltages and
+// 2 pmu/battery messages (or the connection closes), then draws pmu/voltages' avionics
 // against the time axis a Foxglove player uses (the message timestamp when the server has the
 // `time` capability, the arrival time otherwise) and leaves what it saw in window.pmuResult
 // for the test to judge. The page judges nothing itself.
@@ -13,7 +14,7 @@ import { MessageReader } from "@foxglove/omgidl-serialization";
 const params = new URLSearchParams(location.search);
 const url = params.get("ws");
 const protocol = params.get("protocol");
-const seconds = Number(params.get("seconds"));
+const wantedVoltages = Number(params.get("voltages"));
 const wanted = ["pmu/voltages", "pmu/battery"];
 
 const errors = [];
@@ -35,7 +36,10 @@ ws.binaryType = "arraybuffer";
 ws.onerror = () => errors.push(`WebSocket error on ${url}`);
 ws.onclose = (e) => {
   closeCode = e.code;
-  if (!finished) errors.push(`the server closed the connection (code ${e.code} ${e.reason})`);
+  if (!finished) {
+    errors.push(`the server closed the connection (code ${e.code} ${e.reason})`);
+    finish();
+  }
 };
 ws.onmessage = (event) => {
   if (typeof event.data === "string") return onText(event.data);
@@ -57,6 +61,7 @@ ws.onmessage = (event) => {
         latest_time_ns: latestTime === null ? null : latestTime.toString(),
         values: plain(values),
       });
+      if (messages["pmu/voltages"].length >= wantedVoltages && messages["pmu/battery"].length >= 2) finish();
     } catch (e) {
       errors.push(`${sub.topic}: message does not decode: ${e.message}`);
     }
@@ -92,7 +97,8 @@ function onText(text) {
   }
 }
 
-setTimeout(() => {
+function finish() {
+  if (finished) return;
   finished = true;
   ws.close();
   const timeAxis = Boolean(serverInfo?.capabilities?.includes("time"));
@@ -113,7 +119,7 @@ setTimeout(() => {
     errors,
   };
   document.title = "done";
-}, seconds * 1000);
+}
 
 // pmu/voltages' avionics against the player's time axis, with both axes labelled.
 function draw(timeAxis) {
