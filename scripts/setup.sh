@@ -4,7 +4,8 @@
 #         PMU_BUILD_BENCH off, as a plain `cmake -S . -B build` configures it), and the ROS 2
 #         message definitions from npm (npm ci in ros2/): scripts/run.sh
 #   test  everything: the run set, the tests' and benchmarks' libraries, the VMs, the Debian
-#         packaging and its arm64 cross build, ccache, tests/mcap's npm packages: scripts/test.sh
+#         packaging and its arm64 cross build, ccache, tests/mcap's and tests/browser's npm
+#         packages: scripts/test.sh
 #   scripts/setup.sh [run|test]        install the set (default: test)
 #   scripts/setup.sh --list run|test   print the set's Debian packages, one per line
 # Idempotent: packages already present are left alone, and apt is not touched at all
@@ -56,6 +57,8 @@ test_only_packages=(
   # The systemd system test (tests/systemd): a bookworm root file system made with mmdebstrap
   # and written into an image with mkfs.ext4 -d
   mmdebstrap e2fsprogs
+  # The browser test (tests/browser): a page in headless Chromium reads pmuctl serve
+  chromium
 )
 # The arm64 build dependencies, from multiarch (dpkg --add-architecture arm64). yaml-cpp's
 # -dev is not Multi-Arch: same, so the arm64 build takes the runtime library and the amd64
@@ -66,7 +69,7 @@ arm64_packages=(
   libgtest-dev:arm64 libgmock-dev:arm64 pkg-config:arm64 libwebsocketpp-dev:arm64
 )
 # Node.js's npm, which fetches the ROS 2 message definitions (ros2/) and the MCAP tests'
-# readers (tests/mcap); installed below only when node or npm is missing.
+# readers (tests/mcap) and the browser test's driver (tests/browser); installed below only when node or npm is missing.
 node_packages=(nodejs npm)
 
 packages=("${run_packages[@]}")
@@ -138,3 +141,7 @@ npm_ci ros2 "@foxglove/rosmsg-msgs-common: the ROS 2 .msg definitions"
 
 # The MCAP tests (tests/mcap) read pmuctl's files with the ecosystem's own npm packages.
 npm_ci tests/mcap "@mcap/core, @foxglove/ws-protocol, ws, @foxglove/omgidl-parser, @foxglove/omgidl-serialization"
+
+# The browser test (tests/browser) drives Debian's Chromium with puppeteer-core and bundles
+# Foxglove's omgidl decoder for the page with esbuild.
+npm_ci tests/browser "puppeteer-core, esbuild, @foxglove/omgidl-parser, @foxglove/omgidl-serialization"

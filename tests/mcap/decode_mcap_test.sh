@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # pmuctl decode --mcap, read back by @mcap/core and decoded by the omgidl packages, gives the
-# values pmuctl decode --json prints, also from standard output (-) through a pipe; bad
-# outputs are refused with nothing left behind.
+# values pmuctl decode --json prints, each type with its own schema (check_schemas.mjs), also
+# from standard output (-) through a pipe; bad outputs are refused with nothing left behind.
 #   decode_mcap_test.sh PMUCTL DATA_DIR
 set -euo pipefail
 PMUCTL=$1 DATA=$2
@@ -15,6 +15,8 @@ read_mcap --stream "$work/every.mcap" > "$work/stream.jsonl"
 "$PMUCTL" decode --json "$DATA/every_packet.log" > "$work/decode.jsonl" 2>/dev/null
 node "$MCAP_TESTS_DIR/compare_decode.mjs" "$work/indexed.jsonl" "$work/decode.jsonl"
 node "$MCAP_TESTS_DIR/compare_decode.mjs" "$work/stream.jsonl" "$work/decode.jsonl"
+# Each schema is its type's definition and what it uses, each once.
+node "$MCAP_TESTS_DIR/check_schemas.mjs" "$work/every.mcap"
 tail -1 "$work/indexed.jsonl" | grep -q '"statistics":{"message_count":"5"' || { echo "FAIL: summary"; tail -1 "$work/indexed.jsonl"; exit 1; }
 schemas=$(grep -o '"schema":"[^"]*"' "$work/indexed.jsonl" | sort -u | tr '\n' ' ')
 [ "$schemas" = '"schema":"pmu::v4::BatteryEnergy" "schema":"pmu::v4::Currents" "schema":"pmu::v4::Status" "schema":"pmu::v4::Temperatures" "schema":"pmu::v4::Voltages" ' ] \

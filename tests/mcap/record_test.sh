@@ -1,11 +1,11 @@
 #!/usr/bin/env bash
 # pmuctl record against pmu-service on the simulated power system: stopped by SIGINT the
-# file has a summary and @mcap/core reads it; killed with SIGKILL the stream reader still
-# reads its complete chunks; a recorder started late logs the state published before it at
-# its start (publish time kept); an unwritable path and a full disk are refused with what and
-# where; onto each kind of path (interface.md section 9.1, "Where the file goes") nothing
-# record did not create is removed, renamed over or truncated; `record -` pipes the file
-# into a reader.
+# file has a summary, @mcap/core reads it and each schema is its type's own; killed with
+# SIGKILL the stream reader still reads its complete chunks; a recorder started late logs the
+# state published before it at its start (publish time kept); an unwritable path and a full
+# disk are refused with what and where; onto each kind of path (interface.md section 9.1,
+# "Where the file goes") nothing record did not create is removed, renamed over or
+# truncated; `record -` pipes the file into a reader.
 #   record_test.sh PMU-SERVICE PMUCTL SOURCE-DIR
 set -uo pipefail
 svc=$1 ctl=$2 src=$3
@@ -56,6 +56,9 @@ grep -q "messages, .* written to $work/rec.mcap" "$work/rec.err" || fail "no fin
   fail "size printed: $(tail -1 "$work/rec.err"), file: $(stat -c %s "$work/rec.mcap")"
 if read_mcap "$work/rec.mcap" >"$work/rec.jsonl"; then
   node "$MCAP_TESTS_DIR/check_recording.mjs" "$work/rec.jsonl" || fail "recording (indexed reader)"
+  # The 16 default topics' schemas: each its type's definition and what it uses, each once;
+  # together about 16 kB (interface.md 9.1).
+  node "$MCAP_TESTS_DIR/check_schemas.mjs" "$work/rec.mcap" --max-total 20000 || fail "schemas of the recording"
 else
   fail "@mcap/core's indexed reader refused the file"
 fi
