@@ -210,8 +210,8 @@ cli)
   echo "usage: serve_test.sh PMU-SERVICE PMUCTL SOURCE-DIR foxglove|slow|tls|cli" >&2; exit 2 ;;
 esac
 if [ $failures -ne 0 ]; then
-  echo "--- serve stderr" >&2; tail -n 30 "$work/serve.err" 2>/dev/null >&2
-  echo "--- service log" >&2; tail -n 20 "$work/service.log" 2>/dev/null >&2
+  echo "--- serve stderr" >&2; tail -n 30 "$work/serve.err" >&2 2>/dev/null
+  echo "--- service log" >&2; tail -n 20 "$work/service.log" >&2 2>/dev/null
   exit 1
 fi
 echo "serve $mode: PASS"
