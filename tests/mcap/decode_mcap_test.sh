@@ -17,7 +17,7 @@ node "$MCAP_TESTS_DIR/compare_decode.mjs" "$work/indexed.jsonl" "$work/decode.js
 node "$MCAP_TESTS_DIR/compare_decode.mjs" "$work/stream.jsonl" "$work/decode.jsonl"
 tail -1 "$work/indexed.jsonl" | grep -q '"statistics":{"message_count":"5"' || { echo "FAIL: summary"; tail -1 "$work/indexed.jsonl"; exit 1; }
 schemas=$(grep -o '"schema":"[^"]*"' "$work/indexed.jsonl" | sort -u | tr '\n' ' ')
-[ "$schemas" = '"schema":"pmu::v4::BatteryEnergy" "schema":"pmu::v4::Currents" "schema":"pmu::v4::Status" "schema":"pmu::v4::Temperatures" "schema":"pmu::v4::Voltages" ' ] \
+[ "$schemas" = '"schema":"pmu::v5::BatteryEnergy" "schema":"pmu::v5::Currents" "schema":"pmu::v5::Status" "schema":"pmu::v5::Temperatures" "schema":"pmu::v5::Voltages" ' ] \
   || { echo "FAIL: schema names $schemas"; exit 1; }
 
 # Undecodable lines are named (FILE:LINE: reason) and the rest is written.

@@ -135,7 +135,7 @@ TEST(OldContractConsumers, MatchNothingOfAServiceOfV4AloneWhichV4Reads) {
         {"pmu/health", "Health"}, {"pmu/config", "Config"}, {"pmu/voltages", "Voltages"}};
     if (v3) endpoints.insert(endpoints.end(), {{"pmu/command_reply", "CommandReply"}, {"reader:pmu/command", "Command"}});
     for (const auto& [topic, type] : endpoints)
-      EXPECT_TRUE(has(run.final["discovered"].value(topic, Json()), "pmu::v4::" + type)) << topic << ": " << run.out;
+      EXPECT_TRUE(has(run.final["discovered"].value(topic, Json()), "pmu::v5::" + type)) << topic << ": " << run.out;
     EXPECT_EQ(run.final["matched"].size(), v3 ? 5u : 3u) << run.out;
     for (const auto& [topic, n] : run.final["matched"].items()) EXPECT_EQ(n, 0) << topic << ": " << run.out;
     EXPECT_TRUE(run.samples.empty()) << run.out;

@@ -33,7 +33,7 @@ struct RawSampleInfo {
 // The sink may take (move from) `sample.bytes`.
 using RawSampleSink = std::function<void(const RawSampleInfo& info, RawSample& sample)>;
 
-// A RawSampleType for the contract's DDS type name ("pmu::v4::Voltages"); the name must be one of
+// A RawSampleType for the contract's DDS type name ("pmu::v5::Voltages"); the name must be one of
 // recorded_topics()'s.
 eprosima::fastdds::dds::TypeSupport raw_type_support(const std::string& type_name);
 

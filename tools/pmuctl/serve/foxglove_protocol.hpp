@@ -31,7 +31,7 @@ inline constexpr std::string_view kSubprotocol = "foxglove.websocket.v1";
 struct Channel {
   std::uint32_t id = 0;
   std::string topic;        // the DDS topic name, "pmu/voltages"
-  std::string schema_name;  // the DDS type name, "pmu::v4::Voltages"
+  std::string schema_name;  // the DDS type name, "pmu::v5::Voltages"
   std::string_view schema;  // the IDL text (static storage: pmu::idl_text)
 };
 

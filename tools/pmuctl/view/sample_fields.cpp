@@ -107,28 +107,28 @@ std::string text_with_unit(const SampleField& f, bool compact) {
   return f.text + (compact ? "" : " ") + f.unit;
 }
 
-SampleFields fields_of(const pmu::v4::Voltages& s) {
+SampleFields fields_of(const pmu::v5::Voltages& s) {
   return measured<codec::Voltages>(std::array<double, 7>{s.avionics(), s.output_28v(), s.payload(), s.servo(),
                                                           s.battery_a(), s.battery_b(), s.generator()},
                                    kNoReading);
 }
 
-SampleFields fields_of(const pmu::v4::Currents& s) {
+SampleFields fields_of(const pmu::v5::Currents& s) {
   return measured<codec::Currents>(
       std::array<double, 6>{s.avionics(), s.output_28v(), s.payload(), s.servo(), s.battery_a(), s.battery_b()},
       kNoReading);
 }
 
-SampleFields fields_of(const pmu::v4::BatteryEnergy& s) {
+SampleFields fields_of(const pmu::v5::BatteryEnergy& s) {
   return measured<codec::BatteryEnergy>(std::array<std::int64_t, 2>{s.battery_a_mah(), s.battery_b_mah()}, "");
 }
 
-SampleFields fields_of(const pmu::v4::Temperatures& s) {
+SampleFields fields_of(const pmu::v5::Temperatures& s) {
   return measured<codec::Temperatures>(
       std::array<double, 5>{s.internal(), s.battery_a(), s.battery_b(), s.generator(), s.starter()}, kNoSensor);
 }
 
-SampleFields fields_of(const pmu::v4::Status& s) {
+SampleFields fields_of(const pmu::v5::Status& s) {
   codec::Status st;
   st.generator_rpm = s.generator_rpm();
   st.generation_enabled = s.generation_enabled();
@@ -151,7 +151,7 @@ SampleFields fields_of(const pmu::v4::Status& s) {
   return c.out;
 }
 
-SampleFields fields_of(const pmu::v4::Config& s) {
+SampleFields fields_of(const pmu::v5::Config& s) {
   SampleFields out;
   for (const auto& spec : codec::parameter_table()) {
     using P = codec::Parameter;
@@ -189,7 +189,7 @@ SampleFields fields_of(const pmu::v4::Config& s) {
   return out;
 }
 
-SampleFields fields_of(const pmu::v4::DeviceInfo& s) {
+SampleFields fields_of(const pmu::v5::DeviceInfo& s) {
   Json features = Json::array();
   std::string text;
   for (const auto& f : s.features()) {
@@ -202,7 +202,7 @@ SampleFields fields_of(const pmu::v4::DeviceInfo& s) {
           {"features", features, text.empty() ? "none" : text, ""}};
 }
 
-SampleFields fields_of(const pmu::v4::Health& s) {
+SampleFields fields_of(const pmu::v5::Health& s) {
   SampleField age = s.last_frame_age() < 0 || std::isnan(s.last_frame_age())
                         ? none("last_frame_age", kNever)
                         : real("last_frame_age", s.last_frame_age(), "s", kNever);
@@ -224,7 +224,7 @@ SampleFields fields_of(const pmu::v4::Health& s) {
           integer("publish_failures", static_cast<std::int64_t>(s.publish_failures()))};
 }
 
-SampleFields fields_of(const pmu::v4::Battery& s) {
+SampleFields fields_of(const pmu::v5::Battery& s) {
   // In the order of service::kBatteryValues (= IDL order = `received` bits).
   const std::array<double, service::kBatteryValueCount> v{
       s.voltage(),          s.current(),           s.current_discharge(),     s.current_charge(),
@@ -241,7 +241,7 @@ SampleFields fields_of(const pmu::v4::Battery& s) {
   return out;
 }
 
-SampleFields fields_of(const pmu::v4::BatteryCells& s) {
+SampleFields fields_of(const pmu::v5::BatteryCells& s) {
   Json cells = Json::array();
   double lo = INFINITY, hi = -INFINITY;
   for (const auto& c : s.cells()) {
@@ -260,7 +260,7 @@ SampleFields fields_of(const pmu::v4::BatteryCells& s) {
   return {{"cells", cells, text, ""}};
 }
 
-SampleFields fields_of(const pmu::v4::Mppt& s) {
+SampleFields fields_of(const pmu::v5::Mppt& s) {
   // In the order of service::kMpptValues (= IDL order = `received` bits).
   const std::array<double, service::kMpptValueCount> v{
       s.voltage_output_raw(),  s.current_output_raw(),  s.voltage_out_sw_raw(), static_cast<double>(s.mppt_state()),

@@ -120,7 +120,7 @@ class DdsContext {
   const RemoteWriters& remote_writers() const noexcept { return remote_writers_; }
 
   // Registers the type (once) and creates the topic (once). `type` is e.g.
-  // new pmu::v4::VoltagesPubSubType(); it is registered under contract()'s name for it. Its endpoints announce its type object when the context
+  // new pmu::v5::VoltagesPubSubType(); it is registered under contract()'s name for it. Its endpoints announce its type object when the context
   // was made with type_objects and the type is self-contained, never its TypeInformation
   // (dds_type_objects.hpp says why). Throws
   // DdsError at start-up when it fails.
