@@ -15,6 +15,7 @@
 #include "pmu/config/capacity.hpp"
 #include "pmu/config/low_rate.hpp"
 #include "pmu/dds/baseline_sample.hpp"
+#include "pmu/dds/no_value.hpp"
 #include "pmu/dds/telemetry_samples.hpp"
 #include "pmu/idl/alarms.h"
 #include "pmu/idl/alarmsPubSubTypes.h"
@@ -60,22 +61,23 @@ const char* why(ReturnCode_t rc) {
 // The battery's node or the MPPT's device id fits an octet (node 1..127, device 0..7).
 std::uint8_t octet_id(const DeviceKey& k) { return static_cast<std::uint8_t>(k.address & 0xFF); }
 
-// A CANopen state's value by its contract name: float fields carry NaN when not received,
-// integer and boolean fields 0 (the `received` mask tells them apart).
+// A CANopen state's value by its contract name: NaN when not received, in every field (the
+// integer and boolean values too: a 0 would plot as a value the device never sent).
 template <std::size_t N>
 class Values {
  public:
   Values(const CanOpenValues<N>& state, const CanOpenValue (&table)[N]) : state_(state), table_(table) {}
-  float real(std::string_view name) const {
+  float real(std::string_view name) const { return static_cast<float>(exact(name)); }
+  // A 32-bit value as sent: a double holds each exactly, a float does not.
+  double exact(std::string_view name) const {
     const auto i = slot(name);
-    return i < N ? idl_float(state_.values[i]) : std::numeric_limits<float>::quiet_NaN();
+    return i < N && state_.received(i) ? state_.values[i] : std::numeric_limits<double>::quiet_NaN();
   }
-  std::uint32_t u32(std::string_view name) const {
-    const auto i = slot(name);
-    return i < N && state_.received(i) ? static_cast<std::uint32_t>(state_.values[i]) : 0;
+  // A flag as 1 or 0 (any non-zero value the device sent is set).
+  float flag(std::string_view name) const {
+    const double v = exact(name);
+    return std::isnan(v) ? kNoValue : (v != 0 ? 1.0f : 0.0f);
   }
-  std::uint8_t u8(std::string_view name) const { return static_cast<std::uint8_t>(u32(name) & 0xFF); }
-  bool flag(std::string_view name) const { return u32(name) != 0; }
 
  private:
   std::size_t slot(std::string_view name) const {
@@ -348,7 +350,7 @@ void DdsPublisher::on_health(const DeviceKey& key, const HealthReport& h) {
   s.kind(static_cast<pmu::v5::DeviceKind>(static_cast<int>(key.kind)));
   s.state(static_cast<pmu::v5::HealthState>(static_cast<int>(h.state)));
   s.bus_state(static_cast<pmu::v5::BusState>(static_cast<int>(h.bus_state)));
-  s.last_frame_age(idl_float(h.last_frame_age));
+  s.last_frame_age(frame_age_or_nan(h.last_frame_age));  // NaN, never -1: never heard
   s.frames_received(h.frames_received);
   s.frames_sent(h.frames_sent);
   s.decode_errors(h.decode_errors);
@@ -430,12 +432,12 @@ void DdsPublisher::on_battery(const DeviceKey& key, const BatteryState& b, std::
   s.current_discharge(v.real("current_discharge"));
   s.current_charge(v.real("current_charge"));
   s.state_of_charge(v.real("state_of_charge"));
-  s.time_to_go(v.real("time_to_go"));
+  s.time_to_go(time_to_go_or_nan(v.exact("time_to_go")));  // NaN also while not discharging
   s.cell_temperature_high(v.real("cell_temperature_high"));
   s.cell_temperature_low(v.real("cell_temperature_low"));
   s.cell_voltage_high(v.real("cell_voltage_high"));
   s.cell_voltage_low(v.real("cell_voltage_low"));
-  s.bms_state(v.u32("bms_state"));
+  s.bms_state(v.exact("bms_state"));
   s.temperature_1(v.real("temperature_1"));
   s.temperature_2(v.real("temperature_2"));
   s.temperature_3(v.real("temperature_3"));
@@ -474,26 +476,26 @@ void DdsPublisher::on_mppt(const DeviceKey& key, const MpptState& m, std::chrono
   s.voltage_output_raw(v.real("voltage_output_raw"));
   s.current_output_raw(v.real("current_output_raw"));
   s.voltage_out_sw_raw(v.real("voltage_out_sw_raw"));
-  s.mppt_state(v.u8("mppt_state"));
+  s.mppt_state(v.real("mppt_state"));
   s.safety_enabled(v.flag("safety_enabled"));
   s.pwm_enabled(v.flag("pwm_enabled"));
   s.temperature(v.real("temperature"));
   s.voltage_panel_1_raw(v.real("voltage_panel_1_raw"));
   s.current_panel_1_raw(v.real("current_panel_1_raw"));
   s.duty_cycle_panel_1(v.real("duty_cycle_panel_1"));
-  s.channel_1_active(v.u8("channel_1_active"));
+  s.channel_1_active(v.real("channel_1_active"));
   s.voltage_panel_2_raw(v.real("voltage_panel_2_raw"));
   s.current_panel_2_raw(v.real("current_panel_2_raw"));
   s.duty_cycle_panel_2(v.real("duty_cycle_panel_2"));
-  s.channel_2_active(v.u8("channel_2_active"));
+  s.channel_2_active(v.real("channel_2_active"));
   s.voltage_panel_3_raw(v.real("voltage_panel_3_raw"));
   s.current_panel_3_raw(v.real("current_panel_3_raw"));
   s.duty_cycle_panel_3(v.real("duty_cycle_panel_3"));
-  s.channel_3_active(v.u8("channel_3_active"));
+  s.channel_3_active(v.real("channel_3_active"));
   s.voltage_panel_4_raw(v.real("voltage_panel_4_raw"));
   s.current_panel_4_raw(v.real("current_panel_4_raw"));
   s.duty_cycle_panel_4(v.real("duty_cycle_panel_4"));
-  s.channel_4_active(v.u8("channel_4_active"));
+  s.channel_4_active(v.real("channel_4_active"));
   s.received(m.received_mask());
   std::lock_guard<std::mutex> lock(w_->mutex);
   if (!admit(key)) return;

@@ -2,6 +2,7 @@
 
 #include <fastdds/rtps/common/SerializedPayload.h>
 
+#include "pmu/dds/no_value.hpp"
 #include "pmu/idl/telemetryPubSubTypes.h"
 #include "pmu/idl/topics.hpp"
 
@@ -67,7 +68,7 @@ void fill(pmu::v5::Temperatures& s, const codec::Temperatures& t) {
 }
 
 void fill(pmu::v5::Status& s, const codec::Status& st) {
-  s.generator_rpm(st.generator_rpm);
+  s.generator_rpm(rpm_or_nan(st.generator_rpm));  // NaN, never 65535: no reading
   s.generation_enabled(st.generation_enabled);
   s.thermal_shutdown(st.thermal_shutdown);
   s.soa_shutdown(st.soa_shutdown);

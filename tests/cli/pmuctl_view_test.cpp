@@ -42,7 +42,7 @@ pmu::v5::Temperatures temperatures() {
   s.internal(31), s.battery_a(kNaN), s.battery_b(22), s.generator(kNaN), s.starter(-49);
   return s;
 }
-pmu::v5::Status status(std::uint16_t rpm) {
+pmu::v5::Status status(float rpm) {
   pmu::v5::Status s;
   s.generator_rpm(rpm), s.generation_enabled(true), s.payload_on(true);
   return s;
@@ -70,7 +70,7 @@ pmu::v5::Battery battery(float time_to_go) {
 }
 pmu::v5::Mppt mppt() {
   pmu::v5::Mppt s;
-  s.voltage_output_raw(1234), s.current_output_raw(-17), s.mppt_state(3), s.safety_enabled(true);
+  s.voltage_output_raw(1234), s.current_output_raw(-17), s.mppt_state(3), s.safety_enabled(1);
   s.temperature(41), s.duty_cycle_panel_1(45), s.channel_1_active(1);
   // voltage_output_raw, current_output_raw, mppt_state, safety_enabled, temperature,
   // duty_cycle_panel_1, channel_1_active (interface.md 1.4's bit order)
@@ -166,10 +166,11 @@ TEST(PmuctlView, SentinelsAreWordsInTablesAndNullInJson) {
   const std::vector<SentinelRow> rows = {
       {"table 5: -128 = no sensor", fields_of(temperatures()), "battery_a", "no sensor"},
       {"table 5: -128 = no sensor", fields_of(temperatures()), "generator", "no sensor"},
-      {"table 6: the top of 16 bits", fields_of(status(65535)), "generator_rpm", "no reading"},
-      {"health: -1 = never", fields_of(health(-1.0f)), "last_frame_age", "never"},
-      {"battery: 65535 min while not discharging", fields_of(battery(65535.0f * 60)), "time_to_go",
-       "n/a (not discharging)"},
+      {"table 6: NaN = no reading", fields_of(status(kNaN)), "generator_rpm", "no reading"},
+      {"health: NaN = never", fields_of(health(kNaN)), "last_frame_age", "never"},
+      {"battery: NaN received = not discharging", fields_of(battery(kNaN)), "time_to_go", "n/a (not discharging)"},
+      {"battery: time_to_go not received", fields_of([] { auto b = battery(kNaN); b.received(0xFFFF & ~(1u << 5)); return b; }()),
+       "time_to_go", "-"},
       {"battery: float not received", fields_of(none_received), "voltage", "-"},
       {"battery: integer not received", fields_of(none_received), "bms_state", "-"},
       {"battery: NaN with its bit set", fields_of([] { auto b = battery(600); b.voltage(kNaN); return b; }()),
@@ -185,6 +186,7 @@ TEST(PmuctlView, SentinelsAreWordsInTablesAndNullInJson) {
   }
   // Their neighbours are values.
   EXPECT_EQ(field(fields_of(status(65534)), "generator_rpm").json, 65534);
+  EXPECT_EQ(field(fields_of(status(0)), "generator_rpm").json, 0);
   EXPECT_EQ(field(fields_of(battery(65534.0f * 60)), "time_to_go").json, 65534.0 * 60);
   EXPECT_EQ(field(fields_of(health(0.0f)), "last_frame_age").json, 0.0);
   EXPECT_EQ(field(fields_of(temperatures()), "battery_b").json, 22.0);
@@ -410,13 +412,13 @@ namespace {
 // --json through sample_json.hpp: sentinels are null, raw counts integers; the rest as before.
 TEST(PmuctlViewJson, SentinelsAreNullAndRawCountsIntegers) {
   pmu::v5::Health h;
-  h.last_frame_age(-1.0f);
+  h.last_frame_age(std::numeric_limits<float>::quiet_NaN());
   EXPECT_TRUE(values_of(h)["last_frame_age"].is_null()) << values_of(h);
   pmu::v5::Status st;
-  st.generator_rpm(65535);
+  st.generator_rpm(std::numeric_limits<float>::quiet_NaN());
   EXPECT_TRUE(values_of(st)["generator_rpm"].is_null()) << values_of(st);
   pmu::v5::Battery b;
-  b.time_to_go(65535.0f * 60), b.received(1u << 5);
+  b.time_to_go(std::numeric_limits<float>::quiet_NaN()), b.received(1u << 5);
   EXPECT_TRUE(values_of(b)["time_to_go"].is_null()) << values_of(b);
   pmu::v5::Mppt m;
   m.voltage_output_raw(1234), m.received(1u << 0);

@@ -269,7 +269,7 @@ int run_canopen(const Options& o, dds_entity_t pp) {
         checks[0].detail = "received " + std::to_string(s.received) + ", want " + std::to_string(want);
         return;
       }
-      const bool ok = near(s.voltage, 48.123) && near(s.state_of_charge, 87) && s.bms_state == 0x12345678u &&
+      const bool ok = near(s.voltage, 48.123) && near(s.state_of_charge, 87) && s.bms_state == double{0x12345678u} &&
                       near(s.power_level, 77) && std::isnan(s.current);
       checks[0].done = ok;
       checks[0].detail = ok ? "voltage 48.123, state_of_charge 87, bms_state 0x12345678, power_level 77, current NaN"
@@ -285,10 +285,10 @@ int run_canopen(const Options& o, dds_entity_t pp) {
       if (o.canopen_bus != s.bus || s.device != 4) return;
       const uint32_t want = (1u << 0) | (1u << 4) | (1u << 13);
       if (s.received != want) return;
-      const bool ok = near(s.voltage_output_raw, -100) && s.safety_enabled && near(s.duty_cycle_panel_2, 45) &&
-                      std::isnan(s.current_output_raw);
+      const bool ok = near(s.voltage_output_raw, -100) && s.safety_enabled == 1.0f && near(s.duty_cycle_panel_2, 45) &&
+                      std::isnan(s.current_output_raw) && std::isnan(s.pwm_enabled);
       checks[2].done = ok;
-      checks[2].detail = ok ? "voltage_output_raw -100, safety_enabled, duty_cycle_panel_2 45" : "wrong values";
+      checks[2].detail = ok ? "voltage_output_raw -100, safety_enabled 1, duty_cycle_panel_2 45, pwm_enabled NaN" : "wrong values";
     });
     take_all<pmu_v5_Health>(health, [&](const pmu_v5_Health& s) {
       if (o.canopen_bus != s.bus || s.state != pmu_v5_ONLINE) return;

@@ -67,7 +67,7 @@ TEST(DdsCanOpen, BatteryCellsAndMpptArriveWithTheirValuesAndFrameTimes) {
   EXPECT_EQ(b.bus().to_string(), "sim0");
   EXPECT_EQ(b.node(), 2);
   EXPECT_FLOAT_EQ(b.voltage(), 48.123f);
-  EXPECT_EQ(b.bms_state(), 0x12345678u);
+  EXPECT_EQ(b.bms_state(), double{0x12345678u});
   EXPECT_FLOAT_EQ(b.temperature_1(), 20.0f);
   EXPECT_FLOAT_EQ(b.temperature_4(), 23.0f);
   EXPECT_FLOAT_EQ(b.power_level(), 77.0f);
@@ -89,15 +89,14 @@ TEST(DdsCanOpen, BatteryCellsAndMpptArriveWithTheirValuesAndFrameTimes) {
 
   pmu::v5::Mppt m;
   ASSERT_TRUE(wait_for<pmu::v5::Mppt>(mppt_reader, m, si, 5s, [](const pmu::v5::Mppt& x) {
-    return !std::isnan(x.voltage_output_raw()) && !std::isnan(x.duty_cycle_panel_2()) && x.safety_enabled();
+    return !std::isnan(x.voltage_output_raw()) && !std::isnan(x.duty_cycle_panel_2()) && x.safety_enabled() == 1.0f;
   }));
   EXPECT_EQ(m.device(), 4);
   EXPECT_FLOAT_EQ(m.voltage_output_raw(), -100.0f);
   EXPECT_FLOAT_EQ(m.duty_cycle_panel_2(), 45.0f);
   EXPECT_TRUE(std::isnan(m.current_output_raw()));
-  EXPECT_FALSE(m.pwm_enabled());
-  // voltage_output_raw (0), safety_enabled (4), duty_cycle_panel_2 (13); pwm_enabled's
-  // false is "not received" (bit 5 clear), not "off".
+  EXPECT_TRUE(std::isnan(m.pwm_enabled())) << "never sent: NaN, not off";
+  // voltage_output_raw (0), safety_enabled (4), duty_cycle_panel_2 (13).
   EXPECT_EQ(m.received(), (1u << 0) | (1u << 4) | (1u << 13));
 }
 

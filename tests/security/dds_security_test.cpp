@@ -643,14 +643,14 @@ TEST(ServiceProgram, SecurePmuServiceWithPmuctlAndTheExampleClient) {
 // takes the service's identity and permissions, which name topics, not types, so the same
 // files serve both contracts, and a secure ground station sees both.
 TEST(ServiceProgram, ASecureServiceAlsoServesThePreviousContractWithTheSameFiles) {
-  const std::string cfg = write_config("both", Pki::get().files("pmu-service"), "also_serve_contract: 3\n");
+  const std::string cfg = write_config("both", Pki::get().files("pmu-service"), "also_serve_contract: 4\n");
   const auto service = service_process(cfg);
   const std::string d = " --domain " + std::to_string(pmu::test::exclusive_dds_domain());
   const std::string sec = " --security-dir " + Pki::get().dir();
   const std::string pmuctl = PMUCTL_PATH;
   auto r = sh(pmuctl + d + sec + " --identity mission-computer --timeout 10 list --json");
   EXPECT_EQ(r.status, 0) << r.out;
-  EXPECT_NE(r.out.find("\"contracts\":[4,3]"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("\"contracts\":[5,4]"), std::string::npos) << r.out;
   r = sh(pmuctl + d + sec + " --identity ground-station --timeout 10 config set avionics_voltage 24");
   EXPECT_EQ(r.status, 0) << r.out;
   EXPECT_NE(r.out.find("COMPLETED"), std::string::npos) << r.out;

@@ -205,8 +205,9 @@ int main(int argc, char** argv) {
   ok &= command(l, pmu::v5::ENABLE_OUTPUTS, "payload output on", "", 0, 0x02);
   pmu::v5::Status st;
   if (latest(l.status, st, 3000ms))
-    std::printf("status: generator %u rpm, payload %s, avionics %s\n", st.generator_rpm(), st.payload_on() ? "on" : "off",
-                st.avionics_servo_on() ? "on" : "off");
+    // NaN: the PMU has no reading (interface.md section 1.1); printf prints it as "nan".
+    std::printf("status: generator %.0f rpm, payload %s, avionics %s\n", static_cast<double>(st.generator_rpm()),
+                st.payload_on() ? "on" : "off", st.avionics_servo_on() ? "on" : "off");
   else
     ok = false, std::printf("status: not received\n");
 

@@ -429,7 +429,7 @@ int run_watch(const GlobalOptions& o, long count) {
   return 0;
 }
 
-// "v4", or "v4, v3" for a vehicle whose service also serves contract 3's consumers.
+// "v5", or "v5, v4" for a vehicle whose service also serves contract 4's consumers.
 std::string contracts_cell(const std::set<int>& contracts) {
   std::string cell;
   for (auto it = contracts.rbegin(); it != contracts.rend(); ++it) cell += (cell.empty() ? "v" : ", v") + std::to_string(*it);
