@@ -8,6 +8,7 @@
 #include <chrono>
 #include <cmath>
 #include <functional>
+#include <iterator>
 #include <limits>
 #include <map>
 #include <string>
@@ -194,13 +195,15 @@ TEST(DdsNoValue, SentinelsAndValuesNotReceivedAreNaNAndThePreviousContractsAsItS
                                 false, dds::contract_major() - 1);
   DdsPublisher current(current_side, 3s);
   DdsPublisher previous(previous_side, 3s);
+  // A client of each contract: one participant has one topic of a name, of one type.
   dds::DdsContext client(domain, "", "reader-no-value");
+  dds::DdsContext previous_client(domain, "", "reader-no-value-previous");
   Readers<pmu::v5::Status, pmu::v5::StatusPubSubType, pmu::v5::Health, pmu::v5::HealthPubSubType, pmu::v5::Battery,
           pmu::v5::BatteryPubSubType, pmu::v5::Mppt, pmu::v5::MpptPubSubType>
       now_readers(client);
   Readers<pmu::v4::Status, pmu::v4::StatusPubSubType, pmu::v4::Health, pmu::v4::HealthPubSubType, pmu::v4::Battery,
           pmu::v4::BatteryPubSubType, pmu::v4::Mppt, pmu::v4::MpptPubSubType>
-      old_readers(client);
+      old_readers(previous_client);
 
   Collected now, old;
   auto all_read = [&](const Collected& c) {
