@@ -31,7 +31,7 @@ add_library(pmu::sysconf_dir ALIAS pmu_sysconf_dir)
 # The release and contract versions every program's --version prints (pmu::version). The
 # release is the package's: a version in CMakeLists.txt that debian/changelog does not carry
 # would make `--version` lie about the installed package.
-set(PMU_CONTRACT_VERSION 4)
+set(PMU_CONTRACT_VERSION 5)
 file(STRINGS ${PROJECT_SOURCE_DIR}/debian/changelog pmu_changelog_head LIMIT_COUNT 1)
 if(NOT pmu_changelog_head MATCHES "^pmu-dds \\(${PROJECT_VERSION}-[^)]+\\)")
   message(FATAL_ERROR "debian/changelog's newest entry (${pmu_changelog_head}) is not version ${PROJECT_VERSION} "

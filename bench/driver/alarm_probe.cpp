@@ -20,7 +20,7 @@ struct AlarmProbe::Listeners {
   struct Status : DataReaderListener {
     std::atomic<std::int64_t>* at;
     void on_data_available(DataReader* r) override {
-      pmu::v4::Status s;
+      pmu::v5::Status s;
       SampleInfo info;
       while (r->take_next_sample(&s, &info) == ReturnCode_t::RETCODE_OK) {
         std::int64_t none = 0;
@@ -31,12 +31,12 @@ struct AlarmProbe::Listeners {
   struct Alarms : DataReaderListener {
     std::atomic<std::int64_t>* at;
     void on_data_available(DataReader* r) override {
-      pmu::v4::Alarm a;
+      pmu::v5::Alarm a;
       SampleInfo info;
       while (r->take_next_sample(&a, &info) == ReturnCode_t::RETCODE_OK) {
         std::int64_t none = 0;
         if (info.valid_data && a.code().to_string() == "thermal_shutdown" &&
-            a.state() == pmu::v4::ALARM_ACTIVE_UNACKNOWLEDGED)
+            a.state() == pmu::v5::ALARM_ACTIVE_UNACKNOWLEDGED)
           at->compare_exchange_strong(none, steady_ns());
       }
     }
@@ -48,9 +48,9 @@ struct AlarmProbe::Listeners {
 AlarmProbe::AlarmProbe(pmu::dds::DdsContext& dds) : dds_(dds), listeners_(new Listeners) {
   listeners_->status.at = &status_at_;
   listeners_->alarms.at = &alarm_at_;
-  listeners_->status_reader = &dds_.reader(dds_.topic(topics::kStatus, TypeSupport(new pmu::v4::StatusPubSubType())),
+  listeners_->status_reader = &dds_.reader(dds_.topic(topics::kStatus, TypeSupport(new pmu::v5::StatusPubSubType())),
                                            qos_profiles::kTelemetry, &listeners_->status);
-  listeners_->alarm_reader = &dds_.reader(dds_.topic(topics::kAlarms, TypeSupport(new pmu::v4::AlarmPubSubType())),
+  listeners_->alarm_reader = &dds_.reader(dds_.topic(topics::kAlarms, TypeSupport(new pmu::v5::AlarmPubSubType())),
                                           qos_profiles::kAlarms, &listeners_->alarms);
 }
 

@@ -23,7 +23,7 @@ using namespace eprosima::fastdds::dds;
 
 namespace {
 
-std::int64_t embedded_time(const pmu::v4::Voltages& v) {
+std::int64_t embedded_time(const pmu::v5::Voltages& v) {
   const auto part = [](float f) { return static_cast<std::uint64_t>(f); };
   return static_cast<std::int64_t>(part(v.avionics()) << 48 | part(v.output_28v()) << 32 | part(v.payload()) << 16 |
                                    part(v.servo()));
@@ -41,7 +41,7 @@ VoltagesProbe::VoltagesProbe(pmu::dds::DdsContext& dds, WriteTimes* times) : dds
   // The telemetry profile, but a history deep enough that a burst of samples waiting for
   // this listener is not overwritten: a loss counted here is then the sender's, not the
   // probe's (service and reference alike).
-  auto& topic = dds.topic(topics::kVoltages, TypeSupport(new pmu::v4::VoltagesPubSubType()));
+  auto& topic = dds.topic(topics::kVoltages, TypeSupport(new pmu::v5::VoltagesPubSubType()));
   subscriber_ = dds.participant().create_subscriber(SUBSCRIBER_QOS_DEFAULT);
   DataReaderQos qos;
   if (!subscriber_ || subscriber_->get_datareader_qos_from_profile(qos_profiles::kTelemetry, qos) !=
@@ -66,7 +66,7 @@ void VoltagesProbe::on_sample_lost(DataReader*, const SampleLostStatus& status) 
 }
 
 void VoltagesProbe::on_data_available(DataReader* reader) {
-  pmu::v4::Voltages v;
+  pmu::v5::Voltages v;
   SampleInfo info;
   while (reader->take_next_sample(&v, &info) == ReturnCode_t::RETCODE_OK) {
     const std::int64_t now = steady_ns();
@@ -110,18 +110,18 @@ bool VoltagesProbe::wait_matched(std::chrono::milliseconds timeout) {
 }
 
 CommandClient::CommandClient(pmu::dds::DdsContext& dds) : dds_(dds) {
-  replies_ = &dds.reader(dds.topic(topics::kCommandReply, TypeSupport(new pmu::v4::CommandReplyPubSubType())),
+  replies_ = &dds.reader(dds.topic(topics::kCommandReply, TypeSupport(new pmu::v5::CommandReplyPubSubType())),
                          qos_profiles::kCommand, this);
-  writer_ = &dds.writer(dds.topic(topics::kCommand, TypeSupport(new pmu::v4::CommandPubSubType())), qos_profiles::kCommand);
+  writer_ = &dds.writer(dds.topic(topics::kCommand, TypeSupport(new pmu::v5::CommandPubSubType())), qos_profiles::kCommand);
 }
 
 CommandClient::~CommandClient() { replies_->set_listener(nullptr); }
 
 void CommandClient::on_data_available(DataReader* reader) {
-  pmu::v4::CommandReply r;
+  pmu::v5::CommandReply r;
   SampleInfo info;
   while (reader->take_next_sample(&r, &info) == ReturnCode_t::RETCODE_OK) {
-    if (!info.valid_data || r.result() == pmu::v4::IN_PROGRESS) continue;
+    if (!info.valid_data || r.result() == pmu::v5::IN_PROGRESS) continue;
     std::lock_guard lock(mutex_);
     if (r.request_id().to_string() != waiting_for_) continue;
     answered_ = true;
@@ -149,12 +149,12 @@ CommandClient::Result CommandClient::run(int count, const std::string& bus, std:
   static int session = 0;
   ++session;
   for (int i = 0; i < count; ++i) {
-    pmu::v4::Command c;
+    pmu::v5::Command c;
     const std::string id = "bench-" + std::to_string(session) + "-" + std::to_string(i);
     c.request_id(id);
     c.bus(bus);
     c.address(address);
-    c.kind(pmu::v4::GET);
+    c.kind(pmu::v5::GET);
     c.parameter("outputs");
     {
       std::lock_guard lock(mutex_);
@@ -169,7 +169,7 @@ CommandClient::Result CommandClient::run(int count, const std::string& bus, std:
       continue;
     }
     const std::int64_t rtt = steady_ns() - sent;
-    if (result_ == static_cast<int>(pmu::v4::COMPLETED))
+    if (result_ == static_cast<int>(pmu::v5::COMPLETED))
       out.rtt_ns.push_back(rtt);
     else
       ++out.results[result_name(result_)];

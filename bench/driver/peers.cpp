@@ -48,7 +48,7 @@ int peer_writer(const PeerOptions& o) {
   // ports then waits out a health check (333 ms each), which would skew the start-ups.
   StopFlag stop;
   pmu::dds::DdsContext dds(o.domain, o.qos_file, "bench-peer-writer", {}, o.transport);
-  DataWriter& w = dds.writer(dds.topic(topics::kVoltages, TypeSupport(new pmu::v4::VoltagesPubSubType())),
+  DataWriter& w = dds.writer(dds.topic(topics::kVoltages, TypeSupport(new pmu::v5::VoltagesPubSubType())),
                              qos_profiles::kTelemetry);
   for (int i = 0;; ++i) {
     if (stop) return 0;
@@ -61,7 +61,7 @@ int peer_writer(const PeerOptions& o) {
     }
     std::this_thread::sleep_for(std::chrono::milliseconds(5));
   }
-  pmu::v4::Voltages v;
+  pmu::v5::Voltages v;
   v.bus("fd3");  // the same key (and so the same sample size) as the service's samples
   v.address(1);
   v.battery_a(kEmbeddedMarker);
@@ -86,16 +86,16 @@ class Echo : public DataReaderListener {
  public:
   explicit Echo(DataWriter& replies) : replies_(replies) {}
   void on_data_available(DataReader* reader) override {
-    pmu::v4::Command c;
+    pmu::v5::Command c;
     SampleInfo info;
     while (reader->take_next_sample(&c, &info) == ReturnCode_t::RETCODE_OK) {
       if (!info.valid_data) continue;
-      pmu::v4::CommandReply r;
+      pmu::v5::CommandReply r;
       r.request_id(c.request_id());
       r.bus(c.bus());
       r.address(c.address());
       r.kind(c.kind());
-      r.result(pmu::v4::COMPLETED);
+      r.result(pmu::v5::COMPLETED);
       r.has_value(true);
       r.value(15);
       replies_.write(&r);
@@ -111,10 +111,10 @@ class Echo : public DataReaderListener {
 int peer_echo(const PeerOptions& o) {
   transport::StopSignals stop;
   pmu::dds::DdsContext dds(o.domain, o.qos_file, "bench-peer-echo", {}, o.transport);
-  DataWriter& replies = dds.writer(dds.topic(topics::kCommandReply, TypeSupport(new pmu::v4::CommandReplyPubSubType())),
+  DataWriter& replies = dds.writer(dds.topic(topics::kCommandReply, TypeSupport(new pmu::v5::CommandReplyPubSubType())),
                                    qos_profiles::kCommand);
   Echo echo(replies);
-  DataReader& requests = dds.reader(dds.topic(topics::kCommand, TypeSupport(new pmu::v4::CommandPubSubType())),
+  DataReader& requests = dds.reader(dds.topic(topics::kCommand, TypeSupport(new pmu::v5::CommandPubSubType())),
                                     qos_profiles::kCommand, &echo);
   stop.wait();
   requests.set_listener(nullptr);

@@ -48,22 +48,22 @@ int peer_telemetry(const PeerOptions& o) {
     if (!w) throw std::runtime_error(std::string("cannot create a writer of ") + name);
     return w;
   };
-  DataWriter* voltages = writer(topics::kVoltages, TypeSupport(new pmu::v4::VoltagesPubSubType()), qos_profiles::kTelemetry);
-  DataWriter* currents = writer(topics::kCurrents, TypeSupport(new pmu::v4::CurrentsPubSubType()), qos_profiles::kTelemetry);
+  DataWriter* voltages = writer(topics::kVoltages, TypeSupport(new pmu::v5::VoltagesPubSubType()), qos_profiles::kTelemetry);
+  DataWriter* currents = writer(topics::kCurrents, TypeSupport(new pmu::v5::CurrentsPubSubType()), qos_profiles::kTelemetry);
   DataWriter* energy =
-      writer(topics::kBatteryEnergy, TypeSupport(new pmu::v4::BatteryEnergyPubSubType()), qos_profiles::kTelemetry);
+      writer(topics::kBatteryEnergy, TypeSupport(new pmu::v5::BatteryEnergyPubSubType()), qos_profiles::kTelemetry);
   DataWriter* temperatures =
-      writer(topics::kTemperatures, TypeSupport(new pmu::v4::TemperaturesPubSubType()), qos_profiles::kTelemetry);
-  DataWriter* status = writer(topics::kStatus, TypeSupport(new pmu::v4::StatusPubSubType()), qos_profiles::kTelemetry);
-  (void)writer(topics::kConfig, TypeSupport(new pmu::v4::ConfigPubSubType()), qos_profiles::kState);
-  (void)writer(topics::kInfo, TypeSupport(new pmu::v4::DeviceInfoPubSubType()), qos_profiles::kState);
-  (void)writer(topics::kHealth, TypeSupport(new pmu::v4::HealthPubSubType()), qos_profiles::kState);
+      writer(topics::kTemperatures, TypeSupport(new pmu::v5::TemperaturesPubSubType()), qos_profiles::kTelemetry);
+  DataWriter* status = writer(topics::kStatus, TypeSupport(new pmu::v5::StatusPubSubType()), qos_profiles::kTelemetry);
+  (void)writer(topics::kConfig, TypeSupport(new pmu::v5::ConfigPubSubType()), qos_profiles::kState);
+  (void)writer(topics::kInfo, TypeSupport(new pmu::v5::DeviceInfoPubSubType()), qos_profiles::kState);
+  (void)writer(topics::kHealth, TypeSupport(new pmu::v5::HealthPubSubType()), qos_profiles::kState);
 
-  pmu::v4::Voltages v;
-  pmu::v4::Currents c;
-  pmu::v4::BatteryEnergy e;
-  pmu::v4::Temperatures t;
-  pmu::v4::Status st;
+  pmu::v5::Voltages v;
+  pmu::v5::Currents c;
+  pmu::v5::BatteryEnergy e;
+  pmu::v5::Temperatures t;
+  pmu::v5::Status st;
   v.avionics(12.0f);
   c.avionics(1.5f);
   e.battery_a_mah(1200);

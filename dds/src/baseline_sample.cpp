@@ -53,8 +53,8 @@ void set_field(Setting, bool& f, const std::optional<std::uint32_t>& raw) { f = 
 
 }  // namespace
 
-pmu::v4::Baseline baseline_sample(const std::string& vehicle, const std::string& bus, const DeviceConfig& device) {
-  pmu::v4::Baseline s;
+pmu::v5::Baseline baseline_sample(const std::string& vehicle, const std::string& bus, const DeviceConfig& device) {
+  pmu::v5::Baseline s;
   s.vehicle(vehicle);
   s.bus(bus);
   s.address(device.address);
@@ -78,7 +78,7 @@ pmu::v4::Baseline baseline_sample(const std::string& vehicle, const std::string&
   return s;
 }
 
-baseline::ConfigFile config_file_of(const pmu::v4::Baseline& sample) {
+baseline::ConfigFile config_file_of(const pmu::v5::Baseline& sample) {
   baseline::ConfigFile f;
   f.header.vehicle = sample.vehicle();
   f.header.bus = sample.bus();
@@ -91,7 +91,7 @@ baseline::ConfigFile config_file_of(const pmu::v4::Baseline& sample) {
   return f;
 }
 
-baseline::Settings settings_of(const pmu::v4::Config& config) {
+baseline::Settings settings_of(const pmu::v5::Config& config) {
   baseline::Settings s;
   each_setting(config, [&](Setting setting, const auto& field) { s[setting] = raw_field(setting, field); });
   return s;

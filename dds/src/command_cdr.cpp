@@ -42,7 +42,7 @@ struct Out {
 std::optional<CommandSample> read_command_cdr(const std::uint8_t* data, std::size_t size) noexcept {
   if (!data || size < 4) return std::nullopt;
   // Fast CDR reports a short buffer or a bad encapsulation by throwing; the boundary turns
-  // that into "not a pmu::v4::Command", whatever the exception.
+  // that into "not a pmu::v5::Command", whatever the exception.
   try {
     std::vector<char> copy(reinterpret_cast<const char*>(data), reinterpret_cast<const char*>(data) + size);
     FastBuffer buffer(copy.data(), copy.size());

@@ -22,10 +22,10 @@ namespace {
 using namespace eprosima::fastdds::dds;
 
 // parse_alarm_ack reads the kind by AlarmSource's numbers, and the reply's state by AlarmState's.
-static_assert(static_cast<int>(pmu::v4::SOURCE_BUS) == static_cast<int>(alarms::DeviceKind::Bus));
-static_assert(static_cast<int>(pmu::v4::ALARM_CLEARED_UNACKNOWLEDGED) ==
+static_assert(static_cast<int>(pmu::v5::SOURCE_BUS) == static_cast<int>(alarms::DeviceKind::Bus));
+static_assert(static_cast<int>(pmu::v5::ALARM_CLEARED_UNACKNOWLEDGED) ==
               static_cast<int>(alarms::AlarmState::ClearedUnacknowledged));
-static_assert(static_cast<int>(pmu::v4::ACK_REJECTED) == static_cast<int>(AckReplyResult::Rejected));
+static_assert(static_cast<int>(pmu::v5::ACK_REJECTED) == static_cast<int>(AckReplyResult::Rejected));
 
 }  // namespace
 
@@ -39,7 +39,7 @@ struct DdsAlarmAckEndpoint::Impl final : public DataReaderListener {
   std::mutex write_mutex;
   std::atomic<std::uint64_t> not_ours{0};
   LogThrottle not_ours_reports{std::chrono::seconds(10)};
-  idl::Guarded<pmu::v4::AlarmAckPubSubType>* type = nullptr;  // owned by the registered TypeSupport
+  idl::Guarded<pmu::v5::AlarmAckPubSubType>* type = nullptr;  // owned by the registered TypeSupport
   std::uint64_t malformed_logged = 0;
   LogThrottle malformed_reports{std::chrono::seconds(10)};
 
@@ -59,7 +59,7 @@ struct DdsAlarmAckEndpoint::Impl final : public DataReaderListener {
   void take(DataReader* r) {
     std::lock_guard<std::mutex> lock(service_mutex);
     if (!service) return;
-    pmu::v4::AlarmAck s;
+    pmu::v5::AlarmAck s;
     SampleInfo info;
     // A payload that does not deserialize is dropped by Fast DDS before take sees it: the type
     // is Guarded, because fastddsgen's own would throw out of every take, for ever, once one
@@ -86,7 +86,7 @@ struct DdsAlarmAckEndpoint::Impl final : public DataReaderListener {
     // so a flood cannot fill the journal.
     const auto malformed = type ? type->malformed() : 0;
     if (malformed != malformed_logged && malformed_reports.allow(LogThrottle::Clock::now())) {
-      spdlog::warn("pmu/alarm_ack: dropped {} sample(s) that are not a pmu::v4::AlarmAck as idl/alarms.idl "
+      spdlog::warn("pmu/alarm_ack: dropped {} sample(s) that are not a pmu::v5::AlarmAck as idl/alarms.idl "
                    "defines it ({} since start); no reply is possible without a readable request_id",
                    malformed - malformed_logged, malformed);
       malformed_logged = malformed;
@@ -94,16 +94,16 @@ struct DdsAlarmAckEndpoint::Impl final : public DataReaderListener {
   }
 
   void publish(const AlarmAckReplyData& d) {
-    pmu::v4::AlarmAckReply s;
+    pmu::v5::AlarmAckReply s;
     s.request_id(d.request_id);
     s.vehicle(vehicle);
     s.bus(d.bus);
-    s.kind(static_cast<pmu::v4::AlarmSource>(d.kind));
+    s.kind(static_cast<pmu::v5::AlarmSource>(d.kind));
     s.device(d.device);
     s.code(d.code);
-    s.result(static_cast<pmu::v4::AlarmAckResult>(d.result));
+    s.result(static_cast<pmu::v5::AlarmAckResult>(d.result));
     s.reason(d.reason);
-    s.state(static_cast<pmu::v4::AlarmState>(d.state));
+    s.state(static_cast<pmu::v5::AlarmState>(d.state));
     bool ok = false;
     {
       std::lock_guard<std::mutex> lock(write_mutex);
@@ -116,7 +116,7 @@ struct DdsAlarmAckEndpoint::Impl final : public DataReaderListener {
 DdsAlarmAckEndpoint::DdsAlarmAckEndpoint(dds::DdsContext& dds, std::string vehicle)
     : impl_(std::make_unique<Impl>(dds, std::move(vehicle))) {
   try {
-    impl_->writer = &dds.writer(dds.topic(topics::kAlarmAckReply, dds::zero_padded<pmu::v4::AlarmAckReplyPubSubType>()),
+    impl_->writer = &dds.writer(dds.topic(topics::kAlarmAckReply, dds::zero_padded<pmu::v5::AlarmAckReplyPubSubType>()),
                                 qos_profiles::kCommand);
   } catch (const dds::DdsError& e) {
     if (!dds.secure()) throw;
@@ -137,7 +137,7 @@ void DdsAlarmAckEndpoint::start(AlarmAckService& service) {
     impl_->service = &service;
   }
   try {
-    auto* type = new idl::Guarded<pmu::v4::AlarmAckPubSubType>();
+    auto* type = new idl::Guarded<pmu::v5::AlarmAckPubSubType>();
     impl_->type = type;
     impl_->reader = &impl_->dds.reader(
         impl_->dds.topic(topics::kAlarmAck, TypeSupport(type)), qos_profiles::kCommand,

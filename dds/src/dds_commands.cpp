@@ -27,8 +27,8 @@ namespace {
 
 using namespace eprosima::fastdds::dds;
 
-static_assert(static_cast<int>(pmu::v4::GET_FIRMWARE) == static_cast<int>(CommandKind::GetFirmware));
-static_assert(static_cast<int>(pmu::v4::IN_PROGRESS) == static_cast<int>(CommandResult::InProgress));
+static_assert(static_cast<int>(pmu::v5::GET_FIRMWARE) == static_cast<int>(CommandKind::GetFirmware));
+static_assert(static_cast<int>(pmu::v5::IN_PROGRESS) == static_cast<int>(CommandResult::InProgress));
 
 constexpr std::chrono::seconds kMalformedLogInterval{10};
 
@@ -102,27 +102,27 @@ struct DdsCommandEndpoint::Impl final : public DataReaderListener {
     report_malformed();
   }
 
-  // A payload that is not a pmu::v4::Command cannot be answered (it has no readable request id):
+  // A payload that is not a pmu::v5::Command cannot be answered (it has no readable request id):
   // counted by the type, logged at most every few seconds so a flood cannot fill the journal.
   void report_malformed() {
     const auto total = type->malformed();
     const auto now = std::chrono::steady_clock::now();
     if (total == malformed_logged || now < next_malformed_log) return;
     next_malformed_log = now + kMalformedLogInterval;
-    spdlog::warn("pmu/command: dropped {} sample(s) that are not a pmu::v4::Command as idl/command.idl defines it "
+    spdlog::warn("pmu/command: dropped {} sample(s) that are not a pmu::v5::Command as idl/command.idl defines it "
                  "({} since start); no reply is possible without a readable request_id",
                  total - malformed_logged, total);
     malformed_logged = total;
   }
 
   void publish(const CommandReplyData& d) {
-    pmu::v4::CommandReply s;
+    pmu::v5::CommandReply s;
     s.request_id(d.request_id.substr(0, kMaxRequestIdLength));
     s.vehicle(vehicle);
     s.bus(d.bus.substr(0, kMaxBusNameLength));
     s.address(d.address);
-    s.kind(static_cast<pmu::v4::CommandKind>(static_cast<int>(d.kind)));
-    s.result(static_cast<pmu::v4::CommandResult>(static_cast<int>(d.result)));
+    s.kind(static_cast<pmu::v5::CommandKind>(static_cast<int>(d.kind)));
+    s.result(static_cast<pmu::v5::CommandResult>(static_cast<int>(d.result)));
     s.reason(d.reason.substr(0, 255));
     s.has_value(d.has_value);
     s.value(d.value);
@@ -139,7 +139,7 @@ struct DdsCommandEndpoint::Impl final : public DataReaderListener {
 
 DdsCommandEndpoint::DdsCommandEndpoint(dds::DdsContext& dds, DdsPublisher* failures, std::string vehicle)
     : impl_(std::make_unique<Impl>(dds, failures, std::move(vehicle))) {
-  impl_->writer = &dds.writer(dds.topic(topics::kCommandReply, dds::zero_padded<pmu::v4::CommandReplyPubSubType>()),
+  impl_->writer = &dds.writer(dds.topic(topics::kCommandReply, dds::zero_padded<pmu::v5::CommandReplyPubSubType>()),
                               qos_profiles::kCommand);
 }
 

@@ -16,6 +16,7 @@
 #include "pmu/dds/dds_participant.hpp"
 #include "pmu/dds/dds_qos_file.hpp"
 #include "pmu/dds/dds_type_objects.hpp"
+#include "pmu/dds/previous_contract.hpp"
 #include "pmu/dds/security_match_guard.hpp"
 #include "pmu/sysconf_dir.hpp"
 
@@ -171,7 +172,15 @@ DdsContext::~DdsContext() {
 
 Topic& DdsContext::topic(const std::string& name, TypeSupport type) {
   if (auto it = topics_.find(name); it != topics_.end()) return *it->second;
-  if (contract_ != contract_major()) type->setName(type_name_in_contract(type.get_type_name(), contract_).c_str());
+  if (contract_ != contract_major()) {
+    // The previous contract: a type it laid out or filled otherwise is converted, every other
+    // type is this contract's under the previous contract's name (previous_contract.hpp).
+    auto converting = contract_ == contract_major() - 1 ? previous_contract_type(type) : TypeSupport();
+    if (converting)
+      type = converting;
+    else
+      type->setName(type_name_in_contract(type.get_type_name(), contract_).c_str());
+  }
   const std::string type_name = type.get_type_name();
   announce_type_object(type, type_objects_);  // never TypeInformation; the type object when asked and self-contained
   if (type.register_type(participant_) != ReturnCode_t::RETCODE_OK)

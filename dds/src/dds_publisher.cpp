@@ -15,6 +15,7 @@
 #include "pmu/config/capacity.hpp"
 #include "pmu/config/low_rate.hpp"
 #include "pmu/dds/baseline_sample.hpp"
+#include "pmu/dds/no_value.hpp"
 #include "pmu/dds/telemetry_samples.hpp"
 #include "pmu/dds/zero_padded_type.hpp"
 #include "pmu/idl/alarms.h"
@@ -61,22 +62,23 @@ const char* why(ReturnCode_t rc) {
 // The battery's node or the MPPT's device id fits an octet (node 1..127, device 0..7).
 std::uint8_t octet_id(const DeviceKey& k) { return static_cast<std::uint8_t>(k.address & 0xFF); }
 
-// A CANopen state's value by its contract name: float fields carry NaN when not received,
-// integer and boolean fields 0 (the `received` mask tells them apart).
+// A CANopen state's value by its contract name: NaN when not received, in every field (the
+// integer and boolean values too: a 0 would plot as a value the device never sent).
 template <std::size_t N>
 class Values {
  public:
   Values(const CanOpenValues<N>& state, const CanOpenValue (&table)[N]) : state_(state), table_(table) {}
-  float real(std::string_view name) const {
+  float real(std::string_view name) const { return static_cast<float>(exact(name)); }
+  // A 32-bit value as sent: a double holds each exactly, a float does not.
+  double exact(std::string_view name) const {
     const auto i = slot(name);
-    return i < N ? idl_float(state_.values[i]) : std::numeric_limits<float>::quiet_NaN();
+    return i < N && state_.received(i) ? state_.values[i] : std::numeric_limits<double>::quiet_NaN();
   }
-  std::uint32_t u32(std::string_view name) const {
-    const auto i = slot(name);
-    return i < N && state_.received(i) ? static_cast<std::uint32_t>(state_.values[i]) : 0;
+  // A flag as 1 or 0 (any non-zero value the device sent is set).
+  float flag(std::string_view name) const {
+    const double v = exact(name);
+    return std::isnan(v) ? kNoValue : (v != 0 ? 1.0f : 0.0f);
   }
-  std::uint8_t u8(std::string_view name) const { return static_cast<std::uint8_t>(u32(name) & 0xFF); }
-  bool flag(std::string_view name) const { return u32(name) != 0; }
 
  private:
   std::size_t slot(std::string_view name) const {
@@ -145,29 +147,29 @@ DdsPublisher::DdsPublisher(dds::DdsContext& dds, std::chrono::milliseconds telem
     return &dds.writer(dds.topic(name, type), qos_profiles::kState);
   };
   const auto d = telemetry_deadline;
-  w_->voltages = telemetry(topics::kVoltages, dds::zero_padded<pmu::v4::VoltagesPubSubType>(), d);
-  w_->currents = telemetry(topics::kCurrents, dds::zero_padded<pmu::v4::CurrentsPubSubType>(), d);
-  w_->energy = telemetry(topics::kBatteryEnergy, dds::zero_padded<pmu::v4::BatteryEnergyPubSubType>(), d);
-  w_->temperatures = telemetry(topics::kTemperatures, dds::zero_padded<pmu::v4::TemperaturesPubSubType>(), d);
-  w_->status = telemetry(topics::kStatus, dds::zero_padded<pmu::v4::StatusPubSubType>(), d);
+  w_->voltages = telemetry(topics::kVoltages, dds::zero_padded<pmu::v5::VoltagesPubSubType>(), d);
+  w_->currents = telemetry(topics::kCurrents, dds::zero_padded<pmu::v5::CurrentsPubSubType>(), d);
+  w_->energy = telemetry(topics::kBatteryEnergy, dds::zero_padded<pmu::v5::BatteryEnergyPubSubType>(), d);
+  w_->temperatures = telemetry(topics::kTemperatures, dds::zero_padded<pmu::v5::TemperaturesPubSubType>(), d);
+  w_->status = telemetry(topics::kStatus, dds::zero_padded<pmu::v5::StatusPubSubType>(), d);
   if (w_->low_rate.enabled()) {
     // The same types on topics of their own: a reader of one never matches the other's writer.
     const auto low = std::max(telemetry_deadline, 3 * low_rate_period);
-    w_->low[0] = telemetry(topics::kLowRateVoltages, dds::zero_padded<pmu::v4::VoltagesPubSubType>(), low);
-    w_->low[1] = telemetry(topics::kLowRateCurrents, dds::zero_padded<pmu::v4::CurrentsPubSubType>(), low);
-    w_->low[2] = telemetry(topics::kLowRateBatteryEnergy, dds::zero_padded<pmu::v4::BatteryEnergyPubSubType>(), low);
-    w_->low[3] = telemetry(topics::kLowRateTemperatures, dds::zero_padded<pmu::v4::TemperaturesPubSubType>(), low);
-    w_->low[4] = telemetry(topics::kLowRateStatus, dds::zero_padded<pmu::v4::StatusPubSubType>(), low);
+    w_->low[0] = telemetry(topics::kLowRateVoltages, dds::zero_padded<pmu::v5::VoltagesPubSubType>(), low);
+    w_->low[1] = telemetry(topics::kLowRateCurrents, dds::zero_padded<pmu::v5::CurrentsPubSubType>(), low);
+    w_->low[2] = telemetry(topics::kLowRateBatteryEnergy, dds::zero_padded<pmu::v5::BatteryEnergyPubSubType>(), low);
+    w_->low[3] = telemetry(topics::kLowRateTemperatures, dds::zero_padded<pmu::v5::TemperaturesPubSubType>(), low);
+    w_->low[4] = telemetry(topics::kLowRateStatus, dds::zero_padded<pmu::v5::StatusPubSubType>(), low);
   }
   if (canopen_deadline) {
     const auto cd = *canopen_deadline;
-    w_->battery = telemetry(topics::kBattery, dds::zero_padded<pmu::v4::BatteryPubSubType>(), cd);
-    w_->battery_cells = telemetry(topics::kBatteryCells, dds::zero_padded<pmu::v4::BatteryCellsPubSubType>(), cd);
-    w_->mppt = telemetry(topics::kMppt, dds::zero_padded<pmu::v4::MpptPubSubType>(), cd);
+    w_->battery = telemetry(topics::kBattery, dds::zero_padded<pmu::v5::BatteryPubSubType>(), cd);
+    w_->battery_cells = telemetry(topics::kBatteryCells, dds::zero_padded<pmu::v5::BatteryCellsPubSubType>(), cd);
+    w_->mppt = telemetry(topics::kMppt, dds::zero_padded<pmu::v5::MpptPubSubType>(), cd);
   }
-  w_->config = state(topics::kConfig, dds::zero_padded<pmu::v4::ConfigPubSubType>());
-  w_->info = state(topics::kInfo, dds::zero_padded<pmu::v4::DeviceInfoPubSubType>());
-  w_->health = state(topics::kHealth, dds::zero_padded<pmu::v4::HealthPubSubType>());
+  w_->config = state(topics::kConfig, dds::zero_padded<pmu::v5::ConfigPubSubType>());
+  w_->info = state(topics::kInfo, dds::zero_padded<pmu::v5::DeviceInfoPubSubType>());
+  w_->health = state(topics::kHealth, dds::zero_padded<pmu::v5::HealthPubSubType>());
   // Topics newer than the DDS-Security permissions a service may have been given: without a
   // grant the service runs without them rather than not at all.
   auto newer = [&](const char* name, TypeSupport type, const char* profile) -> DataWriter* {
@@ -181,12 +183,12 @@ DdsPublisher::DdsPublisher(dds::DdsContext& dds, std::chrono::milliseconds telem
       return nullptr;
     }
   };
-  w_->alarms = newer(topics::kAlarms, dds::zero_padded<pmu::v4::AlarmPubSubType>(), qos_profiles::kAlarms);
-  w_->readiness = newer(topics::kReadiness, dds::zero_padded<pmu::v4::ReadinessPubSubType>(), qos_profiles::kState);
-  w_->derived_energy = newer(topics::kEnergy, dds::zero_padded<pmu::v4::EnergyPubSubType>(), qos_profiles::kState);
-  w_->baseline = newer(topics::kBaseline, dds::zero_padded<pmu::v4::BaselinePubSubType>(), qos_profiles::kState);
+  w_->alarms = newer(topics::kAlarms, dds::zero_padded<pmu::v5::AlarmPubSubType>(), qos_profiles::kAlarms);
+  w_->readiness = newer(topics::kReadiness, dds::zero_padded<pmu::v5::ReadinessPubSubType>(), qos_profiles::kState);
+  w_->derived_energy = newer(topics::kEnergy, dds::zero_padded<pmu::v5::EnergyPubSubType>(), qos_profiles::kState);
+  w_->baseline = newer(topics::kBaseline, dds::zero_padded<pmu::v5::BaselinePubSubType>(), qos_profiles::kState);
   if (canopen_deadline)
-    w_->bms_energy = newer(topics::kBmsEnergy, dds::zero_padded<pmu::v4::BmsEnergyPubSubType>(), qos_profiles::kState);
+    w_->bms_energy = newer(topics::kBmsEnergy, dds::zero_padded<pmu::v5::BmsEnergyPubSubType>(), qos_profiles::kState);
 }
 
 DdsPublisher::~DdsPublisher() = default;
@@ -232,7 +234,7 @@ void DdsPublisher::count_failed_write(const char* topic, const DeviceKey& key, c
 // instance is kept for late joiners like a written one (state profile).
 void DdsPublisher::dispose_baseline(const DeviceKey& key) {
   if (w_->baseline == nullptr) return;
-  pmu::v4::Baseline s;
+  pmu::v5::Baseline s;
   s.vehicle(w_->vehicle);
   s.bus(key.bus);
   s.address(key.address);
@@ -275,27 +277,27 @@ void DdsPublisher::on_telemetry(const DeviceKey& key, const codec::PmuMessage& m
     if (w_->low_rate.due(key.bus, key.address, packet, received)) write_one(w_->low[packet], sample);
   };
   if (const auto* v = std::get_if<codec::Voltages>(&m.payload)) {
-    pmu::v4::Voltages s;
+    pmu::v5::Voltages s;
     set_key(s, w_->vehicle, key);
     fill(s, *v);
     write(w_->voltages, &s, 0);
   } else if (const auto* c = std::get_if<codec::Currents>(&m.payload)) {
-    pmu::v4::Currents s;
+    pmu::v5::Currents s;
     set_key(s, w_->vehicle, key);
     fill(s, *c);
     write(w_->currents, &s, 1);
   } else if (const auto* e = std::get_if<codec::BatteryEnergy>(&m.payload)) {
-    pmu::v4::BatteryEnergy s;
+    pmu::v5::BatteryEnergy s;
     set_key(s, w_->vehicle, key);
     fill(s, *e);
     write(w_->energy, &s, 2);
   } else if (const auto* t = std::get_if<codec::Temperatures>(&m.payload)) {
-    pmu::v4::Temperatures s;
+    pmu::v5::Temperatures s;
     set_key(s, w_->vehicle, key);
     fill(s, *t);
     write(w_->temperatures, &s, 3);
   } else if (const auto* st = std::get_if<codec::Status>(&m.payload)) {
-    pmu::v4::Status s;
+    pmu::v5::Status s;
     set_key(s, w_->vehicle, key);
     fill(s, *st);
     write(w_->status, &s, 4);
@@ -303,7 +305,7 @@ void DdsPublisher::on_telemetry(const DeviceKey& key, const codec::PmuMessage& m
 }
 
 void DdsPublisher::on_config(const DeviceKey& key, const ConfigState& c) {
-  pmu::v4::Config s;
+  pmu::v5::Config s;
   set_key(s, w_->vehicle, key);
   auto raw8 = [&](Parameter p) {
     return static_cast<std::uint8_t>(c.raw[static_cast<std::size_t>(p)].value_or(0) & 0xFF);
@@ -328,7 +330,7 @@ void DdsPublisher::on_config(const DeviceKey& key, const ConfigState& c) {
 }
 
 void DdsPublisher::on_info(const DeviceKey& key, const InfoState& i) {
-  pmu::v4::DeviceInfo s;
+  pmu::v5::DeviceInfo s;
   set_key(s, w_->vehicle, key);
   s.serial_number(i.serial_number);
   s.firmware_major(i.firmware.firmware_major);
@@ -344,12 +346,12 @@ void DdsPublisher::on_info(const DeviceKey& key, const InfoState& i) {
 }
 
 void DdsPublisher::on_health(const DeviceKey& key, const HealthReport& h) {
-  pmu::v4::Health s;
+  pmu::v5::Health s;
   set_key(s, w_->vehicle, key);
-  s.kind(static_cast<pmu::v4::DeviceKind>(static_cast<int>(key.kind)));
-  s.state(static_cast<pmu::v4::HealthState>(static_cast<int>(h.state)));
-  s.bus_state(static_cast<pmu::v4::BusState>(static_cast<int>(h.bus_state)));
-  s.last_frame_age(idl_float(h.last_frame_age));
+  s.kind(static_cast<pmu::v5::DeviceKind>(static_cast<int>(key.kind)));
+  s.state(static_cast<pmu::v5::HealthState>(static_cast<int>(h.state)));
+  s.bus_state(static_cast<pmu::v5::BusState>(static_cast<int>(h.bus_state)));
+  s.last_frame_age(frame_age_or_nan(h.last_frame_age));  // NaN, never -1: never heard
   s.frames_received(h.frames_received);
   s.frames_sent(h.frames_sent);
   s.decode_errors(h.decode_errors);
@@ -377,20 +379,20 @@ void DdsPublisher::on_gone(const DeviceKey& key) {
     if (rc != ReturnCode_t::RETCODE_PRECONDITION_NOT_MET)
       count(rc == ReturnCode_t::RETCODE_OK, w->get_topic()->get_name().c_str(), key, why(rc));
   };
-  pmu::v4::Health h;
+  pmu::v5::Health h;
   set_key(h, w_->vehicle, key);
-  h.kind(static_cast<pmu::v4::DeviceKind>(static_cast<int>(key.kind)));
+  h.kind(static_cast<pmu::v5::DeviceKind>(static_cast<int>(key.kind)));
   gone(w_->health, &h);
   if (key.kind != DeviceKind::Pmu) return;  // batteries and MPPTs keep their node and device id
-  pmu::v4::Voltages v;
+  pmu::v5::Voltages v;
   set_key(v, w_->vehicle, key);
-  pmu::v4::Currents c;
+  pmu::v5::Currents c;
   set_key(c, w_->vehicle, key);
-  pmu::v4::BatteryEnergy e;
+  pmu::v5::BatteryEnergy e;
   set_key(e, w_->vehicle, key);
-  pmu::v4::Temperatures t;
+  pmu::v5::Temperatures t;
   set_key(t, w_->vehicle, key);
-  pmu::v4::Status st;
+  pmu::v5::Status st;
   set_key(st, w_->vehicle, key);
   void* telemetry[LowRateGate::kPackets] = {&v, &c, &e, &t, &st};
   DataWriter* live[LowRateGate::kPackets] = {w_->voltages, w_->currents, w_->energy, w_->temperatures, w_->status};
@@ -398,13 +400,13 @@ void DdsPublisher::on_gone(const DeviceKey& key) {
     gone(live[i], telemetry[i]);
     gone(w_->low[i], telemetry[i]);
   }
-  pmu::v4::Config cfg;
+  pmu::v5::Config cfg;
   set_key(cfg, w_->vehicle, key);
   gone(w_->config, &cfg);
-  pmu::v4::DeviceInfo info;
+  pmu::v5::DeviceInfo info;
   set_key(info, w_->vehicle, key);
   gone(w_->info, &info);
-  pmu::v4::Energy derived;
+  pmu::v5::Energy derived;
   set_key(derived, w_->vehicle, key);
   gone(w_->derived_energy, &derived);
 }
@@ -421,7 +423,7 @@ void DdsPublisher::write_at(DataWriter* writer, void* sample, const DeviceKey& k
 }
 
 void DdsPublisher::on_battery(const DeviceKey& key, const BatteryState& b, std::chrono::system_clock::time_point newest) {
-  pmu::v4::Battery s;
+  pmu::v5::Battery s;
   s.vehicle(w_->vehicle);
   s.bus(key.bus);
   s.node(octet_id(key));
@@ -431,12 +433,12 @@ void DdsPublisher::on_battery(const DeviceKey& key, const BatteryState& b, std::
   s.current_discharge(v.real("current_discharge"));
   s.current_charge(v.real("current_charge"));
   s.state_of_charge(v.real("state_of_charge"));
-  s.time_to_go(v.real("time_to_go"));
+  s.time_to_go(time_to_go_or_nan(v.exact("time_to_go")));  // NaN also while not discharging
   s.cell_temperature_high(v.real("cell_temperature_high"));
   s.cell_temperature_low(v.real("cell_temperature_low"));
   s.cell_voltage_high(v.real("cell_voltage_high"));
   s.cell_voltage_low(v.real("cell_voltage_low"));
-  s.bms_state(v.u32("bms_state"));
+  s.bms_state(v.exact("bms_state"));
   s.temperature_1(v.real("temperature_1"));
   s.temperature_2(v.real("temperature_2"));
   s.temperature_3(v.real("temperature_3"));
@@ -450,13 +452,13 @@ void DdsPublisher::on_battery(const DeviceKey& key, const BatteryState& b, std::
 
 void DdsPublisher::on_battery_cells(const DeviceKey& key, const BatteryCellsState& c,
                                     std::chrono::system_clock::time_point newest) {
-  pmu::v4::BatteryCells s;
+  pmu::v5::BatteryCells s;
   s.vehicle(w_->vehicle);
   s.bus(key.bus);
   s.node(octet_id(key));
   for (std::size_t cell = 0; cell < c.volts.size(); ++cell) {
     if (std::isnan(c.volts[cell])) continue;
-    pmu::v4::BatteryCell one;
+    pmu::v5::BatteryCell one;
     one.cell(static_cast<std::uint8_t>(cell));
     one.cell_voltage(idl_float(c.volts[cell]));
     s.cells().push_back(one);
@@ -467,7 +469,7 @@ void DdsPublisher::on_battery_cells(const DeviceKey& key, const BatteryCellsStat
 }
 
 void DdsPublisher::on_mppt(const DeviceKey& key, const MpptState& m, std::chrono::system_clock::time_point newest) {
-  pmu::v4::Mppt s;
+  pmu::v5::Mppt s;
   s.vehicle(w_->vehicle);
   s.bus(key.bus);
   s.device(octet_id(key));
@@ -475,26 +477,26 @@ void DdsPublisher::on_mppt(const DeviceKey& key, const MpptState& m, std::chrono
   s.voltage_output_raw(v.real("voltage_output_raw"));
   s.current_output_raw(v.real("current_output_raw"));
   s.voltage_out_sw_raw(v.real("voltage_out_sw_raw"));
-  s.mppt_state(v.u8("mppt_state"));
+  s.mppt_state(v.real("mppt_state"));
   s.safety_enabled(v.flag("safety_enabled"));
   s.pwm_enabled(v.flag("pwm_enabled"));
   s.temperature(v.real("temperature"));
   s.voltage_panel_1_raw(v.real("voltage_panel_1_raw"));
   s.current_panel_1_raw(v.real("current_panel_1_raw"));
   s.duty_cycle_panel_1(v.real("duty_cycle_panel_1"));
-  s.channel_1_active(v.u8("channel_1_active"));
+  s.channel_1_active(v.real("channel_1_active"));
   s.voltage_panel_2_raw(v.real("voltage_panel_2_raw"));
   s.current_panel_2_raw(v.real("current_panel_2_raw"));
   s.duty_cycle_panel_2(v.real("duty_cycle_panel_2"));
-  s.channel_2_active(v.u8("channel_2_active"));
+  s.channel_2_active(v.real("channel_2_active"));
   s.voltage_panel_3_raw(v.real("voltage_panel_3_raw"));
   s.current_panel_3_raw(v.real("current_panel_3_raw"));
   s.duty_cycle_panel_3(v.real("duty_cycle_panel_3"));
-  s.channel_3_active(v.u8("channel_3_active"));
+  s.channel_3_active(v.real("channel_3_active"));
   s.voltage_panel_4_raw(v.real("voltage_panel_4_raw"));
   s.current_panel_4_raw(v.real("current_panel_4_raw"));
   s.duty_cycle_panel_4(v.real("duty_cycle_panel_4"));
-  s.channel_4_active(v.u8("channel_4_active"));
+  s.channel_4_active(v.real("channel_4_active"));
   s.received(m.received_mask());
   std::lock_guard<std::mutex> lock(w_->mutex);
   if (!admit(key)) return;
@@ -503,38 +505,38 @@ void DdsPublisher::on_mppt(const DeviceKey& key, const MpptState& m, std::chrono
 
 namespace {
 
-pmu::v4::AlarmSource source_of(alarms::DeviceKind k) {
+pmu::v5::AlarmSource source_of(alarms::DeviceKind k) {
   switch (k) {
-    case alarms::DeviceKind::Battery: return pmu::v4::SOURCE_BATTERY;
-    case alarms::DeviceKind::Mppt: return pmu::v4::SOURCE_MPPT;
-    case alarms::DeviceKind::Bus: return pmu::v4::SOURCE_BUS;
+    case alarms::DeviceKind::Battery: return pmu::v5::SOURCE_BATTERY;
+    case alarms::DeviceKind::Mppt: return pmu::v5::SOURCE_MPPT;
+    case alarms::DeviceKind::Bus: return pmu::v5::SOURCE_BUS;
     case alarms::DeviceKind::Pmu:
     case alarms::DeviceKind::AnyDevice: break;
   }
-  return pmu::v4::SOURCE_PMU;
+  return pmu::v5::SOURCE_PMU;
 }
 
-pmu::v4::AlarmState state_of(alarms::AlarmState s) {
+pmu::v5::AlarmState state_of(alarms::AlarmState s) {
   switch (s) {
-    case alarms::AlarmState::ActiveUnacknowledged: return pmu::v4::ALARM_ACTIVE_UNACKNOWLEDGED;
-    case alarms::AlarmState::ActiveAcknowledged: return pmu::v4::ALARM_ACTIVE_ACKNOWLEDGED;
-    case alarms::AlarmState::ClearedUnacknowledged: return pmu::v4::ALARM_CLEARED_UNACKNOWLEDGED;
+    case alarms::AlarmState::ActiveUnacknowledged: return pmu::v5::ALARM_ACTIVE_UNACKNOWLEDGED;
+    case alarms::AlarmState::ActiveAcknowledged: return pmu::v5::ALARM_ACTIVE_ACKNOWLEDGED;
+    case alarms::AlarmState::ClearedUnacknowledged: return pmu::v5::ALARM_CLEARED_UNACKNOWLEDGED;
     case alarms::AlarmState::Normal: break;
   }
-  return pmu::v4::ALARM_NORMAL;
+  return pmu::v5::ALARM_NORMAL;
 }
 
 }  // namespace
 
 void DdsPublisher::on_alarm(const AlarmReport& a) {
   const bool flag = alarms::spec_of(a.code).condition == alarms::Condition::Flag;
-  pmu::v4::Alarm s;
+  pmu::v5::Alarm s;
   s.vehicle(w_->vehicle);
   s.bus(a.bus);
   s.device(a.device);
   s.kind(source_of(a.source));
   s.code(std::string(alarms::to_string(a.code)));
-  s.severity(a.severity == alarms::Severity::Critical ? pmu::v4::SEVERITY_CRITICAL : pmu::v4::SEVERITY_WARNING);
+  s.severity(a.severity == alarms::Severity::Critical ? pmu::v5::SEVERITY_CRITICAL : pmu::v5::SEVERITY_WARNING);
   s.state(state_of(a.state));
   s.value(flag ? std::numeric_limits<float>::quiet_NaN() : static_cast<float>(a.value));
   s.limit(flag ? std::numeric_limits<float>::quiet_NaN() : static_cast<float>(a.limit));
@@ -547,18 +549,18 @@ void DdsPublisher::on_alarm(const AlarmReport& a) {
 }
 
 void DdsPublisher::on_readiness(const ReadinessReport& r) {
-  pmu::v4::Readiness s;
+  pmu::v5::Readiness s;
   s.vehicle(w_->vehicle);
   s.ready(r.ready);
-  s.level(!r.ready ? pmu::v4::LEVEL_NOT_READY : r.warnings() ? pmu::v4::LEVEL_WARNING : pmu::v4::LEVEL_READY);
+  s.level(!r.ready ? pmu::v5::LEVEL_NOT_READY : r.warnings() ? pmu::v5::LEVEL_WARNING : pmu::v5::LEVEL_READY);
   s.since(static_cast<std::uint64_t>(
       std::max<std::int64_t>(0, std::chrono::duration_cast<std::chrono::nanoseconds>(r.since.time_since_epoch()).count())));
   constexpr std::size_t kCarried = 64;  // the IDL's bound; reasons_total counts the rest
   for (std::size_t i = 0; i < r.reasons.size() && i < kCarried; ++i) {
     const auto& x = r.reasons[i];
-    pmu::v4::ReadinessReason y;
+    pmu::v5::ReadinessReason y;
     y.code(x.code.substr(0, 31));
-    y.severity(x.severity == alarms::Severity::Critical ? pmu::v4::SEVERITY_CRITICAL : pmu::v4::SEVERITY_WARNING);
+    y.severity(x.severity == alarms::Severity::Critical ? pmu::v5::SEVERITY_CRITICAL : pmu::v5::SEVERITY_WARNING);
     y.bus(x.bus.substr(0, 15));
     y.kind(source_of(x.source));
     y.device(x.device);
@@ -574,8 +576,8 @@ void DdsPublisher::on_readiness(const ReadinessReport& r) {
 
 namespace {
 
-pmu::v4::EnergyBattery battery_of(const energy::BatteryFigures& b) {
-  pmu::v4::EnergyBattery s;
+pmu::v5::EnergyBattery battery_of(const energy::BatteryFigures& b) {
+  pmu::v5::EnergyBattery s;
   s.power(idl_float(b.power));
   s.used_wh(b.used_wh);
   s.integrated_s(idl_float(b.integrated_s));
@@ -587,7 +589,7 @@ pmu::v4::EnergyBattery battery_of(const energy::BatteryFigures& b) {
 }  // namespace
 
 void DdsPublisher::on_energy(const DeviceKey& key, const energy::Figures& f, std::chrono::system_clock::time_point at) {
-  pmu::v4::Energy s;
+  pmu::v5::Energy s;
   set_key(s, w_->vehicle, key);
   s.avionics_power(idl_float(f.avionics_power));
   s.output_28v_power(idl_float(f.output_28v_power));
@@ -603,7 +605,7 @@ void DdsPublisher::on_energy(const DeviceKey& key, const energy::Figures& f, std
 
 void DdsPublisher::on_bms_energy(const DeviceKey& key, const energy::BmsFigures& f,
                                  std::chrono::system_clock::time_point at) {
-  pmu::v4::BmsEnergy s;
+  pmu::v5::BmsEnergy s;
   s.vehicle(w_->vehicle);
   s.bus(key.bus);
   s.node(octet_id(key));

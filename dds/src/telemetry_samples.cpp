@@ -2,6 +2,7 @@
 
 #include <fastdds/rtps/common/SerializedPayload.h>
 
+#include "pmu/dds/no_value.hpp"
 #include "pmu/idl/telemetryPubSubTypes.h"
 #include "pmu/idl/topics.hpp"
 
@@ -34,7 +35,7 @@ bool sample(const std::string& vehicle, const DeviceKey& key, const Codec& value
 
 }  // namespace
 
-void fill(pmu::v4::Voltages& s, const codec::Voltages& v) {
+void fill(pmu::v5::Voltages& s, const codec::Voltages& v) {
   s.avionics(idl_float(v.avionics));
   s.output_28v(idl_float(v.output_28v));
   s.payload(idl_float(v.payload));
@@ -44,7 +45,7 @@ void fill(pmu::v4::Voltages& s, const codec::Voltages& v) {
   s.generator(idl_float(v.generator));
 }
 
-void fill(pmu::v4::Currents& s, const codec::Currents& c) {
+void fill(pmu::v5::Currents& s, const codec::Currents& c) {
   s.avionics(idl_float(c.avionics));
   s.output_28v(idl_float(c.output_28v));
   s.payload(idl_float(c.payload));
@@ -53,12 +54,12 @@ void fill(pmu::v4::Currents& s, const codec::Currents& c) {
   s.battery_b(idl_float(c.battery_b));
 }
 
-void fill(pmu::v4::BatteryEnergy& s, const codec::BatteryEnergy& e) {
+void fill(pmu::v5::BatteryEnergy& s, const codec::BatteryEnergy& e) {
   s.battery_a_mah(e.battery_a_mah);
   s.battery_b_mah(e.battery_b_mah);
 }
 
-void fill(pmu::v4::Temperatures& s, const codec::Temperatures& t) {
+void fill(pmu::v5::Temperatures& s, const codec::Temperatures& t) {
   s.internal(idl_float(t.internal));
   s.battery_a(idl_float(t.battery_a));  // NaN stays NaN: "no sensor"
   s.battery_b(idl_float(t.battery_b));
@@ -66,8 +67,8 @@ void fill(pmu::v4::Temperatures& s, const codec::Temperatures& t) {
   s.starter(idl_float(t.starter));
 }
 
-void fill(pmu::v4::Status& s, const codec::Status& st) {
-  s.generator_rpm(st.generator_rpm);
+void fill(pmu::v5::Status& s, const codec::Status& st) {
+  s.generator_rpm(rpm_or_nan(st.generator_rpm));  // NaN, never 65535: no reading
   s.generation_enabled(st.generation_enabled);
   s.thermal_shutdown(st.thermal_shutdown);
   s.soa_shutdown(st.soa_shutdown);
@@ -83,15 +84,15 @@ void fill(pmu::v4::Status& s, const codec::Status& st) {
 bool telemetry_cdr(const std::string& vehicle, const DeviceKey& key, const codec::PmuMessage& m, TelemetryCdr& out) {
   if (m.request) return false;
   if (const auto* v = std::get_if<codec::Voltages>(&m.payload))
-    return sample<pmu::v4::Voltages, pmu::v4::VoltagesPubSubType>(vehicle, key, *v, topics::kVoltages, out);
+    return sample<pmu::v5::Voltages, pmu::v5::VoltagesPubSubType>(vehicle, key, *v, topics::kVoltages, out);
   if (const auto* c = std::get_if<codec::Currents>(&m.payload))
-    return sample<pmu::v4::Currents, pmu::v4::CurrentsPubSubType>(vehicle, key, *c, topics::kCurrents, out);
+    return sample<pmu::v5::Currents, pmu::v5::CurrentsPubSubType>(vehicle, key, *c, topics::kCurrents, out);
   if (const auto* e = std::get_if<codec::BatteryEnergy>(&m.payload))
-    return sample<pmu::v4::BatteryEnergy, pmu::v4::BatteryEnergyPubSubType>(vehicle, key, *e, topics::kBatteryEnergy, out);
+    return sample<pmu::v5::BatteryEnergy, pmu::v5::BatteryEnergyPubSubType>(vehicle, key, *e, topics::kBatteryEnergy, out);
   if (const auto* t = std::get_if<codec::Temperatures>(&m.payload))
-    return sample<pmu::v4::Temperatures, pmu::v4::TemperaturesPubSubType>(vehicle, key, *t, topics::kTemperatures, out);
+    return sample<pmu::v5::Temperatures, pmu::v5::TemperaturesPubSubType>(vehicle, key, *t, topics::kTemperatures, out);
   if (const auto* st = std::get_if<codec::Status>(&m.payload))
-    return sample<pmu::v4::Status, pmu::v4::StatusPubSubType>(vehicle, key, *st, topics::kStatus, out);
+    return sample<pmu::v5::Status, pmu::v5::StatusPubSubType>(vehicle, key, *st, topics::kStatus, out);
   return false;
 }
 

@@ -94,7 +94,7 @@ TEST(PmuctlAlarmView, AnAlarmsSourceIsLabelledAsWatchLabelsItsDevice) {
 }
 
 WatchRow row(const std::string& label, const std::string& topic) {
-  return {label, topic, pmu::v4::ONLINE, 0.2, {{"internal", 31.0, "31.0", "degC"}}};
+  return {label, topic, pmu::v5::ONLINE, 0.2, {{"internal", 31.0, "31.0", "degC"}}};
 }
 
 // A device with an alarm carries its marker on its rows; a bus, which has no row, and a

@@ -26,51 +26,51 @@ SampleField field(const SampleFields& fields, const std::string& name) {
   return f ? *f : missing;
 }
 
-pmu::v4::Voltages voltages() {
-  pmu::v4::Voltages s;
+pmu::v5::Voltages voltages() {
+  pmu::v5::Voltages s;
   s.avionics(12.3f), s.output_28v(28.0f), s.payload(12.0f), s.servo(6.0f), s.battery_a(24.1f), s.battery_b(24.0f),
       s.generator(0.4f);
   return s;
 }
-pmu::v4::Currents currents() {
-  pmu::v4::Currents s;
+pmu::v5::Currents currents() {
+  pmu::v5::Currents s;
   s.avionics(1.5f), s.output_28v(-0.3f), s.battery_a(-2.5f);
   return s;
 }
-pmu::v4::Temperatures temperatures() {
-  pmu::v4::Temperatures s;
+pmu::v5::Temperatures temperatures() {
+  pmu::v5::Temperatures s;
   s.internal(31), s.battery_a(kNaN), s.battery_b(22), s.generator(kNaN), s.starter(-49);
   return s;
 }
-pmu::v4::Status status(std::uint16_t rpm) {
-  pmu::v4::Status s;
+pmu::v5::Status status(float rpm) {
+  pmu::v5::Status s;
   s.generator_rpm(rpm), s.generation_enabled(true), s.payload_on(true);
   return s;
 }
-pmu::v4::Config config() {
-  pmu::v4::Config s;
+pmu::v5::Config config() {
+  pmu::v5::Config s;
   s.avionics_voltage(24.0f), s.payload_voltage(12.0f), s.servo_voltage(6.0f), s.battery_voltage(25.2f);
   s.packet_period(1.5f), s.packets_streamed(0x1F), s.temperature_offset(128), s.upper_temperature_limit(80);
   s.power_up_state(0x03), s.cranking_time(2.5f), s.can_address(1), s.outputs(0x05), s.generation_enabled(true);
   return s;
 }
-pmu::v4::Health health(float age) {
-  pmu::v4::Health s;
-  s.state(pmu::v4::OFFLINE), s.last_frame_age(age), s.frames_received(42);
+pmu::v5::Health health(float age) {
+  pmu::v5::Health s;
+  s.state(pmu::v5::OFFLINE), s.last_frame_age(age), s.frames_received(42);
   return s;
 }
 // Every value received.
-pmu::v4::Battery battery(float time_to_go) {
-  pmu::v4::Battery s;
+pmu::v5::Battery battery(float time_to_go) {
+  pmu::v5::Battery s;
   s.voltage(48.123f), s.current(-3.2f), s.current_discharge(3.2f), s.current_charge(0.0f), s.state_of_charge(77);
   s.time_to_go(time_to_go), s.cell_temperature_high(31), s.cell_temperature_low(24), s.cell_voltage_high(3.412f);
   s.cell_voltage_low(3.301f), s.bms_state(0x12345678), s.temperature_1(20), s.temperature_2(21), s.temperature_3(22);
   s.temperature_4(23), s.power_level(55), s.received(0xFFFF);
   return s;
 }
-pmu::v4::Mppt mppt() {
-  pmu::v4::Mppt s;
-  s.voltage_output_raw(1234), s.current_output_raw(-17), s.mppt_state(3), s.safety_enabled(true);
+pmu::v5::Mppt mppt() {
+  pmu::v5::Mppt s;
+  s.voltage_output_raw(1234), s.current_output_raw(-17), s.mppt_state(3), s.safety_enabled(1);
   s.temperature(41), s.duty_cycle_panel_1(45), s.channel_1_active(1);
   // voltage_output_raw, current_output_raw, mppt_state, safety_enabled, temperature,
   // duty_cycle_panel_1, channel_1_active (interface.md 1.4's bit order)
@@ -78,10 +78,10 @@ pmu::v4::Mppt mppt() {
   return s;
 }
 
-pmu::v4::BatteryCells battery_cells() {
-  pmu::v4::BatteryCells s;
+pmu::v5::BatteryCells battery_cells() {
+  pmu::v5::BatteryCells s;
   for (const auto& [n, v] : std::vector<std::pair<int, float>>{{1, 3.350f}, {2, 3.301f}, {3, 3.412f}}) {
-    pmu::v4::BatteryCell c;
+    pmu::v5::BatteryCell c;
     c.cell(static_cast<std::uint8_t>(n)), c.cell_voltage(v);
     s.cells().push_back(c);
   }
@@ -103,7 +103,7 @@ TEST(PmuctlView, EveryTableValueHasItsUnit) {
       {"table 2", fields_of(voltages()), "generator", "0.4 V"},
       {"table 3", fields_of(currents()), "avionics", "1.5 A"},
       {"table 3", fields_of(currents()), "battery_a", "-2.5 A"},
-      {"table 4", fields_of([] { pmu::v4::BatteryEnergy e; e.battery_a_mah(-120); return e; }()), "battery_a_mah", "-120 mAh"},
+      {"table 4", fields_of([] { pmu::v5::BatteryEnergy e; e.battery_a_mah(-120); return e; }()), "battery_a_mah", "-120 mAh"},
       {"table 5", fields_of(temperatures()), "internal", "31.0 degC"},
       {"table 5", fields_of(temperatures()), "starter", "-49.0 degC"},
       {"table 6", fields_of(status(6000)), "generator_rpm", "6000 rpm"},
@@ -161,15 +161,16 @@ struct SentinelRow {
 
 // A value standing for "no value" is a word in tables and null in JSON.
 TEST(PmuctlView, SentinelsAreWordsInTablesAndNullInJson) {
-  pmu::v4::Battery none_received;
-  pmu::v4::Mppt mppt_none;
+  pmu::v5::Battery none_received;
+  pmu::v5::Mppt mppt_none;
   const std::vector<SentinelRow> rows = {
       {"table 5: -128 = no sensor", fields_of(temperatures()), "battery_a", "no sensor"},
       {"table 5: -128 = no sensor", fields_of(temperatures()), "generator", "no sensor"},
-      {"table 6: the top of 16 bits", fields_of(status(65535)), "generator_rpm", "no reading"},
-      {"health: -1 = never", fields_of(health(-1.0f)), "last_frame_age", "never"},
-      {"battery: 65535 min while not discharging", fields_of(battery(65535.0f * 60)), "time_to_go",
-       "n/a (not discharging)"},
+      {"table 6: NaN = no reading", fields_of(status(kNaN)), "generator_rpm", "no reading"},
+      {"health: NaN = never", fields_of(health(kNaN)), "last_frame_age", "never"},
+      {"battery: NaN received = not discharging", fields_of(battery(kNaN)), "time_to_go", "n/a (not discharging)"},
+      {"battery: time_to_go not received", fields_of([] { auto b = battery(kNaN); b.received(0xFFFF & ~(1u << 5)); return b; }()),
+       "time_to_go", "-"},
       {"battery: float not received", fields_of(none_received), "voltage", "-"},
       {"battery: integer not received", fields_of(none_received), "bms_state", "-"},
       {"battery: NaN with its bit set", fields_of([] { auto b = battery(600); b.voltage(kNaN); return b; }()),
@@ -185,6 +186,7 @@ TEST(PmuctlView, SentinelsAreWordsInTablesAndNullInJson) {
   }
   // Their neighbours are values.
   EXPECT_EQ(field(fields_of(status(65534)), "generator_rpm").json, 65534);
+  EXPECT_EQ(field(fields_of(status(0)), "generator_rpm").json, 0);
   EXPECT_EQ(field(fields_of(battery(65534.0f * 60)), "time_to_go").json, 65534.0 * 60);
   EXPECT_EQ(field(fields_of(health(0.0f)), "last_frame_age").json, 0.0);
   EXPECT_EQ(field(fields_of(temperatures()), "battery_b").json, 22.0);
@@ -194,7 +196,7 @@ TEST(PmuctlView, SentinelsAreWordsInTablesAndNullInJson) {
 TEST(PmuctlView, SpecialSettingsSayWhatTheyMean) {
   struct Row {
     const char* what;
-    pmu::v4::Config c;
+    pmu::v5::Config c;
     const char* name;
     const char* text;
     double json;
@@ -205,11 +207,11 @@ TEST(PmuctlView, SpecialSettingsSayWhatTheyMean) {
     return c;
   };
   const std::vector<Row> rows = {
-      {"table 15", with([](pmu::v4::Config& c) { c.upper_temperature_limit(0); }), "upper_temperature_limit",
+      {"table 15", with([](pmu::v5::Config& c) { c.upper_temperature_limit(0); }), "upper_temperature_limit",
        "0 (forces thermal shutdown)", 0},
-      {"table 15", with([](pmu::v4::Config& c) { c.upper_temperature_limit(255); }), "upper_temperature_limit",
+      {"table 15", with([](pmu::v5::Config& c) { c.upper_temperature_limit(255); }), "upper_temperature_limit",
        "255 (thermal shutdown disabled)", 255},
-      {"table 17", with([](pmu::v4::Config& c) { c.cranking_time(0); }), "cranking_time", "0.0 (no timeout)", 0},
+      {"table 17", with([](pmu::v5::Config& c) { c.cranking_time(0); }), "cranking_time", "0.0 (no timeout)", 0},
   };
   for (const auto& r : rows) {
     const auto f = field(fields_of(r.c), r.name);
@@ -309,15 +311,15 @@ TEST(PmuctlView, ConfigSetReadsMaskNamesAndNumbers) {
 // Every watch row says its device's health and its values' age.
 TEST(PmuctlView, WatchRowsSayHealthAndAge) {
   struct Row {
-    std::optional<pmu::v4::HealthState> state;
+    std::optional<pmu::v5::HealthState> state;
     double age;
     const char* text;
   };
   const std::vector<Row> rows = {
-      {pmu::v4::ONLINE, 0.2, "ONLINE 0.2s"},  {pmu::v4::STALE, 3.04, "STALE 3.0s"},
-      {pmu::v4::OFFLINE, 9.06, "OFFLINE 9.1s"}, {pmu::v4::OFFLINE, 42, "OFFLINE 42s"},
-      {pmu::v4::OFFLINE, 720, "OFFLINE 12m"}, {pmu::v4::OFFLINE, 72000, "OFFLINE 20h"},
-      {std::nullopt, 1, "UNKNOWN 1.0s"},  {pmu::v4::ONLINE, -0.5, "ONLINE 0.0s"},
+      {pmu::v5::ONLINE, 0.2, "ONLINE 0.2s"},  {pmu::v5::STALE, 3.04, "STALE 3.0s"},
+      {pmu::v5::OFFLINE, 9.06, "OFFLINE 9.1s"}, {pmu::v5::OFFLINE, 42, "OFFLINE 42s"},
+      {pmu::v5::OFFLINE, 720, "OFFLINE 12m"}, {pmu::v5::OFFLINE, 72000, "OFFLINE 20h"},
+      {std::nullopt, 1, "UNKNOWN 1.0s"},  {pmu::v5::ONLINE, -0.5, "ONLINE 0.0s"},
   };
   for (const auto& r : rows) EXPECT_EQ(freshness(r.state, r.age), r.text);
   EXPECT_EQ(row_values(fields_of(temperatures())),
@@ -327,11 +329,11 @@ TEST(PmuctlView, WatchRowsSayHealthAndAge) {
 // One line per device and topic, grouped by topic; the short topics fit an 80-column
 // terminal (the wider ones, e.g. voltages, do not).
 TEST(PmuctlView, WatchTableHasOneLinePerDeviceAndTopic) {
-  pmu::v4::BatteryEnergy e;
+  pmu::v5::BatteryEnergy e;
   e.battery_a_mah(-1200), e.battery_b_mah(850);
-  const auto lines = watch_table({{"uav1/can0/1", "battery_energy", pmu::v4::ONLINE, 0.2, fields_of(e)},
+  const auto lines = watch_table({{"uav1/can0/1", "battery_energy", pmu::v5::ONLINE, 0.2, fields_of(e)},
                                   {"uav1/can0/battery2", "battery_cells", std::nullopt, 1.0, fields_of(battery_cells())},
-                                  {"uav1/can0/2", "battery_energy", pmu::v4::OFFLINE, 9.06, fields_of(e)}});
+                                  {"uav1/can0/2", "battery_energy", pmu::v5::OFFLINE, 9.06, fields_of(e)}});
   const std::vector<std::string> want = {
       "battery_energy:",
       "uav1/can0/1  ONLINE   0.2s  battery_a_mah=-1200mAh battery_b_mah=850mAh",
@@ -350,7 +352,7 @@ TEST(PmuctlView, BatteryCellsAreOneShortRow) {
   EXPECT_EQ(f[0].json.size(), 3u) << "JSON keeps every cell";
   EXPECT_EQ(f[0].json[1]["cell"], 2);
   EXPECT_EQ(f[0].json[1]["cell_voltage"], 3.301);
-  EXPECT_EQ(fields_of(pmu::v4::BatteryCells{})[0].text, "none received");
+  EXPECT_EQ(fields_of(pmu::v5::BatteryCells{})[0].text, "none received");
 }
 
 // The JSON keys are the contract's field names, in its order (interface.md sections 1.3, 1.4).
@@ -409,19 +411,19 @@ namespace {
 
 // --json through sample_json.hpp: sentinels are null, raw counts integers; the rest as before.
 TEST(PmuctlViewJson, SentinelsAreNullAndRawCountsIntegers) {
-  pmu::v4::Health h;
-  h.last_frame_age(-1.0f);
+  pmu::v5::Health h;
+  h.last_frame_age(std::numeric_limits<float>::quiet_NaN());
   EXPECT_TRUE(values_of(h)["last_frame_age"].is_null()) << values_of(h);
-  pmu::v4::Status st;
-  st.generator_rpm(65535);
+  pmu::v5::Status st;
+  st.generator_rpm(std::numeric_limits<float>::quiet_NaN());
   EXPECT_TRUE(values_of(st)["generator_rpm"].is_null()) << values_of(st);
-  pmu::v4::Battery b;
-  b.time_to_go(65535.0f * 60), b.received(1u << 5);
+  pmu::v5::Battery b;
+  b.time_to_go(std::numeric_limits<float>::quiet_NaN()), b.received(1u << 5);
   EXPECT_TRUE(values_of(b)["time_to_go"].is_null()) << values_of(b);
-  pmu::v4::Mppt m;
+  pmu::v5::Mppt m;
   m.voltage_output_raw(1234), m.received(1u << 0);
   EXPECT_EQ(values_of(m)["voltage_output_raw"].dump(), "1234");
-  pmu::v4::Temperatures t;
+  pmu::v5::Temperatures t;
   t.internal(30), t.battery_a(std::numeric_limits<float>::quiet_NaN());
   EXPECT_TRUE(values_of(t)["battery_a"].is_null());
   EXPECT_EQ(values_of(t)["internal"].dump(), "30.0");

@@ -5,11 +5,14 @@ contract's major version.
   idl_layout.py dump FILE...
       Every struct and enum of FILE... (they may refer to each other's types) in a normalised
       form: names without the version module, types spelled one way, bounds evaluated.
-  idl_layout.py check --idl-dir IDL --versions-dir VERSIONS --contract N
+  idl_layout.py check --idl-dir IDL --versions-dir VERSIONS --contract N [--converted HEADER]
       (a) the types of IDL/*.idl are in module vN, and VERSIONS/vN exists;
       (b) every type of VERSIONS/vN has the same layout in IDL (types may be added);
-      (c) every type of VERSIONS/vN-1 has the same layout in VERSIONS/vN, which the service's
-          option to serve contract N-1 as well (vN's types under vN-1's names) relies on.
+      (c) every type of VERSIONS/vN-1 has the same layout in VERSIONS/vN, but those the service
+          converts: the service's option to serve contract N-1 as well writes vN's types under
+          vN-1's names and converts the others. HEADER (C++) names them in its list
+          `kConvertedTypes[] = {"Status", ...}` (dds/include/pmu/dds/previous_contract.hpp);
+          a name there that is no type of vN-1 is a finding too.
 
 Exit status: 0 all hold (one summary line), 1 findings (one a line), 2 bad usage or IDL this
 checker does not understand (file:line). The types are @final / XCDR1, so the layout is the
@@ -481,7 +484,26 @@ def _frozen(directory, version, findings):
     return idl
 
 
-def check(idl_dir, versions_dir, n):
+CONVERTED_LIST = re.compile(r"kConvertedTypes\[\]\s*=\s*\{([^}]*)\}")
+
+
+def converted_types(header):
+    """The names (pmu::Status, ...) of the C++ list kConvertedTypes[] = {"Status", ...} of `header`."""
+    try:
+        text = pathlib.Path(header).read_text()
+    except OSError as e:
+        raise IdlError(f"{header}: {e.strerror}")
+    m = CONVERTED_LIST.search(text)
+    if not m:
+        raise IdlError(f"{header}: no list kConvertedTypes[] = {{...}} of the types the service converts")
+    names = re.findall(r'"([^"]*)"', m.group(1))
+    for name in names:
+        if not re.fullmatch(r"[A-Za-z_][A-Za-z0-9_]*", name):
+            raise IdlError(f"{header}:{text[:m.start()].count(chr(10)) + 1}: kConvertedTypes: {name!r} is not a type name")
+    return {"pmu::" + name for name in names}
+
+
+def check(idl_dir, versions_dir, n, converted=frozenset(), converted_from=None):
     findings = []
     current = Idl(_idl_files(idl_dir))
     # (a)
@@ -515,13 +537,20 @@ def check(idl_dir, versions_dir, n):
                              f"missing: serving contract {n - 1} as well is checked against it"))
         else:
             previous = _frozen(previous_dir, n - 1, findings)
-            differ = compare(previous, frozen, f"v{n - 1}", f"v{n}")
+            for name in sorted(converted - set(previous.types)):
+                findings.append((converted_from, None, name, f"named in kConvertedTypes, but contract {n - 1} "
+                                 f"has no such type ({previous_dir})"))
+            differ = [f for f in compare(previous, frozen, f"v{n - 1}", f"v{n}") if f[2] not in converted]
             findings += differ
             for name in sorted({f[2] for f in differ}):
                 hints.append(f"{name}: contract {n} does not have contract {n - 1}'s layout, so serving "
                              f"contract {n - 1} as well (v{n}'s types under v{n - 1}'s names) needs a converter "
-                             f"for {name}")
-    previous = f"; contract {n - 1}'s types keep their layout in it" if n > 1 else ""
+                             f"for {name} (dds/src/previous_contract.cpp), named in kConvertedTypes"
+                             + (f" of {converted_from}" if converted_from else ""))
+    previous = ""
+    if n > 1:
+        kept = f"; contract {n - 1}'s types keep their layout in it"
+        previous = kept + (f" but the converted {', '.join(sorted(converted))}" if converted else "")
     summary = (f"idl layout: {idl_dir} (module v{n}, {len(current.types)} types) keeps the "
                f"{len(frozen.types)} types of {frozen_dir}{previous}")
     return findings, hints, summary
@@ -538,6 +567,8 @@ def main(argv=None):
     chk.add_argument("--versions-dir", required=True, metavar="VERSIONS",
                      help="the published IDL, one vN per major version")
     chk.add_argument("--contract", required=True, type=int, metavar="N", help="the contract's major version N")
+    chk.add_argument("--converted", metavar="HEADER",
+                     help="the C++ header whose kConvertedTypes lists the types of contract N-1 the service converts")
     args = parser.parse_args(argv)
     try:
         if args.verb == "dump":
@@ -546,7 +577,8 @@ def main(argv=None):
             return 0
         if args.contract < 1:
             parser.error("--contract: a major version is 1 or more")
-        findings, hints, summary = check(args.idl_dir, args.versions_dir, args.contract)
+        converted = converted_types(args.converted) if args.converted else frozenset()
+        findings, hints, summary = check(args.idl_dir, args.versions_dir, args.contract, converted, args.converted)
     except IdlError as e:
         print(f"idl_layout: {e}", file=sys.stderr)
         return 2

@@ -71,6 +71,9 @@ def keep(version):
 
 BUMP_HINT = "bump the contract's major version"
 CONVERTER = "needs a converter"
+# The list of the types the service converts from contract N-1, as ctest's guard reads it.
+CONVERTED = "dds/include/pmu/dds/previous_contract.hpp"
+CONVERTED_NAMES = sorted(idl_layout.converted_types(ROOT / CONVERTED))
 
 # name, edits, status, strings the output must contain, where (file, text: the finding's
 # file:line is that of the text's first line), the contract (default N), strings it must not
@@ -125,8 +128,8 @@ ROWS = [
                              "sequence<string<31>, 32> features;")],
      1, ["pmu::DeviceInfo: member features: sequence<string<31>,16>", "sequence<string<31>,32> in idl"],
      ("idl/state.idl", "features;")),
-    ("member_type", [edit("idl/telemetry.idl", "unsigned short generator_rpm;", "unsigned long generator_rpm;")],
-     1, ["pmu::Status: member generator_rpm: unsigned short", "unsigned long in idl"],
+    ("member_type", [edit("idl/telemetry.idl", "float generator_rpm;", "double generator_rpm;")],
+     1, ["pmu::Status: member generator_rpm: float", "double in idl"],
      ("idl/telemetry.idl", "generator_rpm;")),
     ("referenced_type", [edit("idl/state.idl", "    BusState bus_state;", "    HealthState bus_state;")],
      1, ["pmu::Health: member bus_state: pmu::BusState", "pmu::HealthState in idl"]),
@@ -182,10 +185,22 @@ if N > 1:
                                                r"\1string<31> vehicle;")],
          1, [f"pmu::Command: member vehicle: string<31> in v{N - 1}, string<15> in v{N}", CONVERTER],
          (f"idl/versions/v{N}/command.idl", "string<15> vehicle;"), N, [BUMP_HINT]),
-        ("frozen_copy_edited", [edit(f"idl/versions/v{N}/state.idl", "unsigned long long publish_failures;",
-                                     "unsigned long long publish_failures;\n    unsigned long long restarts;")],
-         1, [f"pmu::Health: member restarts removed (in v{N} at idl/versions/v{N}/state.idl:", BUMP_HINT,
-             f"pmu::Health: member restarts added at position 16 (not in v{N - 1})", CONVERTER]),
+        ("frozen_copy_edited", [edit(f"idl/versions/v{N}/state.idl", "sequence<string<31>, 16> features;",
+                                     "sequence<string<31>, 16> features;\n    unsigned long restarts;")],
+         1, [f"pmu::DeviceInfo: member restarts removed (in v{N} at idl/versions/v{N}/state.idl:", BUMP_HINT,
+             f"pmu::DeviceInfo: member restarts added at position 11 (not in v{N - 1})", CONVERTER]),
+        # The converted types: a layout change from N-1 is allowed for the types the list names
+        # only, and the list names types of N-1 only.
+        ("converted_type_not_listed", [edit_re(CONVERTED, r'(kConvertedTypes\[\] = \{[^}]*)"Status",? ?', r"\1")],
+         1, [f"pmu::Status: member generator_rpm: unsigned short in v{N - 1}, float in v{N}",
+             f"{CONVERTER} for pmu::Status (dds/src/previous_contract.cpp), named in kConvertedTypes of {CONVERTED}"],
+         (f"idl/versions/v{N}/telemetry.idl", "float generator_rpm;")),
+        ("converted_type_unknown", [edit_re(CONVERTED, r"(kConvertedTypes\[\] = \{)", r'\1"Gone", ')],
+         1, [f"{CONVERTED}: pmu::Gone: named in kConvertedTypes, but contract {N - 1} has no such type"]),
+        ("converted_list_missing", [edit_re(CONVERTED, r"kConvertedTypes\[\]", "kTypes[]")],
+         2, [f"{CONVERTED}: no list kConvertedTypes[] = {{...}} of the types the service converts"]),
+        ("converted_list_bad_name", [edit_re(CONVERTED, r"(kConvertedTypes\[\] = \{)", r'\1"pmu::X", ')],
+         2, ["kConvertedTypes: 'pmu::X' is not a type name"]),
     ]
 ROWS += [
     # IDL the checker does not understand: exit 2, naming the file and line.
@@ -225,6 +240,8 @@ class Table(unittest.TestCase):
         for f in (ROOT / "idl").glob("*.idl"):
             shutil.copy(f, self.root / "idl")
         shutil.copytree(ROOT / "idl" / "versions", self.root / "idl" / "versions")
+        (self.root / CONVERTED).parent.mkdir(parents=True)
+        shutil.copy(ROOT / CONVERTED, self.root / CONVERTED)
         os.chdir(self.root)   # the findings then name idl/... as in the source tree
 
     def tearDown(self):
@@ -232,7 +249,11 @@ class Table(unittest.TestCase):
         shutil.rmtree(self.root)
 
     def check(self, contract=N):
-        return _run("check", "--idl-dir", "idl", "--versions-dir", "idl/versions", "--contract", str(contract))
+        # The list names the types converted from contract N-1 to N: for another contract it
+        # would name the wrong ones.
+        converted = ["--converted", CONVERTED] if contract == N else []
+        return _run("check", "--idl-dir", "idl", "--versions-dir", "idl/versions", "--contract", str(contract),
+                    *converted)
 
     def row(self, edits, status, expected, where=None, contract=N, absent=()):
         for apply in edits:
@@ -253,6 +274,18 @@ class Table(unittest.TestCase):
     def test_copy_passes(self):
         status, out = self.check()
         self.assertEqual(status, 0, out)
+        if N > 1:
+            self.assertIn(f"but the converted {', '.join(CONVERTED_NAMES)}", out)
+
+    def test_converted_types_are_the_only_previous_layout_changes(self):
+        # Without the list, every converted type whose layout changed is a finding; no other is.
+        if N < 2:
+            self.skipTest("no previous contract")
+        status, out = _run("check", "--idl-dir", "idl", "--versions-dir", "idl/versions", "--contract", str(N))
+        self.assertEqual(status, 1, out)
+        named = set(re.findall(r"^idl/versions/v%d/\S+ (pmu::\w+):" % N, out, flags=re.M))
+        self.assertTrue(named, out)
+        self.assertLessEqual(named, set(CONVERTED_NAMES), out)
 
     def test_usage_errors(self):
         for argv in ([], ["bogus"], ["check", "--idl-dir", "idl"], ["dump"],
@@ -275,7 +308,7 @@ class Layout(unittest.TestCase):
     def test_real_tree_passes(self):
         # As ctest's idl_layout_guard runs it, in a process of its own.
         run = subprocess.run([sys.executable, str(HERE / "idl_layout.py"), "check", "--idl-dir", "idl",
-                              "--versions-dir", "idl/versions", "--contract", str(N)],
+                              "--versions-dir", "idl/versions", "--contract", str(N), "--converted", CONVERTED],
                              cwd=ROOT, capture_output=True, text=True)
         self.assertEqual(run.returncode, 0, run.stdout + run.stderr)
         self.assertRegex(run.stdout, r"^idl layout: idl \(module v%d, \d+ types\)" % N)

@@ -209,11 +209,11 @@ struct Topic {
 };
 
 struct Request {
-  Request(std::string i, const char* w, pmu_v4_CommandKind k, const char* p, double v)
+  Request(std::string i, const char* w, pmu_v5_CommandKind k, const char* p, double v)
       : id(std::move(i)), what(w), kind(k), parameter(p), value(v) {}
   std::string id;
   const char* what;
-  pmu_v4_CommandKind kind;
+  pmu_v5_CommandKind kind;
   const char* parameter;
   double value;
   Clock::time_point sent{};       // first sent
@@ -224,7 +224,7 @@ struct Request {
   std::string result;
 };
 
-const char* result_name(pmu_v4_CommandResult r) {
+const char* result_name(pmu_v5_CommandResult r) {
   static const char* const names[] = {"COMPLETED", "REJECTED", "DENIED", "UNSUPPORTED", "TIMEOUT", "FAILED",
                                       "IN_PROGRESS"};
   const auto i = static_cast<std::size_t>(r);
@@ -248,10 +248,10 @@ struct CanOpenCheck {
 bool near(float a, double b) { return std::fabs(static_cast<double>(a) - b) < 1e-3; }
 
 int run_canopen(const Options& o, dds_entity_t pp) {
-  const dds_entity_t battery = reader(pp, &pmu_v4_Battery_desc, "pmu/battery", telemetry_qos());
-  const dds_entity_t cells = reader(pp, &pmu_v4_BatteryCells_desc, "pmu/battery_cells", telemetry_qos());
-  const dds_entity_t mppt = reader(pp, &pmu_v4_Mppt_desc, "pmu/mppt", telemetry_qos());
-  const dds_entity_t health = reader(pp, &pmu_v4_Health_desc, "pmu/health", state_qos());
+  const dds_entity_t battery = reader(pp, &pmu_v5_Battery_desc, "pmu/battery", telemetry_qos());
+  const dds_entity_t cells = reader(pp, &pmu_v5_BatteryCells_desc, "pmu/battery_cells", telemetry_qos());
+  const dds_entity_t mppt = reader(pp, &pmu_v5_Mppt_desc, "pmu/mppt", telemetry_qos());
+  const dds_entity_t health = reader(pp, &pmu_v5_Health_desc, "pmu/health", state_qos());
   CanOpenCheck checks[] = {{"pmu/battery"}, {"pmu/battery_cells"}, {"pmu/mppt"}, {"pmu/health battery"},
                            {"pmu/health mppt"}};
   const auto until = Clock::now() + milliseconds(o.telemetry_ms);
@@ -261,7 +261,7 @@ int run_canopen(const Options& o, dds_entity_t pp) {
     return true;
   };
   while (!all() && Clock::now() < until) {
-    take_all<pmu_v4_Battery>(battery, [&](const pmu_v4_Battery& s) {
+    take_all<pmu_v5_Battery>(battery, [&](const pmu_v5_Battery& s) {
       if (o.canopen_bus != s.bus || s.node != 2) return;
       // voltage (bit 0), state_of_charge (4), bms_state (10), power_level (15); current never sent.
       const uint32_t want = (1u << 0) | (1u << 4) | (1u << 10) | (1u << 15);
@@ -269,31 +269,31 @@ int run_canopen(const Options& o, dds_entity_t pp) {
         checks[0].detail = "received " + std::to_string(s.received) + ", want " + std::to_string(want);
         return;
       }
-      const bool ok = near(s.voltage, 48.123) && near(s.state_of_charge, 87) && s.bms_state == 0x12345678u &&
+      const bool ok = near(s.voltage, 48.123) && near(s.state_of_charge, 87) && s.bms_state == double{0x12345678u} &&
                       near(s.power_level, 77) && std::isnan(s.current);
       checks[0].done = ok;
       checks[0].detail = ok ? "voltage 48.123, state_of_charge 87, bms_state 0x12345678, power_level 77, current NaN"
                             : "wrong values";
     });
-    take_all<pmu_v4_BatteryCells>(cells, [&](const pmu_v4_BatteryCells& s) {
+    take_all<pmu_v5_BatteryCells>(cells, [&](const pmu_v5_BatteryCells& s) {
       if (o.canopen_bus != s.bus || s.node != 2 || s.cells._length != 1) return;
       const bool ok = s.cells._buffer[0].cell == 5 && near(s.cells._buffer[0].cell_voltage, 3.301);
       checks[1].done = ok;
       checks[1].detail = ok ? "cell 5 at 3.301 V" : "wrong cell";
     });
-    take_all<pmu_v4_Mppt>(mppt, [&](const pmu_v4_Mppt& s) {
+    take_all<pmu_v5_Mppt>(mppt, [&](const pmu_v5_Mppt& s) {
       if (o.canopen_bus != s.bus || s.device != 4) return;
       const uint32_t want = (1u << 0) | (1u << 4) | (1u << 13);
       if (s.received != want) return;
-      const bool ok = near(s.voltage_output_raw, -100) && s.safety_enabled && near(s.duty_cycle_panel_2, 45) &&
-                      std::isnan(s.current_output_raw);
+      const bool ok = near(s.voltage_output_raw, -100) && s.safety_enabled == 1.0f && near(s.duty_cycle_panel_2, 45) &&
+                      std::isnan(s.current_output_raw) && std::isnan(s.pwm_enabled);
       checks[2].done = ok;
-      checks[2].detail = ok ? "voltage_output_raw -100, safety_enabled, duty_cycle_panel_2 45" : "wrong values";
+      checks[2].detail = ok ? "voltage_output_raw -100, safety_enabled 1, duty_cycle_panel_2 45, pwm_enabled NaN" : "wrong values";
     });
-    take_all<pmu_v4_Health>(health, [&](const pmu_v4_Health& s) {
-      if (o.canopen_bus != s.bus || s.state != pmu_v4_ONLINE) return;
-      if (s.kind == pmu_v4_KIND_BATTERY && s.address == 2) checks[3] = {"pmu/health battery", true, "node 2 ONLINE"};
-      if (s.kind == pmu_v4_KIND_MPPT && s.address == 4) checks[4] = {"pmu/health mppt", true, "device 4 ONLINE"};
+    take_all<pmu_v5_Health>(health, [&](const pmu_v5_Health& s) {
+      if (o.canopen_bus != s.bus || s.state != pmu_v5_ONLINE) return;
+      if (s.kind == pmu_v5_KIND_BATTERY && s.address == 2) checks[3] = {"pmu/health battery", true, "node 2 ONLINE"};
+      if (s.kind == pmu_v5_KIND_MPPT && s.address == 4) checks[4] = {"pmu/health mppt", true, "device 4 ONLINE"};
     });
     std::this_thread::sleep_for(milliseconds(5));
   }
@@ -321,25 +321,25 @@ int main(int argc, char** argv) {
   std::vector<Topic> telemetry = {Topic("pmu/voltages"), Topic("pmu/currents"), Topic("pmu/battery_energy"),
                                   Topic("pmu/temperatures"), Topic("pmu/status")};
   std::vector<Topic> state = {Topic("pmu/config"), Topic("pmu/info"), Topic("pmu/health"), Topic("pmu/readiness")};
-  const dds_topic_descriptor_t* telemetry_types[] = {&pmu_v4_Voltages_desc, &pmu_v4_Currents_desc, &pmu_v4_BatteryEnergy_desc,
-                                                     &pmu_v4_Temperatures_desc, &pmu_v4_Status_desc};
-  const dds_topic_descriptor_t* state_types[] = {&pmu_v4_Config_desc, &pmu_v4_DeviceInfo_desc, &pmu_v4_Health_desc,
-                                                 &pmu_v4_Readiness_desc};
+  const dds_topic_descriptor_t* telemetry_types[] = {&pmu_v5_Voltages_desc, &pmu_v5_Currents_desc, &pmu_v5_BatteryEnergy_desc,
+                                                     &pmu_v5_Temperatures_desc, &pmu_v5_Status_desc};
+  const dds_topic_descriptor_t* state_types[] = {&pmu_v5_Config_desc, &pmu_v5_DeviceInfo_desc, &pmu_v5_Health_desc,
+                                                 &pmu_v5_Readiness_desc};
   for (std::size_t i = 0; i < state.size(); ++i) state[i].reader = reader(pp.get(), state_types[i], state[i].name, state_qos());
   for (std::size_t i = 0; i < telemetry.size(); ++i)
     telemetry[i].reader = reader(pp.get(), telemetry_types[i], telemetry[i].name, telemetry_qos());
-  const dds_entity_t replies = reader(pp.get(), &pmu_v4_CommandReply_desc, "pmu/command_reply", command_qos(false));
+  const dds_entity_t replies = reader(pp.get(), &pmu_v5_CommandReply_desc, "pmu/command_reply", command_qos(false));
   const dds_entity_t command_topic =
-      entity(dds_create_topic(pp.get(), &pmu_v4_Command_desc, "pmu/command", nullptr, nullptr), "pmu/command");
+      entity(dds_create_topic(pp.get(), &pmu_v5_Command_desc, "pmu/command", nullptr, nullptr), "pmu/command");
   dds_qos_t* wq = command_qos(true);
   const dds_entity_t commands = entity(dds_create_writer(pp.get(), command_topic, wq, nullptr), "the command writer");
   dds_delete_qos(wq);
 
   const std::string id_prefix = "cyclone-" + std::to_string(::getpid()) + "-";
   std::vector<Request> requests = {
-      Request(id_prefix + "1", "GET avionics_voltage", pmu_v4_GET, "avionics_voltage", 0.0),
-      Request(id_prefix + "2", "SET_PARAMETER avionics_voltage 24.0", pmu_v4_SET_PARAMETER, "avionics_voltage", 24.0),
-      Request(id_prefix + "3", "GET_FIRMWARE", pmu_v4_GET_FIRMWARE, "", 0.0),
+      Request(id_prefix + "1", "GET avionics_voltage", pmu_v5_GET, "avionics_voltage", 0.0),
+      Request(id_prefix + "2", "SET_PARAMETER avionics_voltage 24.0", pmu_v5_SET_PARAMETER, "avionics_voltage", 24.0),
+      Request(id_prefix + "3", "GET_FIRMWARE", pmu_v5_GET_FIRMWARE, "", 0.0),
   };
   std::optional<Clock::time_point> command_match, sent_at;
 
@@ -358,7 +358,7 @@ int main(int argc, char** argv) {
   };
 
   auto send = [&](Request& r) {
-    pmu_v4_Command c{};
+    pmu_v5_Command c{};
     copy(c.request_id, r.id);
     copy(c.bus, o.bus);
     c.address = o.address;
@@ -406,24 +406,24 @@ int main(int argc, char** argv) {
       if (sent_at && o.resend_ms > 0 && r.finals == 0 && now - r.last_sent >= milliseconds(o.resend_ms) &&
           now - r.sent < milliseconds(o.reply_ms))
         send(r);
-    take_all<pmu_v4_Config>(state[0].reader, [&](const pmu_v4_Config& s) { mark(state[0], s.bus, s.address); });
-    take_all<pmu_v4_DeviceInfo>(state[1].reader, [&](const pmu_v4_DeviceInfo& s) { mark(state[1], s.bus, s.address); });
-    take_all<pmu_v4_Health>(state[2].reader, [&](const pmu_v4_Health& s) { mark(state[2], s.bus, s.address); });
+    take_all<pmu_v5_Config>(state[0].reader, [&](const pmu_v5_Config& s) { mark(state[0], s.bus, s.address); });
+    take_all<pmu_v5_DeviceInfo>(state[1].reader, [&](const pmu_v5_DeviceInfo& s) { mark(state[1], s.bus, s.address); });
+    take_all<pmu_v5_Health>(state[2].reader, [&](const pmu_v5_Health& s) { mark(state[2], s.bus, s.address); });
     // One instance per vehicle: any sample with its reasons decoded counts (a sequence of
     // structs with bounded strings, the contract's deepest type).
-    take_all<pmu_v4_Readiness>(state[3].reader, [&](const pmu_v4_Readiness& s) {
+    take_all<pmu_v5_Readiness>(state[3].reader, [&](const pmu_v5_Readiness& s) {
       if (!state[3].received && s.reasons._length <= 64 && s.reasons_total >= s.reasons._length)
         state[3].received = Clock::now();
     });
-    take_all<pmu_v4_Voltages>(telemetry[0].reader, [&](const pmu_v4_Voltages& s) { mark(telemetry[0], s.bus, s.address); });
-    take_all<pmu_v4_Currents>(telemetry[1].reader, [&](const pmu_v4_Currents& s) { mark(telemetry[1], s.bus, s.address); });
-    take_all<pmu_v4_BatteryEnergy>(telemetry[2].reader,
-                                [&](const pmu_v4_BatteryEnergy& s) { mark(telemetry[2], s.bus, s.address); });
-    take_all<pmu_v4_Temperatures>(telemetry[3].reader,
-                               [&](const pmu_v4_Temperatures& s) { mark(telemetry[3], s.bus, s.address); });
-    take_all<pmu_v4_Status>(telemetry[4].reader, [&](const pmu_v4_Status& s) { mark(telemetry[4], s.bus, s.address); });
-    take_all<pmu_v4_CommandReply>(replies, [&](const pmu_v4_CommandReply& s) {
-      if (s.result == pmu_v4_IN_PROGRESS) return;
+    take_all<pmu_v5_Voltages>(telemetry[0].reader, [&](const pmu_v5_Voltages& s) { mark(telemetry[0], s.bus, s.address); });
+    take_all<pmu_v5_Currents>(telemetry[1].reader, [&](const pmu_v5_Currents& s) { mark(telemetry[1], s.bus, s.address); });
+    take_all<pmu_v5_BatteryEnergy>(telemetry[2].reader,
+                                [&](const pmu_v5_BatteryEnergy& s) { mark(telemetry[2], s.bus, s.address); });
+    take_all<pmu_v5_Temperatures>(telemetry[3].reader,
+                               [&](const pmu_v5_Temperatures& s) { mark(telemetry[3], s.bus, s.address); });
+    take_all<pmu_v5_Status>(telemetry[4].reader, [&](const pmu_v5_Status& s) { mark(telemetry[4], s.bus, s.address); });
+    take_all<pmu_v5_CommandReply>(replies, [&](const pmu_v5_CommandReply& s) {
+      if (s.result == pmu_v5_IN_PROGRESS) return;
       for (auto& r : requests) {
         if (r.id != s.request_id) continue;  // another client's reply: every reply reader sees them
         if (++r.finals == 1) {

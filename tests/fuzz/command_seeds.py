@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
 """Writes the seed corpus of fuzz_command_path: one file per scenario, each a sequence of
-[length: u16 LE][CDR payload of a pmu::v4::Command] records (idl/command.idl's field order, little-
+[length: u16 LE][CDR payload of a pmu::v5::Command] records (idl/command.idl's field order, little-
 endian CDR with its 4-byte encapsulation header). Run from the repository root."""
 import os
 import struct

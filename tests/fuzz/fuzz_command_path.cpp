@@ -1,9 +1,9 @@
-// libFuzzer target: serialized pmu::v4::Command bytes -> the whole command path of the service
+// libFuzzer target: serialized pmu::v5::Command bytes -> the whole command path of the service
 // (read_command_cdr, parse_command, policy, rate limit, CommandService, the executor) against
 // two simulated PMUs (firmware 1.17 and 1.12) on the in-process bus, with a fake clock.
 // Checks the contract's invariants; a broken one traps, which libFuzzer reports as a crash
 // with the input that caused it:
-//   * every sample that reads as a pmu::v4::Command gets exactly one final reply, per request id
+//   * every sample that reads as a pmu::v5::Command gets exactly one final reply, per request id
 //     and sender (a resend is answered again, never executed twice);
 //   * when no request ended COMPLETED, TIMEOUT or FAILED, no frame reached the bus
 //     (REJECTED, DENIED and UNSUPPORTED send nothing);

@@ -63,13 +63,13 @@ TEST(AddressChangeDds, OldKeyEndsOfflineAndIsDisposedAndALateJoinerSeesTheNewKey
   dds::DdsContext service_side(domain, "", "pmu-service-move");
   DdsPublisher publisher(service_side, 3s);
   dds::DdsContext client(domain, "", "reader-move");
-  DataReader& health = state_reader(client, topics::kHealth, TypeSupport(new pmu::v4::HealthPubSubType()));
+  DataReader& health = state_reader(client, topics::kHealth, TypeSupport(new pmu::v5::HealthPubSubType()));
 
   Harness h(sim_bus({device(1)}), {pmu(1)}, Timeouts{}, &publisher);
   std::vector<CommandReplyData> replies;
   CommandService commands({&h.worker()}, PolicyConfig{}, Timeouts{}, h.clock(),
                           [&](const CommandReplyData& r) { replies.push_back(r); });
-  Seen<pmu::v4::Health> seen;
+  Seen<pmu::v5::Health> seen;
   ASSERT_TRUE(pmu::test::wait_until(
       [&] {
         h.run_for(100ms);
@@ -100,15 +100,15 @@ TEST(AddressChangeDds, OldKeyEndsOfflineAndIsDisposedAndALateJoinerSeesTheNewKey
       },
       10s))
       << "old key disposed: " << seen.gone(1);
-  EXPECT_EQ(seen.valid[1].back().state(), pmu::v4::OFFLINE) << "the old key's last health";
+  EXPECT_EQ(seen.valid[1].back().state(), pmu::v5::OFFLINE) << "the old key's last health";
 
   dds::DdsContext late(domain, "", "late-reader");
-  DataReader& late_health = state_reader(late, topics::kHealth, TypeSupport(new pmu::v4::HealthPubSubType()));
-  DataReader& late_info = state_reader(late, topics::kInfo, TypeSupport(new pmu::v4::DeviceInfoPubSubType()));
-  DataReader& late_config = state_reader(late, topics::kConfig, TypeSupport(new pmu::v4::ConfigPubSubType()));
-  Seen<pmu::v4::Health> lh;
-  Seen<pmu::v4::DeviceInfo> li;
-  Seen<pmu::v4::Config> lc;
+  DataReader& late_health = state_reader(late, topics::kHealth, TypeSupport(new pmu::v5::HealthPubSubType()));
+  DataReader& late_info = state_reader(late, topics::kInfo, TypeSupport(new pmu::v5::DeviceInfoPubSubType()));
+  DataReader& late_config = state_reader(late, topics::kConfig, TypeSupport(new pmu::v5::ConfigPubSubType()));
+  Seen<pmu::v5::Health> lh;
+  Seen<pmu::v5::DeviceInfo> li;
+  Seen<pmu::v5::Config> lc;
   auto take_all = [&] {
     h.run_for(10ms);
     lh.take(late_health);
@@ -130,7 +130,7 @@ TEST(AddressChangeDds, OldKeyEndsOfflineAndIsDisposedAndALateJoinerSeesTheNewKey
   EXPECT_EQ(li.valid[7].back().serial_number(), 4001);
   ASSERT_EQ(lc.valid.count(7), 1u);
   EXPECT_EQ(lc.valid[7].back().can_address(), 7);
-  EXPECT_EQ(lh.valid[7].back().state(), pmu::v4::ONLINE);
+  EXPECT_EQ(lh.valid[7].back().state(), pmu::v5::ONLINE);
 }
 
 // ---- across processes: pmu-service --config on its simulated bus, pmuctl ----------------------

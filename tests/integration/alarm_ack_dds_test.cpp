@@ -1,5 +1,5 @@
 // pmu/alarm_ack as a hostile peer can send it (interface.md 1.6): samples of the right type
-// with values no field allows, and payloads that are not a pmu::v4::AlarmAck at all. Each
+// with values no field allows, and payloads that are not a pmu::v5::AlarmAck at all. Each
 // well-formed sample gets one REJECTED reply naming the field, garbage is dropped, and the
 // service keeps answering.
 #include <gtest/gtest.h>
@@ -30,11 +30,11 @@ using namespace std::chrono_literals;
 namespace topics = pmu::topics;
 namespace qos_profiles = pmu::qos_profiles;
 
-// Any bytes under pmu::v4::AlarmAck's name.
+// Any bytes under pmu::v5::AlarmAck's name.
 class RawAckType final : public TopicDataType {
  public:
   RawAckType() {
-    setName("pmu::v4::AlarmAck");
+    setName("pmu::v5::AlarmAck");
     m_typeSize = 4096;
     m_isGetKeyDefined = false;
   }
@@ -69,9 +69,9 @@ TEST(AlarmAckOverDds, HostileSamplesAreRejectedOrDroppedAndTheServiceKeepsAnswer
       PMU_SERVICE_PATH, "domain: " + std::to_string(domain) + "\nqos_file: " PMU_QOS_FILE
                         "\nbuses:\n  - interface: sim\n    devices:\n      - address: 1\n        period: 0.5\n");
   pmu::dds::DdsContext dds(domain, PMU_QOS_FILE, "ack-peer");
-  DataWriter& w = dds.writer(dds.topic(topics::kAlarmAck, TypeSupport(new pmu::v4::AlarmAckPubSubType())),
+  DataWriter& w = dds.writer(dds.topic(topics::kAlarmAck, TypeSupport(new pmu::v5::AlarmAckPubSubType())),
                              qos_profiles::kCommand);
-  DataReader& r = dds.reader(dds.topic(topics::kAlarmAckReply, TypeSupport(new pmu::v4::AlarmAckReplyPubSubType())),
+  DataReader& r = dds.reader(dds.topic(topics::kAlarmAckReply, TypeSupport(new pmu::v5::AlarmAckReplyPubSubType())),
                              qos_profiles::kCommand);
   pmu::dds::DdsContext raw(domain, PMU_QOS_FILE, "ack-garbage");
   DataWriter& g = raw.writer(raw.topic(topics::kAlarmAck, TypeSupport(new RawAckType())), qos_profiles::kCommand);
@@ -90,8 +90,8 @@ TEST(AlarmAckOverDds, HostileSamplesAreRejectedOrDroppedAndTheServiceKeepsAnswer
   };
   for (auto& bytes : garbage) ASSERT_TRUE(g.write(&bytes));
 
-  auto ack = [](const std::string& id, pmu::v4::AlarmSource kind, std::uint16_t device, const std::string& code) {
-    pmu::v4::AlarmAck a;
+  auto ack = [](const std::string& id, pmu::v5::AlarmSource kind, std::uint16_t device, const std::string& code) {
+    pmu::v5::AlarmAck a;
     a.request_id(id);
     a.bus("sim");
     a.kind(kind);
@@ -106,16 +106,16 @@ TEST(AlarmAckOverDds, HostileSamplesAreRejectedOrDroppedAndTheServiceKeepsAnswer
       {"expired", "expires_at: expired"},
       {"good", "nothing to acknowledge: NORMAL"},
   };
-  auto bad_kind = ack("bad-kind", static_cast<pmu::v4::AlarmSource>(9), 1, "thermal_shutdown");
-  auto bad_code = ack("bad-code", pmu::v4::SOURCE_PMU, 1, "melting");
-  auto bad_device = ack("bad-device", pmu::v4::SOURCE_BUS, 3, "bus_off");
-  auto expired = ack("expired", pmu::v4::SOURCE_PMU, 1, "thermal_shutdown");
+  auto bad_kind = ack("bad-kind", static_cast<pmu::v5::AlarmSource>(9), 1, "thermal_shutdown");
+  auto bad_code = ack("bad-code", pmu::v5::SOURCE_PMU, 1, "melting");
+  auto bad_device = ack("bad-device", pmu::v5::SOURCE_BUS, 3, "bus_off");
+  auto expired = ack("expired", pmu::v5::SOURCE_PMU, 1, "thermal_shutdown");
   expired.expires_at(1);
-  auto good = ack("good", pmu::v4::SOURCE_BUS, 0, "bus_off");
+  auto good = ack("good", pmu::v5::SOURCE_BUS, 0, "bus_off");
   // As every client does (interface.md 2.4): what got no reply within 1 s is sent again with
   // the same id, since the service may not have discovered this writer yet. A resend is
   // answered again with the same reply.
-  std::map<std::string, pmu::v4::AlarmAckReply> got;
+  std::map<std::string, pmu::v5::AlarmAckReply> got;
   std::map<std::string, std::size_t> differing;
   const auto until = std::chrono::steady_clock::now() + 20s;
   while (got.size() < want.size() && std::chrono::steady_clock::now() < until) {
@@ -126,7 +126,7 @@ TEST(AlarmAckOverDds, HostileSamplesAreRejectedOrDroppedAndTheServiceKeepsAnswer
     }
     pmu::test::wait_until(
         [&] {
-          pmu::v4::AlarmAckReply reply;
+          pmu::v5::AlarmAckReply reply;
           SampleInfo info;
           while (r.take_next_sample(&reply, &info) == ReturnCode_t::RETCODE_OK) {
             if (!info.valid_data) continue;
@@ -142,7 +142,7 @@ TEST(AlarmAckOverDds, HostileSamplesAreRejectedOrDroppedAndTheServiceKeepsAnswer
   for (const auto& [id, reason] : want) {
     SCOPED_TRACE(id);
     ASSERT_EQ(got.count(id), 1u) << service.describe();
-    EXPECT_EQ(got[id].result(), id == "good" ? pmu::v4::ACK_COMPLETED : pmu::v4::ACK_REJECTED);
+    EXPECT_EQ(got[id].result(), id == "good" ? pmu::v5::ACK_COMPLETED : pmu::v5::ACK_REJECTED);
     EXPECT_EQ(got[id].reason().to_string().rfind(reason, 0), 0u) << got[id].reason().to_string();
   }
   // The garbage comes from a participant of its own: the service may match its writer after

@@ -48,15 +48,15 @@ TEST(DdsAlarms, ALateJoinerGetsEveryAlarmInItsLatestStateWithItsFields) {
 
   dds::DdsContext client(pmu::test::exclusive_dds_domain(), "", "reader-test");
   DataReader& reader =
-      client.reader(client.topic(topics::kAlarms, TypeSupport(new pmu::v4::AlarmPubSubType())), qos_profiles::kAlarms);
-  std::map<std::string, pmu::v4::Alarm> latest;
+      client.reader(client.topic(topics::kAlarms, TypeSupport(new pmu::v5::AlarmPubSubType())), qos_profiles::kAlarms);
+  std::map<std::string, pmu::v5::Alarm> latest;
   ASSERT_TRUE(pmu::test::wait_until(
       [&] {
-        pmu::v4::Alarm a;
+        pmu::v5::Alarm a;
         SampleInfo info;
         while (reader.take_next_sample(&a, &info) == ReturnCode_t::RETCODE_OK)
           if (info.valid_data) latest[a.code().to_string()] = a;
-        return latest.size() == 3 && latest["thermal_shutdown"].state() == pmu::v4::ALARM_CLEARED_UNACKNOWLEDGED;
+        return latest.size() == 3 && latest["thermal_shutdown"].state() == pmu::v5::ALARM_CLEARED_UNACKNOWLEDGED;
       },
       20s, 10ms))
       << latest.size() << " alarms";
@@ -65,21 +65,21 @@ TEST(DdsAlarms, ALateJoinerGetsEveryAlarmInItsLatestStateWithItsFields) {
   EXPECT_EQ(thermal.vehicle(), "uav1");
   EXPECT_EQ(thermal.bus(), "sim0");
   EXPECT_EQ(thermal.device(), 1);
-  EXPECT_EQ(thermal.kind(), pmu::v4::SOURCE_PMU);
-  EXPECT_EQ(thermal.severity(), pmu::v4::SEVERITY_CRITICAL);
+  EXPECT_EQ(thermal.kind(), pmu::v5::SOURCE_PMU);
+  EXPECT_EQ(thermal.severity(), pmu::v5::SEVERITY_CRITICAL);
   EXPECT_TRUE(std::isnan(thermal.value())) << "a flag has no value";
   EXPECT_TRUE(std::isnan(thermal.limit()));
   EXPECT_EQ(thermal.since(), 1002000000000ull);
   EXPECT_EQ(thermal.message(), "thermal shutdown test");
 
   const auto& low = latest["battery_a_low_voltage"];
-  EXPECT_EQ(low.state(), pmu::v4::ALARM_ACTIVE_UNACKNOWLEDGED);
-  EXPECT_EQ(low.severity(), pmu::v4::SEVERITY_WARNING);
+  EXPECT_EQ(low.state(), pmu::v5::ALARM_ACTIVE_UNACKNOWLEDGED);
+  EXPECT_EQ(low.severity(), pmu::v5::SEVERITY_WARNING);
   EXPECT_FLOAT_EQ(low.value(), 20.1f);
   EXPECT_FLOAT_EQ(low.limit(), static_cast<float>(alarms::spec_of(alarms::Code::BatteryALowVoltage).limit));
 
   const auto& bus = latest["bus_error_passive"];
-  EXPECT_EQ(bus.kind(), pmu::v4::SOURCE_BUS);
+  EXPECT_EQ(bus.kind(), pmu::v5::SOURCE_BUS);
   EXPECT_EQ(bus.device(), 0);
 }
 

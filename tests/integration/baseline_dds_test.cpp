@@ -41,10 +41,10 @@ TEST(DdsBaseline, ALateJoinerGetsEachBaselineAndTheDisposalOfEveryOtherPmu) {
 
   dds::DdsContext client(pmu::test::exclusive_dds_domain(), "", "reader-test");
   DataReader& reader =
-      client.reader(client.topic(topics::kBaseline, TypeSupport(new pmu::v4::BaselinePubSubType())), qos_profiles::kState);
-  std::map<std::uint16_t, pmu::v4::Baseline> got;
+      client.reader(client.topic(topics::kBaseline, TypeSupport(new pmu::v5::BaselinePubSubType())), qos_profiles::kState);
+  std::map<std::uint16_t, pmu::v5::Baseline> got;
   std::set<InstanceHandle_t> disposed;
-  pmu::v4::Baseline key;
+  pmu::v5::Baseline key;
   key.vehicle("uav1");
   key.bus("can0");
   key.address(2);
@@ -57,7 +57,7 @@ TEST(DdsBaseline, ALateJoinerGetsEachBaselineAndTheDisposalOfEveryOtherPmu) {
   // wait to know.
   ASSERT_TRUE(pmu::test::wait_until(
       [&] {
-        pmu::v4::Baseline b;
+        pmu::v5::Baseline b;
         SampleInfo info;
         while (reader.take_next_sample(&b, &info) == ReturnCode_t::RETCODE_OK)
           if (info.valid_data)

@@ -47,19 +47,19 @@ TEST(DdsCanOpen, BatteryCellsAndMpptArriveWithTheirValuesAndFrameTimes) {
   DdsPublisher publisher(service_side, 3s, "uav1");  // the vehicle key only; partitions: vehicle_test.cpp
   dds::DdsContext client(pmu::test::exclusive_dds_domain(), "", "reader-canopen");
   auto& battery_reader =
-      client.reader(client.topic(topics::kBattery, TypeSupport(new pmu::v4::BatteryPubSubType())), qos_profiles::kTelemetry);
-  auto& cells_reader = client.reader(client.topic(topics::kBatteryCells, TypeSupport(new pmu::v4::BatteryCellsPubSubType())),
+      client.reader(client.topic(topics::kBattery, TypeSupport(new pmu::v5::BatteryPubSubType())), qos_profiles::kTelemetry);
+  auto& cells_reader = client.reader(client.topic(topics::kBatteryCells, TypeSupport(new pmu::v5::BatteryCellsPubSubType())),
                                      qos_profiles::kTelemetry);
   auto& mppt_reader =
-      client.reader(client.topic(topics::kMppt, TypeSupport(new pmu::v4::MpptPubSubType())), qos_profiles::kTelemetry);
+      client.reader(client.topic(topics::kMppt, TypeSupport(new pmu::v5::MpptPubSubType())), qos_profiles::kTelemetry);
 
   Harness h(bus_with_battery_and_mppt(), {pmu(1)}, Timeouts{}, &publisher);
   BusThread bus(h, document_frames());
 
   SampleInfo si;
-  pmu::v4::Battery b;
+  pmu::v5::Battery b;
   // Every value the node sends is in one sample once a round of frames has been assembled.
-  ASSERT_TRUE(wait_for<pmu::v4::Battery>(battery_reader, b, si, 10s, [](const pmu::v4::Battery& x) {
+  ASSERT_TRUE(wait_for<pmu::v5::Battery>(battery_reader, b, si, 10s, [](const pmu::v5::Battery& x) {
     return !std::isnan(x.voltage()) && !std::isnan(x.power_level()) && !std::isnan(x.temperature_4()) &&
            (x.received() & (1u << 10)) != 0;
   }));
@@ -67,7 +67,7 @@ TEST(DdsCanOpen, BatteryCellsAndMpptArriveWithTheirValuesAndFrameTimes) {
   EXPECT_EQ(b.bus().to_string(), "sim0");
   EXPECT_EQ(b.node(), 2);
   EXPECT_FLOAT_EQ(b.voltage(), 48.123f);
-  EXPECT_EQ(b.bms_state(), 0x12345678u);
+  EXPECT_EQ(b.bms_state(), double{0x12345678u});
   EXPECT_FLOAT_EQ(b.temperature_1(), 20.0f);
   EXPECT_FLOAT_EQ(b.temperature_4(), 23.0f);
   EXPECT_FLOAT_EQ(b.power_level(), 77.0f);
@@ -79,25 +79,24 @@ TEST(DdsCanOpen, BatteryCellsAndMpptArriveWithTheirValuesAndFrameTimes) {
   EXPECT_GE(si.source_timestamp.seconds(), 1700000000);
   EXPECT_LT(si.source_timestamp.seconds(), 1700000000 + 3600);
 
-  pmu::v4::BatteryCells cells;
-  ASSERT_TRUE(wait_for<pmu::v4::BatteryCells>(cells_reader, cells, si, 5s,
-                                          [](const pmu::v4::BatteryCells& x) { return !x.cells().empty(); }));
+  pmu::v5::BatteryCells cells;
+  ASSERT_TRUE(wait_for<pmu::v5::BatteryCells>(cells_reader, cells, si, 5s,
+                                          [](const pmu::v5::BatteryCells& x) { return !x.cells().empty(); }));
   ASSERT_EQ(cells.cells().size(), 1u);
   EXPECT_EQ(cells.cells()[0].cell(), 5);
   EXPECT_FLOAT_EQ(cells.cells()[0].cell_voltage(), 3.301f);
   EXPECT_EQ(cells.node(), 2);
 
-  pmu::v4::Mppt m;
-  ASSERT_TRUE(wait_for<pmu::v4::Mppt>(mppt_reader, m, si, 5s, [](const pmu::v4::Mppt& x) {
-    return !std::isnan(x.voltage_output_raw()) && !std::isnan(x.duty_cycle_panel_2()) && x.safety_enabled();
+  pmu::v5::Mppt m;
+  ASSERT_TRUE(wait_for<pmu::v5::Mppt>(mppt_reader, m, si, 5s, [](const pmu::v5::Mppt& x) {
+    return !std::isnan(x.voltage_output_raw()) && !std::isnan(x.duty_cycle_panel_2()) && x.safety_enabled() == 1.0f;
   }));
   EXPECT_EQ(m.device(), 4);
   EXPECT_FLOAT_EQ(m.voltage_output_raw(), -100.0f);
   EXPECT_FLOAT_EQ(m.duty_cycle_panel_2(), 45.0f);
   EXPECT_TRUE(std::isnan(m.current_output_raw()));
-  EXPECT_FALSE(m.pwm_enabled());
-  // voltage_output_raw (0), safety_enabled (4), duty_cycle_panel_2 (13); pwm_enabled's
-  // false is "not received" (bit 5 clear), not "off".
+  EXPECT_TRUE(std::isnan(m.pwm_enabled())) << "never sent: NaN, not off";
+  // voltage_output_raw (0), safety_enabled (4), duty_cycle_panel_2 (13).
   EXPECT_EQ(m.received(), (1u << 0) | (1u << 4) | (1u << 13));
 }
 
@@ -105,29 +104,29 @@ TEST(DdsCanOpen, HealthHasAnInstancePerDeviceKind) {
   dds::DdsContext service_side(pmu::test::exclusive_dds_domain(), "", "pmu-service-canopen-health");
   DdsPublisher publisher(service_side, 3s);
   dds::DdsContext client(pmu::test::exclusive_dds_domain(), "", "reader-canopen-health");
-  auto& health = client.reader(client.topic(topics::kHealth, TypeSupport(new pmu::v4::HealthPubSubType())),
+  auto& health = client.reader(client.topic(topics::kHealth, TypeSupport(new pmu::v5::HealthPubSubType())),
                                qos_profiles::kState);
   BusConfig config = bus_with_battery_and_mppt();
   config.mppts.push_back(MpptConfig{2, 1000ms, {}});  // configured, never heard
   Harness h(config, {pmu(1)}, Timeouts{}, &publisher);
   BusThread bus(h, document_frames());
 
-  std::map<std::pair<int, int>, pmu::v4::HealthState> seen;  // (kind, address) -> latest state
-  pmu::v4::Health s;
+  std::map<std::pair<int, int>, pmu::v5::HealthState> seen;  // (kind, address) -> latest state
+  pmu::v5::Health s;
   SampleInfo si;
   const bool all = pmu::test::wait_until(
       [&] {
         while (health.take_next_sample(&s, &si) == ReturnCode_t::RETCODE_OK)
           if (si.valid_data) seen[{static_cast<int>(s.kind()), s.address()}] = s.state();
-        return seen.size() == 4 && seen[{pmu::v4::KIND_MPPT, 2}] == pmu::v4::OFFLINE;
+        return seen.size() == 4 && seen[{pmu::v5::KIND_MPPT, 2}] == pmu::v5::OFFLINE;
       },
       20s, 5ms);
   ASSERT_TRUE(all) << seen.size() << " instances";
   // PMU 1, battery 2 and MPPT 4 share numbers' ranges: the kind keeps them apart.
-  EXPECT_EQ((seen[{pmu::v4::KIND_PMU, 1}]), pmu::v4::ONLINE);
-  EXPECT_EQ((seen[{pmu::v4::KIND_BATTERY, 2}]), pmu::v4::ONLINE);
-  EXPECT_EQ((seen[{pmu::v4::KIND_MPPT, 4}]), pmu::v4::ONLINE);
-  EXPECT_EQ((seen[{pmu::v4::KIND_MPPT, 2}]), pmu::v4::OFFLINE) << "configured but silent";
+  EXPECT_EQ((seen[{pmu::v5::KIND_PMU, 1}]), pmu::v5::ONLINE);
+  EXPECT_EQ((seen[{pmu::v5::KIND_BATTERY, 2}]), pmu::v5::ONLINE);
+  EXPECT_EQ((seen[{pmu::v5::KIND_MPPT, 4}]), pmu::v5::ONLINE);
+  EXPECT_EQ((seen[{pmu::v5::KIND_MPPT, 2}]), pmu::v5::OFFLINE) << "configured but silent";
 }
 
 }  // namespace
@@ -144,10 +143,10 @@ TEST(DdsCanOpen, AServiceWithoutBatteriesOrMpptsDoesNotOfferTheirTopics) {
   DdsPublisher publisher(service_side, 3s, "", {}, std::nullopt);
   dds::DdsContext client(pmu::test::exclusive_dds_domain(), "", "reader-no-canopen");
   auto& battery =
-      client.reader(client.topic(topics::kBattery, TypeSupport(new pmu::v4::BatteryPubSubType())), qos_profiles::kTelemetry);
-  auto& mppt = client.reader(client.topic(topics::kMppt, TypeSupport(new pmu::v4::MpptPubSubType())), qos_profiles::kTelemetry);
+      client.reader(client.topic(topics::kBattery, TypeSupport(new pmu::v5::BatteryPubSubType())), qos_profiles::kTelemetry);
+  auto& mppt = client.reader(client.topic(topics::kMppt, TypeSupport(new pmu::v5::MpptPubSubType())), qos_profiles::kTelemetry);
   auto& health =
-      client.reader(client.topic(topics::kHealth, TypeSupport(new pmu::v4::HealthPubSubType())), qos_profiles::kState);
+      client.reader(client.topic(topics::kHealth, TypeSupport(new pmu::v5::HealthPubSubType())), qos_profiles::kState);
   auto matched = [](DataReader& r) {
     SubscriptionMatchedStatus st;
     r.get_subscription_matched_status(st);

@@ -147,7 +147,7 @@ TEST(QosCapacity, PmusBeyondTheCapacityAreCountedInHealthNotDroppedSilently) {
   DdsPublisher publisher(service_side, 3s);
   dds::DdsContext client(pmu::test::exclusive_dds_domain(), PMU_QOS_FILE, "capacity-reader");
   DataReader& health = client.reader(
-      client.topic(topics::kHealth, TypeSupport(new pmu::v4::HealthPubSubType())), qos_profiles::kState);
+      client.topic(topics::kHealth, TypeSupport(new pmu::v5::HealthPubSubType())), qos_profiles::kState);
   HealthReport report;
   report.state = HealthState::Online;
   for (std::size_t a = 1; a <= kMaxDevicesPerService + 1; ++a)
@@ -158,7 +158,7 @@ TEST(QosCapacity, PmusBeyondTheCapacityAreCountedInHealthNotDroppedSilently) {
 
   publisher.on_health(DeviceKey{"sim0", 1}, report);  // an admitted PMU still publishes
   std::map<int, std::uint64_t> failures_by_address;
-  pmu::v4::Health h;
+  pmu::v5::Health h;
   SampleInfo info;
   pmu::test::wait_until(
       [&] {

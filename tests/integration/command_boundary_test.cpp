@@ -1,6 +1,6 @@
 // The command boundary against the real pmu-service process, as a hostile or careless DDS
-// peer would meet it: every kind of malformed or adversarial pmu::v4::Command gets exactly one
-// reply with a reason (or, when it is not a pmu::v4::Command at all, is counted and dropped),
+// peer would meet it: every kind of malformed or adversarial pmu::v5::Command gets exactly one
+// reply with a reason (or, when it is not a pmu::v5::Command at all, is counted and dropped),
 // nothing kills or stalls the service, nothing forges its log, duplicates are told apart per
 // sender, bursts are answered in full and the memory for remembered ids stays bounded.
 #include <gtest/gtest.h>
@@ -100,7 +100,7 @@ class Peer {
   Peer(int domain, const std::string& name)
       : dds_(domain, "", name),
         writer_(dds_.writer(dds_.topic(topics::kCommand, TypeSupport(new CommandSampleType())), qos_profiles::kCommand)),
-        replies_(dds_.reader(dds_.topic(topics::kCommandReply, TypeSupport(new pmu::v4::CommandReplyPubSubType())),
+        replies_(dds_.reader(dds_.topic(topics::kCommandReply, TypeSupport(new pmu::v5::CommandReplyPubSubType())),
                              qos_profiles::kCommand)) {}
 
   bool wait_matched(std::chrono::seconds within = 20s) {
@@ -132,14 +132,14 @@ class Peer {
   }
   // Every reply (from the `since`-th received on) whose id starts with `prefix`, until `count`
   // of them arrived or `within` passed.
-  std::vector<pmu::v4::CommandReply> replies(const std::string& prefix, std::size_t count,
+  std::vector<pmu::v5::CommandReply> replies(const std::string& prefix, std::size_t count,
                                          std::chrono::seconds within = 20s, std::size_t since = 0) {
     // Not wait_until: under a burst the reader must be drained again at once whenever the last
     // take found samples (its history is the command profile's depth), and sleep only when
     // it found none.
     const auto end = Clock::now() + within;
     do {
-      pmu::v4::CommandReply r;
+      pmu::v5::CommandReply r;
       SampleInfo info;
       bool any = false;
       while (replies_.take_next_sample(&r, &info) == ReturnCode_t::RETCODE_OK) {
@@ -160,7 +160,7 @@ class Peer {
   dds::DdsContext dds_;
   DataWriter& writer_;
   DataReader& replies_;
-  std::vector<pmu::v4::CommandReply> all_, mine_;
+  std::vector<pmu::v5::CommandReply> all_, mine_;
 };
 
 CommandSample set(const std::string& id, const char* parameter, double value) {
@@ -183,13 +183,13 @@ class Boundary : public ::testing::Test {
           const std::string id = "ready-" + std::to_string(tries++);
           peer_.send(command(id, CommandKind::GetSerial));
           const auto r = peer_.replies(id, 1, 2s);
-          return !r.empty() && r[0].result() == pmu::v4::COMPLETED;
+          return !r.empty() && r[0].result() == pmu::v5::COMPLETED;
         },
         200s, 100ms);
     if (!ready) FAIL() << "the service never became ready\n" << service_.log();
   }
   // Sends `s` and returns its one reply (fails the test unless exactly one arrives).
-  pmu::v4::CommandReply one_reply(const CommandSample& s) {
+  pmu::v5::CommandReply one_reply(const CommandSample& s) {
     const auto since = peer_.received();
     peer_.send(s);
     auto r = peer_.replies(s.request_id, 1, 20s, since);
@@ -198,7 +198,7 @@ class Boundary : public ::testing::Test {
     std::this_thread::sleep_for(100ms);
     r = peer_.replies(s.request_id, 2, 0s, since);
     EXPECT_EQ(r.size(), 1u) << "replies to " << s.request_id;
-    return r.empty() ? pmu::v4::CommandReply{} : r.front();
+    return r.empty() ? pmu::v5::CommandReply{} : r.front();
   }
 
   int domain_;
@@ -209,7 +209,7 @@ class Boundary : public ::testing::Test {
 struct Hostile {
   const char* what;
   CommandSample sample;
-  pmu::v4::CommandResult result;
+  pmu::v5::CommandResult result;
   const char* reason;  // a part of the reason
 };
 
@@ -221,59 +221,59 @@ TEST_F(Boundary, EveryHostileSampleGetsOneReplyWithAReasonAndTheServiceLivesOn) 
   };
   const std::uint64_t far = 1ull << 63;
   const Hostile cases[] = {
-      {"kind 12", with(command("h-kind12", CommandKind::Get), [](auto& s) { s.kind = 12; }), pmu::v4::REJECTED,
+      {"kind 12", with(command("h-kind12", CommandKind::Get), [](auto& s) { s.kind = 12; }), pmu::v5::REJECTED,
        "unknown command kind 12"},
       {"kind 2^32-1", with(command("h-kindmax", CommandKind::Get), [](auto& s) { s.kind = 0xFFFFFFFF; }),
-       pmu::v4::REJECTED, "unknown command kind 4294967295"},
-      {"NaN", set("h-nan", "avionics_voltage", std::nan("")), pmu::v4::REJECTED, "is not a number"},
-      {"Inf", set("h-inf", "avionics_voltage", inf), pmu::v4::REJECTED, "is not a number"},
-      {"-Inf", set("h-ninf", "servo_voltage", -inf), pmu::v4::REJECTED, "is not a number"},
-      {"huge", set("h-huge", "battery_voltage", 1e300), pmu::v4::REJECTED, "out of range"},
-      {"denormal voltage", set("h-denorm", "payload_voltage", 4e-320), pmu::v4::REJECTED, "out of range"},
+       pmu::v5::REJECTED, "unknown command kind 4294967295"},
+      {"NaN", set("h-nan", "avionics_voltage", std::nan("")), pmu::v5::REJECTED, "is not a number"},
+      {"Inf", set("h-inf", "avionics_voltage", inf), pmu::v5::REJECTED, "is not a number"},
+      {"-Inf", set("h-ninf", "servo_voltage", -inf), pmu::v5::REJECTED, "is not a number"},
+      {"huge", set("h-huge", "battery_voltage", 1e300), pmu::v5::REJECTED, "out of range"},
+      {"denormal voltage", set("h-denorm", "payload_voltage", 4e-320), pmu::v5::REJECTED, "out of range"},
       {"undefined output bits", with(command("h-outbits", CommandKind::EnableOutputs), [](auto& s) { s.outputs = 0xF2; }),
-       pmu::v4::REJECTED, "unknown output bits 0xF0"},
+       pmu::v5::REJECTED, "unknown output bits 0xF0"},
       {"undefined group bits",
-       with(command("h-groups", CommandKind::RequestMeasurements), [](auto& s) { s.groups = 0xE1; }), pmu::v4::REJECTED,
+       with(command("h-groups", CommandKind::RequestMeasurements), [](auto& s) { s.groups = 0xE1; }), pmu::v5::REJECTED,
        "unknown measurement group bits 0xE0"},
       {"broadcast set", with(set("h-bcast", "avionics_voltage", 20), [](auto& s) { s.address = 0xFFFF; }),
-       pmu::v4::REJECTED, "broadcast (65535) is only accepted for engine_stop"},
-      {"unknown address", command("h-addr", CommandKind::GetSerial, 9), pmu::v4::REJECTED, "device 9 not seen on sim0"},
-      {"unknown bus", with(command("h-bus", CommandKind::GetSerial), [](auto& s) { s.bus = "can7"; }), pmu::v4::REJECTED,
+       pmu::v5::REJECTED, "broadcast (65535) is only accepted for engine_stop"},
+      {"unknown address", command("h-addr", CommandKind::GetSerial, 9), pmu::v5::REJECTED, "device 9 not seen on sim0"},
+      {"unknown bus", with(command("h-bus", CommandKind::GetSerial), [](auto& s) { s.bus = "can7"; }), pmu::v5::REJECTED,
        "bus 'can7' is not served here"},
-      {"empty bus", with(command("h-nobus", CommandKind::GetSerial), [](auto& s) { s.bus.clear(); }), pmu::v4::REJECTED,
+      {"empty bus", with(command("h-nobus", CommandKind::GetSerial), [](auto& s) { s.bus.clear(); }), pmu::v5::REJECTED,
        "bus '' is not served here"},
       {"over-long bus name",
        with(command("h-longbus", CommandKind::GetSerial), [](auto& s) { s.bus = std::string(200, 'b'); }),
-       pmu::v4::REJECTED, "bus is 200 bytes long; at most 15 are allowed"},
-      {"over-long parameter", set("h-longparam", std::string(40, 'p').c_str(), 1), pmu::v4::REJECTED,
+       pmu::v5::REJECTED, "bus is 200 bytes long; at most 15 are allowed"},
+      {"over-long parameter", set("h-longparam", std::string(40, 'p').c_str(), 1), pmu::v5::REJECTED,
        "parameter is 40 bytes long"},
       {"confirm byte 2", with(command("h-confirm2", CommandKind::EngineStart), [](auto& s) { s.confirm = 2; }),
-       pmu::v4::REJECTED, "confirm is not a boolean (byte 0x02"},
+       pmu::v5::REJECTED, "confirm is not a boolean (byte 0x02"},
       {"confirm byte 0xFF", with(command("h-confirmff", CommandKind::Reset), [](auto& s) { s.confirm = 0xFF; }),
-       pmu::v4::REJECTED, "confirm is not a boolean (byte 0xFF"},
+       pmu::v5::REJECTED, "confirm is not a boolean (byte 0xFF"},
       {"enable byte 2", with(command("h-enable2", CommandKind::SetGeneration), [](auto& s) { s.enable = 2; }),
-       pmu::v4::REJECTED, "enable is not a boolean"},
-      {"T_U 0.0005 rounds to 0", set("h-tu", "upper_temperature_limit", 0.0005), pmu::v4::DENIED, "rule thermal_shutdown"},
-      {"T_U -0.0009 rounds to 0", set("h-tu2", "upper_temperature_limit", -0.0009), pmu::v4::DENIED,
+       pmu::v5::REJECTED, "enable is not a boolean"},
+      {"T_U 0.0005 rounds to 0", set("h-tu", "upper_temperature_limit", 0.0005), pmu::v5::DENIED, "rule thermal_shutdown"},
+      {"T_U -0.0009 rounds to 0", set("h-tu2", "upper_temperature_limit", -0.0009), pmu::v5::DENIED,
        "rule thermal_shutdown"},
-      {"S0 -0.0004 rounds to 0", set("h-s0", "power_up_state", -0.0004), pmu::v4::DENIED, "rule power_up_avionics_off"},
-      {"newline and escapes in the parameter", set("h-esc", "volts\n\x1b[2Jaudit: x", 1), pmu::v4::REJECTED,
+      {"S0 -0.0004 rounds to 0", set("h-s0", "power_up_state", -0.0004), pmu::v5::DENIED, "rule power_up_avionics_off"},
+      {"newline and escapes in the parameter", set("h-esc", "volts\n\x1b[2Jaudit: x", 1), pmu::v5::REJECTED,
        "unknown parameter 'volts\\x0A\\x1B[2Jaudit: x'"},
       {"expires_at 1", with(command("h-exp1", CommandKind::GetSerial), [](auto& s) { s.expires_at = 1; }),
-       pmu::v4::REJECTED, "expired"},
+       pmu::v5::REJECTED, "expired"},
       {"expired a second ago",
        with(command("h-exp-1s", CommandKind::GetSerial), [](auto& s) { s.expires_at = now_ns() - 1000000000ull; }),
-       pmu::v4::REJECTED, "expired"},
+       pmu::v5::REJECTED, "expired"},
       {"expires_at 2^63", with(command("h-exp63", CommandKind::GetSerial), [&](auto& s) { s.expires_at = far; }),
-       pmu::v4::COMPLETED, ""},
+       pmu::v5::COMPLETED, ""},
       {"expires_at 2^64-2", with(command("h-exp64-2", CommandKind::GetSerial), [](auto& s) { s.expires_at = ~0ull - 1; }),
-       pmu::v4::COMPLETED, ""},
+       pmu::v5::COMPLETED, ""},
       {"expires_at 2^64-1", with(command("h-exp64-1", CommandKind::GetSerial), [](auto& s) { s.expires_at = ~0ull; }),
-       pmu::v4::COMPLETED, ""},
+       pmu::v5::COMPLETED, ""},
       {"expires in 5 s",
        with(command("h-exp5", CommandKind::GetSerial), [](auto& s) { s.expires_at = now_ns() + 5000000000ull; }),
-       pmu::v4::COMPLETED, ""},
-      {"broadcast engine stop", command("h-stopall", CommandKind::EngineStop, 0xFFFF), pmu::v4::COMPLETED,
+       pmu::v5::COMPLETED, ""},
+      {"broadcast engine stop", command("h-stopall", CommandKind::EngineStop, 0xFFFF), pmu::v5::COMPLETED,
        "stop sent to every PMU"},
   };
   for (const auto& c : cases) {
@@ -289,7 +289,7 @@ TEST_F(Boundary, EveryHostileSampleGetsOneReplyWithAReasonAndTheServiceLivesOn) 
   peer_.send(long_id);
   const auto r = peer_.replies("h-longid-", 1);
   ASSERT_EQ(r.size(), 1u);
-  EXPECT_EQ(r[0].result(), pmu::v4::REJECTED);
+  EXPECT_EQ(r[0].result(), pmu::v5::REJECTED);
   EXPECT_NE(r[0].reason().to_string().find("request_id is 69 bytes long"), std::string::npos);
   // An empty id: one reply, REJECTED.
   peer_.send(command("", CommandKind::GetSerial));
@@ -305,7 +305,7 @@ TEST_F(Boundary, EveryHostileSampleGetsOneReplyWithAReasonAndTheServiceLivesOn) 
   count_empties();
   EXPECT_EQ(empties, 1u);
   // Still serving.
-  EXPECT_EQ(one_reply(set("h-after", "avionics_voltage", 20.0)).result(), pmu::v4::COMPLETED);
+  EXPECT_EQ(one_reply(set("h-after", "avionics_voltage", 20.0)).result(), pmu::v5::COMPLETED);
 }
 
 TEST_F(Boundary, NetworkTextCannotForgeTheServiceLog) {
@@ -313,7 +313,7 @@ TEST_F(Boundary, NetworkTextCannotForgeTheServiceLog) {
   s.bus = "s\naudit: FORGED";
   peer_.send(s);
   peer_.replies("x\n", 1);
-  EXPECT_EQ(one_reply(command("log-after", CommandKind::GetSerial)).result(), pmu::v4::COMPLETED);
+  EXPECT_EQ(one_reply(command("log-after", CommandKind::GetSerial)).result(), pmu::v5::COMPLETED);
   const std::string log = service_.log();
   EXPECT_NE(log.find("x\\x0A\\x1B[2Jaudit: FORGED command from nobody"), std::string::npos) << log;
   std::istringstream lines(log);
@@ -332,11 +332,11 @@ TEST_F(Boundary, DuplicatesAreKnownPerSenderAndAReusedIdIsRejected) {
   peer_.send(first);
   const auto both = peer_.replies("dup-1", 2);
   ASSERT_EQ(both.size(), 2u);
-  EXPECT_EQ(both[0].result(), pmu::v4::COMPLETED);
-  EXPECT_EQ(both[1].result(), pmu::v4::COMPLETED);
+  EXPECT_EQ(both[0].result(), pmu::v5::COMPLETED);
+  EXPECT_EQ(both[1].result(), pmu::v5::COMPLETED);
   // The same id with other content from the same sender: rejected, not the old reply.
   const auto reused = one_reply(set("dup-1", "avionics_voltage", 16.5));
-  EXPECT_EQ(reused.result(), pmu::v4::REJECTED);
+  EXPECT_EQ(reused.result(), pmu::v5::REJECTED);
   EXPECT_NE(reused.reason().to_string().find("was already used by this sender for another command"), std::string::npos)
       << reused.reason().to_string();
   // The same id from another sender: its own command, executed.
@@ -345,7 +345,7 @@ TEST_F(Boundary, DuplicatesAreKnownPerSenderAndAReusedIdIsRejected) {
   other.send(set("dup-1", "avionics_voltage", 16.5));
   const auto theirs = other.replies("dup-1", 1);
   ASSERT_EQ(theirs.size(), 1u);
-  EXPECT_EQ(theirs[0].result(), pmu::v4::COMPLETED) << theirs[0].reason().to_string();
+  EXPECT_EQ(theirs[0].result(), pmu::v5::COMPLETED) << theirs[0].reason().to_string();
   EXPECT_DOUBLE_EQ(theirs[0].value(), 16.5);
 
   // The audit lines reach the log file after the replies: wait until both executions and the
@@ -365,12 +365,12 @@ TEST_F(Boundary, DuplicatesAreKnownPerSenderAndAReusedIdIsRejected) {
   EXPECT_NE(log.find("audit: duplicate command dup-1"), std::string::npos) << log;
 }
 
-// A payload that is not a pmu::v4::Command (a look-alike type of the same name with another
+// A payload that is not a pmu::v5::Command (a look-alike type of the same name with another
 // layout, a truncated one, another encapsulation) cannot be answered: dropped and counted.
 class RawCommandType final : public TopicDataType {
  public:
   RawCommandType() {
-    setName("pmu::v4::Command");
+    setName("pmu::v5::Command");
     m_typeSize = 4096;
     m_isGetKeyDefined = false;
   }
@@ -399,13 +399,13 @@ TEST_F(Boundary, ALookAlikeTypeOrGarbageIsDroppedNeverFatal) {
         return p.current_count > 0;
       },
       5s);
-  // The fields of pmu::v4::Command in another order: kind and address first, then the strings.
+  // The fields of pmu::v5::Command in another order: kind and address first, then the strings.
   std::vector<std::uint8_t> reordered = {0, 1, 0, 0, /*kind*/ 7, 0, 0, 0, /*address*/ 1, 0, 0, 0,
                                          /*string length 1000*/ 0xE8, 0x03, 0, 0, 'x', 0};
   const auto valid = write_command_cdr(command("raw-valid", CommandKind::GetSerial));
   std::vector<std::uint8_t> truncated(valid.begin(), valid.begin() + 20);
   std::vector<std::uint8_t> xcdr2 = valid;
-  xcdr2[1] = 0x07;  // CDR2 little-endian: not what pmu::v4::Command's readers speak
+  xcdr2[1] = 0x07;  // CDR2 little-endian: not what pmu::v5::Command's readers speak
   std::vector<std::uint8_t> bool_two = write_command_cdr(command("raw-bool", CommandKind::EngineStart));
   bool_two.back() = 2;  // confirm = 2, which aborted the service before
   for (auto* bytes : {&reordered, &truncated, &xcdr2, &bool_two}) ASSERT_TRUE(w.write(bytes));
@@ -413,8 +413,8 @@ TEST_F(Boundary, ALookAlikeTypeOrGarbageIsDroppedNeverFatal) {
 
   const auto r = peer_.replies("raw-bool", 1);
   ASSERT_EQ(r.size(), 1u);
-  EXPECT_EQ(r[0].result(), pmu::v4::REJECTED);
-  EXPECT_EQ(one_reply(command("raw-after", CommandKind::GetSerial)).result(), pmu::v4::COMPLETED);
+  EXPECT_EQ(r[0].result(), pmu::v5::REJECTED);
+  EXPECT_EQ(one_reply(command("raw-after", CommandKind::GetSerial)).result(), pmu::v5::COMPLETED);
   ASSERT_TRUE(service_.alive());
   const std::string log = service_.log();
   EXPECT_NE(log.find("pmu/command: dropped"), std::string::npos) << log;
@@ -455,7 +455,7 @@ void burst(Service& service, std::vector<Peer*> peers, int per_peer) {
           const auto id = r.request_id().to_string();
           if (!sent.count(id)) continue;
           results[p][id].insert(static_cast<int>(r.result()));
-          if (r.result() != pmu::v4::COMPLETED) refusals[p][id] = r.reason().to_string();
+          if (r.result() != pmu::v5::COMPLETED) refusals[p][id] = r.reason().to_string();
         }
         if (results[p].size() == sent.size()) break;
         for (const auto& [id, c] : sent)
@@ -471,7 +471,7 @@ void burst(Service& service, std::vector<Peer*> peers, int per_peer) {
     const std::size_t ids = static_cast<std::size_t>(per_peer) + (p == 0 ? 1 : 0);  // + the stop
     EXPECT_EQ(results[p].size(), ids) << "peer " << p << ": ids answered";
     for (const auto& [id, seen] : results[p])
-      EXPECT_EQ(seen, std::set<int>{pmu::v4::COMPLETED}) << id << ": " << refusals[p][id];
+      EXPECT_EQ(seen, std::set<int>{pmu::v5::COMPLETED}) << id << ": " << refusals[p][id];
     std::size_t executed = 0;
     const std::string audit = "audit: command b" + std::to_string(p) + "-";
     for (auto at = log.find(audit); at != std::string::npos; at = log.find(audit, at + 1)) ++executed;
@@ -517,21 +517,21 @@ TEST_F(Boundary, FiftyThousandDistinctIdsAreAllAnsweredWithBoundedMemory) {
 // The readers of pmuctl (and any reader built on Guarded) survive what killed the service: a
 // CommandReply whose has_value byte is 2 makes the generated deserialize throw.
 TEST(GuardedType, AMalformedBooleanIsCountedNotThrown) {
-  pmu::v4::CommandReply reply;
+  pmu::v5::CommandReply reply;
   reply.request_id("r");
   reply.bus("b");
   reply.has_value(true);
-  pmu::v4::CommandReplyPubSubType plain;
+  pmu::v5::CommandReplyPubSubType plain;
   eprosima::fastrtps::rtps::SerializedPayload_t payload(1024);
   ASSERT_TRUE(plain.serialize(&reply, &payload));
   // Body offsets (after the 4-byte encapsulation): "r" 0..5, vehicle "" 8..12, "b" 16..21,
   // address 22, kind 24, result 28, reason "" 32..36, has_value 37.
   ASSERT_EQ(payload.data[4 + 37], 1);
   payload.data[4 + 37] = 2;
-  pmu::v4::CommandReply out;
+  pmu::v5::CommandReply out;
   EXPECT_ANY_THROW(plain.deserialize(&payload, &out));  // what the service and pmuctl met
 
-  pmu::idl::Guarded<pmu::v4::CommandReplyPubSubType> guarded;
+  pmu::idl::Guarded<pmu::v5::CommandReplyPubSubType> guarded;
   bool ok = true;
   EXPECT_NO_THROW(ok = guarded.deserialize(&payload, &out));
   EXPECT_FALSE(ok);

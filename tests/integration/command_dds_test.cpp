@@ -37,8 +37,8 @@ using namespace std::chrono_literals;
 struct Sender {
   Sender(int domain, const std::string& name)
       : dds(domain, "", name),
-        writer(dds.writer(dds.topic(topics::kCommand, TypeSupport(new pmu::v4::CommandPubSubType())), qos_profiles::kCommand)),
-        replies(dds.reader(dds.topic(topics::kCommandReply, TypeSupport(new pmu::v4::CommandReplyPubSubType())),
+        writer(dds.writer(dds.topic(topics::kCommand, TypeSupport(new pmu::v5::CommandPubSubType())), qos_profiles::kCommand)),
+        replies(dds.reader(dds.topic(topics::kCommandReply, TypeSupport(new pmu::v5::CommandReplyPubSubType())),
                            qos_profiles::kCommand)) {}
   bool matched() {
     PublicationMatchedStatus p;
@@ -51,14 +51,14 @@ struct Sender {
   // side is not enough). The probe's replies have the id `probe_id`, which no burst id starts
   // with.
   bool until_answered(const std::string& probe_id) {
-    pmu::v4::Command probe;
+    pmu::v5::Command probe;
     probe.request_id(probe_id);
     probe.bus("sim0");
     probe.address(1);
-    probe.kind(pmu::v4::GET_SERIAL);
+    probe.kind(pmu::v5::GET_SERIAL);
     return pmu::test::until_answered([&] { writer.write(&probe); },
                                      [&] {
-                                       pmu::v4::CommandReply r;
+                                       pmu::v5::CommandReply r;
                                        SampleInfo info;
                                        bool got = false;
                                        while (replies.take_next_sample(&r, &info) == ReturnCode_t::RETCODE_OK)
@@ -107,11 +107,11 @@ TEST(CommandsOverDds, TwoSendersBurst1000CommandsAndGetExactly1000Replies) {
   // The devices' start-up reading: over when each has published its configuration (a
   // session publishes pmu/config as it enters its running phase).
   DataReader& configs =
-      a.dds.reader(a.dds.topic(topics::kConfig, TypeSupport(new pmu::v4::ConfigPubSubType())), qos_profiles::kState);
+      a.dds.reader(a.dds.topic(topics::kConfig, TypeSupport(new pmu::v5::ConfigPubSubType())), qos_profiles::kState);
   std::set<unsigned> configured;
   ASSERT_TRUE(pmu::test::wait_until(
       [&] {
-        pmu::v4::Config c;
+        pmu::v5::Config c;
         SampleInfo i;
         while (configs.take_next_sample(&c, &i) == ReturnCode_t::RETCODE_OK)
           if (i.valid_data) configured.insert(c.address());
@@ -126,30 +126,30 @@ TEST(CommandsOverDds, TwoSendersBurst1000CommandsAndGetExactly1000Replies) {
   std::map<std::string, int> replies_a, replies_b;
   std::atomic<bool> done{false};
   auto collect = [&](Sender& s, std::map<std::string, int>& out, const std::string& prefix) {
-    pmu::v4::CommandReply r;
+    pmu::v5::CommandReply r;
     SampleInfo info;
     while (s.replies.take_next_sample(&r, &info) == ReturnCode_t::RETCODE_OK)
       if (info.valid_data && r.request_id().to_string().rfind(prefix, 0) == 0) ++out[r.request_id().to_string()];
   };
   auto send = [&](Sender& s, const std::string& prefix) {
     for (int i = 0; i < 500; ++i) {
-      pmu::v4::Command c;
+      pmu::v5::Command c;
       c.request_id(prefix + std::to_string(i));
       c.bus("sim0");
       c.address(static_cast<unsigned short>(1 + i % 2));
       switch (i % 4) {
         case 0:
-          c.kind(pmu::v4::SET_PARAMETER);
+          c.kind(pmu::v5::SET_PARAMETER);
           c.parameter("payload_voltage");
           c.value(i % 8 == 0 ? 30.0 : 12.0 + (i % 100) / 10.0);  // some out of range
           break;
-        case 1: c.kind(pmu::v4::GET_SERIAL); break;
+        case 1: c.kind(pmu::v5::GET_SERIAL); break;
         case 2:
-          c.kind(pmu::v4::ENABLE_OUTPUTS);
+          c.kind(pmu::v5::ENABLE_OUTPUTS);
           c.outputs(0x02);
           break;
         default:
-          c.kind(pmu::v4::GET);
+          c.kind(pmu::v5::GET);
           c.parameter("outputs");
       }
       s.writer.write(&c);

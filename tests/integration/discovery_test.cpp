@@ -67,7 +67,7 @@ ResolvedNetwork client_of(std::uint16_t port) {
 struct Side {
   Side(const std::string& name, const ResolvedNetwork& network, Transport transport = Transport::UdpOnly)
       : dds(pmu::test::exclusive_dds_domain(), "", name, {}, transport, network),
-        topic(dds.topic(topics::kVoltages, TypeSupport(new pmu::v4::VoltagesPubSubType()))) {}
+        topic(dds.topic(topics::kVoltages, TypeSupport(new pmu::v5::VoltagesPubSubType()))) {}
   DataWriter& writer() { return w ? *w : *(w = &dds.writer(topic, qos_profiles::kTelemetry)); }
   DataReader& reader() { return r ? *r : *(r = &dds.reader(topic, qos_profiles::kTelemetry)); }
   bool matched() {
@@ -89,14 +89,14 @@ struct Side {
 // Writes a sample every 50 ms until the reader has one (best effort: a sample written
 // before matching is lost, so keep writing).
 bool exchange(Side& pub, Side& sub, std::chrono::seconds timeout) {
-  pmu::v4::Voltages v;
+  pmu::v5::Voltages v;
   v.bus("sim0");
   v.address(1);
   v.avionics(12.5f);
   return pmu::test::wait_until(
       [&] {
         pub.writer().write(&v);
-        pmu::v4::Voltages got;
+        pmu::v5::Voltages got;
         SampleInfo info;
         while (sub.reader().take_next_sample(&got, &info) == ReturnCode_t::RETCODE_OK)
           if (info.valid_data && got.avionics() == 12.5f) return true;
@@ -224,15 +224,15 @@ TEST(DiscoveryServer, ALongLivedClientsEndedReadersAreUnmatchedAtTheOtherClients
   const std::uint16_t port = pmu::test::free_udp_port();
   Server server(0, port);
   DdsContext service(pmu::test::exclusive_dds_domain(), "", "ds-service", {}, Transport::UdpOnly, client_of(port));
-  Topic& voltages_topic = service.topic(topics::kVoltages, TypeSupport(new pmu::v4::VoltagesPubSubType()));
-  Topic& currents_topic = service.topic(topics::kCurrents, TypeSupport(new pmu::v4::CurrentsPubSubType()));
+  Topic& voltages_topic = service.topic(topics::kVoltages, TypeSupport(new pmu::v5::VoltagesPubSubType()));
+  Topic& currents_topic = service.topic(topics::kCurrents, TypeSupport(new pmu::v5::CurrentsPubSubType()));
   DataWriter& voltages = service.writer(voltages_topic, qos_profiles::kTelemetry);
   DataWriter& currents = service.writer(currents_topic, qos_profiles::kTelemetry);
 
   DdsContext agent(pmu::test::exclusive_dds_domain(), "", "ds-agent", {}, Transport::UdpOnly, client_of(port));
   agent.reuse_endpoints({qos_profiles::kCommand});
-  Topic& v_topic = agent.topic(topics::kVoltages, TypeSupport(new pmu::v4::VoltagesPubSubType()));
-  Topic& c_topic = agent.topic(topics::kCurrents, TypeSupport(new pmu::v4::CurrentsPubSubType()));
+  Topic& v_topic = agent.topic(topics::kVoltages, TypeSupport(new pmu::v5::VoltagesPubSubType()));
+  Topic& c_topic = agent.topic(topics::kCurrents, TypeSupport(new pmu::v5::CurrentsPubSubType()));
   DataReader* first_job_reader = nullptr;
   for (int job = 1; job <= 4; ++job) {
     const auto mark = agent.endpoint_mark();
@@ -248,7 +248,7 @@ TEST(DiscoveryServer, ALongLivedClientsEndedReadersAreUnmatchedAtTheOtherClients
         << "job " << job << ": the service's writers matched " << matched_readers(voltages) << " and "
         << matched_readers(currents) << " readers";
     // A sample the job leaves unread.
-    pmu::v4::Voltages sample;
+    pmu::v5::Voltages sample;
     sample.bus("sim0");
     sample.address(1);
     ASSERT_TRUE(pmu::test::wait_until([&] { voltages.write(&sample); return v.get_unread_count() > 0; }, 10s, 50ms));
@@ -263,8 +263,8 @@ TEST(DiscoveryServer, ALongLivedClientsEndedReadersAreUnmatchedAtTheOtherClients
   // A command reply reader stays matched between jobs (nothing flows to it unasked), and the
   // next job in the same partitions takes it up without waiting for a match.
   DataWriter& replies = service.writer(
-      service.topic(topics::kCommandReply, TypeSupport(new pmu::v4::CommandReplyPubSubType())), qos_profiles::kCommand);
-  Topic& r_topic = agent.topic(topics::kCommandReply, TypeSupport(new pmu::v4::CommandReplyPubSubType()));
+      service.topic(topics::kCommandReply, TypeSupport(new pmu::v5::CommandReplyPubSubType())), qos_profiles::kCommand);
+  Topic& r_topic = agent.topic(topics::kCommandReply, TypeSupport(new pmu::v5::CommandReplyPubSubType()));
   auto mark = agent.endpoint_mark();
   DataReader* reply_reader = &agent.reader(r_topic, qos_profiles::kCommand);
   ASSERT_TRUE(pmu::test::wait_until([&] { return matched_readers(replies) == 1; }, 20s, 20ms));
@@ -299,7 +299,7 @@ TEST(EndpointReuse, ACommandEndpointLeftMatchedForOneVehicleStaysThereWhileAnoth
   DdsContext uav1(domain, "", "reuse-uav1", {}, Transport::UdpOnly, network, Partitions{{"uav1"}, {"uav1"}});
   DdsContext uav2(domain, "", "reuse-uav2", {}, Transport::UdpOnly, network, Partitions{{"uav2"}, {"uav2"}});
   auto replies_of = [](DdsContext& dds) -> DataWriter& {
-    return dds.writer(dds.topic(topics::kCommandReply, TypeSupport(new pmu::v4::CommandReplyPubSubType())),
+    return dds.writer(dds.topic(topics::kCommandReply, TypeSupport(new pmu::v5::CommandReplyPubSubType())),
                       qos_profiles::kCommand);
   };
   DataWriter& replies1 = replies_of(uav1);
@@ -307,7 +307,7 @@ TEST(EndpointReuse, ACommandEndpointLeftMatchedForOneVehicleStaysThereWhileAnoth
 
   DdsContext agent(domain, "", "reuse-agent", {}, Transport::UdpOnly, network);
   agent.reuse_endpoints({qos_profiles::kCommand});
-  Topic& topic = agent.topic(topics::kCommandReply, TypeSupport(new pmu::v4::CommandReplyPubSubType()));
+  Topic& topic = agent.topic(topics::kCommandReply, TypeSupport(new pmu::v5::CommandReplyPubSubType()));
   auto job = [&](const std::string& vehicle) { return reply_reader_of_a_job(agent, topic, vehicle); };
   DataReader* for_uav1 = job("uav1");
   ASSERT_TRUE(pmu::test::wait_until([&] { return matched_readers(replies1) == 1; }, 20s, 20ms));
@@ -325,7 +325,7 @@ TEST(EndpointReuse, ACommandEndpointLeftMatchedForOneVehicleStaysThereWhileAnoth
 TEST(EndpointReuse, BeyondTheMostLeftMatchedTheLeastRecentlyUsedMoves) {
   DdsContext agent(pmu::test::exclusive_dds_domain(), "", "reuse-bound", {}, Transport::UdpOnly, unicast_to_loopback());
   agent.reuse_endpoints({qos_profiles::kCommand});
-  Topic& topic = agent.topic(topics::kCommandReply, TypeSupport(new pmu::v4::CommandReplyPubSubType()));
+  Topic& topic = agent.topic(topics::kCommandReply, TypeSupport(new pmu::v5::CommandReplyPubSubType()));
   auto job = [&](const std::string& vehicle) { return reply_reader_of_a_job(agent, topic, vehicle); };
   std::vector<DataReader*> made;
   for (std::size_t i = 0; i < DdsContext::kMostIdleMatched; ++i) made.push_back(job("uav" + std::to_string(i)));

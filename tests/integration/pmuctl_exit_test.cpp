@@ -171,9 +171,9 @@ TEST(PmuctlExit, NoReplyIsExitThreeWithOneJsonLine) {
   using namespace eprosima::fastdds::dds;
   const int domain = pmu::test::exclusive_dds_domain();
   pmu::dds::DdsContext silent(domain, PMU_QOS_FILE, "silent-service");
-  (void)silent.reader(silent.topic(pmu::topics::kCommand, TypeSupport(new pmu::v4::CommandPubSubType())),
+  (void)silent.reader(silent.topic(pmu::topics::kCommand, TypeSupport(new pmu::v5::CommandPubSubType())),
                       pmu::qos_profiles::kCommand);
-  (void)silent.writer(silent.topic(pmu::topics::kCommandReply, TypeSupport(new pmu::v4::CommandReplyPubSubType())),
+  (void)silent.writer(silent.topic(pmu::topics::kCommandReply, TypeSupport(new pmu::v5::CommandReplyPubSubType())),
                       pmu::qos_profiles::kCommand);
   // The timeout bounds the match with the silent service too: long enough for a loaded machine.
   const auto r = pmu::test::run_capture(pmuctl(domain) + "--timeout 8 --json --bus can0 --address 1 outputs get");
@@ -251,13 +251,13 @@ void expect_expiry_at_the_end_of_the_wait(const char* request_topic, const char*
 }
 
 TEST(PmuctlExpiry, ACommandExpiresWhenPmuctlStopsWaiting) {
-  expect_expiry_at_the_end_of_the_wait<pmu::v4::CommandPubSubType, pmu::v4::CommandReplyPubSubType, pmu::v4::Command>(
+  expect_expiry_at_the_end_of_the_wait<pmu::v5::CommandPubSubType, pmu::v5::CommandReplyPubSubType, pmu::v5::Command>(
       pmu::topics::kCommand, pmu::topics::kCommandReply, {"--bus", "can0", "--address", "1", "outputs", "get"});
 }
 
 TEST(PmuctlExpiry, AnAlarmAcknowledgementExpiresWhenPmuctlStopsWaiting) {
-  expect_expiry_at_the_end_of_the_wait<pmu::v4::AlarmAckPubSubType, pmu::v4::AlarmAckReplyPubSubType,
-                                       pmu::v4::AlarmAck>(pmu::topics::kAlarmAck, pmu::topics::kAlarmAckReply,
+  expect_expiry_at_the_end_of_the_wait<pmu::v5::AlarmAckPubSubType, pmu::v5::AlarmAckReplyPubSubType,
+                                       pmu::v5::AlarmAck>(pmu::topics::kAlarmAck, pmu::topics::kAlarmAckReply,
                                                           {"--bus", "can0", "alarms", "ack", "bus_off", "--kind", "bus"});
 }
 

@@ -45,11 +45,11 @@ ReadinessReport readiness(const std::string& code, const std::string& bus, const
 
 // The bytes of `raw`'s values serialized into a buffer of zeros: what the sample must be.
 std::vector<std::uint8_t> canonical(const RawSample& raw) {
-  pmu::v4::ReadinessPubSubType type;
+  pmu::v5::ReadinessPubSubType type;
   eprosima::fastrtps::rtps::SerializedPayload_t in(static_cast<std::uint32_t>(raw.bytes.size()));
   std::memcpy(in.data, raw.bytes.data(), raw.bytes.size());
   in.length = static_cast<std::uint32_t>(raw.bytes.size());
-  pmu::v4::Readiness sample;
+  pmu::v5::Readiness sample;
   if (!type.deserialize(&in, &sample)) return {};
   eprosima::fastrtps::rtps::SerializedPayload_t out(type.m_typeSize);
   std::memset(out.data, 0, out.max_size);
@@ -62,7 +62,7 @@ TEST(SampleBytes, ReadinessPaddingIsZerosAfterALongerSample) {
   DdsPublisher publisher(service_side, 3s, "uav1");
   dds::DdsContext client(pmu::test::exclusive_dds_domain(), "", "reader-test");
   DataReader& reader = client.reader(
-      client.topic(topics::kReadiness, TypeSupport(new RawSampleType<pmu::v4::ReadinessPubSubType>())),
+      client.topic(topics::kReadiness, TypeSupport(new RawSampleType<pmu::v5::ReadinessPubSubType>())),
       qos_profiles::kState);
 
   const auto long_one = readiness("battery_a_critical_voltage", "can_long_name", "battery A voltage critical: 18.2 V", 3);

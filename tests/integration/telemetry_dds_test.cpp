@@ -52,16 +52,16 @@ bool wait_sample(DataReader& r, T& out, SampleInfo& info, std::chrono::milliseco
 
 struct Readers {
   explicit Readers(dds::DdsContext& c)
-      : voltages(c.reader(c.topic(topics::kVoltages, TypeSupport(new pmu::v4::VoltagesPubSubType())), qos_profiles::kTelemetry)),
-        currents(c.reader(c.topic(topics::kCurrents, TypeSupport(new pmu::v4::CurrentsPubSubType())), qos_profiles::kTelemetry)),
-        energy(c.reader(c.topic(topics::kBatteryEnergy, TypeSupport(new pmu::v4::BatteryEnergyPubSubType())),
+      : voltages(c.reader(c.topic(topics::kVoltages, TypeSupport(new pmu::v5::VoltagesPubSubType())), qos_profiles::kTelemetry)),
+        currents(c.reader(c.topic(topics::kCurrents, TypeSupport(new pmu::v5::CurrentsPubSubType())), qos_profiles::kTelemetry)),
+        energy(c.reader(c.topic(topics::kBatteryEnergy, TypeSupport(new pmu::v5::BatteryEnergyPubSubType())),
                         qos_profiles::kTelemetry)),
-        temperatures(c.reader(c.topic(topics::kTemperatures, TypeSupport(new pmu::v4::TemperaturesPubSubType())),
+        temperatures(c.reader(c.topic(topics::kTemperatures, TypeSupport(new pmu::v5::TemperaturesPubSubType())),
                               qos_profiles::kTelemetry)),
-        status(c.reader(c.topic(topics::kStatus, TypeSupport(new pmu::v4::StatusPubSubType())), qos_profiles::kTelemetry)),
-        config(c.reader(c.topic(topics::kConfig, TypeSupport(new pmu::v4::ConfigPubSubType())), qos_profiles::kState)),
-        info(c.reader(c.topic(topics::kInfo, TypeSupport(new pmu::v4::DeviceInfoPubSubType())), qos_profiles::kState)),
-        health(c.reader(c.topic(topics::kHealth, TypeSupport(new pmu::v4::HealthPubSubType())), qos_profiles::kState)) {}
+        status(c.reader(c.topic(topics::kStatus, TypeSupport(new pmu::v5::StatusPubSubType())), qos_profiles::kTelemetry)),
+        config(c.reader(c.topic(topics::kConfig, TypeSupport(new pmu::v5::ConfigPubSubType())), qos_profiles::kState)),
+        info(c.reader(c.topic(topics::kInfo, TypeSupport(new pmu::v5::DeviceInfoPubSubType())), qos_profiles::kState)),
+        health(c.reader(c.topic(topics::kHealth, TypeSupport(new pmu::v5::HealthPubSubType())), qos_profiles::kState)) {}
   DataReader& voltages;
   DataReader& currents;
   DataReader& energy;
@@ -89,7 +89,7 @@ TEST(DdsTelemetry, EveryTopicArrivesWithTheSimulatorsValuesAndFrameTimestamps) {
   BusThread bus(h);
 
   SampleInfo si;
-  pmu::v4::Voltages v;
+  pmu::v5::Voltages v;
   ASSERT_TRUE(wait_sample(r.voltages, v, si, 10s));
   EXPECT_EQ(v.bus().to_string(), "sim0");
   EXPECT_EQ(v.address(), 1);
@@ -100,32 +100,32 @@ TEST(DdsTelemetry, EveryTopicArrivesWithTheSimulatorsValuesAndFrameTimestamps) {
   EXPECT_GE(si.source_timestamp.seconds(), 1700000000);
   EXPECT_LT(si.source_timestamp.seconds(), 1700000000 + 3600);
 
-  pmu::v4::Currents c;
+  pmu::v5::Currents c;
   ASSERT_TRUE(wait_sample(r.currents, c, si, 5s));
   EXPECT_FLOAT_EQ(c.payload(), static_cast<float>(expected.currents.payload));
-  pmu::v4::BatteryEnergy e;
+  pmu::v5::BatteryEnergy e;
   ASSERT_TRUE(wait_sample(r.energy, e, si, 5s));
-  pmu::v4::Temperatures t;
+  pmu::v5::Temperatures t;
   ASSERT_TRUE(wait_sample(r.temperatures, t, si, 5s));
   EXPECT_FLOAT_EQ(t.internal(), static_cast<float>(expected.temperatures.internal));
   EXPECT_TRUE(std::isnan(t.generator())) << "no generator sensor in the simulator: NaN";
-  pmu::v4::Status s;
+  pmu::v5::Status s;
   ASSERT_TRUE(wait_sample(r.status, s, si, 5s));
   EXPECT_TRUE(s.generation_enabled());
   EXPECT_TRUE(s.avionics_servo_on());
   EXPECT_GT(s.generator_rpm(), 0);
 
-  pmu::v4::Config cfg;
+  pmu::v5::Config cfg;
   ASSERT_TRUE(wait_sample(r.config, cfg, si, 5s));
   EXPECT_FLOAT_EQ(cfg.avionics_voltage(), 12.0f);
   EXPECT_FLOAT_EQ(cfg.packet_period(), 0.5f);
   EXPECT_EQ(cfg.can_address(), 1);
-  pmu::v4::DeviceInfo info;
+  pmu::v5::DeviceInfo info;
   ASSERT_TRUE(wait_sample(r.info, info, si, 5s));
   EXPECT_EQ(info.serial_number(), 4001);
   EXPECT_EQ(info.firmware_minor(), 17);
   EXPECT_EQ(info.features().size(), std::size(codec::kAllFeatures)) << "1.17 has every feature";
-  pmu::v4::Health hl;
+  pmu::v5::Health hl;
   ASSERT_TRUE(wait_sample(r.health, hl, si, 5s));
   EXPECT_EQ(hl.address(), 1);
 
@@ -148,28 +148,28 @@ TEST(DdsWriters, ReliableWritersHeartbeatNoMoreOftenThanTheLinkAllows) {
   const auto period_of = [](DataWriter& w) { return w.get_qos().reliable_writer_qos().times.heartbeatPeriod; };
   dds::DdsContext plain(pmu::test::exclusive_dds_domain(), "", "heartbeat-plain");
   const auto shipped =
-      period_of(plain.writer(plain.topic(topics::kHealth, TypeSupport(new pmu::v4::HealthPubSubType())), qos_profiles::kState));
+      period_of(plain.writer(plain.topic(topics::kHealth, TypeSupport(new pmu::v5::HealthPubSubType())), qos_profiles::kState));
   ASSERT_LT(shipped, eprosima::fastrtps::Duration_t(0, 900000000)) << "qos.xml's state period is not below the floor tested";
 
   dds::DdsContext radio(pmu::test::exclusive_dds_domain(), "", "heartbeat-radio");
   radio.heartbeat_at_least(900ms);
   auto& health =
-      radio.writer(radio.topic(topics::kHealth, TypeSupport(new pmu::v4::HealthPubSubType())), qos_profiles::kState);
+      radio.writer(radio.topic(topics::kHealth, TypeSupport(new pmu::v5::HealthPubSubType())), qos_profiles::kState);
   EXPECT_EQ(period_of(health), eprosima::fastrtps::Duration_t(0, 900000000));
   auto& replies = radio.writer(
-      radio.topic(topics::kCommandReply, TypeSupport(new pmu::v4::CommandReplyPubSubType())), qos_profiles::kCommand);
+      radio.topic(topics::kCommandReply, TypeSupport(new pmu::v5::CommandReplyPubSubType())), qos_profiles::kCommand);
   EXPECT_EQ(period_of(replies), eprosima::fastrtps::Duration_t(0, 900000000));
   // The rest of the profile is the profile's.
   EXPECT_EQ(health.get_qos().durability().kind, TRANSIENT_LOCAL_DURABILITY_QOS);
   EXPECT_EQ(health.get_qos().history().depth, 1);
   EXPECT_EQ(replies.get_qos().history().depth, 4096);
   auto& voltages =
-      radio.writer(radio.topic(topics::kVoltages, TypeSupport(new pmu::v4::VoltagesPubSubType())), qos_profiles::kTelemetry);
+      radio.writer(radio.topic(topics::kVoltages, TypeSupport(new pmu::v5::VoltagesPubSubType())), qos_profiles::kTelemetry);
   EXPECT_EQ(voltages.get_qos().reliability().kind, BEST_EFFORT_RELIABILITY_QOS);
   // A floor below the profile's period leaves it.
   dds::DdsContext lan(pmu::test::exclusive_dds_domain(), "", "heartbeat-lan");
   lan.heartbeat_at_least(1ms);
-  EXPECT_EQ(period_of(lan.writer(lan.topic(topics::kHealth, TypeSupport(new pmu::v4::HealthPubSubType())), qos_profiles::kState)),
+  EXPECT_EQ(period_of(lan.writer(lan.topic(topics::kHealth, TypeSupport(new pmu::v5::HealthPubSubType())), qos_profiles::kState)),
             shipped);
 }
 
@@ -179,7 +179,7 @@ TEST(DdsTelemetry, RateFollowsThePacketPeriod) {
   dds::DdsContext client(pmu::test::exclusive_dds_domain(), "", "reader-rate");
   Readers r(client);
   Harness h(sim_bus({device(1)}), {pmu(1, codec::kCurrentFirmware, 2)}, Timeouts{}, &publisher);  // PP 0.2 s
-  pmu::v4::Voltages v;
+  pmu::v5::Voltages v;
   SampleInfo si;
   std::set<std::int64_t> stamps;
   {
@@ -278,7 +278,7 @@ TEST(CrossProcess, AContextWhoseReaderNeverAcknowledgedIsDestroyedPromptly) {
   auto dds = std::make_unique<dds::DdsContext>(domain, qos, "unacked-writer");
   ::unlink(qos.c_str());  // loaded
   DataWriter& w =
-      dds->writer(dds->topic(topics::kCommand, TypeSupport(new pmu::v4::CommandPubSubType())), "unacked-1ms-heartbeat");
+      dds->writer(dds->topic(topics::kCommand, TypeSupport(new pmu::v5::CommandPubSubType())), "unacked-1ms-heartbeat");
   ASSERT_TRUE(pmu::test::wait_until(
       [&] {
         PublicationMatchedStatus m;
@@ -288,7 +288,7 @@ TEST(CrossProcess, AContextWhoseReaderNeverAcknowledgedIsDestroyedPromptly) {
       20s))
       << "pmu-service's command reader never matched";
   ASSERT_TRUE(service.signal(SIGSTOP));
-  pmu::v4::Command c;
+  pmu::v5::Command c;
   c.bus("nowhere");
   for (int i = 0; i < 4096; ++i) {
     c.request_id("unacked-" + std::to_string(i));

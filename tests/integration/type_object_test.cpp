@@ -195,7 +195,7 @@ std::set<std::string> service_writer_topics(ToolParticipant& tool, const std::ve
   return found;
 }
 
-// The contract's fields of pmu::v4::Voltages in order (interface.md 1.3): keys first.
+// The contract's fields of pmu::v5::Voltages in order (interface.md 1.3): keys first.
 const std::vector<std::string> kVoltagesFields = {"vehicle",  "bus",       "address",   "avionics", "output_28v",
                                                   "payload",  "servo",     "battery_a", "battery_b", "generator"};
 
@@ -224,7 +224,7 @@ TEST(TypeObject, ReaderBuiltFromTheDiscoveredTypeDecodesVoltages) {
   EXPECT_EQ(tool.discovery().topics_with_types(), self_contained);
 
   // The type as the tools show it: its name, the contract's field names in order, the keys.
-  EXPECT_EQ(type->get_name(), "pmu::v4::Voltages");
+  EXPECT_EQ(type->get_name(), "pmu::v5::Voltages");
   std::map<types::MemberId, types::DynamicTypeMember*> members;
   type->get_all_members(members);
   std::vector<std::string> names;

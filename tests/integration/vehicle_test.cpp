@@ -45,11 +45,11 @@ std::unique_ptr<VehicleService> vehicle_service(int domain, const std::string& v
 struct Ground {
   Ground(int domain, const std::string& name, dds::Partitions partitions)
       : dds(domain, "", name, {}, dds::Transport::Default, {}, std::move(partitions)),
-        writer(dds.writer(dds.topic(topics::kCommand, TypeSupport(new pmu::v4::CommandPubSubType())), qos_profiles::kCommand)),
-        replies(dds.reader(dds.topic(topics::kCommandReply, TypeSupport(new pmu::v4::CommandReplyPubSubType())),
+        writer(dds.writer(dds.topic(topics::kCommand, TypeSupport(new pmu::v5::CommandPubSubType())), qos_profiles::kCommand)),
+        replies(dds.reader(dds.topic(topics::kCommandReply, TypeSupport(new pmu::v5::CommandReplyPubSubType())),
                            qos_profiles::kCommand)),
-        configs(dds.reader(dds.topic(topics::kConfig, TypeSupport(new pmu::v4::ConfigPubSubType())), qos_profiles::kState)),
-        voltages(dds.reader(dds.topic(topics::kVoltages, TypeSupport(new pmu::v4::VoltagesPubSubType())),
+        configs(dds.reader(dds.topic(topics::kConfig, TypeSupport(new pmu::v5::ConfigPubSubType())), qos_profiles::kState)),
+        voltages(dds.reader(dds.topic(topics::kVoltages, TypeSupport(new pmu::v5::VoltagesPubSubType())),
                             qos_profiles::kTelemetry)) {}
 
   std::size_t command_readers() {
@@ -58,21 +58,21 @@ struct Ground {
     return static_cast<std::size_t>(p.current_count);
   }
   std::string send(const std::string& id, const std::string& vehicle, double payload_voltage) {
-    pmu::v4::Command c;
+    pmu::v5::Command c;
     c.request_id(id);
     c.vehicle(vehicle);
     c.bus("sim0");
     c.address(1);
-    c.kind(pmu::v4::SET_PARAMETER);
+    c.kind(pmu::v5::SET_PARAMETER);
     c.parameter("payload_voltage");
     c.value(payload_voltage);
     EXPECT_TRUE(writer.write(&c));
     return id;
   }
   // Replies so far, by request id, but those to probes.
-  std::vector<pmu::v4::CommandReply> take_replies() {
-    std::vector<pmu::v4::CommandReply> out;
-    pmu::v4::CommandReply r;
+  std::vector<pmu::v5::CommandReply> take_replies() {
+    std::vector<pmu::v5::CommandReply> out;
+    pmu::v5::CommandReply r;
     SampleInfo info;
     while (replies.take_next_sample(&r, &info) == ReturnCode_t::RETCODE_OK)
       if (info.valid_data) {
@@ -86,13 +86,13 @@ struct Ground {
   // Until `vehicle`'s service has answered this station (support/answered.hpp says why
   // matching on this side is not enough); what the probe reads changes nothing.
   bool answered_by(const std::string& vehicle) {
-    pmu::v4::Command c;
+    pmu::v5::Command c;
     c.request_id(std::string(kProbe) + vehicle);
     c.vehicle(vehicle);
     c.bus("sim0");
     c.address(1);
-    c.kind(pmu::v4::GET_SERIAL);
-    std::vector<pmu::v4::CommandReply> others;
+    c.kind(pmu::v5::GET_SERIAL);
+    std::vector<pmu::v5::CommandReply> others;
     const bool ok = pmu::test::until_answered([&] { writer.write(&c); },
                                               [&] {
                                                 for (auto& r : take_replies()) others.push_back(r);
@@ -118,8 +118,8 @@ struct Ground {
   bool probes_answered = false;
 
   // Replies as soon as at least one came, or none after `timeout`.
-  std::vector<pmu::v4::CommandReply> first_replies(std::chrono::seconds timeout) {
-    std::vector<pmu::v4::CommandReply> got;
+  std::vector<pmu::v5::CommandReply> first_replies(std::chrono::seconds timeout) {
+    std::vector<pmu::v5::CommandReply> got;
     pmu::test::wait_until(
         [&] {
           for (auto& r : take_replies()) got.push_back(r);
@@ -157,7 +157,7 @@ class Vehicles : public ::testing::Test {
     std::set<std::string> configured;
     ASSERT_TRUE(pmu::test::wait_until(
         [&] {
-          pmu::v4::Config c;
+          pmu::v5::Config c;
           SampleInfo i;
           while (watcher.configs.take_next_sample(&c, &i) == ReturnCode_t::RETCODE_OK)
             if (i.valid_data) configured.insert(c.vehicle().to_string());
@@ -181,11 +181,11 @@ TEST_F(Vehicles, AGroundStationWithDefaultSettingsSeesEveryVehicleAndWhichSample
   std::set<std::string> config_vehicles, voltage_vehicles;
   ASSERT_TRUE(pmu::test::wait_until(
       [&] {
-        pmu::v4::Config c;
+        pmu::v5::Config c;
         SampleInfo i;
         while (g.configs.take_next_sample(&c, &i) == ReturnCode_t::RETCODE_OK)
           if (i.valid_data && c.bus().to_string() == "sim0" && c.address() == 1) config_vehicles.insert(c.vehicle().to_string());
-        pmu::v4::Voltages v;
+        pmu::v5::Voltages v;
         while (g.voltages.take_next_sample(&v, &i) == ReturnCode_t::RETCODE_OK)
           if (i.valid_data) voltage_vehicles.insert(v.vehicle().to_string());
         return config_vehicles.size() == 3 && voltage_vehicles.size() == 3;
@@ -200,7 +200,7 @@ TEST_F(Vehicles, AGroundStationWithDefaultSettingsSeesEveryVehicleAndWhichSample
   std::set<std::string> late_vehicles;
   EXPECT_TRUE(pmu::test::wait_until(
       [&] {
-        pmu::v4::Config c;
+        pmu::v5::Config c;
         SampleInfo i;
         while (late.configs.take_next_sample(&c, &i) == ReturnCode_t::RETCODE_OK)
           if (i.valid_data) late_vehicles.insert(c.vehicle().to_string());
@@ -223,7 +223,7 @@ TEST_F(Vehicles, ACommandReachesOnlyItsVehicleWhichGivesTheOneReply) {
   for (auto& r : g.take_replies()) replies.push_back(r);
   ASSERT_EQ(replies.size(), 1u);
   EXPECT_EQ(replies[0].vehicle().to_string(), "uav1");
-  EXPECT_EQ(replies[0].result(), pmu::v4::COMPLETED) << replies[0].reason();
+  EXPECT_EQ(replies[0].result(), pmu::v5::COMPLETED) << replies[0].reason();
   EXPECT_NE(services_["uav1"]->parameter(codec::Parameter::PayloadVoltage), before_uav1);
   EXPECT_EQ(services_[""]->parameter(codec::Parameter::PayloadVoltage), before_unnamed);
   EXPECT_EQ(services_["uav2"]->parameter(codec::Parameter::PayloadVoltage), before_uav2);
@@ -240,7 +240,7 @@ TEST_F(Vehicles, TheUnnamedVehicleIsCommandedAsBeforeVehiclesExisted) {
   auto replies = g.first_replies(20s);
   ASSERT_FALSE(replies.empty()) << "no reply";
   EXPECT_EQ(replies[0].vehicle().to_string(), "");
-  EXPECT_EQ(replies[0].result(), pmu::v4::COMPLETED) << replies[0].reason();
+  EXPECT_EQ(replies[0].result(), pmu::v5::COMPLETED) << replies[0].reason();
   EXPECT_NE(services_[""]->parameter(codec::Parameter::PayloadVoltage), before);
 }
 
@@ -285,7 +285,7 @@ TEST(VehiclesEarlyPeer, AWildcardWriterFoundBeforeTheCommandEndpointExistedIsSti
   // The start-up reading must be over, so that a command let through would be executed.
   ASSERT_TRUE(pmu::test::wait_until(
       [&] {
-        pmu::v4::Config c;
+        pmu::v5::Config c;
         SampleInfo i;
         return wildcard.configs.take_next_sample(&c, &i) == ReturnCode_t::RETCODE_OK && i.valid_data;
       },

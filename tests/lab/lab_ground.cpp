@@ -1,6 +1,6 @@
 // lab_ground: the ground station of the network lab (tests/lab/README.md).
 //
-// One DDS participant that sends batches of pmu::v4::Command to pmu-service and correlates
+// One DDS participant that sends batches of pmu::v5::Command to pmu-service and correlates
 // the replies by request id, the way a ground-station bridge would over a lossy radio link:
 //   - at most `window` requests in flight (pipelined), each with a unique id `<tag>-<n>`;
 //   - a request without a final reply `resend` s after it was last sent is written again
@@ -76,9 +76,9 @@ double boottime() {
 
 double seconds_between(Clock::time_point a, Clock::time_point b) { return std::chrono::duration<double>(b - a).count(); }
 
-// The service's names for its results; pmu::v4::CommandResult has the same order (static_assert
+// The service's names for its results; pmu::v5::CommandResult has the same order (static_assert
 // in dds/src/dds_commands.cpp). The names are literals, so data() ends in NUL.
-const char* result_name(pmu::v4::CommandResult r) {
+const char* result_name(pmu::v5::CommandResult r) {
   return pmu::service::to_string(static_cast<pmu::service::CommandResult>(r)).data();
 }
 
@@ -112,13 +112,13 @@ struct BatchSpec {
 // What the client knows of one request id.
 struct Request {
   std::string tag;  // its batch
-  pmu::v4::Command command;
+  pmu::v5::Command command;
   Clock::time_point first_send;
   Clock::time_point last_send;
   int sends = 0;
   enum class State { Open, Answered, GivenUp } state = State::Open;
   bool client_timeout = false;  // given up after the batch's timeout (not at its deadline)
-  std::optional<pmu::v4::CommandReply> reply;
+  std::optional<pmu::v5::CommandReply> reply;
   double rtt = 0;  // s, first send to final reply
 };
 
@@ -129,9 +129,9 @@ class Ground : public DataWriterListener, public DataReaderListener {
       : dds_(domain, qos_file, "lab_ground", {}, transport), bus_(std::move(bus)), address_(address) {
     // The reader first: a reply can then never come before the reader exists.
     replies_ = &dds_.reader(dds_.topic(pmu::topics::kCommandReply,
-                                       TypeSupport(new pmu::idl::Guarded<pmu::v4::CommandReplyPubSubType>())),
+                                       TypeSupport(new pmu::idl::Guarded<pmu::v5::CommandReplyPubSubType>())),
                             pmu::qos_profiles::kCommand, this);
-    writer_ = &dds_.writer(dds_.topic(pmu::topics::kCommand, TypeSupport(new pmu::v4::CommandPubSubType())),
+    writer_ = &dds_.writer(dds_.topic(pmu::topics::kCommand, TypeSupport(new pmu::v5::CommandPubSubType())),
                            pmu::qos_profiles::kCommand, this);
   }
   ~Ground() override {
@@ -157,7 +157,7 @@ class Ground : public DataWriterListener, public DataReaderListener {
     wake_.notify_all();
   }
   void on_data_available(DataReader* reader) override {
-    pmu::v4::CommandReply r;
+    pmu::v5::CommandReply r;
     SampleInfo info;
     while (reader->take_next_sample(&r, &info) == ReturnCode_t::RETCODE_OK) {
       if (info.valid_data) on_reply(r);
@@ -166,8 +166,8 @@ class Ground : public DataWriterListener, public DataReaderListener {
 
  private:
   bool matched() const { return writer_matched_ > 0 && reader_matched_ > 0; }
-  void on_reply(const pmu::v4::CommandReply& r);
-  pmu::v4::Command make(const BatchSpec& spec, long n) const;
+  void on_reply(const pmu::v5::CommandReply& r);
+  pmu::v5::Command make(const BatchSpec& spec, long n) const;
   void send(Request& q, Clock::time_point now);
 
   pmu::dds::DdsContext dds_;
@@ -184,12 +184,12 @@ class Ground : public DataWriterListener, public DataReaderListener {
   std::map<std::string, int> duplicates_;    // per batch tag
 };
 
-pmu::v4::Command Ground::make(const BatchSpec& spec, long n) const {
-  pmu::v4::Command c;
+pmu::v5::Command Ground::make(const BatchSpec& spec, long n) const {
+  pmu::v5::Command c;
   c.request_id(spec.tag + "-" + std::to_string(n));
   c.bus(bus_);
   c.address(address_);
-  c.kind(pmu::v4::SET_PARAMETER);
+  c.kind(pmu::v5::SET_PARAMETER);
   c.parameter(spec.parameter);
   c.value(spec.values[static_cast<std::size_t>(n - 1) % spec.values.size()]);
   c.confirm(false);
@@ -213,8 +213,8 @@ void Ground::send(Request& q, Clock::time_point now) {
     emit({{"event", "write_failed"}, {"id", q.command.request_id().to_string()}, {"t", boottime()}});
 }
 
-void Ground::on_reply(const pmu::v4::CommandReply& r) {
-  if (r.result() == pmu::v4::IN_PROGRESS) return;  // not final (engine start); never sent here
+void Ground::on_reply(const pmu::v5::CommandReply& r) {
+  if (r.result() == pmu::v5::IN_PROGRESS) return;  // not final (engine start); never sent here
   const std::string id = r.request_id().to_string();
   std::lock_guard<std::mutex> lock(mutex_);
   auto it = requests_.find(id);
@@ -291,7 +291,7 @@ Json Ground::run(const BatchSpec& spec) {
                            : start;
     };
     while (static_cast<int>(open.size()) < spec.window && next <= spec.count && now >= slot(next)) {
-      pmu::v4::Command c = make(spec, next++);
+      pmu::v5::Command c = make(spec, next++);
       const std::string id = c.request_id().to_string();
       auto [it, fresh] = requests_.try_emplace(id);
       if (!fresh) {  // a tag used twice would make a resend out of a new command: refuse it
@@ -344,7 +344,7 @@ Json Ground::run(const BatchSpec& spec) {
     ++finals;
     ++results[result_name(q.reply->result())];
     rtts.push_back(q.rtt * 1000.0);
-    if (q.reply->result() == pmu::v4::COMPLETED &&
+    if (q.reply->result() == pmu::v5::COMPLETED &&
         (!q.reply->has_value() || std::fabs(q.reply->value() - q.command.value()) > 1e-3))
       value_mismatch.push_back(id);
   }

@@ -19,8 +19,19 @@ node "$MCAP_TESTS_DIR/compare_decode.mjs" "$work/stream.jsonl" "$work/decode.jso
 node "$MCAP_TESTS_DIR/check_schemas.mjs" "$work/every.mcap"
 tail -1 "$work/indexed.jsonl" | grep -q '"statistics":{"message_count":"5"' || { echo "FAIL: summary"; tail -1 "$work/indexed.jsonl"; exit 1; }
 schemas=$(grep -o '"schema":"[^"]*"' "$work/indexed.jsonl" | sort -u | tr '\n' ' ')
-[ "$schemas" = '"schema":"pmu::v4::BatteryEnergy" "schema":"pmu::v4::Currents" "schema":"pmu::v4::Status" "schema":"pmu::v4::Temperatures" "schema":"pmu::v4::Voltages" ' ] \
+[ "$schemas" = '"schema":"pmu::v5::BatteryEnergy" "schema":"pmu::v5::Currents" "schema":"pmu::v5::Status" "schema":"pmu::v5::Temperatures" "schema":"pmu::v5::Voltages" ' ] \
   || { echo "FAIL: schema names $schemas"; exit 1; }
+
+# "No reading" (generator rpm 0xFFFF on the wire) is NaN in the sample (docs/interface.md 1.1),
+# which omgidl decodes as NaN and JSON prints as null; a reading stays a number.
+printf '(1700000000.000000) can0 1E040001#FFFFD08003\n(1700000000.010000) can0 1E040002#0FA0D08003\n' > "$work/rpm.log"
+"$PMUCTL" decode --mcap "$work/rpm.mcap" "$work/rpm.log"
+read_mcap "$work/rpm.mcap" > "$work/rpm.jsonl"
+node -e '
+  const lines = require("fs").readFileSync(process.argv[1], "utf8").split("\n").filter(Boolean).map(JSON.parse);
+  const rpm = Object.fromEntries(lines.filter((l) => l.topic === "pmu/status").map((l) => [l.values.address, l.values.generator_rpm]));
+  if (rpm[1] !== null || rpm[2] !== 4000) { console.error("FAIL: generator_rpm " + JSON.stringify(rpm)); process.exit(1); }
+' "$work/rpm.jsonl"
 
 # Undecodable lines are named (FILE:LINE: reason) and the rest is written.
 "$PMUCTL" decode --mcap "$work/bad.mcap" "$DATA/bad_lines.log" 2> "$work/err" || { echo "FAIL: bad_lines.log: $(cat "$work/err")"; exit 1; }

@@ -35,22 +35,22 @@ const problem = (p) => problems.push(p);
 
 // The topics `pmuctl record` records by default (docs/interface.md section 9.1), and so serve.
 const defaultTopics = {
-  "pmu/voltages": "pmu::v4::Voltages",
-  "pmu/currents": "pmu::v4::Currents",
-  "pmu/battery_energy": "pmu::v4::BatteryEnergy",
-  "pmu/temperatures": "pmu::v4::Temperatures",
-  "pmu/status": "pmu::v4::Status",
-  "pmu/config": "pmu::v4::Config",
-  "pmu/info": "pmu::v4::DeviceInfo",
-  "pmu/health": "pmu::v4::Health",
-  "pmu/battery": "pmu::v4::Battery",
-  "pmu/battery_cells": "pmu::v4::BatteryCells",
-  "pmu/mppt": "pmu::v4::Mppt",
-  "pmu/alarms": "pmu::v4::Alarm",
-  "pmu/readiness": "pmu::v4::Readiness",
-  "pmu/energy": "pmu::v4::Energy",
-  "pmu/bms_energy": "pmu::v4::BmsEnergy",
-  "pmu/baseline": "pmu::v4::Baseline",
+  "pmu/voltages": "pmu::v5::Voltages",
+  "pmu/currents": "pmu::v5::Currents",
+  "pmu/battery_energy": "pmu::v5::BatteryEnergy",
+  "pmu/temperatures": "pmu::v5::Temperatures",
+  "pmu/status": "pmu::v5::Status",
+  "pmu/config": "pmu::v5::Config",
+  "pmu/info": "pmu::v5::DeviceInfo",
+  "pmu/health": "pmu::v5::Health",
+  "pmu/battery": "pmu::v5::Battery",
+  "pmu/battery_cells": "pmu::v5::BatteryCells",
+  "pmu/mppt": "pmu::v5::Mppt",
+  "pmu/alarms": "pmu::v5::Alarm",
+  "pmu/readiness": "pmu::v5::Readiness",
+  "pmu/energy": "pmu::v5::Energy",
+  "pmu/bms_energy": "pmu::v5::BmsEnergy",
+  "pmu/baseline": "pmu::v5::Baseline",
 };
 
 // float32 on the wire: the shortest decimal that is the same float32, as pmuctl prints it.

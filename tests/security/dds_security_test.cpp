@@ -96,24 +96,24 @@ struct Client {
       : dds(domain, "", name, files, dds::Transport::UdpOnly, {}, partitions) {}
   DataReader& voltages() {
     if (!voltages_)
-      voltages_ = &dds.reader(dds.topic(topics::kVoltages, TypeSupport(new pmu::v4::VoltagesPubSubType())),
+      voltages_ = &dds.reader(dds.topic(topics::kVoltages, TypeSupport(new pmu::v5::VoltagesPubSubType())),
                               qos_profiles::kTelemetry);
     return *voltages_;
   }
   DataReader& config() {
     if (!config_)
-      config_ = &dds.reader(dds.topic(topics::kConfig, TypeSupport(new pmu::v4::ConfigPubSubType())), qos_profiles::kState);
+      config_ = &dds.reader(dds.topic(topics::kConfig, TypeSupport(new pmu::v5::ConfigPubSubType())), qos_profiles::kState);
     return *config_;
   }
   DataWriter& commands() {
     if (!commands_)
-      commands_ = &dds.writer(dds.topic(topics::kCommand, TypeSupport(new pmu::v4::CommandPubSubType())),
+      commands_ = &dds.writer(dds.topic(topics::kCommand, TypeSupport(new pmu::v5::CommandPubSubType())),
                               qos_profiles::kCommand);
     return *commands_;
   }
   DataReader& replies() {
     if (!replies_)
-      replies_ = &dds.reader(dds.topic(topics::kCommandReply, TypeSupport(new pmu::v4::CommandReplyPubSubType())),
+      replies_ = &dds.reader(dds.topic(topics::kCommandReply, TypeSupport(new pmu::v5::CommandReplyPubSubType())),
                              qos_profiles::kCommand);
     return *replies_;
   }
@@ -145,13 +145,13 @@ bool wait_sample(DataReader& r, std::chrono::milliseconds timeout) {
   return pmu::test::wait_until([&] { return take_all<T>(r) > 0; }, timeout, 20ms);
 }
 
-pmu::v4::Command command(const std::string& id, const std::string& bus = "sim0", const std::string& vehicle = "") {
-  pmu::v4::Command c;
+pmu::v5::Command command(const std::string& id, const std::string& bus = "sim0", const std::string& vehicle = "") {
+  pmu::v5::Command c;
   c.request_id(id);
   c.vehicle(vehicle);
   c.bus(bus);
   c.address(1);
-  c.kind(pmu::v4::DISABLE_OUTPUTS);  // switch the payload off
+  c.kind(pmu::v5::DISABLE_OUTPUTS);  // switch the payload off
   c.outputs(kPayload);
   const auto expires = std::chrono::system_clock::now() + 10s;
   c.expires_at(static_cast<unsigned long long>(
@@ -159,14 +159,14 @@ pmu::v4::Command command(const std::string& id, const std::string& bus = "sim0",
   return c;
 }
 
-std::optional<pmu::v4::CommandReply> wait_reply(DataReader& r, const std::string& id, std::chrono::milliseconds timeout) {
-  std::optional<pmu::v4::CommandReply> found;
+std::optional<pmu::v5::CommandReply> wait_reply(DataReader& r, const std::string& id, std::chrono::milliseconds timeout) {
+  std::optional<pmu::v5::CommandReply> found;
   pmu::test::wait_until(
       [&] {
-        pmu::v4::CommandReply reply;
+        pmu::v5::CommandReply reply;
         SampleInfo info;
         while (r.take_next_sample(&reply, &info) == ReturnCode_t::RETCODE_OK)
-          if (info.valid_data && reply.request_id().to_string() == id && reply.result() != pmu::v4::IN_PROGRESS) {
+          if (info.valid_data && reply.request_id().to_string() == id && reply.result() != pmu::v5::IN_PROGRESS) {
             found = reply;
             return true;
           }
@@ -178,8 +178,8 @@ std::optional<pmu::v4::CommandReply> wait_reply(DataReader& r, const std::string
 
 // Sends `c`, and again with the same id once a second while no final reply came, as pmuctl
 // does (support/answered.hpp says why this side's match is not enough): its final reply.
-std::optional<pmu::v4::CommandReply> send_until_answered(Client& gs, pmu::v4::Command c, std::chrono::seconds within) {
-  std::optional<pmu::v4::CommandReply> reply;
+std::optional<pmu::v5::CommandReply> send_until_answered(Client& gs, pmu::v5::Command c, std::chrono::seconds within) {
+  std::optional<pmu::v5::CommandReply> reply;
   const std::string id = c.request_id().to_string();
   (void)pmu::test::until_answered([&] { EXPECT_TRUE(gs.commands().write(&c)); },
                                   [&] { return (reply = wait_reply(gs.replies(), id, 0ms)).has_value(); }, within);
@@ -213,7 +213,7 @@ void expect_ground_station_commands(ServiceUnderTest& svc, Client& gs, const std
                       << writer.current_count << " readers, reply reader " << reader.current_count << " writers)";
   const auto reply = send_until_answered(gs, command(id, "sim0", vehicle), 10s);
   ASSERT_TRUE(reply.has_value()) << "no reply to " << id;
-  EXPECT_EQ(reply->result(), pmu::v4::COMPLETED) << reply->reason();
+  EXPECT_EQ(reply->result(), pmu::v5::COMPLETED) << reply->reason();
   EXPECT_EQ(svc.outputs() & kPayload, 0) << "the payload output is still on";
 }
 
@@ -232,9 +232,9 @@ Intrusion intrude(ServiceUnderTest& svc, Client& intruder, Client& good) {
   Intrusion r;
   DataReader& stolen = intruder.voltages();
   DataWriter& writer = intruder.commands();
-  EXPECT_TRUE(wait_sample<pmu::v4::Voltages>(good.voltages(), 20s)) << "the legitimate reader got no telemetry: "
+  EXPECT_TRUE(wait_sample<pmu::v5::Voltages>(good.voltages(), 20s)) << "the legitimate reader got no telemetry: "
                                                                    "the service is not reachable at all";
-  EXPECT_TRUE(wait_sample<pmu::v4::Config>(good.config(), 10s)) << "no pmu/config: the service's start-up is not done";
+  EXPECT_TRUE(wait_sample<pmu::v5::Config>(good.config(), 10s)) << "no pmu/config: the service's start-up is not done";
   // Meant to let time pass (kept as it was): the intruder's discovery and handshake attempts
   // run before the "before" figures are taken; there is nothing to wait for, since it must
   // NOT match.
@@ -242,14 +242,14 @@ Intrusion intrude(ServiceUnderTest& svc, Client& intruder, Client& good) {
   const std::uint64_t handled_before = svc.handled();
   const std::uint8_t outputs_before = svc.outputs();
   EXPECT_NE(outputs_before & kPayload, 0) << "the payload must be on for the test to mean anything";
-  r.stolen_samples = take_all<pmu::v4::Voltages>(stolen);
+  r.stolen_samples = take_all<pmu::v5::Voltages>(stolen);
   for (int i = 0; i < 20; ++i) {
-    pmu::v4::Command c = command("intruder-" + std::to_string(i));
+    pmu::v5::Command c = command("intruder-" + std::to_string(i));
     writer.write(&c);
     // Meant to let time pass: 20 x 200 ms = the 4 s of intrusion; nothing must happen in them.
     std::this_thread::sleep_for(200ms);
-    r.stolen_samples += take_all<pmu::v4::Voltages>(stolen);
-    r.good_samples += take_all<pmu::v4::Voltages>(good.voltages());
+    r.stolen_samples += take_all<pmu::v5::Voltages>(stolen);
+    r.good_samples += take_all<pmu::v5::Voltages>(good.voltages());
   }
   r.writer_matches = intruder.commands_matched();
   r.received = svc.commands.counters().received;
@@ -279,18 +279,18 @@ struct TopicInfo {
 };
 
 const TopicInfo kTopics[] = {
-    {topics::kVoltages, [] { return TypeSupport(new pmu::v4::VoltagesPubSubType()); }, qos_profiles::kTelemetry},
-    {topics::kCurrents, [] { return TypeSupport(new pmu::v4::CurrentsPubSubType()); }, qos_profiles::kTelemetry},
-    {topics::kBatteryEnergy, [] { return TypeSupport(new pmu::v4::BatteryEnergyPubSubType()); }, qos_profiles::kTelemetry},
-    {topics::kTemperatures, [] { return TypeSupport(new pmu::v4::TemperaturesPubSubType()); }, qos_profiles::kTelemetry},
-    {topics::kStatus, [] { return TypeSupport(new pmu::v4::StatusPubSubType()); }, qos_profiles::kTelemetry},
-    {topics::kConfig, [] { return TypeSupport(new pmu::v4::ConfigPubSubType()); }, qos_profiles::kState},
-    {topics::kInfo, [] { return TypeSupport(new pmu::v4::DeviceInfoPubSubType()); }, qos_profiles::kState},
-    {topics::kHealth, [] { return TypeSupport(new pmu::v4::HealthPubSubType()); }, qos_profiles::kState},
-    {topics::kCommand, [] { return TypeSupport(new pmu::v4::CommandPubSubType()); }, qos_profiles::kCommand},
-    {topics::kCommandReply, [] { return TypeSupport(new pmu::v4::CommandReplyPubSubType()); }, qos_profiles::kCommand},
-    {topics::kAlarmAck, [] { return TypeSupport(new pmu::v4::AlarmAckPubSubType()); }, qos_profiles::kCommand},
-    {topics::kAlarmAckReply, [] { return TypeSupport(new pmu::v4::AlarmAckReplyPubSubType()); }, qos_profiles::kCommand},
+    {topics::kVoltages, [] { return TypeSupport(new pmu::v5::VoltagesPubSubType()); }, qos_profiles::kTelemetry},
+    {topics::kCurrents, [] { return TypeSupport(new pmu::v5::CurrentsPubSubType()); }, qos_profiles::kTelemetry},
+    {topics::kBatteryEnergy, [] { return TypeSupport(new pmu::v5::BatteryEnergyPubSubType()); }, qos_profiles::kTelemetry},
+    {topics::kTemperatures, [] { return TypeSupport(new pmu::v5::TemperaturesPubSubType()); }, qos_profiles::kTelemetry},
+    {topics::kStatus, [] { return TypeSupport(new pmu::v5::StatusPubSubType()); }, qos_profiles::kTelemetry},
+    {topics::kConfig, [] { return TypeSupport(new pmu::v5::ConfigPubSubType()); }, qos_profiles::kState},
+    {topics::kInfo, [] { return TypeSupport(new pmu::v5::DeviceInfoPubSubType()); }, qos_profiles::kState},
+    {topics::kHealth, [] { return TypeSupport(new pmu::v5::HealthPubSubType()); }, qos_profiles::kState},
+    {topics::kCommand, [] { return TypeSupport(new pmu::v5::CommandPubSubType()); }, qos_profiles::kCommand},
+    {topics::kCommandReply, [] { return TypeSupport(new pmu::v5::CommandReplyPubSubType()); }, qos_profiles::kCommand},
+    {topics::kAlarmAck, [] { return TypeSupport(new pmu::v5::AlarmAckPubSubType()); }, qos_profiles::kCommand},
+    {topics::kAlarmAckReply, [] { return TypeSupport(new pmu::v5::AlarmAckReplyPubSubType()); }, qos_profiles::kCommand},
 };
 
 TEST(Permissions, EveryIdentityMayCreateExactlyTheWritersAndReadersTheContractAllows) {
@@ -341,9 +341,9 @@ TEST(SecureDds, GroundStationCommandsAndMissionComputerReadsTelemetry) {
   ServiceUnderTest svc(domain, Pki::get().files("pmu-service"));
   Client gs(domain, Pki::get().files("ground-station"), "ground-station");
   Client mc(domain, Pki::get().files("mission-computer"), "mission-computer");
-  EXPECT_TRUE(wait_sample<pmu::v4::Voltages>(gs.voltages(), 20s)) << "ground station: no telemetry";
-  EXPECT_TRUE(wait_sample<pmu::v4::Voltages>(mc.voltages(), 20s)) << "mission computer: no telemetry";
-  EXPECT_TRUE(wait_sample<pmu::v4::Config>(mc.config(), 10s)) << "mission computer: no pmu/config (state)";
+  EXPECT_TRUE(wait_sample<pmu::v5::Voltages>(gs.voltages(), 20s)) << "ground station: no telemetry";
+  EXPECT_TRUE(wait_sample<pmu::v5::Voltages>(mc.voltages(), 20s)) << "mission computer: no telemetry";
+  EXPECT_TRUE(wait_sample<pmu::v5::Config>(mc.config(), 10s)) << "mission computer: no pmu/config (state)";
   ASSERT_NO_FATAL_FAILURE(expect_ground_station_commands(svc, gs, "gs-1"));
   EXPECT_EQ(svc.commands.counters().received, 1u);
 }
@@ -406,8 +406,8 @@ TEST(SecureDds, MissionComputerCannotWriteCommands) {
   const int domain = pmu::test::exclusive_dds_domain();
   ServiceUnderTest svc(domain, Pki::get().files("pmu-service"));
   Client mc(domain, Pki::get().files("mission-computer"), "mission-computer");
-  ASSERT_TRUE(wait_sample<pmu::v4::Voltages>(mc.voltages(), 20s)) << "the mission computer should read telemetry";
-  ASSERT_TRUE(wait_sample<pmu::v4::Config>(mc.config(), 10s)) << "no pmu/config: the service's start-up is not done";
+  ASSERT_TRUE(wait_sample<pmu::v5::Voltages>(mc.voltages(), 20s)) << "the mission computer should read telemetry";
+  ASSERT_TRUE(wait_sample<pmu::v5::Config>(mc.config(), 10s)) << "no pmu/config: the service's start-up is not done";
   const std::uint64_t handled_before = svc.handled();
   // Its own participant refuses to create the writer (local access control) ...
   DataWriter* writer = nullptr;
@@ -419,7 +419,7 @@ TEST(SecureDds, MissionComputerCannotWriteCommands) {
   if (writer) {  // only with broken permissions: then show what it can do
     pmu::test::wait_until([&] { return mc.commands_matched() != 0; }, 3s);
     for (int i = 0; i < 5; ++i) {
-      pmu::v4::Command c = command("mission-computer-" + std::to_string(i));
+      pmu::v5::Command c = command("mission-computer-" + std::to_string(i));
       writer->write(&c);
     }
   }
@@ -447,11 +447,11 @@ TEST(SecureDds, MissionComputerWithARelaxedGovernanceStillCannotCommand) {
   Client good(domain, Pki::get().files("ground-station"), "ground-station");
   Client mc(domain, dds::security_files_in(lax, "mission-computer"), "tampered-mission-computer");
   ASSERT_NO_THROW(mc.commands()) << "the relaxed governance should let its own participant create the writer";
-  ASSERT_TRUE(wait_sample<pmu::v4::Voltages>(mc.voltages(), 20s)) << "it is still a mission computer: telemetry";
-  ASSERT_TRUE(wait_sample<pmu::v4::Config>(good.config(), 10s)) << "no pmu/config: the service's start-up is not done";
+  ASSERT_TRUE(wait_sample<pmu::v5::Voltages>(mc.voltages(), 20s)) << "it is still a mission computer: telemetry";
+  ASSERT_TRUE(wait_sample<pmu::v5::Config>(good.config(), 10s)) << "no pmu/config: the service's start-up is not done";
   const std::uint64_t handled_before = svc.handled();
   for (int i = 0; i < 15; ++i) {
-    pmu::v4::Command c = command("tampered-" + std::to_string(i));
+    pmu::v5::Command c = command("tampered-" + std::to_string(i));
     mc.commands().write(&c);
     // Meant to let time pass: 15 x 200 ms in which nothing may reach the service.
     std::this_thread::sleep_for(200ms);
@@ -561,10 +561,10 @@ WireResult run_on_the_wire(const SecurityFiles& service_files, const SecurityFil
   {
     ServiceUnderTest svc(domain, service_files, bus_marker);
     Client gs(domain, gs_files, "ground-station");
-    EXPECT_TRUE(wait_sample<pmu::v4::Voltages>(gs.voltages(), 20s));
+    EXPECT_TRUE(wait_sample<pmu::v5::Voltages>(gs.voltages(), 20s));
     EXPECT_TRUE(wait_command_link(gs, 10s));
     const auto reply = send_until_answered(gs, command(marker, bus_marker), 10s);
-    EXPECT_TRUE(reply.has_value() && reply->result() == pmu::v4::COMPLETED) << "the command did not complete";
+    EXPECT_TRUE(reply.has_value() && reply->result() == pmu::v5::COMPLETED) << "the command did not complete";
     // Meant to let time pass: a second more of telemetry on the wire. With security the
     // marker must NOT show up, so there is no condition to wait for.
     std::this_thread::sleep_for(1s);
@@ -643,14 +643,14 @@ TEST(ServiceProgram, SecurePmuServiceWithPmuctlAndTheExampleClient) {
 // takes the service's identity and permissions, which name topics, not types, so the same
 // files serve both contracts, and a secure ground station sees both.
 TEST(ServiceProgram, ASecureServiceAlsoServesThePreviousContractWithTheSameFiles) {
-  const std::string cfg = write_config("both", Pki::get().files("pmu-service"), "also_serve_contract: 3\n");
+  const std::string cfg = write_config("both", Pki::get().files("pmu-service"), "also_serve_contract: 4\n");
   const auto service = service_process(cfg);
   const std::string d = " --domain " + std::to_string(pmu::test::exclusive_dds_domain());
   const std::string sec = " --security-dir " + Pki::get().dir();
   const std::string pmuctl = PMUCTL_PATH;
   auto r = sh(pmuctl + d + sec + " --identity mission-computer --timeout 10 list --json");
   EXPECT_EQ(r.status, 0) << r.out;
-  EXPECT_NE(r.out.find("\"contracts\":[4,3]"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("\"contracts\":[5,4]"), std::string::npos) << r.out;
   r = sh(pmuctl + d + sec + " --identity ground-station --timeout 10 config set avionics_voltage 24");
   EXPECT_EQ(r.status, 0) << r.out;
   EXPECT_NE(r.out.find("COMPLETED"), std::string::npos) << r.out;
@@ -798,7 +798,7 @@ DataWriter* writer_with_partitions_property(dds::DdsContext& dds, const std::str
   if (!pub || pub->get_datawriter_qos_from_profile(qos_profiles::kCommand, wq) != ReturnCode_t::RETCODE_OK)
     return nullptr;
   wq.properties().properties().emplace_back("partitions", partitions);
-  return pub->create_datawriter(&dds.topic(topics::kCommand, TypeSupport(new pmu::v4::CommandPubSubType())), wq);
+  return pub->create_datawriter(&dds.topic(topics::kCommand, TypeSupport(new pmu::v5::CommandPubSubType())), wq);
 }
 
 TEST(SecureVehicles, AConfinedIdentityCannotWriteToEveryVehicleNorToAnotherOne) {
@@ -842,8 +842,8 @@ TEST(SecureVehicles, AConfinedIdentityCannotWriteToEveryVehicleNorToAnotherOne) 
   // A command naming uav2 on the writer it may have (partition "uav1") reaches uav1 alone,
   // which does not execute another vehicle's command; uav2 never sees it.
   for (int i = 0; i < 10; ++i) {
-    pmu::v4::Command c = command("ground-uav1-to-uav2-" + std::to_string(i), "sim0", "uav2");
-    c.kind(pmu::v4::ENABLE_OUTPUTS);  // uav2's payload back on: visible if it ran
+    pmu::v5::Command c = command("ground-uav1-to-uav2-" + std::to_string(i), "sim0", "uav2");
+    c.kind(pmu::v5::ENABLE_OUTPUTS);  // uav2's payload back on: visible if it ran
     gs1.commands().write(&c);
   }
   EXPECT_TRUE(pmu::test::wait_until([&] { return uav1.endpoint.not_ours() >= uav1_refused + 10; }, 10s))

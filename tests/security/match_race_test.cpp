@@ -31,7 +31,7 @@ struct Participant {
   Participant(int domain, const std::string& identity, const std::string& name)
       : dds(domain, "", name, Pki::get().files(identity), dds::Transport::UdpOnly) {}
   dds::DdsContext dds;
-  Topic& topic() { return dds.topic(topics::kCommand, TypeSupport(new pmu::v4::CommandPubSubType())); }
+  Topic& topic() { return dds.topic(topics::kCommand, TypeSupport(new pmu::v5::CommandPubSubType())); }
 };
 
 struct Service : Participant {

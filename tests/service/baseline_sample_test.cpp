@@ -63,7 +63,7 @@ TEST(BaselineSample, EveryParameterReadsBackAsTheSameRawValue) {
 }
 
 TEST(BaselineSample, AConfigSampleComparesOnTheWiresValues) {
-  pmu::v4::Config c;
+  pmu::v5::Config c;
   c.avionics_voltage(24.0f);
   c.payload_voltage(12.3f);
   c.servo_voltage(6.0f);

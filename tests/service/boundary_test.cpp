@@ -1,4 +1,4 @@
-// The command boundary (command.hpp): every possible pmu::v4::Command sample gives a typed
+// The command boundary (command.hpp): every possible pmu::v5::Command sample gives a typed
 // request or one rejection reason, never a crash. Table-driven over the edges of each field:
 // the kind's number, the booleans' bytes, every double class, the expiry from 0 to 2^64-1,
 // string lengths at and past the IDL's bounds.

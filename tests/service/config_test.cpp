@@ -773,16 +773,16 @@ TEST(ConfigLink, RoundTripInSecondsOrUnset) {
 }
 
 // also_serve_contract (interface.md 10.3): unset by default; only the contract before this
-// build's, since the second participant writes this build's layouts under its names.
+// build's, whose names the second participant writes and whose changed types it converts.
 TEST(ConfigAlsoServeContract, UnsetByDefaultAndOnlyThePreviousMajorVersion) {
   EXPECT_FALSE(parse_config(kBus, "s.yaml").also_serve_contract);
-  EXPECT_EQ(parse_config(std::string("also_serve_contract: 3\n") + kBus, "s.yaml").also_serve_contract, 3);
+  EXPECT_EQ(parse_config(std::string("also_serve_contract: 4\n") + kBus, "s.yaml").also_serve_contract, 4);
   const BadCase bad[] = {
-      {"domain: 3\nalso_serve_contract: 2\n",
-       "bad.yaml:2: also_serve_contract 2 is not served: this service serves contract 4 and can also serve 3 only "
+      {"domain: 3\nalso_serve_contract: 3\n",
+       "bad.yaml:2: also_serve_contract 3 is not served: this service serves contract 5 and can also serve 4 only "
        "(docs/interface.md section 10)"},
-      {"also_serve_contract: 4\n",
-       "bad.yaml:1: also_serve_contract 4 is not served: this service serves contract 4 and can also serve 3 only "
+      {"also_serve_contract: 5\n",
+       "bad.yaml:1: also_serve_contract 5 is not served: this service serves contract 5 and can also serve 4 only "
        "(docs/interface.md section 10)"},
       {"also_serve_contract: v3\n",
        "bad.yaml:1: also_serve_contract must be a decimal integer (digits, optionally after '-'; no leading 0, '+', 0x, "

@@ -21,20 +21,20 @@ using eprosima::fastdds::dds::TypeSupport;
 TEST(TypeObjects, SelfContainedAreExactlyTheTypesWithoutMembersNamedByHash) {
   register_type_objects();
   register_type_objects();  // idempotent
-  for (const char* t : {"pmu::v4::Voltages", "pmu::v4::Currents", "pmu::v4::BatteryEnergy", "pmu::v4::Temperatures", "pmu::v4::Status",
-                        "pmu::v4::Config", "pmu::v4::DeviceInfo", "pmu::v4::Battery", "pmu::v4::Mppt", "pmu::v4::BatteryCell",
-                        "pmu::v4::Baseline", "pmu::v4::BmsEnergy"})
+  for (const char* t : {"pmu::v5::Voltages", "pmu::v5::Currents", "pmu::v5::BatteryEnergy", "pmu::v5::Temperatures", "pmu::v5::Status",
+                        "pmu::v5::Config", "pmu::v5::DeviceInfo", "pmu::v5::Battery", "pmu::v5::Mppt", "pmu::v5::BatteryCell",
+                        "pmu::v5::Baseline", "pmu::v5::BmsEnergy"})
     EXPECT_TRUE(type_object_is_self_contained(t)) << t;
-  for (const char* t : {"pmu::v4::Health", "pmu::v4::BatteryCells", "pmu::v4::Command", "pmu::v4::CommandReply",
-                        "pmu::v4::DeviceKind", "pmu::v4::Energy", "pmu::NoSuchType"})
+  for (const char* t : {"pmu::v5::Health", "pmu::v5::BatteryCells", "pmu::v5::Command", "pmu::v5::CommandReply",
+                        "pmu::v5::DeviceKind", "pmu::v5::Energy", "pmu::NoSuchType"})
     EXPECT_FALSE(type_object_is_self_contained(t)) << t;
 }
 
 TEST(TypeObjects, NeverTypeInformationAndTheObjectOnlyWhenSelfContained) {
   register_type_objects();
-  TypeSupport voltages(new pmu::v4::VoltagesPubSubType());
-  TypeSupport cells(new pmu::v4::BatteryCellsPubSubType());
-  TypeSupport health(new pmu::v4::HealthPubSubType());
+  TypeSupport voltages(new pmu::v5::VoltagesPubSubType());
+  TypeSupport cells(new pmu::v5::BatteryCellsPubSubType());
+  TypeSupport health(new pmu::v5::HealthPubSubType());
   for (TypeSupport* t : {&voltages, &cells, &health}) {
     ASSERT_TRUE((*t)->auto_fill_type_information()) << "Fast DDS 2.9.1's default, which this changes";
     announce_type_object(*t, true);
@@ -48,7 +48,7 @@ TEST(TypeObjects, NeverTypeInformationAndTheObjectOnlyWhenSelfContained) {
 // Off (dds_type_objects absent): nothing, though the objects are registered in this process.
 TEST(TypeObjects, NothingAnnouncedWhenNotEnabled) {
   register_type_objects();
-  TypeSupport voltages(new pmu::v4::VoltagesPubSubType());
+  TypeSupport voltages(new pmu::v5::VoltagesPubSubType());
   ASSERT_TRUE(voltages->auto_fill_type_object()) << "Fast DDS 2.9.1's default, which this changes";
   announce_type_object(voltages, false);
   EXPECT_FALSE(voltages->auto_fill_type_object());

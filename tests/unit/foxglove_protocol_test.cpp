@@ -58,14 +58,14 @@ TEST(FoxgloveProtocol, SubprotocolIsTheFirstOfferedThatTheServerSpeaks) {
 
 TEST(FoxgloveProtocol, AdvertiseListsEveryChannelAsCdrWithOmgIdlSchema) {
   const std::string_view idl = "module pmu { struct Voltages { float avionics; }; };";
-  const json j = parsed(advertise_json({{0, "pmu/voltages", "pmu::v4::Voltages", idl}, {5, "pmu/health", "pmu::v4::Health", "x"}}));
+  const json j = parsed(advertise_json({{0, "pmu/voltages", "pmu::v5::Voltages", idl}, {5, "pmu/health", "pmu::v5::Health", "x"}}));
   EXPECT_EQ(j["op"], "advertise");
   ASSERT_EQ(j["channels"].size(), 2u);
   const json& c = j["channels"][0];
   EXPECT_EQ(c["id"], 0);
   EXPECT_EQ(c["topic"], "pmu/voltages");
   EXPECT_EQ(c["encoding"], "cdr");
-  EXPECT_EQ(c["schemaName"], "pmu::v4::Voltages");
+  EXPECT_EQ(c["schemaName"], "pmu::v5::Voltages");
   EXPECT_EQ(c["schemaEncoding"], "omgidl");
   EXPECT_EQ(c["schema"], idl);
   EXPECT_EQ(j["channels"][1]["id"], 5);

@@ -177,7 +177,7 @@ TEST(McapWriter, RoundTripWithSummaryAndFooter) {
   pmu::mcap::MemorySink sink;
   auto w = make(sink);
   ASSERT_TRUE(w.open());
-  const auto schema = w.add_schema("pmu::v4::Voltages", "omgidl", "module pmu {};");
+  const auto schema = w.add_schema("pmu::v5::Voltages", "omgidl", "module pmu {};");
   const auto a = w.add_channel(schema, "pmu/voltages", "cdr");
   const auto b = w.add_channel(schema, "pmu/low_rate/voltages", "cdr");
   const std::uint8_t d1[] = {1, 2}, d2[] = {3};

@@ -64,9 +64,9 @@ Topic* topic(DomainParticipant* p, const char* name, TypeSupport type) {
 }
 
 // Sends one command and waits for its final reply (IN_PROGRESS replies are shown, not final).
-bool command(Link& l, pmu::v4::CommandKind kind, const char* what, const char* parameter = "", double value = 0,
+bool command(Link& l, pmu::v5::CommandKind kind, const char* what, const char* parameter = "", double value = 0,
              unsigned char outputs = 0) {
-  pmu::v4::Command c;
+  pmu::v5::Command c;
   const std::string id = "ground-station-example-" + std::to_string(++l.next);
   c.request_id(id);
   c.bus(l.bus);
@@ -90,11 +90,11 @@ bool command(Link& l, pmu::v4::CommandKind kind, const char* what, const char* p
       l.commands->write(&c);
       next_send = std::chrono::steady_clock::now() + 1s;
     }
-    pmu::v4::CommandReply r;
+    pmu::v5::CommandReply r;
     SampleInfo info;
     while (l.replies->take_next_sample(&r, &info) == ReturnCode_t::RETCODE_OK) {
-      if (!info.valid_data || r.request_id().to_string() != id || r.result() == pmu::v4::IN_PROGRESS) continue;
-      const bool ok = r.result() == pmu::v4::COMPLETED;
+      if (!info.valid_data || r.request_id().to_string() != id || r.result() == pmu::v5::IN_PROGRESS) continue;
+      const bool ok = r.result() == pmu::v5::COMPLETED;
       std::printf("%-36s %s%s%s\n", what, ok ? "COMPLETED" : "NOT COMPLETED",
                   r.reason().size() ? ": " : "", r.reason().c_str());
       return ok;
@@ -167,13 +167,13 @@ int main(int argc, char** argv) {
   Publisher* pub = l.participant->create_publisher(PUBLISHER_QOS_DEFAULT);
   Subscriber* sub = l.participant->create_subscriber(SUBSCRIBER_QOS_DEFAULT);
   l.commands = pub->create_datawriter_with_profile(
-      topic(l.participant, "pmu/command", TypeSupport(new pmu::v4::CommandPubSubType())), "command");
+      topic(l.participant, "pmu/command", TypeSupport(new pmu::v5::CommandPubSubType())), "command");
   l.replies = sub->create_datareader_with_profile(
-      topic(l.participant, "pmu/command_reply", TypeSupport(new pmu::v4::CommandReplyPubSubType())), "command");
+      topic(l.participant, "pmu/command_reply", TypeSupport(new pmu::v5::CommandReplyPubSubType())), "command");
   l.config = sub->create_datareader_with_profile(
-      topic(l.participant, "pmu/config", TypeSupport(new pmu::v4::ConfigPubSubType())), "state");
+      topic(l.participant, "pmu/config", TypeSupport(new pmu::v5::ConfigPubSubType())), "state");
   l.status = sub->create_datareader_with_profile(
-      topic(l.participant, "pmu/status", TypeSupport(new pmu::v4::StatusPubSubType())), "telemetry");
+      topic(l.participant, "pmu/status", TypeSupport(new pmu::v5::StatusPubSubType())), "telemetry");
   if (!l.commands || !l.replies || !l.config || !l.status) {
     // With DDS-Security: this identity's permissions do not allow one of them.
     std::fprintf(stderr, "cannot create the command writer and the readers (DDS-Security permissions?)\n");
@@ -193,20 +193,21 @@ int main(int argc, char** argv) {
   }
 
   bool ok = true;
-  pmu::v4::Config cfg;
+  pmu::v5::Config cfg;
   if (latest(l.config, cfg, 3000ms))
     std::printf("config: avionics %.1f V, payload %.1f V, servo %.1f V, outputs 0x%02X\n", cfg.avionics_voltage(),
                 cfg.payload_voltage(), cfg.servo_voltage(), cfg.outputs());
   else
     ok = false, std::printf("config: not received\n");
-  ok &= command(l, pmu::v4::SET_PARAMETER, "set avionics_voltage 24.0 V", "avionics_voltage", 24.0);
-  ok &= command(l, pmu::v4::SET_PARAMETER, "set payload_voltage 18.0 V", "payload_voltage", 18.0);
-  ok &= command(l, pmu::v4::DISABLE_OUTPUTS, "payload output off", "", 0, 0x02);
-  ok &= command(l, pmu::v4::ENABLE_OUTPUTS, "payload output on", "", 0, 0x02);
-  pmu::v4::Status st;
+  ok &= command(l, pmu::v5::SET_PARAMETER, "set avionics_voltage 24.0 V", "avionics_voltage", 24.0);
+  ok &= command(l, pmu::v5::SET_PARAMETER, "set payload_voltage 18.0 V", "payload_voltage", 18.0);
+  ok &= command(l, pmu::v5::DISABLE_OUTPUTS, "payload output off", "", 0, 0x02);
+  ok &= command(l, pmu::v5::ENABLE_OUTPUTS, "payload output on", "", 0, 0x02);
+  pmu::v5::Status st;
   if (latest(l.status, st, 3000ms))
-    std::printf("status: generator %u rpm, payload %s, avionics %s\n", st.generator_rpm(), st.payload_on() ? "on" : "off",
-                st.avionics_servo_on() ? "on" : "off");
+    // NaN: the PMU has no reading (interface.md section 1.1); printf prints it as "nan".
+    std::printf("status: generator %.0f rpm, payload %s, avionics %s\n", static_cast<double>(st.generator_rpm()),
+                st.payload_on() ? "on" : "off", st.avionics_servo_on() ? "on" : "off");
   else
     ok = false, std::printf("status: not received\n");
 

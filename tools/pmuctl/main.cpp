@@ -411,12 +411,12 @@ int run_cli(int argc, char** argv, const AgentCall* served) {
     return run_decode(path, options);
   }
   {
-    const int kind = !*engine ? -1 : start_stop == "start" ? int{pmu::v4::ENGINE_START} : int{pmu::v4::ENGINE_STOP};
+    const int kind = !*engine ? -1 : start_stop == "start" ? int{pmu::v5::ENGINE_START} : int{pmu::v5::ENGINE_STOP};
     if (const auto why = pmu::tools::broadcast_refusal(g, kind); !why.empty())
       return pmu::tools::fail(g, pmu::tools::ExitStatus::BadUsage, why);
   }
   if (*config_set && !pmu::codec::parameter_from_name(set_param)) {
-    // The two fields of pmu::v4::Config that are not stored parameters have verbs of their own.
+    // The two fields of pmu::v5::Config that are not stored parameters have verbs of their own.
     if (set_param == "outputs")
       return pmu::tools::fail(g, pmu::tools::ExitStatus::BadUsage,
                               "outputs are not a stored parameter: switch them with `pmuctl outputs set|enable|disable "
@@ -518,36 +518,36 @@ int run_cli(int argc, char** argv, const AgentCall* served) {
       const auto parsed = pmu::tools::parse_config_value(set_param, set_value);
       if (!parsed.value) return pmu::tools::fail(g, pmu::tools::ExitStatus::BadUsage, parsed.error);
       spec.value = *parsed.value;
-      spec.kind = pmu::v4::SET_PARAMETER;
+      spec.kind = pmu::v5::SET_PARAMETER;
       spec.parameter = set_param;
       return pmu::tools::run_command(g, spec);
     }
     if (*outputs_get) {
-      spec.kind = pmu::v4::GET;
+      spec.kind = pmu::v5::GET;
       spec.parameter = "outputs";
       return pmu::tools::run_command(g, spec);
     }
     if (*outputs_set || *outputs_enable || *outputs_disable) {
       if (!pmu::tools::output_mask(output_names, spec.outputs)) return 2;
-      spec.kind = *outputs_set ? pmu::v4::SET_OUTPUTS : *outputs_enable ? pmu::v4::ENABLE_OUTPUTS : pmu::v4::DISABLE_OUTPUTS;
+      spec.kind = *outputs_set ? pmu::v5::SET_OUTPUTS : *outputs_enable ? pmu::v5::ENABLE_OUTPUTS : pmu::v5::DISABLE_OUTPUTS;
       return pmu::tools::run_command(g, spec);
     }
     if (*generation) {
-      spec.kind = pmu::v4::SET_GENERATION;
+      spec.kind = pmu::v5::SET_GENERATION;
       spec.enable = on_off == "on";
       return pmu::tools::run_command(g, spec);
     }
     if (*engine) {
-      spec.kind = start_stop == "start" ? pmu::v4::ENGINE_START : pmu::v4::ENGINE_STOP;
+      spec.kind = start_stop == "start" ? pmu::v5::ENGINE_START : pmu::v5::ENGINE_STOP;
       return pmu::tools::run_command(g, spec);
     }
     if (*reset) {
-      spec.kind = pmu::v4::RESET;
+      spec.kind = pmu::v5::RESET;
       return pmu::tools::run_command(g, spec);
     }
     if (*measure) {
       if (!pmu::tools::group_mask(groups, spec.groups)) return 2;
-      spec.kind = pmu::v4::REQUEST_MEASUREMENTS;
+      spec.kind = pmu::v5::REQUEST_MEASUREMENTS;
       return pmu::tools::run_command(g, spec);
     }
   } catch (const pmu::dds::PartitionNotGranted& e) {

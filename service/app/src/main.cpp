@@ -195,11 +195,17 @@ int run(const service::Config& cfg, const pmu::dds::ResolvedNetwork& network) {
     command_topics.publish(r);
     if (previous_command_topics) previous_command_topics->publish(r);
   });
-  // Acknowledgements exist from contract v4 on: the previous contract's participant has no
-  // such topics.
+  // Acknowledgements, like commands, in both contracts (they exist from contract v4 on, and
+  // no version since changed their types), each reply in both.
   service::DdsAlarmAckEndpoint ack_topics(participant, cfg.vehicle);
+  std::unique_ptr<service::DdsAlarmAckEndpoint> previous_ack_topics;
+  if (previous_participant)
+    previous_ack_topics = std::make_unique<service::DdsAlarmAckEndpoint>(*previous_participant, cfg.vehicle);
   service::AlarmAckService acks(workers, cfg.vehicle, cfg.policy.lifetimes, clock,
-                                [&](const service::AlarmAckReplyData& r) { ack_topics.publish(r); });
+                                [&](const service::AlarmAckReplyData& r) {
+                                  ack_topics.publish(r);
+                                  if (previous_ack_topics) previous_ack_topics->publish(r);
+                                });
   // Declared after everything the running threads use, so it is destroyed first, on every
   // way out of this function: commands stop first (no new request reaches `commands`, and
   // the bus workers are still there to finish the ones in flight), then the worker threads
@@ -209,11 +215,13 @@ int run(const service::Config& cfg, const pmu::dds::ResolvedNetwork& network) {
     service::DdsCommandEndpoint& command_topics;
     service::DdsCommandEndpoint* previous_command_topics;
     service::DdsAlarmAckEndpoint& ack_topics;
+    service::DdsAlarmAckEndpoint* previous_ack_topics;
     std::vector<BusRuntime>& buses;
     ~Shutdown() {
       command_topics.stop();
       ack_topics.stop();
       if (previous_command_topics) previous_command_topics->stop();
+      if (previous_ack_topics) previous_ack_topics->stop();
       for (auto& b : buses) b.worker->stop();
       for (auto& b : buses) {
         if (b.thread.joinable()) b.thread.join();
@@ -221,7 +229,7 @@ int run(const service::Config& cfg, const pmu::dds::ResolvedNetwork& network) {
       }
       spdlog::info("pmu-service stopped");
     }
-  } shutdown{command_topics, previous_command_topics.get(), ack_topics, buses};
+  } shutdown{command_topics, previous_command_topics.get(), ack_topics, previous_ack_topics.get(), buses};
   for (auto& b : buses) {
     if (b.simulator) b.simulator->start();
     b.thread = std::thread([w = b.worker.get()] { w->run(); });
@@ -229,6 +237,7 @@ int run(const service::Config& cfg, const pmu::dds::ResolvedNetwork& network) {
   command_topics.start(commands);
   if (previous_command_topics) previous_command_topics->start(commands);
   ack_topics.start(acks);
+  if (previous_ack_topics) previous_ack_topics->start(acks);
   spdlog::info("pmu-service ready on DDS domain {}: {}", cfg.domain, summary(buses));
   systemd.ready(summary(buses));
 

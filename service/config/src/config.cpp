@@ -752,8 +752,8 @@ Config parse_config(const std::string& text, const std::string& source, const Co
   }
   if (const auto v = root["dds_type_objects"]) cfg.dds_type_objects = c.scalar<bool>(v, "dds_type_objects", "true or false");
   if (const auto v = root["also_serve_contract"]) {
-    // One step back only: the service writes this build's types under the older names, which
-    // is right only for the contract whose layouts tests/contract keeps equal to this one's.
+    // One step back only: the service writes the previous contract's names, and converts the
+    // types whose layout or meaning changed (dds/include/pmu/dds/previous_contract.hpp).
     const int previous = PMU_CONTRACT_MAJOR - 1;
     const auto n = c.integer(v, "also_serve_contract", 0, 1000);
     if (n != previous)

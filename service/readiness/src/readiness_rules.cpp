@@ -34,7 +34,7 @@ std::string bounded(std::string s, std::size_t n) {
 }
 
 constexpr std::size_t kMessage = 42;       // ArduPilot's pre-arm text
-constexpr std::size_t kDescription = 127;  // pmu::v4::ReadinessReason's bound
+constexpr std::size_t kDescription = 127;  // pmu::v5::ReadinessReason's bound
 
 // "config differs: avionics_voltage, outputs", or as many names as fit and "+N more"; with a
 // shorter lead when even one long name and its count do not fit.

@@ -1,11 +1,12 @@
-// Clients built from older contracts' IDL (old_consumer_v2, old_consumer_v3) against
-// pmu-service on its simulated PMU, with pmuctl (contract v4) as the reference reader:
-// - a service that serves v4 only: neither old client matches anything (v4's type names),
-//   while pmuctl reads it;
-// - with `also_serve_contract: 3`: the v3 client reads every field as pmuctl does and gets
-//   one reply to its command; the v2 client's pmu/health matches (v2 and v3 share the name
-//   pmu::Health) and is misread: the limit docs/interface.md section 10.3 states;
-// - pmuctl against a v3 service names the contract instead of reporting no service.
+// Clients built from older contracts' IDL (old_consumer_v2, _v3, _v4) against pmu-service on
+// its simulated PMUs (address 1 heard, address 2 silent), with pmuctl (contract v5) as the
+// reference reader:
+// - a service that serves v5 only: no old client matches anything (v5's type names), while
+//   pmuctl reads it;
+// - with `also_serve_contract: 4`: the v4 client reads every field as pmuctl does, and the
+//   "no value" values as contract v4 sent them where v5 sends NaN (-1 s for the PMU never
+//   heard), and gets one reply to its command; v3 and v2 clients match nothing;
+// - pmuctl against a v4 service names the contract instead of reporting no service.
 #include <gtest/gtest.h>
 #include <unistd.h>
 
@@ -28,37 +29,40 @@ namespace {
 using namespace std::chrono_literals;
 using Json = nlohmann::json;
 
-// pmu-service on one simulated PMU (sim0, address 1), from a config file of its own.
+// pmu-service on two simulated PMUs (sim0, address 1, and address 2, which never speaks), from
+// a config file of its own.
 class Service : public pmu::test::ConfiguredService {
  public:
-  Service(int domain, bool also_v3)
+  Service(int domain, bool also_v4)
       : ConfiguredService(PMU_SERVICE_PATH,
-                          "domain: " + std::to_string(domain) + (also_v3 ? "\nalso_serve_contract: 3" : "") +
+                          "domain: " + std::to_string(domain) + (also_v4 ? "\nalso_serve_contract: 4" : "") +
                               "\nlog_level: info\nbuses:\n  - interface: sim\n    name: sim0\n    devices:\n"
-                              "      - address: 1\n        period: 0.5\n") {}
+                              "      - address: 1\n        period: 0.5\n"
+                              "      - address: 2\n        period: 0.5\n        sim: {silent: true}\n") {}
 };
 
 std::string pmuctl(int domain) { return std::string(PMUCTL_PATH) + " --domain " + std::to_string(domain) + " "; }
 
-// pmuctl's JSON line of the simulated PMU (unnamed vehicle, sim0/1), or null.
-Json pmu_line(const std::string& out, const char* topic) {
+// pmuctl's JSON line of a simulated PMU (unnamed vehicle, sim0/address), or null.
+Json pmu_line(const std::string& out, const char* topic, int address = 1) {
   for (const auto& j : pmu::test::json_lines(out))
     if (j.is_object() && j.value("topic", "") == topic && j.value("vehicle", "?").empty() &&
-        j.value("bus", "") == "sim0" && j.value("address", 0) == 1)
+        j.value("bus", "") == "sim0" && j.value("address", 0) == address)
       return j;
   return nullptr;
 }
 
-Json v4_state(int domain, const std::string& verb, const char* topic) {
-  return pmu_line(pmu::test::run_capture(pmuctl(domain) + "--timeout 20 --json " + verb + " 2>/dev/null").out, topic);
+Json v5_state(int domain, const std::string& verb, const char* topic, int address = 1) {
+  return pmu_line(pmu::test::run_capture(pmuctl(domain) + "--timeout 20 --json " + verb + " 2>/dev/null").out, topic,
+                  address);
 }
 
 // pmuctl reads the PMU's health as ONLINE: the service is up and discoverable.
-Json wait_v4_online(int domain) {
+Json wait_v5_online(int domain) {
   Json h;
   (void)pmu::test::wait_until(
       [&] {
-        h = v4_state(domain, "health", "health");
+        h = v5_state(domain, "health", "health");
         return h.is_object() && h["values"].value("state", "") == "ONLINE";
       },
       120s, 200ms);
@@ -69,11 +73,11 @@ struct ConsumerRun {
   std::string out;
   std::vector<Json> samples;  // every line but the final one
   Json final;
-  // The newest decoded sample of `topic`, or null.
-  Json last(const std::string& topic) const {
+  // The newest decoded sample of `topic` (of the PMU at `address`), or null.
+  Json last(const std::string& topic, int address = 1) const {
     Json j;
     for (const auto& s : samples)
-      if (s.is_object() && s.value("topic", "") == topic) j = s;
+      if (s.is_object() && s.value("topic", "") == topic && (!s.contains("address") || s["address"] == address)) j = s;
     return j;
   }
   std::size_t count(const std::string& topic) const {
@@ -109,79 +113,107 @@ bool has(const Json& list, const std::string& v) {
   return false;
 }
 
-// A health counter of the v3 client's newest sample lies between pmuctl's reads before and
+// A health counter of the v4 client's newest sample lies between pmuctl's reads before and
 // after the client ran (they only grow): a misread number falls outside.
-void expect_between(const Json& before, const Json& v3, const Json& after, const char* counter) {
+void expect_between(const Json& before, const Json& v4, const Json& after, const char* counter) {
   const auto lo = before["values"].value(counter, ~0ull), hi = after["values"].value(counter, 0ull);
-  const auto got = v3.value(counter, ~0ull);
-  EXPECT_TRUE(lo <= got && got <= hi) << counter << ": v3 read " << got << ", pmuctl " << lo << " before and " << hi
+  const auto got = v4.value(counter, ~0ull);
+  EXPECT_TRUE(lo <= got && got <= hi) << counter << ": v4 read " << got << ", pmuctl " << lo << " before and " << hi
                                       << " after";
 }
 
-TEST(OldContractConsumers, MatchNothingOfAServiceOfV4AloneWhichV4Reads) {
-  const int domain = pmu::test::exclusive_dds_domain();
-  Service service(domain, false);
-  ASSERT_TRUE(wait_v4_online(domain).is_object()) << service.describe();
-
-  for (const char* path : {OLD_CONSUMER_V3_PATH, OLD_CONSUMER_V2_PATH}) {
-    SCOPED_TRACE(path);
-    const bool v3 = std::string(path) == OLD_CONSUMER_V3_PATH;
-    const auto run = run_consumer(path, domain, std::string("--seconds 90 --until discovered --linger 2") +
-                                                    (v3 ? " --command GET_SERIAL" : ""));
-    ASSERT_TRUE(run.final.is_object()) << run.out;
-    // Discovery reported the service's endpoints under v4's names, so "matched nothing" is
-    // the verdict on them, not a run that ended too early.
-    std::vector<std::pair<std::string, std::string>> endpoints{
-        {"pmu/health", "Health"}, {"pmu/config", "Config"}, {"pmu/voltages", "Voltages"}};
-    if (v3) endpoints.insert(endpoints.end(), {{"pmu/command_reply", "CommandReply"}, {"reader:pmu/command", "Command"}});
-    for (const auto& [topic, type] : endpoints)
-      EXPECT_TRUE(has(run.final["discovered"].value(topic, Json()), "pmu::v4::" + type)) << topic << ": " << run.out;
-    EXPECT_EQ(run.final["matched"].size(), v3 ? 5u : 3u) << run.out;
-    for (const auto& [topic, n] : run.final["matched"].items()) EXPECT_EQ(n, 0) << topic << ": " << run.out;
-    EXPECT_TRUE(run.samples.empty()) << run.out;
-    EXPECT_EQ(run.final.value("command_sent", true), false) << run.out;
-    // What a tool of any contract can read without matching: the participant's property.
-    EXPECT_EQ(run.final["service_contracts"], Json::array({"4"})) << run.out;
+// An old client that finds the service's endpoints under names other than its own and
+// matches none of them. `commands`: it also tried to send a command. Every endpoint it
+// discovered has a name that starts with `service_type_prefix`.
+void expect_matched_nothing(const ConsumerRun& run, const std::string& service_type_prefix, bool commands) {
+  ASSERT_TRUE(run.final.is_object()) << run.out;
+  // Discovery reported the service's endpoints under other names, so "matched nothing" is
+  // the verdict on them, not a run that ended too early.
+  std::vector<std::pair<std::string, std::string>> endpoints{
+      {"pmu/health", "Health"}, {"pmu/config", "Config"}, {"pmu/voltages", "Voltages"}, {"pmu/status", "Status"}};
+  if (commands) endpoints.insert(endpoints.end(), {{"pmu/command_reply", "CommandReply"}, {"reader:pmu/command", "Command"}});
+  for (const auto& [topic, type] : endpoints) {
+    const Json found = run.final["discovered"].value(topic, Json());
+    EXPECT_TRUE(found.is_array() && !found.empty()) << topic << ": " << run.out;
+    for (const auto& name : found)
+      EXPECT_EQ(name.get<std::string>().rfind(service_type_prefix, 0), 0u) << topic << ": " << name << " " << run.out;
   }
-  EXPECT_TRUE(wait_v4_online(domain).is_object()) << "pmuctl no longer reads the service: " << service.describe();
+  EXPECT_EQ(run.final["matched"].size(), commands ? 6u : 4u) << run.out;
+  for (const auto& [topic, n] : run.final["matched"].items()) EXPECT_EQ(n, 0) << topic << ": " << run.out;
+  EXPECT_TRUE(run.samples.empty()) << run.out;
+  EXPECT_EQ(run.final.value("command_sent", true), false) << run.out;
 }
 
-TEST(OldContractConsumers, V3ConsumerReadsEveryFieldOfAServiceThatAlsoServesV3) {
+TEST(OldContractConsumers, MatchNothingOfAServiceOfV5AloneWhichV5Reads) {
+  const int domain = pmu::test::exclusive_dds_domain();
+  Service service(domain, false);
+  ASSERT_TRUE(wait_v5_online(domain).is_object()) << service.describe();
+
+  for (const char* path : {OLD_CONSUMER_V4_PATH, OLD_CONSUMER_V3_PATH, OLD_CONSUMER_V2_PATH}) {
+    SCOPED_TRACE(path);
+    const bool commands = std::string(path) != OLD_CONSUMER_V2_PATH;
+    const auto run = run_consumer(path, domain, std::string("--seconds 90 --until discovered --linger 2") +
+                                                    (commands ? " --command GET_SERIAL" : ""));
+    expect_matched_nothing(run, "pmu::v5::", commands);
+    EXPECT_TRUE(has(run.final["discovered"].value("pmu/health", Json()), "pmu::v5::Health")) << run.out;
+    // What a tool of any contract can read without matching: the participant's property.
+    EXPECT_EQ(run.final["service_contracts"], Json::array({"5"})) << run.out;
+  }
+  EXPECT_TRUE(wait_v5_online(domain).is_object()) << "pmuctl no longer reads the service: " << service.describe();
+}
+
+TEST(OldContractConsumers, V4ConsumerReadsEveryFieldOfAServiceThatAlsoServesV4) {
   const int domain = pmu::test::exclusive_dds_domain();
   Service service(domain, true);
-  const Json before = wait_v4_online(domain);
+  const Json before = wait_v5_online(domain);
   ASSERT_TRUE(before.is_object()) << service.describe();
-  // pmuctl sees the v3 participant once discovery has reported it.
+  // pmuctl sees the v4 participant once discovery has reported it.
   Json listed;
   EXPECT_TRUE(pmu::test::wait_until(
       [&] {
-        listed = v4_state(domain, "list", "list");
-        return listed.is_object() && contracts_of(listed) == Json::array({4, 3});
+        listed = v5_state(domain, "list", "list");
+        return listed.is_object() && contracts_of(listed) == Json::array({5, 4});
       },
       60s, 200ms))
       << listed.dump();
-  const Json config = v4_state(domain, "config get", "config");
-  const Json info = v4_state(domain, "info", "info");
+  const Json config = v5_state(domain, "config get", "config");
+  const Json info = v5_state(domain, "info", "info");
   ASSERT_TRUE(config.is_object() && info.is_object()) << config.dump() << "\n" << info.dump();
-  Json voltages;
-  for (const auto& j :
-       pmu::test::json_lines(pmu::test::run_capture(pmuctl(domain) + "--timeout 20 --json watch --count 20").out))
+  Json voltages, status;
+  for (const auto& j : pmu::test::json_lines(
+           pmu::test::run_capture(pmuctl(domain) + "--timeout 20 --json --address 1 watch --count 20").out)) {
     if (j.is_object() && j.value("topic", "") == "voltages") voltages = j;
-  ASSERT_TRUE(voltages.is_object()) << "pmuctl watch printed no voltages";
+    if (j.is_object() && j.value("topic", "") == "status") status = j;
+  }
+  ASSERT_TRUE(voltages.is_object() && status.is_object()) << "pmuctl watch printed no voltages or status";
+  // The silent PMU: pmuctl reads NaN, which it shows as null ("never").
+  const Json silent = v5_state(domain, "health", "health", 2);
+  ASSERT_TRUE(silent.is_object()) << service.describe();
+  EXPECT_TRUE(silent["values"]["last_frame_age"].is_null()) << silent.dump();
 
-  const auto run = run_consumer(OLD_CONSUMER_V3_PATH, domain, "--seconds 90 --until decoded --linger 2 --command GET_SERIAL");
-  const Json after = v4_state(domain, "health", "health");
+  const auto run = run_consumer(OLD_CONSUMER_V4_PATH, domain, "--seconds 90 --until decoded --linger 2 --command GET_SERIAL");
+  const Json after = v5_state(domain, "health", "health");
   ASSERT_TRUE(run.final.is_object() && after.is_object()) << run.out << "\n" << service.describe();
-  for (const char* topic : {"pmu/health", "pmu/config", "pmu/voltages", "pmu/command", "pmu/command_reply"})
-    EXPECT_EQ(run.final["matched"].value(topic, -1), 1) << topic << ": the v3 participant's alone; " << run.out;
+  for (const char* topic : {"pmu/health", "pmu/config", "pmu/voltages", "pmu/status", "pmu/command", "pmu/command_reply"})
+    EXPECT_EQ(run.final["matched"].value(topic, -1), 1) << topic << ": the v4 participant's alone; " << run.out;
   // Two participants named pmu-service, each announcing the contract it serves.
-  EXPECT_EQ(run.final["service_contracts"], Json::array({"3", "4"})) << run.out;
+  EXPECT_EQ(run.final["service_contracts"], Json::array({"4", "5"})) << run.out;
+
+  // Contract v4's "never heard", where v5 sends NaN.
+  const Json never = run.last("pmu/health", 2);
+  ASSERT_TRUE(never.is_object()) << run.out;
+  EXPECT_EQ(never.value("last_frame_age", 0.0), -1.0) << never.dump();
+  // The generator's speed as pmuctl reads it, as v4's unsigned short.
+  const Json st = run.last("pmu/status");
+  ASSERT_TRUE(st.is_object()) << run.out;
+  ASSERT_TRUE(status["values"]["generator_rpm"].is_number()) << status.dump();
+  EXPECT_EQ(st["generator_rpm"], status["values"]["generator_rpm"]) << st.dump() << status.dump();
 
   const Json h = run.last("pmu/health");
   ASSERT_TRUE(h.is_object()) << run.out;
   EXPECT_EQ(h["vehicle"], "");
   EXPECT_EQ(h["bus"], "sim0");
-  EXPECT_EQ(h["address"], before["address"]);
+  EXPECT_EQ(h["address"], 1);
   EXPECT_EQ(h["kind"], "KIND_PMU");
   EXPECT_EQ(h["state"], "ONLINE");
   EXPECT_EQ(h["bus_state"], "UP");
@@ -226,52 +258,40 @@ TEST(OldContractConsumers, V3ConsumerReadsEveryFieldOfAServiceThatAlsoServesV3) 
   EXPECT_EQ(run.final["replies"], 1);
 }
 
-TEST(OldContractConsumers, V2ConsumerOfAServiceThatAlsoServesV3MisreadsHealth) {
+TEST(OldContractConsumers, V3AndV2ConsumersMatchNothingOfAServiceThatAlsoServesV4) {
   const int domain = pmu::test::exclusive_dds_domain();
   Service service(domain, true);
-  const Json before = wait_v4_online(domain);
-  ASSERT_TRUE(before.is_object()) << service.describe();
-  const auto run = run_consumer(OLD_CONSUMER_V2_PATH, domain, "--seconds 90 --until decoded --linger 1");
-  const Json after = v4_state(domain, "health", "health");
-  ASSERT_TRUE(run.final.is_object() && after.is_object()) << run.out;
-
-  // The documented limit: v2 and v3 both name it pmu::Health, so they match ...
-  EXPECT_EQ(run.final["matched"].value("pmu/health", -1), 1) << run.out;
-  const Json h = run.last("pmu/health");
-  ASSERT_TRUE(h.is_object()) << run.out;
-  // ... and v3's `kind` key is read as v2's `state`, every later field one place off.
-  const auto frames = h.value("frames_received", ~0ull);
-  const bool frames_right = before["values"].value("frames_received", ~0ull) <= frames &&
-                            frames <= after["values"].value("frames_received", 0ull);
-  EXPECT_FALSE(h["state"] == "ONLINE" && h["bus_state"] == "UP" && frames_right)
-      << "a v2 client read v3's pmu/health right; docs/interface.md section 10.3 says it cannot: " << h.dump();
-  // The types v3 left as they were still read right.
-  const Json c = run.last("pmu/config");
-  ASSERT_TRUE(c.is_object()) << run.out;
-  const Json config = v4_state(domain, "config get", "config");
-  ASSERT_TRUE(config.is_object());
-  EXPECT_NEAR(c.value("avionics_voltage", 0.0), config["values"].value("avionics_voltage", -1.0), 1e-3) << c.dump();
-  EXPECT_EQ(c["can_address"], 1) << c.dump();
+  ASSERT_TRUE(wait_v5_online(domain).is_object()) << service.describe();
+  // Serving v4 as well serves v4's names only: a v3 client (pmu::Health) matches neither.
+  for (const char* path : {OLD_CONSUMER_V3_PATH, OLD_CONSUMER_V2_PATH}) {
+    SCOPED_TRACE(path);
+    const bool commands = std::string(path) == OLD_CONSUMER_V3_PATH;
+    const auto run = run_consumer(path, domain, std::string("--seconds 90 --until discovered --linger 2") +
+                                                    (commands ? " --command GET_SERIAL" : ""));
+    // Whichever of the service's two participants discovery reported first: their names are
+    // versioned, the client's are not.
+    expect_matched_nothing(run, "pmu::v", commands);
+  }
 }
 
-// A stand-in for a v3 pmu-service: participant "pmu-service", pmu/health as pmu::Health.
-pmu::test::Child fake_v3_service(int domain, const std::string& vehicle) {
+// A stand-in for a v4 pmu-service: participant "pmu-service", pmu/health as pmu::v4::Health.
+pmu::test::Child fake_v4_service(int domain, const std::string& vehicle) {
   pmu::test::ChildOptions o;
   o.stdout_path = o.stderr_path = "/dev/null";
-  return pmu::test::Child({OLD_CONSUMER_V3_PATH, "--domain", std::to_string(domain), "--serve-health", "--vehicle",
+  return pmu::test::Child({OLD_CONSUMER_V4_PATH, "--domain", std::to_string(domain), "--serve-health", "--vehicle",
                            vehicle, "--seconds", "600"},
                           o);
 }
 
 TEST(OldContractConsumers, PmuctlNamesTheContractOfTheOnlyServiceThere) {
   const int domain = pmu::test::exclusive_dds_domain();
-  auto fake = fake_v3_service(domain, "");
-  // With nothing of v4 to read, pmuctl waits out its timeout: 15 s covers discovery.
+  auto fake = fake_v4_service(domain, "");
+  // With nothing of v5 to read, pmuctl waits out its timeout: 15 s covers discovery.
   const auto r = pmu::test::run_capture(pmuctl(domain) + "--timeout 15 list", true);
   EXPECT_EQ(r.status, 3) << r.out;
-  EXPECT_NE(r.out.find("no pmu-service of contract v4 on domain " + std::to_string(domain) +
-                       "; found pmu-service of contract v3 (or older) (vehicles: (unnamed)); this pmuctl reads "
-                       "contract v4 only (docs/interface.md section 10"),
+  EXPECT_NE(r.out.find("no pmu-service of contract v5 on domain " + std::to_string(domain) +
+                       "; found pmu-service of contract v4 (vehicles: (unnamed)); this pmuctl reads "
+                       "contract v5 only (docs/interface.md section 10"),
             std::string::npos)
       << r.out;
   const auto j = pmu::test::run_capture(pmuctl(domain) + "--timeout 15 --json list 2>/dev/null");
@@ -281,18 +301,18 @@ TEST(OldContractConsumers, PmuctlNamesTheContractOfTheOnlyServiceThere) {
   ASSERT_TRUE(lines[0].is_object()) << j.out;
   EXPECT_EQ(lines[0].value("exit_status", -1), 3) << j.out;
   const auto error = lines[0].value("error", "");
-  EXPECT_NE(error.find("contract v3"), std::string::npos) << j.out;
-  EXPECT_NE(error.find("this pmuctl reads contract v4"), std::string::npos) << j.out;
-  EXPECT_TRUE(fake.running()) << "the fake v3 service exited early";
+  EXPECT_NE(error.find("contract v4"), std::string::npos) << j.out;
+  EXPECT_NE(error.find("this pmuctl reads contract v5"), std::string::npos) << j.out;
+  EXPECT_TRUE(fake.running()) << "the fake v4 service exited early";
 }
 
-TEST(OldContractConsumers, PmuctlListsAnotherVehiclesV3ServiceAsUnreadable) {
+TEST(OldContractConsumers, PmuctlListsAnotherVehiclesV4ServiceAsUnreadable) {
   const int domain = pmu::test::exclusive_dds_domain();
   Service service(domain, false);
-  auto fake = fake_v3_service(domain, "uav2");
-  ASSERT_TRUE(wait_v4_online(domain).is_object()) << service.describe();
+  auto fake = fake_v4_service(domain, "uav2");
+  ASSERT_TRUE(wait_v5_online(domain).is_object()) << service.describe();
 
-  // list settles on the v4 state it reads; uav2 is there once discovery has reported it.
+  // list settles on the v5 state it reads; uav2 is there once discovery has reported it.
   Json uav2, own;
   EXPECT_TRUE(pmu::test::wait_until(
       [&] {
@@ -304,10 +324,10 @@ TEST(OldContractConsumers, PmuctlListsAnotherVehiclesV3ServiceAsUnreadable) {
       },
       60s, 200ms))
       << uav2.dump();
-  EXPECT_EQ(contracts_of(uav2), Json::array({3})) << uav2.dump();
-  EXPECT_EQ(uav2["contract"], 4) << uav2.dump();
-  EXPECT_EQ(uav2.value("error", ""), "serves contract v3 (or older), which this pmuctl cannot read") << uav2.dump();
-  EXPECT_EQ(contracts_of(own), Json::array({4})) << own.dump();
+  EXPECT_EQ(contracts_of(uav2), Json::array({4})) << uav2.dump();
+  EXPECT_EQ(uav2["contract"], 5) << uav2.dump();
+  EXPECT_EQ(uav2.value("error", ""), "serves contract v4, which this pmuctl cannot read") << uav2.dump();
+  EXPECT_EQ(contracts_of(own), Json::array({5})) << own.dump();
 
   pmu::test::RunResult text;
   EXPECT_TRUE(pmu::test::wait_until(
@@ -319,17 +339,17 @@ TEST(OldContractConsumers, PmuctlListsAnotherVehiclesV3ServiceAsUnreadable) {
       << text.out;
   EXPECT_EQ(text.status, 0) << text.out;
   EXPECT_NE(text.out.find("\nuav2 "), std::string::npos) << text.out;
-  EXPECT_NE(text.out.find("pmuctl: UNREADABLE: pmu-service of contract v3 (or older) (vehicles: uav2); this pmuctl "
-                          "reads contract v4 only"),
+  EXPECT_NE(text.out.find("pmuctl: UNREADABLE: pmu-service of contract v4 (vehicles: uav2); this pmuctl "
+                          "reads contract v5 only"),
             std::string::npos)
       << text.out;
 
-  // Asked for uav2 alone, while a v4 service serves another vehicle: the message names uav2's
-  // contract, not the v4 vehicles, and nothing answered (3).
+  // Asked for uav2 alone, while a v5 service serves another vehicle: the message names uav2's
+  // contract, not the v5 vehicles, and nothing answered (3).
   const auto one = pmu::test::run_capture(pmuctl(domain) + "--vehicle uav2 --timeout 5 health", true);
   EXPECT_EQ(one.status, 3) << one.out;
-  EXPECT_NE(one.out.find("no pmu-service of contract v4 for vehicle uav2 on domain " + std::to_string(domain) +
-                         "; found pmu-service of contract v3 (or older) (vehicles: uav2)"),
+  EXPECT_NE(one.out.find("no pmu-service of contract v5 for vehicle uav2 on domain " + std::to_string(domain) +
+                         "; found pmu-service of contract v4 (vehicles: uav2)"),
             std::string::npos)
       << one.out;
 }

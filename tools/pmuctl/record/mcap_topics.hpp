@@ -12,7 +12,7 @@ namespace pmu::tools {
 
 struct RecordedTopic {
   const char* topic;        // "pmu/voltages"
-  const char* type_name;    // "pmu::v4::Voltages": the DDS type name and the MCAP schema name
+  const char* type_name;    // "pmu::v5::Voltages": the DDS type name and the MCAP schema name
   std::string_view idl;     // the schema text
   const char* qos_profile;  // deploy/qos.xml's reader profile
   bool by_default;          // recorded when no --topic is given

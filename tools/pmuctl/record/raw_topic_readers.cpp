@@ -45,29 +45,29 @@ class TopicListener final : public DataReaderListener {
 }  // namespace
 
 TypeSupport raw_type_support(const std::string& type_name) {
-  if (type_name == "pmu::v4::Voltages") return TypeSupport(new RawSampleType<pmu::v4::VoltagesPubSubType>());
-  if (type_name == "pmu::v4::Currents") return TypeSupport(new RawSampleType<pmu::v4::CurrentsPubSubType>());
-  if (type_name == "pmu::v4::BatteryEnergy") return TypeSupport(new RawSampleType<pmu::v4::BatteryEnergyPubSubType>());
-  if (type_name == "pmu::v4::Temperatures") return TypeSupport(new RawSampleType<pmu::v4::TemperaturesPubSubType>());
-  if (type_name == "pmu::v4::Status") return TypeSupport(new RawSampleType<pmu::v4::StatusPubSubType>());
-  if (type_name == "pmu::v4::Config") return TypeSupport(new RawSampleType<pmu::v4::ConfigPubSubType>());
-  if (type_name == "pmu::v4::DeviceInfo") return TypeSupport(new RawSampleType<pmu::v4::DeviceInfoPubSubType>());
-  if (type_name == "pmu::v4::Health") return TypeSupport(new RawSampleType<pmu::v4::HealthPubSubType>());
-  if (type_name == "pmu::v4::Battery") return TypeSupport(new RawSampleType<pmu::v4::BatteryPubSubType>());
-  if (type_name == "pmu::v4::BatteryCells") return TypeSupport(new RawSampleType<pmu::v4::BatteryCellsPubSubType>());
-  if (type_name == "pmu::v4::Mppt") return TypeSupport(new RawSampleType<pmu::v4::MpptPubSubType>());
-  if (type_name == "pmu::v4::Alarm") return TypeSupport(new RawSampleType<pmu::v4::AlarmPubSubType>());
-  if (type_name == "pmu::v4::Readiness") return TypeSupport(new RawSampleType<pmu::v4::ReadinessPubSubType>());
-  if (type_name == "pmu::v4::Energy") return TypeSupport(new RawSampleType<pmu::v4::EnergyPubSubType>());
-  if (type_name == "pmu::v4::BmsEnergy") return TypeSupport(new RawSampleType<pmu::v4::BmsEnergyPubSubType>());
-  if (type_name == "pmu::v4::Baseline") return TypeSupport(new RawSampleType<pmu::v4::BaselinePubSubType>());
-  if (type_name == "pmu::v4::Command") return TypeSupport(new RawSampleType<pmu::v4::CommandPubSubType>());
-  if (type_name == "pmu::v4::AlarmAck") return TypeSupport(new RawSampleType<pmu::v4::AlarmAckPubSubType>());
-  if (type_name == "pmu::v4::AlarmAckReply") return TypeSupport(new RawSampleType<pmu::v4::AlarmAckReplyPubSubType>());
+  if (type_name == "pmu::v5::Voltages") return TypeSupport(new RawSampleType<pmu::v5::VoltagesPubSubType>());
+  if (type_name == "pmu::v5::Currents") return TypeSupport(new RawSampleType<pmu::v5::CurrentsPubSubType>());
+  if (type_name == "pmu::v5::BatteryEnergy") return TypeSupport(new RawSampleType<pmu::v5::BatteryEnergyPubSubType>());
+  if (type_name == "pmu::v5::Temperatures") return TypeSupport(new RawSampleType<pmu::v5::TemperaturesPubSubType>());
+  if (type_name == "pmu::v5::Status") return TypeSupport(new RawSampleType<pmu::v5::StatusPubSubType>());
+  if (type_name == "pmu::v5::Config") return TypeSupport(new RawSampleType<pmu::v5::ConfigPubSubType>());
+  if (type_name == "pmu::v5::DeviceInfo") return TypeSupport(new RawSampleType<pmu::v5::DeviceInfoPubSubType>());
+  if (type_name == "pmu::v5::Health") return TypeSupport(new RawSampleType<pmu::v5::HealthPubSubType>());
+  if (type_name == "pmu::v5::Battery") return TypeSupport(new RawSampleType<pmu::v5::BatteryPubSubType>());
+  if (type_name == "pmu::v5::BatteryCells") return TypeSupport(new RawSampleType<pmu::v5::BatteryCellsPubSubType>());
+  if (type_name == "pmu::v5::Mppt") return TypeSupport(new RawSampleType<pmu::v5::MpptPubSubType>());
+  if (type_name == "pmu::v5::Alarm") return TypeSupport(new RawSampleType<pmu::v5::AlarmPubSubType>());
+  if (type_name == "pmu::v5::Readiness") return TypeSupport(new RawSampleType<pmu::v5::ReadinessPubSubType>());
+  if (type_name == "pmu::v5::Energy") return TypeSupport(new RawSampleType<pmu::v5::EnergyPubSubType>());
+  if (type_name == "pmu::v5::BmsEnergy") return TypeSupport(new RawSampleType<pmu::v5::BmsEnergyPubSubType>());
+  if (type_name == "pmu::v5::Baseline") return TypeSupport(new RawSampleType<pmu::v5::BaselinePubSubType>());
+  if (type_name == "pmu::v5::Command") return TypeSupport(new RawSampleType<pmu::v5::CommandPubSubType>());
+  if (type_name == "pmu::v5::AlarmAck") return TypeSupport(new RawSampleType<pmu::v5::AlarmAckPubSubType>());
+  if (type_name == "pmu::v5::AlarmAckReply") return TypeSupport(new RawSampleType<pmu::v5::AlarmAckReplyPubSubType>());
   if (type_name == kRos2BatteryType) return TypeSupport(new RawSampleType<sensor_msgs::msg::BatteryStatePubSubType>());
   if (type_name == kRos2DiagnosticsType)
     return TypeSupport(new RawSampleType<diagnostic_msgs::msg::DiagnosticArrayPubSubType>());
-  return TypeSupport(new RawSampleType<pmu::v4::CommandReplyPubSubType>());
+  return TypeSupport(new RawSampleType<pmu::v5::CommandReplyPubSubType>());
 }
 
 void RawTopicReaders::open(pmu::dds::DdsContext& dds, const std::vector<const RecordedTopic*>& topics) {

@@ -36,7 +36,7 @@ struct RawSampleInfo {
 // The sink may take (move from) `sample.bytes`.
 using RawSampleSink = std::function<void(const RawSampleInfo& info, RawSample& sample)>;
 
-// A RawSampleType for the contract's DDS type name ("pmu::v4::Voltages") or ROS 2's
+// A RawSampleType for the contract's DDS type name ("pmu::v5::Voltages") or ROS 2's
 // (ros2_topics.hpp); the name must be one of recorded_topics()'s or those two.
 eprosima::fastdds::dds::TypeSupport raw_type_support(const std::string& type_name);
 

@@ -41,7 +41,7 @@ std::string_view choose_subprotocol(const std::vector<std::string>& offered);
 struct Channel {
   std::uint32_t id = 0;
   std::string topic;        // the DDS topic name, "pmu/voltages"
-  std::string schema_name;  // the DDS type name, "pmu::v4::Voltages"
+  std::string schema_name;  // the DDS type name, "pmu::v5::Voltages"
   std::string_view schema;  // the IDL text (static storage: pmu::idl_text)
   std::string_view schema_encoding = "omgidl";  // "ros2msg" for a ROS 2 topic (pmu::ros2_msg_text)
 };

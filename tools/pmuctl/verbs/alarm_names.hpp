@@ -7,8 +7,8 @@
 namespace pmu::tools {
 
 // "pmu", "battery", "mppt", "bus".
-const char* alarm_source_name(pmu::v4::AlarmSource k) noexcept;
+const char* alarm_source_name(pmu::v5::AlarmSource k) noexcept;
 // "NORMAL", "ACTIVE_UNACKNOWLEDGED", "ACTIVE_ACKNOWLEDGED", "CLEARED_UNACKNOWLEDGED".
-const char* alarm_state_name(pmu::v4::AlarmState s) noexcept;
+const char* alarm_state_name(pmu::v5::AlarmState s) noexcept;
 
 }  // namespace pmu::tools

@@ -5,26 +5,26 @@
 namespace pmu::tools {
 namespace {
 
-AlarmStatus status_of(pmu::v4::AlarmState s) {
+AlarmStatus status_of(pmu::v5::AlarmState s) {
   switch (s) {
-    case pmu::v4::ALARM_ACTIVE_UNACKNOWLEDGED: return AlarmStatus::ActiveUnacknowledged;
-    case pmu::v4::ALARM_ACTIVE_ACKNOWLEDGED: return AlarmStatus::ActiveAcknowledged;
-    case pmu::v4::ALARM_CLEARED_UNACKNOWLEDGED: return AlarmStatus::ClearedUnacknowledged;
-    case pmu::v4::ALARM_NORMAL: break;
+    case pmu::v5::ALARM_ACTIVE_UNACKNOWLEDGED: return AlarmStatus::ActiveUnacknowledged;
+    case pmu::v5::ALARM_ACTIVE_ACKNOWLEDGED: return AlarmStatus::ActiveAcknowledged;
+    case pmu::v5::ALARM_CLEARED_UNACKNOWLEDGED: return AlarmStatus::ClearedUnacknowledged;
+    case pmu::v5::ALARM_NORMAL: break;
   }
   return AlarmStatus::Normal;
 }
 
 }  // namespace
 
-AlarmEntry alarm_entry_of(const pmu::v4::Alarm& a) {
+AlarmEntry alarm_entry_of(const pmu::v5::Alarm& a) {
   AlarmEntry e;
   e.vehicle = a.vehicle().to_string();
   e.bus = a.bus().to_string();
   e.kind = alarm_source_name(a.kind());
   e.device = a.device();
   e.code = a.code().to_string();
-  e.critical = a.severity() == pmu::v4::SEVERITY_CRITICAL;
+  e.critical = a.severity() == pmu::v5::SEVERITY_CRITICAL;
   e.state = status_of(a.state());
   e.value = a.value();
   e.limit = a.limit();

@@ -1,5 +1,5 @@
 #pragma once
-// The edge between pmu/alarms and pmuctl's views: a pmu::v4::Alarm sample as the plain
+// The edge between pmu/alarms and pmuctl's views: a pmu::v5::Alarm sample as the plain
 // AlarmEntry of view/alarm_marker.hpp, and which alarms the global options select.
 
 #include "pmu/idl/alarms.h"
@@ -8,7 +8,7 @@
 
 namespace pmu::tools {
 
-AlarmEntry alarm_entry_of(const pmu::v4::Alarm& a);
+AlarmEntry alarm_entry_of(const pmu::v5::Alarm& a);
 
 // --address names a PMU: the alarms of batteries, MPPTs and buses drop out then.
 bool selected(const GlobalOptions& o, const AlarmEntry& a);

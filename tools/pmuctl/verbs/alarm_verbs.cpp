@@ -31,7 +31,7 @@ using Clock = std::chrono::steady_clock;
 // One alarm instance: the sample's keys, the kind as the contract orders it (PMU, battery,
 // MPPT, bus), which is the order the lines come in.
 using AlarmKey = std::tuple<std::string, std::string, int, std::uint16_t, std::string>;
-AlarmKey key_of(const pmu::v4::Alarm& a) {
+AlarmKey key_of(const pmu::v5::Alarm& a) {
   return {a.vehicle().to_string(), a.bus().to_string(), static_cast<int>(a.kind()), a.device(), a.code().to_string()};
 }
 
@@ -59,13 +59,13 @@ int run_alarms(const GlobalOptions& o) {
   ContextLease lease(o, kPmuctlParticipant);
   pmu::dds::DdsContext& dds = *lease;
   DataReader& reader = dds.reader(
-      dds.topic(topics::kAlarms, TypeSupport(new idl::Guarded<pmu::v4::AlarmPubSubType>())), qos_profiles::kAlarms);
+      dds.topic(topics::kAlarms, TypeSupport(new idl::Guarded<pmu::v5::AlarmPubSubType>())), qos_profiles::kAlarms);
   // A service with no alarm sends nothing on pmu/alarms, nor does one that is dead but still
   // matched (a participant that knew it holds it until its lease ends): its pmu/readiness,
   // which a live service sends a reader at once, tells them apart. No all-clear is said
   // unless a service answered (docs/safety.md H6).
   DataReader& readiness = dds.reader(
-      dds.topic(topics::kReadiness, TypeSupport(new idl::Guarded<pmu::v4::ReadinessPubSubType>())),
+      dds.topic(topics::kReadiness, TypeSupport(new idl::Guarded<pmu::v5::ReadinessPubSubType>())),
       qos_profiles::kState);
   std::set<InstanceHandle_t> answered;  // readiness writers heard
   const auto deadline = wait_end(o, 3.0);
@@ -78,7 +78,7 @@ int run_alarms(const GlobalOptions& o) {
   std::int32_t matched = 0;
   std::size_t coming = 0;
   while (Clock::now() < deadline) {
-    pmu::v4::Alarm a;
+    pmu::v5::Alarm a;
     SampleInfo info;
     while (reader.take_next_sample(&a, &info) == ReturnCode_t::RETCODE_OK) {
       last_change = Clock::now();
@@ -86,7 +86,7 @@ int run_alarms(const GlobalOptions& o) {
       const AlarmEntry e = alarm_entry_of(a);
       if (selected(o, e)) latest[key_of(a)] = e;
     }
-    pmu::v4::Readiness r;
+    pmu::v5::Readiness r;
     while (readiness.take_next_sample(&r, &info) == ReturnCode_t::RETCODE_OK)
       if (answered.insert(info.publication_handle).second) last_change = Clock::now();
     SubscriptionMatchedStatus st;

@@ -27,9 +27,9 @@ using namespace eprosima::fastdds::dds;
 using Clock = std::chrono::steady_clock;
 }  // namespace
 
-// The service's names for its results; pmu::v4::CommandResult has the same order (static_assert
+// The service's names for its results; pmu::v5::CommandResult has the same order (static_assert
 // in dds/src/dds_commands.cpp). The names are literals, so data() ends in NUL.
-const char* result_name(pmu::v4::CommandResult r) {
+const char* result_name(pmu::v5::CommandResult r) {
   return pmu::service::to_string(static_cast<pmu::service::CommandResult>(r)).data();
 }
 
@@ -53,7 +53,7 @@ std::optional<int> resolve_target(const GlobalOptions& o, const std::string& veh
     address = *o.address;
     return std::nullopt;
   }
-  DataReader& r = dds.reader(dds.topic(topics::kHealth, TypeSupport(new idl::Guarded<pmu::v4::HealthPubSubType>())),
+  DataReader& r = dds.reader(dds.topic(topics::kHealth, TypeSupport(new idl::Guarded<pmu::v5::HealthPubSubType>())),
                              qos_profiles::kState);
   std::set<std::pair<std::string, std::uint16_t>> seen;
   std::set<std::string> vehicles_seen;
@@ -62,7 +62,7 @@ std::optional<int> resolve_target(const GlobalOptions& o, const std::string& veh
   std::optional<Clock::time_point> settle;
   bool heard = false;
   while (Clock::now() < deadline) {
-    pmu::v4::Health h;
+    pmu::v5::Health h;
     SampleInfo info;
     while (r.take_next_sample(&h, &info) == ReturnCode_t::RETCODE_OK) {
       heard = true;
@@ -74,7 +74,7 @@ std::optional<int> resolve_target(const GlobalOptions& o, const std::string& veh
       }
       vehicles_seen.insert(h.vehicle().to_string());
       own_vehicle_seen = own_vehicle_seen || h.vehicle().to_string() == vehicle;
-      if (h.kind() == pmu::v4::KIND_PMU && h.vehicle().to_string() == vehicle &&
+      if (h.kind() == pmu::v5::KIND_PMU && h.vehicle().to_string() == vehicle &&
           (o.bus.empty() || o.bus == h.bus().to_string()) && (!o.address || *o.address == h.address())) {
         seen.insert({h.bus().to_string(), h.address()});
         handles[info.instance_handle] = {h.bus().to_string(), h.address()};
@@ -144,9 +144,9 @@ CommandChannel::CommandChannel(const GlobalOptions& o)
       lease_(o, kPmuctlParticipant),
       dds_(*lease_),
       replies_(dds_.reader(
-          dds_.topic(topics::kCommandReply, TypeSupport(new idl::Guarded<pmu::v4::CommandReplyPubSubType>())),
+          dds_.topic(topics::kCommandReply, TypeSupport(new idl::Guarded<pmu::v5::CommandReplyPubSubType>())),
           qos_profiles::kCommand)),
-      writer_(dds_.writer(dds_.topic(topics::kCommand, TypeSupport(new pmu::v4::CommandPubSubType())),
+      writer_(dds_.writer(dds_.topic(topics::kCommand, TypeSupport(new pmu::v5::CommandPubSubType())),
                           qos_profiles::kCommand)) {}
 
 void open_command_channels(const GlobalOptions& o, const std::vector<std::string>& vehicles) {
@@ -184,7 +184,7 @@ std::optional<int> CommandChannel::open(Clock::time_point deadline, std::string&
 }
 
 bool CommandChannel::recalled_target_gone(const Outcome& out, const std::string& bus, std::uint16_t address) {
-  if (!recalled_ || !options_.pool || !out.reply || out.reply->result() != pmu::v4::REJECTED ||
+  if (!recalled_ || !options_.pool || !out.reply || out.reply->result() != pmu::v5::REJECTED ||
       !says_target_gone(out.reply->reason().to_string(), {bus, address}))
     return false;
   options_.pool->targets().forget(query());
@@ -195,14 +195,14 @@ bool CommandChannel::recalled_target_gone(const Outcome& out, const std::string&
 CommandChannel::Outcome CommandChannel::send(const CommandSpec& spec, const std::string& bus, std::uint16_t address,
                                              double timeout, std::uint64_t expires_at_ns) {
   const auto deadline = Clock::now() + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(timeout));
-  pmu::v4::Command c;
+  pmu::v5::Command c;
   Outcome out;
   out.request_id = spec.request_id.empty() ? request_id() : spec.request_id;
   c.request_id(out.request_id);
   c.vehicle(vehicle_);
   c.bus(bus);
   c.address(address);
-  c.kind(static_cast<pmu::v4::CommandKind>(spec.kind));
+  c.kind(static_cast<pmu::v5::CommandKind>(spec.kind));
   c.parameter(spec.parameter);
   c.value(spec.value);
   c.outputs(spec.outputs);
@@ -231,13 +231,13 @@ CommandChannel::Outcome CommandChannel::send(const CommandSpec& spec, const std:
       (void)writer_.write(&c);
       next_resend = Clock::now() + kResendAfter;
     }
-    pmu::v4::CommandReply r;
+    pmu::v5::CommandReply r;
     SampleInfo info;
     while (replies_.take_next_sample(&r, &info) == ReturnCode_t::RETCODE_OK) {
       if (!info.valid_data || r.request_id().to_string() != out.request_id || r.vehicle().to_string() != vehicle_)
         continue;
       heard = true;
-      if (r.result() == pmu::v4::IN_PROGRESS) {
+      if (r.result() == pmu::v5::IN_PROGRESS) {
         std::fprintf(stderr, "IN_PROGRESS: %s\n", r.reason().c_str());
         wait_until = std::max(wait_until, Clock::now() + kProgressKeepsOpen);
         continue;

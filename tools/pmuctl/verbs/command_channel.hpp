@@ -1,5 +1,5 @@
 #pragma once
-// One participant that sends pmu::v4::Commands to one vehicle's service and takes their
+// One participant that sends pmu::v5::Commands to one vehicle's service and takes their
 // replies (interface.md 2.1, 2.4): `pmuctl` command verbs send one, `config apply` a series
 // over the same participant, so a change of ten settings costs one discovery, not ten.
 //
@@ -20,7 +20,7 @@
 namespace pmu::tools {
 
 // "COMPLETED", "REJECTED", ...: the service's names of its results.
-const char* result_name(pmu::v4::CommandResult r);
+const char* result_name(pmu::v5::CommandResult r);
 
 // A request id unique per sender: "pmuctl-HOST-PID-NANOSECONDS".
 std::string request_id();
@@ -73,7 +73,7 @@ class CommandChannel {
 
   struct Outcome {
     std::string request_id;
-    std::optional<pmu::v4::CommandReply> reply;  // the final reply; nullopt: none within the timeout
+    std::optional<pmu::v5::CommandReply> reply;  // the final reply; nullopt: none within the timeout
     bool written = true;                         // false: DDS refused the first write
   };
   // Sends one command and waits for its final reply, resending with the same id after 1 s

@@ -45,36 +45,36 @@ int run_alarm_ack(const GlobalOptions& o, const std::string& code, const std::st
   const double timeout = o.timeout.value_or(5.0);
   const auto deadline = wait_end(o, timeout);
   const std::string vehicle = o.vehicle.value_or(std::string());
-  pmu::v4::AlarmSource source = pmu::v4::SOURCE_PMU;
+  pmu::v5::AlarmSource source = pmu::v5::SOURCE_PMU;
   if (kind == "battery")
-    source = pmu::v4::SOURCE_BATTERY;
+    source = pmu::v5::SOURCE_BATTERY;
   else if (kind == "mppt")
-    source = pmu::v4::SOURCE_MPPT;
+    source = pmu::v5::SOURCE_MPPT;
   else if (kind == "bus")
-    source = pmu::v4::SOURCE_BUS;
+    source = pmu::v5::SOURCE_BUS;
   else if (kind != "pmu")
     return fail(o, ExitStatus::BadUsage, "--kind '" + pmu::service::printable(kind) + "': pmu, battery, mppt or bus");
-  if (source == pmu::v4::SOURCE_BUS && o.bus.empty())
+  if (source == pmu::v5::SOURCE_BUS && o.bus.empty())
     return fail(o, ExitStatus::BadUsage, "a bus alarm needs --bus");
-  if ((source == pmu::v4::SOURCE_BATTERY || source == pmu::v4::SOURCE_MPPT) && (o.bus.empty() || !o.address))
+  if ((source == pmu::v5::SOURCE_BATTERY || source == pmu::v5::SOURCE_MPPT) && (o.bus.empty() || !o.address))
     return fail(o, ExitStatus::BadUsage, "a " + kind + " alarm needs --bus and --address (the " +
-                                             (source == pmu::v4::SOURCE_BATTERY ? "CANopen node" : "MPPT device id") +
+                                             (source == pmu::v5::SOURCE_BATTERY ? "CANopen node" : "MPPT device id") +
                                              ")");
   ContextLease lease(o, kPmuctlParticipant);
   pmu::dds::DdsContext& dds = *lease;
   DataReader& replies = dds.reader(
-      dds.topic(topics::kAlarmAckReply, TypeSupport(new idl::Guarded<pmu::v4::AlarmAckReplyPubSubType>())),
+      dds.topic(topics::kAlarmAckReply, TypeSupport(new idl::Guarded<pmu::v5::AlarmAckReplyPubSubType>())),
       qos_profiles::kCommand);
   DataWriter& writer =
-      dds.writer(dds.topic(topics::kAlarmAck, TypeSupport(new pmu::v4::AlarmAckPubSubType())), qos_profiles::kCommand);
+      dds.writer(dds.topic(topics::kAlarmAck, TypeSupport(new pmu::v5::AlarmAckPubSubType())), qos_profiles::kCommand);
   std::string bus = o.bus;
-  std::uint16_t device = source == pmu::v4::SOURCE_BUS ? 0 : o.address.value_or(0);
-  if (source == pmu::v4::SOURCE_PMU)
+  std::uint16_t device = source == pmu::v5::SOURCE_BUS ? 0 : o.address.value_or(0);
+  if (source == pmu::v5::SOURCE_PMU)
     if (const auto failed = resolve_target(o, vehicle, dds, deadline, bus, device)) return *failed;
   if (const auto failed = wait_for_match(o, dds, writer, replies, vehicle, deadline, "accepts alarm acknowledgements"))
     return *failed;
 
-  pmu::v4::AlarmAck a;
+  pmu::v5::AlarmAck a;
   const std::string id = request_id();
   a.request_id(id);
   a.vehicle(vehicle);
@@ -97,11 +97,11 @@ int run_alarm_ack(const GlobalOptions& o, const std::string& code, const std::st
       (void)writer.write(&a);
       next_resend = Clock::now() + kResendAfter;
     }
-    pmu::v4::AlarmAckReply r;
+    pmu::v5::AlarmAckReply r;
     SampleInfo info;
     while (replies.take_next_sample(&r, &info) == ReturnCode_t::RETCODE_OK) {
       if (!info.valid_data || r.request_id().to_string() != id || r.vehicle().to_string() != vehicle) continue;
-      const bool done = r.result() == pmu::v4::ACK_COMPLETED;
+      const bool done = r.result() == pmu::v5::ACK_COMPLETED;
       const char* result = done ? "COMPLETED" : "REJECTED";
       if (o.json) {
         Json j{{"request_id", id},
@@ -167,7 +167,7 @@ bool group_mask(const std::vector<std::string>& names, std::uint8_t& mask) {
 }
 
 std::string broadcast_refusal(const GlobalOptions& o, int kind) {
-  if (!o.address || *o.address != codec::kBroadcastAddress || kind == pmu::v4::ENGINE_STOP) return {};
+  if (!o.address || *o.address != codec::kBroadcastAddress || kind == pmu::v5::ENGINE_STOP) return {};
   return "--address 65535 (broadcast) is only for `engine stop`: every other command names one PMU";
 }
 
@@ -178,7 +178,7 @@ int run_command(const GlobalOptions& o, const CommandSpec& spec) {
   // A stop to the broadcast address needs no PMU seen: with --bus it goes to that bus, without
   // to every bus of the service (bus ""), so an engine can be stopped whatever the service
   // has read so far.
-  const bool broadcast = spec.kind == pmu::v4::ENGINE_STOP && o.address && *o.address == codec::kBroadcastAddress;
+  const bool broadcast = spec.kind == pmu::v5::ENGINE_STOP && o.address && *o.address == codec::kBroadcastAddress;
   std::string bus = broadcast ? o.bus : std::string();
   std::uint16_t address = broadcast ? codec::kBroadcastAddress : 0;
   using Find = CommandChannel::Find;
@@ -202,8 +202,8 @@ int run_command(const GlobalOptions& o, const CommandSpec& spec) {
     // A bus the service does not serve, or no such device on it, is no such target (2), as
     // when pmuctl finds that out itself; the service executed nothing (interface.md 3.2).
     const ExitStatus status =
-        r->result() == pmu::v4::COMPLETED ? ExitStatus::Ok
-        : r->result() == pmu::v4::REJECTED && pmu::service::says_no_such_target(r->reason().to_string(), bus, address)
+        r->result() == pmu::v5::COMPLETED ? ExitStatus::Ok
+        : r->result() == pmu::v5::REJECTED && pmu::service::says_no_such_target(r->reason().to_string(), bus, address)
             ? ExitStatus::BadUsage
             : ExitStatus::NotDone;
     if (o.json) {

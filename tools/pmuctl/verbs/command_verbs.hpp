@@ -1,6 +1,6 @@
 #pragma once
-// pmuctl's command verbs (interface.md section 3.2): one pmu::v4::Command, exactly one final
-// pmu::v4::CommandReply. Exit status 0 only for COMPLETED (exit_status.hpp); the result and
+// pmuctl's command verbs (interface.md section 3.2): one pmu::v5::Command, exactly one final
+// pmu::v5::CommandReply. Exit status 0 only for COMPLETED (exit_status.hpp); the result and
 // reason go to stderr.
 
 #include <cstdint>
@@ -12,7 +12,7 @@
 namespace pmu::tools {
 
 struct CommandSpec {
-  int kind = 0;  // pmu::v4::CommandKind
+  int kind = 0;  // pmu::v5::CommandKind
   std::string parameter;
   double value = 0;
   std::uint8_t outputs = 0;
@@ -24,7 +24,7 @@ struct CommandSpec {
 
 int run_command(const GlobalOptions& o, const CommandSpec& spec);
 
-// pmuctl alarms ack CODE: one pmu::v4::AlarmAck, exactly one AlarmAckReply (interface.md 1.6).
+// pmuctl alarms ack CODE: one pmu::v5::AlarmAck, exactly one AlarmAckReply (interface.md 1.6).
 // `kind` is "pmu" (the PMU chosen as for commands), "battery", "mppt" (--bus and --address the
 // node or device id) or "bus" (--bus). Exit 0 for ACK_COMPLETED, 1 otherwise, 3 no answer.
 int run_alarm_ack(const GlobalOptions& o, const std::string& code, const std::string& kind);

@@ -58,32 +58,32 @@ class DeviceReader {
  public:
   DeviceReader(pmu::dds::DdsContext& dds, std::string vehicle)
       : vehicle_(std::move(vehicle)),
-        config_(dds.reader(dds.topic(topics::kConfig, TypeSupport(new idl::Guarded<pmu::v4::ConfigPubSubType>())),
+        config_(dds.reader(dds.topic(topics::kConfig, TypeSupport(new idl::Guarded<pmu::v5::ConfigPubSubType>())),
                            qos_profiles::kState)),
-        info_(dds.reader(dds.topic(topics::kInfo, TypeSupport(new idl::Guarded<pmu::v4::DeviceInfoPubSubType>())),
+        info_(dds.reader(dds.topic(topics::kInfo, TypeSupport(new idl::Guarded<pmu::v5::DeviceInfoPubSubType>())),
                          qos_profiles::kState)),
-        baseline_(dds.reader(dds.topic(topics::kBaseline, TypeSupport(new idl::Guarded<pmu::v4::BaselinePubSubType>())),
+        baseline_(dds.reader(dds.topic(topics::kBaseline, TypeSupport(new idl::Guarded<pmu::v5::BaselinePubSubType>())),
                              qos_profiles::kState)),
-        health_(dds.reader(dds.topic(topics::kHealth, TypeSupport(new idl::Guarded<pmu::v4::HealthPubSubType>())),
+        health_(dds.reader(dds.topic(topics::kHealth, TypeSupport(new idl::Guarded<pmu::v5::HealthPubSubType>())),
                            qos_profiles::kState)) {}
 
   void poll() {
     SampleInfo si;
-    pmu::v4::Config c;
+    pmu::v5::Config c;
     while (config_.take_next_sample(&c, &si) == ReturnCode_t::RETCODE_OK)
       if (si.valid_data && c.vehicle().to_string() == vehicle_) configs_[{c.bus().to_string(), c.address()}] = c;
-    pmu::v4::DeviceInfo i;
+    pmu::v5::DeviceInfo i;
     while (info_.take_next_sample(&i, &si) == ReturnCode_t::RETCODE_OK)
       if (si.valid_data && i.vehicle().to_string() == vehicle_) infos_[{i.bus().to_string(), i.address()}] = i;
-    pmu::v4::Health h;
+    pmu::v5::Health h;
     while (health_.take_next_sample(&h, &si) == ReturnCode_t::RETCODE_OK) {
-      if (si.valid_data && h.vehicle().to_string() == vehicle_ && h.kind() == pmu::v4::KIND_PMU) {
+      if (si.valid_data && h.vehicle().to_string() == vehicle_ && h.kind() == pmu::v5::KIND_PMU) {
         pmus_[si.instance_handle] = {h.bus().to_string(), h.address()};
       } else if (!si.valid_data && si.instance_state != ALIVE_INSTANCE_STATE) {
         pmus_.erase(si.instance_handle);  // disposed: a PMU that moved is no longer at its old address
       }
     }
-    pmu::v4::Baseline b;
+    pmu::v5::Baseline b;
     while (baseline_.take_next_sample(&b, &si) == ReturnCode_t::RETCODE_OK) {
       if (si.valid_data) {
         if (b.vehicle().to_string() == vehicle_) baselines_[{b.bus().to_string(), b.address()}] = b;
@@ -98,7 +98,7 @@ class DeviceReader {
   enum class Said { Nothing, NoBaseline, Baseline };
   Said baseline_said(const std::string& bus, std::uint16_t address) {
     if (baselines_.count({bus, address})) return Said::Baseline;
-    pmu::v4::Baseline key;
+    pmu::v5::Baseline key;
     key.vehicle(vehicle_);
     key.bus(bus);
     key.address(address);
@@ -111,15 +111,15 @@ class DeviceReader {
     poll_until([&] { return baseline_said(bus, address) != Said::Nothing; }, deadline);
     return baseline_said(bus, address);
   }
-  const pmu::v4::Baseline* baseline(const std::string& bus, std::uint16_t address) const {
+  const pmu::v5::Baseline* baseline(const std::string& bus, std::uint16_t address) const {
     const auto it = baselines_.find({bus, address});
     return it == baselines_.end() ? nullptr : &it->second;
   }
-  const pmu::v4::Config* config(const std::string& bus, std::uint16_t address) const {
+  const pmu::v5::Config* config(const std::string& bus, std::uint16_t address) const {
     const auto it = configs_.find({bus, address});
     return it == configs_.end() ? nullptr : &it->second;
   }
-  const pmu::v4::DeviceInfo* info(const std::string& bus, std::uint16_t address) const {
+  const pmu::v5::DeviceInfo* info(const std::string& bus, std::uint16_t address) const {
     const auto it = infos_.find({bus, address});
     return it == infos_.end() ? nullptr : &it->second;
   }
@@ -159,13 +159,13 @@ class DeviceReader {
   DataReader& baseline_;
   DataReader& health_;
   std::map<InstanceHandle_t, std::pair<std::string, std::uint16_t>> pmus_;  // pmu/health of PMUs
-  std::map<std::pair<std::string, std::uint16_t>, pmu::v4::Config> configs_;
-  std::map<std::pair<std::string, std::uint16_t>, pmu::v4::Baseline> baselines_;
+  std::map<std::pair<std::string, std::uint16_t>, pmu::v5::Config> configs_;
+  std::map<std::pair<std::string, std::uint16_t>, pmu::v5::Baseline> baselines_;
   std::set<InstanceHandle_t> disposed_;  // pmu/baseline instances of PMUs without one
-  std::map<std::pair<std::string, std::uint16_t>, pmu::v4::DeviceInfo> infos_;
+  std::map<std::pair<std::string, std::uint16_t>, pmu::v5::DeviceInfo> infos_;
 };
 
-codec::FirmwareVersion firmware_of(const pmu::v4::DeviceInfo& i) { return {i.firmware_major(), i.firmware_minor()}; }
+codec::FirmwareVersion firmware_of(const pmu::v5::DeviceInfo& i) { return {i.firmware_major(), i.firmware_minor()}; }
 
 // The file's text, or the exit status after saying why it cannot be read.
 // Regular and bounded only (the reader the service uses): `config diff /dev/zero` or a FIFO
@@ -268,14 +268,14 @@ CommandSpec command_for(Setting s, std::uint32_t raw, bool confirm) {
   spec.confirm = confirm;
   const auto action = baseline::action_for(s, raw);
   if (const auto* o = std::get_if<service::action::SetOutputs>(&action)) {
-    spec.kind = pmu::v4::SET_OUTPUTS;
+    spec.kind = pmu::v5::SET_OUTPUTS;
     spec.outputs = o->mask;
   } else if (const auto* g = std::get_if<service::action::SetGeneration>(&action)) {
-    spec.kind = pmu::v4::SET_GENERATION;
+    spec.kind = pmu::v5::SET_GENERATION;
     spec.enable = g->enable;
   } else {
     const auto& p = std::get<service::action::SetParameter>(action);
-    spec.kind = pmu::v4::SET_PARAMETER;
+    spec.kind = pmu::v5::SET_PARAMETER;
     spec.parameter = std::string(codec::spec_of(p.parameter).name);
     spec.value = codec::parameter_value(p.parameter, p.raw);
   }
@@ -294,13 +294,13 @@ std::string outcome_text(const CommandChannel::Outcome& out, double timeout) {
   return std::string(result_name(out.reply->result())) + (reason.empty() ? "" : ": " + reason);
 }
 bool completed(const CommandChannel::Outcome& out) {
-  return out.written && out.reply && out.reply->result() == pmu::v4::COMPLETED;
+  return out.written && out.reply && out.reply->result() == pmu::v5::COMPLETED;
 }
 
 // A GET of one setting, under the name `config get` takes.
 CommandSpec read_spec(Setting s) {
   CommandSpec spec;
-  spec.kind = pmu::v4::GET;
+  spec.kind = pmu::v5::GET;
   spec.parameter = std::string(baseline::setting_name(s));
   return spec;
 }
@@ -572,7 +572,7 @@ int apply(const GlobalOptions& o, const std::string& file, bool dry_run, bool co
     const auto out = held.send(read_spec(s), address);
     read[s] = raw_value(s, out);
     if (read[s]) continue;
-    const bool denied = out.reply && out.reply->result() == pmu::v4::DENIED;
+    const bool denied = out.reply && out.reply->result() == pmu::v5::DENIED;
     if (!denied) held.release(address);
     return fail(o, ExitStatus::NotDone,
                 label + ": " + file + " not applied: reading " + std::string(baseline::setting_name(s)) + ": " +

@@ -29,7 +29,7 @@ void print_json(Json j) {
   std::printf("%s\n", j.dump(-1, ' ', false, Json::error_handler_t::replace).c_str());
 }
 
-Json battery_json(const pmu::v4::EnergyBattery& b) {
+Json battery_json(const pmu::v5::EnergyBattery& b) {
   return {{"power", number_or_null(b.power())},
           {"used_wh", number_or_null(b.used_wh())},
           {"integrated_s", number_or_null(b.integrated_s())},
@@ -67,13 +67,13 @@ std::string amp_hours(float ah) {
   return buf;
 }
 
-void print_battery(const char* name, const pmu::v4::EnergyBattery& b) {
+void print_battery(const char* name, const pmu::v5::EnergyBattery& b) {
   std::printf("  %-10s %10s  used %8.3f Wh in %.0f s  endurance %s to %.1f V\n", name, watts(b.power()).c_str(),
               b.used_wh(), static_cast<double>(b.integrated_s()), duration_text(b.endurance_s()).c_str(),
               static_cast<double>(b.critical_voltage()));
 }
 
-void print_pmu(const GlobalOptions& o, const pmu::v4::Energy& e) {
+void print_pmu(const GlobalOptions& o, const pmu::v5::Energy& e) {
   if (o.json) {
     Json values{{"avionics_power", number_or_null(e.avionics_power())},
                 {"output_28v_power", number_or_null(e.output_28v_power())},
@@ -98,7 +98,7 @@ void print_pmu(const GlobalOptions& o, const pmu::v4::Energy& e) {
   print_battery("battery B", e.battery_b());
 }
 
-void print_bms(const GlobalOptions& o, const pmu::v4::BmsEnergy& e) {
+void print_bms(const GlobalOptions& o, const pmu::v5::BmsEnergy& e) {
   if (o.json) {
     Json values{{"power", number_or_null(e.power())},
                 {"used_wh", number_or_null(e.used_wh())},
@@ -125,7 +125,7 @@ void print_bms(const GlobalOptions& o, const pmu::v4::BmsEnergy& e) {
 }  // namespace
 }  // namespace energy_lines
 
-void print_energy(const GlobalOptions& o, const pmu::v4::Energy& e) { energy_lines::print_pmu(o, e); }
-void print_bms_energy(const GlobalOptions& o, const pmu::v4::BmsEnergy& e) { energy_lines::print_bms(o, e); }
+void print_energy(const GlobalOptions& o, const pmu::v5::Energy& e) { energy_lines::print_pmu(o, e); }
+void print_bms_energy(const GlobalOptions& o, const pmu::v5::BmsEnergy& e) { energy_lines::print_bms(o, e); }
 
 }  // namespace pmu::tools

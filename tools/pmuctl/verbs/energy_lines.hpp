@@ -9,8 +9,8 @@
 namespace pmu::tools {
 
 // A PMU's pmu/energy: the outputs', generator's and batteries' figures.
-void print_energy(const GlobalOptions& o, const pmu::v4::Energy& e);
+void print_energy(const GlobalOptions& o, const pmu::v5::Energy& e);
 // A BMS-reported battery's pmu/bms_energy, labelled as watch labels it (`can0/battery2`).
-void print_bms_energy(const GlobalOptions& o, const pmu::v4::BmsEnergy& e);
+void print_bms_energy(const GlobalOptions& o, const pmu::v5::BmsEnergy& e);
 
 }  // namespace pmu::tools

@@ -31,13 +31,13 @@ using Key = std::tuple<std::string, std::string, std::uint16_t>;  // vehicle, bu
 bool selected(const GlobalOptions& o, const std::string& vehicle, const std::string& bus) {
   return (!o.vehicle || *o.vehicle == vehicle) && (o.bus.empty() || o.bus == bus);
 }
-Key key_of(const pmu::v4::Energy& e) { return {e.vehicle().to_string(), e.bus().to_string(), e.address()}; }
-Key key_of(const pmu::v4::BmsEnergy& e) { return {e.vehicle().to_string(), e.bus().to_string(), e.node()}; }
-bool selected(const GlobalOptions& o, const pmu::v4::Energy& e) {
+Key key_of(const pmu::v5::Energy& e) { return {e.vehicle().to_string(), e.bus().to_string(), e.address()}; }
+Key key_of(const pmu::v5::BmsEnergy& e) { return {e.vehicle().to_string(), e.bus().to_string(), e.node()}; }
+bool selected(const GlobalOptions& o, const pmu::v5::Energy& e) {
   return selected(o, e.vehicle().to_string(), e.bus().to_string()) && (!o.address || *o.address == e.address());
 }
 // --address names a PMU, so with it no battery is shown (as list and health do).
-bool selected(const GlobalOptions& o, const pmu::v4::BmsEnergy& e) {
+bool selected(const GlobalOptions& o, const pmu::v5::BmsEnergy& e) {
   return !o.address && selected(o, e.vehicle().to_string(), e.bus().to_string());
 }
 
@@ -78,15 +78,15 @@ int run(const GlobalOptions& o) {
   ContextLease lease(o, kPmuctlParticipant);
   pmu::dds::DdsContext& dds = *lease;
   DataReader& pmus =
-      dds.reader(dds.topic(topics::kEnergy, TypeSupport(new idl::Guarded<pmu::v4::EnergyPubSubType>())),
+      dds.reader(dds.topic(topics::kEnergy, TypeSupport(new idl::Guarded<pmu::v5::EnergyPubSubType>())),
                  qos_profiles::kState);
   DataReader& batteries =
-      dds.reader(dds.topic(topics::kBmsEnergy, TypeSupport(new idl::Guarded<pmu::v4::BmsEnergyPubSubType>())),
+      dds.reader(dds.topic(topics::kBmsEnergy, TypeSupport(new idl::Guarded<pmu::v5::BmsEnergyPubSubType>())),
                  qos_profiles::kState);
   const auto deadline = wait_end(o, 3.0);
   StateSettle settle(std::chrono::milliseconds(300));
-  Latest<pmu::v4::Energy> pmu_figures;
-  Latest<pmu::v4::BmsEnergy> bms_figures;
+  Latest<pmu::v5::Energy> pmu_figures;
+  Latest<pmu::v5::BmsEnergy> bms_figures;
   while (Clock::now() < deadline) {
     pmu_figures.take(o, pmus);
     bms_figures.take(o, batteries);

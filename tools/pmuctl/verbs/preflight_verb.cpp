@@ -25,22 +25,22 @@ namespace {
 using namespace eprosima::fastdds::dds;
 using Clock = std::chrono::steady_clock;
 
-const char* level_name(pmu::v4::ReadinessLevel l) {
+const char* level_name(pmu::v5::ReadinessLevel l) {
   switch (l) {
-    case pmu::v4::LEVEL_WARNING: return "WARNING";
-    case pmu::v4::LEVEL_NOT_READY: return "NOT_READY";
-    case pmu::v4::LEVEL_READY: break;
+    case pmu::v5::LEVEL_WARNING: return "WARNING";
+    case pmu::v5::LEVEL_NOT_READY: return "NOT_READY";
+    case pmu::v5::LEVEL_READY: break;
   }
   return "READY";
 }
 
-void print(const GlobalOptions& o, const pmu::v4::Readiness& r) {
+void print(const GlobalOptions& o, const pmu::v5::Readiness& r) {
   const std::string vehicle = r.vehicle().to_string();
   if (o.json) {
     nlohmann::json reasons = nlohmann::json::array();
     for (const auto& x : r.reasons())
       reasons.push_back({{"code", x.code().to_string()},
-                         {"severity", x.severity() == pmu::v4::SEVERITY_CRITICAL ? "critical" : "warning"},
+                         {"severity", x.severity() == pmu::v5::SEVERITY_CRITICAL ? "critical" : "warning"},
                          {"bus", x.bus().to_string()},
                          {"kind", alarm_source_name(x.kind())},
                          {"device", x.device()},
@@ -58,14 +58,14 @@ void print(const GlobalOptions& o, const pmu::v4::Readiness& r) {
     return;
   }
   std::printf("%s: %s", vehicle.empty() ? "(unnamed vehicle)" : vehicle.c_str(),
-              r.ready() ? (r.level() == pmu::v4::LEVEL_WARNING ? "READY, with warnings" : "READY") : "NOT READY");
+              r.ready() ? (r.level() == pmu::v5::LEVEL_WARNING ? "READY, with warnings" : "READY") : "NOT READY");
   std::printf(r.reasons_total() ? " (%u reason%s)\n" : "\n", r.reasons_total(), r.reasons_total() == 1 ? "" : "s");
   for (const auto& x : r.reasons()) {
     std::string where = x.bus().to_string();
-    if (x.kind() != pmu::v4::SOURCE_BUS)
-      where += "/" + std::string(x.kind() == pmu::v4::SOURCE_PMU ? "" : alarm_source_name(x.kind())) + std::to_string(x.device());
+    if (x.kind() != pmu::v5::SOURCE_BUS)
+      where += "/" + std::string(x.kind() == pmu::v5::SOURCE_PMU ? "" : alarm_source_name(x.kind())) + std::to_string(x.device());
     std::printf("  %-8s %-24s %-14s %s\n           %s\n",
-                x.severity() == pmu::v4::SEVERITY_CRITICAL ? "CRITICAL" : "WARNING", x.code().c_str(), where.c_str(),
+                x.severity() == pmu::v5::SEVERITY_CRITICAL ? "CRITICAL" : "WARNING", x.code().c_str(), where.c_str(),
                 x.message().c_str(), x.description().c_str());
   }
   if (r.reasons_total() > r.reasons().size())
@@ -78,14 +78,14 @@ int run_preflight(const GlobalOptions& o) {
   ContextLease lease(o, kPmuctlParticipant);
   pmu::dds::DdsContext& dds = *lease;
   DataReader& reader =
-      dds.reader(dds.topic(topics::kReadiness, TypeSupport(new idl::Guarded<pmu::v4::ReadinessPubSubType>())),
+      dds.reader(dds.topic(topics::kReadiness, TypeSupport(new idl::Guarded<pmu::v5::ReadinessPubSubType>())),
                  qos_profiles::kState);
   const auto deadline = wait_end(o, 3.0);
   StateSettle settle(std::chrono::milliseconds(300));
-  std::map<std::string, pmu::v4::Readiness> latest;
+  std::map<std::string, pmu::v5::Readiness> latest;
   std::set<InstanceHandle_t> writers;
   while (Clock::now() < deadline) {
-    pmu::v4::Readiness r;
+    pmu::v5::Readiness r;
     SampleInfo info;
     while (reader.take_next_sample(&r, &info) == ReturnCode_t::RETCODE_OK) {
       writers.insert(info.publication_handle);

@@ -43,7 +43,7 @@ using namespace eprosima::fastdds::dds;
 using Clock = std::chrono::steady_clock;
 
 
-// The names `config get` takes: pmu::v4::Config's fields.
+// The names `config get` takes: pmu::v5::Config's fields.
 std::string config_names() {
   std::string names;
   for (const auto& spec : codec::parameter_table()) names += std::string(spec.name) + ", ";
@@ -75,7 +75,7 @@ struct DeviceId {
   std::string vehicle;
   std::string bus;
   std::uint16_t address;
-  pmu::v4::DeviceKind kind = pmu::v4::KIND_PMU;
+  pmu::v5::DeviceKind kind = pmu::v5::KIND_PMU;
   bool operator<(const DeviceId& o) const {
     return std::tie(vehicle, bus, kind, address) < std::tie(o.vehicle, o.bus, o.kind, o.address);
   }
@@ -85,36 +85,36 @@ template <class T>
 DeviceId id_of(const T& s) {
   return {s.vehicle().to_string(), s.bus().to_string(), s.address()};
 }
-DeviceId id_of(const pmu::v4::Health& s) {
+DeviceId id_of(const pmu::v5::Health& s) {
   return {s.vehicle().to_string(), s.bus().to_string(), s.address(), s.kind()};
 }
-DeviceId id_of(const pmu::v4::Battery& s) {
-  return {s.vehicle().to_string(), s.bus().to_string(), s.node(), pmu::v4::KIND_BATTERY};
+DeviceId id_of(const pmu::v5::Battery& s) {
+  return {s.vehicle().to_string(), s.bus().to_string(), s.node(), pmu::v5::KIND_BATTERY};
 }
-DeviceId id_of(const pmu::v4::BatteryCells& s) {
-  return {s.vehicle().to_string(), s.bus().to_string(), s.node(), pmu::v4::KIND_BATTERY};
+DeviceId id_of(const pmu::v5::BatteryCells& s) {
+  return {s.vehicle().to_string(), s.bus().to_string(), s.node(), pmu::v5::KIND_BATTERY};
 }
-DeviceId id_of(const pmu::v4::Mppt& s) {
-  return {s.vehicle().to_string(), s.bus().to_string(), s.device(), pmu::v4::KIND_MPPT};
+DeviceId id_of(const pmu::v5::Mppt& s) {
+  return {s.vehicle().to_string(), s.bus().to_string(), s.device(), pmu::v5::KIND_MPPT};
 }
 
 // --address names a PMU: batteries and MPPTs are selected by vehicle and bus alone, and
 // drop out when a PMU is named.
 bool selected(const GlobalOptions& o, const DeviceId& d) {
   return (!o.vehicle || *o.vehicle == d.vehicle) && (o.bus.empty() || o.bus == d.bus) &&
-         (!o.address || (d.kind == pmu::v4::KIND_PMU && *o.address == d.address));
+         (!o.address || (d.kind == pmu::v5::KIND_PMU && *o.address == d.address));
 }
 
 // "can0/1" for a PMU, "can0/battery2" and "can0/mppt4" for the others.
 std::string label(const DeviceId& d) {
-  if (d.kind == pmu::v4::KIND_PMU) return device_label(d.vehicle, d.bus, d.address);
+  if (d.kind == pmu::v5::KIND_PMU) return device_label(d.vehicle, d.bus, d.address);
   return (d.vehicle.empty() ? std::string() : d.vehicle + "/") + d.bus + "/" + to_string(d.kind) +
          std::to_string(d.address);
 }
 
 // The JSON key of a device's number: the contract's key name of its type.
-const char* number_key(pmu::v4::DeviceKind k) {
-  return k == pmu::v4::KIND_BATTERY ? "node" : k == pmu::v4::KIND_MPPT ? "device" : "address";
+const char* number_key(pmu::v5::DeviceKind k) {
+  return k == pmu::v5::KIND_BATTERY ? "node" : k == pmu::v5::KIND_MPPT ? "device" : "address";
 }
 
 // Reads every sample of one state topic (TRANSIENT_LOCAL: the service's current values
@@ -302,15 +302,15 @@ int run_watch(const GlobalOptions& o, long count) {
   std::vector<std::unique_ptr<TelemetryReader>> readers;
   // --low-rate: only the low-rate topics' writers match, so only their samples cross the link.
   const bool low = o.low_rate;
-  readers.push_back(std::make_unique<TypedTelemetryReader<pmu::v4::Voltages, pmu::v4::VoltagesPubSubType>>(
+  readers.push_back(std::make_unique<TypedTelemetryReader<pmu::v5::Voltages, pmu::v5::VoltagesPubSubType>>(
       dds, low ? topics::kLowRateVoltages : topics::kVoltages));
-  readers.push_back(std::make_unique<TypedTelemetryReader<pmu::v4::Currents, pmu::v4::CurrentsPubSubType>>(
+  readers.push_back(std::make_unique<TypedTelemetryReader<pmu::v5::Currents, pmu::v5::CurrentsPubSubType>>(
       dds, low ? topics::kLowRateCurrents : topics::kCurrents));
-  readers.push_back(std::make_unique<TypedTelemetryReader<pmu::v4::BatteryEnergy, pmu::v4::BatteryEnergyPubSubType>>(
+  readers.push_back(std::make_unique<TypedTelemetryReader<pmu::v5::BatteryEnergy, pmu::v5::BatteryEnergyPubSubType>>(
       dds, low ? topics::kLowRateBatteryEnergy : topics::kBatteryEnergy));
-  readers.push_back(std::make_unique<TypedTelemetryReader<pmu::v4::Temperatures, pmu::v4::TemperaturesPubSubType>>(
+  readers.push_back(std::make_unique<TypedTelemetryReader<pmu::v5::Temperatures, pmu::v5::TemperaturesPubSubType>>(
       dds, low ? topics::kLowRateTemperatures : topics::kTemperatures));
-  readers.push_back(std::make_unique<TypedTelemetryReader<pmu::v4::Status, pmu::v4::StatusPubSubType>>(
+  readers.push_back(std::make_unique<TypedTelemetryReader<pmu::v5::Status, pmu::v5::StatusPubSubType>>(
       dds, low ? topics::kLowRateStatus : topics::kStatus));
   // Batteries and MPPTs have no low-rate topics: their canopen_publish_period already holds
   // them to a few samples a second.
@@ -319,10 +319,10 @@ int run_watch(const GlobalOptions& o, long count) {
   if (!low) {
     try {
       readers.push_back(
-          std::make_unique<TypedTelemetryReader<pmu::v4::Battery, pmu::v4::BatteryPubSubType>>(dds, topics::kBattery));
-      readers.push_back(std::make_unique<TypedTelemetryReader<pmu::v4::BatteryCells, pmu::v4::BatteryCellsPubSubType>>(
+          std::make_unique<TypedTelemetryReader<pmu::v5::Battery, pmu::v5::BatteryPubSubType>>(dds, topics::kBattery));
+      readers.push_back(std::make_unique<TypedTelemetryReader<pmu::v5::BatteryCells, pmu::v5::BatteryCellsPubSubType>>(
           dds, topics::kBatteryCells));
-      readers.push_back(std::make_unique<TypedTelemetryReader<pmu::v4::Mppt, pmu::v4::MpptPubSubType>>(dds, topics::kMppt));
+      readers.push_back(std::make_unique<TypedTelemetryReader<pmu::v5::Mppt, pmu::v5::MpptPubSubType>>(dds, topics::kMppt));
     } catch (const pmu::dds::DdsError& e) {
       std::fprintf(stderr, "pmuctl: not showing batteries and MPPTs: %s\n", e.what());
     }
@@ -333,7 +333,7 @@ int run_watch(const GlobalOptions& o, long count) {
   DataReader* alarm_reader = nullptr;
   try {
     alarm_reader = &dds.reader(
-        dds.topic(topics::kAlarms, TypeSupport(new idl::Guarded<pmu::v4::AlarmPubSubType>())), qos_profiles::kAlarms);
+        dds.topic(topics::kAlarms, TypeSupport(new idl::Guarded<pmu::v5::AlarmPubSubType>())), qos_profiles::kAlarms);
   } catch (const pmu::dds::DdsError& e) {
     std::fprintf(stderr, "pmuctl: not showing alarms: %s\n", e.what());
   }
@@ -348,8 +348,8 @@ int run_watch(const GlobalOptions& o, long count) {
 
   // Every row says its device's health and its values' age: a device gone OFFLINE keeps
   // its last row, which must not look live.
-  StateCollector<pmu::v4::Health, pmu::v4::HealthPubSubType> health(dds, topics::kHealth);
-  const auto health_of = [&health](const DeviceId& d) -> std::optional<pmu::v4::HealthState> {
+  StateCollector<pmu::v5::Health, pmu::v5::HealthPubSubType> health(dds, topics::kHealth);
+  const auto health_of = [&health](const DeviceId& d) -> std::optional<pmu::v5::HealthState> {
     const auto it = health.latest().find(d);
     if (it == health.latest().end()) return std::nullopt;
     return it->second.state();
@@ -366,7 +366,7 @@ int run_watch(const GlobalOptions& o, long count) {
     bool any = false;
     health.poll(o);
     // Before the telemetry, so the lines of a device whose alarm came with them carry its marker.
-    pmu::v4::Alarm alarm;
+    pmu::v5::Alarm alarm;
     SampleInfo alarm_info;
     while (alarm_reader && alarm_reader->take_next_sample(&alarm, &alarm_info) == ReturnCode_t::RETCODE_OK) {
       if (!alarm_info.valid_data) continue;
@@ -429,7 +429,7 @@ int run_watch(const GlobalOptions& o, long count) {
   return 0;
 }
 
-// "v4", or "v4, v3" for a vehicle whose service also serves contract 3's consumers.
+// "v5", or "v5, v4" for a vehicle whose service also serves contract 4's consumers.
 std::string contracts_cell(const std::set<int>& contracts) {
   std::string cell;
   for (auto it = contracts.rbegin(); it != contracts.rend(); ++it) cell += (cell.empty() ? "v" : ", v") + std::to_string(*it);
@@ -444,7 +444,7 @@ template <typename Latest>
 std::vector<std::string> remember_only_pmus(const Latest& latest, TargetMemory& memory) {
   std::map<std::string, std::vector<Target>> pmus;
   for (const auto& entry : latest)
-    if (entry.first.kind == pmu::v4::KIND_PMU) pmus[entry.first.vehicle].push_back({entry.first.bus, entry.first.address});
+    if (entry.first.kind == pmu::v5::KIND_PMU) pmus[entry.first.vehicle].push_back({entry.first.bus, entry.first.address});
   const auto now = TargetMemory::Clock::now();
   std::vector<std::string> remembered;
   for (const auto& [vehicle, found] : pmus) {
@@ -473,8 +473,8 @@ int run_list(const GlobalOptions& o) {
 static int list_once(const GlobalOptions& o, std::vector<std::string>& one_pmu) {
   ContextLease lease(o, kPmuctlParticipant);
   pmu::dds::DdsContext& dds = *lease;
-  StateCollector<pmu::v4::Health, pmu::v4::HealthPubSubType> health(dds, topics::kHealth);
-  StateCollector<pmu::v4::DeviceInfo, pmu::v4::DeviceInfoPubSubType> info(dds, topics::kInfo);
+  StateCollector<pmu::v5::Health, pmu::v5::HealthPubSubType> health(dds, topics::kHealth);
+  StateCollector<pmu::v5::DeviceInfo, pmu::v5::DeviceInfoPubSubType> info(dds, topics::kInfo);
   if (int rc = collect(o, dds, health, 3.0)) return rc;
   info.poll(o);
   if (o.pool && o.bus.empty() && !o.address) one_pmu = remember_only_pmus(health.latest(), o.pool->targets());
@@ -507,7 +507,7 @@ static int list_once(const GlobalOptions& o, std::vector<std::string>& one_pmu) 
       const SampleField age = *find_field(fields_of(h), "last_frame_age");  // "never", or the age
       // A battery or MPPT shows its kind with its number ("battery2"): it has no serial or firmware.
       const std::string number =
-          key.kind == pmu::v4::KIND_PMU ? std::to_string(key.address) : to_string(key.kind) + std::to_string(key.address);
+          key.kind == pmu::v5::KIND_PMU ? std::to_string(key.address) : to_string(key.kind) + std::to_string(key.address);
       rows.push_back({key.vehicle.empty() ? "-" : key.vehicle, key.bus, number, serial, fw, to_string(h.state()),
                       to_string(h.bus_state()), age.json.is_null() ? age.text : age_text(age.json.get<double>()) + " ago",
                       contracts_cell(served)});
@@ -539,14 +539,14 @@ static int list_once(const GlobalOptions& o, std::vector<std::string>& one_pmu) 
 int run_info(const GlobalOptions& o) {
   ContextLease lease(o, kPmuctlParticipant);
   pmu::dds::DdsContext& dds = *lease;
-  StateCollector<pmu::v4::DeviceInfo, pmu::v4::DeviceInfoPubSubType> c(dds, topics::kInfo);
+  StateCollector<pmu::v5::DeviceInfo, pmu::v5::DeviceInfoPubSubType> c(dds, topics::kInfo);
   return print_state(o, dds, c, "info");
 }
 
 int run_health(const GlobalOptions& o) {
   ContextLease lease(o, kPmuctlParticipant);
   pmu::dds::DdsContext& dds = *lease;
-  StateCollector<pmu::v4::Health, pmu::v4::HealthPubSubType> c(dds, topics::kHealth);
+  StateCollector<pmu::v5::Health, pmu::v5::HealthPubSubType> c(dds, topics::kHealth);
   return print_state(o, dds, c, "health", true);
 }
 
@@ -559,7 +559,7 @@ int run_config_get(const GlobalOptions& o, const std::string& parameter) {
   }
   ContextLease lease(o, kPmuctlParticipant);
   pmu::dds::DdsContext& dds = *lease;
-  StateCollector<pmu::v4::Config, pmu::v4::ConfigPubSubType> c(dds, topics::kConfig);
+  StateCollector<pmu::v5::Config, pmu::v5::ConfigPubSubType> c(dds, topics::kConfig);
   if (parameter.empty()) return print_state(o, dds, c, "config");
   if (int rc = collect(o, dds, c, 3.0)) return rc;
   for (const auto& [key, s] : c.latest()) {

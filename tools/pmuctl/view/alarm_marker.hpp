@@ -12,7 +12,7 @@
 
 namespace pmu::tools {
 
-// ISA-18.2's states, as pmu::v4::AlarmState.
+// ISA-18.2's states, as pmu::v5::AlarmState.
 enum class AlarmStatus { Normal, ActiveUnacknowledged, ActiveAcknowledged, ClearedUnacknowledged };
 
 // "NORMAL", "ACTIVE_UNACKNOWLEDGED", ...: the contract's names, as `--json` and tables show them.

@@ -1,5 +1,5 @@
 #pragma once
-// The bit masks of pmu::v4::Config by name, both ways: `config get` shows them as
+// The bit masks of pmu::v5::Config by name, both ways: `config get` shows them as
 // "avionics_servo,payload (0x03)", and `config set` takes names, a comma list, `none` or a
 // number (interface.md section 3.2). The names are the codec's (messages.hpp).
 

@@ -16,11 +16,6 @@
 namespace pmu::tools {
 namespace {
 
-// The top of a 16-bit field, sent where there is nothing to measure.
-constexpr std::uint16_t kTop16 = std::numeric_limits<std::uint16_t>::max();
-// time_to_go in the contract's seconds (canopen_state.hpp scales the document's minutes).
-constexpr double kTimeToGoTop = double{kTop16} * 60;
-
 SampleField none(std::string_view name, const char* word) { return {std::string(name), nullptr, word, ""}; }
 
 SampleField real(std::string_view name, double v, std::string_view unit, const char* nan_word) {
@@ -107,30 +102,32 @@ std::string text_with_unit(const SampleField& f, bool compact) {
   return f.text + (compact ? "" : " ") + f.unit;
 }
 
-SampleFields fields_of(const pmu::v4::Voltages& s) {
+SampleFields fields_of(const pmu::v5::Voltages& s) {
   return measured<codec::Voltages>(std::array<double, 7>{s.avionics(), s.output_28v(), s.payload(), s.servo(),
                                                           s.battery_a(), s.battery_b(), s.generator()},
                                    kNoReading);
 }
 
-SampleFields fields_of(const pmu::v4::Currents& s) {
+SampleFields fields_of(const pmu::v5::Currents& s) {
   return measured<codec::Currents>(
       std::array<double, 6>{s.avionics(), s.output_28v(), s.payload(), s.servo(), s.battery_a(), s.battery_b()},
       kNoReading);
 }
 
-SampleFields fields_of(const pmu::v4::BatteryEnergy& s) {
+SampleFields fields_of(const pmu::v5::BatteryEnergy& s) {
   return measured<codec::BatteryEnergy>(std::array<std::int64_t, 2>{s.battery_a_mah(), s.battery_b_mah()}, "");
 }
 
-SampleFields fields_of(const pmu::v4::Temperatures& s) {
+SampleFields fields_of(const pmu::v5::Temperatures& s) {
   return measured<codec::Temperatures>(
       std::array<double, 5>{s.internal(), s.battery_a(), s.battery_b(), s.generator(), s.starter()}, kNoSensor);
 }
 
-SampleFields fields_of(const pmu::v4::Status& s) {
+SampleFields fields_of(const pmu::v5::Status& s) {
   codec::Status st;
-  st.generator_rpm = s.generator_rpm();
+  // NaN is no reading (below); otherwise a whole number of rpm below 65535 (the PMU's 16 bits).
+  const float rpm = s.generator_rpm();
+  st.generator_rpm = std::isnan(rpm) ? 0 : static_cast<std::uint16_t>(std::lround(std::clamp(rpm, 0.0f, 65534.0f)));
   st.generation_enabled = s.generation_enabled();
   st.thermal_shutdown = s.thermal_shutdown();
   st.soa_shutdown = s.soa_shutdown();
@@ -147,11 +144,11 @@ SampleFields fields_of(const pmu::v4::Status& s) {
   Collect c;
   visit_fields(m, c);
   for (auto& f : c.out)
-    if (f.name == "generator_rpm" && s.generator_rpm() == kTop16) f = none(f.name, kNoReading);
+    if (f.name == "generator_rpm" && std::isnan(rpm)) f = none(f.name, kNoReading);
   return c.out;
 }
 
-SampleFields fields_of(const pmu::v4::Config& s) {
+SampleFields fields_of(const pmu::v5::Config& s) {
   SampleFields out;
   for (const auto& spec : codec::parameter_table()) {
     using P = codec::Parameter;
@@ -189,7 +186,7 @@ SampleFields fields_of(const pmu::v4::Config& s) {
   return out;
 }
 
-SampleFields fields_of(const pmu::v4::DeviceInfo& s) {
+SampleFields fields_of(const pmu::v5::DeviceInfo& s) {
   Json features = Json::array();
   std::string text;
   for (const auto& f : s.features()) {
@@ -202,8 +199,8 @@ SampleFields fields_of(const pmu::v4::DeviceInfo& s) {
           {"features", features, text.empty() ? "none" : text, ""}};
 }
 
-SampleFields fields_of(const pmu::v4::Health& s) {
-  SampleField age = s.last_frame_age() < 0 || std::isnan(s.last_frame_age())
+SampleFields fields_of(const pmu::v5::Health& s) {
+  SampleField age = std::isnan(s.last_frame_age())
                         ? none("last_frame_age", kNever)
                         : real("last_frame_age", s.last_frame_age(), "s", kNever);
   if (age.json.is_number()) {
@@ -224,24 +221,25 @@ SampleFields fields_of(const pmu::v4::Health& s) {
           integer("publish_failures", static_cast<std::int64_t>(s.publish_failures()))};
 }
 
-SampleFields fields_of(const pmu::v4::Battery& s) {
+SampleFields fields_of(const pmu::v5::Battery& s) {
   // In the order of service::kBatteryValues (= IDL order = `received` bits).
   const std::array<double, service::kBatteryValueCount> v{
       s.voltage(),          s.current(),           s.current_discharge(),     s.current_charge(),
       s.state_of_charge(),  s.time_to_go(),        s.cell_temperature_high(), s.cell_temperature_low(),
-      s.cell_voltage_high(), s.cell_voltage_low(), static_cast<double>(s.bms_state()), s.temperature_1(),
+      s.cell_voltage_high(), s.cell_voltage_low(), s.bms_state(),         s.temperature_1(),
       s.temperature_2(),    s.temperature_3(),     s.temperature_4(),         s.power_level()};
   SampleFields out;
   for (std::size_t i = 0; i < v.size(); ++i) {
     const bool is_integer = service::kBatteryValues[i].name == "bms_state";
     auto f = canopen_value(service::kBatteryValues, i, s.received(), v[i], !is_integer, false);
-    if (f.name == "time_to_go" && v[i] == kTimeToGoTop) f = none(f.name, kNotDischarging);
+    // Received, and NaN: the battery sent its field's top, which it sends while not discharging.
+    if (f.name == "time_to_go" && ((s.received() >> i) & 1u) && std::isnan(v[i])) f = none(f.name, kNotDischarging);
     out.push_back(f);
   }
   return out;
 }
 
-SampleFields fields_of(const pmu::v4::BatteryCells& s) {
+SampleFields fields_of(const pmu::v5::BatteryCells& s) {
   Json cells = Json::array();
   double lo = INFINITY, hi = -INFINITY;
   for (const auto& c : s.cells()) {
@@ -260,15 +258,15 @@ SampleFields fields_of(const pmu::v4::BatteryCells& s) {
   return {{"cells", cells, text, ""}};
 }
 
-SampleFields fields_of(const pmu::v4::Mppt& s) {
+SampleFields fields_of(const pmu::v5::Mppt& s) {
   // In the order of service::kMpptValues (= IDL order = `received` bits).
   const std::array<double, service::kMpptValueCount> v{
-      s.voltage_output_raw(),  s.current_output_raw(),  s.voltage_out_sw_raw(), static_cast<double>(s.mppt_state()),
-      s.safety_enabled() ? 1.0 : 0.0, s.pwm_enabled() ? 1.0 : 0.0, s.temperature(),
-      s.voltage_panel_1_raw(), s.current_panel_1_raw(), s.duty_cycle_panel_1(), static_cast<double>(s.channel_1_active()),
-      s.voltage_panel_2_raw(), s.current_panel_2_raw(), s.duty_cycle_panel_2(), static_cast<double>(s.channel_2_active()),
-      s.voltage_panel_3_raw(), s.current_panel_3_raw(), s.duty_cycle_panel_3(), static_cast<double>(s.channel_3_active()),
-      s.voltage_panel_4_raw(), s.current_panel_4_raw(), s.duty_cycle_panel_4(), static_cast<double>(s.channel_4_active())};
+      s.voltage_output_raw(),  s.current_output_raw(),  s.voltage_out_sw_raw(), s.mppt_state(),
+      s.safety_enabled(),      s.pwm_enabled(),         s.temperature(),
+      s.voltage_panel_1_raw(), s.current_panel_1_raw(), s.duty_cycle_panel_1(), s.channel_1_active(),
+      s.voltage_panel_2_raw(), s.current_panel_2_raw(), s.duty_cycle_panel_2(), s.channel_2_active(),
+      s.voltage_panel_3_raw(), s.current_panel_3_raw(), s.duty_cycle_panel_3(), s.channel_3_active(),
+      s.voltage_panel_4_raw(), s.current_panel_4_raw(), s.duty_cycle_panel_4(), s.channel_4_active()};
   SampleFields out;
   for (std::size_t i = 0; i < v.size(); ++i) {
     const std::string_view name = service::kMpptValues[i].name;

@@ -32,19 +32,19 @@ struct SampleField {
 };
 using SampleFields = std::vector<SampleField>;
 
-SampleFields fields_of(const pmu::v4::Voltages& s);
-SampleFields fields_of(const pmu::v4::Currents& s);
-SampleFields fields_of(const pmu::v4::BatteryEnergy& s);
-SampleFields fields_of(const pmu::v4::Temperatures& s);
-SampleFields fields_of(const pmu::v4::Status& s);
-SampleFields fields_of(const pmu::v4::Config& s);
-SampleFields fields_of(const pmu::v4::DeviceInfo& s);
-SampleFields fields_of(const pmu::v4::Health& s);
-SampleFields fields_of(const pmu::v4::Battery& s);
+SampleFields fields_of(const pmu::v5::Voltages& s);
+SampleFields fields_of(const pmu::v5::Currents& s);
+SampleFields fields_of(const pmu::v5::BatteryEnergy& s);
+SampleFields fields_of(const pmu::v5::Temperatures& s);
+SampleFields fields_of(const pmu::v5::Status& s);
+SampleFields fields_of(const pmu::v5::Config& s);
+SampleFields fields_of(const pmu::v5::DeviceInfo& s);
+SampleFields fields_of(const pmu::v5::Health& s);
+SampleFields fields_of(const pmu::v5::Battery& s);
 // One field, `cells`: the JSON array of {cell, cell_voltage}, and in tables a summary
 // ("12 cells 3.301..3.412 V": count, lowest and highest).
-SampleFields fields_of(const pmu::v4::BatteryCells& s);
-SampleFields fields_of(const pmu::v4::Mppt& s);
+SampleFields fields_of(const pmu::v5::BatteryCells& s);
+SampleFields fields_of(const pmu::v5::Mppt& s);
 
 // The field of that name; nullptr when there is none.
 const SampleField* find_field(const SampleFields& fields, std::string_view name);

@@ -13,23 +13,23 @@ namespace pmu::tools {
 
 using Json = nlohmann::ordered_json;
 
-Json values_of(const pmu::v4::Voltages& s);
-Json values_of(const pmu::v4::Currents& s);
-Json values_of(const pmu::v4::BatteryEnergy& s);
-Json values_of(const pmu::v4::Temperatures& s);
-Json values_of(const pmu::v4::Status& s);
-Json values_of(const pmu::v4::Config& s);
-Json values_of(const pmu::v4::DeviceInfo& s);
-Json values_of(const pmu::v4::Health& s);
+Json values_of(const pmu::v5::Voltages& s);
+Json values_of(const pmu::v5::Currents& s);
+Json values_of(const pmu::v5::BatteryEnergy& s);
+Json values_of(const pmu::v5::Temperatures& s);
+Json values_of(const pmu::v5::Status& s);
+Json values_of(const pmu::v5::Config& s);
+Json values_of(const pmu::v5::DeviceInfo& s);
+Json values_of(const pmu::v5::Health& s);
 // Batteries and MPPTs (interface.md 1.4): a value not received is null, for integer and
 // boolean fields too (their `received` bit), so no consumer mistakes "not yet" for 0.
 // Sentinels are null too (sample_fields.hpp).
-Json values_of(const pmu::v4::Battery& s);
-Json values_of(const pmu::v4::BatteryCells& s);
-Json values_of(const pmu::v4::Mppt& s);
+Json values_of(const pmu::v5::Battery& s);
+Json values_of(const pmu::v5::BatteryCells& s);
+Json values_of(const pmu::v5::Mppt& s);
 
-const char* to_string(pmu::v4::HealthState s);
-const char* to_string(pmu::v4::BusState s);
-const char* to_string(pmu::v4::DeviceKind k);  // "pmu", "battery", "mppt"
+const char* to_string(pmu::v5::HealthState s);
+const char* to_string(pmu::v5::BusState s);
+const char* to_string(pmu::v5::DeviceKind k);  // "pmu", "battery", "mppt"
 
 }  // namespace pmu::tools

@@ -20,8 +20,8 @@ std::string age_text(double seconds) {
   return buf;
 }
 
-std::string freshness(std::optional<pmu::v4::HealthState> state, double age_seconds) {
-  return std::string(to_string(state.value_or(pmu::v4::UNKNOWN))) + " " + age_text(age_seconds);
+std::string freshness(std::optional<pmu::v5::HealthState> state, double age_seconds) {
+  return std::string(to_string(state.value_or(pmu::v5::UNKNOWN))) + " " + age_text(age_seconds);
 }
 
 std::string row_values(const SampleFields& fields) {
@@ -76,7 +76,7 @@ std::vector<std::string> watch_table(const std::vector<WatchRow>& rows, const st
     std::vector<std::vector<std::string>> cells;
     for (const auto& r : rows) {
       if (r.topic != t) continue;
-      cells.push_back({r.label, to_string(r.state.value_or(pmu::v4::UNKNOWN)), age_text(r.age)});
+      cells.push_back({r.label, to_string(r.state.value_or(pmu::v5::UNKNOWN)), age_text(r.age)});
       if (with_marker) cells.back().push_back(marker_of(r.label));
       cells.back().push_back(row_values(r.values));
     }

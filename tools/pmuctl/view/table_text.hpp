@@ -19,7 +19,7 @@ std::string age_text(double seconds);
 // What watch prints before a row's values: the device's health state (UNKNOWN when no
 // pmu/health sample of it has arrived) and the age of the values: "ONLINE 0.2s",
 // "OFFLINE 9.1s", so an old value never looks live.
-std::string freshness(std::optional<pmu::v4::HealthState> state, double age_seconds);
+std::string freshness(std::optional<pmu::v5::HealthState> state, double age_seconds);
 
 // "avionics=12.3V output_28v=28V ...": one watch row's values, units attached.
 std::string row_values(const SampleFields& fields);
@@ -28,7 +28,7 @@ std::string row_values(const SampleFields& fields);
 struct WatchRow {
   std::string label;  // "can0/1"
   std::string topic;  // "voltages"
-  std::optional<pmu::v4::HealthState> state;
+  std::optional<pmu::v5::HealthState> state;
   double age = 0;     // s since the sample's source time
   SampleFields values;
 };

@@ -13,13 +13,13 @@ namespace pmu::service {
 
 // `device` must have a baseline. `bus` is the device's bus name; the file is the path as the
 // config writes it.
-pmu::v4::Baseline baseline_sample(const std::string& vehicle, const std::string& bus, const DeviceConfig& device);
+pmu::v5::Baseline baseline_sample(const std::string& vehicle, const std::string& bus, const DeviceConfig& device);
 
 // What the sample holds, as read_config_file() would have given it: the settings `present`
 // names, as raw values, and the serial and minimum firmware pins. Lines are 0 (not a file's).
-baseline::ConfigFile config_file_of(const pmu::v4::Baseline& sample);
+baseline::ConfigFile config_file_of(const pmu::v5::Baseline& sample);
 
 // pmu/config's values as raw values; every setting is there.
-baseline::Settings settings_of(const pmu::v4::Config& config);
+baseline::Settings settings_of(const pmu::v5::Config& config);
 
 }  // namespace pmu::service

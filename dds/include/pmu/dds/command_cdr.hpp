@@ -1,12 +1,12 @@
 #pragma once
-// pmu::v4::Command's bytes on the wire, read without trusting them.
+// pmu::v5::Command's bytes on the wire, read without trusting them.
 //
 // The generated deserialisation (fastddsgen) lets Fast CDR's exceptions escape into Fast
 // DDS's threads (a boolean byte of 2 aborts the process) and coerces what it cannot hold (an
 // enum value, an over-long string). The service's command reader uses CommandSampleType
 // instead: it reads each field as it is on the wire (booleans as bytes, the kind as a
 // number, strings whole) into a CommandSample for parse_command, and marks a payload that is
-// not a pmu::v4::Command at all (too short, unknown encapsulation) as malformed, to be counted
+// not a pmu::v5::Command at all (too short, unknown encapsulation) as malformed, to be counted
 // and dropped. Nothing here throws.
 
 #include <fastdds/dds/topic/TopicDataType.hpp>
@@ -28,9 +28,9 @@ std::optional<CommandSample> read_command_cdr(const std::uint8_t* data, std::siz
 // hostile peer would). Little-endian CDR.
 std::vector<std::uint8_t> write_command_cdr(const CommandSample& s);
 
-// The DDS type "pmu::v4::Command" for readers (and test writers) that work on CommandSamples.
+// The DDS type "pmu::v5::Command" for readers (and test writers) that work on CommandSamples.
 // Reads into a Received; take_next_sample(&received, &info).
-class CommandSampleType final : public pmu::v4::CommandPubSubType {
+class CommandSampleType final : public pmu::v5::CommandPubSubType {
  public:
   struct Received {
     std::optional<CommandSample> sample;  // nullopt: malformed, count and drop
@@ -47,7 +47,7 @@ class CommandSampleType final : public pmu::v4::CommandPubSubType {
   void* createData() override;
   void deleteData(void* data) override;
 
-  // Payloads that were not a pmu::v4::Command, since start.
+  // Payloads that were not a pmu::v5::Command, since start.
   std::uint64_t malformed() const noexcept { return malformed_.load(std::memory_order_relaxed); }
 
  private:

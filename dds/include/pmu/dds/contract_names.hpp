@@ -13,12 +13,12 @@ namespace pmu::dds {
 // The major version this build implements (cmake/install_dirs.cmake, the IDL's module vN).
 int contract_major() noexcept;
 
-// The contract a DDS type name belongs to: "pmu::v4::Health" -> 4; "pmu::Health" -> 3, the
+// The contract a DDS type name belongs to: "pmu::v5::Health" -> 4; "pmu::Health" -> 3, the
 // last contract whose names carried no version (v1 and v2 named theirs the same way); nullopt
 // for a name that is not one of the contract's ("std_msgs::...", "pmu::vx::A").
 std::optional<int> contract_of_type_name(std::string_view type_name);
 
-// `current` (a type name of this build's contract, "pmu::v4::Health") as contract `major`
+// `current` (a type name of this build's contract, "pmu::v5::Health") as contract `major`
 // names it: 3 -> "pmu::Health", 5 -> "pmu::v5::Health". Returns `current` unchanged when it
 // is not one of the contract's names.
 std::string type_name_in_contract(std::string_view current, int major);

@@ -1,7 +1,7 @@
 #pragma once
 // The alarm acknowledgement topics on DDS: reads pmu/alarm_ack (QoS profile `command`) into an
 // AlarmAckService and writes its replies to pmu/alarm_ack_reply. The only place that converts
-// between pmu::v4::AlarmAck / AlarmAckReply and the service's own types.
+// between pmu::v5::AlarmAck / AlarmAckReply and the service's own types.
 //
 // DDS-Security permissions made before these topics existed lack them: the endpoint then logs
 // one error and the service runs without acknowledgements (active() is false), as

@@ -1,7 +1,7 @@
 #pragma once
 // The command topics on DDS: reads pmu/command (QoS profile `command`) into the
 // CommandService and writes every reply to pmu/command_reply. The only place that converts
-// between pmu::v4::Command / pmu::v4::CommandReply and the service's own command types: samples are
+// between pmu::v5::Command / pmu::v5::CommandReply and the service's own command types: samples are
 // read field for field as they arrived (command_cdr.hpp) and parsed by CommandService, so
 // no payload a peer can send reaches Fast DDS's threads as an exception.
 //
@@ -39,7 +39,7 @@ class DdsCommandEndpoint {
   void stop();
   // Publishes one reply (thread-safe).
   void publish(const CommandReplyData& reply);
-  // Received payloads that were not a pmu::v4::Command (counted and dropped, logged rate-limited).
+  // Received payloads that were not a pmu::v5::Command (counted and dropped, logged rate-limited).
   std::uint64_t malformed() const noexcept;
   // Commands for another vehicle, or written outside this vehicle's partition, since start.
   std::uint64_t not_ours() const noexcept;

@@ -99,9 +99,9 @@ class DdsContext {
   // names; with DDS-Security the permissions must allow publishing each, or DdsError says so.
   // `type_objects`: announce the self-contained types' type objects (see above).
   // `contract`: the major version whose type names the context's topics use
-  // (contract_names.hpp): another than this build's makes a participant that serves an older
-  // contract's consumers with this build's types under that contract's names, which is right
-  // only while their layouts are the same (tests/contract checks it). Announced as the
+  // (contract_names.hpp): the previous one makes a participant that serves that contract's
+  // consumers: this build's types under its names, those it changed converted
+  // (previous_contract.hpp; tests/contract checks that no other type changed). Announced as the
   // participant property kContractProperty. An older contract never has type objects.
   DdsContext(int domain, const std::string& qos_file, const std::string& participant_name,
              const SecurityFiles& security = {}, Transport transport = Transport::Default,
@@ -120,7 +120,7 @@ class DdsContext {
   const RemoteWriters& remote_writers() const noexcept { return remote_writers_; }
 
   // Registers the type (once) and creates the topic (once). `type` is e.g.
-  // new pmu::v4::VoltagesPubSubType(); it is registered under contract()'s name for it. Its endpoints announce its type object when the context
+  // new pmu::v5::VoltagesPubSubType(); it is registered under contract()'s name for it. Its endpoints announce its type object when the context
   // was made with type_objects and the type is self-contained, never its TypeInformation
   // (dds_type_objects.hpp says why). Throws
   // DdsError at start-up when it fails.

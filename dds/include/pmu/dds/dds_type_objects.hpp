@@ -27,8 +27,8 @@
 // self-contained (type_object_is_self_contained): every Fast DDS 2.9.1 participant that does
 // not know a type builds a DynamicType from each type object it discovers
 // (PDP::check_and_notify_type_discovery), and for a member whose type is only named by its
-// hash it drops the member (an enum: pmu::v4::Health's kind) or crashes in its receive thread
-// (measured: a sequence of a struct, pmu::v4::BatteryCells' cells, SIGSEGV in
+// hash it drops the member (an enum: pmu::v5::Health's kind) or crashes in its receive thread
+// (measured: a sequence of a struct, pmu::v5::BatteryCells' cells, SIGSEGV in
 // TypeObjectFactory::get_sequence_identifier). A third party's Fast DDS 2.9 client without
 // our type objects would be killed by discovering pmu/battery_cells.
 

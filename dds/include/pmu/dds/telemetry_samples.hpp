@@ -25,11 +25,11 @@ void set_key(T& s, const std::string& vehicle, const DeviceKey& k) {
 inline float idl_float(double v) { return static_cast<float>(v); }
 
 // Values only; the keys are the caller's.
-void fill(pmu::v4::Voltages& s, const codec::Voltages& v);
-void fill(pmu::v4::Currents& s, const codec::Currents& c);
-void fill(pmu::v4::BatteryEnergy& s, const codec::BatteryEnergy& e);
-void fill(pmu::v4::Temperatures& s, const codec::Temperatures& t);
-void fill(pmu::v4::Status& s, const codec::Status& st);
+void fill(pmu::v5::Voltages& s, const codec::Voltages& v);
+void fill(pmu::v5::Currents& s, const codec::Currents& c);
+void fill(pmu::v5::BatteryEnergy& s, const codec::BatteryEnergy& e);
+void fill(pmu::v5::Temperatures& s, const codec::Temperatures& t);
+void fill(pmu::v5::Status& s, const codec::Status& st);
 
 struct TelemetryCdr {
   const char* topic = nullptr;  // topics::kVoltages, ...

@@ -1,11 +1,12 @@
 // old_consumer_vN: a client built from contract vN's IDL alone (idl/versions/vN), as a ground
 // station of that contract was built, so the tests see what such a client gets from today's
-// pmu-service. PMU_OLD_CONTRACT (2 or 3) picks the version; the generated types are vN's.
+// pmu-service. PMU_OLD_CONTRACT (2, 3 or 4) picks the version; the generated types are vN's
+// (pmu::Health up to v3, pmu::v4::Health from v4).
 //
 //   old_consumer_v3 --domain N [--seconds T] [--until decoded|discovered] [--linger S]
 //                   [--command GET_SERIAL|GET [--parameter NAME]] [--bus sim0] [--address 1]
-//     Reads pmu/health, pmu/voltages and pmu/config (and, once a probe is answered, sends one command, waiting for its
-//     replies on pmu/command_reply); one JSON line per decoded sample, with every field, then
+//     Reads pmu/health, pmu/voltages, pmu/config and pmu/status (and, once a probe is
+//     answered, sends one command, waiting for its replies on pmu/command_reply); one JSON line per decoded sample, with every field, then
 //     {"final":true,...}: the remote endpoints each endpoint matched and the type names of
 //     those discovery reported per topic (whatever their type, so "matched none" can be told
 //     from "not discovered yet"), and the `pmu-dds.contract` property of every participant
@@ -48,6 +49,11 @@
 
 using namespace eprosima::fastdds::dds;
 using Json = nlohmann::json;
+#if PMU_OLD_CONTRACT >= 4
+namespace idl = pmu::v4;
+#else
+namespace idl = pmu;
+#endif
 using Clock = std::chrono::steady_clock;
 
 namespace {
@@ -70,7 +76,7 @@ const char* const kResults[] = {"COMPLETED", "REJECTED", "DENIED", "UNSUPPORTED"
 const char* const kDeviceKinds[] = {"KIND_PMU", "KIND_BATTERY", "KIND_MPPT"};
 #endif
 
-Json to_json(const pmu::Health& h) {
+Json to_json(const idl::Health& h) {
   Json j{{"topic", "pmu/health"}, {"vehicle", h.vehicle().to_string()}, {"bus", h.bus().to_string()},
          {"address", h.address()}};
 #if PMU_OLD_CONTRACT >= 3
@@ -90,14 +96,20 @@ Json to_json(const pmu::Health& h) {
   return j;
 }
 
-Json to_json(const pmu::Voltages& v) {
+Json to_json(const idl::Voltages& v) {
   return {{"topic", "pmu/voltages"}, {"vehicle", v.vehicle().to_string()}, {"bus", v.bus().to_string()},
           {"address", v.address()},  {"avionics", v.avionics()},           {"output_28v", v.output_28v()},
           {"payload", v.payload()},  {"servo", v.servo()},                 {"battery_a", v.battery_a()},
           {"battery_b", v.battery_b()}, {"generator", v.generator()}};
 }
 
-Json to_json(const pmu::Config& c) {
+Json to_json(const idl::Status& s) {
+  return {{"topic", "pmu/status"},          {"vehicle", s.vehicle().to_string()}, {"bus", s.bus().to_string()},
+          {"address", s.address()},         {"generator_rpm", s.generator_rpm()}, {"payload_on", s.payload_on()},
+          {"generation_enabled", s.generation_enabled()}};
+}
+
+Json to_json(const idl::Config& c) {
   return {{"topic", "pmu/config"},
           {"vehicle", c.vehicle().to_string()},
           {"bus", c.bus().to_string()},
@@ -117,7 +129,7 @@ Json to_json(const pmu::Config& c) {
           {"generation_enabled", c.generation_enabled()}};
 }
 
-Json to_json(const pmu::CommandReply& r) {
+Json to_json(const idl::CommandReply& r) {
   return {{"topic", "pmu/command_reply"},
           {"request_id", r.request_id().to_string()},
           {"vehicle", r.vehicle().to_string()},
@@ -202,15 +214,15 @@ int serve_health(DomainParticipant* p, const Options& o) {
   if (!o.vehicle.empty()) pq.partition().push_back(o.vehicle.c_str());
   Publisher* pub = p->create_publisher(pq);
   DataWriter* w = pub ? pub->create_datawriter_with_profile(
-                            topic(p, "pmu/health", TypeSupport(new pmu::HealthPubSubType())), "state")
+                            topic(p, "pmu/health", TypeSupport(new idl::HealthPubSubType())), "state")
                       : nullptr;
   if (!w) return 2;
-  pmu::Health h;
+  idl::Health h;
   h.vehicle(o.vehicle);
   h.bus("can0");
   h.address(1);
-  h.state(pmu::ONLINE);
-  h.bus_state(pmu::UP);
+  h.state(idl::ONLINE);
+  h.bus_state(idl::UP);
   h.last_frame_age(0.1f);
   h.frames_received(100);
   w->write(&h);
@@ -235,17 +247,19 @@ int consume(DomainParticipant* p, const Options& o, const Discovery& discovery) 
   if (!sub || !pub) return 2;
   std::map<std::string, DataReader*> readers{
       {"pmu/health", sub->create_datareader_with_profile(
-                         topic(p, "pmu/health", TypeSupport(new pmu::HealthPubSubType())), "state")},
+                         topic(p, "pmu/health", TypeSupport(new idl::HealthPubSubType())), "state")},
       {"pmu/config", sub->create_datareader_with_profile(
-                         topic(p, "pmu/config", TypeSupport(new pmu::ConfigPubSubType())), "state")},
+                         topic(p, "pmu/config", TypeSupport(new idl::ConfigPubSubType())), "state")},
       {"pmu/voltages", sub->create_datareader_with_profile(
-                           topic(p, "pmu/voltages", TypeSupport(new pmu::VoltagesPubSubType())), "telemetry")}};
+                           topic(p, "pmu/voltages", TypeSupport(new idl::VoltagesPubSubType())), "telemetry")},
+      {"pmu/status", sub->create_datareader_with_profile(
+                         topic(p, "pmu/status", TypeSupport(new idl::StatusPubSubType())), "telemetry")}};
   DataWriter* commands = nullptr;
   if (!o.command.empty()) {
     readers["pmu/command_reply"] = sub->create_datareader_with_profile(
-        topic(p, "pmu/command_reply", TypeSupport(new pmu::CommandReplyPubSubType())), "command");
+        topic(p, "pmu/command_reply", TypeSupport(new idl::CommandReplyPubSubType())), "command");
     commands = pub->create_datawriter_with_profile(
-        topic(p, "pmu/command", TypeSupport(new pmu::CommandPubSubType())), "command");
+        topic(p, "pmu/command", TypeSupport(new idl::CommandPubSubType())), "command");
     if (!commands) return 2;
   }
   for (const auto& [name, r] : readers)
@@ -265,37 +279,38 @@ int consume(DomainParticipant* p, const Options& o, const Discovery& discovery) 
   const auto end = Clock::now() + std::chrono::duration<double>(o.seconds);
   auto stop_at = end;
   while (!g_stop && Clock::now() < std::min(end, stop_at)) {
-    samples["pmu/health"] += take_all<pmu::Health>(readers["pmu/health"]);
-    samples["pmu/config"] += take_all<pmu::Config>(readers["pmu/config"]);
-    samples["pmu/voltages"] += take_all<pmu::Voltages>(readers["pmu/voltages"]);
+    samples["pmu/health"] += take_all<idl::Health>(readers["pmu/health"]);
+    samples["pmu/config"] += take_all<idl::Config>(readers["pmu/config"]);
+    samples["pmu/voltages"] += take_all<idl::Voltages>(readers["pmu/voltages"]);
+    samples["pmu/status"] += take_all<idl::Status>(readers["pmu/status"]);
     if (commands) {
-      pmu::CommandReply r;
+      idl::CommandReply r;
       SampleInfo info;
       while (readers["pmu/command_reply"]->take_next_sample(&r, &info) == ReturnCode_t::RETCODE_OK) {
         if (info.valid_data && r.request_id().to_string() == probe_id) probe_answered = true;
         if (!info.valid_data || r.request_id().to_string() != request_id) continue;
         print(to_json(r));
-        if (r.result() != pmu::IN_PROGRESS) ++replies;
+        if (r.result() != idl::IN_PROGRESS) ++replies;
       }
       PublicationMatchedStatus pm;
       SubscriptionMatchedStatus sm;
       commands->get_publication_matched_status(pm);
       readers["pmu/command_reply"]->get_subscription_matched_status(sm);
       if (!probe_answered && pm.current_count > 0 && sm.current_count > 0 && Clock::now() >= next_probe) {
-        pmu::Command probe;
+        idl::Command probe;
         probe.request_id(probe_id);
         probe.bus(o.bus);
         probe.address(o.address);
-        probe.kind(pmu::GET_SERIAL);
+        probe.kind(idl::GET_SERIAL);
         (void)commands->write(&probe);
         next_probe = Clock::now() + std::chrono::seconds(1);
       }
       if (!sent && probe_answered) {
-        pmu::Command c;
+        idl::Command c;
         c.request_id(request_id);
         c.bus(o.bus);
         c.address(o.address);
-        c.kind(o.command == "GET" ? pmu::GET : pmu::GET_SERIAL);
+        c.kind(o.command == "GET" ? idl::GET : idl::GET_SERIAL);
         c.parameter(o.parameter);
         sent = commands->write(&c);
       }

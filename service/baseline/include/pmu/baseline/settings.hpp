@@ -32,7 +32,7 @@ enum class Setting : std::uint8_t {
 };
 inline constexpr std::size_t kSettingCount = 13;
 
-// The names of `pmuctl config get` and pmu::v4::Config.
+// The names of `pmuctl config get` and pmu::v5::Config.
 std::string_view setting_name(Setting s) noexcept;
 std::optional<Setting> setting_from_name(std::string_view name) noexcept;
 // The stored parameter a setting is, if it is one.

@@ -2,7 +2,7 @@
 // Commands in the service's own terms (interface.md, Commands).
 //
 // Two stages, with one total function between them:
-//   CommandSample   a pmu::v4::Command exactly as it arrived: any kind number, any double, any
+//   CommandSample   a pmu::v5::Command exactly as it arrived: any kind number, any double, any
 //                   byte in a boolean, any expiry, strings of any length. Not trusted.
 //   CommandRequest  what the rest of the service works on: one typed action per kind,
 //                   values already in wire units (so policy judges what will be sent), the
@@ -65,7 +65,7 @@ inline constexpr std::size_t kMaxRequestIdLength = 63;
 inline constexpr std::size_t kMaxBusNameLength = 15;
 inline constexpr std::size_t kMaxParameterLength = 31;
 
-// A pmu::v4::Command as received (field for field), before anything is trusted.
+// A pmu::v5::Command as received (field for field), before anything is trusted.
 struct CommandSample {
   std::string request_id;
   std::string vehicle;  // the endpoint passes on only its own vehicle's commands

@@ -2,7 +2,7 @@
 // What the service derives from one PMU's voltages and currents (interface.md 1.8), and from
 // one BMS's pmu/battery values, in SI units. NaN: not known (a value not yet received or
 // older than the device's STALE time, or an estimate that cannot be made). Plain data: the
-// DDS side turns them into pmu::v4::Energy and pmu::v4::BmsEnergy.
+// DDS side turns them into pmu::v5::Energy and pmu::v5::BmsEnergy.
 
 #include <chrono>
 #include <limits>

@@ -31,7 +31,7 @@ struct CanOpenValue {
   std::string_view unit;  // the contract's unit ("" for raw counts, states and flags)
 };
 
-// pmu::v4::Battery's values, in IDL order.
+// pmu::v5::Battery's values, in IDL order.
 inline constexpr CanOpenValue kBatteryValues[] = {
     {"voltage", 1, "V"},
     {"current", 1, "A"},
@@ -52,7 +52,7 @@ inline constexpr CanOpenValue kBatteryValues[] = {
 };
 inline constexpr std::size_t kBatteryValueCount = std::size(kBatteryValues);
 
-// pmu::v4::Mppt's values, in IDL order. Voltages and currents are raw counts: the document gives
+// pmu::v5::Mppt's values, in IDL order. Voltages and currents are raw counts: the document gives
 // them no resolution.
 inline constexpr CanOpenValue kMpptValues[] = {
     {"voltage_output_raw", 1, ""},
@@ -122,9 +122,9 @@ std::optional<std::size_t> mppt_slot(std::string_view name) noexcept;
 
 // What a decoded frame changed. Pure: the session decides what to publish.
 struct Applied {
-  bool battery = false;  // pmu::v4::Battery's values
-  bool cells = false;    // pmu::v4::BatteryCells
-  bool mppt = false;     // pmu::v4::Mppt
+  bool battery = false;  // pmu::v5::Battery's values
+  bool cells = false;    // pmu::v5::BatteryCells
+  bool mppt = false;     // pmu::v5::Mppt
 };
 Applied apply(const codec::canopen::CanOpenMessage& m, BatteryState& battery, BatteryCellsState& cells) noexcept;
 Applied apply(const codec::canopen::CanOpenMessage& m, MpptState& mppt) noexcept;
