@@ -5,6 +5,7 @@
 #include <fastdds/dds/publisher/qos/DataWriterQos.hpp>
 
 #include "diagnostic_msgs/msg/DiagnosticArrayPubSubTypes.h"
+#include "pmu/dds/diagnostics_pace.hpp"
 #include "pmu/dds/ros2_messages.hpp"
 #include "pmu/dds/zero_padded_type.hpp"
 #include "pmu/session/log_throttle.hpp"
@@ -74,6 +75,7 @@ DataWriterQos ros2_writer_qos() {
 
 struct Ros2Publisher::State {
   DdsContext& dds;
+  const transport::Clock& clock;
   service::Ros2Settings settings;
   std::string vehicle;
   std::map<std::pair<std::string, std::uint8_t>, double> capacity_ah;  // (bus, node)
@@ -84,10 +86,12 @@ struct Ros2Publisher::State {
   // diagnostic_updater does), so the one message a KEEP_LAST 1 writer keeps for a late
   // subscriber holds every device's current status.
   std::map<ros2_publisher::Key, diagnostic_msgs::msg::DiagnosticStatus> statuses;
+  DiagnosticsPace diagnostics_pace;
   std::uint64_t failures = 0;
   service::LogThrottle failure_reports{std::chrono::seconds(5)};
 
-  State(DdsContext& d, service::Ros2Settings s, std::string v) : dds(d), settings(std::move(s)), vehicle(std::move(v)) {}
+  State(DdsContext& d, const transport::Clock& c, service::Ros2Settings s, std::string v)
+      : dds(d), clock(c), settings(std::move(s)), vehicle(std::move(v)) {}
 
   std::string name_of(const DeviceKey& k) const {
     return service::ros2_status_name(settings.name_space, vehicle, k.bus, ros2_publisher::ros2_kind(k.kind), k.address);
@@ -114,7 +118,7 @@ struct Ros2Publisher::State {
   }
   void write_diagnostics() {
     diagnostic_msgs::msg::DiagnosticArray array;
-    set_stamp(array.header(), std::chrono::system_clock::now());
+    set_stamp(array.header(), clock.system_now());
     for (const auto& [key, status] : statuses) array.status().push_back(status);
     write(diagnostics, &array, "/diagnostics");
   }
@@ -158,8 +162,8 @@ struct Ros2Publisher::State {
 };
 
 Ros2Publisher::Ros2Publisher(DdsContext& dds, const service::Ros2Settings& settings, std::string vehicle,
-                             const std::vector<service::BusConfig>& buses)
-    : s_(std::make_unique<State>(dds, settings, std::move(vehicle))) {
+                             const std::vector<service::BusConfig>& buses, const transport::Clock& clock)
+    : s_(std::make_unique<State>(dds, clock, settings, std::move(vehicle))) {
   for (const auto& b : buses)
     for (const auto& battery : b.batteries)
       if (battery.capacity_ah) s_->capacity_ah[{b.name, battery.node}] = *battery.capacity_ah;
@@ -217,8 +221,15 @@ void Ros2Publisher::on_health(const DeviceKey& key, const service::HealthReport&
   v.extra.emplace(v.extra.begin(), "bus", key.bus);
   v.health = health;
   v.active = d.active();
-  s_->statuses[ros2_publisher::key_of(key)] = device_status(v);
-  s_->write_diagnostics();
+  auto status = device_status(v);
+  std::optional<ShownStatus> before;
+  const auto k = ros2_publisher::key_of(key);
+  if (auto it = s_->statuses.find(k); it != s_->statuses.end())
+    before = ShownStatus{it->second.level(), it->second.message()};
+  const bool write = s_->diagnostics_pace.on_report(before, ShownStatus{status.level(), status.message()},
+                                                    s_->clock.steady_now());
+  s_->statuses[k] = std::move(status);
+  if (write) s_->write_diagnostics();
 }
 
 void Ros2Publisher::on_gone(const DeviceKey& key) {
@@ -226,7 +237,8 @@ void Ros2Publisher::on_gone(const DeviceKey& key) {
   // joiners: the last one says that nothing is there (not present, nothing measured).
   std::lock_guard<std::mutex> lock(s_->mutex);
   // Its status leaves /diagnostics: the address is no device any more.
-  if (s_->statuses.erase(ros2_publisher::key_of(key))) s_->write_diagnostics();
+  if (s_->statuses.erase(ros2_publisher::key_of(key)) && s_->diagnostics_pace.on_gone(s_->clock.steady_now()))
+    s_->write_diagnostics();
   auto it = s_->devices.find(ros2_publisher::key_of(key));
   if (it == s_->devices.end()) return;
   ros2_publisher::Device fresh;
@@ -237,7 +249,7 @@ void Ros2Publisher::on_gone(const DeviceKey& key) {
   fresh.health.state = service::HealthState::Offline;
   it->second = std::move(fresh);
   auto& d = it->second;
-  const auto now = std::chrono::system_clock::now();
+  const auto now = s_->clock.system_now();
   if (d.battery_a || d.battery_b) s_->write_pmu_batteries(key, d, now);
   if (d.battery) s_->write_bms(key, d, service::BatteryState{}, now);
 }

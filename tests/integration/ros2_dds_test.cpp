@@ -312,7 +312,8 @@ TEST(Ros2OverDds, AGoneDeviceLeavesANotPresentBatteryForLateJoiners) {
   pmu::dds::DdsContext service_side(domain, PMU_QOS_FILE, "pmu-service-ros2");
   pmu::service::Ros2Settings settings;
   settings.enabled = true;
-  pmu::dds::Ros2Publisher publisher(service_side, settings, "uav1", {});
+  const pmu::transport::SystemClock clock;
+  pmu::dds::Ros2Publisher publisher(service_side, settings, "uav1", {}, clock);
   const pmu::service::DeviceKey key{"can0", 1, pmu::service::DeviceKind::Pmu};
   pmu::service::HealthReport online;
   online.state = pmu::service::HealthState::Online;

@@ -84,7 +84,8 @@ TEST(Ros2Diagnostics, ALateLatchedSubscriberGetsEveryDevicesStatusAtOnce) {
   pmu::dds::DdsContext service_side(domain, "", "pmu-service-ros2");
   pmu::service::Ros2Settings settings;
   settings.enabled = true;
-  pmu::dds::Ros2Publisher publisher(service_side, settings, "uav1", {});
+  const pmu::transport::ManualClock clock;
+  pmu::dds::Ros2Publisher publisher(service_side, settings, "uav1", {}, clock);
   const DeviceKey pmu{"can0", 1, DeviceKind::Pmu};
   const DeviceKey bms{"can0", 2, DeviceKind::Battery};
   const DeviceKey mppt{"can1", 3, DeviceKind::Mppt};

@@ -5,15 +5,17 @@
 //                                               one per pmu/voltages sample
 //   <device namespace>/battery                 sensor_msgs/BatteryState of a BMS, one per
 //                                               pmu/battery sample
-//   /diagnostics                               diagnostic_msgs/DiagnosticArray: a device's
-//                                               status with each of its health reports (1 s)
+//   /diagnostics                               diagnostic_msgs/DiagnosticArray: every
+//                                               device's status, at once on a change of
+//                                               level or message, else at most once a second
 // as ROS 2 nodes see them: DDS topics "rt/...", type names sensor_msgs::msg::dds_::..._, no
 // key, the default partition, RELIABLE + TRANSIENT_LOCAL + KEEP_LAST 1 (a default, a
 // sensor-data and a latched subscriber all match), no type object. Only pmu-service writes
 // them: it owns the bus.
 //
-// Lifetime: `dds` must outlive the publisher (it owns the writers' participant). The publisher
-// must outlive every BusWorker that writes through it.
+// Lifetime: `dds` must outlive the publisher (it owns the writers' participant), and so must
+// `clock` (the /diagnostics pace and the stamps of the messages it writes without a frame's
+// time). The publisher must outlive every BusWorker that writes through it.
 // Threads: every StateSink member from any bus worker thread (one mutex); a device's topics
 // are created at its first sample, under that mutex, so no other code may call the
 // context's topic() or writer() functions after the bus workers start.
@@ -22,6 +24,7 @@
 #include <map>
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <string>
 #include <tuple>
 #include <vector>
@@ -31,6 +34,7 @@
 #include "pmu/config/config.hpp"
 #include "pmu/dds/dds_context.hpp"
 #include "pmu/session/device_state.hpp"
+#include "pmu/transport/clock.hpp"
 
 namespace pmu::dds {
 
@@ -42,7 +46,7 @@ class Ros2Publisher final : public service::StateSink {
   // `buses`: the configured batteries' capacity_ah. Creates /diagnostics's writer; throws
   // DdsError at start-up.
   Ros2Publisher(DdsContext& dds, const service::Ros2Settings& settings, std::string vehicle,
-                const std::vector<service::BusConfig>& buses);
+                const std::vector<service::BusConfig>& buses, const transport::Clock& clock);
   ~Ros2Publisher() override;
 
   void on_telemetry(const service::DeviceKey& key, const codec::PmuMessage& message,
