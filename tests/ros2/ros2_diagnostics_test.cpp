@@ -1,7 +1,8 @@
 // /diagnostics from Ros2Publisher (docs/interface.md 11.3) for a latched subscriber (ROS 2's
 // TRANSIENT_LOCAL profile) that joins late: the one message the writer keeps holds every
 // device's current status, as ROS 2's diagnostic_updater publishes its statuses in one array;
-// a device that is gone leaves it.
+// a device that is gone leaves it. The array is written at once on a change a reader sees,
+// else at most once a second of the publisher's clock.
 #include <gtest/gtest.h>
 
 #include <chrono>
@@ -57,20 +58,33 @@ class LateSubscriber {
   // The first message it gets: the one the writer kept. Level of each status by name.
   std::map<std::string, std::uint8_t> first() {
     std::map<std::string, std::uint8_t> out;
-    if (!reader_) return out;
+    const auto array = kept();
+    for (const auto& s : array.status()) out[s.name()] = s.level();
+    return out;
+  }
+  // The message the writer kept; empty if none came.
+  diagnostic_msgs::msg::DiagnosticArray kept() {
     diagnostic_msgs::msg::DiagnosticArray array;
+    if (!reader_) return array;
     SampleInfo info;
-    if (pmu::test::wait_until(
+    if (!pmu::test::wait_until(
             [&] { return reader_->take_next_sample(&array, &info) == ReturnCode_t::RETCODE_OK && info.valid_data; },
             10s))
-      for (const auto& s : array.status()) out[s.name()] = s.level();
-    return out;
+      array.status().clear();
+    return array;
   }
 
  private:
   DomainParticipant* participant_ = nullptr;
   DataReader* reader_ = nullptr;
 };
+
+std::string value_of(const diagnostic_msgs::msg::DiagnosticArray& array, const std::string& key) {
+  for (const auto& s : array.status())
+    for (const auto& kv : s.values())
+      if (kv.key() == key) return kv.value();
+  return "<absent>";
+}
 
 HealthReport health(HealthState state) {
   HealthReport h;
@@ -101,6 +115,35 @@ TEST(Ros2Diagnostics, ALateLatchedSubscriberGetsEveryDevicesStatusAtOnce) {
   publisher.on_gone(pmu);
   const std::map<std::string, std::uint8_t> without_pmu{{"uav1/can0/bms_2", Ds::ERROR}, {"uav1/can1/mppt_3", Ds::OK}};
   EXPECT_EQ(LateSubscriber(domain).first(), without_pmu);
+}
+
+// A report that changes nothing a reader sees (only its counters) within a second of the
+// array before it is not written: the kept array is still that one. A second on, it is.
+TEST(Ros2Diagnostics, AnUnchangedReportIsWrittenAtMostOnceASecond) {
+  const int domain = pmu::test::exclusive_dds_domain();
+  pmu::dds::DdsContext service_side(domain, "", "pmu-service-ros2");
+  pmu::service::Ros2Settings settings;
+  settings.enabled = true;
+  pmu::transport::ManualClock clock;
+  pmu::dds::Ros2Publisher publisher(service_side, settings, "uav1", {}, clock);
+  const DeviceKey pmu{"can0", 1, DeviceKind::Pmu};
+  HealthReport report = health(HealthState::Online);
+  report.frames_received = 10;
+  publisher.on_health(pmu, report);
+  clock.advance(500ms);
+  report.frames_received = 20;
+  publisher.on_health(pmu, report);
+  EXPECT_EQ(value_of(LateSubscriber(domain).kept(), "frames_received"), "10");
+
+  clock.advance(500ms);
+  report.frames_received = 30;
+  publisher.on_health(pmu, report);
+  EXPECT_EQ(value_of(LateSubscriber(domain).kept(), "frames_received"), "30");
+
+  clock.advance(100ms);
+  publisher.on_health(pmu, health(HealthState::Stale));
+  EXPECT_EQ(LateSubscriber(domain).first(), (std::map<std::string, std::uint8_t>{{"uav1/can0/pmu_1", Ds::STALE}}))
+      << "a change of level is written at once";
 }
 
 }  // namespace
