@@ -20,6 +20,7 @@
 #include "pmu/idl/topics.hpp"
 #include "pmuctl/verbs/exit_status.hpp"
 #include "pmuctl/verbs/service_presence.hpp"
+#include "pmuctl/verbs/target_search.hpp"
 
 namespace pmu::tools {
 namespace {
@@ -55,11 +56,12 @@ std::optional<int> resolve_target(const GlobalOptions& o, const std::string& veh
   }
   DataReader& r = dds.reader(dds.topic(topics::kHealth, TypeSupport(new idl::Guarded<pmu::v5::HealthPubSubType>())),
                              qos_profiles::kState);
-  std::set<std::pair<std::string, std::uint16_t>> seen;
   std::set<std::string> vehicles_seen;
   bool own_vehicle_seen = false;
-  std::map<InstanceHandle_t, std::pair<std::string, std::uint16_t>> handles;
-  std::optional<Clock::time_point> settle;
+  std::map<InstanceHandle_t, TargetSearch::Pmu> handles;
+  // The disposal of a moved PMU's old key follows its OFFLINE sample by 250 ms at the service
+  // (target_search.hpp); a second is ample for it to cross a slow link behind that sample.
+  TargetSearch search(std::chrono::milliseconds(300), std::chrono::seconds(1));
   bool heard = false;
   while (Clock::now() < deadline) {
     pmu::v5::Health h;
@@ -69,25 +71,27 @@ std::optional<int> resolve_target(const GlobalOptions& o, const std::string& veh
       if (!info.valid_data) {
         // Disposed: a PMU that moved to another address is not a second PMU.
         if (auto it = handles.find(info.instance_handle); it != handles.end() && info.instance_state != ALIVE_INSTANCE_STATE)
-          seen.erase(it->second);
+          search.gone(it->second);
         continue;
       }
       vehicles_seen.insert(h.vehicle().to_string());
       own_vehicle_seen = own_vehicle_seen || h.vehicle().to_string() == vehicle;
       if (h.kind() == pmu::v5::KIND_PMU && h.vehicle().to_string() == vehicle &&
           (o.bus.empty() || o.bus == h.bus().to_string()) && (!o.address || *o.address == h.address())) {
-        seen.insert({h.bus().to_string(), h.address()});
-        handles[info.instance_handle] = {h.bus().to_string(), h.address()};
+        const TargetSearch::Pmu pmu{h.bus().to_string(), h.address()};
+        search.seen(pmu, h.state() == pmu::v5::OFFLINE, Clock::now());
+        handles[info.instance_handle] = pmu;
       }
     }
     // The service's health is TRANSIENT_LOCAL: all of it comes in one burst once matched, so
     // the settle time starts with its first sample, of the wanted PMU or not. Other
     // vehicles' samples do not start it: on a slow link their services are discovered one
     // by one, and the one asked for may still come.
-    if ((!seen.empty() || own_vehicle_seen) && !settle) settle = Clock::now() + std::chrono::milliseconds(300);
-    if (settle && Clock::now() >= *settle) break;
+    if (!search.pmus().empty() || own_vehicle_seen) search.start(Clock::now());
+    if (search.settled(Clock::now())) break;
     std::this_thread::sleep_for(std::chrono::milliseconds(20));
   }
+  const std::set<TargetSearch::Pmu> seen = search.pmus();
   SubscriptionMatchedStatus st;
   r.get_subscription_matched_status(st);
   if (st.current_count == 0) return no_service(o, dds);
