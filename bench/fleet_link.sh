@@ -5,7 +5,7 @@
 #   bench/fleet_link.sh [--aircraft "1 4 8"] [--rate 250kbit] [--build-dir DIR] [--qos FILE]
 #                       [--pmuctl BIN] [--service BIN] [--discovery-server [--server-xml FILE|none]]
 #                       [--cut SECONDS] [--agent] [--loss PERCENT] [--json FILE] [--keep DIR [--capture]]
-#                       [--breakdown]
+#                       [--breakdown] [--low-rate-period S]
 #
 # Two network namespaces joined by one veth pair, shaped by tbf to RATE each way (a radio
 # modem's queue of about 2 s; no delay or loss: the VM lab adds those): in `air`, N pmu-service
@@ -40,7 +40,8 @@
 # capture's timestamps use; `low` and `low-end` bound the watch's measured 10 s).
 # --breakdown: capture (as --capture) and print, per fleet size, what the low-rate watch's
 # measured 10 s were spent on, by RTPS submessage kind and by topic (bench/rtps_breakdown.py;
-# also breakdown-N.md with --keep).
+# also breakdown-N.md with --keep). --low-rate-period S: the services' config low_rate_period
+# (interface.md 1.5; default theirs, 1 s).
 # Needs root (ip netns); exit status 77 when namespaces cannot be made. Exit status 1 when
 # a --discovery-server run found a command executed twice or by another vehicle.
 set -euo pipefail
@@ -60,6 +61,7 @@ agent=0
 keep=""
 capture=0
 breakdown=0
+low_rate_period=""
 loss=0
 while [ $# -gt 0 ]; do
   case "$1" in
@@ -78,13 +80,15 @@ while [ $# -gt 0 ]; do
     --keep) keep=$2; shift 2 ;;
     --capture) capture=1; shift ;;
     --breakdown) breakdown=1; capture=1; shift ;;
-    -h|--help) sed -n '2,43p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
+    --low-rate-period) low_rate_period=$2; shift 2 ;;
+    -h|--help) sed -n '2,46p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
     *) echo "fleet_link.sh: unknown argument '$1'" >&2; exit 2 ;;
   esac
 done
 [ "$capture" = 0 ] || [ "$breakdown" = 1 ] || [ -n "$keep" ] || { echo "fleet_link.sh: --capture needs --keep DIR" >&2; exit 2; }
 case "$loss" in '' | *[!0-9]* ) echo "fleet_link.sh: --loss takes a whole percentage, 0..99 (got '$loss')" >&2; exit 2 ;; esac
 [ "$loss" -lt 100 ] || { echo "fleet_link.sh: --loss takes a whole percentage, 0..99 (got '$loss')" >&2; exit 2; }
+case "$low_rate_period" in *[!0-9.]*) echo "fleet_link.sh: --low-rate-period takes seconds (got '$low_rate_period')" >&2; exit 2 ;; esac
 case "$cut_s" in '' | *[!0-9]* | 0) echo "fleet_link.sh: --cut takes whole seconds, at least 1 (got '$cut_s')" >&2; exit 2 ;; esac
 for n in $aircraft; do
   case "$n" in '' | *[!0-9]* | 0) echo "fleet_link.sh: --aircraft takes counts of at least 1 (got '$n')" >&2; exit 2 ;; esac
@@ -284,6 +288,7 @@ qos_file: $qos
 dds_transport: udp
 interfaces: [air0]
 log_level: $svc_log_level
+${low_rate_period:+low_rate_period: $low_rate_period}
 $ds_yaml
 buses:
   - interface: sim
