@@ -5,6 +5,7 @@
 #   bench/fleet_link.sh [--aircraft "1 4 8"] [--rate 250kbit] [--build-dir DIR] [--qos FILE]
 #                       [--pmuctl BIN] [--service BIN] [--discovery-server [--server-xml FILE|none]]
 #                       [--cut SECONDS] [--agent] [--loss PERCENT] [--json FILE] [--keep DIR [--capture]]
+#                       [--breakdown] [--low-rate-period S]
 #
 # Two network namespaces joined by one veth pair, shaped by tbf to RATE each way (a radio
 # modem's queue of about 2 s; no delay or loss: the VM lab adds those): in `air`, N pmu-service
@@ -14,7 +15,8 @@
 #   list     one `pmuctl --json list`: bytes over the link, seconds, vehicles listed of N
 #   command  one `pmuctl --vehicle uavN config set payload_voltage 13.0`: bytes, seconds, result
 #   low      10 s of `pmuctl watch --low-rate` (started 15 s before): the steady cost of watching
-# Bytes are the ground interface's received + sent IP bytes; drops are the tbf queues', from
+# Bytes are the ground interface's received + sent bytes (the veth counts each IP packet and
+# its 14-byte Ethernet header; --breakdown counts IP bytes); drops are the tbf queues', from
 # the list to the watch's end and, after discovery, in the watch's measured 10 s.
 # --qos, --pmuctl and --service measure another qos.xml, pmuctl or pmu-service (a before and
 # after, one run each). --discovery-server: Fast DDS's Discovery Server (fast-discovery-server)
@@ -33,9 +35,13 @@
 # --loss PERCENT: each namespace drops that share of the packets it sends on the veth, at
 # random (nftables; the VM lab's netem also delays, which a namespace here cannot).
 # --keep DIR: the run's logs (services, agent, calls) are copied to DIR at the end; with
-# --capture also a packet capture of the ground interface per fleet size (link-N.pcap, the
-# first 256 bytes of each packet) and when each step began (steps-N: its name, uptime and
-# wall-clock time, which the capture's timestamps use).
+# --capture also a packet capture of the ground interface per fleet size (link-N.pcap, whole
+# packets) and when each step began (steps-N: its name, uptime and wall-clock time, which the
+# capture's timestamps use; `low` and `low-end` bound the watch's measured 10 s).
+# --breakdown: capture (as --capture) and print, per fleet size, what the low-rate watch's
+# measured 10 s were spent on, by RTPS submessage kind and by topic (bench/rtps_breakdown.py;
+# also breakdown-N.md with --keep). --low-rate-period S: the services' config low_rate_period
+# (interface.md 1.5; default theirs, 1 s).
 # Needs root (ip netns); exit status 77 when namespaces cannot be made. Exit status 1 when
 # a --discovery-server run found a command executed twice or by another vehicle.
 set -euo pipefail
@@ -54,6 +60,8 @@ cut_s=30
 agent=0
 keep=""
 capture=0
+breakdown=0
+low_rate_period=""
 loss=0
 while [ $# -gt 0 ]; do
   case "$1" in
@@ -71,13 +79,16 @@ while [ $# -gt 0 ]; do
     --loss) loss=$2; shift 2 ;;
     --keep) keep=$2; shift 2 ;;
     --capture) capture=1; shift ;;
-    -h|--help) sed -n '2,38p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
+    --breakdown) breakdown=1; capture=1; shift ;;
+    --low-rate-period) low_rate_period=$2; shift 2 ;;
+    -h|--help) sed -n '2,46p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
     *) echo "fleet_link.sh: unknown argument '$1'" >&2; exit 2 ;;
   esac
 done
-[ "$capture" = 0 ] || [ -n "$keep" ] || { echo "fleet_link.sh: --capture needs --keep DIR" >&2; exit 2; }
+[ "$capture" = 0 ] || [ "$breakdown" = 1 ] || [ -n "$keep" ] || { echo "fleet_link.sh: --capture needs --keep DIR" >&2; exit 2; }
 case "$loss" in '' | *[!0-9]* ) echo "fleet_link.sh: --loss takes a whole percentage, 0..99 (got '$loss')" >&2; exit 2 ;; esac
 [ "$loss" -lt 100 ] || { echo "fleet_link.sh: --loss takes a whole percentage, 0..99 (got '$loss')" >&2; exit 2; }
+case "$low_rate_period" in *[!0-9.]*) echo "fleet_link.sh: --low-rate-period takes seconds (got '$low_rate_period')" >&2; exit 2 ;; esac
 case "$cut_s" in '' | *[!0-9]* | 0) echo "fleet_link.sh: --cut takes whole seconds, at least 1 (got '$cut_s')" >&2; exit 2 ;; esac
 for n in $aircraft; do
   case "$n" in '' | *[!0-9]* | 0) echo "fleet_link.sh: --aircraft takes counts of at least 1 (got '$n')" >&2; exit 2 ;; esac
@@ -88,6 +99,7 @@ done
 [ -n "$ctl" ] || ctl=$(find "$build_dir" -type f -name pmuctl -perm -u+x 2>/dev/null | head -n1 || true)
 [ -x "$svc" ] && [ -x "$ctl" ] || { echo "fleet_link.sh: build pmu-service and pmuctl in $build_dir first" >&2; exit 2; }
 [ -r "$qos" ] || { echo "fleet_link.sh: cannot read $qos" >&2; exit 2; }
+[ "$capture" = 0 ] || command -v tcpdump >/dev/null || { echo "fleet_link.sh: --capture and --breakdown need tcpdump" >&2; exit 2; }
 [ "$(id -u)" = 0 ] || { echo "fleet_link.sh: SKIP: needs root for network namespaces" >&2; exit 77; }
 
 . "$root/tests/support/dds_domain.sh"
@@ -131,7 +143,7 @@ link_up() {
     fi
   done
   if [ "$capture" = 1 ]; then
-    ip netns exec "$gnd" tcpdump -i gnd0 -s 256 -w "$work/link-$1.pcap" >/dev/null 2>&1 &
+    ip netns exec "$gnd" tcpdump -i gnd0 -s 0 -w "$work/link-$1.pcap" >/dev/null 2>&1 &
     sleep 1
   fi
 }
@@ -276,6 +288,7 @@ qos_file: $qos
 dds_transport: udp
 interfaces: [air0]
 log_level: $svc_log_level
+${low_rate_period:+low_rate_period: $low_rate_period}
 $ds_yaml
 buses:
   - interface: sim
@@ -314,14 +327,19 @@ EOF
   (exec_gnd=1 pmuctl_gnd watch --low-rate >"$work/low.out" 2>/dev/null) &
   watcher=$!
   sleep 15  # the watcher's own discovery and the state it gets first are not the steady cost
-  b0=$(link_bytes); l0=$(wc -l <"$work/low.out"); w0=$(link_drops)
+  l0=$(wc -l <"$work/low.out"); w0=$(link_drops)
+  # Per second of the interval the two counter readings really span (reading them takes time).
+  step low
+  t0=$(now); b0=$(link_bytes)
   sleep 10
-  b1=$(link_bytes); l1=$(wc -l <"$work/low.out"); steady_drops=$(( $(link_drops) - w0 ))
+  step low-end
+  b1=$(link_bytes); t1=$(now)
+  l1=$(wc -l <"$work/low.out"); steady_drops=$(( $(link_drops) - w0 ))
   kill "$watcher" 2>/dev/null || true; wait "$watcher" 2>/dev/null || true
   if [ -n "$(ip netns pids "$gnd" | xargs -r ps -o args= -p | grep ' watch ')" ]; then
     echo "fleet_link.sh: the low-rate watch did not end" >&2; exit 1
   fi
-  low=$(( (b1 - b0) / 10 )); low_samples=$(python3 -c "print(round(($l1 - $l0) / 10, 1))")
+  low=$(python3 -c "print(round(($b1 - $b0) / ($t1 - $t0)))"); low_samples=$(python3 -c "print(round(($l1 - $l0) / 10, 1))")
   drops=$(( $(link_drops) - d0 ))
 
   rows+=("$n $idle $list_bytes $list_s $listed $cmd_bytes $cmd_s $result $low $low_samples $drops $steady_drops")
@@ -330,7 +348,8 @@ EOF
   wait 2>/dev/null || true
 done
 
-ROWS=$(printf '%s\n' "${rows[@]}") DS_ROWS=$(printf '%s\n' "${ds_rows[@]}") python3 - "$rate" "$json_out" "$qos" "$ctl" "$ds" "$svc" "$server_xml" "$cut_s" "$agent" "$loss" <<'PY'
+status=0
+( ROWS=$(printf '%s\n' "${rows[@]}") DS_ROWS=$(printf '%s\n' "${ds_rows[@]}") python3 - "$rate" "$json_out" "$qos" "$ctl" "$ds" "$svc" "$server_xml" "$cut_s" "$agent" "$loss" <<'PY'
 import json, os, re, sys
 rate, json_out, qos, ctl, ds, svc, server_xml, cut_s, agent, loss = sys.argv[1:11]
 m = re.match(r"(\d+)kbit", rate)
@@ -376,3 +395,13 @@ if failed:
     print(f"fleet_link.sh: {failed} command(s) executed twice or by another vehicle", file=sys.stderr)
     sys.exit(1)
 PY
+) || status=$?
+if [ "$breakdown" = 1 ]; then
+  for n in $aircraft; do
+    echo
+    python3 "$root/bench/rtps_breakdown.py" "$work/link-$n.pcap" --steps "$work/steps-$n" --from low --to low-end \
+      --local 10.79.0.2 --title "The low-rate watch's measured 10 s, $n aircraft (ground gnd0: sent = to the air)" |
+      tee "$work/breakdown-$n.md"
+  done
+fi
+exit "$status"

@@ -6,6 +6,7 @@
 #include <array>
 #include <cmath>
 #include <limits>
+#include <map>
 #include <string_view>
 #include <mutex>
 #include <set>
@@ -106,6 +107,10 @@ struct DdsPublisher::Writers {
   DataWriter* config;
   DataWriter* info;
   DataWriter* health;
+  // pmu/low_rate/health: null when the low-rate topics are off. `low_health_last`: the state
+  // and bus state last written there, per device.
+  DataWriter* low_health = nullptr;
+  std::map<std::tuple<std::string, DeviceKind, std::uint16_t>, std::pair<HealthState, transport::BusState>> low_health_last;
   // Null when the service serves no battery or MPPT (not offered).
   DataWriter* battery = nullptr;
   DataWriter* battery_cells = nullptr;
@@ -187,6 +192,8 @@ DdsPublisher::DdsPublisher(dds::DdsContext& dds, std::chrono::milliseconds telem
   w_->readiness = newer(topics::kReadiness, dds::zero_padded<pmu::v5::ReadinessPubSubType>(), qos_profiles::kState);
   w_->derived_energy = newer(topics::kEnergy, dds::zero_padded<pmu::v5::EnergyPubSubType>(), qos_profiles::kState);
   w_->baseline = newer(topics::kBaseline, dds::zero_padded<pmu::v5::BaselinePubSubType>(), qos_profiles::kState);
+  if (w_->low_rate.enabled())
+    w_->low_health = newer(topics::kLowRateHealth, dds::zero_padded<pmu::v5::HealthPubSubType>(), qos_profiles::kState);
   if (canopen_deadline)
     w_->bms_energy = newer(topics::kBmsEnergy, dds::zero_padded<pmu::v5::BmsEnergyPubSubType>(), qos_profiles::kState);
 }
@@ -363,6 +370,15 @@ void DdsPublisher::on_health(const DeviceKey& key, const HealthReport& h) {
   if (!admit(key)) return;
   s.publish_failures(failures_.load(std::memory_order_relaxed));
   count(w_->health->write(&s), topics::kHealth, key, "write returned false");
+  if (w_->low_health == nullptr) return;
+  // The low-rate copy changes with the state alone: a watcher on a slow link sees OFFLINE the
+  // moment the service decides it (docs/safety.md H7) without a sample a second for the age.
+  const auto id = std::make_tuple(key.bus, key.kind, key.address);
+  const auto now = std::make_pair(h.state, h.bus_state);
+  const auto last = w_->low_health_last.find(id);
+  if (last != w_->low_health_last.end() && last->second == now) return;
+  w_->low_health_last[id] = now;
+  count(w_->low_health->write(&s), topics::kLowRateHealth, key, "write returned false");
 }
 
 void DdsPublisher::on_gone(const DeviceKey& key) {
@@ -383,6 +399,8 @@ void DdsPublisher::on_gone(const DeviceKey& key) {
   set_key(h, w_->vehicle, key);
   h.kind(static_cast<pmu::v5::DeviceKind>(static_cast<int>(key.kind)));
   gone(w_->health, &h);
+  gone(w_->low_health, &h);
+  w_->low_health_last.erase(std::make_tuple(key.bus, key.kind, key.address));
   if (key.kind != DeviceKind::Pmu) return;  // batteries and MPPTs keep their node and device id
   pmu::v5::Voltages v;
   set_key(v, w_->vehicle, key);

@@ -303,7 +303,7 @@ sign "$out/governance.xml" "$out/governance.p7s"
 telemetry=(pmu/voltages pmu/currents pmu/battery_energy pmu/temperatures pmu/status
            pmu/low_rate/voltages pmu/low_rate/currents pmu/low_rate/battery_energy pmu/low_rate/temperatures
            pmu/low_rate/status pmu/battery pmu/battery_cells pmu/mppt)
-state=(pmu/config pmu/info pmu/health pmu/alarms pmu/readiness pmu/energy pmu/baseline pmu/bms_energy)
+state=(pmu/config pmu/info pmu/health pmu/low_rate/health pmu/alarms pmu/readiness pmu/energy pmu/baseline pmu/bms_energy)
 
 topics_xml() { for t in "$@"; do printf '            <topic>%s</topic>\n' "$t"; done; }
 # partitions_xml LIST: one <partition> per vehicle of LIST; the unnamed vehicle ("") is an

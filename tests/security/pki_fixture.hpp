@@ -121,13 +121,13 @@ inline const std::set<std::string> kTelemetryAndState = {
     "pmu/voltages",          "pmu/currents",          "pmu/battery_energy",          "pmu/temperatures",
     "pmu/status",            "pmu/low_rate/voltages", "pmu/low_rate/currents",       "pmu/low_rate/battery_energy",
     "pmu/low_rate/temperatures", "pmu/low_rate/status", "pmu/battery", "pmu/battery_cells", "pmu/mppt",
-    "pmu/config",            "pmu/info",              "pmu/health",                  "pmu/alarms",
+    "pmu/config",            "pmu/info",              "pmu/health",                  "pmu/low_rate/health", "pmu/alarms",
     "pmu/readiness",         "pmu/energy",            "pmu/baseline", "pmu/bms_energy"};
 inline const char* const kContractTopics[] = {
     "pmu/voltages",          "pmu/currents",          "pmu/battery_energy",          "pmu/temperatures",
     "pmu/status",            "pmu/low_rate/voltages", "pmu/low_rate/currents",       "pmu/low_rate/battery_energy",
     "pmu/low_rate/temperatures", "pmu/low_rate/status", "pmu/battery", "pmu/battery_cells", "pmu/mppt",
-    "pmu/config",            "pmu/info",              "pmu/health",            "pmu/alarms",  "pmu/readiness", "pmu/energy", "pmu/baseline", "pmu/bms_energy", "pmu/command",
+    "pmu/config",            "pmu/info",              "pmu/health",            "pmu/low_rate/health", "pmu/alarms",  "pmu/readiness", "pmu/energy", "pmu/baseline", "pmu/bms_energy", "pmu/command",
     "pmu/command_reply",     "pmu/alarm_ack",         "pmu/alarm_ack_reply"};
 
 // Only the ground station commands and acknowledges alarms; the service publishes telemetry,

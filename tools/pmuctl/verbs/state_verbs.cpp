@@ -8,6 +8,7 @@
 #include <fastdds/dds/core/status/SubscriptionMatchedStatus.hpp>
 #include <fastdds/dds/subscriber/SampleInfo.hpp>
 #include <map>
+#include <memory>
 #include <set>
 #include <thread>
 #include <tuple>
@@ -347,8 +348,21 @@ int run_watch(const GlobalOptions& o, long count) {
   };
 
   // Every row says its device's health and its values' age: a device gone OFFLINE keeps
-  // its last row, which must not look live.
-  StateCollector<pmu::v5::Health, pmu::v5::HealthPubSubType> health(dds, topics::kHealth);
+  // its last row, which must not look live (docs/safety.md H7). --low-rate reads the state
+  // from pmu/low_rate/health, which the service writes when it changes: pmu/health's sample a
+  // second (its frame age and counters, which watch does not show) would cross the link too.
+  using HealthCollector = StateCollector<pmu::v5::Health, pmu::v5::HealthPubSubType>;
+  std::unique_ptr<HealthCollector> health_reader;
+  if (low) {
+    // Permissions made before pmu/low_rate/health existed do not grant it.
+    try {
+      health_reader = std::make_unique<HealthCollector>(dds, topics::kLowRateHealth);
+    } catch (const pmu::dds::DdsError& e) {
+      std::fprintf(stderr, "pmuctl: reading pmu/health, not pmu/low_rate/health: %s\n", e.what());
+    }
+  }
+  if (!health_reader) health_reader = std::make_unique<HealthCollector>(dds, topics::kHealth);
+  HealthCollector& health = *health_reader;
   const auto health_of = [&health](const DeviceId& d) -> std::optional<pmu::v5::HealthState> {
     const auto it = health.latest().find(d);
     if (it == health.latest().end()) return std::nullopt;

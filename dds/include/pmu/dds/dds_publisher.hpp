@@ -34,7 +34,8 @@ class DdsPublisher final : public StateSink {
   // Creates the topics and writers. `telemetry_deadline` is the writers' DEADLINE
   // (3 x the longest packet period served). Throws dds::DdsError at start-up.
   // `vehicle`: the first key of every sample (vehicle.hpp). `low_rate_period` > 0: also the
-  // low-rate telemetry topics, one sample per device and packet per period (low_rate.hpp).
+  // low-rate telemetry topics, one sample per device and packet per period (low_rate.hpp),
+  // and pmu/low_rate/health, written when a device's state or bus state changes.
   // `canopen_deadline`: DEADLINE of pmu/battery, pmu/battery_cells and pmu/mppt (3 x the
   // longest battery/MPPT period, or the publish period if longer); nullopt: a service that
   // serves no battery or MPPT does not offer those topics nor pmu/bms_energy, so DDS-Security

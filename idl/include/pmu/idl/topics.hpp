@@ -19,6 +19,9 @@ inline constexpr const char* kLowRateCurrents = "pmu/low_rate/currents";
 inline constexpr const char* kLowRateBatteryEnergy = "pmu/low_rate/battery_energy";
 inline constexpr const char* kLowRateTemperatures = "pmu/low_rate/temperatures";
 inline constexpr const char* kLowRateStatus = "pmu/low_rate/status";
+// pmu/health when a device's state or bus state changes, without the once-a-second repeats
+// of its frame age and counters: what a watcher on a slow link shows (interface.md 1.5).
+inline constexpr const char* kLowRateHealth = "pmu/low_rate/health";
 // Batteries and MPPTs on the PMUs' buses (CANopen frames): docs/interface.md 1.4.
 inline constexpr const char* kBattery = "pmu/battery";
 inline constexpr const char* kBatteryCells = "pmu/battery_cells";
