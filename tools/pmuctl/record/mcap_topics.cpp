@@ -35,6 +35,7 @@ const std::vector<RecordedTopic>& recorded_topics() {
       {kLowRateBatteryEnergy, "pmu::v5::BatteryEnergy", t::k_BatteryEnergy, q::kTelemetry, false},
       {kLowRateTemperatures, "pmu::v5::Temperatures", t::k_Temperatures, q::kTelemetry, false},
       {kLowRateStatus, "pmu::v5::Status", t::k_Status, q::kTelemetry, false},
+      {kLowRateHealth, "pmu::v5::Health", t::k_Health, q::kState, false},
       {kCommand, "pmu::v5::Command", t::k_Command, q::kCommand, false},
       {kCommandReply, "pmu::v5::CommandReply", t::k_CommandReply, q::kCommand, false},
       {kAlarmAck, "pmu::v5::AlarmAck", t::k_AlarmAck, q::kCommand, false},
