@@ -4,8 +4,8 @@
 #
 #   bench/fleet_link.sh [--aircraft "1 4 8"] [--rate 250kbit] [--build-dir DIR] [--qos FILE]
 #                       [--pmuctl BIN] [--service BIN] [--discovery-server [--server-xml FILE|none]]
-#                       [--cut SECONDS] [--agent] [--loss PERCENT] [--json FILE] [--keep DIR [--capture]]
-#                       [--breakdown] [--low-rate-period S]
+#                       [--cut SECONDS] [--agent] [--loss PERCENT] [--link PROFILE] [--json FILE]
+#                       [--keep DIR [--capture]] [--breakdown] [--low-rate-period S]
 #
 # Two network namespaces joined by one veth pair, shaped by tbf to RATE each way (a radio
 # modem's queue of about 2 s; no delay or loss: the VM lab adds those): in `air`, N pmu-service
@@ -34,6 +34,8 @@
 # never served by an agent and runs on its own as before. Without it, calls run on their own.
 # --loss PERCENT: each namespace drops that share of the packets it sends on the veth, at
 # random (nftables; the VM lab's netem also delays, which a namespace here cannot).
+# --link PROFILE: the link profile on both sides: `link: {profile: PROFILE}` in every service's
+# config and `--link PROFILE` on every pmuctl call and the agent (interface.md section 7.3).
 # --keep DIR: the run's logs (services, agent, calls) are copied to DIR at the end; with
 # --capture also a packet capture of the ground interface per fleet size (link-N.pcap, whole
 # packets) and when each step began (steps-N: its name, uptime and wall-clock time, which the
@@ -63,6 +65,7 @@ capture=0
 breakdown=0
 low_rate_period=""
 loss=0
+link_profile=""
 while [ $# -gt 0 ]; do
   case "$1" in
     --aircraft) aircraft=$2; shift 2 ;;
@@ -81,7 +84,8 @@ while [ $# -gt 0 ]; do
     --capture) capture=1; shift ;;
     --breakdown) breakdown=1; capture=1; shift ;;
     --low-rate-period) low_rate_period=$2; shift 2 ;;
-    -h|--help) sed -n '2,46p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
+    --link) link_profile=$2; shift 2 ;;
+    -h|--help) sed -n '2,48p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
     *) echo "fleet_link.sh: unknown argument '$1'" >&2; exit 2 ;;
   esac
 done
@@ -158,6 +162,11 @@ link_drops() {
 }
 ds_option=()
 [ "$ds" = 1 ] && ds_option=(--discovery-server 10.79.0.2)
+link_yaml=""
+if [ -n "$link_profile" ]; then
+  ds_option+=(--link "$link_profile")
+  link_yaml="link: {profile: $link_profile}"
+fi
 # Without --agent the socket names nothing, so an agent of this host's user is never used.
 pmuctl_gnd() {
   if [ "${exec_gnd:-0}" = 1 ]; then  # in a subshell of its own: become pmuctl
@@ -290,6 +299,7 @@ interfaces: [air0]
 log_level: $svc_log_level
 ${low_rate_period:+low_rate_period: $low_rate_period}
 $ds_yaml
+$link_yaml
 buses:
   - interface: sim
     name: sim0
@@ -349,13 +359,13 @@ EOF
 done
 
 status=0
-( ROWS=$(printf '%s\n' "${rows[@]}") DS_ROWS=$(printf '%s\n' "${ds_rows[@]}") python3 - "$rate" "$json_out" "$qos" "$ctl" "$ds" "$svc" "$server_xml" "$cut_s" "$agent" "$loss" <<'PY'
+( LINK_PROFILE=$link_profile ROWS=$(printf '%s\n' "${rows[@]}") DS_ROWS=$(printf '%s\n' "${ds_rows[@]}") python3 - "$rate" "$json_out" "$qos" "$ctl" "$ds" "$svc" "$server_xml" "$cut_s" "$agent" "$loss" <<'PY'
 import json, os, re, sys
 rate, json_out, qos, ctl, ds, svc, server_xml, cut_s, agent, loss = sys.argv[1:11]
 m = re.match(r"(\d+)kbit", rate)
 cap = int(m.group(1)) * 1000 / 8 if m else None
 out = []
-print(f"fleet over a {rate} link (tbf each way{', ' + loss + ' % loss' if loss != '0' else ''}){', Discovery Server on the ground (' + server_xml + ')' if ds == '1' else ''}{'; the calls through pmuctl agent' if agent == '1' else ''}; qos {qos}; pmuctl {ctl}; pmu-service {svc}")
+print(f"fleet over a {rate} link (tbf each way{', ' + loss + ' % loss' if loss != '0' else ''}){', link profile ' + os.environ['LINK_PROFILE'] if os.environ.get('LINK_PROFILE') else ''}{', Discovery Server on the ground (' + server_xml + ')' if ds == '1' else ''}{'; the calls through pmuctl agent' if agent == '1' else ''}; qos {qos}; pmuctl {ctl}; pmu-service {svc}")
 print("| aircraft | idle B/s | list: bytes, s, listed | command: bytes, s, result | watch --low-rate B/s (samples/s) | low-rate watch / one way's capacity | queue drops: from the list on / in the watch's 10 s |")
 print("|---|---|---|---|---|---|---|")
 for line in os.environ["ROWS"].splitlines():

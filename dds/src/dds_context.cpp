@@ -135,6 +135,9 @@ DdsContext::DdsContext(int domain, const std::string& qos_file, const std::strin
   } catch (const NetworkError& e) {
     throw DdsError(e.what());
   }
+  // The link's floor (link_profile.hpp): every reliable writer of this participant, the
+  // service's and pmuctl's alike.
+  heartbeat_floor_ = network.link.heartbeat_floor.value;
   // Sent in discovery, so a client tells which contract a participant serves before its
   // endpoints are announced (seconds later over a slow link).
   pqos.properties().properties().emplace_back(kContractProperty, std::to_string(contract), true);

@@ -7,6 +7,7 @@
 #include <fastdds/rtps/transport/shared_mem/SharedMemTransportDescriptor.h>
 #include <fastrtps/utils/IPLocator.h>
 
+#include <chrono>
 #include <filesystem>
 #include <memory>
 
@@ -56,6 +57,14 @@ void add_security(DomainParticipantQos& pqos, const SecurityFiles& f) {
   p.emplace_back("dds.sec.crypto.plugin", "builtin.AES-GCM-GMAC");
 }
 
+eprosima::fastrtps::Duration_t duration(std::chrono::milliseconds ms) {
+  return eprosima::fastrtps::Duration_t(static_cast<double>(ms.count()) / 1000.0);
+}
+
+eprosima::fastrtps::Duration_t longer(const eprosima::fastrtps::Duration_t& a, const eprosima::fastrtps::Duration_t& b) {
+  return a < b ? b : a;
+}
+
 }  // namespace
 
 DomainParticipantQos participant_qos(const std::string& name, Transport transport, const ResolvedNetwork& network,
@@ -101,6 +110,15 @@ DomainParticipantQos participant_qos(const std::string& name, Transport transpor
 
   auto& builtin = qos.wire_protocol().builtin;
   builtin.use_WriterLivelinessProtocol = false;
+  // The link's announcement period and lease (link_profile.hpp); Discovery Server clients
+  // keep the longer of theirs and the link's (below).
+  const auto& link = network.link;
+  if (link.announcement_period.set())
+    builtin.discovery_config.leaseDuration_announcementperiod = duration(link.announcement_period.value);
+  if (link.lease.set()) builtin.discovery_config.leaseDuration = duration(link.lease.value);
+  if (link.initial_announcements > 0) {
+    builtin.discovery_config.initial_announcements.count = static_cast<std::uint32_t>(link.initial_announcements);
+  }
   switch (network.mode) {
     case DiscoveryMode::Multicast:
       break;
@@ -115,8 +133,9 @@ DomainParticipantQos participant_qos(const std::string& name, Transport transpor
       // A client's announcements go to its servers alone, which for an aircraft means across
       // the radio link: three per lease instead of every 3 s, so a lossy link must lose three
       // in a row, or be down longer than the lease, before the server gives the client up.
-      builtin.discovery_config.leaseDuration = kClientLease;
-      builtin.discovery_config.leaseDuration_announcementperiod = kClientAnnouncementPeriod;
+      builtin.discovery_config.leaseDuration = longer(builtin.discovery_config.leaseDuration, kClientLease);
+      builtin.discovery_config.leaseDuration_announcementperiod =
+          longer(builtin.discovery_config.leaseDuration_announcementperiod, kClientAnnouncementPeriod);
       builtin.discovery_config.m_DiscoveryServers.clear();
       for (std::size_t id = 0; id < network.servers.size(); ++id) {
         if (network.servers[id].locators.empty()) continue;  // an id left unused

@@ -1,5 +1,5 @@
-// pmuctl's discovery and interface options and their environment variables (interface.md
-// section 7.2): every bad value is refused before any DDS participant exists, with exit
+// pmuctl's discovery, interface and link options and their environment variables (interface.md
+// sections 7.2, 7.3): every bad value is refused before any DDS participant exists, with exit
 // status 2 and a message naming the option or the variable. (That options win over the
 // variables needs a participant: tests/integration/discovery_test.cpp, since Fast DDS 2.9.1
 // trips AddressSanitizer, under which this label runs too.)
@@ -19,7 +19,7 @@ struct BadCase {
 // `env -u` first: a variable exported where the tests run must not change them.
 std::string pmuctl(const std::string& command) {
   const auto at = command.find("pmuctl");
-  return "env -u PMU_DDS_PEERS -u PMU_DISCOVERY_SERVER -u PMU_DDS_INTERFACES " + command.substr(0, at) + PMUCTL_PATH +
+  return "env -u PMU_DDS_PEERS -u PMU_DISCOVERY_SERVER -u PMU_DDS_INTERFACES -u PMU_LINK " + command.substr(0, at) + PMUCTL_PATH +
          command.substr(at + 6) + " 2>&1 >/dev/null";
 }
 
@@ -59,6 +59,9 @@ const BadCase kBad[] = {
     {"PMU_DDS_INTERFACES=lo,lo pmuctl list", "pmuctl: PMU_DDS_INTERFACES 'lo' given twice\n"},
     {"PMU_DDS_INTERFACES=192.168.1 pmuctl list",
      "pmuctl: PMU_DDS_INTERFACES '192.168.1': '192.168.1' is not an IPv4 address (four numbers 0..255)\n"},
+    {"pmuctl --link satellite list", "pmuctl: --link 'satellite': not a link profile (one of: radio, none)\n"},
+    {"PMU_LINK=Radio pmuctl list", "pmuctl: PMU_LINK 'Radio': not a link profile (one of: radio, none)\n"},
+    {"PMU_LINK=radio pmuctl --link lan agent", "pmuctl: --link 'lan': not a link profile (one of: radio, none)\n"},
 };
 
 TEST(PmuctlNetworkOptions, EveryBadValueIsRefusedNamingTheOptionOrVariable) {
@@ -93,7 +96,7 @@ TEST(PmuctlNetworkOptions, HelpNamesTheOptionsAndVariables) {
   const auto r = pmu::test::run_capture(std::string(PMUCTL_PATH) + " --help");
   EXPECT_EQ(r.status, 0);
   for (const char* s : {"--peer", "--discovery-server", "--interface", "PMU_DDS_PEERS", "PMU_DISCOVERY_SERVER",
-                        "PMU_DDS_INTERFACES", "fastdds discovery -i"})
+                        "PMU_DDS_INTERFACES", "fastdds discovery -i", "--link", "PMU_LINK"})
     EXPECT_NE(r.out.find(s), std::string::npos) << s << " missing from:\n" << r.out;
 }
 

@@ -752,24 +752,79 @@ TEST(ConfigTypeObjects, OffUnlessTrueAndRefusedAtItsLineWhenNotABoolean) {
   for (const auto& c : bad) expect_refused(c.yaml + std::string(kBus), c.message);
 }
 
-// link (interface.md 4): the round trip of the link to the ground, which sets how often the
-// reliable writers may heartbeat; unset by default (qos.xml's periods).
+// link (interface.md 4): the link to the ground, a profile and/or its round trip, which set
+// the participant's announcements and how often the reliable writers may heartbeat; unset by
+// default (Fast DDS's and qos.xml's periods).
 TEST(ConfigLink, RoundTripInSecondsOrUnset) {
-  EXPECT_FALSE(parse_config(kBus, "s.yaml").link_round_trip);
+  EXPECT_FALSE(parse_config(kBus, "s.yaml").network.link.round_trip);
   const auto c = parse_config(std::string("link:\n  round_trip: 0.6\n") + kBus, "s.yaml");
-  ASSERT_TRUE(c.link_round_trip);
-  EXPECT_EQ(*c.link_round_trip, std::chrono::milliseconds(600));
-  EXPECT_EQ(*parse_config(std::string("link: {round_trip: 2}\n") + kBus, "s.yaml").link_round_trip,
+  ASSERT_TRUE(c.network.link.round_trip);
+  EXPECT_EQ(*c.network.link.round_trip, std::chrono::milliseconds(600));
+  EXPECT_EQ(c.network.link.round_trip_where, "s.yaml:2");
+  EXPECT_EQ(*parse_config(std::string("link: {round_trip: 2}\n") + kBus, "s.yaml").network.link.round_trip,
             std::chrono::milliseconds(2000));
   const BadCase bad[] = {
-      {"link: 0.6\n", "bad.yaml:1: link must be a map: {round_trip: SECONDS}"},
-      {"domain: 3\nlink: {}\n", "bad.yaml:2: link needs round_trip: the link's round trip in seconds, 0.001..30"},
+      {"link: 0.6\n", "bad.yaml:1: link must be a map: {profile: radio} and/or {round_trip: SECONDS}"},
+      {"domain: 3\nlink: {}\n",
+       "bad.yaml:2: link needs profile (radio, none) or round_trip: the link's round trip in seconds, 0.001..30"},
       {"link:\n  round_trip: 31\n", "bad.yaml:2: link round_trip 31 out of range 0..30"},
       {"link:\n  round_trip: 0\n", "bad.yaml:2: link round_trip 0 is below 0.001 s"},
       {"link:\n  round_trip: fast\n", "bad.yaml:2: link round_trip must be a number, not 'fast'"},
-      {"link:\n  rtt: 0.6\n", "bad.yaml:2: unknown key 'rtt' in link (known: round_trip)"},
+      {"link:\n  rtt: 0.6\n", "bad.yaml:2: unknown key 'rtt' in link (known: profile, round_trip)"},
+      {"domain: 1\nlink:\n  profile: satellite\n", "bad.yaml:3: link profile 'satellite' is not one of: radio, none"},
+      {"link: {profile: Radio}\n", "bad.yaml:1: link profile 'Radio' is not one of: radio, none"},
+      {"link:\n  profile: [radio]\n", "bad.yaml:2: link profile must be radio or none"},
   };
   for (const auto& b : bad) expect_refused(b.yaml + std::string(kBus), b.message);
+}
+
+// link profile (interface.md 4, 7.3): one line gives every value a radio link needs, each
+// with where it came from; round_trip overrides the profile's round trip.
+TEST(ConfigLink, ProfileRadioSetsItsBundleAndRoundTripOverridesIt) {
+  struct Case {
+    const char* yaml;
+    long round_trip_ms, heartbeat_ms, announcement_ms, lease_ms;
+    int initial;
+    bool low_rate;
+    const char* round_trip_from;
+  };
+  const Case cases[] = {
+      {"", 0, 0, 0, 0, 0, false, ""},
+      {"link: {profile: none}\n", 0, 0, 0, 0, 0, false, ""},
+      {"link: {round_trip: 0.6}\n", 600, 900, 0, 0, 0, false, "round_trip, s.yaml:1"},
+      {"link: {profile: radio}\n", 700, 1050, 20000, 60000, 1, true, "profile radio, s.yaml:1"},
+      {"link:\n  profile: radio\n  round_trip: 1.2\n", 1200, 1800, 20000, 60000, 1, true, "round_trip, s.yaml:3"},
+  };
+  for (const auto& k : cases) {
+    SCOPED_TRACE(k.yaml);
+    const auto c = parse_config(k.yaml + std::string(kBus), "s.yaml");
+    const auto plan = pmu::dds::link_plan(c.network.link);
+    EXPECT_EQ(plan.round_trip.value.count(), k.round_trip_ms);
+    EXPECT_EQ(plan.round_trip.from, k.round_trip_from);
+    EXPECT_EQ(plan.heartbeat_floor.value.count(), k.heartbeat_ms);
+    EXPECT_EQ(plan.announcement_period.value.count(), k.announcement_ms);
+    EXPECT_EQ(plan.lease.value.count(), k.lease_ms);
+    EXPECT_EQ(plan.initial_announcements, k.initial);
+    EXPECT_EQ(plan.low_rate_watch, k.low_rate);
+  }
+}
+
+TEST(ConfigLink, ExplanationNamesEachValueAndItsOrigin) {
+  const auto radio = pmu::dds::link_plan(
+      parse_config(std::string("link:\n  profile: radio\n  round_trip: 0.5\n") + kBus, "s.yaml").network.link);
+  const std::vector<std::string> expected = {
+      "link: profile radio",
+      "link: round trip 0.5 s (round_trip, s.yaml:3)",
+      "link: reliable writers heartbeat every 0.75 s at most (1.5 round trips)",
+      "link: participant announced every 20 s (profile radio, s.yaml:2)",
+      "link: participant lease 60 s (profile radio, s.yaml:2)",
+      "link: 1 initial announcement(s) (profile radio)",
+      "link: pmuctl watch reads the low-rate topics pmu/low_rate/* (profile radio)",
+      "link: pmuctl agent runs 1 worker(s) unless --workers (profile radio)",
+  };
+  EXPECT_EQ(radio.explain(), expected);
+  EXPECT_EQ(pmu::dds::link_plan(parse_config(kBus, "s.yaml").network.link).explain(),
+            std::vector<std::string>{"link: none (Fast DDS's discovery periods, qos.xml's heartbeat periods)"});
 }
 
 // also_serve_contract (interface.md 10.3): unset by default; only the contract before this

@@ -183,6 +183,36 @@ TEST(ParticipantQos, AServerClientAnnouncesThreeTimesPerLeaseAndTheOtherModesKee
   EXPECT_EQ(fastdds.wire_protocol().builtin.discovery_config.leaseDuration_announcementperiod, (Duration_t{3, 0}));
 }
 
+// The radio link profile (link_profile.hpp): announcements every 20 s with a lease of 60 s,
+// and one initial announcement, in every discovery mode; a Discovery Server
+// client keeps the longer of its own periods and the link's.
+TEST(ParticipantQos, TheRadioLinkSetsAnnouncementsLeaseAndDiscoveryPace) {
+  struct Case {
+    const char* name;
+    ResolvedNetwork network;
+  };
+  const Case cases[] = {
+      {"multicast", ResolvedNetwork{}},
+      {"unicast", unicast({{"127.0.0.1", 0}})},
+      {"server", server({{{{"10.0.0.1", 11811}}}})},
+  };
+  for (auto c : cases) {
+    SCOPED_TRACE(c.name);
+    LinkSettings settings;
+    settings.profile = LinkProfile::Radio;
+    c.network.link = link_plan(settings);
+    const auto q = participant_qos("x", Transport::UdpOnly, c.network, {});
+    const auto& d = q.wire_protocol().builtin.discovery_config;
+    EXPECT_EQ(d.leaseDuration, (Duration_t{60, 0}));
+    EXPECT_EQ(d.leaseDuration_announcementperiod, (Duration_t{20, 0}));
+    EXPECT_EQ(d.initial_announcements.count, 1u);
+  }
+  // Without a profile: Fast DDS's initial announcements.
+  const auto plain = participant_qos("x", Transport::UdpOnly, ResolvedNetwork{}, {});
+  EXPECT_EQ(plain.wire_protocol().builtin.discovery_config.initial_announcements.count,
+            DomainParticipantQos().wire_protocol().builtin.discovery_config.initial_announcements.count);
+}
+
 TEST(ParticipantQos, AllowlistReplacesTheBuiltinTransportsSoNoneBypassesIt) {
   ResolvedNetwork n;
   n.interface_addresses = {"192.168.10.1", "127.0.0.1"};

@@ -205,6 +205,10 @@ int run_cli(int argc, char** argv, const AgentCall* served) {
                  "DDS over UDP only on this interface (name or IPv4 address); repeat for more "
                  "(default: $PMU_DDS_INTERFACES, comma separated; none: every interface)")
       ->allow_extra_args(false);
+  app.add_option("--link", network.link,
+                 "The link to the aircraft: radio (announcements, leases and heartbeats for a radio's round trip; "
+                 "watch reads the low-rate topics) or none (default: $PMU_LINK, else none)")
+      ->type_name("PROFILE");
   app.add_flag("--no-agent", g.no_agent, "Run this call on its own, not through a `pmuctl agent` of this host");
 
   auto* agent = app.add_subcommand(
@@ -216,8 +220,9 @@ int run_cli(int argc, char** argv, const AgentCall* served) {
                     "agent-DOMAIN.sock, else /run/pmu-dds/agent-DOMAIN.sock)")
       ->type_name("PATH");
   int agent_workers = 4;
-  agent->add_option("--workers", agent_workers,
-                    "Calls served at once, each by a process with its own DDS participant (default 4), besides one "
+  auto* workers_option = agent->add_option("--workers", agent_workers,
+                    "Calls served at once, each by a process with its own DDS participant (default 4; 1 with --link "
+                    "radio), besides one "
                     "for engine stops, which never wait. Calls go to the first while it keeps up; the next takes "
                     "one when all before it have been on theirs for 5 s, so a call that waits for a silent "
                     "aircraft holds up no other for longer")
@@ -441,6 +446,11 @@ int run_cli(int argc, char** argv, const AgentCall* served) {
   if (!setup_vehicle(g, vehicle_option, vehicle)) return 2;
   if (!pmu::tools::resolve_network_options(network, pmu::dds::system_lookup(), !g.security.empty(), g.network))
     return 2;
+  // Over a radio link a ground watch reads the low-rate topics, and the agent keeps one
+  // worker: every ground participant is one more that every aircraft sends its endpoints to
+  // and repairs them for (link_profile.hpp).
+  if (g.network.link.low_rate_watch) g.low_rate = true;
+  if (g.network.link.agent_workers > 0 && workers_option->count() == 0) agent_workers = g.network.link.agent_workers;
   // Calls that end by themselves go through the agent; those that run until stopped keep a
   // participant of their own anyway.
   const bool agent_serves = !*agent && !*watch && !*record && !*serve;

@@ -116,14 +116,10 @@ int run(const service::Config& cfg, const pmu::dds::ResolvedNetwork& network) {
   const auto partitions = service::vehicle_partitions(cfg.vehicle);
   pmu::dds::DdsContext participant(cfg.domain, cfg.qos_file, pmu::dds::kServiceParticipantName, cfg.security.files, cfg.dds_transport,
                                    network, {partitions, partitions}, cfg.dds_statistics, cfg.dds_type_objects);
-  // A writer heartbeats until each reader has acknowledged: over a link whose round trip is
-  // longer than the period, several heartbeats, each answered, per sample (config.hpp).
-  const milliseconds heartbeat_floor = cfg.link_round_trip.value_or(milliseconds{0}) * 3 / 2;
-  if (heartbeat_floor.count() > 0) {
-    participant.heartbeat_at_least(heartbeat_floor);
-    spdlog::info("DDS: link round trip {} ms: reliable writers heartbeat every {} ms at most",
-                 cfg.link_round_trip.value_or(milliseconds{0}).count(), heartbeat_floor.count());
-  }
+  // The link's values (link_profile.hpp): the participant took them from `network`.
+  for (const auto& line : network.link.explain())
+    if (network.link.profile != pmu::dds::LinkProfile::None || network.link.round_trip.set())
+      spdlog::info("DDS: {}", line);
   if (cfg.dds_type_objects) spdlog::info("DDS: type objects announced (dds_type_objects)");
   if (!cfg.dds_statistics.empty())
     spdlog::info("DDS: Fast DDS statistics on: {}", pmu::dds::statistics_property(cfg.dds_statistics));
@@ -141,7 +137,6 @@ int run(const service::Config& cfg, const pmu::dds::ResolvedNetwork& network) {
     previous_participant = std::make_unique<pmu::dds::DdsContext>(
         cfg.domain, cfg.qos_file, pmu::dds::kServiceParticipantName, cfg.security.files, cfg.dds_transport, network,
         pmu::dds::Partitions{partitions, partitions}, std::vector<std::string>{}, false, *cfg.also_serve_contract);
-    previous_participant->heartbeat_at_least(heartbeat_floor);
     previous_publisher = std::make_unique<service::DdsPublisher>(*previous_participant, 3 * longest, cfg.vehicle,
                                                                  cfg.low_rate_period, canopen_deadline);
     spdlog::info("DDS: also serving contract v{} on a second participant (also_serve_contract)",
@@ -359,6 +354,8 @@ int main(int argc, char** argv) {
                 cfg.security.files.empty() ? "" : ", DDS-Security files OK");
     std::printf("%s: QoS profiles %s OK\n", cfg.source.c_str(), cfg.qos_file.c_str());
     std::printf("%s: DDS %s\n", cfg.source.c_str(), network->summary.c_str());
+    // What `link:` sets, each value with the profile or the key it came from.
+    for (const auto& line : network->link.explain()) std::printf("%s: %s\n", cfg.source.c_str(), line.c_str());
     return 0;
   }
   try {

@@ -424,14 +424,27 @@ void parse_ros2(const Ctx& c, const YAML::Node& n, Ros2Settings& r) {
   }
 }
 
-void parse_link(const Ctx& c, const YAML::Node& n, std::optional<std::chrono::milliseconds>& round_trip) {
-  if (!n.IsMap()) c.fail(n, "link must be a map: {round_trip: SECONDS}");
-  c.only_keys(n, "link", {"round_trip"});
+void parse_link(const Ctx& c, const YAML::Node& n, dds::LinkSettings& link) {
+  if (!n.IsMap()) c.fail(n, "link must be a map: {profile: radio} and/or {round_trip: SECONDS}");
+  c.only_keys(n, "link", {"profile", "round_trip"});
+  const auto profile = n["profile"];
   const auto v = n["round_trip"];
-  if (!v) c.fail(n, "link needs round_trip: the link's round trip in seconds, 0.001..30");
-  const double s = c.number(v, "link round_trip", 0, 30);
-  if (s < 0.001) c.fail(v, "link round_trip " + v.Scalar() + " is below 0.001 s");
-  round_trip = std::chrono::milliseconds(std::lround(s * 1000));
+  if (!profile && !v)
+    c.fail(n, std::string("link needs profile (") + dds::kLinkProfileNames +
+                  ") or round_trip: the link's round trip in seconds, 0.001..30");
+  if (profile) {
+    const auto text = c.scalar<std::string>(profile, "link profile", "radio or none");
+    const auto p = dds::parse_link_profile(text);
+    if (!p) c.fail(profile, "link profile " + quoted(text) + " is not one of: " + dds::kLinkProfileNames);
+    link.profile = *p;
+    link.profile_where = c.line_of(profile);
+  }
+  if (v) {
+    const double s = c.number(v, "link round_trip", 0, 30);
+    if (s < 0.001) c.fail(v, "link round_trip " + v.Scalar() + " is below 0.001 s");
+    link.round_trip = std::chrono::milliseconds(std::lround(s * 1000));
+    link.round_trip_where = c.line_of(v);
+  }
 }
 
 void parse_policy(const Ctx& c, const YAML::Node& n, PolicyConfig& p) {
@@ -778,7 +791,7 @@ Config parse_config(const std::string& text, const std::string& source, const Co
   }
   if (const auto v = root["timeouts"]) parse_timeouts(c, v, cfg.timeouts);
   if (const auto v = root["ros2"]) parse_ros2(c, v, cfg.ros2);
-  if (const auto v = root["link"]) parse_link(c, v, cfg.link_round_trip);
+  if (const auto v = root["link"]) parse_link(c, v, cfg.network.link);
   if (const auto v = root["policy"]) parse_policy(c, v, cfg.policy);
   for (const auto& kv : root)
     if (kv.first.as<std::string>() == "security") parse_security(c, kv.first, kv.second, cfg.security);

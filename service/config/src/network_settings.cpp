@@ -270,6 +270,12 @@ ResolvedNetwork resolve_network(const NetworkConfig& config, const NetworkLookup
     if (!had_loopback) r.interface_addresses.push_back("127.0.0.1");
     summary += "; DDS over UDP only on " + join(interfaces) + (had_loopback ? "" : " and loopback (127.0.0.1)");
   }
+  r.link = link_plan(config.link);
+  // The summary is what pmuctl compares with its agent's (a call on another link is not the
+  // agent's to serve) and what the start-up log shows.
+  if (r.link.profile != LinkProfile::None) summary += std::string("; link profile ") + to_string(r.link.profile);
+  if (r.link.round_trip.set())
+    summary += "; link round trip " + std::to_string(r.link.round_trip.value.count()) + " ms";
   r.summary = summary;
   return r;
 }

@@ -25,7 +25,7 @@ namespace pmu::tools {
 // agent runs it with exactly those set and the others unset.
 inline constexpr const char* kAgentEnvironment[] = {
     "PMU_VEHICLE",          "PMU_QOS_FILE",       "PMU_SECURITY_DIR",  "PMU_SECURITY_IDENTITY",
-    "PMU_DDS_PEERS",        "PMU_DISCOVERY_SERVER", "PMU_DDS_INTERFACES",
+    "PMU_DDS_PEERS",        "PMU_DISCOVERY_SERVER", "PMU_DDS_INTERFACES", "PMU_LINK",
 };
 
 struct AgentRequest {

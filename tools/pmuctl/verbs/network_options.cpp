@@ -132,6 +132,23 @@ bool resolve_network_options(const NetworkOptions& o, const dds::NetworkLookup& 
   if (!i) return false;
   config.interfaces = std::move(*i);
 
+  // The link: the option, else the variable (the option wins, also --link none).
+  std::string link = o.link, link_from = "--link";
+  if (link.empty()) {
+    link = env("PMU_LINK");
+    link_from = "PMU_LINK";
+  }
+  if (!link.empty()) {
+    const auto profile = dds::parse_link_profile(link);
+    if (!profile) {
+      std::fprintf(stderr, "pmuctl: %s '%s': not a link profile (one of: %s)\n", link_from.c_str(), link.c_str(),
+                   dds::kLinkProfileNames);
+      return false;
+    }
+    config.link.profile = *profile;
+    config.link.profile_where = link_from;
+  }
+
   try {
     out = dds::resolve_network(config, lookup);
   } catch (const dds::NetworkError& e) {

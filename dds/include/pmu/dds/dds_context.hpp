@@ -136,7 +136,8 @@ class DdsContext {
                                              eprosima::fastdds::dds::DataReaderListener* listener = nullptr);
 
   // From now on, reliable writers heartbeat at most this often (their profile's period when
-  // that is longer): the service's `link: round_trip` (config.hpp says why). Call before the
+  // that is longer): the link's floor (network.link.heartbeat_floor, set by the constructor
+  // from `link:` or pmuctl's --link; config.hpp says why). Call before the
   // writers are made (a writer's period cannot change once it exists); the writers' thread.
   void heartbeat_at_least(std::chrono::milliseconds period) noexcept { heartbeat_floor_ = period; }
 

@@ -28,6 +28,9 @@
 // (127.0.0.1 always among them, see resolve_network); without one it uses every interface.
 // Security: the DDS-Security plugin properties when `security` is not empty, with multicast
 // and unicast discovery and with an allowlist.
+// Link (network.link, link_profile.hpp): its announcement period, lease and initial
+// announcements replace Fast DDS's in every mode (a server client keeps the longer of its
+// own and the link's).
 // Statistics: property `fastdds.statistics` = the topics joined by ';' when `statistics` is
 // not empty (statistics_settings.hpp); nothing otherwise.
 //

@@ -166,12 +166,12 @@ struct Config {
   // Monitor (statistics_settings.hpp); empty (the default): none.
   std::vector<std::string> dds_statistics;
   std::string dds_statistics_line;  // "FILE:LINE" of dds_statistics, for the start-up check
-  // `link: {round_trip: S}`: the round trip of the slowest link between this service and its
-  // readers (a radio to the ground). Its reliable writers then heartbeat at least every
-  // 1.5 round trips (dds::DdsContext::heartbeat_at_least): a writer heartbeats every period
-  // until each reader has acknowledged, so a period shorter than the round trip sends
-  // several heartbeats, each answered, per sample. Unset (the default): qos.xml's periods.
-  std::optional<std::chrono::milliseconds> link_round_trip;
+  // `link:` ({profile: radio, round_trip: S}) is network.link (link_profile.hpp). round_trip:
+  // the round trip of the slowest link between this service and its readers (a radio to the
+  // ground). Its reliable writers then heartbeat at least every 1.5 round trips
+  // (dds::DdsContext::heartbeat_at_least): a writer heartbeats every period until each reader
+  // has acknowledged, so a period shorter than the round trip sends several heartbeats, each
+  // answered, per sample. Unset (the default): qos.xml's periods.
   // `dds_type_objects`: announce the contract's type objects in discovery, for eProsima's
   // dynamic-type tools (dds_type_objects.hpp). Off by default: they add about 10 kB of
   // discovery traffic per joining participant, which a lossy, narrow ground link pays for.

@@ -38,6 +38,8 @@
 #include <string_view>
 #include <vector>
 
+#include "pmu/config/link_profile.hpp"
+
 namespace pmu::dds {
 
 enum class DiscoveryMode {
@@ -63,6 +65,7 @@ struct NetworkConfig {
   // (a server of id 1 alone: ["", "10.0.0.2"]), and at least one names a server.
   std::vector<Address> servers;
   std::vector<Address> interfaces;  // empty: every interface; host = a name or an IPv4 address
+  LinkSettings link;                // `link:` / --link: the link's profile and round trip (link_profile.hpp)
 };
 
 inline constexpr std::uint16_t kDefaultServerPort = 11811;  // `fastdds discovery`'s default
@@ -122,6 +125,8 @@ struct ResolvedNetwork {
   // Empty: every interface. Otherwise the allowed addresses, 127.0.0.1 always among them
   // (same-host traffic; resolve_network says why).
   std::vector<std::string> interface_addresses;
+  // The link's values (link_profile.hpp): announcement period, lease, heartbeat floor.
+  LinkPlan link;
   // One line for the start-up log, e.g. "unicast discovery to 127.0.0.1; interfaces 10.0.0.1 (eth1)".
   std::string summary;
 };
