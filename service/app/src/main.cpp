@@ -117,9 +117,8 @@ int run(const service::Config& cfg, const pmu::dds::ResolvedNetwork& network) {
   pmu::dds::DdsContext participant(cfg.domain, cfg.qos_file, pmu::dds::kServiceParticipantName, cfg.security.files, cfg.dds_transport,
                                    network, {partitions, partitions}, cfg.dds_statistics, cfg.dds_type_objects);
   // The link's values (link_profile.hpp): the participant took them from `network`.
-  for (const auto& line : network.link.explain())
-    if (network.link.profile != pmu::dds::LinkProfile::None || network.link.round_trip.set())
-      spdlog::info("DDS: {}", line);
+  if (network.link.profile != pmu::dds::LinkProfile::None || network.link.round_trip.set())
+    for (const auto& line : network.link.explain()) spdlog::info("DDS: {}", line);
   if (cfg.dds_type_objects) spdlog::info("DDS: type objects announced (dds_type_objects)");
   if (!cfg.dds_statistics.empty())
     spdlog::info("DDS: Fast DDS statistics on: {}", pmu::dds::statistics_property(cfg.dds_statistics));
