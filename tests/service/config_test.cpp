@@ -787,13 +787,21 @@ TEST(ConfigLink, ProfileRadioSetsItsBundleAndRoundTripOverridesIt) {
     int initial;
     bool low_rate;
     const char* round_trip_from;
+    long low_rate_period_ms;  // the service's, after the profile
   };
   const Case cases[] = {
-      {"", 0, 0, 0, 0, 0, false, ""},
-      {"link: {profile: none}\n", 0, 0, 0, 0, 0, false, ""},
-      {"link: {round_trip: 0.6}\n", 600, 900, 0, 0, 0, false, "round_trip, s.yaml:1"},
-      {"link: {profile: radio}\n", 700, 1050, 20000, 60000, 1, true, "profile radio, s.yaml:1"},
-      {"link:\n  profile: radio\n  round_trip: 1.2\n", 1200, 1800, 20000, 60000, 1, true, "round_trip, s.yaml:3"},
+      {"", 0, 0, 0, 0, 0, false, "", 1000},
+      {"link: {profile: none}\n", 0, 0, 0, 0, 0, false, "", 1000},
+      {"link: {round_trip: 0.6}\n", 600, 900, 0, 0, 0, false, "round_trip, s.yaml:1", 1000},
+      {"link: {profile: radio}\n", 700, 1050, 20000, 60000, 1, true, "profile radio, s.yaml:1", 2000},
+      {"link:\n  profile: radio\n  round_trip: 1.2\n", 1200, 1800, 20000, 60000, 1, true, "round_trip, s.yaml:3", 2000},
+      // The config's own low_rate_period wins over the profile's, before or after link:.
+      {"low_rate_period: 1\nlink: {profile: radio}\n", 700, 1050, 20000, 60000, 1, true, "profile radio, s.yaml:2",
+       1000},
+      {"link: {profile: radio}\nlow_rate_period: 0.5\n", 700, 1050, 20000, 60000, 1, true, "profile radio, s.yaml:1",
+       500},
+      {"link: {profile: radio}\nlow_rate_period: 0\n", 700, 1050, 20000, 60000, 1, true, "profile radio, s.yaml:1", 0},
+      {"low_rate_period: 5\n", 0, 0, 0, 0, 0, false, "", 5000},
   };
   for (const auto& k : cases) {
     SCOPED_TRACE(k.yaml);
@@ -806,6 +814,7 @@ TEST(ConfigLink, ProfileRadioSetsItsBundleAndRoundTripOverridesIt) {
     EXPECT_EQ(plan.lease.value.count(), k.lease_ms);
     EXPECT_EQ(plan.initial_announcements, k.initial);
     EXPECT_EQ(plan.low_rate_watch, k.low_rate);
+    EXPECT_EQ(c.low_rate_period.count(), k.low_rate_period_ms);
   }
 }
 
@@ -819,6 +828,8 @@ TEST(ConfigLink, ExplanationNamesEachValueAndItsOrigin) {
       "link: participant announced every 20 s (profile radio, s.yaml:2)",
       "link: participant lease 60 s (profile radio, s.yaml:2)",
       "link: 1 initial announcement(s) (profile radio)",
+      "link: the service writes the low-rate topics every 2 s unless its config sets low_rate_period (profile radio, "
+      "s.yaml:2)",
       "link: pmuctl watch reads the low-rate topics pmu/low_rate/* (profile radio)",
       "link: pmuctl agent runs 1 worker(s) unless --workers (profile radio)",
   };

@@ -233,7 +233,7 @@ int run_cli(int argc, char** argv, const AgentCall* served) {
   watch->add_option("--count", count_text, "Stop after N telemetry samples (alarm samples are not counted)")->type_name("N");
   watch->add_flag("--low-rate", g.low_rate,
                   "The low-rate topics pmu/low_rate/*: at most one sample per device and packet per the service's "
-                  "low_rate_period (1 s by default), for slow links");
+                  "low_rate_period (1 s by default, 2 s with its link profile radio), for slow links");
   app.add_subcommand("list", "PMUs the service knows, with health");
   app.add_subcommand("info", "Serial number, firmware and features");
   app.add_subcommand("health", "Link, bus and device health");

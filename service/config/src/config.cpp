@@ -791,7 +791,12 @@ Config parse_config(const std::string& text, const std::string& source, const Co
   }
   if (const auto v = root["timeouts"]) parse_timeouts(c, v, cfg.timeouts);
   if (const auto v = root["ros2"]) parse_ros2(c, v, cfg.ros2);
-  if (const auto v = root["link"]) parse_link(c, v, cfg.network.link);
+  if (const auto v = root["link"]) {
+    parse_link(c, v, cfg.network.link);
+    cfg.network.link.low_rate_period_given = static_cast<bool>(root["low_rate_period"]);
+    const auto plan = dds::link_plan(cfg.network.link);
+    if (plan.low_rate_period.set()) cfg.low_rate_period = plan.low_rate_period.value;
+  }
   if (const auto v = root["policy"]) parse_policy(c, v, cfg.policy);
   for (const auto& kv : root)
     if (kv.first.as<std::string>() == "security") parse_security(c, kv.first, kv.second, cfg.security);

@@ -48,6 +48,7 @@ LinkPlan link_plan(const LinkSettings& s) {
     p.initial_announcements = kRadioInitialAnnouncements;
     p.low_rate_watch = true;
     p.agent_workers = kRadioAgentWorkers;
+    if (!s.low_rate_period_given) p.low_rate_period = {kRadioLowRatePeriod, profile_from};
   }
   if (s.round_trip) p.round_trip = {*s.round_trip, origin("round_trip", s.round_trip_where)};
   if (p.round_trip.set()) p.heartbeat_floor = {p.round_trip.value * 3 / 2, "1.5 round trips"};
@@ -73,6 +74,9 @@ std::vector<std::string> LinkPlan::explain() const {
   if (initial_announcements > 0)
     out.push_back("link: " + std::to_string(initial_announcements) + " initial announcement(s) (profile " +
                   to_string(profile) + ")");
+  if (low_rate_period.set())
+    out.push_back("link: the service writes the low-rate topics every " + seconds(low_rate_period.value) +
+                  " unless its config sets low_rate_period (" + low_rate_period.from + ")");
   if (low_rate_watch)
     out.push_back(std::string("link: pmuctl watch reads the low-rate topics pmu/low_rate/* (profile ") +
                   to_string(profile) + ")");

@@ -21,6 +21,11 @@
 //     through the participant's throughput controller, and with one pmu-service aborts at
 //     start (FlowControllerImpl.hpp:1109, `!change->writer_info.is_linked`);
 //   pmuctl watch reads the low-rate topics pmu/low_rate/* (pmuctl --link radio);
+//   the service writes them every 2 s unless its config sets low_rate_period: each of the
+//   five low-rate samples of a PMU crosses the link as a datagram of its own of about 200
+//   bytes, 130 of them headers (IP, RTPS, the time stamp, Fast DDS's statistics submessage),
+//   so a period of 1 s costs one aircraft's watcher about 1,000 B/s, 2 s about 500
+//   (bench/results/2026-12-06-one-aircraft-low-rate.md);
 //   pmuctl agent runs one worker (and its engine-stop lane) unless --workers says otherwise:
 //     each worker is a participant of its own, which every aircraft sends all its endpoints to
 //     and repairs that discovery for, pair by pair; with five ground participants and eight
@@ -56,6 +61,8 @@ struct LinkSettings {
   std::string profile_where;
   std::optional<std::chrono::milliseconds> round_trip;
   std::string round_trip_where;
+  // The service's config gives low_rate_period itself: the profile leaves it alone.
+  bool low_rate_period_given = false;
 };
 
 // The radio profile's values (the header comment says why each).
@@ -64,6 +71,7 @@ inline constexpr std::chrono::milliseconds kRadioAnnouncementPeriod{20000};
 inline constexpr std::chrono::milliseconds kRadioLease{60000};
 inline constexpr int kRadioInitialAnnouncements = 1;
 inline constexpr int kRadioAgentWorkers = 1;
+inline constexpr std::chrono::milliseconds kRadioLowRatePeriod{2000};
 
 // One value a participant gets from the link settings, and where it came from.
 struct LinkValue {
@@ -78,6 +86,7 @@ struct LinkPlan {
   LinkValue heartbeat_floor;      // reliable writers heartbeat at most this often: 1.5 round trips
   LinkValue announcement_period;  // SPDP announcement period (multicast and unicast discovery)
   LinkValue lease;                // SPDP lease duration
+  LinkValue low_rate_period;      // the service's low_rate_period when its config gives none
   int initial_announcements = 0;  // 0: Fast DDS's (5 at 100 ms)
   bool low_rate_watch = false;    // pmuctl watch reads pmu/low_rate/*
   int agent_workers = 0;          // pmuctl agent's workers when --workers is not given; 0: its default (4)
