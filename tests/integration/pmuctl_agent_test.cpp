@@ -76,6 +76,13 @@ pmu::test::Child command_through(const std::string& socket, int domain, const st
                           o);
 }
 
+// Whether a worker took the call whose arguments end in `call`: the agent's log says so
+// ("pmuctl agent: worker W: pid P: ARGS: started") before the call runs. Waits for that line
+// (a bound for a loaded machine, not a measurement).
+bool taken(const std::string& log, const std::string& call) {
+  return pmu::test::wait_until([&] { return read_file(log).find(call + ": started") != std::string::npos; }, 60s);
+}
+
 bool wait_for_socket(const std::string& path) {
   for (int i = 0; i < 200; ++i) {
     struct stat st{};
@@ -338,7 +345,7 @@ TEST_F(PmuctlAgentWithUav1, ACallThatWaitsForASilentAircraftHoldsUpNoOtherAndADe
   // uav9 has no service: its command waits out its whole timeout inside one worker.
   const std::string silent_out = dir.path() + "/silent.out";
   auto silent = command_through(socket, domain, "uav9", "25", silent_out);
-  std::this_thread::sleep_for(1s);
+  ASSERT_TRUE(taken(log, "--vehicle uav9 config set payload_voltage 23")) << read_file(log) << read_file(silent_out);
   ASSERT_TRUE(silent.running()) << read_file(silent_out);
   // Meanwhile a command to uav1 goes through another worker and completes.
   auto r = sh(p + "--timeout 20 --vehicle uav1 --json config set payload_voltage 22");
@@ -403,7 +410,7 @@ class PmuctlAgentWithOneWorker : public ::testing::Test {
 TEST_F(PmuctlAgentWithOneWorker, AnEngineStopNeverWaitsBehindAnotherCall) {
   const std::string silent_out = dir.path() + "/silent.out";
   auto silent = command_through(socket, domain, "uav9", "60", silent_out);
-  std::this_thread::sleep_for(1s);
+  ASSERT_TRUE(taken(log, "--vehicle uav9 config set payload_voltage 23")) << read_file(log) << read_file(silent_out);
   ASSERT_TRUE(silent.running()) << read_file(silent_out);
 
   const auto r = sh(calls() + "--timeout 20 --vehicle uav1 engine stop");
@@ -420,7 +427,7 @@ TEST_F(PmuctlAgentWithOneWorker, AnEngineStopNeverWaitsBehindAnotherCall) {
 TEST_F(PmuctlAgentWithOneWorker, ACallWhoseCallerGaveUpIsNeverRun) {
   const std::string silent_out = dir.path() + "/silent.out";
   auto silent = command_through(socket, domain, "uav9", "15", silent_out);
-  std::this_thread::sleep_for(1s);
+  ASSERT_TRUE(taken(log, "--vehicle uav9 config set payload_voltage 23")) << read_file(log) << read_file(silent_out);
   ASSERT_TRUE(silent.running()) << read_file(silent_out);
 
   auto r = sh("timeout -s INT 2 env " + calls() + "--timeout 30 --vehicle uav1 config set payload_voltage 21");
@@ -446,6 +453,8 @@ TEST_F(PmuctlAgentWithOneWorker, ACallWhoseCallerGaveUpIsNeverRun) {
   EXPECT_NE(agent_log.find("config set payload_voltage 20: dropped: its caller's wait ended before a worker was free"),
             std::string::npos)
       << agent_log;
+  EXPECT_EQ(count(agent_log, "payload_voltage 21: started"), 0u) << agent_log;
+  EXPECT_EQ(count(agent_log, "payload_voltage 20: started"), 0u) << agent_log;
   EXPECT_EQ(count(agent_log, "payload_voltage 21: exit"), 0u) << agent_log;
   EXPECT_EQ(count(agent_log, "payload_voltage 20: exit"), 0u) << agent_log;
 }
@@ -558,7 +567,8 @@ TEST(PmuctlAgent, AnAgentThatEndsDuringACallLeavesNoAnswerAndNoSecondRun) {
   // No service on the domain: the call waits its whole timeout inside the agent.
   const std::string call_out = dir.path() + "/call.out";
   auto call = command_through(socket, domain, "uav1", "20", call_out);
-  std::this_thread::sleep_for(1500ms);
+  // Ended once a worker holds the call: before, the call would find no agent and run on its own.
+  ASSERT_TRUE(taken(log, "--vehicle uav1 config set payload_voltage 23")) << read_file(log) << read_file(call_out);
   ASSERT_TRUE(agent.signal(SIGKILL));
   const auto st = call.wait_for(15s);
   ASSERT_TRUE(st) << "the call did not end when its agent did";

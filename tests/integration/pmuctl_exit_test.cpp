@@ -159,6 +159,10 @@ const Case kNobody[] = {
     {"--timeout 1 engine stop", 3, "no pmu-service on domain"},
     {"--timeout 1 --address 65535 engine stop", 3, "no pmu-service on domain"},
     {"--timeout 1 --vehicle uav1 list", 3, "no pmu-service of vehicle uav1 on domain"},
+    // Named whole, the PMU is not looked up first: the wait for its configuration is the
+    // first to hear from the service, and what did not answer is the service, not the PMU.
+    {"--timeout 1 --bus sim --address 1 config diff", 3, "no pmu-service on domain"},
+    {"--timeout 1 --bus sim --address 1 config snapshot -", 3, "no pmu-service on domain"},
 };
 
 TEST(PmuctlExit, NothingOnTheDomainIsExitThreeForEveryVerb) {

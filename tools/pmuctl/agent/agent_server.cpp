@@ -95,13 +95,17 @@ std::uint64_t epoch_ns_now() {
 std::string worker_name(int index) { return index < 0 ? "stop" : std::to_string(index); }
 
 // Runs one call a worker was handed: the request the agent read, and its connection and the
-// caller's three streams. Every outcome is one line of the agent's log, which names the
-// worker: whether calls spilled over to further workers shows there.
+// caller's three streams. The agent's log has a line when the worker takes the call and one
+// for its outcome, each naming the worker: whether calls spilled over to further workers
+// shows there, and a call that waits long for an aircraft shows as started while it waits.
 void serve(int connection, const AgentRequest& request, const std::vector<UniqueFd>& streams, ContextPool& pool,
            const AgentCallRunner& run, int worker) {
   ucred peer{};
   socklen_t len = sizeof peer;
   (void)::getsockopt(connection, SOL_SOCKET, SO_PEERCRED, &peer, &len);
+  // Before the caller's streams take stderr's place (CallerScope): this line is the agent's.
+  std::fprintf(stderr, "pmuctl agent: worker %s: pid %d: %s: started\n", worker_name(worker).c_str(),
+               static_cast<int>(peer.pid), words(request.arguments).c_str());
   const auto start = std::chrono::steady_clock::now();
   AgentReply reply;
   std::string error;

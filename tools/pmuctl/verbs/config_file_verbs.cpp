@@ -77,6 +77,7 @@ class DeviceReader {
       if (si.valid_data && i.vehicle().to_string() == vehicle_) infos_[{i.bus().to_string(), i.address()}] = i;
     pmu::v5::Health h;
     while (health_.take_next_sample(&h, &si) == ReturnCode_t::RETCODE_OK) {
+      health_heard_ = health_heard_ || (si.valid_data && h.vehicle().to_string() == vehicle_);
       if (si.valid_data && h.vehicle().to_string() == vehicle_ && h.kind() == pmu::v5::KIND_PMU) {
         pmus_[si.instance_handle] = {h.bus().to_string(), h.address()};
       } else if (!si.valid_data && si.instance_state != ALIVE_INSTANCE_STATE) {
@@ -140,6 +141,16 @@ class DeviceReader {
   bool wait(const std::string& bus, std::uint16_t address, Clock::time_point deadline) {
     return poll_until([&] { return config(bus, address) && info(bus, address); }, deadline);
   }
+  // Whether the vehicle's service sent its pmu/health during the call: a live service's
+  // comes at once (TRANSIENT_LOCAL), with an instance for each PMU it serves, read or not.
+  bool service_heard() const { return health_heard_; }
+  // Whether this participant matched a service's pmu/health writer (an agent's worker still
+  // matches a service that was killed, until its lease ends: service_presence.hpp).
+  bool service_matched() const {
+    SubscriptionMatchedStatus st;
+    health_.get_subscription_matched_status(st);
+    return st.current_count > 0;
+  }
 
  private:
   // Polls until `done()`, or the deadline passed; whether `done()`.
@@ -162,6 +173,7 @@ class DeviceReader {
   std::map<std::pair<std::string, std::uint16_t>, pmu::v5::Config> configs_;
   std::map<std::pair<std::string, std::uint16_t>, pmu::v5::Baseline> baselines_;
   std::set<InstanceHandle_t> disposed_;  // pmu/baseline instances of PMUs without one
+  bool health_heard_ = false;            // a pmu/health sample of the vehicle came
   std::map<std::pair<std::string, std::uint16_t>, pmu::v5::DeviceInfo> infos_;
 };
 
@@ -196,10 +208,15 @@ struct Target {
   std::string bus;
   std::uint16_t address = 0;
 };
-// Both of the PMU's state samples, or the exit status after saying which did not come.
-std::optional<int> await_device(const GlobalOptions& o, DeviceReader& device, const std::string& vehicle,
-                                const Target& t, Clock::time_point deadline) {
+// Both of the PMU's state samples, or the exit status after saying which did not come and
+// why. Only a service that answered (its pmu/health came) can be said not to have read the
+// PMU: with --bus and --address nothing before this waited for the service, and a service
+// that is not there, or whose discovery outlasted the wait, is "no pmu-service", as every
+// verb says it.
+std::optional<int> await_device(const GlobalOptions& o, const pmu::dds::DdsContext& dds, DeviceReader& device,
+                                const std::string& vehicle, const Target& t, Clock::time_point deadline) {
   if (device.wait(t.bus, t.address, deadline)) return std::nullopt;
+  if (!device.service_heard()) return device.service_matched() ? nothing_heard(o) : no_service(o, dds);
   return fail(o, ExitStatus::NoAnswer,
               device_label(vehicle, t.bus, t.address) + ": its " +
                   (device.config(t.bus, t.address) ? "identity (pmu/info)" : "configuration (pmu/config)") +
@@ -213,7 +230,7 @@ std::optional<Target> find_device(const GlobalOptions& o, pmu::dds::DdsContext& 
     status = *failed;
     return std::nullopt;
   }
-  if (const auto failed = await_device(o, device, vehicle, t, deadline)) {
+  if (const auto failed = await_device(o, dds, device, vehicle, t, deadline)) {
     status = *failed;
     return std::nullopt;
   }
@@ -504,7 +521,8 @@ int apply(const GlobalOptions& o, const std::string& file, bool dry_run, bool co
   std::string bus;
   std::uint16_t address = 0;
   if (const auto failed = channel.open(deadline_after(timeout), bus, address)) return *failed;
-  if (const auto failed = await_device(o, device, channel.vehicle(), {bus, address}, deadline_after(timeout)))
+  if (const auto failed =
+          await_device(o, channel.dds(), device, channel.vehicle(), {bus, address}, deadline_after(timeout)))
     return *failed;
   const std::string label = device_label(channel.vehicle(), bus, address);
   const auto firmware = firmware_of(*device.info(bus, address));
