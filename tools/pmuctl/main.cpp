@@ -561,7 +561,7 @@ int run_cli(int argc, char** argv, const AgentCall* served) {
       return pmu::tools::run_command(g, spec);
     }
   } catch (const pmu::dds::PartitionNotGranted& e) {
-    // A partition is a vehicle (service/vehicle.hpp): say it in the operator's terms.
+    // A partition is a vehicle (pmu/config/vehicle.hpp): say it in the operator's terms.
     std::fprintf(stderr, "pmuctl: %s\n", e.what());
     if (!g.vehicle)
       std::fprintf(stderr, "pmuctl: without --vehicle pmuctl reads every vehicle (partitions \"\" and \"*\") and "
