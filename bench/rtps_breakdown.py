@@ -2,7 +2,7 @@
 """What each byte of a captured DDS link is for: by RTPS submessage kind and by topic.
 
     bench/rtps_breakdown.py PCAP [--steps FILE --from STEP [--to STEP]] [--start T --end T]
-                                 [--local PREFIX]
+                                 [--local PREFIX] [--pairs N]
 
 Reads a pcap (tcpdump -w; Ethernet, Linux cooked or raw IP; whole packets: a packet cut by
 the snaplen is counted by its IP length but its cut submessages as "truncated"), walks
@@ -25,6 +25,11 @@ reassembled; a datagram belongs to the window its last fragment arrived in.
 Prints markdown: bytes/s by kind, by topic (with the kinds and the two directions), and
 the totals. --local ADDRESS (a prefix of this side's IP address, such as 10.79.0.2) makes
 the direction columns "sent" and "received"; without it they are by source address.
+--pairs N adds the N writer-reader pairs that exchanged the most HEARTBEATs and ACKNACKs,
+each with the pre-emptive ACKNACKs among them (an empty set based at 0: the "I am here" a
+reader sends a writer it matched until the writer's first heartbeat reaches it). A
+participant is its GUID prefix's bytes 2..7 (Fast DDS: host and process), an entity its
+builtin name or id; a HEARTBEAT without INFO_DST goes to "every reader".
 Python 3 standard library only.
 """
 import argparse
@@ -264,6 +269,8 @@ class Tally:
         self.topic_kind = collections.defaultdict(collections.Counter)
         self.topic_dir = collections.defaultdict(collections.Counter)
         self.samples = collections.Counter()  # DATA / DATA_FRAG submessages of each topic
+        # (writer prefix, writer entity, reader prefix, reader entity) -> submessage counts
+        self.pairs = collections.defaultdict(collections.Counter)
         self.packets = 0
         self.total = 0
 
@@ -296,6 +303,15 @@ def attribute(p, by_guid, by_entity, tally, direction):
                 dest = None
         elif sid == 0x0C and len(body) >= 20:
             source = body[8:20].hex()
+        if sid in (0x06, 0x07) and len(body) >= 8:
+            reader, writer = entity(body, 0, flags), entity(body, 4, flags)
+            if sid == 0x06:
+                pair = tally.pairs[(dest, writer, source, reader)]
+                pair["ACKNACK"] += 1
+                if len(body) >= 20 and body[8:20] == b"\0" * 12:  # base 0.0, no bits
+                    pair["pre-emptive"] += 1
+            else:
+                tally.pairs[(source, writer, dest, reader)]["HEARTBEAT"] += 1
         if sid in WRITER_OFFSET:
             at, sender_is_writer = WRITER_OFFSET[sid]
             topic = topic_of(source if sender_is_writer else dest, entity(body, at, flags), by_guid, by_entity)
@@ -360,6 +376,8 @@ def main(argv=None):
     ap.add_argument("--end", type=float, help="window end, s since the epoch")
     ap.add_argument("--local", help="IP address prefix of this side (the ground): the direction columns")
     ap.add_argument("--title", default="", help="a line printed above the tables")
+    ap.add_argument("--pairs", type=int, default=0, metavar="N",
+                    help="also the N writer-reader pairs with the most HEARTBEATs and ACKNACKs")
     args = ap.parse_args(argv)
     if args.steps and not args.from_step:
         ap.error("--steps needs --from STEP")
@@ -417,7 +435,28 @@ def render(t, seconds, args, by_guid):
                  + " | ".join(rate(sum(t.topic_kind[x][k] for x in t.topic_kind)) for k in kinds)
                  + f" | {rate(sum(other(c) for c in t.topic_kind.values()))} | "
                  + " | ".join(rate(sum(t.topic_dir[x][d] for x in t.topic_dir)) for d in dirs) + " |")
+    if args.pairs > 0:
+        lines += ["", f"{len(t.pairs)} writer-reader pairs exchanged HEARTBEATs or ACKNACKs; the {args.pairs} busiest:", "",
+                  "| writer | reader | HEARTBEAT/s | ACKNACK/s | of them pre-emptive/s |", "|---|---|---:|---:|---:|"]
+        busiest = sorted(t.pairs.items(), key=lambda kv: (-(kv[1]["HEARTBEAT"] + kv[1]["ACKNACK"]), kv[0][0] or "", kv[0][2] or ""))
+        for (wp, we, rp, re_), c in busiest[:args.pairs]:
+            lines.append(f"| {endpoint_name(wp, we)} | {endpoint_name(rp, re_) if rp else 'every reader'} | "
+                         f"{c['HEARTBEAT'] / seconds:.1f} | {c['ACKNACK'] / seconds:.1f} | {c['pre-emptive'] / seconds:.1f} |")
     return "\n".join(lines)
+
+
+ENDPOINT_NAMES = {
+    0x000100C2: "SPDP writer", 0x000100C7: "SPDP reader",
+    0x000003C2: "SEDP publications writer", 0x000003C7: "SEDP publications reader",
+    0x000004C2: "SEDP subscriptions writer", 0x000004C7: "SEDP subscriptions reader",
+    0x000200C2: "participant message writer", 0x000200C7: "participant message reader",
+}
+
+
+def endpoint_name(prefix, ent):
+    who = prefix[4:16] if prefix else "?"
+    what = "?" if ent is None else ENDPOINT_NAMES.get(ent, f"{ent:08x}")
+    return f"{who} {what}"
 
 
 if __name__ == "__main__":

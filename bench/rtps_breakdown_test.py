@@ -156,6 +156,27 @@ class Breakdown(unittest.TestCase):
         # Three IP headers, one UDP header.
         self.assertEqual(self.row(text, "IP/UDP headers")[1], f"{(3 * 20 + 8) / 10:.0f}")
 
+    def test_pairs_count_heartbeats_and_acknacks_and_which_acknacks_are_pre_emptive(self):
+        sedp_pub_writer, sedp_pub_reader = 0x000003C2, 0x000003C7
+        pre_emptive = sub(0x06, eid(sedp_pub_reader) + eid(sedp_pub_writer) + struct.pack("<iII", 0, 0, 0) + struct.pack("<i", 1))
+        nack = sub(0x06, eid(sedp_pub_reader) + eid(sedp_pub_writer) + struct.pack("<iII", 0, 3, 2) + b"\xc0\0\0\0" +
+                   struct.pack("<i", 2))
+        hb = sub(0x07, eid(0) + eid(sedp_pub_writer) + struct.pack("<iIiIi", 0, 1, 0, 4, 1))
+        # The aircraft's reader asks the ground's writer five times; the ground's writer
+        # heartbeats every reader once; the ground's reader nacks the aircraft's writer once.
+        frames = [(1.0 + i / 10, ipv4(A, G, rtps(AIR, info_dst(GROUND), pre_emptive))) for i in range(5)]
+        frames += [(2.0, ipv4(G, A, rtps(GROUND, hb))), (2.5, ipv4(G, A, rtps(GROUND, info_dst(AIR), nack)))]
+        text = self.run_tool(frames, "--start", "0", "--end", "10", "--pairs", "5")
+        self.assertIn("3 writer-reader pairs exchanged HEARTBEATs or ACKNACKs", text)
+        air, ground = AIR[2:8].hex(), GROUND[2:8].hex()
+        self.assertEqual(self.row(text, f"{ground} SEDP publications writer")[1:],
+                         [f"{air} SEDP publications reader", "0.0", "0.5", "0.5"])
+        rows = [line for line in text.splitlines() if line.startswith(f"| {ground} SEDP publications writer | every reader")]
+        self.assertEqual(rows, [f"| {ground} SEDP publications writer | every reader | 0.1 | 0.0 | 0.0 |"])
+        self.assertEqual(self.row(text, f"{air} SEDP publications writer")[1:], [f"{ground} SEDP publications reader", "0.0", "0.1", "0.0"])
+        # Without --pairs, no such table.
+        self.assertNotIn("writer-reader pairs", self.run_tool(frames, "--start", "0", "--end", "10"))
+
     def test_a_writer_never_announced_is_named_by_its_entity(self):
         frames = [(1.0, ipv4(A, G, rtps(AIR, info_dst(GROUND), heartbeat(0x00001102))))]
         text = self.run_tool(frames, "--start", "0", "--end", "2")

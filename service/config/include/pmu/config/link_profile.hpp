@@ -17,9 +17,10 @@
 //   one initial announcement instead of Fast DDS's five at 100 ms: a participant that starts
 //     answers every other's announcement anyway, and eight aircraft starting together
 //     otherwise send forty announcements into the link's queue at once;
-//   discovery is not paced: Fast DDS 2.9.1 can hold its discovery writers to a throughput only
-//     through the participant's throughput controller, and with one pmu-service aborts at
-//     start (FlowControllerImpl.hpp:1109, `!change->writer_info.is_linked`);
+//   discovery is not paced: in Fast DDS 2.9.1 the participant's throughput controller paces
+//     only the announcement writer (the endpoint discovery writers are synchronous), and it
+//     aborts when an announcement is queued again before the last one left
+//     (FlowControllerImpl.hpp:1109, `!change->writer_info.is_linked`);
 //   pmuctl watch reads the low-rate topics pmu/low_rate/* (pmuctl --link radio);
 //   the service writes them every 2 s unless its config sets low_rate_period: each of the
 //   five low-rate samples of a PMU crosses the link as a datagram of its own of about 200
