@@ -721,6 +721,49 @@ TEST(Commands, EveryCommandAndItsResultIsInTheAuditTrail) {
       << text;
 }
 
+// A client that asks again for a reply that was out for most of a second has a slow link:
+// once two clients did, the service says once that a link profile exists (interface.md 7.3),
+// and never when its config names the link.
+TEST(Commands, ResendsLongAfterTheirReplySayOnceThatALinkProfileExists) {
+  const std::string hint = "their link has a round trip or a loss a LAN does not have";
+  for (const bool configured : {false, true}) {
+    SCOPED_TRACE(configured ? "link configured" : "no link configured");
+    CapturedLog log;
+    std::uint64_t late = 0;
+    {
+      Commands c({pmu(1)});
+      if (configured) c.service.link_configured();
+      const auto resend_after = [&c](const char* sender, std::chrono::milliseconds out_for) {
+        auto r = c.req(CommandKind::GetSerial);
+        r.sender = sender;
+        c.run(r);
+        c.h.run_for(out_for);
+        c.service.submit(r);  // answered again at once: the first one's reply
+      };
+      resend_after("a", 100ms);  // the service's own slowness, not the link's
+      resend_after("b", 100ms);
+      resend_after("a", 900ms);  // one client: possibly its reply reader matched late
+      resend_after("a", 900ms);
+      EXPECT_EQ(log.text().find(hint), std::string::npos) << log.text();
+      resend_after("b", 800ms);  // a second client
+      resend_after("c", 900ms);
+      EXPECT_EQ(c.replies.size(), 12u) << "every resend answered again";
+      late = c.service.counters().resends_after_reply;
+    }
+    const std::string text = log.text();
+    EXPECT_EQ(late, 4u);
+    const auto at = text.find(hint);
+    if (configured) {
+      EXPECT_EQ(at, std::string::npos) << text;
+    } else {
+      ASSERT_NE(at, std::string::npos) << text;
+      EXPECT_EQ(text.find(hint, at + 1), std::string::npos) << "said once: " << text;
+      EXPECT_NE(text.find("had published 0.8 s before"), std::string::npos) << text;
+      EXPECT_NE(text.find("`link: {profile: radio}` here and `--link radio` on the ground"), std::string::npos) << text;
+    }
+  }
+}
+
 TEST(Commands, NetworkTextCannotForgeAuditLines) {
   CapturedLog log;
   {

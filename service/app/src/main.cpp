@@ -189,6 +189,7 @@ int run(const service::Config& cfg, const pmu::dds::ResolvedNetwork& network) {
     command_topics.publish(r);
     if (previous_command_topics) previous_command_topics->publish(r);
   });
+  if (network.link.profile != pmu::dds::LinkProfile::None || network.link.round_trip.set()) commands.link_configured();
   // Acknowledgements, like commands, in both contracts (they exist from contract v4 on, and
   // no version since changed their types), each reply in both.
   service::DdsAlarmAckEndpoint ack_topics(participant, cfg.vehicle);

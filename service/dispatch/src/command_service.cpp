@@ -32,8 +32,14 @@ std::size_t CommandService::remembered() const {
   return seen_.size();
 }
 
+void CommandService::link_configured() {
+  std::lock_guard<std::mutex> lock(mutex_);
+  slow_link_.quiet();
+}
+
 CommandService::Seen CommandService::remember(const std::string& key, const CommandSample& s,
-                                              std::optional<CommandReplyData>& again) {
+                                              std::optional<CommandReplyData>& again,
+                                              std::optional<std::chrono::nanoseconds>& slow_link) {
   const std::uint64_t fingerprint = content_fingerprint(s);
   std::lock_guard<std::mutex> lock(mutex_);
   ++counters_.received;
@@ -43,13 +49,17 @@ CommandService::Seen CommandService::remember(const std::string& key, const Comm
       return Seen::Reused;
     }
     ++counters_.duplicates;
-    if (it->second.final)
+    if (it->second.final) {
       again = it->second.final;
-    else
+      const auto out_for = clock_.steady_now() - it->second.final_at;
+      if (out_for >= SlowLinkHint::kReplyOut) ++counters_.resends_after_reply;
+      if (slow_link_.resend(s.sender, out_for)) slow_link = out_for;
+    } else {
       ++it->second.owed;
+    }
     return Seen::Resend;
   }
-  seen_.emplace(key, Entry{fingerprint, std::nullopt, 0});
+  seen_.emplace(key, Entry{fingerprint, std::nullopt, {}, 0});
   order_.push_back(key);
   while (order_.size() > kRememberedRequests) {
     seen_.erase(order_.front());
@@ -74,6 +84,7 @@ void CommandService::finish(const std::string& key, const std::string& sender, c
     if (auto it = seen_.find(key); it != seen_.end()) {
       if (it->second.final) return;  // already answered: never a second final reply
       it->second.final = reply;
+      it->second.final_at = clock_.steady_now();
       copies += it->second.owed;
       it->second.owed = 0;
     }
@@ -134,11 +145,18 @@ void CommandService::reject_without_id(const CommandSample& s) {
 
 bool CommandService::first_time(const std::string& key, const CommandSample& s) {
   std::optional<CommandReplyData> again;
-  switch (remember(key, s, again)) {
+  std::optional<std::chrono::nanoseconds> slow_link;
+  switch (remember(key, s, again, slow_link)) {
     case Seen::New: return true;
     case Seen::Resend:
       spdlog::info("audit: duplicate command {} from {}: answered again, not executed", printable(s.request_id),
                    printable(s.sender));
+      if (slow_link)
+        spdlog::info(
+            "DDS: a client asked again for a reply this service had published {:.1f} s before, and so did another "
+            "before it: their link has a round trip or a loss a LAN does not have. On a radio link, `link: {{profile: "
+            "radio}}` here and `--link radio` on the ground set what it needs (interface.md 7.3)",
+            std::chrono::duration<double>(*slow_link).count());
       if (again) reply_(*again);  // else owed: sent with the first one's final reply
       return false;
     case Seen::Reused:

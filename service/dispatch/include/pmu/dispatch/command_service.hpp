@@ -17,6 +17,8 @@
 //     device by the device session, in parallel across devices and buses.
 // Replies are handed to `reply` outside the service's lock. Every command and its result is
 // logged as an audit trail (who, what, result, reason), with network text made printable.
+// Resends that came long after their reply was out say the clients' link is slow: the
+// service logs once that a link profile exists (slow_link_hint.hpp, interface.md 7.3).
 //
 // Memory: at most kRememberedRequests ids are kept (oldest forgotten first); no request
 // lives longer than policy.lifetimes.max_lifetime, so at any rate below
@@ -44,6 +46,7 @@
 #include "pmu/command/config_holds.hpp"
 #include "pmu/command/policy.hpp"
 #include "pmu/dispatch/command_executor.hpp"
+#include "pmu/dispatch/slow_link_hint.hpp"
 #include "pmu/session/bus_worker.hpp"
 
 namespace pmu::service {
@@ -60,16 +63,22 @@ class CommandService {
 
   struct Counters {
     std::uint64_t received = 0, duplicates = 0, reused_ids = 0, completed = 0, refused = 0, failed = 0;
+    // Duplicates that arrived SlowLinkHint::kReplyOut or longer after their final reply.
+    std::uint64_t resends_after_reply = 0;
   };
   Counters counters() const;
   // Request ids currently remembered for duplicate detection (at most kRememberedRequests).
   std::size_t remembered() const;
+  // The config names the link (a profile or a round trip): no slow-link hint. Call before
+  // the first submit().
+  void link_configured();
 
  private:
   struct Entry {
     std::uint64_t fingerprint = 0;
     std::optional<CommandReplyData> final;
-    unsigned owed = 0;  // resends that arrived while it ran
+    SteadyTime final_at{};  // when `final` was published
+    unsigned owed = 0;      // resends that arrived while it ran
   };
   enum class Seen { New, Resend, Reused };
 
@@ -83,7 +92,10 @@ class CommandService {
   void reject_without_id(const CommandSample& s);
   // Duplicate detection: false when `s` is a resend (answered again) or reuses an id.
   bool first_time(const std::string& key, const CommandSample& s);
-  Seen remember(const std::string& key, const CommandSample& s, std::optional<CommandReplyData>& again);
+  // `slow_link`: this resend makes the slow-link hint due (log it, outside the lock), with the
+  // time its reply had been out.
+  Seen remember(const std::string& key, const CommandSample& s, std::optional<CommandReplyData>& again,
+                std::optional<std::chrono::nanoseconds>& slow_link);
   // Routing: the bus is not one of this service's (when worker_for found none).
   Refusal not_served(const CommandRequest& r) const;
   // The deny list and confirm rules (policy.hpp), on the worker's thread: `use` is what the
@@ -123,6 +135,7 @@ class CommandService {
   std::deque<std::string> order_;                // oldest first, to bound seen_
   std::map<std::pair<std::string, std::uint16_t>, RateLimiter> limiters_;
   ConfigHolds holds_;
+  SlowLinkHint slow_link_;
   Counters counters_;
 };
 
