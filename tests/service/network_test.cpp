@@ -2,6 +2,8 @@
 // look-up at start through a fake NetworkLookup (no real interface or name server).
 #include <gtest/gtest.h>
 
+#include <algorithm>
+
 #include "pmu/config/network_settings.hpp"
 
 namespace pmu::dds {
@@ -116,6 +118,31 @@ TEST(NetworkResolve, ServersKeepTheirPositionAndGetTheDefaultPort) {
   EXPECT_EQ(r.summary,
             "server discovery through Discovery Server id 0 at 10.0.0.1:11811, id 1 at 192.168.10.20:14520, "
             "192.168.11.20:14520");
+}
+
+// The radio profile's single agent worker holds for multicast and unicast discovery only:
+// through a Discovery Server a ground participant costs the aircraft a few endpoints, and
+// the agent keeps its workers (interface.md 7.3).
+TEST(NetworkResolve, TheRadioProfileLimitsTheAgentsWorkersOnlyWithoutADiscoveryServer) {
+  const struct {
+    DiscoveryMode mode;
+    int workers;
+  } cases[] = {{DiscoveryMode::Multicast, 1}, {DiscoveryMode::Unicast, 1}, {DiscoveryMode::Server, 0}};
+  for (const auto& k : cases) {
+    SCOPED_TRACE(to_string(k.mode));
+    NetworkConfig c;
+    c.mode = k.mode;
+    if (k.mode == DiscoveryMode::Unicast) c.peers = {address("10.0.0.7")};
+    if (k.mode == DiscoveryMode::Server) c.servers = {address("10.0.0.1")};
+    c.link.profile = LinkProfile::Radio;
+    const ResolvedNetwork r = resolve_network(c, fake_lookup());
+    EXPECT_EQ(r.link.agent_workers, k.workers);
+    EXPECT_EQ(r.link.round_trip.value.count(), 700) << "the rest of the profile holds";
+    const auto lines = r.link.explain();
+    const bool says_workers = std::any_of(lines.begin(), lines.end(),
+                                          [](const std::string& l) { return l.find("agent runs") != std::string::npos; });
+    EXPECT_EQ(says_workers, k.workers > 0);
+  }
 }
 
 TEST(NetworkResolve, AnEmptyServerEntryKeepsItsIdAndHasNoLocator) {

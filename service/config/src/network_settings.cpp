@@ -271,6 +271,10 @@ ResolvedNetwork resolve_network(const NetworkConfig& config, const NetworkLookup
     summary += "; DDS over UDP only on " + join(interfaces) + (had_loopback ? "" : " and loopback (127.0.0.1)");
   }
   r.link = link_plan(config.link);
+  // The profile's one agent worker spares aircraft the discovery of more ground
+  // participants; through a Discovery Server a new participant costs them a few endpoints,
+  // and eight calls at once want the agent's workers (interface.md 7.3).
+  if (config.mode == DiscoveryMode::Server) r.link.agent_workers = 0;
   // The summary is what pmuctl compares with its agent's (a call on another link is not the
   // agent's to serve) and what the start-up log shows.
   if (r.link.profile != LinkProfile::None) summary += std::string("; link profile ") + to_string(r.link.profile);

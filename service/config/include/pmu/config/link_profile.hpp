@@ -31,7 +31,9 @@
 //     each worker is a participant of its own, which every aircraft sends all its endpoints to
 //     and repairs that discovery for, pair by pair; with five ground participants and eight
 //     aircraft the repairs of those forty pairs filled a 250 kbit/s link for good
-//     (bench/fleet_link.sh).
+//     (bench/fleet_link.sh). Through a Discovery Server that does not hold, and the agent
+//     keeps its workers (resolve_network): eight calls at once, after a radio dropout, take
+//     one round trip each rather than eight in a row.
 //   Datagrams stay at most kUdpMaxMessageSize (1,400 B, one packet on a 1,500-byte MTU),
 //   which every participant uses already (dds_participant.hpp).
 // Without a profile and without round_trip nothing changes: Fast DDS's periods and qos.xml's.
