@@ -34,15 +34,15 @@
 #include "pmuctl/view/mask_names.hpp"
 #include "pmu/command/command.hpp"
 #include "pmu/config/vehicle.hpp"
-#include "pmuctl/verbs/network_options.hpp"
+#include "pmuctl/call/network_options.hpp"
 #include "pmu/sysconf_dir.hpp"
 #include "pmu/version.hpp"
-#include "pmuctl/verbs/exit_status.hpp"
-#include "pmuctl/verbs/option_values.hpp"
+#include "pmuctl/call/exit_status.hpp"
+#include "pmuctl/call/option_values.hpp"
 #include "pmuctl/agent/agent_client.hpp"
 #include "pmuctl/agent/agent_request.hpp"
 #include "pmuctl/agent/agent_server.hpp"
-#include "pmuctl/verbs/context_lease.hpp"
+#include "pmuctl/call/context_lease.hpp"
 
 namespace {
 

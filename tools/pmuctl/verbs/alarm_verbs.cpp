@@ -18,9 +18,9 @@
 #include "pmu/idl/guarded_type.hpp"
 #include "pmu/idl/topics.hpp"
 #include "pmuctl/verbs/alarm_sample.hpp"
-#include "pmuctl/verbs/exit_status.hpp"
-#include "pmuctl/verbs/service_presence.hpp"
-#include "pmuctl/verbs/context_lease.hpp"
+#include "pmuctl/call/exit_status.hpp"
+#include "pmuctl/call/service_presence.hpp"
+#include "pmuctl/call/context_lease.hpp"
 
 namespace pmu::tools {
 namespace {

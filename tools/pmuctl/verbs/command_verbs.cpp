@@ -27,11 +27,11 @@
 #include "pmu/idl/statePubSubTypes.h"
 #include "pmu/idl/topics.hpp"
 #include "pmuctl/verbs/alarm_names.hpp"
-#include "pmuctl/verbs/command_channel.hpp"
-#include "pmuctl/verbs/exit_status.hpp"
-#include "pmuctl/verbs/service_presence.hpp"
+#include "pmuctl/call/command_channel.hpp"
+#include "pmuctl/call/exit_status.hpp"
+#include "pmuctl/call/service_presence.hpp"
 #include "pmuctl/view/sample_json.hpp"
-#include "pmuctl/verbs/context_lease.hpp"
+#include "pmuctl/call/context_lease.hpp"
 
 namespace pmu::tools {
 namespace {

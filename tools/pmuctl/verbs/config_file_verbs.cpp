@@ -30,10 +30,10 @@
 #include "pmu/idl/statePubSubTypes.h"
 #include "pmu/idl/topics.hpp"
 #include "pmu/mcap/output_file.hpp"
-#include "pmuctl/verbs/command_channel.hpp"
-#include "pmuctl/verbs/exit_status.hpp"
-#include "pmuctl/verbs/service_presence.hpp"
-#include "pmuctl/verbs/context_lease.hpp"
+#include "pmuctl/call/command_channel.hpp"
+#include "pmuctl/call/exit_status.hpp"
+#include "pmuctl/call/service_presence.hpp"
+#include "pmuctl/call/context_lease.hpp"
 
 namespace pmu::tools {
 // A namespace of its own: the unity builds put this file in one translation unit with the

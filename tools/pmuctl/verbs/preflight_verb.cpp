@@ -14,10 +14,10 @@
 #include "pmu/idl/guarded_type.hpp"
 #include "pmu/idl/topics.hpp"
 #include "pmuctl/verbs/alarm_names.hpp"
-#include "pmuctl/verbs/exit_status.hpp"
-#include "pmuctl/verbs/service_presence.hpp"
-#include "pmuctl/verbs/state_settle.hpp"
-#include "pmuctl/verbs/context_lease.hpp"
+#include "pmuctl/call/exit_status.hpp"
+#include "pmuctl/call/service_presence.hpp"
+#include "pmuctl/call/state_settle.hpp"
+#include "pmuctl/call/context_lease.hpp"
 
 namespace pmu::tools {
 namespace {

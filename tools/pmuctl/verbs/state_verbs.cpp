@@ -27,15 +27,15 @@
 #include "pmu/idl/topics.hpp"
 #include "pmu/transport/stop_signals.hpp"
 #include "pmuctl/verbs/alarm_sample.hpp"
-#include "pmuctl/verbs/command_channel.hpp"
-#include "pmuctl/verbs/exit_status.hpp"
-#include "pmuctl/verbs/service_presence.hpp"
-#include "pmuctl/verbs/state_settle.hpp"
+#include "pmuctl/call/command_channel.hpp"
+#include "pmuctl/call/exit_status.hpp"
+#include "pmuctl/call/service_presence.hpp"
+#include "pmuctl/call/state_settle.hpp"
 #include "pmuctl/view/alarm_marker.hpp"
 #include "pmuctl/view/sample_fields.hpp"
 #include "pmuctl/view/sample_json.hpp"
 #include "pmuctl/view/table_text.hpp"
-#include "pmuctl/verbs/context_lease.hpp"
+#include "pmuctl/call/context_lease.hpp"
 
 namespace pmu::tools {
 namespace {

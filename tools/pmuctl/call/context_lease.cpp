@@ -1,4 +1,4 @@
-#include "pmuctl/verbs/context_lease.hpp"
+#include "pmuctl/call/context_lease.hpp"
 
 #include <filesystem>
 
