@@ -3,6 +3,7 @@
 #include <filesystem>
 
 #include "pmu/idl/topics.hpp"
+#include "pmuctl/verbs/state_verbs.hpp"
 
 namespace pmu::tools {
 namespace {

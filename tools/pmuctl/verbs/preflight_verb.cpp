@@ -1,5 +1,6 @@
 #include "pmuctl/verbs/preflight_verb.hpp"
 
+#include <CLI/CLI.hpp>
 #include <chrono>
 #include <cstdio>
 #include <fastdds/dds/core/status/SubscriptionMatchedStatus.hpp>
@@ -111,5 +112,24 @@ int run_preflight(const GlobalOptions& o) {
   }
   return static_cast<int>(ready ? ExitStatus::Ok : ExitStatus::NotDone);
 }
+
+namespace {
+
+class PreflightVerb : public Verb {
+ public:
+  explicit PreflightVerb(CLI::App& app)
+      : preflight_(app.add_subcommand(
+            "preflight", "Whether the vehicle may fly, and every reason it may not (exit 0 ready, 1 not)")) {}
+  bool chosen() const override { return preflight_->parsed(); }
+  bool reads_state() const override { return true; }
+  int run(GlobalOptions& g) override { return run_preflight(g); }
+
+ private:
+  CLI::App* preflight_;
+};
+
+}  // namespace
+
+std::unique_ptr<Verb> add_preflight_verb(CLI::App& app) { return std::make_unique<PreflightVerb>(app); }
 
 }  // namespace pmu::tools
