@@ -9,7 +9,7 @@
 #include <optional>
 #include <string>
 
-#include "pmuctl/verbs/network_options.hpp"
+#include "pmuctl/call/network_options.hpp"
 
 namespace {
 

@@ -4,7 +4,7 @@
 #include <cmath>
 #include <string>
 
-#include "pmuctl/verbs/option_values.hpp"
+#include "pmuctl/call/option_values.hpp"
 
 namespace {
 

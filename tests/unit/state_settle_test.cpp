@@ -6,7 +6,7 @@
 #include <chrono>
 #include <vector>
 
-#include "pmuctl/verbs/state_settle.hpp"
+#include "pmuctl/call/state_settle.hpp"
 
 namespace pmu::tools::state_settle_test {
 

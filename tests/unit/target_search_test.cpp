@@ -7,7 +7,7 @@
 #include <set>
 #include <vector>
 
-#include "pmuctl/verbs/target_search.hpp"
+#include "pmuctl/call/target_search.hpp"
 
 namespace pmu::tools::target_search_test {
 

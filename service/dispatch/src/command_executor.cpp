@@ -1,6 +1,7 @@
 #include "pmu/dispatch/command_executor.hpp"
 
 #include "pmu/codec/encode.hpp"
+#include "pmu/dispatch/command_reply.hpp"
 #include "pmu/dispatch/engine_start.hpp"
 
 namespace pmu::service {
@@ -11,17 +12,6 @@ CommandResult result_of(const codec::EncodeError& e) {
 }
 
 }  // namespace
-
-CommandReplyData make_reply(const CommandSample& s, CommandResult result, std::string reason) {
-  CommandReplyData d;
-  d.request_id = s.request_id;
-  d.bus = s.bus;
-  d.address = s.address;
-  d.kind = s.kind < kCommandKindCount ? static_cast<CommandKind>(s.kind) : CommandKind::Get;
-  d.result = result;
-  d.reason = std::move(reason);
-  return d;
-}
 
 std::optional<CommandReplyData> check_firmware(const CommandRequest& r, std::optional<codec::FirmwareVersion> fw) {
   if (const auto* set = std::get_if<action::SetParameter>(&r.action)) {

@@ -8,6 +8,7 @@
 
 #include "pmu/codec/encode.hpp"
 #include "pmu/dispatch/command_plan.hpp"
+#include "pmu/dispatch/command_reply.hpp"
 
 namespace pmu::service {
 namespace {
@@ -138,17 +139,6 @@ class Run : public std::enable_shared_from_this<Run> {
 void run_plan(DeviceSession& session, const CommandRequest& r, CommandPlan plan, SteadyTime now,
               const Timeouts& timeouts, ReplyFn reply) {
   std::make_shared<Run>(session, r, std::move(plan), timeouts, std::move(reply))->start(now);
-}
-
-CommandReplyData make_reply(const CommandRequest& r, CommandResult result, std::string reason) {
-  CommandReplyData d;
-  d.request_id = r.request_id;
-  d.bus = r.bus;
-  d.address = r.address;
-  d.kind = r.kind();
-  d.result = result;
-  d.reason = std::move(reason);
-  return d;
 }
 
 }  // namespace pmu::service

@@ -7,6 +7,7 @@
 
 #include "pmu/alarms/settings.hpp"
 #include "pmu/codec/encode.hpp"
+#include "pmu/dispatch/command_reply.hpp"
 #include "pmu/codec/ids.hpp"
 #include "sender_key.hpp"
 

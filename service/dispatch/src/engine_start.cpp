@@ -5,6 +5,7 @@
 #include <memory>
 
 #include "pmu/codec/encode.hpp"
+#include "pmu/dispatch/command_reply.hpp"
 
 namespace pmu::service {
 namespace {

@@ -10,7 +10,7 @@
 #include "pmuctl/agent/agent_request.hpp"
 #include "pmuctl/agent/agent_trust.hpp"
 #include "pmuctl/agent/unix_socket.hpp"
-#include "pmuctl/verbs/exit_status.hpp"
+#include "pmuctl/call/exit_status.hpp"
 
 namespace pmu::tools {
 namespace {

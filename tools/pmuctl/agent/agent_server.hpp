@@ -26,7 +26,7 @@
 #include <vector>
 
 #include "pmuctl/agent/agent_request.hpp"
-#include "pmuctl/verbs/context_lease.hpp"
+#include "pmuctl/call/context_lease.hpp"
 
 namespace pmu::tools {
 

@@ -2,6 +2,7 @@
 
 #include <unistd.h>
 
+#include <CLI/CLI.hpp>
 #include <chrono>
 #include <csignal>
 #include <cstdio>
@@ -99,5 +100,35 @@ int run_record(const GlobalOptions& o, const std::string& path, const std::vecto
                shared->rec.name().c_str(), static_cast<unsigned long long>(shared->rec.bytes()));
   return 0;
 }
+
+namespace {
+
+class RecordVerb : public Verb {
+ public:
+  explicit RecordVerb(CLI::App& app) {
+    record_ = app.add_subcommand(
+        "record", "Record the topics into an MCAP file (Foxglove, Lichtblick, PlotJuggler) until Ctrl-C or SIGTERM");
+    record_->add_option("file", path_,
+                        "The MCAP file (a regular file is replaced when the recording ends), a FIFO or a "
+                        "character device (written in place), or - for standard output")
+        ->required();
+    record_->add_option("--topic", topics_,
+                        "Only this topic (pmu/voltages or voltages; also low_rate/..., command, command_reply); "
+                        "repeat for more (default: telemetry, state, health, battery and MPPT topics)")
+        ->allow_extra_args(false);
+  }
+  bool chosen() const override { return record_->parsed(); }
+  bool ends_by_itself() const override { return false; }
+  int run(GlobalOptions& g) override { return run_record(g, path_, topics_); }
+
+ private:
+  CLI::App* record_;
+  std::string path_;
+  std::vector<std::string> topics_;
+};
+
+}  // namespace
+
+std::unique_ptr<Verb> add_record_verb(CLI::App& app) { return std::make_unique<RecordVerb>(app); }
 
 }  // namespace pmu::tools

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "pmuctl/verbs/state_verbs.hpp"
+#include "pmuctl/verbs/verb.hpp"
 
 namespace pmu::tools {
 
@@ -17,5 +18,7 @@ namespace pmu::tools {
 // (disk full, a reader that went away: what and where on stderr); 2 bad arguments, or a path
 // that cannot be created or is refused (a directory, ...), before any DDS participant exists.
 int run_record(const GlobalOptions& o, const std::string& path, const std::vector<std::string>& topics);
+
+std::unique_ptr<Verb> add_record_verb(CLI::App& app);
 
 }  // namespace pmu::tools

@@ -2,6 +2,7 @@
 
 #include <unistd.h>
 
+#include <CLI/CLI.hpp>
 #include <cstdio>
 #include <string_view>
 #include <tuple>
@@ -112,5 +113,60 @@ int run_serve(const GlobalOptions& o, const ServeOptions& serve, const std::vect
   std::fprintf(stderr, "pmuctl serve: stopped; %s\n", progress(server.counters()).c_str());
   return 0;
 }
+
+namespace {
+
+class ServeVerb : public Verb {
+ public:
+  explicit ServeVerb(CLI::App& app) {
+    serve_ = app.add_subcommand(
+        "serve",
+        "Serve the topics live to Foxglove or Lichtblick (Foxglove WebSocket protocol) until Ctrl-C or SIGTERM");
+    serve_->add_option("--listen", listen_,
+                       "IP address to listen on (0.0.0.0: every interface; there is no authentication; a web page "
+                       "served over https needs --tls-cert for a remote address)")
+        ->type_name("ADDR")
+        ->capture_default_str();
+    serve_->add_option("--port", port_, "TCP port (Foxglove's default)")->type_name("N")->capture_default_str();
+    serve_->add_option("--client-queue", queue_,
+                       "kB held for a client that does not read; beyond, its messages are dropped")
+        ->type_name("KB")
+        ->capture_default_str();
+    serve_->add_option("--topic", topics_, "Only this topic, as for record; repeat for more (default: record's)")
+        ->type_name("NAME")
+        ->allow_extra_args(false);
+    serve_->add_option("--allow-origin", origins_,
+                       "Also let pages of this origin connect (scheme://host[:port], exactly; '*': every page); "
+                       "repeat for more (default: the Foxglove app, the Foxglove and Lichtblick desktop apps, pages "
+                       "on localhost, and clients that send no Origin)")
+        ->type_name("ORIGIN")
+        ->allow_extra_args(false);
+    serve_->add_option("--tls-cert", cert_, "Serve wss:// with this certificate (chain), PEM; with --tls-key")
+        ->type_name("FILE");
+    serve_->add_option("--tls-key", key_, "The certificate's private key, PEM, without a passphrase")
+        ->type_name("FILE");
+  }
+  bool chosen() const override { return serve_->parsed(); }
+  std::optional<int> check(const GlobalOptions&) override {
+    auto why = parse_serve_options(listen_, port_, queue_, options_);
+    if (why.empty()) why = parse_serve_access(origins_, cert_, key_, options_);
+    if (why.empty()) return std::nullopt;
+    std::fprintf(stderr, "pmuctl serve: %s\n", why.c_str());
+    return 2;
+  }
+  bool ends_by_itself() const override { return false; }
+  int run(GlobalOptions& g) override { return run_serve(g, options_, topics_); }
+
+ private:
+  CLI::App* serve_;
+  std::string listen_ = "127.0.0.1", port_ = "8765", queue_ = "1024";
+  std::vector<std::string> topics_, origins_;
+  std::string cert_, key_;
+  ServeOptions options_;
+};
+
+}  // namespace
+
+std::unique_ptr<Verb> add_serve_verb(CLI::App& app) { return std::make_unique<ServeVerb>(app); }
 
 }  // namespace pmu::tools

@@ -10,11 +10,16 @@
 
 #include "pmuctl/serve/serve_options.hpp"
 #include "pmuctl/verbs/state_verbs.hpp"
+#include "pmuctl/verbs/verb.hpp"
 
 namespace pmu::tools {
 
 // Exit status: 0 stopped by a signal; 1 the address cannot be listened on (in use, not this
-// host's); 2 bad arguments (main checks --listen, --port and --client-queue before).
+// host's); 2 bad arguments (checked before, by the verb's Verb::check: --listen, --port,
+// --client-queue, --allow-origin, --tls-cert and --tls-key).
 int run_serve(const GlobalOptions& o, const ServeOptions& serve, const std::vector<std::string>& topics);
+
+// serve; its listener, queue and access options are checked by Verb::check.
+std::unique_ptr<Verb> add_serve_verb(CLI::App& app);
 
 }  // namespace pmu::tools

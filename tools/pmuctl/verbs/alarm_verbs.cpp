@@ -1,5 +1,6 @@
 #include "pmuctl/verbs/alarm_verbs.hpp"
 
+#include <CLI/CLI.hpp>
 #include <chrono>
 #include <cstdio>
 #include <ctime>
@@ -18,9 +19,10 @@
 #include "pmu/idl/guarded_type.hpp"
 #include "pmu/idl/topics.hpp"
 #include "pmuctl/verbs/alarm_sample.hpp"
-#include "pmuctl/verbs/exit_status.hpp"
-#include "pmuctl/verbs/service_presence.hpp"
-#include "pmuctl/verbs/context_lease.hpp"
+#include "pmuctl/call/exit_status.hpp"
+#include "pmuctl/call/service_presence.hpp"
+#include "pmuctl/call/context_lease.hpp"
+#include "pmuctl/verbs/command_verbs.hpp"
 
 namespace pmu::tools {
 namespace {
@@ -113,5 +115,33 @@ int run_alarms(const GlobalOptions& o) {
   if (shown == 0 && !o.json) std::fprintf(stderr, "no alarm is active or waiting for acknowledgement\n");
   return 0;
 }
+
+namespace {
+
+// alarms, and alarms ack CODE [--kind KIND].
+class AlarmVerbs : public Verb {
+ public:
+  explicit AlarmVerbs(CLI::App& app) {
+    alarms_ = app.add_subcommand("alarms", "Alarms that are active or wait for acknowledgement");
+    ack_ = alarms_->add_subcommand(
+        "ack", "Acknowledge an alarm (a PMU's by default, chosen as for commands; exit 0 COMPLETED, 1 not)");
+    ack_->add_option("code", code_, "The alarm's code, e.g. thermal_shutdown")->required();
+    ack_->add_option("--kind", kind_,
+                     "Whose alarm: pmu (default), battery or mppt (--address: the node or device id), bus "
+                     "(--bus)");
+  }
+  bool chosen() const override { return alarms_->parsed(); }
+  bool reads_state() const override { return !*ack_; }
+  int run(GlobalOptions& g) override { return *ack_ ? run_alarm_ack(g, code_, kind_) : run_alarms(g); }
+
+ private:
+  CLI::App* alarms_;
+  CLI::App* ack_;
+  std::string code_, kind_ = "pmu";
+};
+
+}  // namespace
+
+std::unique_ptr<Verb> add_alarm_verbs(CLI::App& app) { return std::make_unique<AlarmVerbs>(app); }
 
 }  // namespace pmu::tools

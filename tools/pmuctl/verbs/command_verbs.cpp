@@ -2,6 +2,7 @@
 
 #include <unistd.h>
 
+#include <CLI/CLI.hpp>
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
@@ -16,6 +17,7 @@
 
 #include "pmu/codec/ids.hpp"
 #include "pmu/codec/messages.hpp"
+#include "pmu/codec/parameters.hpp"
 #include "pmu/command/command.hpp"
 #include "pmu/dds/dds_context.hpp"
 #include "pmu/idl/alarms.h"
@@ -27,11 +29,12 @@
 #include "pmu/idl/statePubSubTypes.h"
 #include "pmu/idl/topics.hpp"
 #include "pmuctl/verbs/alarm_names.hpp"
-#include "pmuctl/verbs/command_channel.hpp"
-#include "pmuctl/verbs/exit_status.hpp"
-#include "pmuctl/verbs/service_presence.hpp"
+#include "pmuctl/call/command_channel.hpp"
+#include "pmuctl/call/exit_status.hpp"
+#include "pmuctl/call/service_presence.hpp"
+#include "pmuctl/view/mask_names.hpp"
 #include "pmuctl/view/sample_json.hpp"
-#include "pmuctl/verbs/context_lease.hpp"
+#include "pmuctl/call/context_lease.hpp"
 
 namespace pmu::tools {
 namespace {
@@ -239,6 +242,142 @@ int run_command(const GlobalOptions& o, const CommandSpec& spec) {
     std::printf("%s\n", j.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace).c_str());
   }
   return static_cast<int>(ExitStatus::NoAnswer);
+}
+
+namespace {
+
+// Every stored parameter's name, as `config set` lists them in its help and its refusal.
+std::string parameter_names() {
+  std::string names;
+  for (const auto& spec : pmu::codec::parameter_table()) names += (names.empty() ? "" : ", ") + std::string(spec.name);
+  return names;
+}
+
+// config set PARAM VALUE.
+class ConfigSet : public Verb {
+ public:
+  ConfigSet(CLI::App& config, const bool& confirm) : confirm_(confirm), parameter_names_(parameter_names()) {
+    set_ = config.add_subcommand("set", "Set a stored parameter; verified by reading it back");
+    set_->add_option("param", param_, parameter_names_)->required();
+    set_->add_option("value", value_,
+                     "Value in the parameter's unit (V, s, degC, a number); a mask: names a,b or none, or a number")
+        ->required();
+  }
+  bool chosen() const override { return set_->parsed(); }
+  std::optional<int> check(const GlobalOptions& g) override {
+    if (pmu::codec::parameter_from_name(param_)) return std::nullopt;
+    // The two fields of pmu::v5::Config that are not stored parameters have verbs of their own.
+    if (param_ == "outputs")
+      return fail(g, ExitStatus::BadUsage,
+                  "outputs are not a stored parameter: switch them with `pmuctl outputs set|enable|disable "
+                  "NAME...` (their state at power-up is the parameter power_up_state)");
+    if (param_ == "generation_enabled")
+      return fail(g, ExitStatus::BadUsage,
+                  "generation is not a stored parameter: switch it with `pmuctl generation on|off`");
+    return fail(g, ExitStatus::BadUsage,
+                "unknown parameter '" + pmu::service::printable(param_) + "' (parameters: " + parameter_names_ + ")");
+  }
+  int run(GlobalOptions& g) override {
+    const auto parsed = parse_config_value(param_, value_);
+    if (!parsed.value) return fail(g, ExitStatus::BadUsage, parsed.error);
+    CommandSpec spec;
+    spec.confirm = confirm_;
+    spec.value = *parsed.value;
+    spec.kind = pmu::v5::SET_PARAMETER;
+    spec.parameter = param_;
+    return run_command(g, spec);
+  }
+
+ private:
+  const bool& confirm_;
+  std::string parameter_names_;
+  CLI::App* set_;
+  std::string param_, value_;
+};
+
+// outputs get|set|enable|disable, generation on|off, engine start|stop, reset, measure.
+class CommandVerbs : public Verb {
+ public:
+  CommandVerbs(CLI::App& app, const bool& confirm) : confirm_(confirm) {
+    outputs_ = app.add_subcommand(
+        "outputs",
+        "Output states (" + pmu::codec::names_of(pmu::codec::kOutputNames, pmu::codec::output_bit::All, ", ") + ")");
+    outputs_->require_subcommand(1);
+    outputs_get_ = outputs_->add_subcommand("get", "Read the output states from the PMU");
+    outputs_set_ = outputs_->add_subcommand("set", "Set exactly these outputs on (the others off)");
+    outputs_set_->add_option("names", output_names_, "Outputs to have on (or none)")->required();
+    outputs_enable_ = outputs_->add_subcommand("enable", "Switch these outputs on");
+    outputs_enable_->add_option("names", output_names_, "Outputs")->required();
+    auto* outputs_disable = outputs_->add_subcommand("disable", "Switch these outputs off");
+    outputs_disable->add_option("names", output_names_, "Outputs")->required();
+    generation_ = app.add_subcommand("generation", "Electrical power generation on|off");
+    generation_->add_option("state", on_off_, "on or off")->required()->check(CLI::IsMember({"on", "off"}));
+    engine_ = app.add_subcommand(
+        "engine",
+        "Engine start (verified by the generator speed) | stop (0x25: stops the starter cranking; a running engine "
+        "keeps running, no PMU command stops it)");
+    engine_
+        ->add_option("action", start_stop_,
+                     "start: crank until the engine runs; stop: stop the starter cranking (not a running engine)")
+        ->required()
+        ->check(CLI::IsMember({"start", "stop"}));
+    reset_ = app.add_subcommand("reset", "Restart the PMU (outputs to power-up state, energies to zero)");
+    measure_ = app.add_subcommand("measure", "Ask for measurements now (0x0F; firmware 1.14+)");
+    measure_->add_option("groups", groups_,
+                         pmu::codec::names_of(pmu::codec::kGroupNames, pmu::codec::group_bit::All, ", ") +
+                             " (default all)");
+  }
+  bool chosen() const override { return *outputs_ || *generation_ || *engine_ || *reset_ || *measure_; }
+  int command_kind() const override {
+    return !*engine_ ? -1 : start_stop_ == "start" ? int{pmu::v5::ENGINE_START} : int{pmu::v5::ENGINE_STOP};
+  }
+  int run(GlobalOptions& g) override {
+    CommandSpec spec;
+    spec.confirm = confirm_;
+    if (*outputs_get_) {
+      spec.kind = pmu::v5::GET;
+      spec.parameter = "outputs";
+    } else if (*outputs_) {
+      if (!output_mask(output_names_, spec.outputs)) return 2;
+      spec.kind = *outputs_set_      ? pmu::v5::SET_OUTPUTS
+                  : *outputs_enable_ ? pmu::v5::ENABLE_OUTPUTS
+                                     : pmu::v5::DISABLE_OUTPUTS;
+    } else if (*generation_) {
+      spec.kind = pmu::v5::SET_GENERATION;
+      spec.enable = on_off_ == "on";
+    } else if (*engine_) {
+      spec.kind = command_kind();
+    } else if (*reset_) {
+      spec.kind = pmu::v5::RESET;
+    } else {
+      if (!group_mask(groups_, spec.groups)) return 2;
+      spec.kind = pmu::v5::REQUEST_MEASUREMENTS;
+    }
+    return run_command(g, spec);
+  }
+
+ private:
+  const bool& confirm_;
+  CLI::App* outputs_;
+  CLI::App* outputs_get_;
+  CLI::App* outputs_set_;
+  CLI::App* outputs_enable_;
+  CLI::App* generation_;
+  CLI::App* engine_;
+  CLI::App* reset_;
+  CLI::App* measure_;
+  std::vector<std::string> output_names_, groups_;
+  std::string on_off_, start_stop_;
+};
+
+}  // namespace
+
+std::unique_ptr<Verb> add_config_set(CLI::App& config, const bool& confirm) {
+  return std::make_unique<ConfigSet>(config, confirm);
+}
+
+std::unique_ptr<Verb> add_command_verbs(CLI::App& app, const bool& confirm) {
+  return std::make_unique<CommandVerbs>(app, confirm);
 }
 
 }  // namespace pmu::tools

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "pmuctl/verbs/state_verbs.hpp"
+#include "pmuctl/verbs/verb.hpp"
 
 namespace pmu::tools {
 
@@ -36,5 +37,11 @@ std::string broadcast_refusal(const GlobalOptions& o, int kind);
 // "avionics_servo" -> bit 0 ... ; false (with a message on stderr) for an unknown name.
 bool output_mask(const std::vector<std::string>& names, std::uint8_t& mask);
 bool group_mask(const std::vector<std::string>& names, std::uint8_t& mask);
+
+// config set PARAM VALUE, added to the `config` subcommand; its parameter is checked by
+// Verb::check, its value when it runs. `confirm` (--confirm) is read when it runs.
+std::unique_ptr<Verb> add_config_set(CLI::App& config, const bool& confirm);
+// outputs, generation, engine, reset, measure: added to `app` in that order.
+std::unique_ptr<Verb> add_command_verbs(CLI::App& app, const bool& confirm);
 
 }  // namespace pmu::tools

@@ -2,6 +2,7 @@
 
 #include <unistd.h>
 
+#include <CLI/CLI.hpp>
 #include <cerrno>
 #include <chrono>
 #include <cmath>
@@ -30,10 +31,10 @@
 #include "pmu/idl/statePubSubTypes.h"
 #include "pmu/idl/topics.hpp"
 #include "pmu/mcap/output_file.hpp"
-#include "pmuctl/verbs/command_channel.hpp"
-#include "pmuctl/verbs/exit_status.hpp"
-#include "pmuctl/verbs/service_presence.hpp"
-#include "pmuctl/verbs/context_lease.hpp"
+#include "pmuctl/call/command_channel.hpp"
+#include "pmuctl/call/exit_status.hpp"
+#include "pmuctl/call/service_presence.hpp"
+#include "pmuctl/call/context_lease.hpp"
 
 namespace pmu::tools {
 // A namespace of its own: the unity builds put this file in one translation unit with the
@@ -719,6 +720,51 @@ int run_config_snapshot(const GlobalOptions& o, const std::string& file, bool fo
 int run_config_diff(const GlobalOptions& o, const std::string& file) { return config_file_verbs::diff(o, file); }
 int run_config_apply(const GlobalOptions& o, const std::string& file, bool dry_run, bool confirm, bool other_unit) {
   return config_file_verbs::apply(o, file, dry_run, confirm, other_unit);
+}
+
+namespace {
+
+// config snapshot FILE [--force], config diff [FILE], config apply FILE [--dry-run] [--other-unit].
+class ConfigFileVerbs : public Verb {
+ public:
+  ConfigFileVerbs(CLI::App& config, const bool& confirm) : confirm_(confirm) {
+    snapshot_ = config.add_subcommand(
+        "snapshot", "Write the PMU's configuration to a file (- for stdout): what `config apply` reads back");
+    snapshot_->add_option("file", file_, "The file to write; an existing one is kept unless --force")->required();
+    snapshot_->add_flag("--force", force_, "Replace an existing file");
+    diff_ = config.add_subcommand(
+        "diff", "Compare the PMU with a configuration file (exit 0 equal, 1 different, 2 bad file, 3 no answer)");
+    diff_->add_option("file", file_,
+                      "A file written by `config snapshot` or by hand; without it the service's baseline of "
+                      "the PMU (pmu-service.yaml `baseline:`)");
+    apply_ = config.add_subcommand(
+        "apply", "Write what differs from a configuration file, verified, in a safe order; undone on a failure");
+    apply_->add_option("file", file_, "A file written by `config snapshot` or by hand")->required();
+    apply_->add_flag("--dry-run", dry_run_, "Check the file and print the changes in order; send nothing");
+    apply_->add_flag("--other-unit", other_unit_,
+                     "Apply a file read from another unit (its device.serial is not this PMU's); refused "
+                     "without it");
+  }
+  bool chosen() const override { return *snapshot_ || *diff_ || *apply_; }
+  int run(GlobalOptions& g) override {
+    if (*snapshot_) return run_config_snapshot(g, file_, force_);
+    if (*diff_) return run_config_diff(g, file_);
+    return run_config_apply(g, file_, dry_run_, confirm_, other_unit_);
+  }
+
+ private:
+  const bool& confirm_;
+  CLI::App* snapshot_;
+  CLI::App* diff_;
+  CLI::App* apply_;
+  std::string file_;
+  bool force_ = false, dry_run_ = false, other_unit_ = false;
+};
+
+}  // namespace
+
+std::unique_ptr<Verb> add_config_file_verbs(CLI::App& config, const bool& confirm) {
+  return std::make_unique<ConfigFileVerbs>(config, confirm);
 }
 
 }  // namespace pmu::tools

@@ -6,6 +6,7 @@
 #include <string>
 
 #include "pmuctl/verbs/state_verbs.hpp"
+#include "pmuctl/verbs/verb.hpp"
 
 namespace pmu::tools {
 
@@ -27,5 +28,9 @@ int run_config_diff(const GlobalOptions& o, const std::string& file);
 // can_address another served PMU has (nothing sent), 3 nothing answers. The dry run refuses
 // what the apply would.
 int run_config_apply(const GlobalOptions& o, const std::string& file, bool dry_run, bool confirm, bool other_unit);
+
+// config snapshot, diff and apply, added to the `config` subcommand in that order; apply reads
+// `confirm` (--confirm) when it runs.
+std::unique_ptr<Verb> add_config_file_verbs(CLI::App& config, const bool& confirm);
 
 }  // namespace pmu::tools

@@ -1,5 +1,6 @@
 #include "pmuctl/verbs/energy_verb.hpp"
 
+#include <CLI/CLI.hpp>
 #include <algorithm>
 #include <chrono>
 #include <fastdds/dds/core/status/SubscriptionMatchedStatus.hpp>
@@ -13,10 +14,10 @@
 #include "pmu/idl/guarded_type.hpp"
 #include "pmu/idl/topics.hpp"
 #include "pmuctl/verbs/energy_lines.hpp"
-#include "pmuctl/verbs/exit_status.hpp"
-#include "pmuctl/verbs/service_presence.hpp"
-#include "pmuctl/verbs/state_settle.hpp"
-#include "pmuctl/verbs/context_lease.hpp"
+#include "pmuctl/call/exit_status.hpp"
+#include "pmuctl/call/service_presence.hpp"
+#include "pmuctl/call/state_settle.hpp"
+#include "pmuctl/call/context_lease.hpp"
 
 namespace pmu::tools {
 // A namespace of its own: the unity builds put this file in one translation unit with the
@@ -114,5 +115,24 @@ int run(const GlobalOptions& o) {
 }  // namespace energy_verb
 
 int run_energy(const GlobalOptions& o) { return energy_verb::run(o); }
+
+namespace {
+
+class EnergyVerb : public Verb {
+ public:
+  explicit EnergyVerb(CLI::App& app)
+      : energy_(app.add_subcommand(
+            "energy", "Power per output, generator power, energy used and endurance of each battery")) {}
+  bool chosen() const override { return energy_->parsed(); }
+  bool reads_state() const override { return true; }
+  int run(GlobalOptions& g) override { return run_energy(g); }
+
+ private:
+  CLI::App* energy_;
+};
+
+}  // namespace
+
+std::unique_ptr<Verb> add_energy_verb(CLI::App& app) { return std::make_unique<EnergyVerb>(app); }
 
 }  // namespace pmu::tools

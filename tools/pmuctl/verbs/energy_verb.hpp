@@ -6,9 +6,12 @@
 // device has any, 3 when no service answers.
 
 #include "pmuctl/verbs/state_verbs.hpp"
+#include "pmuctl/verbs/verb.hpp"
 
 namespace pmu::tools {
 
 int run_energy(const GlobalOptions& o);
+
+std::unique_ptr<Verb> add_energy_verb(CLI::App& app);
 
 }  // namespace pmu::tools

@@ -1,5 +1,6 @@
 #include "pmuctl/verbs/preflight_verb.hpp"
 
+#include <CLI/CLI.hpp>
 #include <chrono>
 #include <cstdio>
 #include <fastdds/dds/core/status/SubscriptionMatchedStatus.hpp>
@@ -14,10 +15,10 @@
 #include "pmu/idl/guarded_type.hpp"
 #include "pmu/idl/topics.hpp"
 #include "pmuctl/verbs/alarm_names.hpp"
-#include "pmuctl/verbs/exit_status.hpp"
-#include "pmuctl/verbs/service_presence.hpp"
-#include "pmuctl/verbs/state_settle.hpp"
-#include "pmuctl/verbs/context_lease.hpp"
+#include "pmuctl/call/exit_status.hpp"
+#include "pmuctl/call/service_presence.hpp"
+#include "pmuctl/call/state_settle.hpp"
+#include "pmuctl/call/context_lease.hpp"
 
 namespace pmu::tools {
 namespace {
@@ -111,5 +112,24 @@ int run_preflight(const GlobalOptions& o) {
   }
   return static_cast<int>(ready ? ExitStatus::Ok : ExitStatus::NotDone);
 }
+
+namespace {
+
+class PreflightVerb : public Verb {
+ public:
+  explicit PreflightVerb(CLI::App& app)
+      : preflight_(app.add_subcommand(
+            "preflight", "Whether the vehicle may fly, and every reason it may not (exit 0 ready, 1 not)")) {}
+  bool chosen() const override { return preflight_->parsed(); }
+  bool reads_state() const override { return true; }
+  int run(GlobalOptions& g) override { return run_preflight(g); }
+
+ private:
+  CLI::App* preflight_;
+};
+
+}  // namespace
+
+std::unique_ptr<Verb> add_preflight_verb(CLI::App& app) { return std::make_unique<PreflightVerb>(app); }
 
 }  // namespace pmu::tools

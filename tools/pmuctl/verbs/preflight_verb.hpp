@@ -4,9 +4,12 @@
 // reasons printed), 3 when no service answers.
 
 #include "pmuctl/verbs/state_verbs.hpp"
+#include "pmuctl/verbs/verb.hpp"
 
 namespace pmu::tools {
 
 int run_preflight(const GlobalOptions& o);
+
+std::unique_ptr<Verb> add_preflight_verb(CLI::App& app);
 
 }  // namespace pmu::tools

@@ -2,6 +2,7 @@
 
 #include <unistd.h>
 
+#include <CLI/CLI.hpp>
 #include <chrono>
 #include <ctime>
 #include <cstdio>
@@ -12,6 +13,7 @@
 #include <set>
 #include <thread>
 #include <tuple>
+#include <variant>
 #include <vector>
 
 #include "pmu/codec/parameters.hpp"
@@ -27,15 +29,16 @@
 #include "pmu/idl/topics.hpp"
 #include "pmu/transport/stop_signals.hpp"
 #include "pmuctl/verbs/alarm_sample.hpp"
-#include "pmuctl/verbs/command_channel.hpp"
-#include "pmuctl/verbs/exit_status.hpp"
-#include "pmuctl/verbs/service_presence.hpp"
-#include "pmuctl/verbs/state_settle.hpp"
+#include "pmuctl/call/command_channel.hpp"
+#include "pmuctl/call/exit_status.hpp"
+#include "pmuctl/call/option_values.hpp"
+#include "pmuctl/call/service_presence.hpp"
+#include "pmuctl/call/state_settle.hpp"
 #include "pmuctl/view/alarm_marker.hpp"
 #include "pmuctl/view/sample_fields.hpp"
 #include "pmuctl/view/sample_json.hpp"
 #include "pmuctl/view/table_text.hpp"
-#include "pmuctl/verbs/context_lease.hpp"
+#include "pmuctl/call/context_lease.hpp"
 
 namespace pmu::tools {
 namespace {
@@ -587,5 +590,69 @@ int run_config_get(const GlobalOptions& o, const std::string& parameter) {
   }
   return 0;
 }
+
+namespace {
+
+// watch, list, info, health.
+class StateVerbs : public Verb {
+ public:
+  StateVerbs(CLI::App& app, GlobalOptions& g) {
+    watch_ = app.add_subcommand(
+        "watch", "Live telemetry with each device's alarm marker: a refreshing table, or one JSON object per sample");
+    watch_->add_option("--count", count_text_, "Stop after N telemetry samples (alarm samples are not counted)")
+        ->type_name("N");
+    watch_->add_flag("--low-rate", g.low_rate,
+                     "The low-rate topics pmu/low_rate/*: at most one sample per device and packet per the "
+                     "service's low_rate_period (1 s by default, 2 s with its link profile radio), for slow links");
+    list_ = app.add_subcommand("list", "PMUs the service knows, with health");
+    info_ = app.add_subcommand("info", "Serial number, firmware and features");
+    health_ = app.add_subcommand("health", "Link, bus and device health");
+  }
+  bool chosen() const override { return *watch_ || *list_ || *info_ || *health_; }
+  std::optional<int> take_values(const GlobalOptions& g) override {
+    if (count_text_.empty()) return std::nullopt;
+    const auto n = parse_count("--count", count_text_);
+    if (const auto* why = std::get_if<std::string>(&n)) return fail(g, ExitStatus::BadUsage, *why);
+    count_ = std::get<long>(n);
+    return std::nullopt;
+  }
+  bool ends_by_itself() const override { return !*watch_; }
+  bool reads_state() const override { return !*watch_; }
+  int run(GlobalOptions& g) override {
+    if (*watch_) return run_watch(g, count_);
+    if (*list_) return run_list(g);
+    if (*info_) return run_info(g);
+    return run_health(g);
+  }
+
+ private:
+  CLI::App* watch_;
+  CLI::App* list_;
+  CLI::App* info_;
+  CLI::App* health_;
+  std::string count_text_;
+  long count_ = 0;
+};
+
+class ConfigGet : public Verb {
+ public:
+  explicit ConfigGet(CLI::App& config) {
+    get_ = config.add_subcommand("get", "Show the stored parameters (or one)");
+    get_->add_option("param", parameter_, "A parameter name, e.g. avionics_voltage");
+  }
+  bool chosen() const override { return get_->parsed(); }
+  bool reads_state() const override { return true; }
+  int run(GlobalOptions& g) override { return run_config_get(g, parameter_); }
+
+ private:
+  CLI::App* get_;
+  std::string parameter_;
+};
+
+}  // namespace
+
+std::unique_ptr<Verb> add_state_verbs(CLI::App& app, GlobalOptions& g) { return std::make_unique<StateVerbs>(app, g); }
+
+std::unique_ptr<Verb> add_config_get(CLI::App& config) { return std::make_unique<ConfigGet>(config); }
 
 }  // namespace pmu::tools

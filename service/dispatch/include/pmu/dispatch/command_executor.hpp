@@ -39,8 +39,4 @@ std::optional<CommandReplyData> check_firmware(const CommandRequest& r, std::opt
 void execute_command(DeviceSession& session, const CommandRequest& r, SteadyTime now, const Timeouts& timeouts,
                      ReplyFn reply);
 
-// A final reply to a sample that did not parse (an unknown kind is answered as GET);
-// make_reply for a parsed request is in command_plan.hpp.
-CommandReplyData make_reply(const CommandSample& s, CommandResult result, std::string reason);
-
 }  // namespace pmu::service

@@ -85,7 +85,4 @@ CommandPlan plan_command(const CommandRequest& r, const DeviceFacts& device);
 void run_plan(DeviceSession& session, const CommandRequest& r, CommandPlan plan, SteadyTime now,
               const Timeouts& timeouts, ReplyFn reply);
 
-// A final reply to `r` with `result` and `reason`.
-CommandReplyData make_reply(const CommandRequest& r, CommandResult result, std::string reason);
-
 }  // namespace pmu::service

@@ -1,4 +1,4 @@
-#include "pmuctl/verbs/option_values.hpp"
+#include "pmuctl/call/option_values.hpp"
 
 #include <cerrno>
 #include <cmath>

@@ -1,4 +1,4 @@
-#include "pmuctl/verbs/command_channel.hpp"
+#include "pmuctl/call/command_channel.hpp"
 
 #include <unistd.h>
 
@@ -18,9 +18,9 @@
 #include "pmu/idl/state.h"
 #include "pmu/idl/statePubSubTypes.h"
 #include "pmu/idl/topics.hpp"
-#include "pmuctl/verbs/exit_status.hpp"
-#include "pmuctl/verbs/service_presence.hpp"
-#include "pmuctl/verbs/target_search.hpp"
+#include "pmuctl/call/exit_status.hpp"
+#include "pmuctl/call/service_presence.hpp"
+#include "pmuctl/call/target_search.hpp"
 
 namespace pmu::tools {
 namespace {

@@ -1,4 +1,4 @@
-#include "pmuctl/verbs/exit_status.hpp"
+#include "pmuctl/call/exit_status.hpp"
 
 #include <nlohmann/json.hpp>
 

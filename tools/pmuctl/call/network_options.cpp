@@ -1,4 +1,4 @@
-#include "pmuctl/verbs/network_options.hpp"
+#include "pmuctl/call/network_options.hpp"
 
 #include <algorithm>
 #include <cctype>

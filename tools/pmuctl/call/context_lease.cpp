@@ -1,8 +1,9 @@
-#include "pmuctl/verbs/context_lease.hpp"
+#include "pmuctl/call/context_lease.hpp"
 
 #include <filesystem>
 
 #include "pmu/idl/topics.hpp"
+#include "pmuctl/verbs/state_verbs.hpp"
 
 namespace pmu::tools {
 namespace {

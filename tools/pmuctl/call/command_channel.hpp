@@ -15,7 +15,7 @@
 #include "pmu/dds/dds_context.hpp"
 #include "pmu/idl/command.h"
 #include "pmuctl/verbs/command_verbs.hpp"
-#include "pmuctl/verbs/context_lease.hpp"
+#include "pmuctl/call/context_lease.hpp"
 
 namespace pmu::tools {
 

@@ -17,7 +17,7 @@
 #include <string>
 
 #include "pmu/dds/dds_context.hpp"
-#include "pmuctl/verbs/state_verbs.hpp"
+#include "pmuctl/call/global_options.hpp"
 
 namespace pmu::tools {
 

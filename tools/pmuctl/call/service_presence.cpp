@@ -1,11 +1,11 @@
-#include "pmuctl/verbs/service_presence.hpp"
+#include "pmuctl/call/service_presence.hpp"
 
 #include <algorithm>
 #include <fastdds/dds/core/status/SubscriptionMatchedStatus.hpp>
 
 #include "pmu/dds/contract_names.hpp"
 #include "pmu/idl/topics.hpp"
-#include "pmuctl/verbs/exit_status.hpp"
+#include "pmuctl/call/exit_status.hpp"
 
 namespace pmu::tools {
 
