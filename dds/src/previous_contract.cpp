@@ -12,7 +12,7 @@
 #include "pmu/idl_previous/canopenPubSubTypes.h"
 #include "pmu/idl_previous/statePubSubTypes.h"
 #include "pmu/idl_previous/telemetryPubSubTypes.h"
-#include "pmu/session/canopen_state.hpp"
+#include "pmu/idl_tables/canopen_values.hpp"
 
 namespace pmu::dds {
 namespace {

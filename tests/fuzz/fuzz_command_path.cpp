@@ -21,8 +21,8 @@
 #include "../service/harness.hpp"
 #include "pmu/codec/decode.hpp"
 #include "pmu/codec/encode.hpp"
-#include "pmu/dds/command_cdr.hpp"
 #include "pmu/dispatch/command_service.hpp"
+#include "pmu/endpoints/command_cdr.hpp"
 
 #include <spdlog/spdlog.h>
 

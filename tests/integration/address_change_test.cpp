@@ -15,8 +15,8 @@
 
 #include "../service/harness.hpp"
 #include "pmu/dds/dds_context.hpp"
-#include "pmu/dds/dds_publisher.hpp"
 #include "pmu/dispatch/command_service.hpp"
+#include "pmu/endpoints/dds_publisher.hpp"
 #include "pmu/idl/statePubSubTypes.h"
 #include "pmu/idl/topics.hpp"
 #include "support/domain.hpp"

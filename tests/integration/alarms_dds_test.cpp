@@ -8,7 +8,7 @@
 #include <map>
 
 #include "pmu/dds/dds_context.hpp"
-#include "pmu/dds/dds_publisher.hpp"
+#include "pmu/endpoints/dds_publisher.hpp"
 #include "pmu/idl/alarmsPubSubTypes.h"
 #include "pmu/idl/topics.hpp"
 #include "support/domain.hpp"

@@ -17,7 +17,7 @@
 
 #include "canopen_bus.hpp"
 #include "pmu/dds/dds_context.hpp"
-#include "pmu/dds/dds_publisher.hpp"
+#include "pmu/endpoints/dds_publisher.hpp"
 #include "pmu/idl/canopenPubSubTypes.h"
 #include "pmu/idl/statePubSubTypes.h"
 #include "pmu/idl/topics.hpp"

@@ -9,7 +9,7 @@
 
 #include "canopen_bus.hpp"
 #include "pmu/dds/dds_context.hpp"
-#include "pmu/dds/dds_publisher.hpp"
+#include "pmu/endpoints/dds_publisher.hpp"
 #include "support/domain.hpp"
 #include "support/json_lines.hpp"
 #include "support/process.hpp"

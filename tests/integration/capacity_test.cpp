@@ -18,7 +18,7 @@
 
 #include "pmu/config/capacity.hpp"
 #include "pmu/dds/dds_context.hpp"
-#include "pmu/dds/dds_publisher.hpp"
+#include "pmu/endpoints/dds_publisher.hpp"
 #include "pmu/idl/statePubSubTypes.h"
 #include "pmu/idl/topics.hpp"
 #include "support/domain.hpp"

@@ -21,8 +21,8 @@
 #include <sstream>
 #include <thread>
 
-#include "pmu/dds/command_cdr.hpp"
 #include "pmu/dds/dds_context.hpp"
+#include "pmu/endpoints/command_cdr.hpp"
 #include "pmu/idl/command.h"
 #include "pmu/idl/commandPubSubTypes.h"
 #include "pmu/idl/guarded_type.hpp"

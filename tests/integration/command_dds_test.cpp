@@ -12,10 +12,10 @@
 #include <set>
 #include <thread>
 
-#include "pmu/dds/dds_commands.hpp"
 #include "pmu/dds/dds_context.hpp"
-#include "pmu/dds/dds_publisher.hpp"
 #include "pmu/dispatch/command_service.hpp"
+#include "pmu/endpoints/dds_commands.hpp"
+#include "pmu/endpoints/dds_publisher.hpp"
 #include "pmu/idl/command.h"
 #include "pmu/idl/commandPubSubTypes.h"
 #include "pmu/idl/statePubSubTypes.h"

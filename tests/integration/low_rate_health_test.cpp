@@ -11,7 +11,7 @@
 #include <thread>
 
 #include "pmu/dds/dds_context.hpp"
-#include "pmu/dds/dds_publisher.hpp"
+#include "pmu/endpoints/dds_publisher.hpp"
 #include "pmu/idl/statePubSubTypes.h"
 #include "pmu/idl/telemetryPubSubTypes.h"
 #include "pmu/idl/topics.hpp"

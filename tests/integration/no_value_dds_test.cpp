@@ -15,7 +15,7 @@
 #include <string_view>
 
 #include "pmu/dds/dds_context.hpp"
-#include "pmu/dds/dds_publisher.hpp"
+#include "pmu/endpoints/dds_publisher.hpp"
 #include "pmu/idl/canopenPubSubTypes.h"
 #include "pmu/idl/statePubSubTypes.h"
 #include "pmu/idl/telemetryPubSubTypes.h"

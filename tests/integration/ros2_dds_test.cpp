@@ -29,7 +29,7 @@
 #include "../ros2/ros2_reader_qos.hpp"
 #include "diagnostic_msgs/msg/DiagnosticArrayPubSubTypes.h"
 #include "pmu/dds/dds_context.hpp"
-#include "pmu/dds/ros2_publisher.hpp"
+#include "pmu/endpoints/ros2_publisher.hpp"
 #include "sensor_msgs/msg/BatteryStatePubSubTypes.h"
 #include "support/configured_service.hpp"
 #include "support/domain.hpp"

@@ -13,7 +13,7 @@
 
 #include "../../tools/pmuctl/record/raw_sample_type.hpp"
 #include "pmu/dds/dds_context.hpp"
-#include "pmu/dds/dds_publisher.hpp"
+#include "pmu/endpoints/dds_publisher.hpp"
 #include "pmu/idl/alarmsPubSubTypes.h"
 #include "pmu/idl/topics.hpp"
 #include "support/domain.hpp"

@@ -77,7 +77,7 @@ double boottime() {
 double seconds_between(Clock::time_point a, Clock::time_point b) { return std::chrono::duration<double>(b - a).count(); }
 
 // The service's names for its results; pmu::v5::CommandResult has the same order (static_assert
-// in dds/src/dds_commands.cpp). The names are literals, so data() ends in NUL.
+// in service/endpoints/src/dds_commands.cpp). The names are literals, so data() ends in NUL.
 const char* result_name(pmu::v5::CommandResult r) {
   return pmu::service::to_string(static_cast<pmu::service::CommandResult>(r)).data();
 }

@@ -10,7 +10,7 @@
 #include <string>
 #include <vector>
 
-#include "pmu/dds/diagnostics_pace.hpp"
+#include "pmu/endpoints/diagnostics_pace.hpp"
 
 namespace pmu::dds {
 namespace {

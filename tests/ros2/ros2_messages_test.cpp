@@ -9,7 +9,7 @@
 #include <vector>
 
 #include "pmu/alarms/alarm_table.hpp"
-#include "pmu/dds/ros2_messages.hpp"
+#include "pmu/endpoints/ros2_messages.hpp"
 
 namespace pmu::dds {
 namespace {

@@ -16,7 +16,7 @@
 #include <fastdds/dds/topic/Topic.hpp>
 #include <fastdds/dds/topic/TypeSupport.hpp>
 
-#include "pmu/dds/ros2_publisher.hpp"
+#include "pmu/endpoints/ros2_publisher.hpp"
 #include "ros2_reader_qos.hpp"
 #include "sensor_msgs/msg/BatteryStatePubSubTypes.h"
 #include "support/domain.hpp"

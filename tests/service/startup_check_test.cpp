@@ -13,7 +13,7 @@
 
 #include "pmu/config/config.hpp"
 #include "pmu/dds/dds_context.hpp"
-#include "pmu/dds/startup_check.hpp"
+#include "pmu/endpoints/startup_check.hpp"
 #include "support/process.hpp"
 
 namespace pmu::service {

@@ -13,10 +13,10 @@
 #include <thread>
 
 #include "pmu/config/vehicle.hpp"
-#include "pmu/dds/dds_commands.hpp"
 #include "pmu/dds/dds_context.hpp"
-#include "pmu/dds/dds_publisher.hpp"
 #include "pmu/dispatch/command_service.hpp"
+#include "pmu/endpoints/dds_commands.hpp"
+#include "pmu/endpoints/dds_publisher.hpp"
 #include "pmu/session/bus_worker.hpp"
 #include "pmu/sim/bus_runner.hpp"
 #include "pmu/transport/sim_bus.hpp"

@@ -29,7 +29,7 @@ using Clock = std::chrono::steady_clock;
 }  // namespace
 
 // The service's names for its results; pmu::v5::CommandResult has the same order (static_assert
-// in dds/src/dds_commands.cpp). The names are literals, so data() ends in NUL.
+// in service/endpoints/src/dds_commands.cpp). The names are literals, so data() ends in NUL.
 const char* result_name(pmu::v5::CommandResult r) {
   return pmu::service::to_string(static_cast<pmu::service::CommandResult>(r)).data();
 }

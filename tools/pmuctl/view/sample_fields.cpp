@@ -9,7 +9,7 @@
 
 #include "pmu/codec/parameters.hpp"
 #include "pmu/codec/telemetry.hpp"
-#include "pmu/session/canopen_state.hpp"
+#include "pmu/idl_tables/canopen_values.hpp"
 #include "pmuctl/decode/frame_fields.hpp"
 #include "pmuctl/view/mask_names.hpp"
 

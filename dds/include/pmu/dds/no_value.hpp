@@ -16,7 +16,7 @@ inline constexpr float kNoValue = std::numeric_limits<float>::quiet_NaN();
 // codec::Status::generator_rpm when the PMU has no reading: the top of its 16-bit field.
 inline constexpr std::uint16_t kNoRpm = std::numeric_limits<std::uint16_t>::max();
 // A battery's time_to_go (s) while it is not discharging: the top of the document's 16-bit
-// minutes (canopen_state.hpp scales them to seconds), which the document defines no meaning for.
+// minutes (canopen_values.hpp scales them to seconds), which the document defines no meaning for.
 inline constexpr double kNotDischarging = double{std::numeric_limits<std::uint16_t>::max()} * 60;
 // HealthReport::last_frame_age of a device never heard.
 inline constexpr double kNeverHeard = -1;

@@ -9,7 +9,7 @@
 
 #include "pmu/codec/decode.hpp"
 #include "pmu/idl/telemetry.h"
-#include "pmu/session/device_state.hpp"
+#include "pmu/idl_tables/device_key.hpp"
 
 namespace pmu::service {
 

@@ -13,25 +13,14 @@
 #include "pmu/codec/decode.hpp"
 #include "pmu/codec/parameters.hpp"
 #include "pmu/energy/figures.hpp"
+#include "pmu/idl_tables/device_key.hpp"
 #include "pmu/session/canopen_state.hpp"
 #include "pmu/transport/can_bus.hpp"
 
 namespace pmu::service {
 
-// What a device on a bus is. PMUs are addressed by CAN address; a battery by its CANopen
-// node, an MPPT by its device id (0..7): the three number ranges overlap, so the kind is part
-// of every device's key (pmu/health's `kind`).
-enum class DeviceKind : std::uint8_t { Pmu, Battery, Mppt };
+// "pmu", "battery", "mppt" (DeviceKind and DeviceKey: pmu/idl_tables/device_key.hpp).
 const char* to_string(DeviceKind k) noexcept;
-
-struct DeviceKey {
-  std::string bus;
-  std::uint16_t address = 0;  // PMU: CAN address; battery: CANopen node; MPPT: device id
-  DeviceKind kind = DeviceKind::Pmu;
-  friend bool operator==(const DeviceKey& a, const DeviceKey& b) {
-    return a.bus == b.bus && a.address == b.address && a.kind == b.kind;
-  }
-};
 
 // Stored parameters as last read from (or verified on) the device, raw wire values.
 struct ConfigState {

@@ -1,4 +1,4 @@
-#include "pmu/dds/diagnostics_pace.hpp"
+#include "pmu/endpoints/diagnostics_pace.hpp"
 
 namespace pmu::dds {
 

@@ -1,4 +1,4 @@
-#include "pmu/dds/startup_check.hpp"
+#include "pmu/endpoints/startup_check.hpp"
 
 #include <cstdlib>
 

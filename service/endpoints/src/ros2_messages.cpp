@@ -1,4 +1,4 @@
-#include "pmu/dds/ros2_messages.hpp"
+#include "pmu/endpoints/ros2_messages.hpp"
 
 #include <algorithm>
 #include <cmath>

@@ -1,4 +1,4 @@
-#include "pmu/dds/dds_alarm_acks.hpp"
+#include "pmu/endpoints/dds_alarm_acks.hpp"
 
 #include <fastdds/dds/subscriber/DataReaderListener.hpp>
 #include <fastdds/dds/subscriber/SampleInfo.hpp>

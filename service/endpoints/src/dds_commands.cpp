@@ -1,4 +1,4 @@
-#include "pmu/dds/dds_commands.hpp"
+#include "pmu/endpoints/dds_commands.hpp"
 
 #include <fastdds/dds/subscriber/DataReaderListener.hpp>
 #include <fastdds/dds/subscriber/SampleInfo.hpp>
@@ -12,10 +12,10 @@
 #include <vector>
 
 #include "pmu/config/vehicle.hpp"
-#include "pmu/dds/command_cdr.hpp"
-#include "pmu/dds/dds_publisher.hpp"
 #include "pmu/dds/zero_padded_type.hpp"
 #include "pmu/dispatch/command_service.hpp"
+#include "pmu/endpoints/command_cdr.hpp"
+#include "pmu/endpoints/dds_publisher.hpp"
 #include "pmu/idl/command.h"
 #include "pmu/idl/commandPubSubTypes.h"
 #include "pmu/idl/topics.hpp"

@@ -1,4 +1,4 @@
-#include "pmu/dds/command_cdr.hpp"
+#include "pmu/endpoints/command_cdr.hpp"
 
 #include <fastcdr/Cdr.h>
 #include <fastcdr/FastBuffer.h>

@@ -1,4 +1,4 @@
-#include "pmu/dds/dds_publisher.hpp"
+#include "pmu/endpoints/dds_publisher.hpp"
 
 #include <spdlog/spdlog.h>
 

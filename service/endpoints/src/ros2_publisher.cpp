@@ -1,13 +1,13 @@
-#include "pmu/dds/ros2_publisher.hpp"
+#include "pmu/endpoints/ros2_publisher.hpp"
 
 #include <spdlog/spdlog.h>
 
 #include <fastdds/dds/publisher/qos/DataWriterQos.hpp>
 
 #include "diagnostic_msgs/msg/DiagnosticArrayPubSubTypes.h"
-#include "pmu/dds/diagnostics_pace.hpp"
-#include "pmu/dds/ros2_messages.hpp"
 #include "pmu/dds/zero_padded_type.hpp"
+#include "pmu/endpoints/diagnostics_pace.hpp"
+#include "pmu/endpoints/ros2_messages.hpp"
 #include "pmu/session/log_throttle.hpp"
 #include "sensor_msgs/msg/BatteryStatePubSubTypes.h"
 
