@@ -105,7 +105,7 @@ class DeviceReader {
     key.bus(bus);
     key.address(address);
     InstanceHandle_t handle;
-    if (baseline_.type().get_key(&key, &handle) && disposed_.count(handle)) return Said::NoBaseline;
+    if (baseline_key_.getKey(&key, &handle) && disposed_.count(handle)) return Said::NoBaseline;
     return Said::Nothing;
   }
   // Polls until the service has said either, or the deadline passed.
@@ -170,6 +170,9 @@ class DeviceReader {
   DataReader& info_;
   DataReader& baseline_;
   DataReader& health_;
+  // The key of a PMU's baseline instance, computed on this thread: the reader's type support
+  // computes keys on Fast DDS's receive thread into a buffer of its own, so it is not shared.
+  pmu::v5::BaselinePubSubType baseline_key_;
   std::map<InstanceHandle_t, std::pair<std::string, std::uint16_t>> pmus_;  // pmu/health of PMUs
   std::map<std::pair<std::string, std::uint16_t>, pmu::v5::Config> configs_;
   std::map<std::pair<std::string, std::uint16_t>, pmu::v5::Baseline> baselines_;
