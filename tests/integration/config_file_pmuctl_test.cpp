@@ -99,6 +99,12 @@ class StderrGate {
   std::string text_;
 };
 
+// Each pmuctl call is a process of its own that discovers the service before it reads or
+// sends anything. These tests check what the config verbs say and do, not how soon a new
+// participant discovers the service, which under a sanitizer on a loaded host can take longer
+// than pmuctl's interactive default of 5 s: so every call here states its deadline.
+constexpr const char* kCallDeadline = "--timeout 30 ";
+
 // Lets `child` (stopped on `gate`) go on to its end; its exit status, -1 when it did not exit.
 int run_to_end(pmu::test::Child& child, StderrGate& gate) {
   const bool ended = pmu::test::wait_until(
@@ -214,7 +220,7 @@ TEST(ConfigFilesOverDds, AFailedChangeRestoresWhatWasApplied) {
   const std::string file = files.write("bad-memory.yaml",
                                        "parameters:\n  avionics_voltage: 22.0\n  cranking_time: 3.5\n"
                                        "  temperature_offset: 100\n");
-  const auto r = pmu::test::run_capture(p + "--json config apply " + file + " 2>&1");
+  const auto r = pmu::test::run_capture(p + kCallDeadline + "--json config apply " + file + " 2>&1");
   EXPECT_EQ(r.status, 1) << r.out << service.describe();
   EXPECT_NE(r.out.find("temperature_offset 128 -> 100: COMPLETED"), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("cranking_time 5.0 s -> 3.5 s: FAILED"), std::string::npos) << r.out;
@@ -228,7 +234,7 @@ TEST(ConfigFilesOverDds, AFailedChangeRestoresWhatWasApplied) {
   EXPECT_EQ(j["applied"], false);
   EXPECT_EQ(j["restored"].size(), 1u);
   EXPECT_EQ(j["exit_status"], 1);
-  EXPECT_EQ(pmu::test::run_capture(p + "config diff " + factory).status, 0) << "the device is as it was";
+  EXPECT_EQ(pmu::test::run_capture(p + kCallDeadline + "config diff " + factory).status, 0) << "the device is as it was";
 }
 
 // Two applies at once (docs/safety.md H11): the first holds the PMU from its first command to
@@ -272,8 +278,8 @@ TEST(ConfigFilesOverDds, TwoAppliesAtOnceTheSecondIsRefusedNamingTheHolder) {
 
   EXPECT_EQ(run_to_end(a, gate), 0) << gate.text() << service.describe();
   EXPECT_NE(gate.text().find("3 change(s) applied; it matches " + first), std::string::npos) << gate.text();
-  EXPECT_EQ(pmu::test::run_capture(p + "config diff " + first).status, 0) << "exactly the first file's values";
-  EXPECT_EQ(pmu::test::run_capture(p + "config diff " + second).status, 1);
+  EXPECT_EQ(pmu::test::run_capture(p + kCallDeadline + "config diff " + first).status, 0) << "exactly the first file's values";
+  EXPECT_EQ(pmu::test::run_capture(p + kCallDeadline + "config diff " + second).status, 1);
 }
 
 // A restore puts back only what the apply changed (docs/safety.md H11): a setting another
@@ -301,7 +307,7 @@ TEST(ConfigFilesOverDds, ARestoreLeavesWhatAnotherWriterChangedMeanwhile) {
       << service.describe();
   // The hold ends 10 s after the apply's latest command; until then the set is DENIED.
   ASSERT_TRUE(pmu::test::wait_until(
-      [&] { return pmu::test::run_capture(p + "config set temperature_offset 90").status == 0; },
+      [&] { return pmu::test::run_capture(p + kCallDeadline + "config set temperature_offset 90").status == 0; },
       std::chrono::seconds(60), std::chrono::milliseconds(200)))
       << service.describe();
 
@@ -317,7 +323,7 @@ TEST(ConfigFilesOverDds, ARestoreLeavesWhatAnotherWriterChangedMeanwhile) {
             std::string::npos)
       << out;
   const std::string theirs = files.write("theirs.yaml", "parameters:\n  temperature_offset: 90\n");
-  EXPECT_EQ(pmu::test::run_capture(p + "config diff " + theirs).status, 0) << "the other writer's value stays";
+  EXPECT_EQ(pmu::test::run_capture(p + kCallDeadline + "config diff " + theirs).status, 0) << "the other writer's value stays";
 }
 
 // A bad file is exit 2 with FILE:LINE and no frame; a file for a newer firmware is refused for
@@ -346,14 +352,14 @@ TEST(ConfigFilesOverDds, BadFilesSendNothing) {
   const auto audits = count_of(service.describe(), "audit: command");
   for (const auto& b : kBad) {
     const std::string file = files.write("bad.yaml", b.text);
-    const auto r = pmu::test::run_capture(p + "config apply " + file + " 2>&1");
+    const auto r = pmu::test::run_capture(p + kCallDeadline + "config apply " + file + " 2>&1");
     EXPECT_EQ(r.status, 2) << b.text << r.out;
     EXPECT_NE(r.out.find(file + b.says), std::string::npos) << b.text << r.out;
-    const auto d = pmu::test::run_capture(p + "config diff " + file + " 2>&1");
+    const auto d = pmu::test::run_capture(p + kCallDeadline + "config diff " + file + " 2>&1");
     EXPECT_EQ(d.status, b.diff_status) << b.text << d.out;
   }
   EXPECT_EQ(count_of(service.describe(), "audit: command"), audits) << "a bad file sent a command";
-  const auto missing = pmu::test::run_capture(p + "config diff " + files.path("none.yaml") + " 2>&1");
+  const auto missing = pmu::test::run_capture(p + kCallDeadline + "config diff " + files.path("none.yaml") + " 2>&1");
   EXPECT_EQ(missing.status, 2) << missing.out;
 }
 
@@ -378,18 +384,18 @@ TEST(ConfigFilesOverDds, DiffWithoutAFileUsesTheServicesBaseline) {
     const auto read = pmu::test::run_capture(p + "--timeout 30 --address " + address + " config snapshot - 2>&1");
     ASSERT_EQ(read.status, 0) << "sim/" << address << ": " << read.out << service.describe();
   }
-  const auto differs = pmu::test::run_capture(p + "--address 1 config diff 2>&1");
+  const auto differs = pmu::test::run_capture(p + kCallDeadline + "--address 1 config diff 2>&1");
   EXPECT_EQ(differs.status, 1) << differs.out << service.describe();
   EXPECT_NE(differs.out.find(settings + ": avionics_voltage: device 12.0 V, file 22.0 V"), std::string::npos)
       << differs.out;
   EXPECT_NE(differs.out.find("differs from " + settings + " in 1 of 1 settings"), std::string::npos) << differs.out;
-  const auto set = pmu::test::run_capture(p + "--address 1 config set avionics_voltage 22.0 2>&1");
+  const auto set = pmu::test::run_capture(p + kCallDeadline + "--address 1 config set avionics_voltage 22.0 2>&1");
   ASSERT_EQ(set.status, 0) << set.out;
-  const auto equal = pmu::test::run_capture(p + "--address 1 config diff 2>&1");
+  const auto equal = pmu::test::run_capture(p + kCallDeadline + "--address 1 config diff 2>&1");
   EXPECT_EQ(equal.status, 0) << equal.out;
 
   // Another unit than the baseline's differs, whatever its settings: never "matches".
-  const auto other_unit = pmu::test::run_capture(p + "--address 2 config diff 2>&1");
+  const auto other_unit = pmu::test::run_capture(p + kCallDeadline + "--address 2 config diff 2>&1");
   EXPECT_EQ(other_unit.status, 1) << other_unit.out;
   EXPECT_NE(other_unit.out.find(pinned + ": serial: device 1002, baseline 4242: another unit than the baseline's"),
             std::string::npos)
@@ -399,7 +405,7 @@ TEST(ConfigFilesOverDds, DiffWithoutAFileUsesTheServicesBaseline) {
             std::string::npos)
       << other_unit.out;
   EXPECT_EQ(other_unit.out.find("matches"), std::string::npos) << other_unit.out;
-  const auto other_json = pmu::test::run_capture(p + "--address 2 --json config diff");
+  const auto other_json = pmu::test::run_capture(p + kCallDeadline + "--address 2 --json config diff");
   ASSERT_EQ(other_json.status, 1) << other_json.out;
   // Read with at() and value(): a const json's operator[] with a key it lacks is undefined.
   const auto j = Json::parse(other_json.out, nullptr, false);
@@ -412,7 +418,7 @@ TEST(ConfigFilesOverDds, DiffWithoutAFileUsesTheServicesBaseline) {
   EXPECT_EQ(serial.value("device", ""), "1002") << other_json.out;
   EXPECT_EQ(serial.value("file", ""), "4242") << other_json.out;
 
-  const auto none = pmu::test::run_capture(p + "--address 3 config diff 2>&1");
+  const auto none = pmu::test::run_capture(p + kCallDeadline + "--address 3 config diff 2>&1");
   EXPECT_EQ(none.status, 2) << none.out;
   EXPECT_NE(none.out.find("no baseline configured for PMU sim/3"), std::string::npos) << none.out;
 }
