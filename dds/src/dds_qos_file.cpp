@@ -3,7 +3,8 @@
 #include <fastdds/dds/domain/DomainParticipantFactory.hpp>
 #include <fastrtps/attributes/PublisherAttributes.h>
 #include <fastrtps/attributes/SubscriberAttributes.h>
-#include <fastrtps/xmlparser/XMLProfileManager.h>
+#include <fastrtps/xmlparser/XMLParser.h>
+#include <fastrtps/xmlparser/XMLTree.h>
 #include <tinyxml2.h>
 
 #include <cerrno>
@@ -17,8 +18,11 @@
 namespace pmu::dds {
 namespace {
 
+using eprosima::fastrtps::xmlparser::BaseNode;
+using eprosima::fastrtps::xmlparser::DataNode;
+using eprosima::fastrtps::xmlparser::NodeType;
 using eprosima::fastrtps::xmlparser::XMLP_ret;
-using eprosima::fastrtps::xmlparser::XMLProfileManager;
+using eprosima::fastrtps::xmlparser::XMLParser;
 
 // Far above any profile file; a bound, so a device named as the QoS file is refused.
 constexpr std::size_t kMaxQosFileBytes = std::size_t{1} << 20;
@@ -34,6 +38,23 @@ int profile_line(const tinyxml2::XMLElement* e, const char* tag, const char* pro
     if (const int line = profile_line(e->FirstChildElement(), tag, profile)) return line;
   }
   return 0;
+}
+
+// The attributes of the file's own <data_writer> (T = PublisherAttributes, type PUBLISHER) or
+// <data_reader> profile of that name, or null. Read from this file's parse tree, never from
+// Fast DDS's process-wide registry: that one keeps the first file's profile of a name, so a
+// process that had loaded another file would judge that file's profile instead of this one's.
+template <class T>
+const T* own_profile(BaseNode& node, NodeType type, const std::string& name) {
+  if (node.getType() == type) {
+    auto& data = static_cast<DataNode<T>&>(node);
+    const auto& attributes = data.getAttributes();
+    if (const auto it = attributes.find("profile_name"); it != attributes.end() && it->second == name)
+      return data.get();
+  }
+  for (auto& child : node.getChildren())
+    if (const T* found = own_profile<T>(*child, type, name)) return found;
+  return nullptr;
 }
 
 }  // namespace
@@ -61,37 +82,41 @@ std::vector<std::string> qos_file_problems(const std::string& file, const std::v
   tinyxml2::XMLDocument doc;
   if (doc.Parse(text.text.data(), text.text.size()) != tinyxml2::XML_SUCCESS)
     return {file + ":" + std::to_string(doc.ErrorLineNum()) + ": not well-formed XML: " + doc.ErrorStr()};
-  try {
-    load_qos_profiles(file);
-  } catch (const DdsError& e) {
-    return {e.what()};
-  }
+  eprosima::fastrtps::xmlparser::up_base_node_t tree;
+  if (XMLParser::loadXML(doc, tree) != XMLP_ret::XML_OK || !tree)
+    return {file + ": Fast DDS cannot read its profiles (see the Fast DDS XML error above)"};
   std::vector<std::string> problems;
   for (const auto& use : uses) {
     const bool writer = use.kind == EndpointKind::Writer;
     const char* tag = writer ? "data_writer" : "data_reader";
     const std::string element = std::string("<") + tag + " profile_name=\"" + use.profile + "\">";
-    eprosima::fastrtps::TopicAttributes topic;
-    bool found = false;
+    const eprosima::fastrtps::TopicAttributes* own = nullptr;
     if (writer) {
-      eprosima::fastrtps::PublisherAttributes a;
-      found = XMLProfileManager::fillPublisherAttributes(use.profile, a, false) == XMLP_ret::XML_OK;
-      topic = a.topic;
-    } else {
-      eprosima::fastrtps::SubscriberAttributes a;
-      found = XMLProfileManager::fillSubscriberAttributes(use.profile, a, false) == XMLP_ret::XML_OK;
-      topic = a.topic;
+      if (const auto* a = own_profile<eprosima::fastrtps::PublisherAttributes>(*tree, NodeType::PUBLISHER, use.profile))
+        own = &a->topic;
+    } else if (const auto* a =
+                   own_profile<eprosima::fastrtps::SubscriberAttributes>(*tree, NodeType::SUBSCRIBER, use.profile)) {
+      own = &a->topic;
     }
+    const bool found = own != nullptr;
     if (!found) {
       problems.push_back(file + ": no " + element + ", needed for " + use.used_for);
       continue;
     }
-    if (const auto s = capacity_shortfall(use.profile, use.kind, topic.resourceLimitsQos, topic.historyQos);
+    if (const auto s = capacity_shortfall(use.profile, use.kind, own->resourceLimitsQos, own->historyQos);
         !s.empty()) {
       const int line = profile_line(doc.RootElement(), tag, use.profile);
       problems.push_back(file + (line > 0 ? ":" + std::to_string(line) : std::string()) + ": " + element + " (" +
                          use.used_for + "): " + s +
                          ": raise its <resourceLimitsQos> (deploy/qos.xml says how each number is derived)");
+    }
+  }
+  // Loaded only once judged sound, so the registry holds no file the check refused.
+  if (problems.empty()) {
+    try {
+      load_qos_profiles(file);
+    } catch (const DdsError& e) {
+      return {e.what()};
     }
   }
   return problems;

@@ -1,7 +1,7 @@
 // The start-up check (startup_check.hpp) that every start and --check-config run: the QoS
 // profile file, found, well-formed, loaded and holding the service's profiles, each problem
-// with FILE:LINE. Fast DDS keeps loaded profiles for the process, and each test here runs in
-// a process of its own (gtest_discover_tests), so each loads at most one file.
+// with FILE:LINE. Fast DDS keeps loaded profiles for the process (the first file's profile of
+// each name); a file is judged by its own profiles whatever the process loaded before.
 #include <gtest/gtest.h>
 #include <sys/stat.h>
 #include <unistd.h>
@@ -116,6 +116,23 @@ TEST(StartupCheck, AProfileShortOfTheCapacityIsNamedAtItsLine) {
                              ":29: <data_writer profile_name=\"telemetry\"> (the telemetry topics' writers): "
                              "max_instances 10 < 256 (PMUs per service, pmu::service::kMaxDevicesPerService): raise "
                              "its <resourceLimitsQos> (deploy/qos.xml says how each number is derived)");
+}
+
+// After the shipped file is loaded, a file that lacks a profile or holds one short of the
+// capacity is still named for it: the registry's profiles of the same names are not its own.
+TEST(StartupCheck, AFileIsJudgedByItsOwnProfilesAfterAnotherWasLoaded) {
+  ASSERT_TRUE(check("qos_file: " + kShippedQos + "\n" + kBus, "a.yaml").ok());
+  const std::string dir = scratch("after-another");
+  const std::string missing =
+      edited_qos(dir, "<data_reader profile_name=\"command\">", "<data_reader profile_name=\"commands\">");
+  auto c = check("qos_file: " + missing + "\n" + kBus, "a.yaml");
+  ASSERT_EQ(c.errors.size(), 1u);
+  EXPECT_NE(c.errors[0].find(": no <data_reader profile_name=\"command\">"), std::string::npos) << c.errors[0];
+  const std::string short_one =
+      edited_qos(dir, "<max_instances>256</max_instances>", "<max_instances>10</max_instances>");
+  c = check("qos_file: " + short_one + "\n" + kBus, "a.yaml");
+  ASSERT_EQ(c.errors.size(), 1u);
+  EXPECT_NE(c.errors[0].find("max_instances 10 < 256"), std::string::npos) << c.errors[0];
 }
 
 TEST(StartupCheck, PmuQosFileIsNamedWhenItIsTheOneUsed) {

@@ -24,8 +24,10 @@ struct ProfileUse {
 
 // What is wrong with `file` for endpoints made with `uses`, each "FILE[:LINE]: what"
 // (LINE: the file's own line, where the XML has one); empty when nothing is. Checks, in
-// order: it opens, it is well-formed XML, Fast DDS loads it, and each profile exists and
-// holds the declared capacity (capacity_shortfall). Loads the file into Fast DDS.
+// order: it opens, it is well-formed XML, Fast DDS's parser reads it, each profile exists in
+// this file and holds the declared capacity (capacity_shortfall), and Fast DDS loads it.
+// Profiles are judged from the file's own parse, never from the process-wide registry, which
+// keeps the first file's profile of each name. Loads the file into Fast DDS when it is sound.
 std::vector<std::string> qos_file_problems(const std::string& file, const std::vector<ProfileUse>& uses);
 
 }  // namespace pmu::dds
