@@ -10,15 +10,16 @@ std::size_t truncated_length(const Payload& payload, std::size_t full_length) no
   return length;
 }
 
-std::vector<std::uint8_t> FrameWriter::encode(std::uint32_t msgid, const Payload& payload) {
+std::vector<std::uint8_t> FrameWriter::encode(std::uint32_t msgid, const Payload& payload,
+                                              SigningLink* signing, std::uint64_t now) {
   const MessageInfo* info = find_message(msgid);
   if (info == nullptr) return {};
   const std::size_t length = truncated_length(payload, info->max_length);
   std::vector<std::uint8_t> out;
-  out.reserve(kHeaderLength + length + kChecksumLength);
+  out.reserve(kHeaderLength + length + kChecksumLength + (signing != nullptr ? kSignatureLength : 0));
   out.push_back(kStartV2);
   out.push_back(static_cast<std::uint8_t>(length));
-  out.push_back(0);  // incompat flags
+  out.push_back(signing != nullptr ? kIncompatSigned : 0);
   out.push_back(0);  // compat flags
   out.push_back(sequence_++);
   out.push_back(sysid_);
@@ -31,6 +32,14 @@ std::vector<std::uint8_t> FrameWriter::encode(std::uint32_t msgid, const Payload
   crc = crc_accumulate(info->crc_extra, crc);
   out.push_back(static_cast<std::uint8_t>(crc & 0xFFU));
   out.push_back(static_cast<std::uint8_t>(crc >> 8));
+  if (signing != nullptr) {
+    const std::uint64_t stamp = signing->next_timestamp(now);
+    out.push_back(signing->link_id());
+    for (int i = 0; i < 6; ++i) out.push_back(static_cast<std::uint8_t>((stamp >> (8 * i)) & 0xFFU));
+    const auto sig = compute_signature(signing->key(), out.data(), out.size());
+    out.insert(out.end(), sig.begin(), sig.end());
+    signing->count_signed();
+  }
   return out;
 }
 
