@@ -4,8 +4,8 @@
 #         PMU_BUILD_BENCH off, as a plain `cmake -S . -B build` configures it), and the ROS 2
 #         message definitions from npm (npm ci in ros2/): scripts/run.sh
 #   test  everything: the run set, the tests' and benchmarks' libraries, the VMs, the Debian
-#         packaging and its arm64 cross build, ccache, tests/mcap's and tests/browser's npm
-#         packages: scripts/test.sh
+#         packaging and its arm64 cross build, ccache, tests/mcap's, tests/browser's and
+#         tests/mavlink's npm packages: scripts/test.sh
 #   scripts/setup.sh [run|test]        install the set (default: test)
 #   scripts/setup.sh --list run|test   print the set's Debian packages, one per line
 # Idempotent: packages already present are left alone, and apt is not touched at all
@@ -145,3 +145,7 @@ npm_ci tests/mcap "@mcap/core, @foxglove/ws-protocol, ws, @foxglove/omgidl-parse
 # The browser test (tests/browser) drives Debian's Chromium with puppeteer-core and bundles
 # Foxglove's omgidl decoder for the page with esbuild.
 npm_ci tests/browser "puppeteer-core, esbuild, @foxglove/omgidl-parser, @foxglove/omgidl-serialization"
+
+# The MAVLink cross-check (tests/mavlink) reads and writes pmu::mavlink's frames with
+# node-mavlink, a MAVLink implementation generated from the same XML by other hands.
+npm_ci tests/mavlink "node-mavlink"
