@@ -5,6 +5,7 @@
 #include <algorithm>
 
 #include "pmu/mavlink_params/param_server.hpp"
+#include "pmu/mavlink_params/status_text.hpp"
 
 namespace pmu::mavlink_params {
 namespace {
@@ -318,6 +319,42 @@ TEST(ParamSet, AChangeByAnotherClientIsSentAgain) {
   const auto sent = run(s, t0, 1000ms);
   ASSERT_EQ(sent.size(), 1U);
   EXPECT_FLOAT_EQ(sent[0].second.param_value, 20.0F);
+}
+
+TEST(ParamSet, TheDevicesNewValueArrivingBeforeTheReplyIsNotASecondAnswer) {
+  auto s = server(1);
+  s.poll(t0);
+  const auto asked = s.on_param_set(qgc, set_of("PMU1_AVION_V", 20.0F), t0);
+  ASSERT_TRUE(asked.request);
+  auto changed = device();
+  changed[Setting::AvionicsVoltage] = 200;  // pmu/config after the set, before the reply
+  s.set_device(0, changed);
+  EXPECT_TRUE(run(s, t0, 1000ms).empty());
+  EXPECT_EQ(values(s.on_set_reply(asked.request->tag, CommandResult::Completed, "")).size(), 1U);
+}
+
+TEST(StatusText, LongReasonsGoInChunksOfOneTextAndAreCut) {
+  const std::string text(120, 'a');
+  const auto three = status_text(mavlink::mav_severity::kWarning, text, 7);
+  ASSERT_EQ(three.size(), 3U);
+  for (std::size_t i = 0; i < three.size(); ++i) {
+    EXPECT_EQ(three[i].id, 7);
+    EXPECT_EQ(three[i].chunk_seq, i);
+    EXPECT_EQ(three[i].severity, mavlink::mav_severity::kWarning);
+  }
+  EXPECT_EQ(three[0].text.size() + three[1].text.size() + three[2].text.size(), 120U);
+  const auto whole = status_text(mavlink::mav_severity::kInfo, std::string(100, 'b'), 8);
+  ASSERT_EQ(whole.size(), 3U) << "two full chunks and the empty one that ends the text";
+  EXPECT_TRUE(whole[2].text.empty());
+  const auto one = status_text(mavlink::mav_severity::kInfo, "short\n\x1b[2J", 9);
+  ASSERT_EQ(one.size(), 1U);
+  EXPECT_EQ(one[0].id, 0);
+  EXPECT_EQ(one[0].text, "short??[2J") << "a peer cannot move a ground station's cursor";
+  const auto control = status_text(mavlink::mav_severity::kInfo, std::string("a\nb\x1b", 4), 9);
+  EXPECT_EQ(control.at(0).text, "a?b?");
+  const auto cut = status_text(mavlink::mav_severity::kInfo, std::string(1000, 'c'), 10);
+  ASSERT_EQ(cut.size(), kMaxChunks);
+  EXPECT_EQ(cut.back().text.substr(cut.back().text.size() - 3), "...");
 }
 
 }  // namespace

@@ -8,7 +8,8 @@ std::vector<mavlink::Statustext> status_text(std::uint8_t severity, std::string_
   constexpr std::size_t n = mavlink::Statustext::kTextLength;
   std::string clean;
   for (const char c : text) clean += (c >= 0x20 && c < 0x7F) ? c : '?';
-  if (clean.size() > n * kMaxChunks) clean = clean.substr(0, n * kMaxChunks - 3) + "...";
+  // Cut so that the last chunk is not full: kMaxChunks messages, the terminator included.
+  if (clean.size() >= n * kMaxChunks) clean = clean.substr(0, n * kMaxChunks - 4) + "...";
   std::vector<mavlink::Statustext> out;
   if (clean.size() <= n) {
     out.push_back({severity, clean, 0, 0});
