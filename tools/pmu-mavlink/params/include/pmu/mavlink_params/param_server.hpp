@@ -43,12 +43,12 @@
 #include "pmu/command/command.hpp"
 #include "pmu/command/policy.hpp"
 #include "pmu/mavlink/messages.hpp"
+#include "pmu/mavlink_params/confirm_set.hpp"
 #include "pmu/mavlink_params/param_table.hpp"
 
 namespace pmu::mavlink_params {
 
 using Time = std::chrono::steady_clock::time_point;
-using ConfirmSet = std::array<bool, service::kConfirmRuleCount>;  // by service::ConfirmRule
 
 // Who sent a message (its frame's system and component id).
 struct Sender {
