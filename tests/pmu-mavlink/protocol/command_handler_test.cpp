@@ -178,11 +178,34 @@ INSTANTIATE_TEST_SUITE_P(Results, EngineStartAck,
 TEST(EngineStart, NoReplyIsFailedAtTheTimeout) {
   auto h = handler();
   ASSERT_TRUE(h.on_command_long(qgc, start(), t0).command);
-  EXPECT_TRUE(h.poll(t0 + 39s).acks.empty());
+  const auto before = h.poll(t0 + 39s);
+  ASSERT_EQ(before.acks.size(), 1U);
+  EXPECT_EQ(before.acks[0].result, result::kInProgress) << "still waiting";
   const auto out = h.poll(t0 + 40s);
   ASSERT_EQ(out.acks.size(), 1U);
   EXPECT_EQ(out.acks[0].result, result::kFailed);
   EXPECT_FALSE(texts(out).empty());
+}
+
+TEST(EngineStart, InProgressIsRepeatedEverySecondBetweenTheServicesReplies) {
+  auto h = handler();
+  const auto out = h.on_command_long(qgc, start(), t0);
+  ASSERT_TRUE(out.command);
+  EXPECT_TRUE(h.poll(t0 + 999ms).acks.empty());
+  const auto repeated = h.poll(t0 + 1s);
+  ASSERT_EQ(repeated.acks.size(), 1U);
+  EXPECT_EQ(repeated.acks[0].result, result::kInProgress);
+  EXPECT_EQ(repeated.acks[0].target_component, qgc.component);
+  h.on_reply(out.command->tag, CommandResult::InProgress, "cranking: 1.5 s of up to 5.0 s", t0 + 1500ms);
+  EXPECT_TRUE(h.poll(t0 + 2s).acks.empty()) << "the service's own came 0.5 s ago";
+  const auto again = h.poll(t0 + 2500ms);
+  ASSERT_EQ(again.acks.size(), 1U);
+  EXPECT_EQ(again.acks[0].progress, 30);
+  h.on_reply(out.command->tag, CommandResult::Completed, "engine running", t0 + 3s);
+  EXPECT_TRUE(h.poll(t0 + 5s).acks.empty());
+  // Other commands are not kept waiting long: no IN_PROGRESS for them.
+  ASSERT_TRUE(h.on_command_long(qgc, command(cmd::kDoSetRelay, {1, 1}), t0 + 6s).command);
+  EXPECT_TRUE(h.poll(t0 + 8s).acks.empty());
 }
 
 TEST(StartProgress, FromTheServicesReason) {

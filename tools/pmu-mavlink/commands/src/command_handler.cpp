@@ -246,6 +246,8 @@ Output CommandHandler::on_command_long(Sender from, const mavlink::CommandLong& 
   e.param = m.param;
   e.tag = next_tag_++;
   e.stop = stop;
+  e.start = start;
+  e.last_ack = now;
   e.result = result::kInProgress;
   e.progress = 0;
   e.deadline = now + (start ? config_.start_timeout : config_.reply_timeout);
@@ -268,6 +270,7 @@ Output CommandHandler::on_reply(std::uint64_t tag, CommandResult r, std::string_
   Output out;
   if (!service::is_final(r)) {
     e->progress = start_progress(reason);
+    e->last_ack = now;
     out.acks.push_back(ack(*e));
     return out;
   }
@@ -288,6 +291,10 @@ Output CommandHandler::on_reply(std::uint64_t tag, CommandResult r, std::string_
 Output CommandHandler::poll(Time now) {
   Output out;
   for (auto& e : entries_) {
+    if (!e.final && e.start && now < e.deadline && now - e.last_ack >= config_.in_progress_every) {
+      e.last_ack = now;
+      out.acks.push_back(ack(e));
+    }
     if (e.final || now < e.deadline) continue;
     ++counters_.timed_out;
     e.final = true;

@@ -12,7 +12,8 @@
 // - Acks: an engine start is answered IN_PROGRESS at once and with each of the service's
 //   IN_PROGRESS replies (progress from its "cranking: E s of up to CT s"), then ACCEPTED only
 //   when the service's start is COMPLETED (the engine runs, interface.md 2.7), FAILED
-//   otherwise. Final results: COMPLETED -> ACCEPTED; REJECTED, DENIED -> DENIED (with the
+//   otherwise; between the service's replies the last IN_PROGRESS is repeated every
+//   in_progress_every, so a ground station never waits long for a sign. Final results: COMPLETED -> ACCEPTED; REJECTED, DENIED -> DENIED (with the
 //   service's reason as STATUSTEXT); UNSUPPORTED -> UNSUPPORTED; TIMEOUT, FAILED, and no reply
 //   within the timeout -> FAILED.
 // - Retransmissions (docs/safety.md H8): a command with the same sender, command and params
@@ -89,6 +90,7 @@ struct CommandConfig {
   std::chrono::milliseconds reply_timeout{12000};
   std::chrono::milliseconds start_timeout{40000};
   std::chrono::milliseconds retransmission_window{10000};
+  std::chrono::milliseconds in_progress_every{1000};
   std::size_t max_pending = 16;
   std::size_t max_remembered = 64;  // answered commands kept for retransmissions
 };
@@ -117,7 +119,8 @@ class CommandHandler {
   Output on_command_long(Sender from, const mavlink::CommandLong& m, Time now);
   // The service's reply to the command `tag`, IN_PROGRESS or final.
   Output on_reply(std::uint64_t tag, service::CommandResult result, std::string_view reason, Time now);
-  // Commands whose reply is overdue are answered FAILED; old answers are forgotten.
+  // Commands whose reply is overdue are answered FAILED, a running engine start's
+  // IN_PROGRESS is repeated when due; old answers are forgotten.
   Output poll(Time now);
 
   const CommandCounters& counters() const noexcept { return counters_; }
@@ -132,6 +135,8 @@ class CommandHandler {
     bool final = false;
     std::uint8_t result = 0;
     std::uint8_t progress = 0;
+    bool start = false;
+    Time last_ack;     // an engine start's latest IN_PROGRESS
     Time deadline;     // of the reply, while not final
     Time answered_at;  // once final
   };
