@@ -148,6 +148,26 @@ TEST(ParamList, ValuesNotKnownAreNotSent) {
   EXPECT_TRUE(run(s, t0 + 6s, 3000ms).empty());
 }
 
+TEST(ParamList, AFloodFromManySendersOfListsAndReadsIsCountedAndCarriedAtThePace) {
+  auto s = server(9);
+  s.poll(t0);
+  std::size_t sent = 0;
+  for (int i = 0; i < 10000; ++i) {
+    const auto t = t0 + std::chrono::microseconds(100 * i);  // 10,000 a second
+    const Sender from{static_cast<std::uint8_t>(i % 50), 190};
+    if (i % 10 == 0) s.on_request_list(from, t);
+    mavlink::ParamRequestRead read;
+    read.param_index = static_cast<std::int16_t>(i % 200);  // some beyond the table
+    s.on_request_read(from, read, t);
+    sent += values(s.poll(t)).size();
+  }
+  EXPECT_LE(sent, 12U) << "one second at 10 a second";
+  EXPECT_EQ(s.counters().list_requests, 1000U);
+  EXPECT_EQ(s.counters().reads, 10000U);
+  EXPECT_GT(s.counters().list_requests_merged, 900U);
+  EXPECT_GT(s.counters().reads_unanswered, 0U);
+}
+
 TEST(ParamRead, ByNameAndByIndexOnceEachAndNotForUnknownNames) {
   auto s = server(2);
   s.poll(t0);
