@@ -5,7 +5,9 @@
 # HEARTBEAT, the BATTERY_STATUS of the PMU's two inputs (ids 10, 11) and of the BMS (id 20)
 # and the GENERATOR_STATUS against the service's own samples (pmuctl --json watch), the
 # sentinels of what the service does not know, and the answers to SET_MESSAGE_INTERVAL and
-# RUN_PREARM_CHECKS. Exit 77 (skipped) without Node.js or node-mavlink.
+# RUN_PREARM_CHECKS, the readiness said once as STATUSTEXT; and, started without
+# --system-id, that it takes the autopilot's system id from its HEARTBEAT. Exit 77 (skipped)
+# without Node.js or node-mavlink.
 #   end_to_end.sh PMU-SERVICE PMU-MAVLINK PMUCTL SOURCE-DIR
 set -uo pipefail
 svc=$1 bridge=$2 ctl=$3 src=$4
@@ -116,8 +118,27 @@ if acks.get(511, {}).get("result") != 0: problems.append(f"SET_MESSAGE_INTERVAL:
 if acks.get(401, {}).get("result") != 0: problems.append(f"RUN_PREARM_CHECKS: {acks.get(401)}, want ACCEPTED")
 for a in acks.values():
     if (a["targetSystem"], a["targetComponent"]) != (255, 190): problems.append(f"COMMAND_ACK not addressed to the asker: {a}")
+said = [m["fields"]["text"] for m in msgs if m["name"] == "STATUSTEXT" and m["fields"]["text"].startswith("PMU: ") and "ready" in m["fields"]["text"] and "pre-arm" not in m["fields"]["text"]]
+if len(said) != 1: problems.append(f"readiness said {len(said)} times, want once: {said}")
+if hb and hb["systemStatus"] not in (3, 4): problems.append(f"HEARTBEAT system_status {hb['systemStatus']} with the service's readiness heard, want STANDBY or ACTIVE")
 if problems:
     print("FAIL: " + "\n  ".join(problems), file=sys.stderr); sys.exit(1)
 print(f"{len(msgs)} MAVLink messages checked against {len(samples)} service samples")
 PY
+# Without --system-id: the autopilot's (system 7, from its HEARTBEAT) once heard.
+: >"$work/port"
+node "$gs" "$work/port" "$work/learn.jsonl" learn 2>"$work/learn.err" &
+gs_pid=$!
+pids+=($gs_pid)
+for _ in $(seq 100); do [ -s "$work/port" ] && break; sleep 0.1; done
+"$bridge" --udp "127.0.0.1:$(cat "$work/port")" --domain "$domain" >"$work/learn.log" 2>&1 &
+pids+=($!)
+end=$((SECONDS + 30))
+while kill -0 "$gs_pid" 2>/dev/null && ((SECONDS < end)); do sleep 0.2; done
+if kill -0 "$gs_pid" 2>/dev/null; then
+  fail "no frame from system 7 after the autopilot's HEARTBEAT: $(cut -c1-100 "$work/learn.jsonl" | tail -n3)"
+else
+  wait "$gs_pid" || fail "learn: $(cat "$work/learn.err")"
+  head -n1 "$work/learn.jsonl" | grep -q '"sysid":1,' || fail "before the autopilot is heard: $(head -n1 "$work/learn.jsonl" | cut -c1-100), want system 1"
+fi
 exit $((failures > 0))

@@ -1,19 +1,21 @@
 // A ground station made of node-mavlink (npm, tests/mavlink's package) for end_to_end.sh:
-//   node ground_station.mjs PORTFILE OUTFILE
+//   node ground_station.mjs PORTFILE OUTFILE [learn]
 // Listens on a UDP port of 127.0.0.1 (written to PORTFILE once bound), decodes every frame
 // pmu-mavlink sends there and writes it as one JSON line to OUTFILE. Once it has the
 // messages end_to_end.sh checks (HEARTBEAT, BATTERY_STATUS 10, 11 and 20 and GENERATOR_STATUS
 // with values), it answers from where the frames came (as a GCS on mavlink-router's UDP
 // endpoint would): SET_MESSAGE_INTERVAL for GENERATOR_STATUS and RUN_PREARM_CHECKS, and waits
 // for both COMMAND_ACKs and the pre-arm STATUSTEXT lines. Exit 0 then; end_to_end.sh bounds
-// the wait.
+// the wait. With `learn` it plays the autopilot instead: on the first frame it sends an
+// ArduPilot HEARTBEAT from system 7, component 1, and exits 0 at the first frame from
+// system 7, component 180 (pmu-mavlink took the autopilot's system id).
 import { createSocket } from 'node:dgram'
 import { writeFileSync, appendFileSync } from 'node:fs'
 import { PassThrough } from 'node:stream'
 import { createMavLinkStream, MavLinkProtocolV2, minimal, common } from 'node-mavlink'
 
 const REGISTRY = { ...minimal.REGISTRY, ...common.REGISTRY }
-const [portFile, outFile] = process.argv.slice(2)
+const [portFile, outFile, mode] = process.argv.slice(2)
 writeFileSync(outFile, '')
 const socket = createSocket('udp4')
 const bytes = new PassThrough()
@@ -41,6 +43,14 @@ for await (const packet of createMavLinkStream(bytes)) {
   const fields = {}
   for (const f of clazz.FIELDS) fields[f.name] = Array.isArray(data[f.name]) ? data[f.name].map(plain) : plain(data[f.name])
   appendFileSync(outFile, JSON.stringify({ msgid: h.msgid, name: clazz.MSG_NAME, sysid: h.sysid, compid: h.compid, fields }) + '\n')
+  if (mode === 'learn') {
+    if (h.sysid === 7 && h.compid === 180) { socket.close(); process.exit(0) }
+    // ArduPilot's HEARTBEAT: MAV_TYPE_FIXED_WING (1), MAV_AUTOPILOT_ARDUPILOTMEGA (3).
+    const autopilot = new MavLinkProtocolV2(7, 1)
+    const hb = Object.assign(new minimal.Heartbeat(), { type: 1, autopilot: 3, baseMode: 0, customMode: 0, systemStatus: 3, mavlinkVersion: 3 })
+    socket.send(autopilot.serialize(hb, seq++), peer.port, peer.address)
+    continue
+  }
   if (h.msgid === minimal.Heartbeat.MSG_ID) have.add('heartbeat')
   if (h.msgid === common.BatteryStatus.MSG_ID && data.voltages[0] !== 65535) have.add(`battery ${data.id}`)
   if (h.msgid === common.GeneratorStatus.MSG_ID && !Number.isNaN(data.busVoltage)) have.add('generator')
