@@ -6,7 +6,9 @@
 # and the GENERATOR_STATUS against the service's own samples (pmuctl --json watch), the
 # sentinels of what the service does not know, and the answers to SET_MESSAGE_INTERVAL and
 # RUN_PREARM_CHECKS, the readiness said once as STATUSTEXT; and, started without
-# --system-id, that it takes the autopilot's system id from its HEARTBEAT. Exit 77 (skipped)
+# --system-id, that it takes the autopilot's system id from its HEARTBEAT; then, with the
+# simulated PMU in SOA shutdown (a critical alarm without delay), the alarm as a CRITICAL
+# STATUSTEXT, the reason as a "PreArm:" line, the fault flag and "not ready". Exit 77 (skipped)
 # without Node.js or node-mavlink.
 #   end_to_end.sh PMU-SERVICE PMU-MAVLINK PMUCTL SOURCE-DIR
 set -uo pipefail
@@ -119,7 +121,9 @@ if acks.get(401, {}).get("result") != 0: problems.append(f"RUN_PREARM_CHECKS: {a
 for a in acks.values():
     if (a["targetSystem"], a["targetComponent"]) != (255, 190): problems.append(f"COMMAND_ACK not addressed to the asker: {a}")
 said = [m["fields"]["text"] for m in msgs if m["name"] == "STATUSTEXT" and m["fields"]["text"].startswith("PMU: ") and "ready" in m["fields"]["text"] and "pre-arm" not in m["fields"]["text"]]
-if len(said) != 1: problems.append(f"readiness said {len(said)} times, want once: {said}")
+# Each change once: the service may say not ready while its devices come online, then ready.
+if not said or said[-1] != "PMU: ready" or any(a == b for a, b in zip(said, said[1:])):
+    problems.append(f"readiness said as {said}: want each change once, ending 'PMU: ready'")
 if hb and hb["systemStatus"] not in (3, 4): problems.append(f"HEARTBEAT system_status {hb['systemStatus']} with the service's readiness heard, want STANDBY or ACTIVE")
 if problems:
     print("FAIL: " + "\n  ".join(problems), file=sys.stderr); sys.exit(1)
@@ -141,4 +145,43 @@ else
   wait "$gs_pid" || fail "learn: $(cat "$work/learn.err")"
   head -n1 "$work/learn.jsonl" | grep -q '"sysid":1,' || fail "before the autopilot is heard: $(head -n1 "$work/learn.jsonl" | cut -c1-100), want system 1"
 fi
+
+# An active critical alarm: the service restarted with the PMU in SOA shutdown.
+for p in "${pids[@]}"; do kill "$p" 2>/dev/null; done
+wait 2>/dev/null
+pids=()
+sed 's/^      - address: 1$/      - address: 1\n        sim: {soa_shutdown: true}/' "$src/deploy/examples/sim-power-system.yaml" >"$work/soa.yaml"
+grep -q soa_shutdown "$work/soa.yaml" || fail "the demo config's PMU line moved: cannot add its sim: setting"
+"$svc" --config "$work/soa.yaml" --domain "$domain" >"$work/service2.log" 2>&1 &
+pids+=($!)
+: >"$work/port"
+node "$gs" "$work/port" "$work/soa.jsonl" 2>"$work/soa.err" &
+gs_pid=$!
+pids+=($gs_pid)
+for _ in $(seq 100); do [ -s "$work/port" ] && break; sleep 0.1; done
+"$bridge" --udp "127.0.0.1:$(cat "$work/port")" --system-id 1 --domain "$domain" >"$work/soa.log" 2>&1 &
+pids+=($!)
+end=$((SECONDS + 60))
+while kill -0 "$gs_pid" 2>/dev/null && ((SECONDS < end)); do sleep 0.2; done
+if kill -0 "$gs_pid" 2>/dev/null; then
+  fail "SOA shutdown: the ground station did not get every message and answer in 60 s"
+else
+  wait "$gs_pid" || fail "SOA shutdown ground station: $(cat "$work/soa.err")"
+fi
+python3 - "$work/soa.jsonl" <<'PY' || failures=$((failures + 1))
+import json, sys
+msgs = [json.loads(l) for l in open(sys.argv[1]) if l.strip()]
+texts = [(m["fields"]["severity"], m["fields"]["text"]) for m in msgs if m["name"] == "STATUSTEXT"]
+problems = []
+alarm = [t for s, t in texts if s == 2 and t.startswith("PMU: ") and "soa" in t.lower()]
+if len(alarm) != 1: problems.append(f"the SOA alarm said {len(alarm)} times as CRITICAL 'PMU: ...', want once: {texts}")
+if not any(s == 2 and t.startswith("PreArm: ") and "soa" in t.lower() for s, t in texts): problems.append(f"no CRITICAL 'PreArm:' line for the SOA shutdown: {texts}")
+if not any(s == 4 and t.startswith("PMU: not ready") for s, t in texts): problems.append(f"'PMU: not ready' not said as WARNING: {texts}")
+gens = [m["fields"] for m in msgs if m["name"] == "GENERATOR_STATUS"]
+if not gens or not int(gens[-1]["status"]) & 32768: problems.append(f"GENERATOR_STATUS without OVERCURRENT_FAULT: {gens[-1:] }")
+hbs = [m["fields"] for m in msgs if m["name"] == "HEARTBEAT"]
+if not hbs or hbs[-1]["systemStatus"] != 3: problems.append(f"HEARTBEAT system_status {hbs[-1:]} while not ready, want STANDBY (3)")
+if problems:
+    print("FAIL (SOA shutdown): " + "\n  ".join(problems), file=sys.stderr); sys.exit(1)
+PY
 exit $((failures > 0))
