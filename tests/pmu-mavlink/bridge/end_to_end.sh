@@ -58,6 +58,10 @@ kill -TERM "$bridge_pid"
 wait "$bridge_pid"; status=$?
 [ $status -eq 0 ] || fail "pmu-mavlink exited $status on SIGTERM: $(tail -n3 "$work/bridge.log")"
 grep -q "frames in" "$work/bridge.log" || fail "pmu-mavlink did not report its counters: $(cat "$work/bridge.log")"
+# The ground station's noise and bad-CRC frame: counted, and the program went on (it answered
+# the commands sent after them, checked below).
+grep -Eq "bad CRC [1-9][0-9]*, .*garbage bytes [1-9]" "$work/bridge.log" ||
+  fail "the bad input is not counted: $(grep 'frames in' "$work/bridge.log")"
 
 python3 - "$work/gs.jsonl" "$work/watch" <<'PY' || failures=$((failures + 1))
 import json, math, sys

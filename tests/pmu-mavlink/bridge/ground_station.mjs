@@ -4,7 +4,8 @@
 // pmu-mavlink sends there and writes it as one JSON line to OUTFILE. Once it has the
 // messages end_to_end.sh checks (HEARTBEAT, BATTERY_STATUS 10, 11 and 20 and GENERATOR_STATUS
 // with values), it answers from where the frames came (as a GCS on mavlink-router's UDP
-// endpoint would): SET_MESSAGE_INTERVAL for GENERATOR_STATUS and RUN_PREARM_CHECKS, and waits
+// endpoint would): noise and a frame with a bad CRC, then SET_MESSAGE_INTERVAL for
+// GENERATOR_STATUS and RUN_PREARM_CHECKS, and waits
 // for both COMMAND_ACKs and the pre-arm STATUSTEXT lines. Exit 0 then; end_to_end.sh bounds
 // the wait. With `learn` it plays the autopilot instead: on the first frame it sends an
 // ArduPilot HEARTBEAT from system 7, component 1, and exits 0 at the first frame from
@@ -59,6 +60,12 @@ for await (const packet of createMavLinkStream(bytes)) {
   const ready = ['heartbeat', 'battery 10', 'battery 11', 'battery 20', 'generator'].every((k) => have.has(k))
   if (ready && !asked) {
     asked = true
+    // Bad input first: noise, and a HEARTBEAT whose CRC is wrong. pmu-mavlink counts both
+    // and goes on (end_to_end.sh reads its counts).
+    socket.send(Buffer.from(Array.from({ length: 64 }, (_, i) => (i * 37 + 11) & 0x7f)), peer.port, peer.address)
+    const bad = gcs.serialize(Object.assign(new minimal.Heartbeat(), { type: 6, autopilot: 8, baseMode: 0, customMode: 0, systemStatus: 4, mavlinkVersion: 3 }), seq++)
+    bad[bad.length - 1] ^= 0xff
+    socket.send(bad, peer.port, peer.address)
     // GENERATOR_STATUS at 4 Hz; then the pre-arm checks of the component.
     send(common.CommandLong, { targetSystem: h.sysid, targetComponent: h.compid, command: 511, confirmation: 0,
       _param1: 373, _param2: 250000, _param3: 0, _param4: 0, _param5: 0, _param6: 0, _param7: 0 })
