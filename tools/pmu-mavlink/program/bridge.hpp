@@ -45,8 +45,8 @@ class Bridge {
 
   std::uint8_t system_id() const noexcept { return system_id_; }
   const pmu::mavlink::ParserCounters& parser_counters() const noexcept { return parser_.counters(); }
-  // Frames addressed to this component that could not be used (a command's parameters out
-  // of range are answered; this counts only what has no answer: nothing so far).
+  // Frames written since start; each went to every endpoint (their counters say what each
+  // could send).
   std::uint64_t frames_sent() const noexcept { return frames_sent_; }
 
  private:
