@@ -14,7 +14,10 @@
 #   --dry-run        print what would be done, change nothing
 #
 # What goes where (DESTDIR prefixed to every path):
-#   PREFIX/bin/{pmu-service,pmuctl,pmu-sim}          binaries (pmu-service is required)
+#   PREFIX/bin/{pmu-service,pmuctl,pmu-sim,pmu-mavlink}
+#                                                    binaries (pmu-service is required)
+#   /etc/pmu-dds/pmu-mavlink.yaml                    pmu-mavlink's config, only if absent, with
+#   PREFIX/lib/systemd/system/pmu-mavlink.service      its unit and .example: with pmu-mavlink
 #   /etc/pmu-dds/qos.xml                             QoS profiles; a different existing
 #                                                    file is kept as qos.xml.old
 #   /etc/pmu-dds/pmu-service.yaml                    example config, only if absent; the
@@ -89,10 +92,11 @@ service_bin=$(find_binary pmu-service service) ||
   die "no pmu-service in '$build_dir' (looked in service/ and bin/); pass --build-dir DIR"
 pmuctl_bin=$(find_binary pmuctl tools) || pmuctl_bin=
 sim_bin=$(find_binary pmu-sim tools) || sim_bin=
+mavlink_bin=$(find_binary pmu-mavlink tools/pmu-mavlink) || mavlink_bin=
 
 for f in qos.xml pmu-service.yaml systemd/pmu-service.service systemd/80-can0.network README.md \
          security/make_pki.sh security/README.md systemd/pmu-discovery-server.service discovery-server.env discovery-server.xml \
-         systemd/pmuctl-agent@.service; do
+         systemd/pmuctl-agent@.service systemd/pmu-mavlink.service pmu-mavlink.yaml; do
   [ -f "$script_dir/$f" ] || die "missing deploy/$f in $script_dir"
 done
 
@@ -170,6 +174,7 @@ say "pmu-dds install: build dir $build_dir, prefix $prefix${destdir:+, DESTDIR $
 put 0755 "$service_bin" "$bindir/pmu-service"
 if [ -n "$pmuctl_bin" ]; then put 0755 "$pmuctl_bin" "$bindir/pmuctl"; else say "skipped    pmuctl (not built in $build_dir)"; fi
 if [ -n "$sim_bin" ]; then put 0755 "$sim_bin" "$bindir/pmu-sim"; else say "skipped    pmu-sim (not built in $build_dir)"; fi
+if [ -n "$mavlink_bin" ]; then put 0755 "$mavlink_bin" "$bindir/pmu-mavlink"; else say "skipped    pmu-mavlink (not built in $build_dir)"; fi
 
 # ---- configuration -------------------------------------------------------------------------
 put_backup 0644 "$script_dir/qos.xml" "$confdir/qos.xml"
@@ -194,6 +199,14 @@ if [ "$last_changed" -eq 1 ]; then unit_changed=1; fi
 if [ -n "$pmuctl_bin" ]; then
   for_prefix pmuctl-agent@.service
   put 0644 "$tmp/pmuctl-agent@.service" "$userunitdir/pmuctl-agent@.service" "$script_dir/systemd/pmuctl-agent@.service (ExecStart= under $bin_path)"
+fi
+# pmu-mavlink's unit and config: installed with it; the site enables it (systemctl enable).
+if [ -n "$mavlink_bin" ]; then
+  for_prefix pmu-mavlink.service
+  put 0644 "$tmp/pmu-mavlink.service" "$unitdir/pmu-mavlink.service" "$script_dir/systemd/pmu-mavlink.service (ExecStart= under $bin_path)"
+  if [ "$last_changed" -eq 1 ]; then unit_changed=1; fi
+  put_keep 0644 "$script_dir/pmu-mavlink.yaml" "$confdir/pmu-mavlink.yaml"
+  put 0644 "$script_dir/pmu-mavlink.yaml" "$confdir/pmu-mavlink.yaml.example"
 fi
 put_keep 0644 "$script_dir/discovery-server.env" "$confdir/discovery-server.env"
 put 0644 "$script_dir/discovery-server.env" "$confdir/discovery-server.env.example"

@@ -1,6 +1,6 @@
 #pragma once
 // The confirm rules the bridge sends as confirmed (`--confirm RULE`, repeatable, and the same
-// list in its config file; interface.md 12.2), read by a total function at start-up.
+// list in its config file; commands/README.md), read by a total function at start-up.
 
 #include <array>
 #include <string>

@@ -1,0 +1,84 @@
+#pragma once
+// The program's core: what the endpoints bring in (parsed, counted), what the DDS inputs
+// hold, and what goes out when (the rate scheduler). No DDS entity or socket of its own:
+// main.cpp owns those and calls step().
+// Lifetime: the endpoints and the inputs outlive the Bridge. Threads: one (the loop).
+#include <chrono>
+#include <cstdint>
+#include <functional>
+#include <map>
+#include <memory>
+#include <optional>
+#include <vector>
+
+#include "link/endpoint.hpp"
+#include "pmu/mavlink/frame.hpp"
+#include "pmu/mavlink/parser.hpp"
+#include "pmu/mavlink/writer.hpp"
+#include "program/dds_inputs.hpp"
+#include "program/settings.hpp"
+#include "schedule/rate_scheduler.hpp"
+#include "status/status_texts.hpp"
+#include "telemetry/heartbeat.hpp"
+
+namespace pmu::mavlink_bridge {
+
+class Bridge {
+ public:
+  using Clock = RateScheduler::Clock;
+
+  // What another part of the program answers: a frame the bridge does not handle itself
+  // (parameters, and every command but SET_MESSAGE_INTERVAL and RUN_PREARM_CHECKS) goes
+  // here with a function that sends a message's frame on every endpoint. The parameter and
+  // command protocol (tools/pmu-mavlink/params, commands) plugs in here; without it a
+  // COMMAND_LONG addressed to this component gets MAV_RESULT_UNSUPPORTED.
+  using Send = std::function<void(std::uint32_t msgid, const pmu::mavlink::Payload& payload)>;
+  using FrameHandler = std::function<void(const pmu::mavlink::Frame& frame, const Send& send)>;
+
+  Bridge(const Settings& settings, std::vector<Endpoint*> endpoints, DdsInputs& inputs);
+
+  void set_frame_handler(FrameHandler handler) { other_frames_ = std::move(handler); }
+
+  // Reads every endpoint, takes the DDS samples, says alarm and readiness changes, and sends
+  // what the scheduler says is due at `now`. False when an endpoint is gone for good.
+  bool step(Clock::time_point now);
+
+  std::uint8_t system_id() const noexcept { return system_id_; }
+  const pmu::mavlink::ParserCounters& parser_counters() const noexcept { return parser_.counters(); }
+  // Frames written since start; each went to every endpoint (their counters say what each
+  // could send).
+  std::uint64_t frames_sent() const noexcept { return frames_sent_; }
+
+ private:
+  template <class Message>
+  void send(const Message& m) {
+    pmu::mavlink::Payload payload{};
+    m.pack(payload);
+    send_payload(Message::kId, payload);
+  }
+  void send_payload(std::uint32_t msgid, const pmu::mavlink::Payload& payload);
+  void on_frame(const pmu::mavlink::Frame& frame, Clock::time_point now);
+  void on_command(const pmu::mavlink::Frame& frame, const pmu::mavlink::CommandLong& command, Clock::time_point now);
+  void send_due(Clock::time_point now);
+  std::uint8_t pmu_slot(const DeviceKey& key);
+  std::uint8_t bms_slot(const DeviceKey& key);
+  ServiceReadiness readiness() const;
+
+  const Settings& settings_;
+  std::vector<Endpoint*> endpoints_;
+  DdsInputs& inputs_;
+  std::uint8_t system_id_;
+  bool system_id_fixed_;
+  pmu::mavlink::Parser parser_;
+  std::unique_ptr<pmu::mavlink::FrameWriter> writer_;
+  RateScheduler scheduler_;
+  AlarmTexts alarm_texts_;
+  ReadinessTexts readiness_texts_;
+  std::map<DeviceKey, std::uint8_t> pmu_slots_;
+  std::map<DeviceKey, std::uint8_t> bms_slots_;
+  FrameHandler other_frames_;
+  std::uint64_t frames_sent_ = 0;
+  std::vector<std::uint8_t> inbound_;
+};
+
+}  // namespace pmu::mavlink_bridge
