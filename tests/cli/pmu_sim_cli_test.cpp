@@ -1,7 +1,7 @@
 // pmu-sim's options: bad values are refused before any bus is opened, and --help documents
 // them. (Playing them on a bus: tests/sim/runner_solar_test.cpp, the same BusRunner pmu-sim
 // uses; the world options are the keys of pmu-service's sim: mappings, whose effect on the
-// models tests/service/simulated_bus_test.cpp shows.)
+// models tests/service/app/simulated_bus_test.cpp shows.)
 #include <gtest/gtest.h>
 
 #include <string>

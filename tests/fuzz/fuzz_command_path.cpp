@@ -18,7 +18,7 @@
 #include <string>
 #include <vector>
 
-#include "../service/harness.hpp"
+#include "../support/harness.hpp"  // the fuzz targets do not link pmu::test_support
 #include "pmu/codec/decode.hpp"
 #include "pmu/codec/encode.hpp"
 #include "pmu/dispatch/command_service.hpp"

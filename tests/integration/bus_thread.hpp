@@ -1,5 +1,5 @@
 #pragma once
-// The bus side of a fake-clock Harness (../service/harness.hpp) run in a thread of its own
+// The bus side of a fake-clock Harness (support/harness.hpp) run in a thread of its own
 // while the DDS side runs in real time: 10 ms of bus time per 2 ms of real time, so bus time
 // runs about five times faster. With `repeated` frames, a node on the same simulated bus sends
 // them again every 200 ms of bus time, as a BMS and an MPPT repeat their values.
@@ -12,7 +12,7 @@
 #include <thread>
 #include <vector>
 
-#include "../service/harness.hpp"
+#include "support/harness.hpp"
 
 namespace pmu::service::test {
 

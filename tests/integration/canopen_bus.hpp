@@ -5,8 +5,8 @@
 #include <chrono>
 #include <vector>
 
-#include "../service/canopen_frames.hpp"
-#include "../service/harness.hpp"
+#include "support/canopen_frames.hpp"
+#include "support/harness.hpp"
 #include "bus_thread.hpp"
 
 namespace pmu::service::test {

@@ -26,7 +26,7 @@
 #include <vector>
 
 #include "../../tools/pmuctl/record/raw_sample_type.hpp"
-#include "../ros2/ros2_reader_qos.hpp"
+#include "support/ros2_reader_qos.hpp"
 #include "diagnostic_msgs/msg/DiagnosticArrayPubSubTypes.h"
 #include "pmu/dds/dds_context.hpp"
 #include "pmu/endpoints/ros2_publisher.hpp"

@@ -19,7 +19,7 @@
 #include <set>
 #include <thread>
 
-#include "../service/harness.hpp"
+#include "support/harness.hpp"
 #include "bus_thread.hpp"
 #include "pmu/dds/dds_context.hpp"
 #include "pmu/endpoints/dds_publisher.hpp"

@@ -18,7 +18,7 @@
 #include "diagnostic_msgs/msg/DiagnosticArrayPubSubTypes.h"
 #include "pmu/dds/dds_context.hpp"
 #include "pmu/endpoints/ros2_publisher.hpp"
-#include "ros2_reader_qos.hpp"
+#include "support/ros2_reader_qos.hpp"
 #include "support/domain.hpp"
 #include "support/wait.hpp"
 

@@ -17,7 +17,7 @@
 #include <fastdds/dds/topic/TypeSupport.hpp>
 
 #include "pmu/endpoints/ros2_publisher.hpp"
-#include "ros2_reader_qos.hpp"
+#include "support/ros2_reader_qos.hpp"
 #include "sensor_msgs/msg/BatteryStatePubSubTypes.h"
 #include "support/domain.hpp"
 #include "support/wait.hpp"

@@ -35,7 +35,7 @@
 #include <sstream>
 #include <thread>
 
-#include "pki_fixture.hpp"
+#include "support/pki_fixture.hpp"
 #include "pmu/config/config.hpp"
 #include "pmu/config/vehicle.hpp"
 #include "pmu/dds/dds_context.hpp"

@@ -10,7 +10,7 @@
 #include <string>
 
 #include "match_race_window.hpp"
-#include "pki_fixture.hpp"
+#include "support/pki_fixture.hpp"
 #include "pmu/dds/dds_context.hpp"
 #include "pmu/dds/security_match_guard.hpp"
 #include "pmu/idl/commandPubSubTypes.h"

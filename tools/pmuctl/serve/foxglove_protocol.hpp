@@ -3,7 +3,7 @@
 // `foxglove.sdk.v1`, github.com/foxglove/ws-protocol docs/spec.md) as far as `pmuctl serve`
 // speaks it: the server's JSON messages, binary MessageData and Time frames, the choice of
 // subprotocol, and the client's subscribe and unsubscribe requests turned into typed values. Pure: no sockets, threads or clock, so every
-// byte is checked by tests/unit/foxglove_protocol_test.cpp.
+// byte is checked by tests/pmuctl/foxglove_protocol_test.cpp.
 //
 //   message_data(7, 1700000000123456789, {0x00,0x01,0x00,0x00})
 //     -> 01 | 07 00 00 00 | 15 CD 85 3D FE 9C 97 17 | 00 01 00 00

@@ -5,7 +5,7 @@
 //   bits 23..16  packet id  (table 1)
 //   bits 15..0   address    (0..65534 a device, 0xFFFF broadcast)
 //
-// Worked examples (also in tests/unit/ids_test.cpp):
+// Worked examples (also in tests/codec/ids_test.cpp):
 //   0x1E000001 -> group 0x1E, packet 0x00 (voltages), address 1
 //   0x1E31FFFF -> packet 0x31 (firmware), broadcast
 //   0x1F000001 -> not ours (group 0x1F)

@@ -4,7 +4,7 @@
 // is not READY (readiness_rules.hpp, input_missing). docs/safety.md H2, H3, H6.
 #include <gtest/gtest.h>
 
-#include "harness.hpp"
+#include "support/harness.hpp"
 #include "pmu/dispatch/command_service.hpp"
 #include "pmu/readiness/readiness_tracker.hpp"
 

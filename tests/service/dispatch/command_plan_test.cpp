@@ -11,7 +11,7 @@
 #include "pmu/codec/decode.hpp"
 #include "pmu/codec/encode.hpp"
 #include "pmu/dispatch/command_executor.hpp"
-#include "recording_sink.hpp"
+#include "support/recording_sink.hpp"
 
 namespace pmu::service {
 namespace {

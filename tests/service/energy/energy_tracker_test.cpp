@@ -7,7 +7,7 @@
 #include <limits>
 
 #include "pmu/energy_sink/energy_tracker.hpp"
-#include "recording_sink.hpp"
+#include "support/recording_sink.hpp"
 
 namespace pmu::service::test::energy_tracker {
 namespace {

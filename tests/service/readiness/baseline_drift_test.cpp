@@ -8,7 +8,7 @@
 
 #include <sstream>
 
-#include "harness.hpp"
+#include "support/harness.hpp"
 #include "pmu/baseline/config_file.hpp"
 #include "pmu/codec/encode.hpp"
 #include "pmu/dispatch/command_service.hpp"

@@ -6,7 +6,7 @@
 #include <string>
 #include <vector>
 
-#include "harness.hpp"
+#include "support/harness.hpp"
 #include "pmu/dispatch/alarm_ack_service.hpp"
 
 namespace pmu::service::test {

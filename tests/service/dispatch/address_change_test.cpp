@@ -7,7 +7,7 @@
 #include <algorithm>
 #include <functional>
 
-#include "harness.hpp"
+#include "support/harness.hpp"
 #include "pmu/codec/encode.hpp"
 #include "pmu/dispatch/command_service.hpp"
 

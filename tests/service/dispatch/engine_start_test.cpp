@@ -4,7 +4,7 @@
 // is stopped while cranking.
 #include <gtest/gtest.h>
 
-#include "harness.hpp"
+#include "support/harness.hpp"
 #include "pmu/codec/encode.hpp"
 #include "pmu/codec/ids.hpp"
 #include "pmu/dispatch/command_service.hpp"

@@ -14,7 +14,7 @@
 #include "pmu/config/config.hpp"
 #include "pmu/session/bus_worker.hpp"
 #include "pmu/session/canopen_state.hpp"
-#include "recording_sink.hpp"
+#include "support/recording_sink.hpp"
 
 namespace pmu::service::test {
 namespace {

@@ -6,7 +6,7 @@
 #include "pmu/baseline/config_file.hpp"
 #include "pmu/readiness/readiness_tracker.hpp"
 #include "pmu/transport/clock.hpp"
-#include "recording_sink.hpp"
+#include "support/recording_sink.hpp"
 
 namespace pmu::service::test {
 namespace {

@@ -6,8 +6,8 @@
 #include <functional>
 #include <optional>
 
-#include "canopen_frames.hpp"
-#include "harness.hpp"
+#include "support/canopen_frames.hpp"
+#include "support/harness.hpp"
 
 namespace pmu::service::test {
 namespace {

@@ -1,7 +1,7 @@
 // pmu-service on a config whose `interface: sim` devices have `sim:` mappings
 // (docs/interface.md section 4.4), read by pmuctl as a ground station would: what the
 // service publishes shows the simulated world the config asked for. (Each key's effect in
-// detail, without DDS: tests/service/simulated_bus_test.cpp.)
+// detail, without DDS: tests/service/app/simulated_bus_test.cpp.)
 #include <gtest/gtest.h>
 
 #include <chrono>

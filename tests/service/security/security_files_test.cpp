@@ -15,7 +15,7 @@
 #include <utility>
 #include <vector>
 
-#include "pki_fixture.hpp"
+#include "support/pki_fixture.hpp"
 #include "pmu/security/security_files.hpp"
 
 namespace pmu::security_test {

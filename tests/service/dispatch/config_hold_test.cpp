@@ -8,7 +8,7 @@
 #include <regex>
 
 #include "frame_text.hpp"
-#include "harness.hpp"
+#include "support/harness.hpp"
 #include "pmu/dispatch/command_service.hpp"
 #include "support/pmu_frames.hpp"
 

@@ -8,7 +8,7 @@
 #include <optional>
 #include <string>
 
-#include "harness.hpp"
+#include "support/harness.hpp"
 #include "pmu/codec/encode.hpp"
 
 namespace pmu::service::test {

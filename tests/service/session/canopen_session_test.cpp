@@ -5,9 +5,9 @@
 
 #include <cmath>
 
-#include "canopen_frames.hpp"
+#include "support/canopen_frames.hpp"
 #include "pmu/session/canopen_session.hpp"
-#include "recording_sink.hpp"
+#include "support/recording_sink.hpp"
 
 namespace pmu::service::test {
 namespace {

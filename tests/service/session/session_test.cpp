@@ -6,7 +6,7 @@
 #include <algorithm>
 #include <cmath>
 
-#include "harness.hpp"
+#include "support/harness.hpp"
 #include "pmu/codec/encode.hpp"
 
 namespace pmu::service::test {

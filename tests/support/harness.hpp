@@ -12,7 +12,7 @@
 #include "pmu/session/bus_worker.hpp"
 #include "pmu/sim/bus_runner.hpp"
 #include "pmu/transport/sim_bus.hpp"
-#include "recording_sink.hpp"
+#include "recording_sink.hpp"  // beside this header: a fuzz target includes it without pmu::test_support
 
 namespace pmu::service::test {
 

@@ -1,6 +1,6 @@
 // The `sim:` mapping of a device on an `interface: sim` bus (docs/interface.md section 4.4):
 // every key read into plain settings, every bad one refused with FILE:LINE and what is wrong.
-// What the simulated units then do with them: simulated_bus_test.cpp.
+// What the simulated units then do with them: tests/service/app/simulated_bus_test.cpp.
 #include <gtest/gtest.h>
 
 #include <string>

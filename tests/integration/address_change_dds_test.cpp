@@ -13,7 +13,7 @@
 #include <set>
 #include <string>
 
-#include "../service/harness.hpp"
+#include "support/harness.hpp"
 #include "pmu/dds/dds_context.hpp"
 #include "pmu/dispatch/command_service.hpp"
 #include "pmu/endpoints/dds_publisher.hpp"

@@ -4,8 +4,8 @@
 
 #include <cmath>
 
-#include "canopen_frames.hpp"
-#include "harness.hpp"
+#include "support/canopen_frames.hpp"
+#include "support/harness.hpp"
 #include "pmu/session/receive_filters.hpp"
 
 namespace pmu::service::test {

@@ -1,7 +1,7 @@
 // The codec's own tables (packets.hpp, telemetry.hpp) checked for consistency with the
-// codec's behaviour. Whether their values match the spec is telemetry_test's job, which
-// types them from protocol v1.9 tables 1..5 independently; here: every row round-trips,
-// the rows of a packet tile its frame, and names and ids map both ways.
+// codec's behaviour. Whether their values match the spec is telemetry_packets_test's job,
+// which types them from protocol v1.9 tables 1..5 independently; here: every row
+// round-trips, the rows of a packet tile its frame, and names and ids map both ways.
 #include <gtest/gtest.h>
 
 #include <chrono>

@@ -9,7 +9,7 @@
 #include <atomic>
 #include <thread>
 
-#include "harness.hpp"
+#include "support/harness.hpp"
 #include "support/wait.hpp"
 #include "pmu/dispatch/command_service.hpp"
 

@@ -9,7 +9,7 @@
 #include <random>
 
 #include "frame_text.hpp"
-#include "harness.hpp"
+#include "support/harness.hpp"
 #include "pmu/codec/encode.hpp"
 #include "pmu/dispatch/command_service.hpp"
 #include "support/pmu_frames.hpp"
