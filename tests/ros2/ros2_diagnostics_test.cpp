@@ -96,7 +96,7 @@ HealthReport health(HealthState state) {
 TEST(Ros2Diagnostics, ALateLatchedSubscriberGetsEveryDevicesStatusAtOnce) {
   const int domain = pmu::test::exclusive_dds_domain();
   pmu::dds::DdsContext service_side(domain, "", "pmu-service-ros2");
-  pmu::service::Ros2Settings settings;
+  pmu::dds::Ros2Settings settings;
   settings.enabled = true;
   const pmu::transport::ManualClock clock;
   pmu::dds::Ros2Publisher publisher(service_side, settings, "uav1", {}, clock);
@@ -122,7 +122,7 @@ TEST(Ros2Diagnostics, ALateLatchedSubscriberGetsEveryDevicesStatusAtOnce) {
 TEST(Ros2Diagnostics, AnUnchangedReportIsWrittenAtMostOnceASecond) {
   const int domain = pmu::test::exclusive_dds_domain();
   pmu::dds::DdsContext service_side(domain, "", "pmu-service-ros2");
-  pmu::service::Ros2Settings settings;
+  pmu::dds::Ros2Settings settings;
   settings.enabled = true;
   pmu::transport::ManualClock clock;
   pmu::dds::Ros2Publisher publisher(service_side, settings, "uav1", {}, clock);

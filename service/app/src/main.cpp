@@ -25,8 +25,8 @@
 #include "pmu/app/simulated_bus.hpp"
 #include "pmu/app/systemd.hpp"
 #include "pmu/config/config.hpp"
-#include "pmu/config/statistics_settings.hpp"
-#include "pmu/config/vehicle.hpp"
+#include "pmu/dds_settings/statistics_settings.hpp"
+#include "pmu/dds_settings/vehicle.hpp"
 #include "pmu/dds/dds_context.hpp"
 #include "pmu/dispatch/command_service.hpp"
 #include "pmu/endpoints/dds_alarm_acks.hpp"
@@ -113,7 +113,7 @@ int run(const service::Config& cfg, const pmu::dds::ResolvedNetwork& network) {
   }
 
   spdlog::info("DDS: {}", network.summary);
-  const auto partitions = service::vehicle_partitions(cfg.vehicle);
+  const auto partitions = pmu::dds::vehicle_partitions(cfg.vehicle);
   pmu::dds::DdsContext participant(cfg.domain, cfg.qos_file, pmu::dds::kServiceParticipantName, cfg.security.files, cfg.dds_transport,
                                    network, {partitions, partitions}, cfg.dds_statistics, cfg.dds_type_objects);
   // The link's values (link_profile.hpp): the participant took them from `network`.

@@ -17,7 +17,7 @@ using eprosima::fastdds::dds::DataWriter;
 using eprosima::fastdds::dds::DataWriterQos;
 using service::DeviceKey;
 using service::DeviceKind;
-using service::Ros2Device;
+using dds::Ros2Device;
 
 namespace ros2_publisher {
 
@@ -76,7 +76,7 @@ DataWriterQos ros2_writer_qos() {
 struct Ros2Publisher::State {
   DdsContext& dds;
   const transport::Clock& clock;
-  service::Ros2Settings settings;
+  dds::Ros2Settings settings;
   std::string vehicle;
   std::map<std::pair<std::string, std::uint8_t>, double> capacity_ah;  // (bus, node)
   std::mutex mutex;
@@ -90,17 +90,17 @@ struct Ros2Publisher::State {
   std::uint64_t failures = 0;
   service::LogThrottle failure_reports{std::chrono::seconds(5)};
 
-  State(DdsContext& d, const transport::Clock& c, service::Ros2Settings s, std::string v)
+  State(DdsContext& d, const transport::Clock& c, dds::Ros2Settings s, std::string v)
       : dds(d), clock(c), settings(std::move(s)), vehicle(std::move(v)) {}
 
   std::string name_of(const DeviceKey& k) const {
-    return service::ros2_status_name(settings.name_space, vehicle, k.bus, ros2_publisher::ros2_kind(k.kind), k.address);
+    return dds::ros2_status_name(settings.name_space, vehicle, k.bus, ros2_publisher::ros2_kind(k.kind), k.address);
   }
   DataWriter* battery_writer(const DeviceKey& k, const char* leaf) {
     const std::string ros_name =
-        service::ros2_device_namespace(settings.name_space, vehicle, k.bus, ros2_publisher::ros2_kind(k.kind), k.address) + "/" + leaf;
+        dds::ros2_device_namespace(settings.name_space, vehicle, k.bus, ros2_publisher::ros2_kind(k.kind), k.address) + "/" + leaf;
     try {
-      auto& topic = dds.topic(service::ros2_dds_topic(ros_name), zero_padded<sensor_msgs::msg::BatteryStatePubSubType>());
+      auto& topic = dds.topic(dds::ros2_dds_topic(ros_name), zero_padded<sensor_msgs::msg::BatteryStatePubSubType>());
       return &dds.default_partition_writer(topic, ros2_writer_qos());
     } catch (const DdsError& e) {
       failed(ros_name.c_str(), e.what());
@@ -161,7 +161,7 @@ struct Ros2Publisher::State {
   }
 };
 
-Ros2Publisher::Ros2Publisher(DdsContext& dds, const service::Ros2Settings& settings, std::string vehicle,
+Ros2Publisher::Ros2Publisher(DdsContext& dds, const dds::Ros2Settings& settings, std::string vehicle,
                              const std::vector<service::BusConfig>& buses, const transport::Clock& clock)
     : s_(std::make_unique<State>(dds, clock, settings, std::move(vehicle))) {
   for (const auto& b : buses)

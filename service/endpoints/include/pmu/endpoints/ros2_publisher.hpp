@@ -45,7 +45,7 @@ class Ros2Publisher final : public service::StateSink {
  public:
   // `buses`: the configured batteries' capacity_ah. Creates /diagnostics's writer; throws
   // DdsError at start-up.
-  Ros2Publisher(DdsContext& dds, const service::Ros2Settings& settings, std::string vehicle,
+  Ros2Publisher(DdsContext& dds, const dds::Ros2Settings& settings, std::string vehicle,
                 const std::vector<service::BusConfig>& buses, const transport::Clock& clock);
   ~Ros2Publisher() override;
 
