@@ -33,7 +33,7 @@
 
 #include "pmu/config/config.hpp"
 #include "pmu/dds/dds_context.hpp"
-#include "pmu/session/device_state.hpp"
+#include "pmu/session/state_sink.hpp"
 #include "pmu/transport/clock.hpp"
 
 namespace pmu::dds {
