@@ -313,7 +313,7 @@ TEST(Ros2OverDds, AGoneDeviceLeavesANotPresentBatteryForLateJoiners) {
   pmu::dds::Ros2Settings settings;
   settings.enabled = true;
   const pmu::transport::SystemClock clock;
-  pmu::dds::Ros2Publisher publisher(service_side, settings, "uav1", {}, clock);
+  pmu::service::Ros2Publisher publisher(service_side, settings, "uav1", {}, clock);
   const pmu::service::DeviceKey key{"can0", 1, pmu::service::DeviceKind::Pmu};
   pmu::service::HealthReport online;
   online.state = pmu::service::HealthState::Online;

@@ -99,7 +99,7 @@ TEST(Ros2Diagnostics, ALateLatchedSubscriberGetsEveryDevicesStatusAtOnce) {
   pmu::dds::Ros2Settings settings;
   settings.enabled = true;
   const pmu::transport::ManualClock clock;
-  pmu::dds::Ros2Publisher publisher(service_side, settings, "uav1", {}, clock);
+  pmu::service::Ros2Publisher publisher(service_side, settings, "uav1", {}, clock);
   const DeviceKey pmu{"can0", 1, DeviceKind::Pmu};
   const DeviceKey bms{"can0", 2, DeviceKind::Battery};
   const DeviceKey mppt{"can1", 3, DeviceKind::Mppt};
@@ -125,7 +125,7 @@ TEST(Ros2Diagnostics, AnUnchangedReportIsWrittenAtMostOnceASecond) {
   pmu::dds::Ros2Settings settings;
   settings.enabled = true;
   pmu::transport::ManualClock clock;
-  pmu::dds::Ros2Publisher publisher(service_side, settings, "uav1", {}, clock);
+  pmu::service::Ros2Publisher publisher(service_side, settings, "uav1", {}, clock);
   const DeviceKey pmu{"can0", 1, DeviceKind::Pmu};
   HealthReport report = health(HealthState::Online);
   report.frames_received = 10;

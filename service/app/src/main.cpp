@@ -149,9 +149,9 @@ int run(const service::Config& cfg, const pmu::dds::ResolvedNetwork& network) {
   std::vector<service::StateSink*> sinks{&publisher};
   if (previous_publisher) sinks.push_back(previous_publisher.get());
   // ROS 2's names and types, on the service's own participant (this build's contract).
-  std::unique_ptr<pmu::dds::Ros2Publisher> ros2;
+  std::unique_ptr<pmu::service::Ros2Publisher> ros2;
   if (cfg.ros2.enabled) {
-    ros2 = std::make_unique<pmu::dds::Ros2Publisher>(participant, cfg.ros2, cfg.vehicle, cfg.buses, clock);
+    ros2 = std::make_unique<pmu::service::Ros2Publisher>(participant, cfg.ros2, cfg.vehicle, cfg.buses, clock);
     sinks.push_back(ros2.get());
     spdlog::info("ROS 2: sensor_msgs/BatteryState and /diagnostics under '{}' (ros2)",
                  cfg.ros2.name_space.empty() ? "/" : cfg.ros2.name_space);
