@@ -6,7 +6,7 @@
 #include <string>
 #include <thread>
 
-#include "pmu/config/transport_choice.hpp"
+#include "pmu/dds_settings/transport_choice.hpp"
 #include "pmu/transport/stop_signals.hpp"
 
 namespace pmu::bench {

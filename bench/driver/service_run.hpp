@@ -9,7 +9,7 @@
 
 #include "child_process.hpp"
 #include "fake_pmu.hpp"
-#include "pmu/config/transport_choice.hpp"
+#include "pmu/dds_settings/transport_choice.hpp"
 
 namespace pmu::bench {
 

@@ -53,14 +53,15 @@ void set_field(Setting, bool& f, const std::optional<std::uint32_t>& raw) { f = 
 
 }  // namespace
 
-pmu::v5::Baseline baseline_sample(const std::string& vehicle, const std::string& bus, const DeviceConfig& device) {
+pmu::v5::Baseline baseline_sample(const std::string& vehicle, const std::string& bus, std::uint16_t address,
+                                  const std::string& file, const std::optional<baseline::ConfigFile>& content) {
   pmu::v5::Baseline s;
   s.vehicle(vehicle);
   s.bus(bus);
-  s.address(device.address);
-  s.file(device.baseline_file.substr(0, kMaxBaselinePath));
-  if (!device.baseline) return s;
-  const auto& f = *device.baseline;
+  s.address(address);
+  s.file(file.substr(0, baseline::kMaxPathBytes));
+  if (!content) return s;
+  const auto& f = *content;
   s.has_serial(f.header.serial.has_value());
   s.serial(f.header.serial.value_or(0));
   s.has_min_firmware(f.header.min_firmware.has_value());

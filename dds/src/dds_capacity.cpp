@@ -3,7 +3,7 @@
 #include <algorithm>
 #include <cstdint>
 
-#include "pmu/config/capacity.hpp"
+#include "pmu/dds_settings/capacity.hpp"
 #include "pmu/idl/topics.hpp"
 
 namespace pmu::dds {
@@ -26,19 +26,18 @@ std::string short_of(const char* field, std::int32_t have, std::size_t need, con
 
 std::string capacity_shortfall(const std::string& profile, EndpointKind kind, const ResourceLimitsQosPolicy& limits,
                                const HistoryQosPolicy& history) {
-  using namespace pmu::service;
   Need need{};
   if (profile == qos_profiles::kTelemetry || profile == qos_profiles::kState) {
     need = kind == EndpointKind::Writer
-               ? Need{kMaxDevicesPerService, 1, "PMUs per service, pmu::service::kMaxDevicesPerService"}
-               : Need{kFleetDevices, 1, "PMUs of a fleet, pmu::service::kFleetDevices"};
+               ? Need{kMaxDevicesPerService, 1, "PMUs per service, pmu::dds::kMaxDevicesPerService"}
+               : Need{kFleetDevices, 1, "PMUs of a fleet, pmu::dds::kFleetDevices"};
   } else if (profile == qos_profiles::kAlarms) {
     need = kind == EndpointKind::Writer
-               ? Need{kMaxAlarmsPerService, 1, "alarms per service, pmu::service::kMaxAlarmsPerService"}
-               : Need{kFleetAlarms, 1, "alarms of a fleet, pmu::service::kFleetAlarms"};
+               ? Need{kMaxAlarmsPerService, 1, "alarms per service, pmu::dds::kMaxAlarmsPerService"}
+               : Need{kFleetAlarms, 1, "alarms of a fleet, pmu::dds::kFleetAlarms"};
   } else if (profile == qos_profiles::kCommand) {
     // pmu/command and pmu/command_reply have no key: one instance holds the whole queue.
-    need = Need{1, kCommandQueueDepth, "commands queued, pmu::service::kCommandQueueDepth"};
+    need = Need{1, kCommandQueueDepth, "commands queued, pmu::dds::kCommandQueueDepth"};
   } else {
     return {};
   }

@@ -1,6 +1,6 @@
 #include "pmu/dds/dds_participant.hpp"
 
-#include "pmu/config/statistics_settings.hpp"
+#include "pmu/dds_settings/statistics_settings.hpp"
 
 #include <fastdds/rtps/attributes/ServerAttributes.h>
 #include <fastdds/rtps/transport/UDPv4TransportDescriptor.h>

@@ -66,7 +66,7 @@ vehicles="*"        # the standard identities' partitions, comma separated ("*":
 extra=()            # --ground-station identities: NAME
 declare -A extra_vehicles=()  # NAME -> its comma separated vehicles
 
-# Why NAME cannot be a vehicle name, or nothing: service/config/src/vehicle.cpp
+# Why NAME cannot be a vehicle name, or nothing: dds/settings/src/vehicle.cpp
 # vehicle_name_problem, word for word. ('*', '?', '[' would be patterns in a partition.)
 vehicle_problem() {
   local v=$1

@@ -11,6 +11,13 @@ namespace {
 
 using baseline::Setting;
 
+// What the service's config holds of a PMU with a `baseline:`.
+struct DeviceConfig {
+  std::uint16_t address = 1;
+  std::string baseline_file;
+  std::optional<baseline::ConfigFile> baseline;
+};
+
 DeviceConfig configured(const std::string& text) {
   DeviceConfig d;
   d.address = 3;
@@ -19,6 +26,11 @@ DeviceConfig configured(const std::string& text) {
   EXPECT_TRUE(f.ok()) << (f.ok() ? "" : f.error().message);
   if (f.ok()) d.baseline = *f;
   return d;
+}
+
+// The sample of a configured device, as the service's publisher writes it.
+pmu::v5::Baseline baseline_sample(const std::string& vehicle, const std::string& bus, const DeviceConfig& d) {
+  return service::baseline_sample(vehicle, bus, d.address, d.baseline_file, d.baseline);
 }
 
 TEST(BaselineSample, KeysPinsAndOnlyTheSettingsTheFileHas) {

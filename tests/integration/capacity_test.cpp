@@ -16,7 +16,7 @@
 #include <string>
 #include <thread>
 
-#include "pmu/config/capacity.hpp"
+#include "pmu/dds_settings/capacity.hpp"
 #include "pmu/dds/dds_context.hpp"
 #include "pmu/endpoints/dds_publisher.hpp"
 #include "pmu/idl/statePubSubTypes.h"
@@ -134,7 +134,7 @@ TEST(QosCapacity, AMiseditedProfileIsAStartUpError) {
   const std::string line = std::to_string(std::count(xml.begin(), xml.begin() + static_cast<std::ptrdiff_t>(at), '\n') + 1);
   EXPECT_NE(r.out.find(std::string(path) + ":" + line +
                        ": <data_writer profile_name=\"state\"> (the pmu/config, pmu/info and pmu/health writers): "
-                       "max_instances 10 < 256 (PMUs per service, pmu::service::kMaxDevicesPerService)"),
+                       "max_instances 10 < 256 (PMUs per service, pmu::dds::kMaxDevicesPerService)"),
             std::string::npos)
       << r.out;
 }
@@ -150,9 +150,9 @@ TEST(QosCapacity, PmusBeyondTheCapacityAreCountedInHealthNotDroppedSilently) {
       client.topic(topics::kHealth, TypeSupport(new pmu::v5::HealthPubSubType())), qos_profiles::kState);
   HealthReport report;
   report.state = HealthState::Online;
-  for (std::size_t a = 1; a <= kMaxDevicesPerService + 1; ++a)
+  for (std::size_t a = 1; a <= dds::kMaxDevicesPerService + 1; ++a)
     publisher.on_health(DeviceKey{"sim0", static_cast<std::uint16_t>(a)}, report);
-  EXPECT_EQ(publisher.samples_written(), kMaxDevicesPerService);
+  EXPECT_EQ(publisher.samples_written(), dds::kMaxDevicesPerService);
   EXPECT_EQ(publisher.samples_over_capacity(), 1u);
   EXPECT_EQ(publisher.write_failures(), 1u);
 
@@ -164,11 +164,11 @@ TEST(QosCapacity, PmusBeyondTheCapacityAreCountedInHealthNotDroppedSilently) {
       [&] {
         while (health.take_next_sample(&h, &info) == ReturnCode_t::RETCODE_OK)
           if (info.valid_data) failures_by_address[h.address()] = h.publish_failures();
-        return failures_by_address.size() >= kMaxDevicesPerService;
+        return failures_by_address.size() >= dds::kMaxDevicesPerService;
       },
       20s);
-  EXPECT_EQ(failures_by_address.size(), kMaxDevicesPerService);
-  EXPECT_EQ(failures_by_address.count(static_cast<int>(kMaxDevicesPerService) + 1), 0u);
+  EXPECT_EQ(failures_by_address.size(), dds::kMaxDevicesPerService);
+  EXPECT_EQ(failures_by_address.count(static_cast<int>(dds::kMaxDevicesPerService) + 1), 0u);
   EXPECT_EQ(failures_by_address[1], 1u) << "the refused PMU's sample is counted in the next health sample";
 }
 

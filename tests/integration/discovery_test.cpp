@@ -29,7 +29,7 @@
 #include <thread>
 #include <vector>
 
-#include "pmu/config/network_settings.hpp"
+#include "pmu/dds_settings/network_settings.hpp"
 #include "pmu/dds/dds_context.hpp"
 #include "pmu/idl/commandPubSubTypes.h"
 #include "pmu/idl/telemetryPubSubTypes.h"

@@ -310,10 +310,10 @@ TEST(Ros2OverDds, BatteriesAndDiagnosticsReachARos2DefaultReaderWithTheSimulator
 TEST(Ros2OverDds, AGoneDeviceLeavesANotPresentBatteryForLateJoiners) {
   const int domain = pmu::test::exclusive_dds_domain();
   pmu::dds::DdsContext service_side(domain, PMU_QOS_FILE, "pmu-service-ros2");
-  pmu::service::Ros2Settings settings;
+  pmu::dds::Ros2Settings settings;
   settings.enabled = true;
   const pmu::transport::SystemClock clock;
-  pmu::dds::Ros2Publisher publisher(service_side, settings, "uav1", {}, clock);
+  pmu::service::Ros2Publisher publisher(service_side, settings, "uav1", {}, clock);
   const pmu::service::DeviceKey key{"can0", 1, pmu::service::DeviceKind::Pmu};
   pmu::service::HealthReport online;
   online.state = pmu::service::HealthState::Online;

@@ -13,7 +13,7 @@
 #include <thread>
 #include <vector>
 
-#include "pmu/config/vehicle.hpp"
+#include "pmu/dds_settings/vehicle.hpp"
 #include "pmu/dds/dds_context.hpp"
 #include "pmu/idl/command.h"
 #include "pmu/idl/commandPubSubTypes.h"
@@ -139,8 +139,8 @@ struct Ground {
 // Not the simulator's default (12.0 V), so a set that executes changes the stored value.
 constexpr double kNewPayloadVoltage = 23.0;
 
-dds::Partitions every_vehicle() { return {vehicle_partitions(""), every_vehicle_partitions()}; }
-dds::Partitions only(const std::string& v) { return {vehicle_partitions(v), vehicle_partitions(v)}; }
+dds::Partitions every_vehicle() { return {dds::vehicle_partitions(""), dds::every_vehicle_partitions()}; }
+dds::Partitions only(const std::string& v) { return {dds::vehicle_partitions(v), dds::vehicle_partitions(v)}; }
 
 class Vehicles : public ::testing::Test {
  protected:
@@ -248,7 +248,7 @@ TEST_F(Vehicles, TheUnnamedVehicleIsCommandedAsBeforeVehiclesExisted) {
 // matches every vehicle's command reader) that names uav2: neither is executed or answered.
 TEST_F(Vehicles, ACommandNotAddressedToThisVehicleAloneIsNeitherExecutedNorAnswered) {
   Ground wrong_name(domain_, "ground-wrong-name", only("uav2"));
-  Ground wildcard(domain_, "ground-wildcard", {{"*"}, every_vehicle_partitions()});
+  Ground wildcard(domain_, "ground-wildcard", {{"*"}, dds::every_vehicle_partitions()});
   ready(wrong_name, 1);
   ready(wildcard, 2);  // uav1's and uav2's: "*" matches every named partition
   const auto before = services_["uav2"]->parameter(codec::Parameter::PayloadVoltage);
@@ -276,7 +276,7 @@ TEST_F(Vehicles, ACommandNotAddressedToThisVehicleAloneIsNeitherExecutedNorAnswe
 // its command, which names the service's own vehicle, is refused like any from "*".
 TEST(VehiclesEarlyPeer, AWildcardWriterFoundBeforeTheCommandEndpointExistedIsStillRefused) {
   const int domain = pmu::test::exclusive_dds_domain();
-  Ground wildcard(domain, "ground-wildcard-early", {{"*"}, every_vehicle_partitions()});
+  Ground wildcard(domain, "ground-wildcard-early", {{"*"}, dds::every_vehicle_partitions()});
   VehicleService::Options o;
   o.vehicle = "uav1";
   o.endpoint_delay = 3s;

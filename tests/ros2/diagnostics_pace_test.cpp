@@ -12,7 +12,7 @@
 
 #include "pmu/endpoints/diagnostics_pace.hpp"
 
-namespace pmu::dds {
+namespace pmu::service {
 namespace {
 
 using namespace std::chrono_literals;
@@ -115,4 +115,4 @@ TEST(DiagnosticsPace, ALevelChangeAmongSteadyDevicesIsWrittenAtOnce) {
 }
 
 }  // namespace
-}  // namespace pmu::dds
+}  // namespace pmu::service

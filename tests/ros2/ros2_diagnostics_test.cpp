@@ -96,10 +96,10 @@ HealthReport health(HealthState state) {
 TEST(Ros2Diagnostics, ALateLatchedSubscriberGetsEveryDevicesStatusAtOnce) {
   const int domain = pmu::test::exclusive_dds_domain();
   pmu::dds::DdsContext service_side(domain, "", "pmu-service-ros2");
-  pmu::service::Ros2Settings settings;
+  pmu::dds::Ros2Settings settings;
   settings.enabled = true;
   const pmu::transport::ManualClock clock;
-  pmu::dds::Ros2Publisher publisher(service_side, settings, "uav1", {}, clock);
+  pmu::service::Ros2Publisher publisher(service_side, settings, "uav1", {}, clock);
   const DeviceKey pmu{"can0", 1, DeviceKind::Pmu};
   const DeviceKey bms{"can0", 2, DeviceKind::Battery};
   const DeviceKey mppt{"can1", 3, DeviceKind::Mppt};
@@ -122,10 +122,10 @@ TEST(Ros2Diagnostics, ALateLatchedSubscriberGetsEveryDevicesStatusAtOnce) {
 TEST(Ros2Diagnostics, AnUnchangedReportIsWrittenAtMostOnceASecond) {
   const int domain = pmu::test::exclusive_dds_domain();
   pmu::dds::DdsContext service_side(domain, "", "pmu-service-ros2");
-  pmu::service::Ros2Settings settings;
+  pmu::dds::Ros2Settings settings;
   settings.enabled = true;
   pmu::transport::ManualClock clock;
-  pmu::dds::Ros2Publisher publisher(service_side, settings, "uav1", {}, clock);
+  pmu::service::Ros2Publisher publisher(service_side, settings, "uav1", {}, clock);
   const DeviceKey pmu{"can0", 1, DeviceKind::Pmu};
   HealthReport report = health(HealthState::Online);
   report.frames_received = 10;

@@ -11,7 +11,7 @@
 #include "pmu/alarms/alarm_table.hpp"
 #include "pmu/endpoints/ros2_messages.hpp"
 
-namespace pmu::dds {
+namespace pmu::service {
 namespace {
 
 namespace Bs = sensor_msgs::msg::BatteryState_Constants;
@@ -284,4 +284,4 @@ TEST(Ros2Messages, DiagnosticOfADeviceNeverHeard) {
 }
 
 }  // namespace
-}  // namespace pmu::dds
+}  // namespace pmu::service

@@ -84,7 +84,7 @@ bool take_one(DataReader& reader, sensor_msgs::msg::BatteryState& out) {
 TEST(Ros2Qos, StateWriterMatchesRos2DefaultReader) {
   Participant dds;
   ASSERT_TRUE(dds.ready());
-  DataWriter* writer = dds.writer(pmu::dds::ros2_writer_qos());
+  DataWriter* writer = dds.writer(pmu::service::ros2_writer_qos());
   DataReader* reader = dds.reader(pmu::test::ros2_reader_qos(RELIABLE_RELIABILITY_QOS, VOLATILE_DURABILITY_QOS));
   ASSERT_NE(writer, nullptr);
   ASSERT_NE(reader, nullptr);
@@ -108,7 +108,7 @@ TEST(Ros2Qos, StateWriterMatchesRos2DefaultReader) {
 TEST(Ros2Qos, LateTransientLocalReaderGetsTheLastSample) {
   Participant dds;
   ASSERT_TRUE(dds.ready());
-  DataWriter* writer = dds.writer(pmu::dds::ros2_writer_qos());
+  DataWriter* writer = dds.writer(pmu::service::ros2_writer_qos());
   ASSERT_NE(writer, nullptr);
   auto first = sample(48.0f);
   auto last = sample(47.5f);

@@ -37,7 +37,7 @@
 
 #include "support/pki_fixture.hpp"
 #include "pmu/config/config.hpp"
-#include "pmu/config/vehicle.hpp"
+#include "pmu/dds_settings/vehicle.hpp"
 #include "pmu/dds/dds_context.hpp"
 #include "pmu/dispatch/command_service.hpp"
 #include "pmu/endpoints/dds_commands.hpp"

@@ -12,7 +12,7 @@
 #include <string>
 #include <thread>
 
-#include "pmu/config/vehicle.hpp"
+#include "pmu/dds_settings/vehicle.hpp"
 #include "pmu/dds/dds_context.hpp"
 #include "pmu/dispatch/command_service.hpp"
 #include "pmu/endpoints/dds_commands.hpp"
@@ -40,7 +40,7 @@ class InProcessService {
       : network(clock),
         pmus(network.attach("pmu-sim"), clock),
         dds(domain, "", dds::kServiceParticipantName, o.security, o.transport, {},
-            {service::vehicle_partitions(o.vehicle), service::vehicle_partitions(o.vehicle)}),
+            {dds::vehicle_partitions(o.vehicle), dds::vehicle_partitions(o.vehicle)}),
         publisher(dds, std::chrono::seconds(3), o.vehicle),
         worker(bus_config(o.bus_name), network.attach(o.bus_name), clock, service::Timeouts{}, publisher),
         pause_(o.endpoint_delay),

@@ -5,7 +5,7 @@
 #include <map>
 #include <vector>
 
-#include "pmu/session/device_state.hpp"
+#include "pmu/session/state_sink.hpp"
 
 namespace pmu::service::test {
 

@@ -215,7 +215,7 @@ int run_cli(int argc, char** argv, const AgentCall* served) {
   try {
     return verb->run(g);
   } catch (const pmu::dds::PartitionNotGranted& e) {
-    // A partition is a vehicle (pmu/config/vehicle.hpp): say it in the operator's terms.
+    // A partition is a vehicle (pmu/dds_settings/vehicle.hpp): say it in the operator's terms.
     std::fprintf(stderr, "pmuctl: %s\n", e.what());
     if (!g.vehicle)
       std::fprintf(stderr, "pmuctl: without --vehicle pmuctl reads every vehicle (partitions \"\" and \"*\") and "

@@ -25,8 +25,8 @@
 #include "pmu/app/simulated_bus.hpp"
 #include "pmu/app/systemd.hpp"
 #include "pmu/config/config.hpp"
-#include "pmu/config/statistics_settings.hpp"
-#include "pmu/config/vehicle.hpp"
+#include "pmu/dds_settings/statistics_settings.hpp"
+#include "pmu/dds_settings/vehicle.hpp"
 #include "pmu/dds/dds_context.hpp"
 #include "pmu/dispatch/command_service.hpp"
 #include "pmu/endpoints/dds_alarm_acks.hpp"
@@ -113,7 +113,7 @@ int run(const service::Config& cfg, const pmu::dds::ResolvedNetwork& network) {
   }
 
   spdlog::info("DDS: {}", network.summary);
-  const auto partitions = service::vehicle_partitions(cfg.vehicle);
+  const auto partitions = pmu::dds::vehicle_partitions(cfg.vehicle);
   pmu::dds::DdsContext participant(cfg.domain, cfg.qos_file, pmu::dds::kServiceParticipantName, cfg.security.files, cfg.dds_transport,
                                    network, {partitions, partitions}, cfg.dds_statistics, cfg.dds_type_objects);
   // The link's values (link_profile.hpp): the participant took them from `network`.
@@ -149,9 +149,9 @@ int run(const service::Config& cfg, const pmu::dds::ResolvedNetwork& network) {
   std::vector<service::StateSink*> sinks{&publisher};
   if (previous_publisher) sinks.push_back(previous_publisher.get());
   // ROS 2's names and types, on the service's own participant (this build's contract).
-  std::unique_ptr<pmu::dds::Ros2Publisher> ros2;
+  std::unique_ptr<pmu::service::Ros2Publisher> ros2;
   if (cfg.ros2.enabled) {
-    ros2 = std::make_unique<pmu::dds::Ros2Publisher>(participant, cfg.ros2, cfg.vehicle, cfg.buses, clock);
+    ros2 = std::make_unique<pmu::service::Ros2Publisher>(participant, cfg.ros2, cfg.vehicle, cfg.buses, clock);
     sinks.push_back(ros2.get());
     spdlog::info("ROS 2: sensor_msgs/BatteryState and /diagnostics under '{}' (ros2)",
                  cfg.ros2.name_space.empty() ? "/" : cfg.ros2.name_space);

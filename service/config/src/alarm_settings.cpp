@@ -3,10 +3,12 @@
 #include <algorithm>
 
 #include "pmu/config/config.hpp"
-#include "pmu/config/quoted.hpp"
+#include "pmu/dds_settings/quoted.hpp"
 
 namespace pmu::service {
 namespace {
+
+using dds::quoted;
 
 constexpr const char* kKeys[] = {"limit", "deadband", "on_delay", "off_delay", "severity", "enabled"};
 

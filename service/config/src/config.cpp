@@ -24,9 +24,9 @@
 #include "pmu/codec/firmware.hpp"
 #include "pmu/codec/messages.hpp"
 #include "pmu/codec/telemetry.hpp"
-#include "pmu/config/quoted.hpp"
-#include "pmu/config/statistics_settings.hpp"
-#include "pmu/config/vehicle.hpp"
+#include "pmu/dds_settings/quoted.hpp"
+#include "pmu/dds_settings/statistics_settings.hpp"
+#include "pmu/dds_settings/vehicle.hpp"
 #include "pmu/files/bounded_file.hpp"
 #include "pmu/version.hpp"
 #include "alarm_settings.hpp"
@@ -34,6 +34,8 @@
 
 namespace pmu::service {
 namespace {
+
+using dds::quoted;
 
 constexpr std::size_t kMaxBusName = 15;  // the IDL key is string<15>; IFNAMSIZ - 1 too
 
@@ -412,14 +414,14 @@ void parse_timeouts(const Ctx& c, const YAML::Node& n, Timeouts& t) {
     c.fail(n["offline_periods"] ? n["offline_periods"] : n, "offline_periods must be greater than stale_periods");
 }
 
-void parse_ros2(const Ctx& c, const YAML::Node& n, Ros2Settings& r) {
+void parse_ros2(const Ctx& c, const YAML::Node& n, dds::Ros2Settings& r) {
   if (!n.IsMap()) c.fail(n, "ros2 must be a map: {enabled: true, namespace: /fleet}");
   c.only_keys(n, "ros2", {"enabled", "namespace"});
   r.source_line = c.line_of(n);
   if (const auto v = n["enabled"]) r.enabled = c.scalar<bool>(v, "ros2 enabled", "true or false");
   if (const auto v = n["namespace"]) {
     if (!v.IsNull()) r.name_space = c.scalar<std::string>(v, "ros2 namespace", "a ROS 2 namespace");
-    if (const auto why = ros2_namespace_problem(r.name_space); !why.empty())
+    if (const auto why = dds::ros2_namespace_problem(r.name_space); !why.empty())
       c.fail(v, "ros2 namespace " + quoted(r.name_space) + " " + why);
   }
 }
@@ -733,7 +735,7 @@ Config parse_config(const std::string& text, const std::string& source, const Co
   if (const auto v = root["vehicle"]) {
     // `vehicle:` with nothing after it is YAML null: the unnamed vehicle, like no key.
     if (!v.IsNull()) cfg.vehicle = c.scalar<std::string>(v, "vehicle", "a name");
-    if (const auto why = vehicle_name_problem(cfg.vehicle); !why.empty())
+    if (const auto why = dds::vehicle_name_problem(cfg.vehicle); !why.empty())
       c.fail(v, "vehicle " + quoted(cfg.vehicle) + " " + why);
   }
   if (const auto v = root["low_rate_period"]) {
@@ -814,27 +816,27 @@ Config parse_config(const std::string& text, const std::string& source, const Co
   for (const auto& bn : buses) {
     BusConfig b = parse_bus(c, bn);
     b.canopen_publish_period = canopen_publish_period;
-    // The QoS profiles hold kMaxDevicesPerService instances per writer; past that Fast DDS
+    // The QoS profiles hold dds::kMaxDevicesPerService instances per writer; past that Fast DDS
     // would refuse the extra PMUs' samples at run time.
-    if (devices + b.devices.size() > kMaxDevicesPerService)
-      c.fail(bn["devices"][kMaxDevicesPerService - devices],
-             "more than " + std::to_string(kMaxDevicesPerService) +
+    if (devices + b.devices.size() > dds::kMaxDevicesPerService)
+      c.fail(bn["devices"][dds::kMaxDevicesPerService - devices],
+             "more than " + std::to_string(dds::kMaxDevicesPerService) +
                  " devices in one service (the capacity its DDS writers are sized for, "
-                 "pmu::service::kMaxDevicesPerService); split them across services");
+                 "pmu::dds::kMaxDevicesPerService); split them across services");
     devices += b.devices.size();
     // Batteries and MPPTs are instances of pmu/health too.
     const std::size_t canopen = b.batteries.size() + b.mppts.size();
-    if (devices + canopen > kMaxDevicesPerService)
+    if (devices + canopen > dds::kMaxDevicesPerService)
       c.fail(bn[b.batteries.empty() ? "mppts" : "batteries"],
-             "more than " + std::to_string(kMaxDevicesPerService) +
+             "more than " + std::to_string(dds::kMaxDevicesPerService) +
                  " devices (PMUs, batteries and MPPTs) in one service (the capacity its DDS writers are sized for, "
-                 "pmu::service::kMaxDevicesPerService); split them across services");
+                 "pmu::dds::kMaxDevicesPerService); split them across services");
     devices += canopen;
     if (!names.insert(b.name).second) c.fail(bn, "bus name " + quoted(b.name) + " appears twice");
     // ROS 2 names allow fewer characters than bus names: two buses must not share one.
-    if (cfg.ros2.enabled && !ros2_names.emplace(ros2_token(b.name), b.name).second)
-      c.fail(bn, "bus names " + quoted(ros2_names[ros2_token(b.name)]) + " and " + quoted(b.name) +
-                     " are both " + quoted(ros2_token(b.name)) + " in ROS 2 topic names (ros2 enabled); rename one");
+    if (cfg.ros2.enabled && !ros2_names.emplace(dds::ros2_token(b.name), b.name).second)
+      c.fail(bn, "bus names " + quoted(ros2_names[dds::ros2_token(b.name)]) + " and " + quoted(b.name) +
+                     " are both " + quoted(dds::ros2_token(b.name)) + " in ROS 2 topic names (ros2 enabled); rename one");
     if (b.interface != "sim" && !interfaces.insert(b.interface).second)
       c.fail(bn, "interface " + quoted(b.interface) + " is used by two buses (the service owns each bus alone)");
     cfg.buses.push_back(std::move(b));

@@ -7,7 +7,7 @@
 #include <atomic>
 #include <mutex>
 
-#include "pmu/config/vehicle.hpp"
+#include "pmu/dds_settings/vehicle.hpp"
 #include "pmu/dds/zero_padded_type.hpp"
 #include "pmu/idl/alarms.h"
 #include "pmu/idl/alarmsPubSubTypes.h"
@@ -70,7 +70,7 @@ struct DdsAlarmAckEndpoint::Impl final : public DataReaderListener {
                             static_cast<std::int64_t>(static_cast<std::uint32_t>(s.kind())), s.device(), s.code().to_string(),
                             s.expires_at()};
       const auto partitions = dds.remote_writers().partitions_of(info);
-      if (partitions && partitions_address_only(*partitions, vehicle)) {
+      if (partitions && dds::partitions_address_only(*partitions, vehicle)) {
         service->submit(sample);
         continue;
       }

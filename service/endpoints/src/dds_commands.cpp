@@ -11,7 +11,7 @@
 #include <mutex>
 #include <vector>
 
-#include "pmu/config/vehicle.hpp"
+#include "pmu/dds_settings/vehicle.hpp"
 #include "pmu/dds/zero_padded_type.hpp"
 #include "pmu/dispatch/command_service.hpp"
 #include "pmu/endpoints/command_cdr.hpp"
@@ -72,9 +72,9 @@ struct DdsCommandEndpoint::Impl final : public DataReaderListener {
       why = "is for vehicle '" + printable(s.vehicle) + "'";
     } else if (!partitions) {
       why = "came from a writer discovery never reported (its partitions are unknown)";
-    } else if (!partitions_address_only(*partitions, vehicle)) {
+    } else if (!dds::partitions_address_only(*partitions, vehicle)) {
       why = "was written in " + partition_list(*partitions) + ", not in " +
-            partition_list(vehicle_partitions(vehicle)) + " alone";
+            partition_list(dds::vehicle_partitions(vehicle)) + " alone";
     } else {
       return true;
     }

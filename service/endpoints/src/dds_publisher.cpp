@@ -13,7 +13,7 @@
 #include <tuple>
 #include <utility>
 
-#include "pmu/config/capacity.hpp"
+#include "pmu/dds_settings/capacity.hpp"
 #include "pmu/config/low_rate.hpp"
 #include "pmu/dds/baseline_sample.hpp"
 #include "pmu/dds/no_value.hpp"
@@ -203,7 +203,7 @@ DdsPublisher::~DdsPublisher() = default;
 bool DdsPublisher::admit(const DeviceKey& key) {
   const auto id = std::make_tuple(key.bus, key.kind, key.address);
   if (w_->admitted.count(id)) return true;
-  if (w_->admitted.size() < service::kMaxDevicesPerService) {
+  if (w_->admitted.size() < dds::kMaxDevicesPerService) {
     w_->admitted.insert(id);
     if (key.kind == DeviceKind::Pmu && !w_->with_baseline.count({key.bus, key.address})) dispose_baseline(key);
     return true;
@@ -214,7 +214,7 @@ bool DdsPublisher::admit(const DeviceKey& key) {
     spdlog::error("{}/{}: not published on DDS: this service already publishes {} PMUs, the capacity its DDS "
                   "writers are sized for (kMaxDevicesPerService); {} sample(s) of PMUs over capacity not "
                   "published so far{}",
-                  key.bus, key.address, service::kMaxDevicesPerService, refused,
+                  key.bus, key.address, dds::kMaxDevicesPerService, refused,
                   *held ? " (" + std::to_string(*held) + " such messages held back)" : std::string());
   return false;
 }
@@ -264,7 +264,7 @@ void DdsPublisher::publish_baselines(const std::vector<BusConfig>& buses) {
         continue;
       }
       if (!admit(key)) continue;
-      auto s = baseline_sample(w_->vehicle, b.name, d);
+      auto s = baseline_sample(w_->vehicle, b.name, d.address, d.baseline_file, d.baseline);
       write_at(w_->baseline, &s, key, std::chrono::system_clock::now());
     }
 }

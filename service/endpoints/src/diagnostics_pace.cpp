@@ -1,6 +1,6 @@
 #include "pmu/endpoints/diagnostics_pace.hpp"
 
-namespace pmu::dds {
+namespace pmu::service {
 
 bool operator==(const ShownStatus& a, const ShownStatus& b) noexcept {
   return a.level == b.level && a.message == b.message;
@@ -26,4 +26,4 @@ bool DiagnosticsPace::at_once(TimePoint now) noexcept {
   return true;
 }
 
-}  // namespace pmu::dds
+}  // namespace pmu::service

@@ -5,7 +5,7 @@
 
 #include "pmu/alarms/alarm_table.hpp"
 
-namespace pmu::dds {
+namespace pmu::service {
 namespace ros2_messages {
 
 namespace Bs = sensor_msgs::msg::BatteryState_Constants;
@@ -25,12 +25,12 @@ std::uint8_t supply_status(double current, double soc_percent) {
 // What the battery's own alarms say of its health, the worst first: over-temperature, then a
 // critical low (voltage or charge: the battery is spent), then any other fault of the pack.
 // Nothing is known of the health of a battery that is not there.
-std::uint8_t supply_health(bool present, service::HealthState health, const std::vector<service::AlarmReport>& active,
+std::uint8_t supply_health(bool present, HealthState health, const std::vector<AlarmReport>& active,
                            const std::vector<Code>& overheat, const std::vector<Code>& dead,
                            const std::vector<Code>& failure) {
-  if (!present || health != service::HealthState::Online) return Bs::POWER_SUPPLY_HEALTH_UNKNOWN;
+  if (!present || health != HealthState::Online) return Bs::POWER_SUPPLY_HEALTH_UNKNOWN;
   auto any = [&](const std::vector<Code>& codes) {
-    return std::any_of(active.begin(), active.end(), [&](const service::AlarmReport& a) {
+    return std::any_of(active.begin(), active.end(), [&](const AlarmReport& a) {
       return alarm_active(a) && std::find(codes.begin(), codes.end(), a.code) != codes.end();
     });
   };
@@ -40,8 +40,8 @@ std::uint8_t supply_health(bool present, service::HealthState health, const std:
   return Bs::POWER_SUPPLY_HEALTH_GOOD;
 }
 
-double slot(const service::BatteryState& b, std::string_view name) {
-  const auto i = service::battery_slot(name);
+double slot(const BatteryState& b, std::string_view name) {
+  const auto i = battery_slot(name);
   return i ? b.values[*i] : kUnknown;
 }
 
@@ -61,7 +61,7 @@ std::string seconds_text(double s) {
 
 }  // namespace ros2_messages
 
-bool alarm_active(const service::AlarmReport& a) noexcept {
+bool alarm_active(const AlarmReport& a) noexcept {
   return a.state == alarms::AlarmState::ActiveUnacknowledged || a.state == alarms::AlarmState::ActiveAcknowledged;
 }
 
@@ -143,26 +143,26 @@ diagnostic_msgs::msg::DiagnosticStatus device_status(const DeviceDiagnosticsView
   diagnostic_msgs::msg::DiagnosticStatus s;
   s.name(v.name);
   s.hardware_id(v.hardware_id);
-  std::vector<const service::AlarmReport*> active;
+  std::vector<const AlarmReport*> active;
   for (const auto& a : v.active)
     if (alarm_active(a)) active.push_back(&a);
   std::stable_sort(active.begin(), active.end(), [](const auto* x, const auto* y) {
     return x->severity == alarms::Severity::Critical && y->severity != alarms::Severity::Critical;
   });
   switch (v.health.state) {
-    case service::HealthState::Unknown:
+    case HealthState::Unknown:
       s.level(Ds::STALE);
       s.message("no frame yet");
       break;
-    case service::HealthState::Stale:
+    case HealthState::Stale:
       s.level(Ds::STALE);
-      s.message("stale: " + service::last_frame_text(v.health.last_frame_age));
+      s.message("stale: " + last_frame_text(v.health.last_frame_age));
       break;
-    case service::HealthState::Offline:
+    case HealthState::Offline:
       s.level(Ds::ERROR);
-      s.message("offline: " + service::last_frame_text(v.health.last_frame_age));
+      s.message("offline: " + last_frame_text(v.health.last_frame_age));
       break;
-    case service::HealthState::Online:
+    case HealthState::Online:
       if (active.empty()) {
         s.level(Ds::OK);
         s.message("online");
@@ -173,7 +173,7 @@ diagnostic_msgs::msg::DiagnosticStatus device_status(const DeviceDiagnosticsView
       }
       break;
   }
-  add(s, "state", service::to_string(v.health.state));
+  add(s, "state", to_string(v.health.state));
   add(s, "last_frame_age_s", seconds_text(v.health.last_frame_age));
   add(s, "frames_received", std::to_string(v.health.frames_received));
   add(s, "frames_sent", std::to_string(v.health.frames_sent));
@@ -193,4 +193,4 @@ diagnostic_msgs::msg::DiagnosticStatus device_status(const DeviceDiagnosticsView
   return s;
 }
 
-}  // namespace pmu::dds
+}  // namespace pmu::service

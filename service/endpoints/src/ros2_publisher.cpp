@@ -11,19 +11,17 @@
 #include "pmu/session/log_throttle.hpp"
 #include "sensor_msgs/msg/BatteryStatePubSubTypes.h"
 
-namespace pmu::dds {
+namespace pmu::service {
 
 using eprosima::fastdds::dds::DataWriter;
 using eprosima::fastdds::dds::DataWriterQos;
-using service::DeviceKey;
-using service::DeviceKind;
-using service::Ros2Device;
+using dds::Ros2Device;
 
 namespace ros2_publisher {
 
 using Key = std::tuple<std::string, std::uint16_t, DeviceKind>;
 Key key_of(const DeviceKey& k) { return {k.bus, k.address, k.kind}; }
-Key key_of(const service::AlarmReport& a) {
+Key key_of(const AlarmReport& a) {
   const DeviceKind kind = a.source == alarms::DeviceKind::Battery ? DeviceKind::Battery
                           : a.source == alarms::DeviceKind::Mppt  ? DeviceKind::Mppt
                                                                   : DeviceKind::Pmu;
@@ -34,8 +32,8 @@ Ros2Device ros2_kind(DeviceKind k) {
 }
 
 struct Device {
-  service::HealthReport health;
-  std::map<alarms::Code, service::AlarmReport> alarms;  // the newest report of each code
+  HealthReport health;
+  std::map<alarms::Code, AlarmReport> alarms;  // the newest report of each code
   // PMU
   codec::Voltages voltages;
   bool voltages_known = false;
@@ -46,14 +44,14 @@ struct Device {
   DataWriter* battery_a = nullptr;
   DataWriter* battery_b = nullptr;
   // BMS
-  service::BatteryCellsState cells;
+  BatteryCellsState cells;
   DataWriter* battery = nullptr;
   // A battery writer Fast DDS refused (DDS-Security permissions) is not asked for again with
   // every frame: refused once, said once.
   bool refused = false;
 
-  std::vector<service::AlarmReport> active() const {
-    std::vector<service::AlarmReport> out;
+  std::vector<AlarmReport> active() const {
+    std::vector<AlarmReport> out;
     for (const auto& [code, a] : alarms)
       if (alarm_active(a)) out.push_back(a);
     return out;
@@ -74,9 +72,9 @@ DataWriterQos ros2_writer_qos() {
 }
 
 struct Ros2Publisher::State {
-  DdsContext& dds;
+  dds::DdsContext& dds;
   const transport::Clock& clock;
-  service::Ros2Settings settings;
+  dds::Ros2Settings settings;
   std::string vehicle;
   std::map<std::pair<std::string, std::uint8_t>, double> capacity_ah;  // (bus, node)
   std::mutex mutex;
@@ -88,21 +86,21 @@ struct Ros2Publisher::State {
   std::map<ros2_publisher::Key, diagnostic_msgs::msg::DiagnosticStatus> statuses;
   DiagnosticsPace diagnostics_pace;
   std::uint64_t failures = 0;
-  service::LogThrottle failure_reports{std::chrono::seconds(5)};
+  LogThrottle failure_reports{std::chrono::seconds(5)};
 
-  State(DdsContext& d, const transport::Clock& c, service::Ros2Settings s, std::string v)
+  State(dds::DdsContext& d, const transport::Clock& c, dds::Ros2Settings s, std::string v)
       : dds(d), clock(c), settings(std::move(s)), vehicle(std::move(v)) {}
 
   std::string name_of(const DeviceKey& k) const {
-    return service::ros2_status_name(settings.name_space, vehicle, k.bus, ros2_publisher::ros2_kind(k.kind), k.address);
+    return dds::ros2_status_name(settings.name_space, vehicle, k.bus, ros2_publisher::ros2_kind(k.kind), k.address);
   }
   DataWriter* battery_writer(const DeviceKey& k, const char* leaf) {
     const std::string ros_name =
-        service::ros2_device_namespace(settings.name_space, vehicle, k.bus, ros2_publisher::ros2_kind(k.kind), k.address) + "/" + leaf;
+        dds::ros2_device_namespace(settings.name_space, vehicle, k.bus, ros2_publisher::ros2_kind(k.kind), k.address) + "/" + leaf;
     try {
-      auto& topic = dds.topic(service::ros2_dds_topic(ros_name), zero_padded<sensor_msgs::msg::BatteryStatePubSubType>());
+      auto& topic = dds.topic(dds::ros2_dds_topic(ros_name), dds::zero_padded<sensor_msgs::msg::BatteryStatePubSubType>());
       return &dds.default_partition_writer(topic, ros2_writer_qos());
-    } catch (const DdsError& e) {
+    } catch (const dds::DdsError& e) {
       failed(ros_name.c_str(), e.what());
       return nullptr;
     }
@@ -113,7 +111,7 @@ struct Ros2Publisher::State {
   }
   void failed(const char* what, const char* why) {
     ++failures;
-    if (failure_reports.allow(service::LogThrottle::Clock::now()))
+    if (failure_reports.allow(LogThrottle::Clock::now()))
       spdlog::warn("ROS 2: {}: {} ({} failure(s) so far)", what, why, failures);
   }
   void write_diagnostics() {
@@ -142,7 +140,7 @@ struct Ros2Publisher::State {
     }
   }
   // `values` NaN throughout: the message of a device that is gone.
-  void write_bms(const DeviceKey& k, ros2_publisher::Device& d, const service::BatteryState& values,
+  void write_bms(const DeviceKey& k, ros2_publisher::Device& d, const BatteryState& values,
                  std::chrono::system_clock::time_point at) {
     if (!d.refused && !d.battery) d.battery = battery_writer(k, "battery");
     d.refused = !d.battery;
@@ -161,13 +159,13 @@ struct Ros2Publisher::State {
   }
 };
 
-Ros2Publisher::Ros2Publisher(DdsContext& dds, const service::Ros2Settings& settings, std::string vehicle,
-                             const std::vector<service::BusConfig>& buses, const transport::Clock& clock)
+Ros2Publisher::Ros2Publisher(dds::DdsContext& dds, const dds::Ros2Settings& settings, std::string vehicle,
+                             const std::vector<BusConfig>& buses, const transport::Clock& clock)
     : s_(std::make_unique<State>(dds, clock, settings, std::move(vehicle))) {
   for (const auto& b : buses)
     for (const auto& battery : b.batteries)
       if (battery.capacity_ah) s_->capacity_ah[{b.name, battery.node}] = *battery.capacity_ah;
-  auto& topic = dds.topic("rt/diagnostics", zero_padded<diagnostic_msgs::msg::DiagnosticArrayPubSubType>());
+  auto& topic = dds.topic("rt/diagnostics", dds::zero_padded<diagnostic_msgs::msg::DiagnosticArrayPubSubType>());
   s_->diagnostics = &dds.default_partition_writer(topic, ros2_writer_qos());
 }
 
@@ -195,7 +193,7 @@ void Ros2Publisher::on_telemetry(const DeviceKey& key, const codec::PmuMessage& 
   }
 }
 
-void Ros2Publisher::on_info(const DeviceKey& key, const service::InfoState& info) {
+void Ros2Publisher::on_info(const DeviceKey& key, const InfoState& info) {
   std::lock_guard<std::mutex> lock(s_->mutex);
   auto& d = s_->devices[ros2_publisher::key_of(key)];
   d.serial = info.serial_number;
@@ -203,7 +201,7 @@ void Ros2Publisher::on_info(const DeviceKey& key, const service::InfoState& info
     d.firmware = std::to_string(info.firmware.firmware_major) + "." + std::to_string(info.firmware.firmware_minor);
 }
 
-void Ros2Publisher::on_health(const DeviceKey& key, const service::HealthReport& health) {
+void Ros2Publisher::on_health(const DeviceKey& key, const HealthReport& health) {
   std::lock_guard<std::mutex> lock(s_->mutex);
   auto& d = s_->devices[ros2_publisher::key_of(key)];
   d.health = health;
@@ -246,30 +244,30 @@ void Ros2Publisher::on_gone(const DeviceKey& key) {
   fresh.battery_b = it->second.battery_b;
   fresh.battery = it->second.battery;
   fresh.refused = it->second.refused;
-  fresh.health.state = service::HealthState::Offline;
+  fresh.health.state = HealthState::Offline;
   it->second = std::move(fresh);
   auto& d = it->second;
   const auto now = s_->clock.system_now();
   if (d.battery_a || d.battery_b) s_->write_pmu_batteries(key, d, now);
-  if (d.battery) s_->write_bms(key, d, service::BatteryState{}, now);
+  if (d.battery) s_->write_bms(key, d, BatteryState{}, now);
 }
 
-void Ros2Publisher::on_battery(const DeviceKey& key, const service::BatteryState& battery,
+void Ros2Publisher::on_battery(const DeviceKey& key, const BatteryState& battery,
                                std::chrono::system_clock::time_point newest) {
   std::lock_guard<std::mutex> lock(s_->mutex);
   s_->write_bms(key, s_->devices[ros2_publisher::key_of(key)], battery, newest);
 }
 
-void Ros2Publisher::on_battery_cells(const DeviceKey& key, const service::BatteryCellsState& cells,
+void Ros2Publisher::on_battery_cells(const DeviceKey& key, const BatteryCellsState& cells,
                                      std::chrono::system_clock::time_point) {
   std::lock_guard<std::mutex> lock(s_->mutex);
   s_->devices[ros2_publisher::key_of(key)].cells = cells;
 }
 
-void Ros2Publisher::on_alarm(const service::AlarmReport& alarm) {
+void Ros2Publisher::on_alarm(const AlarmReport& alarm) {
   if (alarm.source == alarms::DeviceKind::Bus) return;  // a bus is no device of /diagnostics
   std::lock_guard<std::mutex> lock(s_->mutex);
   s_->devices[ros2_publisher::key_of(alarm)].alarms[alarm.code] = alarm;
 }
 
-}  // namespace pmu::dds
+}  // namespace pmu::service

@@ -21,7 +21,7 @@ bool same(const std::vector<ReadinessReason>& a, const std::vector<ReadinessReas
 
 ReadinessTracker::ReadinessTracker(const std::vector<BusConfig>& buses, double stale_periods, StateSink& next,
                                    const transport::Clock& clock)
-    : stale_periods_(stale_periods), next_(next), clock_(clock) {
+    : ForwardingSink(next), stale_periods_(stale_periods), clock_(clock) {
   for (const auto& b : buses) buses_[b.name] = b;
   report_.since = clock_.system_now();
 }
@@ -72,7 +72,7 @@ void ReadinessTracker::refresh_inputs(const Key& key, DeviceView& v) {
 
 void ReadinessTracker::on_telemetry(const DeviceKey& key, const codec::PmuMessage& message,
                                     std::chrono::system_clock::time_point received) {
-  next_.on_telemetry(key, message, received);
+  next().on_telemetry(key, message, received);
   const auto index = static_cast<std::size_t>(message.packet);
   if (key.kind != DeviceKind::Pmu || index >= DeviceView{}.received.size()) return;
   std::lock_guard<std::mutex> lock(mutex_);
@@ -87,7 +87,7 @@ void ReadinessTracker::on_telemetry(const DeviceKey& key, const codec::PmuMessag
 }
 
 void ReadinessTracker::on_config(const DeviceKey& key, const ConfigState& config) {
-  next_.on_config(key, config);
+  next().on_config(key, config);
   std::lock_guard<std::mutex> lock(mutex_);
   auto& v = view_of(key);
   v.settings = settings_of(config);
@@ -131,7 +131,7 @@ void ReadinessTracker::log_drift(const DeviceKey& key, const DeviceView& v) {
 }
 
 void ReadinessTracker::on_info(const DeviceKey& key, const InfoState& info) {
-  next_.on_info(key, info);
+  next().on_info(key, info);
   std::lock_guard<std::mutex> lock(mutex_);
   auto& v = view_of(key);
   if (info.firmware_known) v.firmware = info.firmware.version();
@@ -141,7 +141,7 @@ void ReadinessTracker::on_info(const DeviceKey& key, const InfoState& info) {
 }
 
 void ReadinessTracker::on_health(const DeviceKey& key, const HealthReport& health) {
-  next_.on_health(key, health);
+  next().on_health(key, health);
   std::lock_guard<std::mutex> lock(mutex_);
   auto& v = view_of(key);
   v.state = health.state;
@@ -150,7 +150,7 @@ void ReadinessTracker::on_health(const DeviceKey& key, const HealthReport& healt
 }
 
 void ReadinessTracker::on_gone(const DeviceKey& key) {
-  next_.on_gone(key);
+  next().on_gone(key);
   std::lock_guard<std::mutex> lock(mutex_);
   // A unit that moved to another address: its new key reports on its own.
   input_.devices.erase(Key{key.bus, key.kind, key.address});
@@ -160,7 +160,7 @@ void ReadinessTracker::on_gone(const DeviceKey& key) {
 }
 
 void ReadinessTracker::on_alarm(const AlarmReport& alarm) {
-  next_.on_alarm(alarm);
+  next().on_alarm(alarm);
   std::lock_guard<std::mutex> lock(mutex_);
   const auto id = std::make_tuple(alarm.bus, alarm.source, alarm.device, alarm.code);
   if (auto it = alarm_index_.find(id); it != alarm_index_.end()) {
@@ -189,7 +189,7 @@ void ReadinessTracker::update(bool force) {
   report_.ready = ready;
   report_.reasons = std::move(reasons);
   last_sent_ = now;
-  next_.on_readiness(report_);
+  next().on_readiness(report_);
 }
 
 }  // namespace pmu::service

@@ -9,7 +9,7 @@
 #include <string>
 
 #include "pmu/config/config.hpp"
-#include "pmu/config/statistics_settings.hpp"
+#include "pmu/dds_settings/statistics_settings.hpp"
 
 namespace pmu::service {
 namespace {
@@ -462,21 +462,21 @@ std::string many_devices(int n) {
 }
 
 TEST(Config, AsManyDevicesAsTheDdsWritersHoldAreAccepted) {
-  const Config c = parse_config(many_devices(static_cast<int>(kMaxDevicesPerService)), "fleet.yaml");
+  const Config c = parse_config(many_devices(static_cast<int>(dds::kMaxDevicesPerService)), "fleet.yaml");
   ASSERT_EQ(c.buses.size(), 2u);
-  EXPECT_EQ(c.buses[0].devices.size() + c.buses[1].devices.size(), kMaxDevicesPerService);
+  EXPECT_EQ(c.buses[0].devices.size() + c.buses[1].devices.size(), dds::kMaxDevicesPerService);
 }
 
 TEST(Config, MoreDevicesThanTheDdsWritersHoldAreRefusedAtTheFirstOneTooMany) {
   // 257 devices: can0 has 1..128 (lines 4..131), can1 header lines 132-133, then 129..257;
   // the 257th is on line 133 + 129 = 262.
   try {
-    (void)parse_config(many_devices(static_cast<int>(kMaxDevicesPerService) + 1), "fleet.yaml");
+    (void)parse_config(many_devices(static_cast<int>(dds::kMaxDevicesPerService) + 1), "fleet.yaml");
     ADD_FAILURE() << "accepted";
   } catch (const ConfigError& e) {
     EXPECT_EQ(std::string(e.what()),
               "fleet.yaml:262: more than 256 devices in one service (the capacity its DDS writers are sized for, "
-              "pmu::service::kMaxDevicesPerService); split them across services");
+              "pmu::dds::kMaxDevicesPerService); split them across services");
   }
 }
 
@@ -484,7 +484,7 @@ TEST(Config, BatteriesAndMpptsCountTowardsTheDevicesTheDdsWritersHold) {
   // 255 PMUs leave room for one more pmu/health instance: a battery fits, a battery and an
   // MPPT do not. can0 holds 1..127 (lines 4..130), can1 128..255 (lines 133..260), then
   // `batteries:` (261) and its list (262).
-  const std::string pmus = many_devices(static_cast<int>(kMaxDevicesPerService) - 1);
+  const std::string pmus = many_devices(static_cast<int>(dds::kMaxDevicesPerService) - 1);
   const Config c = parse_config(pmus + "    batteries:\n      - node: 2\n", "fleet.yaml");
   EXPECT_EQ(c.buses[1].batteries.size(), 1u);
   try {
@@ -493,7 +493,7 @@ TEST(Config, BatteriesAndMpptsCountTowardsTheDevicesTheDdsWritersHold) {
   } catch (const ConfigError& e) {
     EXPECT_EQ(std::string(e.what()),
               "fleet.yaml:262: more than 256 devices (PMUs, batteries and MPPTs) in one service (the capacity its DDS "
-              "writers are sized for, pmu::service::kMaxDevicesPerService); split them across services");
+              "writers are sized for, pmu::dds::kMaxDevicesPerService); split them across services");
   }
 }
 

@@ -4,7 +4,7 @@
 
 #include <algorithm>
 
-#include "pmu/config/network_settings.hpp"
+#include "pmu/dds_settings/network_settings.hpp"
 
 namespace pmu::dds {
 namespace {

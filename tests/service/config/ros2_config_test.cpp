@@ -6,7 +6,7 @@
 #include <string>
 
 #include "pmu/config/config.hpp"
-#include "pmu/config/ros2_names.hpp"
+#include "pmu/dds_settings/ros2_names.hpp"
 
 namespace pmu::service {
 namespace {
@@ -32,9 +32,9 @@ TEST(Ros2Names, NamespacesFollowRos2sRules) {
       {"/a b", "contains ' '; a ROS 2 name is letters, digits, '_' and '/' between tokens"},
       {"~/x", "contains '~'; a ROS 2 name is letters, digits, '_' and '/' between tokens"},
   };
-  for (const auto& c : cases) EXPECT_EQ(ros2_namespace_problem(c.ns), c.problem) << c.ns;
-  EXPECT_NE(ros2_namespace_problem(std::string(151, 'a')), "");
-  EXPECT_EQ(ros2_namespace_problem(std::string(150, 'a')), "");
+  for (const auto& c : cases) EXPECT_EQ(dds::ros2_namespace_problem(c.ns), c.problem) << c.ns;
+  EXPECT_NE(dds::ros2_namespace_problem(std::string(151, 'a')), "");
+  EXPECT_EQ(dds::ros2_namespace_problem(std::string(150, 'a')), "");
 }
 
 TEST(Ros2Names, VehicleAndBusBecomeTokens) {
@@ -44,19 +44,19 @@ TEST(Ros2Names, VehicleAndBusBecomeTokens) {
   };
   const Case cases[] = {{"uav1", "uav1"}, {"uav-1", "uav_1"}, {"uav.1", "uav_1"}, {"1st", "_1st"},
                         {"can0", "can0"}, {"", ""},          {"A_b", "A_b"}};
-  for (const auto& c : cases) EXPECT_EQ(ros2_token(c.text), c.token) << c.text;
+  for (const auto& c : cases) EXPECT_EQ(dds::ros2_token(c.text), c.token) << c.text;
 }
 
 TEST(Ros2Names, DeviceTopicsAndStatusNames) {
-  EXPECT_EQ(ros2_device_namespace("", "uav1", "can0", Ros2Device::Pmu, 1), "/uav1/can0/pmu_1");
-  EXPECT_EQ(ros2_device_namespace("/", "uav1", "can0", Ros2Device::Pmu, 1), "/uav1/can0/pmu_1");
-  EXPECT_EQ(ros2_device_namespace("fleet", "uav-7", "can0", Ros2Device::Bms, 2), "/fleet/uav_7/can0/bms_2");
-  EXPECT_EQ(ros2_device_namespace("/fleet/a", "", "0can", Ros2Device::Mppt, 0), "/fleet/a/_0can/mppt_0");
-  EXPECT_EQ(ros2_dds_topic("/uav1/can0/pmu_1/battery_a"), "rt/uav1/can0/pmu_1/battery_a");
-  EXPECT_EQ(ros2_status_name("", "uav1", "can0", Ros2Device::Pmu, 3), "uav1/can0/pmu_3");
-  EXPECT_EQ(ros2_status_name("/fleet", "", "can0", Ros2Device::Bms, 2), "fleet/can0/bms_2");
+  EXPECT_EQ(dds::ros2_device_namespace("", "uav1", "can0", dds::Ros2Device::Pmu, 1), "/uav1/can0/pmu_1");
+  EXPECT_EQ(dds::ros2_device_namespace("/", "uav1", "can0", dds::Ros2Device::Pmu, 1), "/uav1/can0/pmu_1");
+  EXPECT_EQ(dds::ros2_device_namespace("fleet", "uav-7", "can0", dds::Ros2Device::Bms, 2), "/fleet/uav_7/can0/bms_2");
+  EXPECT_EQ(dds::ros2_device_namespace("/fleet/a", "", "0can", dds::Ros2Device::Mppt, 0), "/fleet/a/_0can/mppt_0");
+  EXPECT_EQ(dds::ros2_dds_topic("/uav1/can0/pmu_1/battery_a"), "rt/uav1/can0/pmu_1/battery_a");
+  EXPECT_EQ(dds::ros2_status_name("", "uav1", "can0", dds::Ros2Device::Pmu, 3), "uav1/can0/pmu_3");
+  EXPECT_EQ(dds::ros2_status_name("/fleet", "", "can0", dds::Ros2Device::Bms, 2), "fleet/can0/bms_2");
   // Every name made is a valid ROS 2 namespace (the same rules as a topic name).
-  EXPECT_EQ(ros2_namespace_problem(ros2_device_namespace("/f", "9-x.y", "b.1", Ros2Device::Pmu, 255)), "");
+  EXPECT_EQ(dds::ros2_namespace_problem(ros2_device_namespace("/f", "9-x.y", "b.1", dds::Ros2Device::Pmu, 255)), "");
 }
 
 TEST(Ros2Config, OffUnlessEnabledAndTheNamespaceIsKept) {

@@ -114,7 +114,7 @@ TEST(StartupCheck, AProfileShortOfTheCapacityIsNamedAtItsLine) {
   ASSERT_EQ(c.errors.size(), 1u);
   EXPECT_EQ(c.errors[0], "a.yaml:1: qos_file: " + qos +
                              ":29: <data_writer profile_name=\"telemetry\"> (the telemetry topics' writers): "
-                             "max_instances 10 < 256 (PMUs per service, pmu::service::kMaxDevicesPerService): raise "
+                             "max_instances 10 < 256 (PMUs per service, pmu::dds::kMaxDevicesPerService): raise "
                              "its <resourceLimitsQos> (deploy/qos.xml says how each number is derived)");
 }
 

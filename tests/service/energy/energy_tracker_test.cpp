@@ -98,6 +98,27 @@ TEST(EnergyTracker, PassesEveryEventOnAndReportsOncePerSecond) {
   for (std::size_t i = 1; i < sink.energy.size(); ++i) EXPECT_GE(sink.energy[i].at - sink.energy[i - 1].at, 1s);
 }
 
+TEST(EnergyTracker, HandsOnOnceEachEventItDerivesNothingFrom) {
+  RecordingSink sink;
+  EnergyTracker tracker(buses(), 3, sink);
+  const DeviceKey pmu{"can0", 1, DeviceKind::Pmu};
+  tracker.on_config(pmu, ConfigState{});
+  tracker.on_info(pmu, InfoState{});
+  tracker.on_health(pmu, HealthReport{});
+  tracker.on_battery_cells(DeviceKey{"can0", 2, DeviceKind::Battery}, BatteryCellsState{}, t0);
+  tracker.on_mppt(DeviceKey{"can0", 0, DeviceKind::Mppt}, MpptState{}, t0);
+  tracker.on_alarm(AlarmReport{});
+  tracker.on_readiness(ReadinessReport{});
+  tracker.on_energy(pmu, energy::Figures{}, t0);
+  tracker.on_bms_energy(DeviceKey{"can0", 2, DeviceKind::Battery}, energy::BmsFigures{}, t0);
+  const std::pair<const char*, std::size_t> handed_on[] = {
+      {"config", sink.configs.size()},   {"info", sink.infos.size()},       {"health", sink.healths.size()},
+      {"cells", sink.cells.size()},      {"mppt", sink.mppts.size()},       {"alarm", sink.alarms.size()},
+      {"readiness", sink.readiness.size()}, {"energy", sink.energy.size()}, {"bms_energy", sink.bms_energy.size()},
+  };
+  for (const auto& [event, count] : handed_on) EXPECT_EQ(count, 1u) << event;
+}
+
 TEST(EnergyTracker, AGoneDeviceStartsAgain) {
   RecordingSink sink;
   EnergyTracker tracker(buses(), 3, sink);

@@ -406,6 +406,24 @@ std::vector<std::string> messages_of(const ReadinessReport& r, std::uint16_t dev
   return out;
 }
 
+TEST(ReadinessTracker, HandsOnOnceEachEventItDoesNotWatch) {
+  transport::ManualClock clock;
+  RecordingSink next;
+  ReadinessTracker t({bus_with_min_firmware()}, Timeouts{}.stale_periods, next, clock);
+  const auto at = clock.system_now();
+  t.on_battery(DeviceKey{"can0", 2, DeviceKind::Battery}, BatteryState{}, at);
+  t.on_battery_cells(DeviceKey{"can0", 2, DeviceKind::Battery}, BatteryCellsState{}, at);
+  t.on_mppt(DeviceKey{"can0", 0, DeviceKind::Mppt}, MpptState{}, at);
+  t.on_readiness(ReadinessReport{});
+  t.on_energy(DeviceKey{"can0", 1, DeviceKind::Pmu}, energy::Figures{}, at);
+  t.on_bms_energy(DeviceKey{"can0", 2, DeviceKind::Battery}, energy::BmsFigures{}, at);
+  const std::pair<const char*, std::size_t> handed_on[] = {
+      {"battery", next.batteries.size()}, {"cells", next.cells.size()},   {"mppt", next.mppts.size()},
+      {"readiness", next.readiness.size()}, {"energy", next.energy.size()}, {"bms_energy", next.bms_energy.size()},
+  };
+  for (const auto& [event, count] : handed_on) EXPECT_EQ(count, 1u) << event;
+}
+
 TEST(ReadinessTracker, ReportsEveryChangeAndOnceASecondAndPassesEverythingOn) {
   transport::ManualClock clock;
   RecordingSink next;

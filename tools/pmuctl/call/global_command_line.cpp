@@ -7,7 +7,7 @@
 
 #include "pmu/codec/ids.hpp"
 #include "pmu/command/command.hpp"
-#include "pmu/config/vehicle.hpp"
+#include "pmu/dds_settings/vehicle.hpp"
 #include "pmu/sysconf_dir.hpp"
 #include "pmuctl/call/exit_status.hpp"
 #include "pmuctl/call/option_values.hpp"
@@ -58,7 +58,7 @@ bool setup_vehicle(GlobalOptions& g, const CLI::Option* option, const std::strin
     from = "PMU_VEHICLE";
   }
   if (!g.vehicle) return true;
-  if (const auto why = pmu::service::vehicle_name_problem(*g.vehicle); !why.empty()) {
+  if (const auto why = pmu::dds::vehicle_name_problem(*g.vehicle); !why.empty()) {
     std::fprintf(stderr, "pmuctl: %s '%s' %s\n", from, pmu::service::printable(*g.vehicle).c_str(), why.c_str());
     return false;
   }

@@ -8,7 +8,7 @@
 #include <optional>
 #include <string>
 
-#include "pmu/config/network_settings.hpp"
+#include "pmu/dds_settings/network_settings.hpp"
 #include "pmu/security/security_files.hpp"
 
 namespace pmu::tools {

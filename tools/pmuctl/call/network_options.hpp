@@ -17,7 +17,7 @@
 #include <string>
 #include <vector>
 
-#include "pmu/config/network_settings.hpp"
+#include "pmu/dds_settings/network_settings.hpp"
 
 namespace pmu::tools {
 

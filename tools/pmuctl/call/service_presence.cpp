@@ -12,7 +12,7 @@ namespace pmu::tools {
 namespace {
 
 // A service's writers sit in its vehicle's partition, or in none for the unnamed vehicle
-// (pmu/config/vehicle.hpp).
+// (pmu/dds_settings/vehicle.hpp).
 std::string vehicle_of(const std::vector<std::string>& partitions) {
   return partitions.empty() ? std::string() : partitions.front();
 }

@@ -2,7 +2,7 @@
 
 #include <vector>
 
-#include "pmu/config/ros2_names.hpp"
+#include "pmu/dds_settings/ros2_names.hpp"
 #include "pmu/ros2/msg_text.hpp"
 
 namespace pmu::tools {
@@ -44,7 +44,7 @@ std::optional<Ros2TopicName> ros2_topic_named(std::string_view name) {
 bool ros2_topic_of_vehicle(std::string_view dds_topic, std::string_view vehicle) {
   if (dds_topic == "rt/diagnostics") return true;
   const auto parts = segments(dds_topic);  // "rt", [ns...], vehicle, bus, device, battery
-  return !vehicle.empty() && parts.size() >= 5 && parts[parts.size() - 4] == service::ros2_token(vehicle);
+  return !vehicle.empty() && parts.size() >= 5 && parts[parts.size() - 4] == dds::ros2_token(vehicle);
 }
 
 const RecordedTopic* Ros2Topics::get(const Ros2TopicName& name) {

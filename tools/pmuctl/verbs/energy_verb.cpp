@@ -116,23 +116,10 @@ int run(const GlobalOptions& o) {
 
 int run_energy(const GlobalOptions& o) { return energy_verb::run(o); }
 
-namespace {
-
-class EnergyVerb : public Verb {
- public:
-  explicit EnergyVerb(CLI::App& app)
-      : energy_(app.add_subcommand(
-            "energy", "Power per output, generator power, energy used and endurance of each battery")) {}
-  bool chosen() const override { return energy_->parsed(); }
-  bool reads_state() const override { return true; }
-  int run(GlobalOptions& g) override { return run_energy(g); }
-
- private:
-  CLI::App* energy_;
-};
-
-}  // namespace
-
-std::unique_ptr<Verb> add_energy_verb(CLI::App& app) { return std::make_unique<EnergyVerb>(app); }
+std::unique_ptr<Verb> add_energy_verb(CLI::App& app) {
+  return add_state_reading_verb(app, "energy",
+                                "Power per output, generator power, energy used and endurance of each battery",
+                                run_energy);
+}
 
 }  // namespace pmu::tools

@@ -113,23 +113,10 @@ int run_preflight(const GlobalOptions& o) {
   return static_cast<int>(ready ? ExitStatus::Ok : ExitStatus::NotDone);
 }
 
-namespace {
-
-class PreflightVerb : public Verb {
- public:
-  explicit PreflightVerb(CLI::App& app)
-      : preflight_(app.add_subcommand(
-            "preflight", "Whether the vehicle may fly, and every reason it may not (exit 0 ready, 1 not)")) {}
-  bool chosen() const override { return preflight_->parsed(); }
-  bool reads_state() const override { return true; }
-  int run(GlobalOptions& g) override { return run_preflight(g); }
-
- private:
-  CLI::App* preflight_;
-};
-
-}  // namespace
-
-std::unique_ptr<Verb> add_preflight_verb(CLI::App& app) { return std::make_unique<PreflightVerb>(app); }
+std::unique_ptr<Verb> add_preflight_verb(CLI::App& app) {
+  return add_state_reading_verb(app, "preflight",
+                                "Whether the vehicle may fly, and every reason it may not (exit 0 ready, 1 not)",
+                                run_preflight);
+}
 
 }  // namespace pmu::tools

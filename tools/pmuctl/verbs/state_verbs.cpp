@@ -18,7 +18,7 @@
 
 #include "pmu/codec/parameters.hpp"
 #include "pmu/command/command.hpp"
-#include "pmu/config/vehicle.hpp"
+#include "pmu/dds_settings/vehicle.hpp"
 #include "pmu/dds/dds_context.hpp"
 #include "pmu/idl/alarmsPubSubTypes.h"
 #include "pmu/idl/canopenPubSubTypes.h"
@@ -289,8 +289,8 @@ class TypedTelemetryReader final : public TelemetryReader {
 }  // namespace
 
 pmu::dds::Partitions partitions_for(const GlobalOptions& o) {
-  return {service::vehicle_partitions(o.vehicle.value_or(std::string())),
-          o.vehicle ? service::vehicle_partitions(*o.vehicle) : service::every_vehicle_partitions()};
+  return {dds::vehicle_partitions(o.vehicle.value_or(std::string())),
+          o.vehicle ? dds::vehicle_partitions(*o.vehicle) : dds::every_vehicle_partitions()};
 }
 
 std::string device_label(const std::string& vehicle, const std::string& bus, std::uint16_t address) {

@@ -17,7 +17,7 @@ namespace pmu::tools {
 // The end of the call's wait: o.deadline, else --timeout or `default_timeout` s from now.
 std::chrono::steady_clock::time_point wait_end(const GlobalOptions& o, double default_timeout);
 
-// The partitions of pmuctl's participant for these options (pmu/config/vehicle.hpp).
+// The partitions of pmuctl's participant for these options (pmu/dds_settings/vehicle.hpp).
 pmu::dds::Partitions partitions_for(const GlobalOptions& o);
 // "uav1/can0/1", or "can0/1" for the unnamed vehicle.
 std::string device_label(const std::string& vehicle, const std::string& bus, std::uint16_t address);

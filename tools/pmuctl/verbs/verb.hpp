@@ -45,4 +45,9 @@ class Verb {
   virtual int run(GlobalOptions& g) = 0;
 };
 
+// A verb of one subcommand with no options of its own that reads state (energy, preflight):
+// `name` and `description` are the subcommand's as --help shows them, `run` the whole call.
+std::unique_ptr<Verb> add_state_reading_verb(CLI::App& app, const char* name, const char* description,
+                                             int (*run)(const GlobalOptions&));
+
 }  // namespace pmu::tools

@@ -40,8 +40,8 @@
 #include <string>
 #include <vector>
 
-#include "pmu/config/network_settings.hpp"
-#include "pmu/config/transport_choice.hpp"
+#include "pmu/dds_settings/network_settings.hpp"
+#include "pmu/dds_settings/transport_choice.hpp"
 #include "pmu/dds/contract_names.hpp"
 #include "pmu/dds/dds_remote_writers.hpp"
 #include "pmu/security/security_files.hpp"

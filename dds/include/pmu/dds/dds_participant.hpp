@@ -43,8 +43,8 @@
 #include <string>
 #include <vector>
 
-#include "pmu/config/network_settings.hpp"
-#include "pmu/config/transport_choice.hpp"
+#include "pmu/dds_settings/network_settings.hpp"
+#include "pmu/dds_settings/transport_choice.hpp"
 #include "pmu/security/security_files.hpp"
 
 namespace pmu::dds {

@@ -23,7 +23,7 @@ double value_of(const BatteryState& battery, std::string_view name) {
 }  // namespace
 
 EnergyTracker::EnergyTracker(const std::vector<BusConfig>& buses, double stale_periods, StateSink& next)
-    : stale_periods_(stale_periods), next_(next) {
+    : ForwardingSink(next), stale_periods_(stale_periods) {
   for (const auto& b : buses) buses_[b.name] = b;
 }
 
@@ -66,7 +66,7 @@ std::chrono::nanoseconds EnergyTracker::max_gap(std::chrono::milliseconds period
 
 void EnergyTracker::on_telemetry(const DeviceKey& key, const codec::PmuMessage& message,
                                  std::chrono::system_clock::time_point received) {
-  next_.on_telemetry(key, message, received);
+  next().on_telemetry(key, message, received);
   if (key.kind != DeviceKind::Pmu || message.request) return;
   const auto* volts = std::get_if<codec::Voltages>(&message.payload);
   const auto* amps = std::get_if<codec::Currents>(&message.payload);
@@ -75,23 +75,23 @@ void EnergyTracker::on_telemetry(const DeviceKey& key, const codec::PmuMessage& 
   auto& e = energy_of(key);
   if (volts) e.on_voltages(received, *volts);
   if (amps) e.on_currents(received, *amps);
-  if (const auto figures = e.report(received)) next_.on_energy(key, *figures, received);
+  if (const auto figures = e.report(received)) next().on_energy(key, *figures, received);
 }
 
 void EnergyTracker::on_battery(const DeviceKey& key, const BatteryState& battery,
                                std::chrono::system_clock::time_point newest) {
-  next_.on_battery(key, battery, newest);
+  next().on_battery(key, battery, newest);
   if (key.kind != DeviceKind::Battery) return;
   const energy::BmsReading reading{value_of(battery, "voltage"), value_of(battery, "current"),
                                    value_of(battery, "state_of_charge")};
   std::lock_guard<std::mutex> lock(mutex_);
   auto& e = bms_energy_of(key);
   e.on_sample(newest, reading);
-  if (const auto figures = e.report(newest)) next_.on_bms_energy(key, *figures, newest);
+  if (const auto figures = e.report(newest)) next().on_bms_energy(key, *figures, newest);
 }
 
 void EnergyTracker::on_gone(const DeviceKey& key) {
-  next_.on_gone(key);
+  next().on_gone(key);
   std::lock_guard<std::mutex> lock(mutex_);
   // A PMU that moved starts again at its new address: what was integrated here stays with
   // the instance that was disposed.

@@ -9,7 +9,7 @@
 #include <utility>
 #include <vector>
 
-#include "pmu/session/device_state.hpp"
+#include "pmu/session/state_sink.hpp"
 
 namespace pmu::service {
 

@@ -32,6 +32,9 @@ namespace pmu::baseline {
 
 // The largest PMU configuration file read (interface.md 4.6): a full one is under 1 KiB.
 inline constexpr std::size_t kMaxConfigFileBytes = std::size_t{64} << 10;
+// The longest path a service's config may give as a PMU's `baseline:`: pmu/baseline's
+// `file` is a string<255>.
+inline constexpr std::size_t kMaxPathBytes = 255;
 
 struct Header {
   std::string vehicle;

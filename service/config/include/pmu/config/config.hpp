@@ -16,17 +16,15 @@
 #include "pmu/baseline/config_file.hpp"
 #include "pmu/codec/messages.hpp"
 #include "pmu/command/policy.hpp"
-#include "pmu/config/capacity.hpp"
-#include "pmu/config/network_settings.hpp"
-#include "pmu/config/ros2_names.hpp"
+#include "pmu/dds_settings/capacity.hpp"
+#include "pmu/dds_settings/network_settings.hpp"
+#include "pmu/dds_settings/ros2_names.hpp"
 #include "pmu/config/sim_settings.hpp"
-#include "pmu/config/transport_choice.hpp"
+#include "pmu/dds_settings/transport_choice.hpp"
 #include "pmu/security/security_files.hpp"
 
 namespace pmu::service {
 
-// The longest `baseline:` path: pmu/baseline's `file` is a string<255>.
-inline constexpr std::size_t kMaxBaselinePath = 255;
 // The largest config file read (interface.md 4.1): far above any real one, and a bound, so a
 // device or a runaway file named as the config is refused (docs/safety.md H12).
 inline constexpr std::size_t kMaxConfigFileBytes = std::size_t{1} << 20;
@@ -183,7 +181,7 @@ struct Config {
   std::optional<int> also_serve_contract;
   // `ros2`: sensor_msgs/BatteryState and diagnostic_msgs/DiagnosticArray in ROS 2's own
   // names and types (ros2_names.hpp, docs/interface.md section 11).
-  Ros2Settings ros2;
+  dds::Ros2Settings ros2;
   std::string log_level = "info";
   std::vector<BusConfig> buses;
   Timeouts timeouts;

@@ -25,7 +25,7 @@
 
 #include "pmu/config/config.hpp"
 #include "pmu/dds/dds_context.hpp"
-#include "pmu/session/device_state.hpp"
+#include "pmu/session/state_sink.hpp"
 
 namespace pmu::service {
 

@@ -13,7 +13,7 @@
 #include <optional>
 #include <string>
 
-namespace pmu::dds {
+namespace pmu::service {
 
 // What a reader sees change in a device's DiagnosticStatus.
 struct ShownStatus {
@@ -44,4 +44,4 @@ class DiagnosticsPace {
   std::optional<TimePoint> due_;
 };
 
-}  // namespace pmu::dds
+}  // namespace pmu::service

@@ -18,7 +18,7 @@
 #include "pmu/session/device_state.hpp"
 #include "sensor_msgs/msg/BatteryState.h"
 
-namespace pmu::dds {
+namespace pmu::service {
 
 // Below this magnitude (A) a battery is taken as neither charging nor discharging: the PMU
 // reports its currents in 0.1 A steps.
@@ -32,8 +32,8 @@ struct PmuBatteryView {
   double current = kUnknown;
   double temperature = kUnknown;  // NaN: no sensor, or firmware before 1.12
   std::optional<std::uint16_t> pmu_serial;
-  service::HealthState health = service::HealthState::Unknown;
-  std::vector<service::AlarmReport> active;  // the PMU's active alarms
+  HealthState health = HealthState::Unknown;
+  std::vector<AlarmReport> active;  // the PMU's active alarms
   std::chrono::system_clock::time_point stamp{};  // receive time of the pmu/voltages frame
   std::string frame_id;                           // ros2_status_name of the PMU
 };
@@ -41,11 +41,11 @@ sensor_msgs::msg::BatteryState pmu_battery_message(const PmuBatteryView& v);
 
 // A BMS-reported battery (pmu/battery and pmu/battery_cells).
 struct BmsView {
-  service::BatteryState values;
-  service::BatteryCellsState cells;
+  BatteryState values;
+  BatteryCellsState cells;
   std::optional<double> capacity_ah;  // the config's nameplate capacity
-  service::HealthState health = service::HealthState::Unknown;
-  std::vector<service::AlarmReport> active;
+  HealthState health = HealthState::Unknown;
+  std::vector<AlarmReport> active;
   std::chrono::system_clock::time_point stamp{};  // receive time of the newest frame
   std::string frame_id;
   std::string location;
@@ -57,16 +57,16 @@ sensor_msgs::msg::BatteryState bms_battery_message(const BmsView& v);
 struct DeviceDiagnosticsView {
   std::string name;         // ros2_status_name
   std::string hardware_id;  // "pmu serial 1234", "bms node 2", "mppt 0"
-  service::HealthReport health;
-  std::vector<service::AlarmReport> active;
+  HealthReport health;
+  std::vector<AlarmReport> active;
   std::vector<std::pair<std::string, std::string>> extra;
 };
 diagnostic_msgs::msg::DiagnosticStatus device_status(const DeviceDiagnosticsView& v);
 
 // The alarm states that count as active (raised, acknowledged or not).
-bool alarm_active(const service::AlarmReport& a) noexcept;
+bool alarm_active(const AlarmReport& a) noexcept;
 
 // ROS 2's builtin_interfaces/Time of a wall-clock time (seconds and nanoseconds).
 void set_stamp(std_msgs::msg::Header& header, std::chrono::system_clock::time_point t);
 
-}  // namespace pmu::dds
+}  // namespace pmu::service

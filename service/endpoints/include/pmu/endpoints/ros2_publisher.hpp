@@ -33,37 +33,37 @@
 
 #include "pmu/config/config.hpp"
 #include "pmu/dds/dds_context.hpp"
-#include "pmu/session/device_state.hpp"
+#include "pmu/session/state_sink.hpp"
 #include "pmu/transport/clock.hpp"
 
-namespace pmu::dds {
+namespace pmu::service {
 
 // The QoS of every ROS 2 writer (above): what ROS 2 subscribers of every usual profile match.
 eprosima::fastdds::dds::DataWriterQos ros2_writer_qos();
 
-class Ros2Publisher final : public service::StateSink {
+class Ros2Publisher final : public StateSink {
  public:
   // `buses`: the configured batteries' capacity_ah. Creates /diagnostics's writer; throws
   // DdsError at start-up.
-  Ros2Publisher(DdsContext& dds, const service::Ros2Settings& settings, std::string vehicle,
-                const std::vector<service::BusConfig>& buses, const transport::Clock& clock);
+  Ros2Publisher(dds::DdsContext& dds, const dds::Ros2Settings& settings, std::string vehicle,
+                const std::vector<BusConfig>& buses, const transport::Clock& clock);
   ~Ros2Publisher() override;
 
-  void on_telemetry(const service::DeviceKey& key, const codec::PmuMessage& message,
+  void on_telemetry(const DeviceKey& key, const codec::PmuMessage& message,
                     std::chrono::system_clock::time_point received) override;
-  void on_config(const service::DeviceKey&, const service::ConfigState&) override {}
-  void on_info(const service::DeviceKey& key, const service::InfoState& info) override;
-  void on_health(const service::DeviceKey& key, const service::HealthReport& health) override;
-  void on_gone(const service::DeviceKey& key) override;
-  void on_battery(const service::DeviceKey& key, const service::BatteryState& battery,
+  void on_config(const DeviceKey&, const ConfigState&) override {}
+  void on_info(const DeviceKey& key, const InfoState& info) override;
+  void on_health(const DeviceKey& key, const HealthReport& health) override;
+  void on_gone(const DeviceKey& key) override;
+  void on_battery(const DeviceKey& key, const BatteryState& battery,
                   std::chrono::system_clock::time_point newest) override;
-  void on_battery_cells(const service::DeviceKey& key, const service::BatteryCellsState& cells,
+  void on_battery_cells(const DeviceKey& key, const BatteryCellsState& cells,
                         std::chrono::system_clock::time_point newest) override;
-  void on_mppt(const service::DeviceKey&, const service::MpptState&, std::chrono::system_clock::time_point) override {}
-  void on_alarm(const service::AlarmReport& alarm) override;
-  void on_readiness(const service::ReadinessReport&) override {}
-  void on_energy(const service::DeviceKey&, const energy::Figures&, std::chrono::system_clock::time_point) override {}
-  void on_bms_energy(const service::DeviceKey&, const energy::BmsFigures&,
+  void on_mppt(const DeviceKey&, const MpptState&, std::chrono::system_clock::time_point) override {}
+  void on_alarm(const AlarmReport& alarm) override;
+  void on_readiness(const ReadinessReport&) override {}
+  void on_energy(const DeviceKey&, const energy::Figures&, std::chrono::system_clock::time_point) override {}
+  void on_bms_energy(const DeviceKey&, const energy::BmsFigures&,
                      std::chrono::system_clock::time_point) override {}
 
   // Writes Fast DDS refused (logged at most every few seconds too). Any thread.
@@ -74,4 +74,4 @@ class Ros2Publisher final : public service::StateSink {
   std::unique_ptr<State> s_;
 };
 
-}  // namespace pmu::dds
+}  // namespace pmu::service

@@ -25,12 +25,12 @@
 
 #include "pmu/config/config.hpp"
 #include "pmu/readiness/readiness_rules.hpp"
-#include "pmu/session/device_state.hpp"
+#include "pmu/session/state_sink.hpp"
 #include "pmu/transport/clock.hpp"
 
 namespace pmu::service {
 
-class ReadinessTracker final : public StateSink {
+class ReadinessTracker final : public ForwardingSink {
  public:
   // `buses`: the config's, for each PMU's min_firmware, baseline, mode, packets, period and
   // alarms (a discovered PMU takes its bus's discover: settings, and has no baseline).
@@ -45,28 +45,9 @@ class ReadinessTracker final : public StateSink {
   void on_info(const DeviceKey& key, const InfoState& info) override;
   void on_health(const DeviceKey& key, const HealthReport& health) override;
   void on_gone(const DeviceKey& key) override;
-  void on_battery(const DeviceKey& key, const BatteryState& battery,
-                  std::chrono::system_clock::time_point newest) override {
-    next_.on_battery(key, battery, newest);
-  }
-  void on_battery_cells(const DeviceKey& key, const BatteryCellsState& cells,
-                        std::chrono::system_clock::time_point newest) override {
-    next_.on_battery_cells(key, cells, newest);
-  }
-  void on_mppt(const DeviceKey& key, const MpptState& mppt, std::chrono::system_clock::time_point newest) override {
-    next_.on_mppt(key, mppt, newest);
-  }
   void on_alarm(const AlarmReport& alarm) override;
-  // Reports come from this tracker; one handed to it is passed on unchanged.
-  void on_readiness(const ReadinessReport& readiness) override { next_.on_readiness(readiness); }
-  void on_energy(const DeviceKey& key, const energy::Figures& figures,
-                 std::chrono::system_clock::time_point at) override {
-    next_.on_energy(key, figures, at);
-  }
-  void on_bms_energy(const DeviceKey& key, const energy::BmsFigures& figures,
-                     std::chrono::system_clock::time_point at) override {
-    next_.on_bms_energy(key, figures, at);
-  }
+  // The rest pass on unchanged (ForwardingSink): reports come from this tracker, and one
+  // handed to it goes on as it is.
 
   // The latest report (for tests and the start-up log).
   ReadinessReport current() const;
@@ -98,7 +79,6 @@ class ReadinessTracker final : public StateSink {
   std::map<std::string, BusConfig> buses_;  // by bus name
   double stale_periods_;
   std::map<Key, Expected> expected_;  // PMUs
-  StateSink& next_;
   const transport::Clock& clock_;
   mutable std::mutex mutex_;
   ReadinessInput input_;

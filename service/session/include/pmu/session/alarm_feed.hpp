@@ -11,7 +11,7 @@
 #include <string>
 
 #include "pmu/alarms/alarm_set.hpp"
-#include "pmu/session/device_state.hpp"
+#include "pmu/session/state_sink.hpp"
 #include "pmu/session/request_queue.hpp"
 
 namespace pmu::service {

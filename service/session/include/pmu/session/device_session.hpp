@@ -51,7 +51,7 @@
 #include "pmu/codec/decode.hpp"
 #include "pmu/config/config.hpp"
 #include "pmu/session/alarm_feed.hpp"
-#include "pmu/session/device_state.hpp"
+#include "pmu/session/state_sink.hpp"
 #include "pmu/session/health_tracker.hpp"
 #include "pmu/session/reading_machine.hpp"
 #include "pmu/session/request_queue.hpp"

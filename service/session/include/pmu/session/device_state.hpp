@@ -100,41 +100,4 @@ struct ReadinessReport {
   bool warnings() const noexcept { return !reasons.empty(); }
 };
 
-// Where the service's view of the devices goes: the DDS publisher in the daemon, a recorder
-// in tests. Called on the bus worker's thread (on_readiness: whichever worker's event changed
-// it).
-class StateSink {
- public:
-  virtual ~StateSink() = default;
-  // A telemetry frame (packets 0x00..0x04) decoded; `received` is the frame's receive time.
-  virtual void on_telemetry(const DeviceKey& key, const codec::PmuMessage& message,
-                            std::chrono::system_clock::time_point received) = 0;
-  virtual void on_config(const DeviceKey& key, const ConfigState& config) = 0;
-  virtual void on_info(const DeviceKey& key, const InfoState& info) = 0;
-  virtual void on_health(const DeviceKey& key, const HealthReport& health) = 0;
-  // No device is at `key` any more (a PMU that moved to another CAN address): every
-  // instance of every topic under it is unregistered and disposed, so neither a reader
-  // nor a late joiner keeps a device that is not there. The last health sent before is
-  // OFFLINE.
-  virtual void on_gone(const DeviceKey& key) = 0;
-  // A battery's or MPPT's assembled values changed (canopen_session.hpp); `newest` is the
-  // receive time of the newest frame that contributed.
-  virtual void on_battery(const DeviceKey& key, const BatteryState& battery,
-                          std::chrono::system_clock::time_point newest) = 0;
-  virtual void on_battery_cells(const DeviceKey& key, const BatteryCellsState& cells,
-                                std::chrono::system_clock::time_point newest) = 0;
-  virtual void on_mppt(const DeviceKey& key, const MpptState& mppt, std::chrono::system_clock::time_point newest) = 0;
-  // An alarm changed state (raised, acknowledged, cleared, back to NORMAL).
-  virtual void on_alarm(const AlarmReport& alarm) = 0;
-  virtual void on_readiness(const ReadinessReport& readiness) = 0;
-  // A PMU's derived energy (interface.md 1.8), from the EnergyTracker; `at` is the receive
-  // time of the sample that made it due.
-  virtual void on_energy(const DeviceKey& key, const energy::Figures& figures,
-                         std::chrono::system_clock::time_point at) = 0;
-  // A BMS-reported battery's derived energy (pmu/bms_energy), from the EnergyTracker; `at`
-  // is the receive time of the pmu/battery sample that made it due.
-  virtual void on_bms_energy(const DeviceKey& key, const energy::BmsFigures& figures,
-                             std::chrono::system_clock::time_point at) = 0;
-};
-
 }  // namespace pmu::service

@@ -28,11 +28,11 @@
 #include "pmu/config/config.hpp"
 #include "pmu/energy/bms_energy.hpp"
 #include "pmu/energy/pmu_energy.hpp"
-#include "pmu/session/device_state.hpp"
+#include "pmu/session/state_sink.hpp"
 
 namespace pmu::service {
 
-class EnergyTracker final : public StateSink {
+class EnergyTracker final : public ForwardingSink {
  public:
   // `stale_periods`: the config's timeouts.stale_periods; a device's period times this is the
   // longest gap integrated (the time after which its health reads STALE).
@@ -40,30 +40,11 @@ class EnergyTracker final : public StateSink {
 
   void on_telemetry(const DeviceKey& key, const codec::PmuMessage& message,
                     std::chrono::system_clock::time_point received) override;
-  void on_config(const DeviceKey& key, const ConfigState& config) override { next_.on_config(key, config); }
-  void on_info(const DeviceKey& key, const InfoState& info) override { next_.on_info(key, info); }
-  void on_health(const DeviceKey& key, const HealthReport& health) override { next_.on_health(key, health); }
   void on_gone(const DeviceKey& key) override;
   void on_battery(const DeviceKey& key, const BatteryState& battery,
                   std::chrono::system_clock::time_point newest) override;
-  void on_battery_cells(const DeviceKey& key, const BatteryCellsState& cells,
-                        std::chrono::system_clock::time_point newest) override {
-    next_.on_battery_cells(key, cells, newest);
-  }
-  void on_mppt(const DeviceKey& key, const MpptState& mppt, std::chrono::system_clock::time_point newest) override {
-    next_.on_mppt(key, mppt, newest);
-  }
-  void on_alarm(const AlarmReport& alarm) override { next_.on_alarm(alarm); }
-  void on_readiness(const ReadinessReport& readiness) override { next_.on_readiness(readiness); }
-  // Figures come from this tracker; ones handed to it are passed on unchanged.
-  void on_energy(const DeviceKey& key, const energy::Figures& figures,
-                 std::chrono::system_clock::time_point at) override {
-    next_.on_energy(key, figures, at);
-  }
-  void on_bms_energy(const DeviceKey& key, const energy::BmsFigures& figures,
-                     std::chrono::system_clock::time_point at) override {
-    next_.on_bms_energy(key, figures, at);
-  }
+  // The rest pass on unchanged (ForwardingSink): figures come from this tracker, and ones
+  // handed to it go on as they are.
 
  private:
   using Key = std::tuple<std::string, std::uint16_t>;  // (bus, PMU address or battery node)
@@ -73,7 +54,6 @@ class EnergyTracker final : public StateSink {
 
   std::map<std::string, BusConfig> buses_;  // by bus name
   double stale_periods_;
-  StateSink& next_;
   std::mutex mutex_;
   std::map<Key, energy::PmuEnergy> pmus_;
   std::map<Key, energy::BmsEnergy> batteries_;

@@ -7,7 +7,7 @@
 // which Fast DDS reads by itself for every participant of the process.
 //
 // Fast DDS itself only logs an unknown name; the config refuses it at its line instead.
-// No DDS here: the names only (pmu::config, like the rest of the config).
+// No DDS entity here: the names only, so the config can check them at their line.
 
 #include <string>
 #include <vector>

@@ -1,6 +1,6 @@
-#include "pmu/config/ros2_names.hpp"
+#include "pmu/dds_settings/ros2_names.hpp"
 
-namespace pmu::service {
+namespace pmu::dds {
 namespace ros2_names {
 
 bool is_letter(char c) { return (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z'); }
@@ -79,4 +79,4 @@ std::string ros2_status_name(std::string_view ns, std::string_view vehicle, std:
   return ros2_device_namespace(ns, vehicle, bus, kind, address).substr(1);
 }
 
-}  // namespace pmu::service
+}  // namespace pmu::dds

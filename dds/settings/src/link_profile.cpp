@@ -1,4 +1,4 @@
-#include "pmu/config/link_profile.hpp"
+#include "pmu/dds_settings/link_profile.hpp"
 
 #include <cstdio>
 

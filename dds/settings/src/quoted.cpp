@@ -1,8 +1,8 @@
-#include "pmu/config/quoted.hpp"
+#include "pmu/dds_settings/quoted.hpp"
 
 #include <cstdio>
 
-namespace pmu::service {
+namespace pmu::dds {
 namespace {
 
 constexpr std::size_t kWhole = 32;   // shown whole up to this many bytes
@@ -55,4 +55,4 @@ std::string character_at(std::string_view s, std::size_t at) {
   return "'" + std::string(s.substr(at, n)) + "'";
 }
 
-}  // namespace pmu::service
+}  // namespace pmu::dds

@@ -1,8 +1,8 @@
-#include "pmu/config/vehicle.hpp"
+#include "pmu/dds_settings/vehicle.hpp"
 
-#include "pmu/config/quoted.hpp"
+#include "pmu/dds_settings/quoted.hpp"
 
-namespace pmu::service {
+namespace pmu::dds {
 
 std::string vehicle_name_problem(std::string_view name) {
   // Bytes: the IDL bound counts them (every character a vehicle name may hold is one byte).
@@ -42,4 +42,4 @@ bool partitions_address_only(const std::vector<std::string>& writer_partitions, 
   return writer_partitions.size() == 1 && writer_partitions.front() == vehicle;
 }
 
-}  // namespace pmu::service
+}  // namespace pmu::dds

@@ -38,7 +38,7 @@
 #include <string_view>
 #include <vector>
 
-#include "pmu/config/link_profile.hpp"
+#include "pmu/dds_settings/link_profile.hpp"
 
 namespace pmu::dds {
 

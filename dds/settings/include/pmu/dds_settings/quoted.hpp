@@ -6,7 +6,7 @@
 #include <string>
 #include <string_view>
 
-namespace pmu::service {
+namespace pmu::dds {
 
 // 'value' in quotes; past 32 bytes the first 24 (never cut inside a UTF-8 sequence) and
 // "...' (N bytes)", so a message stays one readable line. Control bytes and bytes that start
@@ -18,4 +18,4 @@ std::string quoted(std::string_view value);
 // sequence.
 std::string character_at(std::string_view s, std::size_t at);
 
-}  // namespace pmu::service
+}  // namespace pmu::dds

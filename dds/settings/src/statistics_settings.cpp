@@ -1,4 +1,4 @@
-#include "pmu/config/statistics_settings.hpp"
+#include "pmu/dds_settings/statistics_settings.hpp"
 
 #include <fastdds/statistics/topic_names.hpp>  // constants only: no Fast DDS library call
 

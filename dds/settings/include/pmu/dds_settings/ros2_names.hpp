@@ -13,7 +13,7 @@
 #include <string>
 #include <string_view>
 
-namespace pmu::service {
+namespace pmu::dds {
 
 struct Ros2Settings {
   // Off by default: every participant that joins the domain, over a radio link too, gets the
@@ -49,4 +49,4 @@ std::string ros2_dds_topic(std::string_view ros_name);
 std::string ros2_status_name(std::string_view ns, std::string_view vehicle, std::string_view bus, Ros2Device kind,
                              std::uint16_t address);
 
-}  // namespace pmu::service
+}  // namespace pmu::dds

@@ -9,7 +9,7 @@
 
 #include "pmu/alarms/alarm_table.hpp"
 
-namespace pmu::service {
+namespace pmu::dds {
 
 // PMUs one pmu-service serves (configured plus discovered, all buses together): the
 // instances of each of its telemetry and state writers.
@@ -26,4 +26,4 @@ inline constexpr std::size_t kCommandQueueDepth = 4096;
 inline constexpr std::size_t kMaxAlarmsPerService = kMaxDevicesPerService * alarms::kCodeCount;
 inline constexpr std::size_t kFleetAlarms = kMaxAlarmsPerService * kFleetServices;
 
-}  // namespace pmu::service
+}  // namespace pmu::dds

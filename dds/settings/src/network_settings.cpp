@@ -1,4 +1,4 @@
-#include "pmu/config/network_settings.hpp"
+#include "pmu/dds_settings/network_settings.hpp"
 
 #include <arpa/inet.h>
 #include <ifaddrs.h>

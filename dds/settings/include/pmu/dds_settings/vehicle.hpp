@@ -14,7 +14,7 @@
 #include <string_view>
 #include <vector>
 
-namespace pmu::service {
+namespace pmu::dds {
 
 inline constexpr std::size_t kMaxVehicleNameLength = 15;  // string<15> in the IDL
 
@@ -37,4 +37,4 @@ std::vector<std::string> every_vehicle_partitions();
 // vehicle's service at once (an identity granted "*", or any peer without security).
 bool partitions_address_only(const std::vector<std::string>& writer_partitions, const std::string& vehicle);
 
-}  // namespace pmu::service
+}  // namespace pmu::dds
