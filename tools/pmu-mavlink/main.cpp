@@ -13,7 +13,7 @@
 
 #include "link/serial_endpoint.hpp"
 #include "link/udp_endpoint.hpp"
-#include "pmu/config/vehicle.hpp"
+#include "pmu/dds_settings/vehicle.hpp"
 #include "pmu/dds/dds_context.hpp"
 #include "pmu/files/bounded_file.hpp"
 #include "pmu/security/security_files.hpp"
@@ -116,7 +116,7 @@ int main(int argc, char** argv) {
   std::unique_ptr<pmu::dds::DdsContext> dds;
   std::unique_ptr<DdsInputs> inputs;
   try {
-    const auto partitions = pmu::service::vehicle_partitions(settings.vehicle);
+    const auto partitions = pmu::dds::vehicle_partitions(settings.vehicle);
     const std::string qos = settings.qos_file.empty() ? pmu::dds::default_qos_file() : settings.qos_file;
     // The default transport and network (as pmu-service's defaults), in the vehicle's partitions.
     dds = std::make_unique<pmu::dds::DdsContext>(settings.domain, qos, "pmu-mavlink", security,
