@@ -87,9 +87,8 @@ Stream service_stream(ServiceRun& svc, VoltagesProbe& probe, WriteTimes& times, 
   const auto lost_before = probe.lost_in_delivery();
   Stream out;
   auto cpu = std::async(std::launch::async, [&] { return cpu_during(svc.pid(), 0.25, std::max(secs - 0.5, 0.2)); });
-  const Injection inj = svc.pmu().inject(rate, std::chrono::duration_cast<std::chrono::nanoseconds>(
-                                                   std::chrono::duration<double>(secs)),
-                                         times);
+  const Injection inj = svc.pmu().inject(
+      rate, std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::duration<double>(secs)), times);
   out.cpu_percent = cpu.get();
   sleep_s(0.3);  // the last samples in flight
   auto lat = probe.take_latencies();
@@ -115,8 +114,7 @@ Stream peer_stream(const Settings& s, VoltagesProbe& probe, int domain, dds::Tra
   const auto before = probe.received();
   const auto lost_before = probe.lost_in_delivery();
   ChildProcess peer({s.self_exe, "peer-writer", "--domain", std::to_string(domain), "--qos", s.qos_file, "--transport",
-                     transport_name(t), "--rate", std::to_string(rate), "--seconds",
-                     std::to_string(secs + 1.0)},
+                     transport_name(t), "--rate", std::to_string(rate), "--seconds", std::to_string(secs + 1.0)},
                     {}, {}, s.workdir + "/" + tag + ".log");
   while (probe.first_sample_ns() == 0) {
     if (!peer.running()) throw std::runtime_error("peer-writer exited early: " + tail(s.workdir + "/" + tag + ".log"));
@@ -193,7 +191,7 @@ Percentiles socketpair_hop(const Settings& s, int count, double rate) {
   transport::UniqueFd ours(ends[0]);
   ChildProcess pong({s.self_exe, "peer-pong"}, {}, transport::UniqueFd(ends[1]), s.workdir + "/peer-pong.log");
   std::vector<std::int64_t> half;
-  struct can_frame f{};
+  struct can_frame f {};
   const int warm = rate >= 100 ? 50 : 2;  // the first frames warm up
   paced(rate, static_cast<std::uint64_t>(count + warm), nullptr, [&](std::uint64_t i) {
     const std::int64_t t0 = steady_ns();
@@ -222,8 +220,8 @@ void latency_phase(const Settings& s, Rows& rows, WriteTimes& times, dds::Transp
   progress("reference: bare writer at 7,634 samples/s over " + name);
   dds::DdsContext ref_dds(ref_domain, s.qos_file, "pmu-bench-ref", {}, t);
   VoltagesProbe ref_probe(ref_dds, nullptr);
-  const Stream ref = peer_stream(s, ref_probe, ref_domain, t, kSaturatedBus, d.latency,
-                                 std::string("peer-") + transport_name(t));
+  const Stream ref =
+      peer_stream(s, ref_probe, ref_domain, t, kSaturatedBus, d.latency, std::string("peer-") + transport_name(t));
   latency_rows(rows, kSaturatedLatency, name, st, ref, hop);
   cpu_row(rows, name, st, ref);
 }
@@ -263,10 +261,11 @@ std::string startup_failure(ServiceRun& svc, VoltagesProbe& probe, const std::op
   if (!ready) {
     what += "no READY=1 from pmu-service within 20 s";
   } else {
-    const auto after = std::chrono::duration_cast<std::chrono::milliseconds>(
-        std::chrono::nanoseconds(*ready) - svc.spawned_at().time_since_epoch());
+    const auto after = std::chrono::duration_cast<std::chrono::milliseconds>(std::chrono::nanoseconds(*ready) -
+                                                                             svc.spawned_at().time_since_epoch());
     what += "READY=1 after " + std::to_string(after.count()) + " ms, but no sample of an injected frame reached the " +
-            "reader within 20 s (reader matched a writer: " + (probe.wait_matched(std::chrono::milliseconds(0)) ? "yes" : "no") +
+            "reader within 20 s (reader matched a writer: " +
+            (probe.wait_matched(std::chrono::milliseconds(0)) ? "yes" : "no") +
             "; samples received since it was created: " + std::to_string(probe.received()) + ")";
   }
   return what + "; the service's log: " + svc.log_tail();
@@ -296,7 +295,8 @@ void startup_rows(const Settings& s, const Durations& d, Rows& rows, dds::Transp
     got = true;
     feeder.join();
     if (!ready || probe.first_sample_ns() == 0) throw std::runtime_error(startup_failure(*svc, probe, ready, name));
-    const auto spawned = std::chrono::duration_cast<std::chrono::nanoseconds>(svc->spawned_at().time_since_epoch()).count();
+    const auto spawned =
+        std::chrono::duration_cast<std::chrono::nanoseconds>(svc->spawned_at().time_since_epoch()).count();
     ready_ms.push_back(static_cast<double>(*ready - spawned) / 1e6);
     first_ms.push_back(static_cast<double>(probe.first_sample_ns() - spawned) / 1e6);
     char line[112];
@@ -320,12 +320,14 @@ void startup_rows(const Settings& s, const Durations& d, Rows& rows, dds::Transp
       if (!peer.running()) throw std::runtime_error("peer-writer exited early: " + tail(s.workdir + "/peer-start.log"));
       sleep_s(0.0005);
     }
-    if (ref_probe.first_sample_ns() == 0) throw std::runtime_error("the bare writer's first sample did not come within 20 s");
-    const auto spawned = std::chrono::duration_cast<std::chrono::nanoseconds>(peer.spawned_at().time_since_epoch()).count();
+    if (ref_probe.first_sample_ns() == 0)
+      throw std::runtime_error("the bare writer's first sample did not come within 20 s");
+    const auto spawned =
+        std::chrono::duration_cast<std::chrono::nanoseconds>(peer.spawned_at().time_since_epoch()).count();
     ref_ms.push_back(static_cast<double>(ref_probe.first_sample_ns() - spawned) / 1e6);
     char line[112];
-    std::snprintf(line, sizeof line, "start-up over %s, bare writer %d: first sample after %.1f ms", name.c_str(), i + 1,
-                  ref_ms.back());
+    std::snprintf(line, sizeof line, "start-up over %s, bare writer %d: first sample after %.1f ms", name.c_str(),
+                  i + 1, ref_ms.back());
     progress(line);
   }
   std::sort(ready_ms.begin(), ready_ms.end());
@@ -334,7 +336,8 @@ void startup_rows(const Settings& s, const Durations& d, Rows& rows, dds::Transp
   const auto median = [](const std::vector<double>& v) { return v[v.size() / 2]; };
   const std::string n = "median of " + std::to_string(d.startups) + " starts";
   char note[160];
-  std::snprintf(note, sizeof note, "%s, fastest %.1f ms, slowest %.1f ms", n.c_str(), ready_ms.front(), ready_ms.back());
+  std::snprintf(note, sizeof note, "%s, fastest %.1f ms, slowest %.1f ms", n.c_str(), ready_ms.front(),
+                ready_ms.back());
   rows.push_back(row("start-up: exec -> READY=1, " + name, median(ready_ms), "ms", std::nullopt, "", "< 100 ms",
                      median(ready_ms) < 100, note));
   std::snprintf(note, sizeof note,
@@ -423,8 +426,8 @@ Rows run_all(const Settings& s) {
       sleep_s(0.2);
     }
     if (alarm_ns.size() < static_cast<std::size_t>(d.alarms))
-      throw std::runtime_error("alarm latency: " + std::to_string(alarm_ns.size()) + " of " +
-                               std::to_string(d.alarms) + " thermal_shutdown alarms arrived within 2 s");
+      throw std::runtime_error("alarm latency: " + std::to_string(alarm_ns.size()) + " of " + std::to_string(d.alarms) +
+                               " thermal_shutdown alarms arrived within 2 s");
     const Percentiles alarm_p = percentiles(alarm_ns);
     const Percentiles flag_p = percentiles(status_ns);
 
@@ -433,18 +436,15 @@ Rows run_all(const Settings& s) {
     VoltagesProbe ref_probe(ref_dds, nullptr);
     progress("reference: bare writer idle (5 samples/s)");
     ProcSample ref_footprint;
-    const Stream ref_idle = peer_stream(s, ref_probe, d_ref_shm, kShm, 5, d.idle + 2.0,
-                                        "peer-idle", &ref_footprint);
+    const Stream ref_idle = peer_stream(s, ref_probe, d_ref_shm, kShm, 5, d.idle + 2.0, "peer-idle", &ref_footprint);
     progress("reference: bare writer at 7,634 samples/s");
-    const Stream ref_shm = peer_stream(s, ref_probe, d_ref_shm, kShm, kSaturatedBus, d.latency,
-                                       "peer-shm");
+    const Stream ref_shm = peer_stream(s, ref_probe, d_ref_shm, kShm, kSaturatedBus, d.latency, "peer-shm");
     progress("reference: bare request/reply");
     Percentiles echo_p;
     {
-      ChildProcess echo({s.self_exe, "peer-echo", "--domain", std::to_string(d_ref_shm), "--qos", s.qos_file,
-                         "--transport", "shm"},
-                        {}, {},
-                        s.workdir + "/peer-echo.log");
+      ChildProcess echo(
+          {s.self_exe, "peer-echo", "--domain", std::to_string(d_ref_shm), "--qos", s.qos_file, "--transport", "shm"},
+          {}, {}, s.workdir + "/peer-echo.log");
       CommandClient ref_client(ref_dds);
       if (!ref_client.wait_matched(seconds(10))) throw std::runtime_error("peer-echo did not match");
       (void)ref_client.run(20, "fd3", 1, seconds(2));
@@ -507,7 +507,8 @@ Rows run_all(const Settings& s) {
                        "the same frame's pmu/status sample", "ratio <= 3", alarm_p.p50_us / flag_p.p50_us <= 3,
                        std::to_string(d.alarms) + " thermal shutdowns raised, SHM"));
     rows.push_back(row("RSS, one PMU, all topics", footprint.rss_mib, "MiB", ref_footprint.rss_mib,
-                       "bare participant + one writer", "ratio <= 1.5", footprint.rss_mib / ref_footprint.rss_mib <= 1.5));
+                       "bare participant + one writer", "ratio <= 1.5",
+                       footprint.rss_mib / ref_footprint.rss_mib <= 1.5));
     rows.push_back(row("threads, one PMU, all topics", footprint.threads, "threads", ref_footprint.threads,
                        "bare participant + one writer", "ratio <= 1.5",
                        static_cast<double>(footprint.threads) / ref_footprint.threads <= 1.5));

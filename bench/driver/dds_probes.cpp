@@ -30,7 +30,8 @@ std::int64_t embedded_time(const pmu::v5::Voltages& v) {
 }
 
 const char* result_name(int r) {
-  static const char* const names[] = {"COMPLETED", "REJECTED", "DENIED", "UNSUPPORTED", "TIMEOUT", "FAILED", "IN_PROGRESS"};
+  static const char* const names[] = {"COMPLETED", "REJECTED", "DENIED",     "UNSUPPORTED",
+                                      "TIMEOUT",   "FAILED",   "IN_PROGRESS"};
   return r >= 0 && r < 7 ? names[r] : "?";
 }
 
@@ -44,8 +45,8 @@ VoltagesProbe::VoltagesProbe(pmu::dds::DdsContext& dds, WriteTimes* times) : dds
   auto& topic = dds.topic(topics::kVoltages, TypeSupport(new pmu::v5::VoltagesPubSubType()));
   subscriber_ = dds.participant().create_subscriber(SUBSCRIBER_QOS_DEFAULT);
   DataReaderQos qos;
-  if (!subscriber_ || subscriber_->get_datareader_qos_from_profile(qos_profiles::kTelemetry, qos) !=
-                          ReturnCode_t::RETCODE_OK)
+  if (!subscriber_ ||
+      subscriber_->get_datareader_qos_from_profile(qos_profiles::kTelemetry, qos) != ReturnCode_t::RETCODE_OK)
     throw std::runtime_error("no telemetry reader profile in the QoS file");
   qos.history().depth = 4096;
   qos.resource_limits().max_instances = 4;
@@ -112,7 +113,8 @@ bool VoltagesProbe::wait_matched(std::chrono::milliseconds timeout) {
 CommandClient::CommandClient(pmu::dds::DdsContext& dds) : dds_(dds) {
   replies_ = &dds.reader(dds.topic(topics::kCommandReply, TypeSupport(new pmu::v5::CommandReplyPubSubType())),
                          qos_profiles::kCommand, this);
-  writer_ = &dds.writer(dds.topic(topics::kCommand, TypeSupport(new pmu::v5::CommandPubSubType())), qos_profiles::kCommand);
+  writer_ =
+      &dds.writer(dds.topic(topics::kCommand, TypeSupport(new pmu::v5::CommandPubSubType())), qos_profiles::kCommand);
 }
 
 CommandClient::~CommandClient() { replies_->set_listener(nullptr); }

@@ -52,7 +52,7 @@ void FakePmu::run() {
     const auto wait = std::chrono::duration_cast<std::chrono::milliseconds>(next - sim::Clock::now());
     pollfd p{fd_.get(), POLLIN, 0};
     ::poll(&p, 1, static_cast<int>(std::clamp<std::int64_t>(wait.count(), 0, 20)));
-    struct can_frame raw{};
+    struct can_frame raw {};
     while (::recv(fd_.get(), &raw, sizeof raw, MSG_DONTWAIT) == static_cast<ssize_t>(sizeof raw)) {
       ++from_service_;
       // Every unit sees every frame, as on a bus; each acts on its own address only.

@@ -122,7 +122,7 @@ int peer_echo(const PeerOptions& o) {
 }
 
 int peer_pong() {
-  struct can_frame f{};
+  struct can_frame f {};
   for (;;) {
     const ssize_t n = ::recv(3, &f, sizeof f, 0);
     if (n <= 0) return n == 0 ? 0 : 1;

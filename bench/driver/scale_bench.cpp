@@ -16,9 +16,9 @@ using nlohmann::json;
 using std::chrono::seconds;
 
 constexpr dds::Transport kShm = dds::Transport::ShmOnly;  // as the main rows (benchmarks.cpp says why)
-constexpr std::uint32_t kTenHertz = 1;                       // PP in tenths of a second
-constexpr int kSubscriberUnits = 10;                         // PMUs while subscribers are added
-constexpr int kMaxUnits = 256;                               // instance limit of the bench readers
+constexpr std::uint32_t kTenHertz = 1;                    // PP in tenths of a second
+constexpr int kSubscriberUnits = 10;                      // PMUs while subscribers are added
+constexpr int kMaxUnits = 256;                            // instance limit of the bench readers
 
 void progress(const std::string& what) { std::fprintf(stderr, "pmu_bench: %s\n", what.c_str()); }
 void sleep_s(double s) { std::this_thread::sleep_for(std::chrono::duration<double>(s)); }
@@ -54,7 +54,8 @@ Cost measure(pid_t pid, const Timing& t, const TelemetryReaders* readers) {
 }
 
 std::vector<std::string> peer_args(const Settings& s, const char* what, int domain) {
-  return {s.self_exe, what, "--domain", std::to_string(domain), "--qos", s.qos_file, "--transport", transport_name(kShm)};
+  return {s.self_exe, what,       "--domain",    std::to_string(domain),
+          "--qos",    s.qos_file, "--transport", transport_name(kShm)};
 }
 
 std::unique_ptr<ChildProcess> telemetry_peer(const Settings& s, int domain, int units, const std::string& tag) {
@@ -82,10 +83,15 @@ std::vector<std::uint64_t> stop_readers(std::vector<std::unique_ptr<ChildProcess
 
 json row(const std::string& name, double value, const std::string& unit, double reference,
          const std::string& reference_name, const std::string& note) {
-  return json{{"benchmark", name},     {"value", value}, {"unit", unit},
-              {"reference", reference}, {"reference_name", reference_name},
+  return json{{"benchmark", name},
+              {"value", value},
+              {"unit", unit},
+              {"reference", reference},
+              {"reference_name", reference_name},
               {"ratio", reference > 0 ? json(value / reference) : json(nullptr)},
-              {"target", ""},          {"met", nullptr}, {"note", note}};
+              {"target", ""},
+              {"met", nullptr},
+              {"note", note}};
 }
 
 void units_rows(const Settings& s, Rows& rows, int domain, int ref_domain, int units) {

@@ -48,8 +48,10 @@ int peer_telemetry(const PeerOptions& o) {
     if (!w) throw std::runtime_error(std::string("cannot create a writer of ") + name);
     return w;
   };
-  DataWriter* voltages = writer(topics::kVoltages, TypeSupport(new pmu::v5::VoltagesPubSubType()), qos_profiles::kTelemetry);
-  DataWriter* currents = writer(topics::kCurrents, TypeSupport(new pmu::v5::CurrentsPubSubType()), qos_profiles::kTelemetry);
+  DataWriter* voltages =
+      writer(topics::kVoltages, TypeSupport(new pmu::v5::VoltagesPubSubType()), qos_profiles::kTelemetry);
+  DataWriter* currents =
+      writer(topics::kCurrents, TypeSupport(new pmu::v5::CurrentsPubSubType()), qos_profiles::kTelemetry);
   DataWriter* energy =
       writer(topics::kBatteryEnergy, TypeSupport(new pmu::v5::BatteryEnergyPubSubType()), qos_profiles::kTelemetry);
   DataWriter* temperatures =

@@ -95,8 +95,7 @@ std::optional<std::int64_t> ServiceRun::wait_ready(std::chrono::milliseconds tim
 }
 
 void ServiceRun::check_alive() {
-  if (!process_->running())
-    throw std::runtime_error("pmu-service exited (" + log_ + "): " + tail(log_));
+  if (!process_->running()) throw std::runtime_error("pmu-service exited (" + log_ + "): " + tail(log_));
 }
 
 std::string ServiceRun::log_tail() const { return log_ + ": " + tail(log_, 20); }

@@ -20,12 +20,12 @@ struct Settings {
   std::string workdir;  // config, logs, sockets
   bool quick = false;   // one short pass of everything (the test command's smoke run)
   int domain_base = 0;
-  double latency_seconds = 0;  // > 0: length of each 7,634 frames/s run (e.g. for profiling)
-  int startups = 0;             // > 0: how many starts the start-up rows take the median of
-  bool startup_only = false;    // the start-up rows alone (to study start-up)
-  bool scale_only = false;      // the scale rows alone (scale_bench.hpp)
-  bool latency_only = false;    // the latency rows over SHM alone, saturated and realistic (to profile)
-  double realistic_seconds = 0; // > 0: length of the realistic-rate runs (default 60, quick 2)
+  double latency_seconds = 0;    // > 0: length of each 7,634 frames/s run (e.g. for profiling)
+  int startups = 0;              // > 0: how many starts the start-up rows take the median of
+  bool startup_only = false;     // the start-up rows alone (to study start-up)
+  bool scale_only = false;       // the scale rows alone (scale_bench.hpp)
+  bool latency_only = false;     // the latency rows over SHM alone, saturated and realistic (to profile)
+  double realistic_seconds = 0;  // > 0: length of the realistic-rate runs (default 60, quick 2)
 };
 
 // The config file's name of a transport: default, udp, shm.
@@ -36,8 +36,7 @@ class ServiceRun {
   // Writes the config, starts pmu-service with `--bus fd:3` and the fake PMU(s): one PMU
   // streaming once a second unless `load` says otherwise. Throws std::runtime_error when
   // it cannot.
-  ServiceRun(const Settings& s, int domain, dds::Transport transport, const std::string& tag,
-             FakePmuLoad load = {});
+  ServiceRun(const Settings& s, int domain, dds::Transport transport, const std::string& tag, FakePmuLoad load = {});
   ~ServiceRun();
 
   pid_t pid() const noexcept { return process_->pid(); }

@@ -56,13 +56,16 @@ TelemetryReaders::TelemetryReaders(pmu::dds::DdsContext& dds, int max_units) : d
     listeners_.push_back(std::move(listener));
     readers_.push_back(r);
   };
-  add(topics::kVoltages, TypeSupport(new pmu::v5::VoltagesPubSubType()), std::make_unique<Counter<pmu::v5::Voltages>>(shared, true));
-  add(topics::kCurrents, TypeSupport(new pmu::v5::CurrentsPubSubType()), std::make_unique<Counter<pmu::v5::Currents>>(shared, false));
+  add(topics::kVoltages, TypeSupport(new pmu::v5::VoltagesPubSubType()),
+      std::make_unique<Counter<pmu::v5::Voltages>>(shared, true));
+  add(topics::kCurrents, TypeSupport(new pmu::v5::CurrentsPubSubType()),
+      std::make_unique<Counter<pmu::v5::Currents>>(shared, false));
   add(topics::kBatteryEnergy, TypeSupport(new pmu::v5::BatteryEnergyPubSubType()),
       std::make_unique<Counter<pmu::v5::BatteryEnergy>>(shared, false));
   add(topics::kTemperatures, TypeSupport(new pmu::v5::TemperaturesPubSubType()),
       std::make_unique<Counter<pmu::v5::Temperatures>>(shared, false));
-  add(topics::kStatus, TypeSupport(new pmu::v5::StatusPubSubType()), std::make_unique<Counter<pmu::v5::Status>>(shared, false));
+  add(topics::kStatus, TypeSupport(new pmu::v5::StatusPubSubType()),
+      std::make_unique<Counter<pmu::v5::Status>>(shared, false));
 }
 
 TelemetryReaders::~TelemetryReaders() {

@@ -107,10 +107,9 @@ Result<CanOpenMessage, Error> decode(const CanFrame& frame) noexcept {
   if (frame.id == 0x482) m.fields[m.field_count++] = Field{"cell", static_cast<double>(m.subindex), ""};
   if (hit->type == Type::U8x4) {
     // Four values, one per byte; the names are fixed so no string is built at run time.
-    static constexpr std::string_view kTemps[4] = {"temperature_1", "temperature_2", "temperature_3",
-                                                   "temperature_4"};
-    static constexpr std::string_view kChannels[4] = {"channel_1_active", "channel_2_active",
-                                                      "channel_3_active", "channel_4_active"};
+    static constexpr std::string_view kTemps[4] = {"temperature_1", "temperature_2", "temperature_3", "temperature_4"};
+    static constexpr std::string_view kChannels[4] = {"channel_1_active", "channel_2_active", "channel_3_active",
+                                                      "channel_4_active"};
     const auto* names = hit->name == "temperature_collection" ? kTemps : kChannels;
     for (std::size_t i = 0; i < 4; ++i) m.fields[i] = Field{names[i], static_cast<double>(v[i]), hit->unit};
     m.field_count = 4;
@@ -123,9 +122,7 @@ Result<CanOpenMessage, Error> decode(const CanFrame& frame) noexcept {
 std::string Error::describe() const {
   char buf[160];
   switch (kind) {
-    case ErrorKind::NotOurs:
-      std::snprintf(buf, sizeof buf, "id %03X is not a battery or MPPT frame", cob_id);
-      break;
+    case ErrorKind::NotOurs: std::snprintf(buf, sizeof buf, "id %03X is not a battery or MPPT frame", cob_id); break;
     case ErrorKind::TooShort:
       std::snprintf(buf, sizeof buf, "CANopen frame %03X too short: length %u, needs %u", cob_id, length, needed);
       break;
@@ -133,12 +130,10 @@ std::string Error::describe() const {
       std::snprintf(buf, sizeof buf, "CANopen frame %03X: unknown index 0x%04X", cob_id, index);
       break;
     case ErrorKind::UnknownSubindex:
-      std::snprintf(buf, sizeof buf, "CANopen frame %03X: unknown subindex 0x%02X of index 0x%04X", cob_id,
-                    subindex, index);
+      std::snprintf(buf, sizeof buf, "CANopen frame %03X: unknown subindex 0x%02X of index 0x%04X", cob_id, subindex,
+                    index);
       break;
-    case ErrorKind::RemoteFrame:
-      std::snprintf(buf, sizeof buf, "remote frame %03X carries no data", cob_id);
-      break;
+    case ErrorKind::RemoteFrame: std::snprintf(buf, sizeof buf, "remote frame %03X carries no data", cob_id); break;
   }
   return buf;
 }

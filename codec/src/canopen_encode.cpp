@@ -104,7 +104,8 @@ Result<std::uint16_t, EncodeError> mppt_id(const Entry& e, std::uint8_t device) 
   return static_cast<std::uint16_t>(kMpptBase + kMpptStride * device + e.cob_offset);
 }
 
-Encoded scalar(const Entry& e, Result<std::uint16_t, EncodeError> id, double value, std::uint8_t subindex = 0) noexcept {
+Encoded scalar(const Entry& e, Result<std::uint16_t, EncodeError> id, double value,
+               std::uint8_t subindex = 0) noexcept {
   if (!id) return Unexpected{id.error()};
   const auto raw = raw_of(e, value, e.name);
   if (!raw) return Unexpected{raw.error()};
@@ -128,8 +129,7 @@ Encoded four(const Entry& e, Result<std::uint16_t, EncodeError> id, const std::a
 }
 
 // The names decode() gives each byte of a collection, for refusals.
-constexpr std::string_view kTemperatureNames[4] = {"temperature_1", "temperature_2", "temperature_3",
-                                                   "temperature_4"};
+constexpr std::string_view kTemperatureNames[4] = {"temperature_1", "temperature_2", "temperature_3", "temperature_4"};
 constexpr std::string_view kChannelNames[4] = {"channel_1_active", "channel_2_active", "channel_3_active",
                                                "channel_4_active"};
 
@@ -147,7 +147,8 @@ std::string_view name_of(MpptValue v) noexcept {
 
 Encoded encode_battery(BatteryValue v, double value, std::uint8_t node) noexcept {
   const auto i = static_cast<std::size_t>(v);
-  if (i >= kBatteryValueCount) return Unexpected{refuse(EncodeErrorKind::OutOfRange, "battery value", "", double(i), 0, kBatteryValueCount - 1)};
+  if (i >= kBatteryValueCount)
+    return Unexpected{refuse(EncodeErrorKind::OutOfRange, "battery value", "", double(i), 0, kBatteryValueCount - 1)};
   const Entry& e = kBattery[kBatteryRow[i]];
   return scalar(e, battery_id(e, node), value);
 }
@@ -164,7 +165,8 @@ Encoded encode_temperature_collection(const std::array<double, 4>& celsius, std:
 
 Encoded encode_mppt(std::uint8_t device, MpptValue v, double value) noexcept {
   const auto i = static_cast<std::size_t>(v);
-  if (i >= kMpptValueCount) return Unexpected{refuse(EncodeErrorKind::OutOfRange, "MPPT value", "", double(i), 0, kMpptValueCount - 1)};
+  if (i >= kMpptValueCount)
+    return Unexpected{refuse(EncodeErrorKind::OutOfRange, "MPPT value", "", double(i), 0, kMpptValueCount - 1)};
   const Entry& e = kMppt[i];
   return scalar(e, mppt_id(e, device), value);
 }

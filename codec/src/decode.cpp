@@ -154,8 +154,7 @@ Result<PmuMessage, DecodeError> decode(const CanFrame& frame, const PmuId& id,
   PmuMessage msg;
   msg.packet = packet;
   msg.address = id.address;
-  msg.unsupported_by_firmware =
-      packet == PacketId::MeasurementRequest && !supports(fw, Feature::MeasurementRequest);
+  msg.unsupported_by_firmware = packet == PacketId::MeasurementRequest && !supports(fw, Feature::MeasurementRequest);
 
   const std::uint8_t want = data_length(packet);
   if (frame.length == 0 && (want == 0 || has_zero_length_get(packet))) {
@@ -183,12 +182,10 @@ std::string DecodeError::describe() const {
       std::snprintf(buf, sizeof buf, "unknown packet 0x%02X in id %08X", packet, id);
       break;
     case DecodeErrorKind::RemoteFrame:
-      std::snprintf(buf, sizeof buf, "remote frame for packet 0x%02X %.*s (the PMU uses data frames only)",
-                    packet, static_cast<int>(name.size()), name.data());
+      std::snprintf(buf, sizeof buf, "remote frame for packet 0x%02X %.*s (the PMU uses data frames only)", packet,
+                    static_cast<int>(name.size()), name.data());
       break;
-    case DecodeErrorKind::BadLength:
-      std::snprintf(buf, sizeof buf, "length %u exceeds 8 bytes", length);
-      break;
+    case DecodeErrorKind::BadLength: std::snprintf(buf, sizeof buf, "length %u exceeds 8 bytes", length); break;
     case DecodeErrorKind::WrongLength: {
       const auto p = static_cast<PacketId>(packet);
       const char* get = has_zero_length_get(p) ? ", or 0 for a get" : "";

@@ -41,8 +41,8 @@ EncodeError error(EncodeErrorKind kind, std::string_view field, double value) no
 
 // A measured value in [min, max] rounded to its resolution `1/divisor`. Used for telemetry,
 // where any real reading is legitimate but must fit the field.
-Result<long, EncodeError> measured(double value, double divisor, long raw_min, long raw_max,
-                                   std::string_view field, std::string_view unit) noexcept {
+Result<long, EncodeError> measured(double value, double divisor, long raw_min, long raw_max, std::string_view field,
+                                   std::string_view unit) noexcept {
   if (!std::isfinite(value)) return Unexpected{error(EncodeErrorKind::NotANumber, field, value)};
   const double x = value * divisor;
   if (x < static_cast<double>(raw_min) - 0.5 || x > static_cast<double>(raw_max) + 0.5) {
@@ -227,9 +227,7 @@ Encoded encode_currents(const Currents& c, std::uint16_t address) noexcept { ret
 Encoded encode_battery_energy(const BatteryEnergy& e, std::uint16_t address) noexcept {
   return encode_fields(e, address);
 }
-Encoded encode_temperatures(const Temperatures& t, std::uint16_t address) noexcept {
-  return encode_fields(t, address);
-}
+Encoded encode_temperatures(const Temperatures& t, std::uint16_t address) noexcept { return encode_fields(t, address); }
 
 Encoded encode_status(const Status& s, std::uint16_t address, std::optional<FirmwareVersion> fw) noexcept {
   if (s.outputs & ~output_bit::All) {
@@ -292,14 +290,13 @@ std::string EncodeError::describe() const {
   const int decimals = (unit == "V" || unit == "s" || unit == "A") ? 1 : 0;
   char hex[32];
   switch (kind) {
-    case EncodeErrorKind::NotANumber:
-      return f + ": value " + number(value, 0) + " is not a number";
+    case EncodeErrorKind::NotANumber: return f + ": value " + number(value, 0) + " is not a number";
     case EncodeErrorKind::OutOfRange:
       return "value " + number(value, decimals) + u + " out of range " + number(min, decimals) + ".." +
              number(max, decimals) + u + " for " + f;
     case EncodeErrorKind::NotOnStep:
-      return "value " + number(value, decimals) + u + " for " + f + " is not a multiple of " +
-             number(min, decimals) + u;
+      return "value " + number(value, decimals) + u + " for " + f + " is not a multiple of " + number(min, decimals) +
+             u;
     case EncodeErrorKind::InvalidBits:
       std::snprintf(hex, sizeof hex, "0x%02X", bits);
       if (!(value >= 0) || value != std::round(value) || value > 255)
@@ -310,10 +307,8 @@ std::string EncodeError::describe() const {
       s += firmware ? " (device has " + to_string(*firmware) + ")" : std::string();
       return s;
     }
-    case EncodeErrorKind::NotAGet:
-      return "packet " + f + " has no zero-length get";
-    case EncodeErrorKind::EmptyMask:
-      return f + ": no output or group named";
+    case EncodeErrorKind::NotAGet: return "packet " + f + " has no zero-length get";
+    case EncodeErrorKind::EmptyMask: return f + ": no output or group named";
   }
   return f + ": invalid value";
 }

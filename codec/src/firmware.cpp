@@ -19,9 +19,7 @@ std::optional<FirmwareVersion> parse_firmware(std::string_view text) noexcept {
   return FirmwareVersion{static_cast<std::uint8_t>(major), static_cast<std::uint8_t>(minor)};
 }
 
-std::string to_string(FirmwareVersion v) {
-  return std::to_string(v.major) + "." + std::to_string(v.minor);
-}
+std::string to_string(FirmwareVersion v) { return std::to_string(v.major) + "." + std::to_string(v.minor); }
 
 FirmwareVersion first_firmware_with(Feature f) noexcept {
   switch (f) {
@@ -54,8 +52,7 @@ bool supports(std::optional<FirmwareVersion> fw, Feature f) noexcept {
 }
 
 FlagInterpretation interpret_flags(std::optional<FirmwareVersion> fw) noexcept {
-  return {supports(fw, Feature::SoaShutdownFlag) ? Bit6Meaning::SoaShutdown : Bit6Meaning::StartButton,
-          fw.has_value()};
+  return {supports(fw, Feature::SoaShutdownFlag) ? Bit6Meaning::SoaShutdown : Bit6Meaning::StartButton, fw.has_value()};
 }
 
 std::uint8_t power_up_state_mask(std::optional<FirmwareVersion> fw) noexcept {

@@ -4,9 +4,7 @@
 
 namespace pmu::codec {
 
-bool is_known_packet(std::uint8_t packet) noexcept {
-  return find_packet(static_cast<PacketId>(packet)) != nullptr;
-}
+bool is_known_packet(std::uint8_t packet) noexcept { return find_packet(static_cast<PacketId>(packet)) != nullptr; }
 
 std::string_view packet_name(PacketId packet) noexcept {
   const PacketSpec* p = find_packet(packet);

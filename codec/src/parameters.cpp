@@ -21,7 +21,8 @@ constexpr ParameterSpec kTable[kParameterCount] = {
     // PS: bits 0..4 (bits 5..7 "don't care").
     {Parameter::PacketsStreamed, PacketId::PacketsStreamed, "packets_streamed", "", K::Mask, 1, 0, 0x1F, 1},
     {Parameter::TemperatureOffset, PacketId::TemperatureOffset, "temperature_offset", "", K::Integer, 1, 0, 255, 1},
-    {Parameter::UpperTemperatureLimit, PacketId::UpperTemperatureLimit, "upper_temperature_limit", "degC", K::Integer, 1, 0, 255, 1},
+    {Parameter::UpperTemperatureLimit, PacketId::UpperTemperatureLimit, "upper_temperature_limit", "degC", K::Integer,
+     1, 0, 255, 1},
     // S0: the defined bits depend on firmware (power_up_state_mask); 0x7F is the widest.
     {Parameter::PowerUpState, PacketId::PowerUpState, "power_up_state", "", K::Mask, 1, 0, 0x7F, 1},
     // CT: 0.1..25.5 s, and 0 disables the timeout (table 17).

@@ -18,7 +18,9 @@ float value_of(codec::Parameter p, const std::optional<std::uint32_t>& raw) {
   return raw ? static_cast<float>(codec::parameter_value(p, *raw)) : 0.0f;
 }
 
-std::uint8_t octet_of(const std::optional<std::uint32_t>& raw) { return static_cast<std::uint8_t>(raw.value_or(0) & 0xFF); }
+std::uint8_t octet_of(const std::optional<std::uint32_t>& raw) {
+  return static_cast<std::uint8_t>(raw.value_or(0) & 0xFF);
+}
 
 // One accessor list for both directions, in Setting's order.
 template <class Sample, class Visit>
@@ -44,7 +46,9 @@ std::uint32_t raw_field(Setting, std::uint8_t v) { return v; }
 std::uint32_t raw_field(Setting, std::uint16_t v) { return v; }
 std::uint32_t raw_field(Setting, bool v) { return v ? 1u : 0u; }
 
-void set_field(Setting s, float& f, const std::optional<std::uint32_t>& raw) { f = value_of(*baseline::parameter_of(s), raw); }
+void set_field(Setting s, float& f, const std::optional<std::uint32_t>& raw) {
+  f = value_of(*baseline::parameter_of(s), raw);
+}
 void set_field(Setting, std::uint8_t& f, const std::optional<std::uint32_t>& raw) { f = octet_of(raw); }
 void set_field(Setting, std::uint16_t& f, const std::optional<std::uint32_t>& raw) {
   f = static_cast<std::uint16_t>(raw.value_or(0) & 0xFFFF);
@@ -85,7 +89,8 @@ baseline::ConfigFile config_file_of(const pmu::v5::Baseline& sample) {
   f.header.bus = sample.bus();
   f.header.address = sample.address();
   if (sample.has_serial()) f.header.serial = sample.serial();
-  if (sample.has_min_firmware()) f.header.min_firmware = codec::FirmwareVersion{sample.min_firmware_major(), sample.min_firmware_minor()};
+  if (sample.has_min_firmware())
+    f.header.min_firmware = codec::FirmwareVersion{sample.min_firmware_major(), sample.min_firmware_minor()};
   each_setting(sample, [&](Setting setting, const auto& field) {
     if (sample.present() & (1u << static_cast<unsigned>(setting))) f.settings[setting] = raw_field(setting, field);
   });

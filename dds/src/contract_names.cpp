@@ -19,7 +19,8 @@ std::optional<int> contract_of_type_name(std::string_view name) {
   if (name.substr(0, kModule.size()) != kModule) return std::nullopt;
   const std::string_view rest = name.substr(kModule.size());
   const auto sep = rest.find("::");
-  if (sep == std::string_view::npos) return rest.empty() ? std::nullopt : std::optional<int>(kFirstVersionedContract - 1);
+  if (sep == std::string_view::npos)
+    return rest.empty() ? std::nullopt : std::optional<int>(kFirstVersionedContract - 1);
   const std::string_view module = rest.substr(0, sep);
   if (module.size() < 2 || module.size() > 4 || module[0] != 'v' || sep + 2 >= rest.size()) return std::nullopt;
   int major = 0;

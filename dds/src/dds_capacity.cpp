@@ -41,16 +41,16 @@ std::string capacity_shortfall(const std::string& profile, EndpointKind kind, co
   } else {
     return {};
   }
-  const std::size_t depth = history.kind == KEEP_LAST_HISTORY_QOS ? static_cast<std::size_t>(std::max(history.depth, 1))
-                                                                  : need.per_instance;
+  const std::size_t depth =
+      history.kind == KEEP_LAST_HISTORY_QOS ? static_cast<std::size_t>(std::max(history.depth, 1)) : need.per_instance;
   // Every instance's KEEP_LAST history must fit in max_samples at once.
   const std::size_t samples = need.instances * std::max(depth, need.per_instance);
-  for (auto s : {short_of("max_instances", limits.max_instances, need.instances, need.why),
-                 short_of("max_samples_per_instance", limits.max_samples_per_instance, need.per_instance, need.why),
-                 short_of("max_samples", limits.max_samples, samples, need.why),
-                 history.kind == KEEP_LAST_HISTORY_QOS
-                     ? short_of("history depth", history.depth, need.per_instance, need.why)
-                     : std::string()})
+  for (auto s :
+       {short_of("max_instances", limits.max_instances, need.instances, need.why),
+        short_of("max_samples_per_instance", limits.max_samples_per_instance, need.per_instance, need.why),
+        short_of("max_samples", limits.max_samples, samples, need.why),
+        history.kind == KEEP_LAST_HISTORY_QOS ? short_of("history depth", history.depth, need.per_instance, need.why)
+                                              : std::string()})
     if (!s.empty()) return s;
   return {};
 }

@@ -88,8 +88,8 @@ std::string patterns_text(const std::vector<std::string>& patterns) {
 std::optional<std::string> statistics_topic_not_granted(const SecurityFiles& security,
                                                         const std::vector<std::string>& topics) {
   for (const auto& topic : topics)
-    if (const auto grant = topic_grant(security, topic, true); !grant || !grant->allowed ||
-                                                                partition_not_granted({}, grant->partitions))
+    if (const auto grant = topic_grant(security, topic, true);
+        !grant || !grant->allowed || partition_not_granted({}, grant->partitions))
       return topic;
   return std::nullopt;
 }
@@ -109,10 +109,17 @@ DdsContext::DdsContext(int domain, const std::string& qos_file, const std::strin
                        const SecurityFiles& security, Transport transport, const ResolvedNetwork& network,
                        const Partitions& partitions, const std::vector<std::string>& statistics, bool type_objects,
                        int contract)
-    : domain_(domain), contract_(contract), type_objects_(type_objects && contract == contract_major()), secure_(!security.empty()), security_(security), partitions_(partitions) {
+    : domain_(domain),
+      contract_(contract),
+      type_objects_(type_objects && contract == contract_major()),
+      secure_(!security.empty()),
+      security_(security),
+      partitions_(partitions) {
   const std::string file = qos_file.empty() ? default_qos_file() : qos_file;
   qos_file_ = file;
-  if (file.empty()) throw DdsError("no QoS profile file: neither " PMU_SYSCONFDIR "/qos.xml nor " PMU_DATADIR "/qos.xml exists; install deploy/qos.xml, set PMU_QOS_FILE or set qos_file");
+  if (file.empty())
+    throw DdsError("no QoS profile file: neither " PMU_SYSCONFDIR "/qos.xml nor " PMU_DATADIR
+                   "/qos.xml exists; install deploy/qos.xml, set PMU_QOS_FILE or set qos_file");
   load_qos_profiles(file);
   // Before any endpoint exists: Fast DDS copies a type's object into the endpoint's discovery
   // data when the endpoint is created, from what is registered then.
@@ -126,8 +133,9 @@ DdsContext::DdsContext(int domain, const std::string& qos_file, const std::strin
   // Without the guard a secured participant may never authenticate a peer it found at the
   // same time as another (security_match_guard.hpp).
   if (secure_ && !security_match_guard_active())
-    spdlog::warn("DDS-Security without the guard against Fast DDS 2.9.1's matching race: a peer found at the same "
-                 "moment as another may stay unauthenticated until one of them restarts");
+    spdlog::warn(
+        "DDS-Security without the guard against Fast DDS 2.9.1's matching race: a peer found at the same "
+        "moment as another may stay unauthenticated until one of them restarts");
   // Transports, discovery, interfaces, security and statistics: dds_participant.hpp says what each sets.
   DomainParticipantQos pqos;
   try {
@@ -158,8 +166,9 @@ DdsContext::DdsContext(int domain, const std::string& qos_file, const std::strin
   subscriber_ = participant_->create_subscriber(sub_qos);
   if (!publisher_ || !subscriber_) {
     DomainParticipantFactory::get_instance()->delete_participant(participant_);
-    throw DdsError("cannot create a DDS publisher/subscriber on domain " + std::to_string(domain) +
-                   (secure_ ? " (DDS-Security: this identity's permissions may not allow its vehicle's partition)" : ""));
+    throw DdsError(
+        "cannot create a DDS publisher/subscriber on domain " + std::to_string(domain) +
+        (secure_ ? " (DDS-Security: this identity's permissions may not allow its vehicle's partition)" : ""));
   }
 }
 
@@ -195,7 +204,8 @@ Topic& DdsContext::topic(const std::string& name, TypeSupport type) {
 }
 
 DataWriter& DdsContext::writer(Topic& topic, const std::string& profile, DataWriterListener* listener) {
-  DataWriter* w = reuse_ && !listener ? kept_writer(topic, profile) : make_writer(*publisher_, topic, profile, listener);
+  DataWriter* w =
+      reuse_ && !listener ? kept_writer(topic, profile) : make_writer(*publisher_, topic, profile, listener);
   writers_.push_back(w);
   return *w;
 }
@@ -226,7 +236,8 @@ DataWriter* DdsContext::make_writer(Publisher& publisher, Topic& topic, const st
 }
 
 DataReader& DdsContext::reader(Topic& topic, const std::string& profile, DataReaderListener* listener) {
-  DataReader* r = reuse_ && !listener ? kept_reader(topic, profile) : make_reader(*subscriber_, topic, profile, listener);
+  DataReader* r =
+      reuse_ && !listener ? kept_reader(topic, profile) : make_reader(*subscriber_, topic, profile, listener);
   readers_.push_back(r);
   return *r;
 }
@@ -258,8 +269,8 @@ bool DdsContext::move(Kept& k, const std::vector<std::string>& partitions) {
 DdsContext::Kept* DdsContext::take_up(const std::string& topic, const std::string& profile, bool writer,
                                       const std::vector<std::string>& partitions) {
   std::size_t alike = 0;
-  Kept* here = nullptr;   // idle, in these partitions: taking it up costs the link nothing
-  Kept* oldest = nullptr; // idle elsewhere, the least recently taken up
+  Kept* here = nullptr;    // idle, in these partitions: taking it up costs the link nothing
+  Kept* oldest = nullptr;  // idle elsewhere, the least recently taken up
   for (auto& k : kept_) {
     if ((k.writer != nullptr) != writer || k.topic != topic || k.profile != profile) continue;
     ++alike;
@@ -296,7 +307,8 @@ DataWriter* DdsContext::kept_writer(Topic& topic, const std::string& profile) {
     if (publisher) participant_->delete_publisher(publisher);
     throw;
   }
-  kept_.push_back({topic.get_name(), profile, partitions_.publisher, publisher, w, nullptr, nullptr, true, ++take_ups_});
+  kept_.push_back(
+      {topic.get_name(), profile, partitions_.publisher, publisher, w, nullptr, nullptr, true, ++take_ups_});
   return w;
 }
 
@@ -311,7 +323,8 @@ DataReader* DdsContext::kept_reader(Topic& topic, const std::string& profile) {
     if (subscriber) participant_->delete_subscriber(subscriber);
     throw;
   }
-  kept_.push_back({topic.get_name(), profile, partitions_.subscriber, nullptr, nullptr, subscriber, r, true, ++take_ups_});
+  kept_.push_back(
+      {topic.get_name(), profile, partitions_.subscriber, nullptr, nullptr, subscriber, r, true, ++take_ups_});
   return r;
 }
 
@@ -357,7 +370,8 @@ void DdsContext::delete_endpoints_since(EndpointMark mark) {
 
 DataWriter& DdsContext::default_partition_writer(Topic& topic, const DataWriterQos& qos) {
   if (!default_publisher_) default_publisher_ = participant_->create_publisher(PUBLISHER_QOS_DEFAULT);
-  if (!default_publisher_) throw DdsError("cannot create a DDS publisher in the default partition for " + topic.get_name());
+  if (!default_publisher_)
+    throw DdsError("cannot create a DDS publisher in the default partition for " + topic.get_name());
   DataWriter* w = default_publisher_->create_datawriter(&topic, qos);
   if (!w) {
     const std::string what = "cannot create a writer for " + topic.get_name() + " in the default partition";
@@ -382,8 +396,8 @@ DataReader& DdsContext::default_partition_reader(Topic& topic, const DataReaderQ
 
 void DdsContext::too_small(const std::string& topic, const std::string& profile, bool publish,
                            const std::string& shortfall) const {
-  throw DdsError(qos_file_ + ": <" + (publish ? "data_writer" : "data_reader") + " profile_name=\"" + profile + "\"> (" +
-                 topic + "): " + shortfall +
+  throw DdsError(qos_file_ + ": <" + (publish ? "data_writer" : "data_reader") + " profile_name=\"" + profile +
+                 "\"> (" + topic + "): " + shortfall +
                  ": raise its <resourceLimitsQos> (deploy/qos.xml says how each number is derived)");
 }
 

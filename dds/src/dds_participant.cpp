@@ -61,7 +61,8 @@ eprosima::fastrtps::Duration_t duration(std::chrono::milliseconds ms) {
   return eprosima::fastrtps::Duration_t(static_cast<double>(ms.count()) / 1000.0);
 }
 
-eprosima::fastrtps::Duration_t longer(const eprosima::fastrtps::Duration_t& a, const eprosima::fastrtps::Duration_t& b) {
+eprosima::fastrtps::Duration_t longer(const eprosima::fastrtps::Duration_t& a,
+                                      const eprosima::fastrtps::Duration_t& b) {
   return a < b ? b : a;
 }
 
@@ -73,7 +74,8 @@ DomainParticipantQos participant_qos(const std::string& name, Transport transpor
   DomainParticipantQos qos;
   qos.name(name);
   if (!security.empty()) add_security(qos, security);
-  if (!statistics.empty()) qos.properties().properties().emplace_back("fastdds.statistics", statistics_property(statistics));
+  if (!statistics.empty())
+    qos.properties().properties().emplace_back("fastdds.statistics", statistics_property(statistics));
 
   const bool allowlist = !network.interface_addresses.empty();
   if (transport == Transport::ShmOnly && (allowlist || network.mode != DiscoveryMode::Multicast))
@@ -120,8 +122,7 @@ DomainParticipantQos participant_qos(const std::string& name, Transport transpor
     builtin.discovery_config.initial_announcements.count = static_cast<std::uint32_t>(link.initial_announcements);
   }
   switch (network.mode) {
-    case DiscoveryMode::Multicast:
-      break;
+    case DiscoveryMode::Multicast: break;
     case DiscoveryMode::Unicast:
       builtin.discovery_config.discoveryProtocol = eprosima::fastrtps::rtps::DiscoveryProtocol_t::SIMPLE;
       builtin.initialPeersList.clear();

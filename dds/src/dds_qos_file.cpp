@@ -103,8 +103,7 @@ std::vector<std::string> qos_file_problems(const std::string& file, const std::v
       problems.push_back(file + ": no " + element + ", needed for " + use.used_for);
       continue;
     }
-    if (const auto s = capacity_shortfall(use.profile, use.kind, own->resourceLimitsQos, own->historyQos);
-        !s.empty()) {
+    if (const auto s = capacity_shortfall(use.profile, use.kind, own->resourceLimitsQos, own->historyQos); !s.empty()) {
       const int line = profile_line(doc.RootElement(), tag, use.profile);
       problems.push_back(file + (line > 0 ? ":" + std::to_string(line) : std::string()) + ": " + element + " (" +
                          use.used_for + "): " + s +

@@ -36,13 +36,9 @@ void RemoteWriters::on_participant_discovery(eprosima::fastdds::dds::DomainParti
   std::lock_guard<std::mutex> lock(mutex_);
   switch (info.status) {
     case Status::DISCOVERED_PARTICIPANT:
-    case Status::CHANGED_QOS_PARTICIPANT:
-      participants_[prefix] = info.info.m_participantName.to_string();
-      break;
+    case Status::CHANGED_QOS_PARTICIPANT: participants_[prefix] = info.info.m_participantName.to_string(); break;
     case Status::REMOVED_PARTICIPANT:
-    case Status::DROPPED_PARTICIPANT:
-      participants_.erase(prefix);
-      break;
+    case Status::DROPPED_PARTICIPANT: participants_.erase(prefix); break;
   }
 }
 

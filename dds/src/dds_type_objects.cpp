@@ -28,8 +28,7 @@ bool fully_descriptive(const xt::TypeIdentifier& id) {
     case xt::TI_STRING8_SMALL:
     case xt::TI_STRING8_LARGE:
     case xt::TI_STRING16_SMALL:
-    case xt::TI_STRING16_LARGE:
-      return true;
+    case xt::TI_STRING16_LARGE: return true;
     case xt::TI_PLAIN_SEQUENCE_SMALL:
       return id.seq_sdefn().element_identifier() && fully_descriptive(*id.seq_sdefn().element_identifier());
     case xt::TI_PLAIN_SEQUENCE_LARGE:
@@ -38,8 +37,7 @@ bool fully_descriptive(const xt::TypeIdentifier& id) {
       return id.array_sdefn().element_identifier() && fully_descriptive(*id.array_sdefn().element_identifier());
     case xt::TI_PLAIN_ARRAY_LARGE:
       return id.array_ldefn().element_identifier() && fully_descriptive(*id.array_ldefn().element_identifier());
-    default:
-      return false;
+    default: return false;
   }
 }
 
@@ -60,8 +58,7 @@ void register_type_objects() {
 
 bool type_object_is_self_contained(const std::string& type_name) {
   const xt::TypeObject* object = xt::TypeObjectFactory::get_instance()->get_type_object(type_name, true);
-  if (object == nullptr || object->_d() != xt::EK_COMPLETE || object->complete()._d() != xt::TK_STRUCTURE)
-    return false;
+  if (object == nullptr || object->_d() != xt::EK_COMPLETE || object->complete()._d() != xt::TK_STRUCTURE) return false;
   const auto& s = object->complete().struct_type();
   if (s.header().base_type()._d() != 0) return false;  // inheritance: a type named by hash
   for (const auto& member : s.member_seq())

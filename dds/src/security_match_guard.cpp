@@ -8,7 +8,7 @@
 
 #define PMU_FASTDDS_MATCH_BUILTIN \
   "_ZN8eprosima8fastrtps4rtps8security15SecurityManager23match_builtin_endpointsERKNS1_20ParticipantProxyDataE"
-#define PMU_FASTDDS_MATCH_KEY_EXCHANGE                                                              \
+#define PMU_FASTDDS_MATCH_KEY_EXCHANGE                                                                \
   "_ZN8eprosima8fastrtps4rtps8security15SecurityManager36match_builtin_key_exchange_endpointsERKNS1_" \
   "20ParticipantProxyDataE"
 

@@ -88,7 +88,8 @@ bool telemetry_cdr(const std::string& vehicle, const DeviceKey& key, const codec
   if (const auto* c = std::get_if<codec::Currents>(&m.payload))
     return sample<pmu::v5::Currents, pmu::v5::CurrentsPubSubType>(vehicle, key, *c, topics::kCurrents, out);
   if (const auto* e = std::get_if<codec::BatteryEnergy>(&m.payload))
-    return sample<pmu::v5::BatteryEnergy, pmu::v5::BatteryEnergyPubSubType>(vehicle, key, *e, topics::kBatteryEnergy, out);
+    return sample<pmu::v5::BatteryEnergy, pmu::v5::BatteryEnergyPubSubType>(vehicle, key, *e, topics::kBatteryEnergy,
+                                                                            out);
   if (const auto* t = std::get_if<codec::Temperatures>(&m.payload))
     return sample<pmu::v5::Temperatures, pmu::v5::TemperaturesPubSubType>(vehicle, key, *t, topics::kTemperatures, out);
   if (const auto* st = std::get_if<codec::Status>(&m.payload))

@@ -17,8 +17,7 @@ struct Look {
   std::optional<ParseResult> result;
 };
 
-Look reject(RejectReason reason, std::uint32_t msgid, std::uint8_t sysid, std::uint8_t compid,
-            std::size_t consumed) {
+Look reject(RejectReason reason, std::uint32_t msgid, std::uint8_t sysid, std::uint8_t compid, std::size_t consumed) {
   return {Step::result, consumed, ParseResult{Rejection{reason, msgid, sysid, compid}}};
 }
 
@@ -67,8 +66,8 @@ void Parser::push(const std::uint8_t* data, std::size_t size) {
 std::optional<ParseResult> Parser::next() {
   while (true) {
     const auto begin = buffer_.begin() + static_cast<std::ptrdiff_t>(start_);
-    const auto marker = std::find_if(begin, buffer_.end(),
-                                     [](std::uint8_t b) { return b == kStartV2 || b == kStartV1; });
+    const auto marker =
+        std::find_if(begin, buffer_.end(), [](std::uint8_t b) { return b == kStartV2 || b == kStartV1; });
     counters_.garbage_bytes += static_cast<std::uint64_t>(marker - begin);
     start_ = static_cast<std::size_t>(marker - buffer_.begin());
     if (marker == buffer_.end()) {
@@ -87,16 +86,15 @@ std::optional<ParseResult> Parser::next() {
       if (available < kHeaderLength) return std::nullopt;
       const std::uint8_t length = p[1];
       const std::uint8_t incompat = p[2];
-      const std::uint32_t id = p[7] | (static_cast<std::uint32_t>(p[8]) << 8) |
-                               (static_cast<std::uint32_t>(p[9]) << 16);
+      const std::uint32_t id =
+          p[7] | (static_cast<std::uint32_t>(p[8]) << 8) | (static_cast<std::uint32_t>(p[9]) << 16);
       if ((incompat & static_cast<std::uint8_t>(~kIncompatSigned)) != 0) {
         ++counters_.unsupported_incompat_flags;
         // The frame's length is unknown with a flag not understood: resynchronise.
         look = reject(RejectReason::unsupported_incompat_flags, id, p[5], p[6], 1);
       } else {
         const bool is_signed = (incompat & kIncompatSigned) != 0;
-        const std::size_t total =
-            kHeaderLength + length + kChecksumLength + (is_signed ? kSignatureLength : 0);
+        const std::size_t total = kHeaderLength + length + kChecksumLength + (is_signed ? kSignatureLength : 0);
         if (available < total) return std::nullopt;
         const MessageInfo* info = find_message(id);
         if (info == nullptr) {
@@ -137,15 +135,12 @@ std::optional<ParseResult> Parser::next() {
     }
 
     switch (look.step) {
-      case Step::need_more:
-        return std::nullopt;
+      case Step::need_more: return std::nullopt;
       case Step::not_a_frame:
         ++counters_.garbage_bytes;
         ++start_;
         continue;
-      case Step::result:
-        start_ += look.consumed;
-        return std::move(look.result);
+      case Step::result: start_ += look.consumed; return std::move(look.result);
     }
   }
 }

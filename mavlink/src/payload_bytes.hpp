@@ -16,8 +16,8 @@ template <class T>
 void put(Payload& out, std::size_t offset, T value) {
   static_assert(std::is_integral_v<T> || std::is_floating_point_v<T>);
   using U = std::conditional_t<sizeof(T) == 1, std::uint8_t,
-            std::conditional_t<sizeof(T) == 2, std::uint16_t,
-            std::conditional_t<sizeof(T) == 4, std::uint32_t, std::uint64_t>>>;
+                               std::conditional_t<sizeof(T) == 2, std::uint16_t,
+                                                  std::conditional_t<sizeof(T) == 4, std::uint32_t, std::uint64_t>>>;
   U bits = 0;
   std::memcpy(&bits, &value, sizeof(T));
   for (std::size_t i = 0; i < sizeof(T); ++i) {
@@ -28,8 +28,8 @@ void put(Payload& out, std::size_t offset, T value) {
 template <class T>
 T get(const Payload& in, std::size_t offset) {
   using U = std::conditional_t<sizeof(T) == 1, std::uint8_t,
-            std::conditional_t<sizeof(T) == 2, std::uint16_t,
-            std::conditional_t<sizeof(T) == 4, std::uint32_t, std::uint64_t>>>;
+                               std::conditional_t<sizeof(T) == 2, std::uint16_t,
+                                                  std::conditional_t<sizeof(T) == 4, std::uint32_t, std::uint64_t>>>;
   U bits = 0;
   for (std::size_t i = 0; i < sizeof(T); ++i) {
     bits = static_cast<U>(bits | (static_cast<U>(in[offset + i]) << (8 * i)));

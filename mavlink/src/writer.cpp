@@ -10,8 +10,8 @@ std::size_t truncated_length(const Payload& payload, std::size_t full_length) no
   return length;
 }
 
-std::vector<std::uint8_t> FrameWriter::encode(std::uint32_t msgid, const Payload& payload,
-                                              SigningLink* signing, std::uint64_t now) {
+std::vector<std::uint8_t> FrameWriter::encode(std::uint32_t msgid, const Payload& payload, SigningLink* signing,
+                                              std::uint64_t now) {
   const MessageInfo* info = find_message(msgid);
   if (info == nullptr) return {};
   const std::size_t length = truncated_length(payload, info->max_length);

@@ -15,12 +15,11 @@ using codec::canopen::BatteryValue;
 
 // The table's order (spec "Battery (MG) CAN-format"): 0x302, then 0x402; the cells and 0x202
 // follow.
-constexpr BatteryValue k302[] = {BatteryValue::Voltage,       BatteryValue::Current,
+constexpr BatteryValue k302[] = {BatteryValue::Voltage,          BatteryValue::Current,
                                  BatteryValue::CurrentDischarge, BatteryValue::CurrentCharge,
-                                 BatteryValue::StateOfCharge, BatteryValue::TimeToGo};
+                                 BatteryValue::StateOfCharge,    BatteryValue::TimeToGo};
 constexpr BatteryValue k402[] = {BatteryValue::CellTemperatureHigh, BatteryValue::CellTemperatureLow,
-                                 BatteryValue::CellVoltageHigh, BatteryValue::CellVoltageLow,
-                                 BatteryValue::BmsState};
+                                 BatteryValue::CellVoltageHigh, BatteryValue::CellVoltageLow, BatteryValue::BmsState};
 constexpr std::size_t kFixedBefore = std::size(k302) + std::size(k402) + 1;  // + temperature collection
 
 // Readings beyond a field are clamped, as PmuModel does: a real BMS saturates, it does not
@@ -90,8 +89,8 @@ BatteryModel::BatteryModel(const BatterySimConfig& config, std::shared_ptr<Solar
   check(config_);
   if (!plant_) plant_ = std::make_shared<SolarPlant>(SolarWorld{}, now);
   token_ = plant_->add_battery(config_);
-  sender_ = std::make_unique<Sender>(Sender{detail::Spread(config_.period, frames_per_period(), now),
-                                            detail::CanOpenSender(std::move(sink))});
+  sender_ = std::make_unique<Sender>(
+      Sender{detail::Spread(config_.period, frames_per_period(), now), detail::CanOpenSender(std::move(sink))});
 }
 
 BatteryModel::~BatteryModel() { plant_->remove_battery(config_.node, token_); }
@@ -126,9 +125,9 @@ void BatteryModel::send_frame(std::size_t slot) noexcept {
   } else if (slot < kFixedBefore + cells) {
     const std::size_t i = slot - kFixedBefore;
     // Every subindex is a cell number on 0x482: spoil the index instead.
-    sender_->out.send(co::encode_cell_voltage(static_cast<std::uint8_t>(i + 1),
-                                              std::clamp(r.cell_voltages[i], 0.0, 65.535), node),
-                      {std::nullopt, 0x2001});
+    sender_->out.send(
+        co::encode_cell_voltage(static_cast<std::uint8_t>(i + 1), std::clamp(r.cell_voltages[i], 0.0, 65.535), node),
+        {std::nullopt, 0x2001});
   } else {
     sender_->out.send(scalar(BatteryValue::PowerLevel), {});  // 0x202 checks neither: cut short
   }

@@ -49,8 +49,7 @@ void ModelState::on_frame(const codec::CanFrame& frame, TimePoint now) noexcept 
     return;
   }
   // v1.9 6.5: 0x0F exists from firmware 1.14; older units do not know the packet at all.
-  if (id.id->packet == PacketId::MeasurementRequest &&
-      !codec::supports(firmware, codec::Feature::MeasurementRequest)) {
+  if (id.id->packet == PacketId::MeasurementRequest && !codec::supports(firmware, codec::Feature::MeasurementRequest)) {
     ++counters.unsupported;
     return;
   }
@@ -103,8 +102,7 @@ void ModelState::handle(const codec::PmuMessage& msg, TimePoint now) noexcept {
       if (const auto* e = payload<codec::EnableOutputs>(msg)) outputs = static_cast<std::uint8_t>(outputs | e->mask);
       break;
     case PacketId::DisableOutputs:
-      if (const auto* d = payload<codec::DisableOutputs>(msg))
-        outputs = static_cast<std::uint8_t>(outputs & ~d->mask);
+      if (const auto* d = payload<codec::DisableOutputs>(msg)) outputs = static_cast<std::uint8_t>(outputs & ~d->mask);
       break;
     case PacketId::Generation:
       if (msg.request) {
@@ -128,9 +126,7 @@ void ModelState::handle(const codec::PmuMessage& msg, TimePoint now) noexcept {
       // 5.23 stops cranking only; the PMU has no way to stop a running engine.
       if (engine == EngineState::Cranking) engine = EngineState::Stopped;
       break;
-    case PacketId::Reset:
-      restart(now);
-      break;
+    case PacketId::Reset: restart(now); break;
     case PacketId::Serial:
     case PacketId::Firmware:
       if (!msg.request) {  // another unit's answer
@@ -155,9 +151,7 @@ void ModelState::handle(const codec::PmuMessage& msg, TimePoint now) noexcept {
     case PacketId::UpperTemperatureLimit:
     case PacketId::PowerUpState:
     case PacketId::CrankingTime:
-    case PacketId::CanAddress:
-      handle_parameter(msg, now);
-      return;  // counts for itself
+    case PacketId::CanAddress: handle_parameter(msg, now); return;  // counts for itself
   }
   ++counters.handled;
 }
@@ -197,9 +191,7 @@ void ModelState::handle_parameter(const codec::PmuMessage& msg, TimePoint now) n
     case codec::Parameter::PacketPeriod:
       next_stream = now + packet_period();  // the new period starts now
       break;
-    case codec::Parameter::UpperTemperatureLimit:
-      update_thermal();
-      break;
+    case codec::Parameter::UpperTemperatureLimit: update_thermal(); break;
     case codec::Parameter::CanAddress:
       // Chosen: the new address applies at once (the spec does not say it waits for a
       // restart); the unit answers on it from the next frame.
@@ -207,10 +199,8 @@ void ModelState::handle_parameter(const codec::PmuMessage& msg, TimePoint now) n
       break;
     case codec::Parameter::AvionicsVoltage:
     case codec::Parameter::PayloadVoltage:
-    case codec::Parameter::ServoVoltage:
-      break;  // they show in the next measurement
-    case codec::Parameter::PowerUpState:
-      break;  // applies at the next reset
+    case codec::Parameter::ServoVoltage: break;  // they show in the next measurement
+    case codec::Parameter::PowerUpState: break;  // applies at the next reset
     case codec::Parameter::BatteryVoltage:
     case codec::Parameter::PacketsStreamed:
     case codec::Parameter::TemperatureOffset:

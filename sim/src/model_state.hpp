@@ -57,9 +57,7 @@ struct ModelState {
   void on_frame(const codec::CanFrame& frame, TimePoint now) noexcept;
   void handle(const codec::PmuMessage& msg, TimePoint now) noexcept;
   void handle_parameter(const codec::PmuMessage& msg, TimePoint now) noexcept;
-  bool addressed_to_us(std::uint16_t to) const noexcept {
-    return to == address || to == codec::kBroadcastAddress;
-  }
+  bool addressed_to_us(std::uint16_t to) const noexcept { return to == address || to == codec::kBroadcastAddress; }
 
  private:
   void integrate(TimePoint to) noexcept;

@@ -67,8 +67,7 @@ void ModelState::advance(TimePoint now) noexcept {
 }
 
 void ModelState::update_thermal() noexcept {
-  thermal = next_thermal_shutdown(thermal, plant.internal_temperature,
-                                  params.raw(Parameter::UpperTemperatureLimit));
+  thermal = next_thermal_shutdown(thermal, plant.internal_temperature, params.raw(Parameter::UpperTemperatureLimit));
 }
 
 void ModelState::tick(TimePoint now) noexcept {

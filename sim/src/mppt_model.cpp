@@ -19,7 +19,9 @@ constexpr std::size_t kValues = codec::canopen::kMpptValueCount;  // then the ch
 static_assert(MpptModel::frames_per_period() == kValues + 1);
 
 // Counts of the sim's scale, clamped into the int16 the document gives them.
-double counts(double si, double per_count) noexcept { return std::clamp(std::round(si / per_count), -32768.0, 32767.0); }
+double counts(double si, double per_count) noexcept {
+  return std::clamp(std::round(si / per_count), -32768.0, 32767.0);
+}
 double volts(double v) noexcept { return counts(v, kMpptVoltsPerCount); }
 double amps(double a) noexcept { return counts(a, kMpptAmpsPerCount); }
 
@@ -70,8 +72,8 @@ MpptModel::MpptModel(const MpptSimConfig& config, std::shared_ptr<SolarPlant> pl
   check(config_);
   if (!plant_) plant_ = std::make_shared<SolarPlant>(SolarWorld{}, now);
   token_ = plant_->add_mppt(config_);
-  sender_ = std::make_unique<Sender>(Sender{detail::Spread(config_.period, frames_per_period(), now),
-                                            detail::CanOpenSender(std::move(sink))});
+  sender_ = std::make_unique<Sender>(
+      Sender{detail::Spread(config_.period, frames_per_period(), now), detail::CanOpenSender(std::move(sink))});
 }
 
 MpptModel::~MpptModel() { plant_->remove_mppt(config_.device, token_); }

@@ -15,9 +15,7 @@ bool on(const Operating& op, std::uint8_t bit) noexcept { return (op.outputs & b
 // A battery below this reads as absent and cannot supply the outputs.
 constexpr double kBatteryPresentVolts = 1.0;
 
-double highest_battery(const Plant& p) noexcept {
-  return std::max({0.0, p.battery_a_voltage, p.battery_b_voltage});
-}
+double highest_battery(const Plant& p) noexcept { return std::max({0.0, p.battery_a_voltage, p.battery_b_voltage}); }
 
 }  // namespace
 
@@ -56,8 +54,8 @@ codec::Currents currents(const Plant& p, const Operating& op) noexcept {
   // The batteries share the output power equally (chosen: the spec says nothing about how
   // the PMU splits the load); each draws that share at its own voltage.
   const codec::Voltages v = voltages(p, op);
-  const double power = v.avionics * c.avionics + v.servo * c.servo + v.payload * c.payload +
-                       v.output_28v * c.output_28v;
+  const double power =
+      v.avionics * c.avionics + v.servo * c.servo + v.payload * c.payload + v.output_28v * c.output_28v;
   const bool a = p.battery_a_voltage >= kBatteryPresentVolts;
   const bool b = p.battery_b_voltage >= kBatteryPresentVolts;
   const int supplying = (a ? 1 : 0) + (b ? 1 : 0);

@@ -24,9 +24,7 @@ PmuModel::~PmuModel() = default;
 PmuModel::PmuModel(PmuModel&&) noexcept = default;
 PmuModel& PmuModel::operator=(PmuModel&&) noexcept = default;
 
-void PmuModel::on_frame(const codec::CanFrame& frame, TimePoint now) noexcept {
-  impl_->on_frame(frame, now);
-}
+void PmuModel::on_frame(const codec::CanFrame& frame, TimePoint now) noexcept { impl_->on_frame(frame, now); }
 
 void PmuModel::tick(TimePoint now) noexcept { impl_->tick(now); }
 

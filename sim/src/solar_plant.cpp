@@ -211,8 +211,8 @@ BatteryReading SolarPlant::battery(std::uint8_t node) const noexcept {
   r.current_discharge = f.discharge_per_battery;
   r.current = r.current_charge - r.current_discharge;
   r.state_of_charge = b.soc * 100.0;
-  r.time_to_go = r.current < -0.01 ? std::min(65534.0, b.soc * b.config.capacity_ah / -r.current * 60.0)
-                                   : kTimeToGoNotDischarging;
+  r.time_to_go =
+      r.current < -0.01 ? std::min(65534.0, b.soc * b.config.capacity_ah / -r.current * 60.0) : kTimeToGoNotDischarging;
   r.cells = std::clamp(b.config.cells, 0, kMaxCells);
   r.cell_voltage_low = 1e9;
   for (int i = 0; i < r.cells; ++i) {

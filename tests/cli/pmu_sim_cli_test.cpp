@@ -89,8 +89,7 @@ TEST(PmuSimOptions, GoodWorldOptionsAreAccepted) {
   };
   for (const char* args : good) {
     SCOPED_TRACE(args);
-    const auto r =
-        pmu::test::run_capture("timeout 2 " + std::string(PMU_SIM_PATH) + " pmusimnone0 " + args + " 2>&1");
+    const auto r = pmu::test::run_capture("timeout 2 " + std::string(PMU_SIM_PATH) + " pmusimnone0 " + args + " 2>&1");
     EXPECT_TRUE(r.status == 1 || r.status == 124) << r.status << ": " << r.out;
     EXPECT_NE(r.out.find("pmusimnone0"), std::string::npos) << "(it should have tried the bus) " << r.out;
   }
@@ -99,11 +98,30 @@ TEST(PmuSimOptions, GoodWorldOptionsAreAccepted) {
 TEST(PmuSimOptions, HelpDocumentsEveryOption) {
   const auto r = pmu::test::run_capture(std::string(PMU_SIM_PATH) + " --help");
   EXPECT_EQ(r.status, 0);
-  for (const char* option : {"--battery", "--mppt", "--no-pmu", "--cells", "--battery-period", "--mppt-period",
-                             "--load", "--sun", "--engine", "--engine-stopped", "--engine-starts-after",
-                             "--internal-temperature", "--battery-a-voltage", "--battery-b-voltage",
-                             "--starter-ready", "--soa-shutdown", "--payload-shed", "--silent", "--state-of-charge",
-                             "--cell-voltages", "--battery-garble", "--battery-silent", "--panels", "--mppt-garble",
+  for (const char* option : {"--battery",
+                             "--mppt",
+                             "--no-pmu",
+                             "--cells",
+                             "--battery-period",
+                             "--mppt-period",
+                             "--load",
+                             "--sun",
+                             "--engine",
+                             "--engine-stopped",
+                             "--engine-starts-after",
+                             "--internal-temperature",
+                             "--battery-a-voltage",
+                             "--battery-b-voltage",
+                             "--starter-ready",
+                             "--soa-shutdown",
+                             "--payload-shed",
+                             "--silent",
+                             "--state-of-charge",
+                             "--cell-voltages",
+                             "--battery-garble",
+                             "--battery-silent",
+                             "--panels",
+                             "--mppt-garble",
                              "--mppt-silent"}) {
     EXPECT_NE(r.out.find(option), std::string::npos) << option;
   }

@@ -57,11 +57,11 @@ struct Expect {
 
 // Line by line, what tests/data/every_packet.log holds (computed by hand from tables 2..24).
 const Expect kEveryPacket[] = {
-    {"voltages", "avionics", 12.3},          // 0x7B = 123 -> 12.3 V
-    {"currents", "output_28v", -12.5},       // 0x83 signed = -125
+    {"voltages", "avionics", 12.3},             // 0x7B = 123 -> 12.3 V
+    {"currents", "output_28v", -12.5},          // 0x83 signed = -125
     {"battery_energy", "battery_a_mah", -100},  // 0xFF9C
-    {"temperatures", "battery_a", nullptr},  // -128 = no sensor
-    {"status", "generator_rpm", 4000},       // 0x0FA0
+    {"temperatures", "battery_a", nullptr},     // -128 = no sensor
+    {"status", "generator_rpm", 4000},          // 0x0FA0
     {"measurement_request", "measurements", 31},
     {"avionics_voltage", "avionics_voltage", 12.0},
     {"payload_voltage", "payload_voltage", 24.0},
@@ -148,7 +148,7 @@ TEST(PmuctlDecode, TableOutputHasAHeaderAndOneRowPerLine) {
 // what scripts comparing decodings rely on.
 TEST(PmuctlDecode, JsonLinesAreByteForByteNlohmannDumps) {
   for (const std::string& log : {data("every_packet.log"), data("bad_lines.log"), data("screen_format.log"),
-                                data("../../bench/testdata/all_packets.log")}) {
+                                 data("../../bench/testdata/all_packets.log")}) {
     const CliRun r = run("decode --json " + log);
     ASSERT_EQ(r.status, 0) << log;
     ASSERT_FALSE(r.lines.empty()) << log;
@@ -203,14 +203,15 @@ std::map<std::string, Node> names_in(const std::string& dir) {
       const std::string name = r.out.substr(start, i - start);
       start = i + 1;
       struct stat st {};
-      if (::lstat((dir + "/" + name).c_str(), &st) == 0) out[name] = {static_cast<mode_t>(st.st_mode & S_IFMT), st.st_ino};
+      if (::lstat((dir + "/" + name).c_str(), &st) == 0)
+        out[name] = {static_cast<mode_t>(st.st_mode & S_IFMT), st.st_ino};
     }
   return out;
 }
 
 struct McapTarget {
   const char* kind;
-  bool root;  // mknod
+  bool root;                                         // mknod
   std::function<void(const std::string& dir)> make;  // makes dir/out (and what it points to)
   const char* path;
   int status;
@@ -264,8 +265,10 @@ void decode_mcap_onto(const McapTarget& t) {
   if (*t.mcap_in) {
     EXPECT_TRUE(is_mcap(slurp(dir + "/" + t.mcap_in)));
     const auto was = before.find(t.mcap_in);  // the one name that may change: renamed onto
-    if (was == before.end()) after.erase(t.mcap_in);
-    else after[t.mcap_in] = was->second;
+    if (was == before.end())
+      after.erase(t.mcap_in);
+    else
+      after[t.mcap_in] = was->second;
   }
   EXPECT_EQ(after, before) << "names in " << dir << " changed";
   std::system(("rm -rf '" + dir + "'").c_str());

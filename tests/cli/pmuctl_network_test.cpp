@@ -19,8 +19,8 @@ struct BadCase {
 // `env -u` first: a variable exported where the tests run must not change them.
 std::string pmuctl(const std::string& command) {
   const auto at = command.find("pmuctl");
-  return "env -u PMU_DDS_PEERS -u PMU_DISCOVERY_SERVER -u PMU_DDS_INTERFACES -u PMU_LINK " + command.substr(0, at) + PMUCTL_PATH +
-         command.substr(at + 6) + " 2>&1 >/dev/null";
+  return "env -u PMU_DDS_PEERS -u PMU_DISCOVERY_SERVER -u PMU_DDS_INTERFACES -u PMU_LINK " + command.substr(0, at) +
+         PMUCTL_PATH + command.substr(at + 6) + " 2>&1 >/dev/null";
 }
 
 const BadCase kBad[] = {

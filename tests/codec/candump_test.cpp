@@ -72,9 +72,16 @@ void expect_all_bad(const Bad (&rows)[N]) {
 // ---- the header's examples ---------------------------------------------------------------------
 TEST(Candump, HeaderExamplesLogForm) {
   const Good rows[] = {
-      {"(1700000000.000000) can0 1E000001#FA0A", kTime, 1700000000, 0, "can0", 0x1E000001, kExt, kData, 2,
-       {0xFA, 0x0A}},
-      {"(1700000000.000000) can0 202#0102030405060708", kTime, 1700000000, 0, "can0", 0x202, kStd, kData, 8,
+      {"(1700000000.000000) can0 1E000001#FA0A", kTime, 1700000000, 0, "can0", 0x1E000001, kExt, kData, 2, {0xFA, 0x0A}},
+      {"(1700000000.000000) can0 202#0102030405060708",
+       kTime,
+       1700000000,
+       0,
+       "can0",
+       0x202,
+       kStd,
+       kData,
+       8,
        {0x01, 0x02, 0x03, 0x04, 0x05, 0x06, 0x07, 0x08}},
       {"(1700000000.000000) can0 1E240001#", kTime, 1700000000, 0, "can0", 0x1E240001, kExt, kData, 0, {}},
       {"(1700000000.000000) can0 123#R", kTime, 1700000000, 0, "can0", 0x123, kStd, kRtr, 0, {}},
@@ -85,8 +92,16 @@ TEST(Candump, HeaderExamplesLogForm) {
 TEST(Candump, HeaderExamplesScreenForm) {
   const Good rows[] = {
       {"  can0  1E000001   [2]  FA 0A", kNoTime, 0, 0, "can0", 0x1E000001, kExt, kData, 2, {0xFA, 0x0A}},
-      {" (1700000000.000000)  can0  202   [8]  01 02 03 04 05 06 07 08", kTime, 1700000000, 0, "can0", 0x202, kStd,
-       kData, 8, {0x01, 0x02, 0x03, 0x04, 0x05, 0x06, 0x07, 0x08}},
+      {" (1700000000.000000)  can0  202   [8]  01 02 03 04 05 06 07 08",
+       kTime,
+       1700000000,
+       0,
+       "can0",
+       0x202,
+       kStd,
+       kData,
+       8,
+       {0x01, 0x02, 0x03, 0x04, 0x05, 0x06, 0x07, 0x08}},
       {"  can0  123   [0]  remote request", kNoTime, 0, 0, "can0", 0x123, kStd, kRtr, 0, {}},
   };
   expect_all_good(rows);
@@ -128,8 +143,7 @@ TEST(Candump, EveryLengthZeroToEight) {
     };
     for (std::size_t k = 0; k < 4; ++k) {
       const bool timed = k % 2 == 1;
-      expect_good({lines[k], timed, timed ? 1700000001 : 0, timed ? 2u : 0u, "can0", 0x1E000001, kExt, kData, n,
-                   data});
+      expect_good({lines[k], timed, timed ? 1700000001 : 0, timed ? 2u : 0u, "can0", 0x1E000001, kExt, kData, n, data});
     }
   }
 }
@@ -138,7 +152,15 @@ TEST(Candump, CansendDotsBetweenBytes) {
   // cansend's syntax (can-utils lib.h): "5AA#11.2233.44556677.88" - dots may separate bytes.
   const Good rows[] = {
       {"can0 123#01.02.03", kNoTime, 0, 0, "can0", 0x123, kStd, kData, 3, {0x01, 0x02, 0x03}},
-      {"can0 5AA#11.2233.44556677.88", kNoTime, 0, 0, "can0", 0x5AA, kStd, kData, 8,
+      {"can0 5AA#11.2233.44556677.88",
+       kNoTime,
+       0,
+       0,
+       "can0",
+       0x5AA,
+       kStd,
+       kData,
+       8,
        {0x11, 0x22, 0x33, 0x44, 0x55, 0x66, 0x77, 0x88}},
   };
   expect_all_good(rows);
@@ -162,9 +184,25 @@ TEST(Candump, RemoteFrames) {
 // ---- candump -x direction flag, candump -a ASCII, line endings ------------------------------------
 TEST(Candump, TrailingDirectionFlag) {
   const Good rows[] = {
-      {"(1700000000.000000) can0 1E000001#FA0A T", kTime, 1700000000, 0, "can0", 0x1E000001, kExt, kData, 2,
+      {"(1700000000.000000) can0 1E000001#FA0A T",
+       kTime,
+       1700000000,
+       0,
+       "can0",
+       0x1E000001,
+       kExt,
+       kData,
+       2,
        {0xFA, 0x0A}},
-      {"(1700000000.000000) can0 1E000001#FA0A R", kTime, 1700000000, 0, "can0", 0x1E000001, kExt, kData, 2,
+      {"(1700000000.000000) can0 1E000001#FA0A R",
+       kTime,
+       1700000000,
+       0,
+       "can0",
+       0x1E000001,
+       kExt,
+       kData,
+       2,
        {0xFA, 0x0A}},
       {"can0 123#R R", kNoTime, 0, 0, "can0", 0x123, kStd, kRtr, 0, {}},
       {"can0 123# T\r\n", kNoTime, 0, 0, "can0", 0x123, kStd, kData, 0, {}},
@@ -174,11 +212,9 @@ TEST(Candump, TrailingDirectionFlag) {
 
 TEST(Candump, AsciiSuffix) {
   const Good rows[] = {
-      {"  can0  123   [4]  31 32 33 34   '1234'", kNoTime, 0, 0, "can0", 0x123, kStd, kData, 4,
-       {0x31, 0x32, 0x33, 0x34}},
+      {"  can0  123   [4]  31 32 33 34   '1234'", kNoTime, 0, 0, "can0", 0x123, kStd, kData, 4, {0x31, 0x32, 0x33, 0x34}},
       {"  can0  1E000001   [2]  FA 0A   '..'", kNoTime, 0, 0, "can0", 0x1E000001, kExt, kData, 2, {0xFA, 0x0A}},
-      {" (1700000000.000000)  can0  202   [1]  41   'A'", kTime, 1700000000, 0, "can0", 0x202, kStd, kData, 1,
-       {0x41}},
+      {" (1700000000.000000)  can0  202   [1]  41   'A'", kTime, 1700000000, 0, "can0", 0x202, kStd, kData, 1, {0x41}},
       {"  can0  123   [0]   ''", kNoTime, 0, 0, "can0", 0x123, kStd, kData, 0, {}},
   };
   expect_all_good(rows);
@@ -186,14 +222,29 @@ TEST(Candump, AsciiSuffix) {
 
 TEST(Candump, LineEndingsAndWhitespace) {
   const Good rows[] = {
-      {"(1700000000.000000) can0 1E000001#FA0A\r\n", kTime, 1700000000, 0, "can0", 0x1E000001, kExt, kData, 2,
+      {"(1700000000.000000) can0 1E000001#FA0A\r\n",
+       kTime,
+       1700000000,
+       0,
+       "can0",
+       0x1E000001,
+       kExt,
+       kData,
+       2,
        {0xFA, 0x0A}},
-      {"(1700000000.000000) can0 1E000001#FA0A\n", kTime, 1700000000, 0, "can0", 0x1E000001, kExt, kData, 2,
+      {"(1700000000.000000) can0 1E000001#FA0A\n",
+       kTime,
+       1700000000,
+       0,
+       "can0",
+       0x1E000001,
+       kExt,
+       kData,
+       2,
        {0xFA, 0x0A}},
       {"  can0  1E000001   [2]  FA 0A\r\n", kNoTime, 0, 0, "can0", 0x1E000001, kExt, kData, 2, {0xFA, 0x0A}},
       {"\tcan0\t1E000001\t[2]\tFA\t0A\t", kNoTime, 0, 0, "can0", 0x1E000001, kExt, kData, 2, {0xFA, 0x0A}},
-      {"   (1700000000.000000)    can0    123#11   \n", kTime, 1700000000, 0, "can0", 0x123, kStd, kData, 1,
-       {0x11}},
+      {"   (1700000000.000000)    can0    123#11   \n", kTime, 1700000000, 0, "can0", 0x123, kStd, kData, 1, {0x11}},
       {"  can0  123   [0]  remote request\r\n", kNoTime, 0, 0, "can0", 0x123, kStd, kRtr, 0, {}},
   };
   expect_all_good(rows);
@@ -295,12 +346,9 @@ TEST(CandumpErrors, WrongIdWidthOrValue) {
 
 TEST(CandumpErrors, MissingInterfaceOrFrame) {
   const Bad rows[] = {
-      {"(1700000000.000000)", "missing interface"},
-      {"(1700000000.000000) 1E000001#FA0A", "missing interface"},
-      {"1E000001#FA0A", "missing interface"},
-      {"can0", "missing frame"},
-      {"(1700000000.000000) can0", "missing frame"},
-      {"(1700000000.000000) can0 \r\n", "missing frame"},
+      {"(1700000000.000000)", "missing interface"},  {"(1700000000.000000) 1E000001#FA0A", "missing interface"},
+      {"1E000001#FA0A", "missing interface"},        {"can0", "missing frame"},
+      {"(1700000000.000000) can0", "missing frame"}, {"(1700000000.000000) can0 \r\n", "missing frame"},
   };
   expect_all_bad(rows);
 }
@@ -308,21 +356,18 @@ TEST(CandumpErrors, MissingInterfaceOrFrame) {
 TEST(CandumpErrors, BadTimestamp) {
   constexpr std::string_view kTs = "bad timestamp: expected (seconds.microseconds)";
   const Bad rows[] = {
-      {"(1700000000) can0 123#", kTs},  {"(1700000000.) can0 123#", kTs}, {"(.5) can0 123#", kTs},
-      {"(17x0.5) can0 123#", kTs},      {"(1.5x) can0 123#", kTs},        {"(1.5 can0 123#", kTs},
-      {"() can0 123#", kTs},            {"(-1.5) can0 123#", kTs},
+      {"(1700000000) can0 123#", kTs}, {"(1700000000.) can0 123#", kTs}, {"(.5) can0 123#", kTs},
+      {"(17x0.5) can0 123#", kTs},     {"(1.5x) can0 123#", kTs},        {"(1.5 can0 123#", kTs},
+      {"() can0 123#", kTs},           {"(-1.5) can0 123#", kTs},
   };
   expect_all_bad(rows);
 }
 
 TEST(CandumpErrors, BadLengthField) {
   const Bad rows[] = {
-      {"  can0  123", "missing [length]"},
-      {"  can0  123  01 02", "missing [length]"},
-      {"  can0  123  [2 01 02", "missing [length]"},
-      {"  can0  123  []", "missing [length]"},
-      {"  can0  123  [x]  01", "bad [length]"},
-      {"  can0  123  [-1]", "bad [length]"},
+      {"  can0  123", "missing [length]"},           {"  can0  123  01 02", "missing [length]"},
+      {"  can0  123  [2 01 02", "missing [length]"}, {"  can0  123  []", "missing [length]"},
+      {"  can0  123  [x]  01", "bad [length]"},      {"  can0  123  [-1]", "bad [length]"},
   };
   expect_all_bad(rows);
 }

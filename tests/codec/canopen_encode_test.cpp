@@ -20,15 +20,15 @@ namespace {
 
 // One value of the document's tables: where it goes and what its type and resolution allow.
 struct Row {
-  std::string_view name;   // canopen::decode()'s name
-  std::uint16_t offset;    // battery: COB-ID of node 2; MPPT: 0 base id, 1 base + 1
-  std::uint16_t index;     // 0 where the document says "Don't Care"
+  std::string_view name;  // canopen::decode()'s name
+  std::uint16_t offset;   // battery: COB-ID of node 2; MPPT: 0 base id, 1 base + 1
+  std::uint16_t index;    // 0 where the document says "Don't Care"
   std::uint8_t subindex;
-  std::uint8_t size;       // bytes of the value
-  double lsb;              // resolution in `unit`
-  double raw_min, raw_max; // the type's range in counts
+  std::uint8_t size;        // bytes of the value
+  double lsb;               // resolution in `unit`
+  double raw_min, raw_max;  // the type's range in counts
   std::string_view unit;
-  double sample;           // a value in range, in `unit`
+  double sample;                           // a value in range, in `unit`
   std::vector<std::uint8_t> sample_bytes;  // its little-endian counts
 };
 
@@ -147,7 +147,8 @@ void check_row(const Row& r, std::uint16_t id, Encode encode, std::uint8_t subin
 TEST(CanOpenEncodeBattery, EveryValueRoundTripsAndItsRangeIsEnforced) {
   for (const auto& [value, r] : kBatteryRows) {
     EXPECT_EQ(name_of(value), r.name);
-    check_row(r, r.offset, [v = value](double x) { return encode_battery(v, x); }, r.subindex);
+    check_row(
+        r, r.offset, [v = value](double x) { return encode_battery(v, x); }, r.subindex);
   }
 }
 
@@ -167,7 +168,8 @@ TEST(CanOpenEncodeBattery, CellVoltagesCarryTheCellNumberAsSubindex) {
   for (unsigned cell : {1u, 2u, 12u, 16u, 255u}) {
     SCOPED_TRACE(cell);
     const auto c = static_cast<std::uint8_t>(cell);
-    check_row(r, 0x482, [c](double x) { return encode_cell_voltage(c, x); }, c);
+    check_row(
+        r, 0x482, [c](double x) { return encode_cell_voltage(c, x); }, c);
     const auto d = canopen::decode(*encode_cell_voltage(c, 3.7));
     ASSERT_TRUE(d.ok());
     EXPECT_EQ(d->fields[0].name, "cell");
@@ -226,7 +228,8 @@ TEST(CanOpenEncodeMppt, EveryValueOfEveryDeviceRoundTrips) {
     for (const auto& [value, r] : kMpptRows) {
       EXPECT_EQ(name_of(value), r.name);
       const auto id = static_cast<std::uint16_t>(mppt_base(device) + r.offset);
-      check_row(r, id, [device, v = value](double x) { return encode_mppt(device, v, x); }, r.subindex);
+      check_row(
+          r, id, [device, v = value](double x) { return encode_mppt(device, v, x); }, r.subindex);
       const auto d = canopen::decode(*encode_mppt(device, value, r.sample));
       ASSERT_TRUE(d.ok());
       EXPECT_EQ(d->device, device);
@@ -269,10 +272,14 @@ TEST(CanOpenEncode, HeaderExamples) {
     std::array<std::uint8_t, 8> data;
   };
   const Example examples[] = {
-      {"voltage 48.123 V", encode_battery(BatteryValue::Voltage, 48.123), 0x302,
+      {"voltage 48.123 V",
+       encode_battery(BatteryValue::Voltage, 48.123),
+       0x302,
        {0x4B, 0x05, 0x20, 0x01, 0xFB, 0xBB, 0x00, 0x00}},
       {"cell 3 3.7 V", encode_cell_voltage(3, 3.7), 0x482, {0x4B, 0x00, 0x20, 0x03, 0x74, 0x0E, 0x00, 0x00}},
-      {"MPPT 1 duty 2 40 %", encode_mppt(1, MpptValue::DutyCyclePanel2, 40), 0x4EF,
+      {"MPPT 1 duty 2 40 %",
+       encode_mppt(1, MpptValue::DutyCyclePanel2, 40),
+       0x4EF,
        {0x4F, 0x00, 0x00, 0x02, 0x28, 0x00, 0x00, 0x00}},
   };
   for (const auto& x : examples) {

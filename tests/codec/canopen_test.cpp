@@ -22,8 +22,8 @@ namespace {
 //   Data[0] Node-ID | Data[1] Index Low | Data[2] Index High | Data[3] Subindex | Data[4..7] Data
 std::vector<std::uint8_t> payload(std::uint8_t data0, std::uint16_t index, std::uint8_t subindex,
                                   std::initializer_list<std::uint8_t> value) {
-  std::vector<std::uint8_t> p{data0, static_cast<std::uint8_t>(index & 0xFFu),
-                              static_cast<std::uint8_t>(index >> 8), subindex};
+  std::vector<std::uint8_t> p{data0, static_cast<std::uint8_t>(index & 0xFFu), static_cast<std::uint8_t>(index >> 8),
+                              subindex};
   for (std::uint8_t b : value) p.push_back(b);
   return p;
 }
@@ -122,8 +122,7 @@ const std::vector<Row> kBatteryRows = {
             {{"current_discharge", -327.68, "A"}}),
     battery("B302_04_charge_5A", 0x302, 0x80, 0x2005, 0x04, {0xF4, 0x01}, {{"current_charge", 5.0, "A"}}),
     battery("B302_04_charge_int16_max", 0x302, 0x80, 0x2005, 0x04, {0xFF, 0x7F}, {{"current_charge", 327.67, "A"}}),
-    battery("B302_04_charge_int16_min", 0x302, 0x80, 0x2005, 0x04, {0x00, 0x80},
-            {{"current_charge", -327.68, "A"}}),
+    battery("B302_04_charge_int16_min", 0x302, 0x80, 0x2005, 0x04, {0x00, 0x80}, {{"current_charge", -327.68, "A"}}),
     battery("B302_05_soc_75", 0x302, 0x4F, 0x2005, 0x05, {0x4B}, {{"state_of_charge", 75.0, "%"}}),
     battery("B302_05_soc_int8_max", 0x302, 0x4F, 0x2005, 0x05, {0x7F}, {{"state_of_charge", 127.0, "%"}}),
     battery("B302_05_soc_int8_min", 0x302, 0x4F, 0x2005, 0x05, {0x80}, {{"state_of_charge", -128.0, "%"}}),
@@ -131,26 +130,21 @@ const std::vector<Row> kBatteryRows = {
     battery("B302_07_time_to_go_1000", 0x302, 0x4B, 0x2005, 0x07, {0xE8, 0x03}, {{"time_to_go", 1000.0, "min"}}),
     // uint16: 0x8000 and 0xFFFF are large positive numbers, not negative.
     battery("B302_07_time_to_go_32768", 0x302, 0x4B, 0x2005, 0x07, {0x00, 0x80}, {{"time_to_go", 32768.0, "min"}}),
-    battery("B302_07_time_to_go_uint16_max", 0x302, 0x4B, 0x2005, 0x07, {0xFF, 0xFF},
-            {{"time_to_go", 65535.0, "min"}}),
+    battery("B302_07_time_to_go_uint16_max", 0x302, 0x4B, 0x2005, 0x07, {0xFF, 0xFF}, {{"time_to_go", 65535.0, "min"}}),
     // 0x402, index 0x2005
     battery("B402_09_temp_high_25", 0x402, 0x40, 0x2005, 0x09, {0x19}, {{"cell_temperature_high", 25.0, "degC"}}),
     battery("B402_09_temp_high_int8_max", 0x402, 0x40, 0x2005, 0x09, {0x7F},
             {{"cell_temperature_high", 127.0, "degC"}}),
     battery("B402_09_temp_high_int8_min", 0x402, 0x40, 0x2005, 0x09, {0x80},
             {{"cell_temperature_high", -128.0, "degC"}}),
-    battery("B402_0B_temp_low_minus_10", 0x402, 0x00, 0x2005, 0x0B, {0xF6},
-            {{"cell_temperature_low", -10.0, "degC"}}),
-    battery("B402_0B_temp_low_int8_max", 0x402, 0x00, 0x2005, 0x0B, {0x7F},
-            {{"cell_temperature_low", 127.0, "degC"}}),
-    battery("B402_0B_temp_low_int8_min", 0x402, 0x00, 0x2005, 0x0B, {0x80},
-            {{"cell_temperature_low", -128.0, "degC"}}),
+    battery("B402_0B_temp_low_minus_10", 0x402, 0x00, 0x2005, 0x0B, {0xF6}, {{"cell_temperature_low", -10.0, "degC"}}),
+    battery("B402_0B_temp_low_int8_max", 0x402, 0x00, 0x2005, 0x0B, {0x7F}, {{"cell_temperature_low", 127.0, "degC"}}),
+    battery("B402_0B_temp_low_int8_min", 0x402, 0x00, 0x2005, 0x0B, {0x80}, {{"cell_temperature_low", -128.0, "degC"}}),
     battery("B402_0C_cell_high_3600mV", 0x402, 0x43, 0x2005, 0x0C, {0x10, 0x0E}, {{"cell_voltage_high", 3.6, "V"}}),
     battery("B402_0C_cell_high_uint16_max", 0x402, 0x43, 0x2005, 0x0C, {0xFF, 0xFF},
             {{"cell_voltage_high", 65.535, "V"}}),
     battery("B402_0D_cell_low_3000mV", 0x402, 0x4B, 0x2005, 0x0D, {0xB8, 0x0B}, {{"cell_voltage_low", 3.0, "V"}}),
-    battery("B402_0D_cell_low_32768mV", 0x402, 0x4B, 0x2005, 0x0D, {0x00, 0x80},
-            {{"cell_voltage_low", 32.768, "V"}}),
+    battery("B402_0D_cell_low_32768mV", 0x402, 0x4B, 0x2005, 0x0D, {0x00, 0x80}, {{"cell_voltage_low", 32.768, "V"}}),
     battery("B402_0E_bms_state", 0x402, 0x43, 0x2005, 0x0E, {0x78, 0x56, 0x34, 0x12},
             {{"bms_state", 305419896.0, ""}}),  // 0x12345678
     battery("B402_0E_bms_state_uint32_max", 0x402, 0x43, 0x2005, 0x0E, {0xFF, 0xFF, 0xFF, 0xFF},
@@ -186,8 +180,12 @@ std::vector<Row> mppt_rows(std::uint8_t device) {
   const std::string dev = "D" + std::to_string(device) + "_";
   auto row = [&](std::string label, std::uint16_t offset, std::uint8_t data0, std::uint16_t index, std::uint8_t sub,
                  std::initializer_list<std::uint8_t> value, std::vector<Expected> fields) {
-    return Row{dev + label, static_cast<std::uint16_t>(base + offset), payload(data0, index, sub, value),
-               Source::Mppt, device, std::move(fields)};
+    return Row{dev + label,
+               static_cast<std::uint16_t>(base + offset),
+               payload(data0, index, sub, value),
+               Source::Mppt,
+               device,
+               std::move(fields)};
   };
   return {
       // base id, table 1
@@ -217,8 +215,7 @@ std::vector<Row> mppt_rows(std::uint8_t device) {
       row("0C_voltage_panel_3_int16_min", 0, 0x01, 0x0000, 0x0C, {0x00, 0x80}, {{"voltage_panel_3_raw", -32768, ""}}),
       row("0D_current_panel_3_int16_max", 0, 0x01, 0x0000, 0x0D, {0xFF, 0x7F}, {{"current_panel_3_raw", 32767, ""}}),
       row("0E_voltage_panel_4_10000", 0, 0x01, 0x0000, 0x0E, {0x10, 0x27}, {{"voltage_panel_4_raw", 10000, ""}}),
-      row("0F_current_panel_4_minus_10000", 0, 0x01, 0x0000, 0x0F, {0xF0, 0xD8},
-          {{"current_panel_4_raw", -10000, ""}}),
+      row("0F_current_panel_4_minus_10000", 0, 0x01, 0x0000, 0x0F, {0xF0, 0xD8}, {{"current_panel_4_raw", -10000, ""}}),
       // base + 1, table 3
       row("P1_01_duty_cycle_1_zero", 1, 0x00, 0x0000, 0x01, {0x00}, {{"duty_cycle_panel_1", 0, "%"}}),
       row("P1_02_duty_cycle_2_100", 1, 0x00, 0x2005, 0x02, {0x64}, {{"duty_cycle_panel_2", 100, "%"}}),
@@ -242,7 +239,8 @@ TEST(CanOpenMppt, BaseIdFormulaGivesTheHexIdsOfTheDocument) {
   for (std::uint8_t d = 0; d < 8; ++d) {
     SCOPED_TRACE(static_cast<int>(d));
     for (std::uint16_t offset = 0; offset < 2; ++offset) {
-      const auto r = canopen::decode(frame11(static_cast<std::uint32_t>(mppt_base(d) + offset), payload(0, 0, 0x03, {0x07})));
+      const auto r =
+          canopen::decode(frame11(static_cast<std::uint32_t>(mppt_base(d) + offset), payload(0, 0, 0x03, {0x07})));
       if (offset == 0) {
         ASSERT_TRUE(r.ok()) << r.error().describe();
         EXPECT_EQ(r->device, d);
@@ -327,9 +325,9 @@ struct ErrorCase {
   const char* what;
   CanFrame frame;
   ErrorKind kind;
-  std::uint16_t index;     // checked for UnknownIndex / UnknownSubindex
-  std::uint8_t subindex;   // checked for UnknownSubindex
-  std::uint8_t needed;     // checked for TooShort
+  std::uint16_t index;    // checked for UnknownIndex / UnknownSubindex
+  std::uint8_t subindex;  // checked for UnknownSubindex
+  std::uint8_t needed;    // checked for TooShort
 };
 
 CanFrame remote(std::uint32_t id, std::uint8_t length) {
@@ -375,25 +373,25 @@ TEST(CanOpenErrors, UnknownIndexAndSubindex) {
       {"402 index 0000", frame11(0x402, payload(0, 0x0000, 0x09, {0})), ErrorKind::UnknownIndex, 0x0000, 0, 0},
       {"482 index 2005", frame11(0x482, payload(0, 0x2005, 0x01, {0, 0})), ErrorKind::UnknownIndex, 0x2005, 0, 0},
       {"302 sub 00", frame11(0x302, payload(0, 0x2005, 0x00, {0, 0})), ErrorKind::UnknownSubindex, 0x2005, 0x00, 0},
-      {"302 sub 06 (blank row)", frame11(0x302, payload(0, 0x2005, 0x06, {0, 0})), ErrorKind::UnknownSubindex,
-       0x2005, 0x06, 0},
+      {"302 sub 06 (blank row)", frame11(0x302, payload(0, 0x2005, 0x06, {0, 0})), ErrorKind::UnknownSubindex, 0x2005,
+       0x06, 0},
       {"302 sub 08", frame11(0x302, payload(0, 0x2005, 0x08, {0, 0})), ErrorKind::UnknownSubindex, 0x2005, 0x08, 0},
-      {"302 sub 09 (a 0x402 row)", frame11(0x302, payload(0, 0x2005, 0x09, {0})), ErrorKind::UnknownSubindex,
-       0x2005, 0x09, 0},
-      {"402 sub 01 (a 0x302 row)", frame11(0x402, payload(0, 0x2005, 0x01, {0, 0})), ErrorKind::UnknownSubindex,
-       0x2005, 0x01, 0},
-      {"402 sub 0A (blank row)", frame11(0x402, payload(0, 0x2005, 0x0A, {0})), ErrorKind::UnknownSubindex,
-       0x2005, 0x0A, 0},
-      {"402 sub 10", frame11(0x402, payload(0, 0x2005, 0x10, {0, 0, 0, 0})), ErrorKind::UnknownSubindex, 0x2005,
+      {"302 sub 09 (a 0x402 row)", frame11(0x302, payload(0, 0x2005, 0x09, {0})), ErrorKind::UnknownSubindex, 0x2005,
+       0x09, 0},
+      {"402 sub 01 (a 0x302 row)", frame11(0x402, payload(0, 0x2005, 0x01, {0, 0})), ErrorKind::UnknownSubindex, 0x2005,
+       0x01, 0},
+      {"402 sub 0A (blank row)", frame11(0x402, payload(0, 0x2005, 0x0A, {0})), ErrorKind::UnknownSubindex, 0x2005,
+       0x0A, 0},
+      {"402 sub 10", frame11(0x402, payload(0, 0x2005, 0x10, {0, 0, 0, 0})), ErrorKind::UnknownSubindex, 0x2005, 0x10,
+       0},
+      {"MPPT0 sub 07", frame11(mppt_base(0), payload(0, 0x1234, 0x07, {0, 0})), ErrorKind::UnknownSubindex, 0x1234,
+       0x07, 0},
+      {"MPPT7 sub 10", frame11(mppt_base(7), payload(0, 0x0000, 0x10, {0, 0})), ErrorKind::UnknownSubindex, 0x0000,
        0x10, 0},
-      {"MPPT0 sub 07", frame11(mppt_base(0), payload(0, 0x1234, 0x07, {0, 0})), ErrorKind::UnknownSubindex,
-       0x1234, 0x07, 0},
-      {"MPPT7 sub 10", frame11(mppt_base(7), payload(0, 0x0000, 0x10, {0, 0})), ErrorKind::UnknownSubindex,
-       0x0000, 0x10, 0},
-      {"MPPT0+1 sub 00", frame11(mppt_base(0) + 1u, payload(0, 0x0000, 0x00, {0, 0, 0, 0})),
-       ErrorKind::UnknownSubindex, 0x0000, 0x00, 0},
-      {"MPPT7+1 sub 06", frame11(mppt_base(7) + 1u, payload(0, 0xFFFF, 0x06, {0, 0, 0, 0})),
-       ErrorKind::UnknownSubindex, 0xFFFF, 0x06, 0},
+      {"MPPT0+1 sub 00", frame11(mppt_base(0) + 1u, payload(0, 0x0000, 0x00, {0, 0, 0, 0})), ErrorKind::UnknownSubindex,
+       0x0000, 0x00, 0},
+      {"MPPT7+1 sub 06", frame11(mppt_base(7) + 1u, payload(0, 0xFFFF, 0x06, {0, 0, 0, 0})), ErrorKind::UnknownSubindex,
+       0xFFFF, 0x06, 0},
   };
   for (const auto& c : cases) expect_error(c);
 }
@@ -410,14 +408,13 @@ TEST(CanOpenErrors, TooShortFrames) {
       {"302 int16 in 1 byte", frame11(0x302, payload(0, 0x2005, 0x02, {0x39})), ErrorKind::TooShort, 0, 0, 6},
       {"402 uint16 in 1 byte", frame11(0x402, payload(0, 0x2005, 0x0C, {0x10})), ErrorKind::TooShort, 0, 0, 6},
       {"402 uint32 in 3 bytes", frame11(0x402, payload(0, 0x2005, 0x0E, {1, 2, 3})), ErrorKind::TooShort, 0, 0, 8},
-      {"402 4x uint8 in 3 bytes", frame11(0x402, payload(0, 0x2005, 0x0F, {1, 2, 3})), ErrorKind::TooShort, 0, 0,
-       8},
+      {"402 4x uint8 in 3 bytes", frame11(0x402, payload(0, 0x2005, 0x0F, {1, 2, 3})), ErrorKind::TooShort, 0, 0, 8},
       {"482 uint16 in 1 byte", frame11(0x482, payload(0, 0x2000, 0x01, {0x7B})), ErrorKind::TooShort, 0, 0, 6},
       {"202 length 4", frame11(0x202, payload(0, 0, 0, {})), ErrorKind::TooShort, 0, 0, 5},
       {"MPPT0 length 3", frame11(mppt_base(0), {0, 0, 0}), ErrorKind::TooShort, 0, 0, 5},
       {"MPPT0 int16 in 1 byte", frame11(mppt_base(0), payload(0, 0, 0x00, {0xFF})), ErrorKind::TooShort, 0, 0, 6},
-      {"MPPT7+1 4x uint8 in 2 bytes", frame11(mppt_base(7) + 1u, payload(0, 0, 0x05, {1, 0})), ErrorKind::TooShort,
-       0, 0, 8},
+      {"MPPT7+1 4x uint8 in 2 bytes", frame11(mppt_base(7) + 1u, payload(0, 0, 0x05, {1, 0})), ErrorKind::TooShort, 0,
+       0, 8},
   };
   for (const auto& c : cases) expect_error(c);
 }
@@ -450,14 +447,14 @@ TEST(CanOpenErrors, ExtendedIdsAreNotOurs) {
 TEST(CanOpenIds, IdsNotInTheTables) {
   // Neighbours of every table id, the gaps inside each MPPT block of 8 (base + 2 .. base + 7),
   // the first id after device 7's block, and the ends of the 11-bit range.
-  const std::uint32_t ids[] = {0x000, 0x001, 0x182, 0x201, 0x203, 0x282, 0x301, 0x303, 0x401, 0x403,
-                               0x481, 0x483, 0x4E5, 0x4E8, 0x4EB, 0x4ED, 0x4F0, 0x518, 0x520, 0x525,
-                               0x526, 0x527, 0x52E, 0x602, 0x7FF};
+  const std::uint32_t ids[] = {0x000, 0x001, 0x182, 0x201, 0x203, 0x282, 0x301, 0x303, 0x401,
+                               0x403, 0x481, 0x483, 0x4E5, 0x4E8, 0x4EB, 0x4ED, 0x4F0, 0x518,
+                               0x520, 0x525, 0x526, 0x527, 0x52E, 0x602, 0x7FF};
   for (std::uint32_t id : ids) {
     SCOPED_TRACE(id);
     EXPECT_FALSE(is_canopen_id(id, false));
-    expect_error({"not in the table", frame11(id, payload(0, 0x2005, 0x01, {0x39, 0x30})), ErrorKind::NotOurs, 0, 0,
-                  0});
+    expect_error(
+        {"not in the table", frame11(id, payload(0, 0x2005, 0x01, {0x39, 0x30})), ErrorKind::NotOurs, 0, 0, 0});
   }
 }
 

@@ -154,8 +154,7 @@ TEST(Commands, ErrorsSayWhatAndWhere) {
   CanFrame remote = pmu_frame(0x00, 1, {});
   remote.remote = true;
   EXPECT_EQ(decode(remote).error().kind, DecodeErrorKind::RemoteFrame);
-  EXPECT_EQ(decode(pmu_frame(0x26, 1, {1})).error().describe(),
-            "wrong length 1 for packet 0x26 reset (expects 0)");
+  EXPECT_EQ(decode(pmu_frame(0x26, 1, {1})).error().describe(), "wrong length 1 for packet 0x26 reset (expects 0)");
 }
 
 }  // namespace

@@ -14,14 +14,14 @@ struct Row {
 };
 
 const Row kRows[] = {
-    {"0", true, true},       {"7", true, true},         {"65534", true, true},   {"-3", true, true},
-    {"-0", true, true},      {"24.0", false, true},     {"0.5", false, true},    {"-12.25", false, true},
-    {"1.5", false, true},    {"", false, false},        {"-", false, false},     {"010", false, false},
-    {"00", false, false},    {"0x10", false, false},    {"0x18", false, false},  {"0o10", false, false},
-    {"1e1", false, false},   {"2.4e1", false, false},   {"+5", false, false},    {"+24.0", false, false},
-    {".5", false, false},    {"5.", false, false},      {"-.5", false, false},   {" 5", false, false},
-    {"5 ", false, false},    {"24 V", false, false},    {"inf", false, false},   {"nan", false, false},
-    {"1.2.3", false, false}, {"024.0", false, false},   {"1,5", false, false},   {"--1", false, false},
+    {"0", true, true},       {"7", true, true},       {"65534", true, true},  {"-3", true, true},
+    {"-0", true, true},      {"24.0", false, true},   {"0.5", false, true},   {"-12.25", false, true},
+    {"1.5", false, true},    {"", false, false},      {"-", false, false},    {"010", false, false},
+    {"00", false, false},    {"0x10", false, false},  {"0x18", false, false}, {"0o10", false, false},
+    {"1e1", false, false},   {"2.4e1", false, false}, {"+5", false, false},   {"+24.0", false, false},
+    {".5", false, false},    {"5.", false, false},    {"-.5", false, false},  {" 5", false, false},
+    {"5 ", false, false},    {"24 V", false, false},  {"inf", false, false},  {"nan", false, false},
+    {"1.2.3", false, false}, {"024.0", false, false}, {"1,5", false, false},  {"--1", false, false},
 };
 
 TEST(DecimalText, OnlyPlainDecimalIsANumber) {

@@ -27,13 +27,13 @@ struct FeatureCase {
 };
 
 const FeatureCase kFeatures[] = {
-    {Feature::ExternalTemperatures, {1, 11}, {1, 12}},   // 6.1
-    {Feature::StarterReadyFlag, {1, 11}, {1, 12}},       // 6.1
-    {Feature::MeasurementRequest, {1, 13}, {1, 14}},     // 6.5
-    {Feature::BatteryDisconnectDetect, {1, 14}, {1, 15}},// 6.7
-    {Feature::SoaManagement, {1, 15}, {1, 16}},          // 6.8
-    {Feature::SoaShutdownFlag, {1, 15}, {1, 16}},        // 6.8
-    {Feature::MultipleBaudRates, {1, 16}, {1, 17}},      // 6.9
+    {Feature::ExternalTemperatures, {1, 11}, {1, 12}},     // 6.1
+    {Feature::StarterReadyFlag, {1, 11}, {1, 12}},         // 6.1
+    {Feature::MeasurementRequest, {1, 13}, {1, 14}},       // 6.5
+    {Feature::BatteryDisconnectDetect, {1, 14}, {1, 15}},  // 6.7
+    {Feature::SoaManagement, {1, 15}, {1, 16}},            // 6.8
+    {Feature::SoaShutdownFlag, {1, 15}, {1, 16}},          // 6.8
+    {Feature::MultipleBaudRates, {1, 16}, {1, 17}},        // 6.9
 };
 
 TEST(Firmware, FeatureTable) {

@@ -58,11 +58,16 @@ TEST(Ids, KnownPacketsAreExactlyTable1) {
 
 TEST(Ids, NamesRoundTrip) {
   const std::pair<PacketId, const char*> names[] = {
-      {PacketId::Voltages, "voltages"},         {PacketId::BatteryEnergy, "battery_energy"},
-      {PacketId::Status, "status"},             {PacketId::MeasurementRequest, "measurement_request"},
-      {PacketId::CanAddress, "can_address"},    {PacketId::Outputs, "outputs"},
-      {PacketId::EnableOutputs, "enable_outputs"}, {PacketId::EngineStop, "engine_stop"},
-      {PacketId::Serial, "serial"},             {PacketId::Firmware, "firmware"},
+      {PacketId::Voltages, "voltages"},
+      {PacketId::BatteryEnergy, "battery_energy"},
+      {PacketId::Status, "status"},
+      {PacketId::MeasurementRequest, "measurement_request"},
+      {PacketId::CanAddress, "can_address"},
+      {PacketId::Outputs, "outputs"},
+      {PacketId::EnableOutputs, "enable_outputs"},
+      {PacketId::EngineStop, "engine_stop"},
+      {PacketId::Serial, "serial"},
+      {PacketId::Firmware, "firmware"},
   };
   for (const auto& [id, name] : names) {
     EXPECT_EQ(packet_name(id), name);

@@ -16,21 +16,21 @@ using test::pmu_frame;
 struct RangeCase {
   const char* name;
   std::uint8_t packet;
-  double min, max;   // engineering units, inclusive, as the spec states
-  double step;       // resolution
+  double min, max;  // engineering units, inclusive, as the spec states
+  double step;      // resolution
   std::uint32_t raw_min, raw_max;
 };
 
 const RangeCase kRanges[] = {
-    {"avionics_voltage", 0x10, 12.0, 24.0, 0.1, 120, 240},          // table 8
-    {"payload_voltage", 0x11, 12.0, 24.0, 0.1, 120, 240},           // table 9
-    {"servo_voltage", 0x12, 5.0, 12.0, 0.1, 50, 120},               // table 10
-    {"battery_voltage", 0x13, 20.0, 25.2, 0.1, 200, 252},           // table 11
-    {"packet_period", 0x14, 0.1, 25.5, 0.1, 1, 255},                // table 12
-    {"temperature_offset", 0x16, 0, 255, 1, 0, 255},                // table 14
-    {"upper_temperature_limit", 0x17, 0, 255, 1, 0, 255},           // table 15
-    {"cranking_time", 0x19, 0.0, 25.5, 0.1, 0, 255},                // table 17 (0 = no timeout)
-    {"can_address", 0x1B, 0, 65534, 1, 0, 65534},                   // table 18
+    {"avionics_voltage", 0x10, 12.0, 24.0, 0.1, 120, 240},  // table 8
+    {"payload_voltage", 0x11, 12.0, 24.0, 0.1, 120, 240},   // table 9
+    {"servo_voltage", 0x12, 5.0, 12.0, 0.1, 50, 120},       // table 10
+    {"battery_voltage", 0x13, 20.0, 25.2, 0.1, 200, 252},   // table 11
+    {"packet_period", 0x14, 0.1, 25.5, 0.1, 1, 255},        // table 12
+    {"temperature_offset", 0x16, 0, 255, 1, 0, 255},        // table 14
+    {"upper_temperature_limit", 0x17, 0, 255, 1, 0, 255},   // table 15
+    {"cranking_time", 0x19, 0.0, 25.5, 0.1, 0, 255},        // table 17 (0 = no timeout)
+    {"can_address", 0x1B, 0, 65534, 1, 0, 65534},           // table 18
 };
 
 std::uint32_t frame_raw(const CanFrame& f) {
@@ -199,8 +199,8 @@ TEST(Parameters, DecodeReplyInEngineeringUnits) {
     std::initializer_list<std::uint8_t> bytes;
     double value;
   };
-  const Case cases[] = {{0x10, {240}, 24.0}, {0x11, {120}, 12.0}, {0x12, {50}, 5.0},  {0x13, {252}, 25.2},
-                        {0x14, {1}, 0.1},    {0x15, {0x1F}, 31},  {0x16, {255}, 255}, {0x17, {0}, 0},
+  const Case cases[] = {{0x10, {240}, 24.0}, {0x11, {120}, 12.0}, {0x12, {50}, 5.0},          {0x13, {252}, 25.2},
+                        {0x14, {1}, 0.1},    {0x15, {0x1F}, 31},  {0x16, {255}, 255},         {0x17, {0}, 0},
                         {0x18, {0x21}, 33},  {0x19, {0}, 0},      {0x1B, {0xFF, 0xFE}, 65534}};
   for (const auto& c : cases) {
     SCOPED_TRACE(int(c.packet));

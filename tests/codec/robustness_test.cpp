@@ -35,11 +35,11 @@ struct Table1Row {
   bool zero_get;
 };
 constexpr Table1Row kTable1[] = {
-    {0x00, 7, true}, {0x01, 6, true}, {0x02, 4, true}, {0x03, 5, true}, {0x04, 5, true}, {0x0F, 1, true},
-    {0x10, 1, true}, {0x11, 1, true}, {0x12, 1, true}, {0x13, 1, true}, {0x14, 1, true}, {0x15, 1, true},
-    {0x16, 1, true}, {0x17, 1, true}, {0x18, 1, true}, {0x19, 1, true}, {0x1B, 2, true}, {0x20, 1, true},
+    {0x00, 7, true},  {0x01, 6, true},  {0x02, 4, true}, {0x03, 5, true}, {0x04, 5, true}, {0x0F, 1, true},
+    {0x10, 1, true},  {0x11, 1, true},  {0x12, 1, true}, {0x13, 1, true}, {0x14, 1, true}, {0x15, 1, true},
+    {0x16, 1, true},  {0x17, 1, true},  {0x18, 1, true}, {0x19, 1, true}, {0x1B, 2, true}, {0x20, 1, true},
     {0x21, 1, false}, {0x22, 1, false}, {0x23, 1, true}, {0x24, 0, true}, {0x25, 0, true}, {0x26, 0, true},
-    {0x30, 2, true}, {0x31, 6, true},
+    {0x30, 2, true},  {0x31, 6, true},
 };
 
 const Table1Row* table1(unsigned packet) {
@@ -71,14 +71,11 @@ bool payload_fits_packet(std::uint8_t packet, const Payload& p) {
 }
 
 // Section 4: group (bits 28..24) 0x1E, packet (23..16), address (15..0).
-constexpr std::uint32_t pmu_id(unsigned packet, unsigned address) {
-  return (0x1Eu << 24) | (packet << 16) | address;
-}
+constexpr std::uint32_t pmu_id(unsigned packet, unsigned address) { return (0x1Eu << 24) | (packet << 16) | address; }
 
-const std::optional<FirmwareVersion> kFirmwares[] = {std::nullopt,           FirmwareVersion{1, 11},
-                                                     FirmwareVersion{1, 12}, FirmwareVersion{1, 13},
-                                                     FirmwareVersion{1, 14}, FirmwareVersion{1, 15},
-                                                     FirmwareVersion{1, 16}, FirmwareVersion{1, 17}};
+const std::optional<FirmwareVersion> kFirmwares[] = {
+    std::nullopt,           FirmwareVersion{1, 11}, FirmwareVersion{1, 12}, FirmwareVersion{1, 13},
+    FirmwareVersion{1, 14}, FirmwareVersion{1, 15}, FirmwareVersion{1, 16}, FirmwareVersion{1, 17}};
 
 bool at_least(std::optional<FirmwareVersion> fw, int major, int minor) {
   return !fw || fw->major * 100 + fw->minor >= major * 100 + minor;  // unknown = current (1.17)
@@ -143,8 +140,7 @@ struct Flatten {
   void operator()(const GenerationState& g) const { add({num(g.enabled)}); }
   void operator()(const SerialNumber& s) const { add({num(s.serial_number)}); }
   void operator()(const FirmwareInfo& f) const {
-    add({num(f.firmware_major), num(f.firmware_minor), num(f.build_day), num(f.build_month),
-         num(f.build_year)});
+    add({num(f.firmware_major), num(f.firmware_minor), num(f.build_day), num(f.build_month), num(f.build_year)});
   }
 };
 
@@ -152,12 +148,15 @@ std::vector<double> outcome(const Result<PmuMessage, DecodeError>& r) {
   std::vector<double> out;
   if (!r.ok()) {
     const DecodeError& e = r.error();
-    out = {0, num(static_cast<std::uint8_t>(e.kind)), num(e.id), num(e.packet), num(e.length),
-           num(e.expected)};
+    out = {0, num(static_cast<std::uint8_t>(e.kind)), num(e.id), num(e.packet), num(e.length), num(e.expected)};
     return out;
   }
-  out = {1, num(static_cast<std::uint8_t>(r->packet)), num(r->address), num(r->request),
-         num(r->unsupported_by_firmware), static_cast<double>(r->payload.index())};
+  out = {1,
+         num(static_cast<std::uint8_t>(r->packet)),
+         num(r->address),
+         num(r->request),
+         num(r->unsupported_by_firmware),
+         static_cast<double>(r->payload.index())};
   std::visit(Flatten{out}, r->payload);
   return out;
 }
@@ -166,8 +165,7 @@ std::vector<double> outcome(const Result<canopen::CanOpenMessage, canopen::Error
   std::vector<double> out;
   if (!r.ok()) {
     const canopen::Error& e = r.error();
-    out = {0,           num(static_cast<std::uint8_t>(e.kind)), num(e.cob_id), num(e.index),
-           num(e.subindex), num(e.needed)};
+    out = {0, num(static_cast<std::uint8_t>(e.kind)), num(e.cob_id), num(e.index), num(e.subindex), num(e.needed)};
     return out;
   }
   out = {1,
@@ -361,8 +359,8 @@ TEST(CanOpenRobustness, EveryStandardIdEveryLength) {
   for (std::uint32_t id = 0; id <= kMaxStandardId; ++id) {
     for (std::uint8_t length = 0; length <= 15; ++length) {
       for (bool remote : {false, true}) {
-        SCOPED_TRACE(::testing::Message() << "id " << std::hex << id << std::dec << " length " << int{length}
-                                          << (remote ? " remote" : ""));
+        SCOPED_TRACE(::testing::Message()
+                     << "id " << std::hex << id << std::dec << " length " << int{length} << (remote ? " remote" : ""));
         const CanFrame f = random_frame(id, false, remote, length, rng);
         const auto pmu = decode(f);
         ASSERT_FALSE(pmu.ok());
@@ -395,8 +393,8 @@ TEST(CanOpenRobustness, EverySubindexOfEveryTableId) {
   for (std::uint32_t id = 0; id <= kMaxStandardId; ++id) {
     if (!spec_canopen_id(id)) continue;
     for (unsigned sub = 0; sub <= 0xFF; ++sub) {
-      for (std::uint16_t index : {std::uint16_t{0x2005}, std::uint16_t{0x2000},
-                                  static_cast<std::uint16_t>(rand32(rng) & 0xFFFFu)}) {
+      for (std::uint16_t index :
+           {std::uint16_t{0x2005}, std::uint16_t{0x2000}, static_cast<std::uint16_t>(rand32(rng) & 0xFFFFu)}) {
         for (std::uint8_t length = 0; length <= kMaxDataLength; ++length) {
           CanFrame f = random_frame(id, false, false, length, rng);
           f.data[1] = static_cast<std::uint8_t>(index & 0xFFu);
@@ -427,8 +425,9 @@ TEST(Robustness, RandomFramesAreTotal) {
     if ((bits & 0x80u) != 0) id = (id & 0x00FFFFFFu) | (0x1Eu << 24);  // often in the PMU group
     if (!extended) id &= (bits & 0x100u) != 0 ? 0x7FFu : 0xFFFFFFFFu;
     const CanFrame f = random_frame(id, extended, remote, length, rng);
-    const std::optional<FirmwareVersion> fw =
-        (bits & 0x200u) != 0 ? std::optional<FirmwareVersion>{} : FirmwareVersion{1, static_cast<std::uint8_t>(bits >> 24)};
+    const std::optional<FirmwareVersion> fw = (bits & 0x200u) != 0
+                                                  ? std::optional<FirmwareVersion>{}
+                                                  : FirmwareVersion{1, static_cast<std::uint8_t>(bits >> 24)};
     const auto r = decode(f, fw);
     if (r.ok()) {
       ++pmu_values;
@@ -512,7 +511,7 @@ TEST(RoundTrip, Currents) {
       const Encoded e = encode_currents(c, address);
       expect_frame(e, 0x01, address);
       EXPECT_EQ(e->data[0], u2);
-      EXPECT_EQ(e->data[1], static_cast<std::uint8_t>(raw & 0xFF));   // two's complement
+      EXPECT_EQ(e->data[1], static_cast<std::uint8_t>(raw & 0xFF));  // two's complement
       EXPECT_EQ(e->data[5], static_cast<std::uint8_t>(-raw & 0xFF));
       const auto d = decoded<Currents>(e);
       EXPECT_DOUBLE_EQ(d.avionics, c.avionics);
@@ -633,11 +632,11 @@ struct ParamRow {
   unsigned max_raw;
 };
 const ParamRow kParams[] = {
-    {Parameter::AvionicsVoltage, 0x10, 10, 0xFF},      {Parameter::PayloadVoltage, 0x11, 10, 0xFF},
-    {Parameter::ServoVoltage, 0x12, 10, 0xFF},         {Parameter::BatteryVoltage, 0x13, 10, 0xFF},
-    {Parameter::PacketPeriod, 0x14, 10, 0xFF},         {Parameter::PacketsStreamed, 0x15, 1, 0xFF},
-    {Parameter::TemperatureOffset, 0x16, 1, 0xFF},     {Parameter::UpperTemperatureLimit, 0x17, 1, 0xFF},
-    {Parameter::PowerUpState, 0x18, 1, 0xFF},          {Parameter::CrankingTime, 0x19, 10, 0xFF},
+    {Parameter::AvionicsVoltage, 0x10, 10, 0xFF},  {Parameter::PayloadVoltage, 0x11, 10, 0xFF},
+    {Parameter::ServoVoltage, 0x12, 10, 0xFF},     {Parameter::BatteryVoltage, 0x13, 10, 0xFF},
+    {Parameter::PacketPeriod, 0x14, 10, 0xFF},     {Parameter::PacketsStreamed, 0x15, 1, 0xFF},
+    {Parameter::TemperatureOffset, 0x16, 1, 0xFF}, {Parameter::UpperTemperatureLimit, 0x17, 1, 0xFF},
+    {Parameter::PowerUpState, 0x18, 1, 0xFF},      {Parameter::CrankingTime, 0x19, 10, 0xFF},
     {Parameter::CanAddress, 0x1B, 1, 0xFFFF},
 };
 

@@ -192,11 +192,8 @@ TEST(Names, OutputsByNameAndBack) {
 }
 
 TEST(Names, GroupsByNameAndBack) {
-  const std::pair<const char*, std::uint8_t> typed[] = {{"voltages", 0x01},
-                                                        {"currents", 0x02},
-                                                        {"battery_energy", 0x04},
-                                                        {"temperatures", 0x08},
-                                                        {"status", 0x10}};
+  const std::pair<const char*, std::uint8_t> typed[] = {
+      {"voltages", 0x01}, {"currents", 0x02}, {"battery_energy", 0x04}, {"temperatures", 0x08}, {"status", 0x10}};
   for (const auto& [name, bit] : typed) {
     EXPECT_EQ(bit_named(kGroupNames, name), bit) << name;
     EXPECT_EQ(names_of(kGroupNames, bit), name);
@@ -242,7 +239,8 @@ TEST(Durations, PacketPeriodAndCrankingTimeInMilliseconds) {
 TEST(Durations, OtherParametersAreNotDurations) {
   EXPECT_TRUE(std::isnan(duration_value(Parameter::AvionicsVoltage, std::chrono::milliseconds(1000))));
   EXPECT_EQ(duration_of(Parameter::UpperTemperatureLimit, 80), std::chrono::milliseconds(0));
-  EXPECT_FALSE(to_raw(Parameter::AvionicsVoltage, duration_value(Parameter::AvionicsVoltage, std::chrono::seconds(12))).ok());
+  EXPECT_FALSE(
+      to_raw(Parameter::AvionicsVoltage, duration_value(Parameter::AvionicsVoltage, std::chrono::seconds(12))).ok());
 }
 
 }  // namespace

@@ -32,17 +32,15 @@ double currents_field(const Currents& c, std::size_t i) {
 }
 
 const ByteScale kVoltages[] = {
-    {"avionics", 0, 10, false, 0, 250},  {"output_28v", 1, 5, false, 0, 250},
-    {"payload", 2, 10, false, 0, 250},   {"servo", 3, 10, false, 0, 125},
-    {"battery_a", 4, 10, false, 0, 250}, {"battery_b", 5, 10, false, 0, 250},
+    {"avionics", 0, 10, false, 0, 250},   {"output_28v", 1, 5, false, 0, 250}, {"payload", 2, 10, false, 0, 250},
+    {"servo", 3, 10, false, 0, 125},      {"battery_a", 4, 10, false, 0, 250}, {"battery_b", 5, 10, false, 0, 250},
     {"generator", 6, 2.5, false, 0, 250},
 };
 
 // Table 3: 28 V and battery currents signed, output currents unsigned; all 0.1 A.
 const ByteScale kCurrents[] = {
-    {"avionics", 0, 10, false, 0, 100},     {"output_28v", 1, 10, true, -125, 125},
-    {"payload", 2, 10, false, 0, 100},      {"servo", 3, 10, false, 0, 100},
-    {"battery_a", 4, 10, true, -125, 125},  {"battery_b", 5, 10, true, -125, 125},
+    {"avionics", 0, 10, false, 0, 100}, {"output_28v", 1, 10, true, -125, 125}, {"payload", 2, 10, false, 0, 100},
+    {"servo", 3, 10, false, 0, 100},    {"battery_a", 4, 10, true, -125, 125},  {"battery_b", 5, 10, true, -125, 125},
 };
 
 std::uint8_t wire(int raw) { return static_cast<std::uint8_t>(raw & 0xFF); }
@@ -199,10 +197,8 @@ struct TemperatureRow {
 };
 
 const TemperatureRow kTemperatureRows[] = {
-    {"internal", 0, &Temperatures::internal, {1, 0}},
-    {"battery_a", 1, &Temperatures::battery_a, {1, 12}},
-    {"battery_b", 2, &Temperatures::battery_b, {1, 12}},
-    {"generator", 3, &Temperatures::generator, {1, 12}},
+    {"internal", 0, &Temperatures::internal, {1, 0}},    {"battery_a", 1, &Temperatures::battery_a, {1, 12}},
+    {"battery_b", 2, &Temperatures::battery_b, {1, 12}}, {"generator", 3, &Temperatures::generator, {1, 12}},
     {"starter", 4, &Temperatures::starter, {1, 0}},
 };
 

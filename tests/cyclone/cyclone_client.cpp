@@ -68,8 +68,7 @@ long number(const char* option, const char* text, long lo, long hi) {
   char* end = nullptr;
   const long v = std::strtol(text, &end, 10);
   if (end == text || *end != '\0' || v < lo || v > hi)
-    usage((std::string(option) + " " + text + ": expected an integer " + std::to_string(lo) + ".." +
-           std::to_string(hi))
+    usage((std::string(option) + " " + text + ": expected an integer " + std::to_string(lo) + ".." + std::to_string(hi))
               .c_str());
   return v;
 }
@@ -216,7 +215,7 @@ struct Request {
   pmu_v5_CommandKind kind;
   const char* parameter;
   double value;
-  Clock::time_point sent{};       // first sent
+  Clock::time_point sent{};  // first sent
   Clock::time_point last_sent{};
   int sends = 0;
   int finals = 0;
@@ -225,8 +224,8 @@ struct Request {
 };
 
 const char* result_name(pmu_v5_CommandResult r) {
-  static const char* const names[] = {"COMPLETED", "REJECTED", "DENIED", "UNSUPPORTED", "TIMEOUT", "FAILED",
-                                      "IN_PROGRESS"};
+  static const char* const names[] = {"COMPLETED", "REJECTED", "DENIED",     "UNSUPPORTED",
+                                      "TIMEOUT",   "FAILED",   "IN_PROGRESS"};
   const auto i = static_cast<std::size_t>(r);
   return i < sizeof names / sizeof names[0] ? names[i] : "UNKNOWN";
 }
@@ -252,8 +251,8 @@ int run_canopen(const Options& o, dds_entity_t pp) {
   const dds_entity_t cells = reader(pp, &pmu_v5_BatteryCells_desc, "pmu/battery_cells", telemetry_qos());
   const dds_entity_t mppt = reader(pp, &pmu_v5_Mppt_desc, "pmu/mppt", telemetry_qos());
   const dds_entity_t health = reader(pp, &pmu_v5_Health_desc, "pmu/health", state_qos());
-  CanOpenCheck checks[] = {{"pmu/battery"}, {"pmu/battery_cells"}, {"pmu/mppt"}, {"pmu/health battery"},
-                           {"pmu/health mppt"}};
+  CanOpenCheck checks[] = {
+      {"pmu/battery"}, {"pmu/battery_cells"}, {"pmu/mppt"}, {"pmu/health battery"}, {"pmu/health mppt"}};
   const auto until = Clock::now() + milliseconds(o.telemetry_ms);
   auto all = [&] {
     for (const auto& c : checks)
@@ -272,8 +271,8 @@ int run_canopen(const Options& o, dds_entity_t pp) {
       const bool ok = near(s.voltage, 48.123) && near(s.state_of_charge, 87) && s.bms_state == double{0x12345678u} &&
                       near(s.power_level, 77) && std::isnan(s.current);
       checks[0].done = ok;
-      checks[0].detail = ok ? "voltage 48.123, state_of_charge 87, bms_state 0x12345678, power_level 77, current NaN"
-                            : "wrong values";
+      checks[0].detail =
+          ok ? "voltage 48.123, state_of_charge 87, bms_state 0x12345678, power_level 77, current NaN" : "wrong values";
     });
     take_all<pmu_v5_BatteryCells>(cells, [&](const pmu_v5_BatteryCells& s) {
       if (o.canopen_bus != s.bus || s.node != 2 || s.cells._length != 1) return;
@@ -288,7 +287,8 @@ int run_canopen(const Options& o, dds_entity_t pp) {
       const bool ok = near(s.voltage_output_raw, -100) && s.safety_enabled == 1.0f && near(s.duty_cycle_panel_2, 45) &&
                       std::isnan(s.current_output_raw) && std::isnan(s.pwm_enabled);
       checks[2].done = ok;
-      checks[2].detail = ok ? "voltage_output_raw -100, safety_enabled 1, duty_cycle_panel_2 45, pwm_enabled NaN" : "wrong values";
+      checks[2].detail =
+          ok ? "voltage_output_raw -100, safety_enabled 1, duty_cycle_panel_2 45, pwm_enabled NaN" : "wrong values";
     });
     take_all<pmu_v5_Health>(health, [&](const pmu_v5_Health& s) {
       if (o.canopen_bus != s.bus || s.state != pmu_v5_ONLINE) return;
@@ -321,11 +321,13 @@ int main(int argc, char** argv) {
   std::vector<Topic> telemetry = {Topic("pmu/voltages"), Topic("pmu/currents"), Topic("pmu/battery_energy"),
                                   Topic("pmu/temperatures"), Topic("pmu/status")};
   std::vector<Topic> state = {Topic("pmu/config"), Topic("pmu/info"), Topic("pmu/health"), Topic("pmu/readiness")};
-  const dds_topic_descriptor_t* telemetry_types[] = {&pmu_v5_Voltages_desc, &pmu_v5_Currents_desc, &pmu_v5_BatteryEnergy_desc,
-                                                     &pmu_v5_Temperatures_desc, &pmu_v5_Status_desc};
+  const dds_topic_descriptor_t* telemetry_types[] = {&pmu_v5_Voltages_desc, &pmu_v5_Currents_desc,
+                                                     &pmu_v5_BatteryEnergy_desc, &pmu_v5_Temperatures_desc,
+                                                     &pmu_v5_Status_desc};
   const dds_topic_descriptor_t* state_types[] = {&pmu_v5_Config_desc, &pmu_v5_DeviceInfo_desc, &pmu_v5_Health_desc,
                                                  &pmu_v5_Readiness_desc};
-  for (std::size_t i = 0; i < state.size(); ++i) state[i].reader = reader(pp.get(), state_types[i], state[i].name, state_qos());
+  for (std::size_t i = 0; i < state.size(); ++i)
+    state[i].reader = reader(pp.get(), state_types[i], state[i].name, state_qos());
   for (std::size_t i = 0; i < telemetry.size(); ++i)
     telemetry[i].reader = reader(pp.get(), telemetry_types[i], telemetry[i].name, telemetry_qos());
   const dds_entity_t replies = reader(pp.get(), &pmu_v5_CommandReply_desc, "pmu/command_reply", command_qos(false));
@@ -415,12 +417,14 @@ int main(int argc, char** argv) {
       if (!state[3].received && s.reasons._length <= 64 && s.reasons_total >= s.reasons._length)
         state[3].received = Clock::now();
     });
-    take_all<pmu_v5_Voltages>(telemetry[0].reader, [&](const pmu_v5_Voltages& s) { mark(telemetry[0], s.bus, s.address); });
-    take_all<pmu_v5_Currents>(telemetry[1].reader, [&](const pmu_v5_Currents& s) { mark(telemetry[1], s.bus, s.address); });
+    take_all<pmu_v5_Voltages>(telemetry[0].reader,
+                              [&](const pmu_v5_Voltages& s) { mark(telemetry[0], s.bus, s.address); });
+    take_all<pmu_v5_Currents>(telemetry[1].reader,
+                              [&](const pmu_v5_Currents& s) { mark(telemetry[1], s.bus, s.address); });
     take_all<pmu_v5_BatteryEnergy>(telemetry[2].reader,
-                                [&](const pmu_v5_BatteryEnergy& s) { mark(telemetry[2], s.bus, s.address); });
+                                   [&](const pmu_v5_BatteryEnergy& s) { mark(telemetry[2], s.bus, s.address); });
     take_all<pmu_v5_Temperatures>(telemetry[3].reader,
-                               [&](const pmu_v5_Temperatures& s) { mark(telemetry[3], s.bus, s.address); });
+                                  [&](const pmu_v5_Temperatures& s) { mark(telemetry[3], s.bus, s.address); });
     take_all<pmu_v5_Status>(telemetry[4].reader, [&](const pmu_v5_Status& s) { mark(telemetry[4], s.bus, s.address); });
     take_all<pmu_v5_CommandReply>(replies, [&](const pmu_v5_CommandReply& s) {
       if (s.result == pmu_v5_IN_PROGRESS) return;
@@ -489,8 +493,7 @@ int main(int argc, char** argv) {
     std::printf("%s %s (%s): %s after %ld ms, %d final repl%s, sent %d time(s)\n", bad ? "MISS" : "ok", r.what,
                 r.id.c_str(), r.result.c_str(), after, r.finals, r.finals == 1 ? "y" : "ies", r.sends);
   }
-  std::printf(
-      "summary misses=%d match_ms=%ld state_after_match_ms=%ld replies_lost=%d resent=%d reply_worst_ms=%ld\n",
-      misses, command_match ? ms(*command_match - t0) : -1L, state_worst, lost, resent, reply_worst);
+  std::printf("summary misses=%d match_ms=%ld state_after_match_ms=%ld replies_lost=%d resent=%d reply_worst_ms=%ld\n",
+              misses, command_match ? ms(*command_match - t0) : -1L, state_worst, lost, resent, reply_worst);
   return misses == 0 ? 0 : 1;
 }

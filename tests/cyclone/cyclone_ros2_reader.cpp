@@ -59,12 +59,13 @@ bool wait_for(dds_entity_t r, Done done) {
 }
 
 void print_battery(const char* what, const sensor_msgs_msg_dds__BatteryState_& m) {
-  std::printf("%s voltage=%g current=%g temperature=%g percentage=%g charge=%g design_capacity=%g cells=%u "
-              "present=%d status=%u health=%u location=%s serial=%s frame_id=%s\n",
-              what, static_cast<double>(m.voltage), static_cast<double>(m.current),
-              static_cast<double>(m.temperature), static_cast<double>(m.percentage), static_cast<double>(m.charge),
-              static_cast<double>(m.design_capacity), m.cell_voltage._length, m.present ? 1 : 0,
-              m.power_supply_status, m.power_supply_health, m.location, m.serial_number, m.header.frame_id);
+  std::printf(
+      "%s voltage=%g current=%g temperature=%g percentage=%g charge=%g design_capacity=%g cells=%u "
+      "present=%d status=%u health=%u location=%s serial=%s frame_id=%s\n",
+      what, static_cast<double>(m.voltage), static_cast<double>(m.current), static_cast<double>(m.temperature),
+      static_cast<double>(m.percentage), static_cast<double>(m.charge), static_cast<double>(m.design_capacity),
+      m.cell_voltage._length, m.present ? 1 : 0, m.power_supply_status, m.power_supply_health, m.location,
+      m.serial_number, m.header.frame_id);
 }
 
 }  // namespace

@@ -34,8 +34,9 @@ pmu::v5::Baseline baseline_sample(const std::string& vehicle, const std::string&
 }
 
 TEST(BaselineSample, KeysPinsAndOnlyTheSettingsTheFileHas) {
-  const auto s = baseline_sample("uav1", "can0", configured("device:\n  serial: 1001\n  min_firmware: \"1.14\"\n"
-                                                             "parameters:\n  servo_voltage: 7.5\noutputs: [payload]\n"));
+  const auto s = baseline_sample("uav1", "can0",
+                                 configured("device:\n  serial: 1001\n  min_firmware: \"1.14\"\n"
+                                            "parameters:\n  servo_voltage: 7.5\noutputs: [payload]\n"));
   EXPECT_EQ(s.vehicle(), "uav1");
   EXPECT_EQ(s.bus(), "can0");
   EXPECT_EQ(s.address(), 3);
@@ -96,7 +97,9 @@ TEST(BaselineSample, AConfigSampleComparesOnTheWiresValues) {
   EXPECT_EQ(device[Setting::GenerationEnabled], 1u);
 
   const auto file = config_file_of(baseline_sample(
-      "", "can0", configured("parameters:\n  avionics_voltage: 22.0\n  payload_voltage: 12.3\noutputs: [avionics_servo, payload]\n")));
+      "", "can0",
+      configured(
+          "parameters:\n  avionics_voltage: 22.0\n  payload_voltage: 12.3\noutputs: [avionics_servo, payload]\n")));
   const auto diffs = baseline::differences(device, file);
   ASSERT_EQ(diffs.size(), 1u);
   EXPECT_EQ(diffs[0].setting, Setting::AvionicsVoltage);

@@ -18,11 +18,17 @@ struct OfCase {
 
 TEST(ContractNames, TheContractOfATypeName) {
   const OfCase cases[] = {
-      {"pmu::v4::Health", 4},     {"pmu::v5::Health", 5},     {"pmu::v12::Voltages", 12},
-      {"pmu::Health", 3},  // v1..v3: unversioned
+      {"pmu::v4::Health", 4},
+      {"pmu::v5::Health", 5},
+      {"pmu::v12::Voltages", 12},
+      {"pmu::Health", 3},                 // v1..v3: unversioned
       {"pmu::v3::Health", std::nullopt},  // no contract was named so
-      {"pmu::vx::Health", std::nullopt},  {"pmu::v5::", std::nullopt},           {"pmu::", std::nullopt},
-      {"std_msgs::msg::dds_::Header_", std::nullopt}, {"Health", std::nullopt},   {"", std::nullopt},
+      {"pmu::vx::Health", std::nullopt},
+      {"pmu::v5::", std::nullopt},
+      {"pmu::", std::nullopt},
+      {"std_msgs::msg::dds_::Header_", std::nullopt},
+      {"Health", std::nullopt},
+      {"", std::nullopt},
   };
   for (const auto& c : cases) EXPECT_EQ(contract_of_type_name(c.name), c.contract) << c.name;
 }

@@ -26,9 +26,7 @@ using eprosima::fastrtps::rtps::DiscoveryProtocol_t;
 using eprosima::fastrtps::rtps::IPLocator;
 using eprosima::fastrtps::rtps::Locator_t;
 
-std::string text(const Locator_t& l) {
-  return IPLocator::toIPv4string(l) + ":" + std::to_string(l.port);
-}
+std::string text(const Locator_t& l) { return IPLocator::toIPv4string(l) + ":" + std::to_string(l.port); }
 
 std::vector<std::string> texts(const eprosima::fastrtps::rtps::LocatorList_t& list) {
   std::vector<std::string> v;
@@ -100,8 +98,10 @@ TEST(ParticipantQos, UnicastSendsOnlyToPeersAndListensOnlyOnUnicast) {
 TEST(ParticipantQos, NoParticipantRunsTheWriterLivelinessProtocol) {
   ResolvedNetwork allowlist;
   allowlist.interface_addresses = {"127.0.0.1"};
-  for (const auto& network : {ResolvedNetwork{}, unicast({{"127.0.0.1", 0}}), server({{{{"10.0.0.1", 11811}}}}), allowlist})
-    EXPECT_FALSE(participant_qos("x", Transport::Default, network, {}).wire_protocol().builtin.use_WriterLivelinessProtocol);
+  for (const auto& network :
+       {ResolvedNetwork{}, unicast({{"127.0.0.1", 0}}), server({{{{"10.0.0.1", 11811}}}}), allowlist})
+    EXPECT_FALSE(
+        participant_qos("x", Transport::Default, network, {}).wire_protocol().builtin.use_WriterLivelinessProtocol);
   EXPECT_TRUE(DomainParticipantQos().wire_protocol().builtin.use_WriterLivelinessProtocol) << "Fast DDS's default";
 }
 
@@ -111,7 +111,8 @@ TEST(ParticipantQos, NoParticipantRunsTheWriterLivelinessProtocol) {
 TEST(ParticipantQos, EveryUdpTransportSendsDatagramsThatFitOnePacket) {
   ResolvedNetwork allowlist;
   allowlist.interface_addresses = {"192.168.10.1", "127.0.0.1"};
-  for (const auto& network : {ResolvedNetwork{}, unicast({{"127.0.0.1", 0}}), server({{{{"10.0.0.1", 11811}}}}), allowlist})
+  for (const auto& network :
+       {ResolvedNetwork{}, unicast({{"127.0.0.1", 0}}), server({{{{"10.0.0.1", 11811}}}}), allowlist})
     for (const auto transport : {Transport::Default, Transport::UdpOnly}) {
       const DomainParticipantQos q = participant_qos("x", transport, network, {});
       EXPECT_FALSE(q.transport().use_builtin_transports);
@@ -129,9 +130,9 @@ TEST(ParticipantQos, EveryUdpTransportSendsDatagramsThatFitOnePacket) {
 }
 
 TEST(ParticipantQos, ServerModeIsAClientOfEachServerByPositionWithFastddsDiscoveryPrefixes) {
-  const DomainParticipantQos q = participant_qos(
-      "pmu-service", Transport::Default,
-      server({{{{"10.0.0.1", 11811}}}, {{{"192.168.10.20", 14520}, {"192.168.11.20", 14520}}}}), {});
+  const DomainParticipantQos q =
+      participant_qos("pmu-service", Transport::Default,
+                      server({{{{"10.0.0.1", 11811}}}, {{{"192.168.10.20", 14520}, {"192.168.11.20", 14520}}}}), {});
   const auto& b = q.wire_protocol().builtin;
   EXPECT_EQ(b.discovery_config.discoveryProtocol, DiscoveryProtocol_t::CLIENT);
   const auto& servers = b.discovery_config.m_DiscoveryServers;

@@ -184,7 +184,8 @@ std::map<int, int> listed(const std::string& pmuctl) {
   std::map<int, int> out;
   for (const auto& j : pmu::test::json_lines(sh(pmuctl + "--timeout 20 --json list").out))
     if (!j.is_discarded() && j.value("kind", "") == "pmu")
-      out[j["address"].get<int>()] = j["values"]["serial_number"].is_null() ? -1 : j["values"]["serial_number"].get<int>();
+      out[j["address"].get<int>()] =
+          j["values"]["serial_number"].is_null() ? -1 : j["values"]["serial_number"].get<int>();
   return out;
 }
 

@@ -66,11 +66,12 @@ bool matched(Endpoint& e) {
 TEST(AlarmAckOverDds, HostileSamplesAreRejectedOrDroppedAndTheServiceKeepsAnswering) {
   const int domain = pmu::test::exclusive_dds_domain();
   pmu::test::ConfiguredService service(
-      PMU_SERVICE_PATH, "domain: " + std::to_string(domain) + "\nqos_file: " PMU_QOS_FILE
-                        "\nbuses:\n  - interface: sim\n    devices:\n      - address: 1\n        period: 0.5\n");
+      PMU_SERVICE_PATH, "domain: " + std::to_string(domain) +
+                            "\nqos_file: " PMU_QOS_FILE
+                            "\nbuses:\n  - interface: sim\n    devices:\n      - address: 1\n        period: 0.5\n");
   pmu::dds::DdsContext dds(domain, PMU_QOS_FILE, "ack-peer");
-  DataWriter& w = dds.writer(dds.topic(topics::kAlarmAck, TypeSupport(new pmu::v5::AlarmAckPubSubType())),
-                             qos_profiles::kCommand);
+  DataWriter& w =
+      dds.writer(dds.topic(topics::kAlarmAck, TypeSupport(new pmu::v5::AlarmAckPubSubType())), qos_profiles::kCommand);
   DataReader& r = dds.reader(dds.topic(topics::kAlarmAckReply, TypeSupport(new pmu::v5::AlarmAckReplyPubSubType())),
                              qos_profiles::kCommand);
   pmu::dds::DdsContext raw(domain, PMU_QOS_FILE, "ack-garbage");
@@ -84,7 +85,7 @@ TEST(AlarmAckOverDds, HostileSamplesAreRejectedOrDroppedAndTheServiceKeepsAnswer
       << service.describe();
 
   std::vector<std::vector<std::uint8_t>> garbage = {
-      {0, 1, 0, 0, 0xE8, 0x03, 0, 0, 'x', 0},           // a string 1000 bytes long in 6
+      {0, 1, 0, 0, 0xE8, 0x03, 0, 0, 'x', 0},            // a string 1000 bytes long in 6
       {0, 1, 0, 0, 2, 0, 0, 0, 'a', 0, 0, 0, 9},         // truncated
       {0, 7, 0, 0, 1, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0},  // XCDR2
   };
@@ -100,10 +101,8 @@ TEST(AlarmAckOverDds, HostileSamplesAreRejectedOrDroppedAndTheServiceKeepsAnswer
     return a;
   };
   std::map<std::string, std::string> want = {
-      {"bad-kind", "kind 9 is not an AlarmSource"},
-      {"bad-code", "code 'melting' is not an alarm code"},
-      {"bad-device", "device must be 0 for a bus alarm"},
-      {"expired", "expires_at: expired"},
+      {"bad-kind", "kind 9 is not an AlarmSource"},       {"bad-code", "code 'melting' is not an alarm code"},
+      {"bad-device", "device must be 0 for a bus alarm"}, {"expired", "expires_at: expired"},
       {"good", "nothing to acknowledge: NORMAL"},
   };
   auto bad_kind = ack("bad-kind", static_cast<pmu::v5::AlarmSource>(9), 1, "thermal_shutdown");

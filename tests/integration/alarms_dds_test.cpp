@@ -43,8 +43,8 @@ TEST(DdsAlarms, ALateJoinerGetsEveryAlarmInItsLatestStateWithItsFields) {
   publisher.on_alarm(report(alarms::Code::ThermalShutdown, S::ActiveUnacknowledged, 1, 1000s));
   publisher.on_alarm(report(alarms::Code::BatteryALowVoltage, S::ActiveUnacknowledged, 20.1, 1001s));
   publisher.on_alarm(report(alarms::Code::ThermalShutdown, S::ClearedUnacknowledged, 0, 1002s));
-  publisher.on_alarm(report(alarms::Code::BusErrorPassive, S::ActiveUnacknowledged, 1, 1003s,
-                            alarms::DeviceKind::Bus, 0));
+  publisher.on_alarm(
+      report(alarms::Code::BusErrorPassive, S::ActiveUnacknowledged, 1, 1003s, alarms::DeviceKind::Bus, 0));
 
   dds::DdsContext client(pmu::test::exclusive_dds_domain(), "", "reader-test");
   DataReader& reader =

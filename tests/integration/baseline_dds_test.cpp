@@ -40,8 +40,8 @@ TEST(DdsBaseline, ALateJoinerGetsEachBaselineAndTheDisposalOfEveryOtherPmu) {
   publisher.on_health(DeviceKey{"can0", 7, DeviceKind::Pmu}, HealthReport{});
 
   dds::DdsContext client(pmu::test::exclusive_dds_domain(), "", "reader-test");
-  DataReader& reader =
-      client.reader(client.topic(topics::kBaseline, TypeSupport(new pmu::v5::BaselinePubSubType())), qos_profiles::kState);
+  DataReader& reader = client.reader(client.topic(topics::kBaseline, TypeSupport(new pmu::v5::BaselinePubSubType())),
+                                     qos_profiles::kState);
   std::map<std::uint16_t, pmu::v5::Baseline> got;
   std::set<InstanceHandle_t> disposed;
   pmu::v5::Baseline key;

@@ -29,7 +29,8 @@ using Json = nlohmann::json;
 constexpr double kCapacityAh = 20;
 constexpr double kCriticalSoc = 10;
 std::string config(const std::string& domain, const std::string& extra) {
-  return "domain: " + domain + "\nqos_file: " PMU_QOS_FILE
+  return "domain: " + domain +
+         "\nqos_file: " PMU_QOS_FILE
          "\nbuses:\n  - interface: sim\n    devices:\n      - address: 1\n"
          "    batteries:\n      - node: 2\n        capacity_ah: 20\n"
          "        alarms:\n          bms_critical_soc: {limit: 10}\n"
@@ -46,8 +47,8 @@ Json battery_line(const std::string& out) {
 }
 
 struct Measured {
-  Json energy;                      // the bms_energy line
-  Json battery;                     // the latest pmu/battery values
+  Json energy;                       // the bms_energy line
+  Json battery;                      // the latest pmu/battery values
   double soc_low = 0, soc_high = 0;  // % over the pmu/battery samples read around it
 };
 
@@ -58,7 +59,8 @@ Measured measure(const std::string& p, double seconds) {
   m.soc_low = 1e9;
   m.soc_high = -1e9;
   auto watch = [&] {
-    for (const auto& l : pmu::test::json_lines(pmu::test::run_capture(p + "--timeout 10 --json watch --count 12").out)) {
+    for (const auto& l :
+         pmu::test::json_lines(pmu::test::run_capture(p + "--timeout 10 --json watch --count 12").out)) {
       if (l.value("topic", "") != "battery" || !l["values"]["state_of_charge"].is_number()) continue;
       m.battery = l["values"];
       m.soc_low = std::min(m.soc_low, m.battery["state_of_charge"].get<double>());

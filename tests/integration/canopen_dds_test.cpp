@@ -46,10 +46,11 @@ TEST(DdsCanOpen, BatteryCellsAndMpptArriveWithTheirValuesAndFrameTimes) {
   dds::DdsContext service_side(pmu::test::exclusive_dds_domain(), "", "pmu-service-canopen");
   DdsPublisher publisher(service_side, 3s, "uav1");  // the vehicle key only; partitions: vehicle_test.cpp
   dds::DdsContext client(pmu::test::exclusive_dds_domain(), "", "reader-canopen");
-  auto& battery_reader =
-      client.reader(client.topic(topics::kBattery, TypeSupport(new pmu::v5::BatteryPubSubType())), qos_profiles::kTelemetry);
-  auto& cells_reader = client.reader(client.topic(topics::kBatteryCells, TypeSupport(new pmu::v5::BatteryCellsPubSubType())),
-                                     qos_profiles::kTelemetry);
+  auto& battery_reader = client.reader(client.topic(topics::kBattery, TypeSupport(new pmu::v5::BatteryPubSubType())),
+                                       qos_profiles::kTelemetry);
+  auto& cells_reader =
+      client.reader(client.topic(topics::kBatteryCells, TypeSupport(new pmu::v5::BatteryCellsPubSubType())),
+                    qos_profiles::kTelemetry);
   auto& mppt_reader =
       client.reader(client.topic(topics::kMppt, TypeSupport(new pmu::v5::MpptPubSubType())), qos_profiles::kTelemetry);
 
@@ -81,7 +82,7 @@ TEST(DdsCanOpen, BatteryCellsAndMpptArriveWithTheirValuesAndFrameTimes) {
 
   pmu::v5::BatteryCells cells;
   ASSERT_TRUE(wait_for<pmu::v5::BatteryCells>(cells_reader, cells, si, 5s,
-                                          [](const pmu::v5::BatteryCells& x) { return !x.cells().empty(); }));
+                                              [](const pmu::v5::BatteryCells& x) { return !x.cells().empty(); }));
   ASSERT_EQ(cells.cells().size(), 1u);
   EXPECT_EQ(cells.cells()[0].cell(), 5);
   EXPECT_FLOAT_EQ(cells.cells()[0].cell_voltage(), 3.301f);
@@ -104,8 +105,8 @@ TEST(DdsCanOpen, HealthHasAnInstancePerDeviceKind) {
   dds::DdsContext service_side(pmu::test::exclusive_dds_domain(), "", "pmu-service-canopen-health");
   DdsPublisher publisher(service_side, 3s);
   dds::DdsContext client(pmu::test::exclusive_dds_domain(), "", "reader-canopen-health");
-  auto& health = client.reader(client.topic(topics::kHealth, TypeSupport(new pmu::v5::HealthPubSubType())),
-                               qos_profiles::kState);
+  auto& health =
+      client.reader(client.topic(topics::kHealth, TypeSupport(new pmu::v5::HealthPubSubType())), qos_profiles::kState);
   BusConfig config = bus_with_battery_and_mppt();
   config.mppts.push_back(MpptConfig{2, 1000ms, {}});  // configured, never heard
   Harness h(config, {pmu(1)}, Timeouts{}, &publisher);
@@ -142,9 +143,10 @@ TEST(DdsCanOpen, AServiceWithoutBatteriesOrMpptsDoesNotOfferTheirTopics) {
   dds::DdsContext service_side(pmu::test::exclusive_dds_domain(), "", "pmu-service-no-canopen");
   DdsPublisher publisher(service_side, 3s, "", {}, std::nullopt);
   dds::DdsContext client(pmu::test::exclusive_dds_domain(), "", "reader-no-canopen");
-  auto& battery =
-      client.reader(client.topic(topics::kBattery, TypeSupport(new pmu::v5::BatteryPubSubType())), qos_profiles::kTelemetry);
-  auto& mppt = client.reader(client.topic(topics::kMppt, TypeSupport(new pmu::v5::MpptPubSubType())), qos_profiles::kTelemetry);
+  auto& battery = client.reader(client.topic(topics::kBattery, TypeSupport(new pmu::v5::BatteryPubSubType())),
+                                qos_profiles::kTelemetry);
+  auto& mppt =
+      client.reader(client.topic(topics::kMppt, TypeSupport(new pmu::v5::MpptPubSubType())), qos_profiles::kTelemetry);
   auto& health =
       client.reader(client.topic(topics::kHealth, TypeSupport(new pmu::v5::HealthPubSubType())), qos_profiles::kState);
   auto matched = [](DataReader& r) {

@@ -131,7 +131,8 @@ TEST(QosCapacity, AMiseditedProfileIsAStartUpError) {
   // A rejected configuration, found by the start-up check before anything is opened, at the
   // profile's line.
   EXPECT_EQ(r.status, 2) << r.out;
-  const std::string line = std::to_string(std::count(xml.begin(), xml.begin() + static_cast<std::ptrdiff_t>(at), '\n') + 1);
+  const std::string line =
+      std::to_string(std::count(xml.begin(), xml.begin() + static_cast<std::ptrdiff_t>(at), '\n') + 1);
   EXPECT_NE(r.out.find(std::string(path) + ":" + line +
                        ": <data_writer profile_name=\"state\"> (the pmu/config, pmu/info and pmu/health writers): "
                        "max_instances 10 < 256 (PMUs per service, pmu::dds::kMaxDevicesPerService)"),
@@ -146,8 +147,8 @@ TEST(QosCapacity, PmusBeyondTheCapacityAreCountedInHealthNotDroppedSilently) {
   dds::DdsContext service_side(pmu::test::exclusive_dds_domain(), PMU_QOS_FILE, "capacity-publisher");
   DdsPublisher publisher(service_side, 3s);
   dds::DdsContext client(pmu::test::exclusive_dds_domain(), PMU_QOS_FILE, "capacity-reader");
-  DataReader& health = client.reader(
-      client.topic(topics::kHealth, TypeSupport(new pmu::v5::HealthPubSubType())), qos_profiles::kState);
+  DataReader& health =
+      client.reader(client.topic(topics::kHealth, TypeSupport(new pmu::v5::HealthPubSubType())), qos_profiles::kState);
   HealthReport report;
   report.state = HealthState::Online;
   for (std::size_t a = 1; a <= dds::kMaxDevicesPerService + 1; ++a)

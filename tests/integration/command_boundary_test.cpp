@@ -43,8 +43,7 @@ std::uint32_t wire(CommandKind k) { return static_cast<std::uint32_t>(k); }
 
 std::uint64_t now_ns() {
   return static_cast<std::uint64_t>(
-      std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::system_clock::now().time_since_epoch())
-          .count());
+      std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::system_clock::now().time_since_epoch()).count());
 }
 
 // pmu-service on two simulated PMUs, its log in a file. No rate limit: the bursts below are
@@ -99,7 +98,8 @@ class Peer {
  public:
   Peer(int domain, const std::string& name)
       : dds_(domain, "", name),
-        writer_(dds_.writer(dds_.topic(topics::kCommand, TypeSupport(new CommandSampleType())), qos_profiles::kCommand)),
+        writer_(
+            dds_.writer(dds_.topic(topics::kCommand, TypeSupport(new CommandSampleType())), qos_profiles::kCommand)),
         replies_(dds_.reader(dds_.topic(topics::kCommandReply, TypeSupport(new pmu::v5::CommandReplyPubSubType())),
                              qos_profiles::kCommand)) {}
 
@@ -133,7 +133,7 @@ class Peer {
   // Every reply (from the `since`-th received on) whose id starts with `prefix`, until `count`
   // of them arrived or `within` passed.
   std::vector<pmu::v5::CommandReply> replies(const std::string& prefix, std::size_t count,
-                                         std::chrono::seconds within = 20s, std::size_t since = 0) {
+                                             std::chrono::seconds within = 20s, std::size_t since = 0) {
     // Not wait_until: under a burst the reader must be drained again at once whenever the last
     // take found samples (its history is the command profile's depth), and sleep only when
     // it found none.
@@ -230,16 +230,17 @@ TEST_F(Boundary, EveryHostileSampleGetsOneReplyWithAReasonAndTheServiceLivesOn) 
       {"-Inf", set("h-ninf", "servo_voltage", -inf), pmu::v5::REJECTED, "is not a number"},
       {"huge", set("h-huge", "battery_voltage", 1e300), pmu::v5::REJECTED, "out of range"},
       {"denormal voltage", set("h-denorm", "payload_voltage", 4e-320), pmu::v5::REJECTED, "out of range"},
-      {"undefined output bits", with(command("h-outbits", CommandKind::EnableOutputs), [](auto& s) { s.outputs = 0xF2; }),
-       pmu::v5::REJECTED, "unknown output bits 0xF0"},
+      {"undefined output bits",
+       with(command("h-outbits", CommandKind::EnableOutputs), [](auto& s) { s.outputs = 0xF2; }), pmu::v5::REJECTED,
+       "unknown output bits 0xF0"},
       {"undefined group bits",
        with(command("h-groups", CommandKind::RequestMeasurements), [](auto& s) { s.groups = 0xE1; }), pmu::v5::REJECTED,
        "unknown measurement group bits 0xE0"},
       {"broadcast set", with(set("h-bcast", "avionics_voltage", 20), [](auto& s) { s.address = 0xFFFF; }),
        pmu::v5::REJECTED, "broadcast (65535) is only accepted for engine_stop"},
       {"unknown address", command("h-addr", CommandKind::GetSerial, 9), pmu::v5::REJECTED, "device 9 not seen on sim0"},
-      {"unknown bus", with(command("h-bus", CommandKind::GetSerial), [](auto& s) { s.bus = "can7"; }), pmu::v5::REJECTED,
-       "bus 'can7' is not served here"},
+      {"unknown bus", with(command("h-bus", CommandKind::GetSerial), [](auto& s) { s.bus = "can7"; }),
+       pmu::v5::REJECTED, "bus 'can7' is not served here"},
       {"empty bus", with(command("h-nobus", CommandKind::GetSerial), [](auto& s) { s.bus.clear(); }), pmu::v5::REJECTED,
        "bus '' is not served here"},
       {"over-long bus name",
@@ -253,7 +254,8 @@ TEST_F(Boundary, EveryHostileSampleGetsOneReplyWithAReasonAndTheServiceLivesOn) 
        pmu::v5::REJECTED, "confirm is not a boolean (byte 0xFF"},
       {"enable byte 2", with(command("h-enable2", CommandKind::SetGeneration), [](auto& s) { s.enable = 2; }),
        pmu::v5::REJECTED, "enable is not a boolean"},
-      {"T_U 0.0005 rounds to 0", set("h-tu", "upper_temperature_limit", 0.0005), pmu::v5::DENIED, "rule thermal_shutdown"},
+      {"T_U 0.0005 rounds to 0", set("h-tu", "upper_temperature_limit", 0.0005), pmu::v5::DENIED,
+       "rule thermal_shutdown"},
       {"T_U -0.0009 rounds to 0", set("h-tu2", "upper_temperature_limit", -0.0009), pmu::v5::DENIED,
        "rule thermal_shutdown"},
       {"S0 -0.0004 rounds to 0", set("h-s0", "power_up_state", -0.0004), pmu::v5::DENIED, "rule power_up_avionics_off"},
@@ -266,7 +268,8 @@ TEST_F(Boundary, EveryHostileSampleGetsOneReplyWithAReasonAndTheServiceLivesOn) 
        pmu::v5::REJECTED, "expired"},
       {"expires_at 2^63", with(command("h-exp63", CommandKind::GetSerial), [&](auto& s) { s.expires_at = far; }),
        pmu::v5::COMPLETED, ""},
-      {"expires_at 2^64-2", with(command("h-exp64-2", CommandKind::GetSerial), [](auto& s) { s.expires_at = ~0ull - 1; }),
+      {"expires_at 2^64-2",
+       with(command("h-exp64-2", CommandKind::GetSerial), [](auto& s) { s.expires_at = ~0ull - 1; }),
        pmu::v5::COMPLETED, ""},
       {"expires_at 2^64-1", with(command("h-exp64-1", CommandKind::GetSerial), [](auto& s) { s.expires_at = ~0ull; }),
        pmu::v5::COMPLETED, ""},
@@ -400,8 +403,24 @@ TEST_F(Boundary, ALookAlikeTypeOrGarbageIsDroppedNeverFatal) {
       },
       5s);
   // The fields of pmu::v5::Command in another order: kind and address first, then the strings.
-  std::vector<std::uint8_t> reordered = {0, 1, 0, 0, /*kind*/ 7, 0, 0, 0, /*address*/ 1, 0, 0, 0,
-                                         /*string length 1000*/ 0xE8, 0x03, 0, 0, 'x', 0};
+  std::vector<std::uint8_t> reordered = {0,
+                                         1,
+                                         0,
+                                         0,
+                                         /*kind*/ 7,
+                                         0,
+                                         0,
+                                         0,
+                                         /*address*/ 1,
+                                         0,
+                                         0,
+                                         0,
+                                         /*string length 1000*/ 0xE8,
+                                         0x03,
+                                         0,
+                                         0,
+                                         'x',
+                                         0};
   const auto valid = write_command_cdr(command("raw-valid", CommandKind::GetSerial));
   std::vector<std::uint8_t> truncated(valid.begin(), valid.begin() + 20);
   std::vector<std::uint8_t> xcdr2 = valid;
@@ -451,7 +470,7 @@ void burst(Service& service, std::vector<Peer*> peers, int per_peer) {
       }
       for (const auto end = Clock::now() + 120s; Clock::now() < end;) {
         (void)peer.replies(prefix, static_cast<std::size_t>(per_peer), 2s);  // waits for the burst's
-        for (const auto& r : peer.replies("", 0, 0s)) {                        // then takes them all
+        for (const auto& r : peer.replies("", 0, 0s)) {                      // then takes them all
           const auto id = r.request_id().to_string();
           if (!sent.count(id)) continue;
           results[p][id].insert(static_cast<int>(r.result()));

@@ -37,7 +37,8 @@ using namespace std::chrono_literals;
 struct Sender {
   Sender(int domain, const std::string& name)
       : dds(domain, "", name),
-        writer(dds.writer(dds.topic(topics::kCommand, TypeSupport(new pmu::v5::CommandPubSubType())), qos_profiles::kCommand)),
+        writer(dds.writer(dds.topic(topics::kCommand, TypeSupport(new pmu::v5::CommandPubSubType())),
+                          qos_profiles::kCommand)),
         replies(dds.reader(dds.topic(topics::kCommandReply, TypeSupport(new pmu::v5::CommandReplyPubSubType())),
                            qos_profiles::kCommand)) {}
   bool matched() {
@@ -148,9 +149,7 @@ TEST(CommandsOverDds, TwoSendersBurst1000CommandsAndGetExactly1000Replies) {
           c.kind(pmu::v5::ENABLE_OUTPUTS);
           c.outputs(0x02);
           break;
-        default:
-          c.kind(pmu::v5::GET);
-          c.parameter("outputs");
+        default: c.kind(pmu::v5::GET); c.parameter("outputs");
       }
       s.writer.write(&c);
       // A well-behaved client sends bursts the command QoS depth (1024) holds, and lets
@@ -188,7 +187,9 @@ TEST(CommandsOverDds, TwoSendersBurst1000CommandsAndGetExactly1000Replies) {
   EXPECT_EQ(counters.received - before.received, 1000u);
   EXPECT_EQ(counters.duplicates - before.duplicates, 0u);
   for (std::uint16_t addr : {std::uint16_t{1}, std::uint16_t{2}})
-    pmus.with_model(addr, [](sim::PmuModel& m) { EXPECT_EQ(m.counters().rejected_sets, 0u) << "an out-of-range set reached a unit"; });
+    pmus.with_model(addr, [](sim::PmuModel& m) {
+      EXPECT_EQ(m.counters().rejected_sets, 0u) << "an out-of-range set reached a unit";
+    });
 }
 
 // ---- pmuctl and the example client against pmu-service ----------------------------------

@@ -140,9 +140,13 @@ std::string every_setting_changed(int minor, int new_address) {
          "  packets_streamed: [voltages, currents, temperatures, status]\n"
          "  temperature_offset: 100\n"
          "  upper_temperature_limit: 90\n"
-         "  power_up_state: " + s0 + "\n"
+         "  power_up_state: " +
+         s0 +
+         "\n"
          "  cranking_time: 3.5\n"
-         "  can_address: " + std::to_string(new_address) + "\n"
+         "  can_address: " +
+         std::to_string(new_address) +
+         "\n"
          "outputs: [avionics_servo, charger_a]\n"
          "generation_enabled: false\n";
 }
@@ -234,7 +238,8 @@ TEST(ConfigFilesOverDds, AFailedChangeRestoresWhatWasApplied) {
   EXPECT_EQ(j["applied"], false);
   EXPECT_EQ(j["restored"].size(), 1u);
   EXPECT_EQ(j["exit_status"], 1);
-  EXPECT_EQ(pmu::test::run_capture(p + kCallDeadline + "config diff " + factory).status, 0) << "the device is as it was";
+  EXPECT_EQ(pmu::test::run_capture(p + kCallDeadline + "config diff " + factory).status, 0)
+      << "the device is as it was";
 }
 
 // Two applies at once (docs/safety.md H11): the first holds the PMU from its first command to
@@ -256,13 +261,13 @@ TEST(ConfigFilesOverDds, TwoAppliesAtOnceTheSecondIsRefusedNamingTheHolder) {
   pmu::test::ChildOptions stopped;
   stopped.stderr_path = gate.path();
   stopped.stdout_path = files.path("first.stdout");
-  pmu::test::Child a({PMUCTL_PATH, "--domain", domain, "--bus", "sim", "--address", "17", "--timeout", "60", "config",
-                      "apply", first},
-                     stopped);
+  pmu::test::Child a(
+      {PMUCTL_PATH, "--domain", domain, "--bus", "sim", "--address", "17", "--timeout", "60", "config", "apply", first},
+      stopped);
   // Its first change (cranking_time, section 4.6's order) is made; it stops at its line.
   const std::regex changed(R"(set_parameter cranking_time=3.5 to sim/17[^\n]* -> COMPLETED)");
-  ASSERT_TRUE(pmu::test::wait_until([&] { return std::regex_search(service.describe(), changed); },
-                                    std::chrono::seconds(60)))
+  ASSERT_TRUE(
+      pmu::test::wait_until([&] { return std::regex_search(service.describe(), changed); }, std::chrono::seconds(60)))
       << service.describe();
 
   const auto b = pmu::test::run_capture(p + "--timeout 20 config apply " + second + " 2>&1");
@@ -278,7 +283,8 @@ TEST(ConfigFilesOverDds, TwoAppliesAtOnceTheSecondIsRefusedNamingTheHolder) {
 
   EXPECT_EQ(run_to_end(a, gate), 0) << gate.text() << service.describe();
   EXPECT_NE(gate.text().find("3 change(s) applied; it matches " + first), std::string::npos) << gate.text();
-  EXPECT_EQ(pmu::test::run_capture(p + kCallDeadline + "config diff " + first).status, 0) << "exactly the first file's values";
+  EXPECT_EQ(pmu::test::run_capture(p + kCallDeadline + "config diff " + first).status, 0)
+      << "exactly the first file's values";
   EXPECT_EQ(pmu::test::run_capture(p + kCallDeadline + "config diff " + second).status, 1);
 }
 
@@ -298,12 +304,12 @@ TEST(ConfigFilesOverDds, ARestoreLeavesWhatAnotherWriterChangedMeanwhile) {
   pmu::test::ChildOptions stopped;
   stopped.stderr_path = gate.path();
   stopped.stdout_path = files.path("apply.stdout");
-  pmu::test::Child a({PMUCTL_PATH, "--domain", domain, "--bus", "sim", "--address", "20", "--timeout", "10", "config",
-                      "apply", file},
-                     stopped);
+  pmu::test::Child a(
+      {PMUCTL_PATH, "--domain", domain, "--bus", "sim", "--address", "20", "--timeout", "10", "config", "apply", file},
+      stopped);
   const std::regex changed(R"(set_parameter temperature_offset=100 to sim/20[^\n]* -> COMPLETED)");
-  ASSERT_TRUE(pmu::test::wait_until([&] { return std::regex_search(service.describe(), changed); },
-                                    std::chrono::seconds(60)))
+  ASSERT_TRUE(
+      pmu::test::wait_until([&] { return std::regex_search(service.describe(), changed); }, std::chrono::seconds(60)))
       << service.describe();
   // The hold ends 10 s after the apply's latest command; until then the set is DENIED.
   ASSERT_TRUE(pmu::test::wait_until(
@@ -323,7 +329,8 @@ TEST(ConfigFilesOverDds, ARestoreLeavesWhatAnotherWriterChangedMeanwhile) {
             std::string::npos)
       << out;
   const std::string theirs = files.write("theirs.yaml", "parameters:\n  temperature_offset: 90\n");
-  EXPECT_EQ(pmu::test::run_capture(p + kCallDeadline + "config diff " + theirs).status, 0) << "the other writer's value stays";
+  EXPECT_EQ(pmu::test::run_capture(p + kCallDeadline + "config diff " + theirs).status, 0)
+      << "the other writer's value stays";
 }
 
 // A bad file is exit 2 with FILE:LINE and no frame; a file for a newer firmware is refused for
@@ -368,14 +375,20 @@ TEST(ConfigFilesOverDds, BadFilesSendNothing) {
 TEST(ConfigFilesOverDds, DiffWithoutAFileUsesTheServicesBaseline) {
   Files files;
   const std::string settings = files.write("settings.yaml", "parameters:\n  avionics_voltage: 22.0\n");
-  const std::string pinned = files.write("pinned.yaml", "device:\n  serial: 4242\noutputs: [avionics_servo, payload, charger_a, charger_b]\n");
+  const std::string pinned =
+      files.write("pinned.yaml", "device:\n  serial: 4242\noutputs: [avionics_servo, payload, charger_a, charger_b]\n");
   const std::string domain = std::to_string(pmu::test::exclusive_dds_domain());
-  pmu::test::ConfiguredService service(
-      PMU_SERVICE_PATH, "domain: " + domain + "\nqos_file: " PMU_QOS_FILE
-                            "\nbuses:\n  - interface: sim\n    devices:\n"
-                            "      - address: 1\n        period: 0.5\n        baseline: " + settings + "\n"
-                            "      - address: 2\n        period: 0.5\n        baseline: " + pinned + "\n"
-                            "      - address: 3\n        period: 0.5\n");
+  pmu::test::ConfiguredService service(PMU_SERVICE_PATH,
+                                       "domain: " + domain +
+                                           "\nqos_file: " PMU_QOS_FILE
+                                           "\nbuses:\n  - interface: sim\n    devices:\n"
+                                           "      - address: 1\n        period: 0.5\n        baseline: " +
+                                           settings +
+                                           "\n"
+                                           "      - address: 2\n        period: 0.5\n        baseline: " +
+                                           pinned +
+                                           "\n"
+                                           "      - address: 3\n        period: 0.5\n");
   const std::string p = std::string(PMUCTL_PATH) + " --domain " + domain + " --bus sim ";
   // Each PMU's configuration and identity, which every diff below compares, are there once
   // the service has read it: the service reads its PMUs each on its own, so having read one
@@ -400,7 +413,8 @@ TEST(ConfigFilesOverDds, DiffWithoutAFileUsesTheServicesBaseline) {
   EXPECT_NE(other_unit.out.find(pinned + ": serial: device 1002, baseline 4242: another unit than the baseline's"),
             std::string::npos)
       << other_unit.out;
-  EXPECT_NE(other_unit.out.find("sim/2 differs from " + pinned + ": it is another unit (serial 1002, the baseline's "
+  EXPECT_NE(other_unit.out.find("sim/2 differs from " + pinned +
+                                ": it is another unit (serial 1002, the baseline's "
                                 "4242); its 1 settings match"),
             std::string::npos)
       << other_unit.out;
@@ -429,14 +443,16 @@ TEST(ConfigFilesOverDds, DiffWithoutAFileUsesTheServicesBaseline) {
 TEST(ConfigFilesOverDds, ApplyJudgesTheUnitAndTheNewAddressBeforeSending) {
   Files files;
   const std::string domain = std::to_string(pmu::test::exclusive_dds_domain());
-  pmu::test::ConfiguredService service(PMU_SERVICE_PATH, "domain: " + domain + "\nqos_file: " PMU_QOS_FILE
-                                                         "\nbuses:\n  - interface: sim\n    devices:\n"
-                                                         "      - address: 1\n        period: 0.5\n"
-                                                         "      - address: 2\n        period: 0.5\n");
+  pmu::test::ConfiguredService service(PMU_SERVICE_PATH, "domain: " + domain +
+                                                             "\nqos_file: " PMU_QOS_FILE
+                                                             "\nbuses:\n  - interface: sim\n    devices:\n"
+                                                             "      - address: 1\n        period: 0.5\n"
+                                                             "      - address: 2\n        period: 0.5\n");
   const std::string p = std::string(PMUCTL_PATH) + " --domain " + domain + " --bus sim ";
   ASSERT_EQ(pmu::test::run_capture(p + "--timeout 30 --address 2 config get can_address").status, 0)
       << service.describe();
-  const std::string from_1 = files.write("from-1.yaml", "device:\n  serial: 1001\nparameters:\n  avionics_voltage: 22.0\n");
+  const std::string from_1 =
+      files.write("from-1.yaml", "device:\n  serial: 1001\nparameters:\n  avionics_voltage: 22.0\n");
   const std::string to_1 = files.write("to-1.yaml", "parameters:\n  can_address: 1\n");
   const std::string to_5 = files.write("to-5.yaml", "parameters:\n  can_address: 5\n");
   struct Case {
@@ -464,7 +480,8 @@ TEST(ConfigFilesOverDds, ApplyJudgesTheUnitAndTheNewAddressBeforeSending) {
   }
   EXPECT_EQ(count_of(service.describe(), "audit: command"), audits) << "a refused or dry-run apply sent a command";
   // Said so, it is applied to this unit.
-  const auto applied = pmu::test::run_capture(p + "--timeout 10 --address 2 config apply --other-unit " + from_1 + " 2>&1");
+  const auto applied =
+      pmu::test::run_capture(p + "--timeout 10 --address 2 config apply --other-unit " + from_1 + " 2>&1");
   EXPECT_EQ(applied.status, 0) << applied.out << service.describe();
   EXPECT_NE(applied.out.find("sim/2: avionics_voltage 12.0 V -> 22.0 V: COMPLETED"), std::string::npos) << applied.out;
 }

@@ -251,7 +251,12 @@ TEST(DiscoveryServer, ALongLivedClientsEndedReadersAreUnmatchedAtTheOtherClients
     pmu::v5::Voltages sample;
     sample.bus("sim0");
     sample.address(1);
-    ASSERT_TRUE(pmu::test::wait_until([&] { voltages.write(&sample); return v.get_unread_count() > 0; }, 10s, 50ms));
+    ASSERT_TRUE(pmu::test::wait_until(
+        [&] {
+          voltages.write(&sample);
+          return v.get_unread_count() > 0;
+        },
+        10s, 50ms));
 
     agent.delete_endpoints_since(mark);
     EXPECT_TRUE(pmu::test::wait_until([&] { return matched_readers(voltages) == 0 && matched_readers(currents) == 0; },
@@ -449,7 +454,8 @@ TEST(DiscoveryEndToEnd, ServiceWithUnicastPeersFeedsPmuctlWithPeer) {
   o.stderr_path = config.path + ".log";
   pmu::test::Child service({PMU_SERVICE_PATH, "--config", config.path, "--bus", "sim"}, o);
   expect_watch("", "--peer 127.0.0.1", domain);
-  EXPECT_TRUE(pmu::test::dds_discovery_port_free(std::stoi(domain))) << "pmu-service or pmuctl opened the multicast port";
+  EXPECT_TRUE(pmu::test::dds_discovery_port_free(std::stoi(domain)))
+      << "pmu-service or pmuctl opened the multicast port";
   service.stop(5s);
   std::ifstream log(o.stderr_path);
   const std::string text((std::istreambuf_iterator<char>(log)), std::istreambuf_iterator<char>());
@@ -463,8 +469,8 @@ TEST(DiscoveryEndToEnd, ServiceAndPmuctlAsClientsOfADiscoveryServer) {
   const std::string domain = std::to_string(pmu::test::exclusive_dds_domain());
   const std::string port = std::to_string(pmu::test::free_udp_port());
   Server server(0, static_cast<std::uint16_t>(std::stoi(port)));
-  ConfigFile config("domain: " + domain + "\ndds_transport: udp\ndiscovery:\n  mode: server\n  servers: [\"127.0.0.1:" +
-                    port + "\"]\n");
+  ConfigFile config("domain: " + domain +
+                    "\ndds_transport: udp\ndiscovery:\n  mode: server\n  servers: [\"127.0.0.1:" + port + "\"]\n");
   pmu::test::Child service({PMU_SERVICE_PATH, "--config", config.path, "--bus", "sim", "--log-level", "warn"});
   // The variable, as an operator's shell profile would set it.
   expect_watch("PMU_DISCOVERY_SERVER=127.0.0.1:" + port, "", domain);
@@ -480,8 +486,9 @@ TEST(DiscoveryEndToEnd, AClientOfTheServerWithId1Alone) {
   const std::string domain = std::to_string(pmu::test::exclusive_dds_domain());
   const std::string port = std::to_string(pmu::test::free_udp_port());
   Server server(1, static_cast<std::uint16_t>(std::stoi(port)));
-  ConfigFile config("domain: " + domain + "\ndds_transport: udp\ndiscovery:\n  mode: server\n  servers: [\"\", \"127.0.0.1:" +
-                    port + "\"]\n");
+  ConfigFile config("domain: " + domain +
+                    "\ndds_transport: udp\ndiscovery:\n  mode: server\n  servers: [\"\", \"127.0.0.1:" + port +
+                    "\"]\n");
   pmu::test::Child service({PMU_SERVICE_PATH, "--config", config.path, "--bus", "sim", "--log-level", "warn"});
   expect_watch("", "--discovery-server ,127.0.0.1:" + port, domain);
   EXPECT_TRUE(service.running());

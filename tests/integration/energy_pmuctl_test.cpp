@@ -25,9 +25,11 @@ using Json = nlohmann::json;
 // figures must carry the configured one.
 constexpr double kCriticalA = 20.5;
 std::string config(const std::string& domain, const std::string& sim) {
-  return "domain: " + domain + "\nqos_file: " PMU_QOS_FILE
+  return "domain: " + domain +
+         "\nqos_file: " PMU_QOS_FILE
          "\nbuses:\n  - interface: sim\n    devices:\n      - address: 1\n        period: 0.5\n"
-         "        alarms:\n          battery_a_critical_voltage: {limit: 20.5}\n" + sim;
+         "        alarms:\n          battery_a_critical_voltage: {limit: 20.5}\n" +
+         sim;
 }
 
 template <class Done>

@@ -40,9 +40,11 @@ TEST(EngineStartOverDds, PmuctlShowsProgressAndExitsZeroOnlyWhenTheEngineRuns) {
     SCOPED_TRACE(c.what);
     const std::string domain = std::to_string(pmu::test::exclusive_dds_domain());
     pmu::test::ConfiguredService service(
-        PMU_SERVICE_PATH, "domain: " + domain + "\nqos_file: " PMU_QOS_FILE
+        PMU_SERVICE_PATH, "domain: " + domain +
+                              "\nqos_file: " PMU_QOS_FILE
                               "\nbuses:\n  - interface: sim\n    devices:\n      - address: 1\n        period: 0.5\n"
-                              "        sim: " + std::string(c.sim) + "\n");
+                              "        sim: " +
+                              std::string(c.sim) + "\n");
     const std::string p = std::string(PMUCTL_PATH) + " --domain " + domain + " ";
     // Ready once the PMU's configuration has been read (a start needs its firmware).
     const auto ready = pmu::test::run_capture(p + "--timeout 30 --address 1 config get cranking_time");

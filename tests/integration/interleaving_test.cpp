@@ -77,9 +77,7 @@ std::optional<double> log_line_time(const std::string& line) {
   return static_cast<double>(std::mktime(&tm)) + ms / 1000.0;
 }
 
-double wall_now() {
-  return std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count();
-}
+double wall_now() { return std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count(); }
 
 // pmu-service on this test's config, started again after a kill; each start logs to a file of
 // its own, and log() is all of them. Start and kill it from the test's main thread.
@@ -89,8 +87,8 @@ class Service {
     std::ofstream(dir_ + "/pmu-service.yaml")
         << "domain: " << domain_ << "\nqos_file: " << PMU_QOS_FILE << "\nlog_level: info\n"
         << "buses:\n  - interface: sim\n    devices:\n      - address: 1\n        period: 0.5\n"
-        << "        sim: {engine: stopped, engine_starts_after: never, internal_temperature: "
-        << kInternalTemperature << "}\n";
+        << "        sim: {engine: stopped, engine_starts_after: never, internal_temperature: " << kInternalTemperature
+        << "}\n";
   }
   void start() {
     pmu::test::ChildOptions o;
@@ -149,10 +147,10 @@ std::vector<std::string> final_lines(const std::string& output) {
 
 // What the unit holds and streams after a step, read by calls of the test's own.
 struct Observed {
-  Json config;                         // pmu/config values
-  std::optional<Json> status;          // the last pmu/status values, when it is streamed
-  std::optional<Json> readiness;       // the unnamed vehicle's pmu/readiness
-  std::string raw;                     // for messages
+  Json config;                    // pmu/config values
+  std::optional<Json> status;     // the last pmu/status values, when it is streamed
+  std::optional<Json> readiness;  // the unnamed vehicle's pmu/readiness
+  std::string raw;                // for messages
 };
 
 class Interleavings : public ::testing::Test {
@@ -204,7 +202,8 @@ class Interleavings : public ::testing::Test {
     }
     std::stable_sort(events.begin(), events.end(), [](const Event& a, const Event& b) { return a.at < b.at; });
     for (const auto& e : events) {
-      std::this_thread::sleep_until(t0 + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(e.at)));
+      std::this_thread::sleep_until(t0 +
+                                    std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(e.at)));
       Call& c = calls[e.call];
       if (!e.give_up) {
         c.wall_started = wall_now();
@@ -215,8 +214,8 @@ class Interleavings : public ::testing::Test {
       }
     }
     for (auto& c : calls) {
-      const auto st = c.child.wait_for(std::chrono::duration_cast<std::chrono::milliseconds>(
-          std::chrono::duration<double>(c.timeout + 30)));
+      const auto st = c.child.wait_for(
+          std::chrono::duration_cast<std::chrono::milliseconds>(std::chrono::duration<double>(c.timeout + 30)));
       if (st && WIFEXITED(*st)) c.status = WEXITSTATUS(*st);
       c.output = read_text(c.out_path);
       history_ += "  " + args_text(c) + " at " + std::to_string(c.at) + " s -> " +
@@ -226,20 +225,18 @@ class Interleavings : public ::testing::Test {
   }
 
   pmu::test::RunResult own(const std::string& args) {
-    return pmu::test::run_capture(std::string(PMUCTL_PATH) + " --domain " + std::to_string(domain_) +
-                                      " --no-agent " + args,
-                                  true);
+    return pmu::test::run_capture(
+        std::string(PMUCTL_PATH) + " --domain " + std::to_string(domain_) + " --no-agent " + args, true);
   }
   pmu::test::RunResult through_agent(const std::string& args) {
-    return pmu::test::run_capture("PMU_AGENT_SOCKET=" + socket_ + " " + PMUCTL_PATH + " --domain " +
-                                      std::to_string(domain_) + " " + args,
-                                  true);
+    return pmu::test::run_capture(
+        "PMU_AGENT_SOCKET=" + socket_ + " " + PMUCTL_PATH + " --domain " + std::to_string(domain_) + " " + args, true);
   }
 
   // The service answers for its PMU: up, configured as the steps expect (cranking time).
   bool service_ready() {
-    const bool up = pmu::test::wait_until(
-        [&] { return own("--timeout 5 config get cranking_time").status == 0; }, 60s, 500ms);
+    const bool up =
+        pmu::test::wait_until([&] { return own("--timeout 5 config get cranking_time").status == 0; }, 60s, 500ms);
     if (!up) return false;
     return own("--timeout 10 config set cranking_time " + std::to_string(kCrankingTime)).status == 0;
   }
@@ -324,12 +321,15 @@ class Interleavings : public ::testing::Test {
         case 3: c.args = {"outputs", "set", "payload"}; break;
         case 4: c.args = {"config", "set", "power_up_state", "payload"}; break;
         case 5: {
-          static const char* kReduced[] = {"voltages", "voltages,currents", "voltages,currents,battery_energy",
-                                           "temperatures", "status", "voltages,status"};
+          static const char* kReduced[] = {
+              "voltages", "voltages,currents", "voltages,currents,battery_energy", "temperatures",
+              "status",   "voltages,status"};
           c.args = {"config", "set", "packets_streamed", kReduced[integer(0, 5)]};
           break;
         }
-        case 6: c.args = {"config", "set", "packets_streamed", "voltages,currents,battery_energy,temperatures,status"}; break;
+        case 6:
+          c.args = {"config", "set", "packets_streamed", "voltages,currents,battery_energy,temperatures,status"};
+          break;
         default: c.args = {"--confirm", "reset"}; break;
       }
       c.what = c.args[0] == "--confirm" ? "reset" : c.args[0] + " " + c.args[1];
@@ -396,7 +396,8 @@ class Interleavings : public ::testing::Test {
     for (int f = 0; f < 2; ++f) {
       Json values;
       std::string file = text;
-      const std::vector<std::string> picked{tenths(integer(120, 240)), tenths(integer(50, 120)), tenths(integer(200, 252))};
+      const std::vector<std::string> picked{tenths(integer(120, 240)), tenths(integer(50, 120)),
+                                            tenths(integer(200, 252))};
       for (std::size_t i = 0; i < names.size(); ++i) {
         file = std::regex_replace(file, std::regex("(\\n  " + names[i] + ": )[^\\n#]*"), "$1" + picked[i] + " ");
         values[names[i]] = std::stod(picked[i]);
@@ -420,14 +421,16 @@ class Interleavings : public ::testing::Test {
   // I1: every call that was not given up ended with a documented status and at most one final
   // result, and a stop is never refused.
   void check_calls(const std::vector<Call>& calls) {
-    const bool moved = std::any_of(calls.begin(), calls.end(), [](const Call& c) { return c.what == "address change"; });
+    const bool moved =
+        std::any_of(calls.begin(), calls.end(), [](const Call& c) { return c.what == "address change"; });
     for (const auto& c : calls) {
       if (c.gave_up) continue;
       // A call that found the PMU at the address it was just moved from is refused by the
       // service, not executed elsewhere (docs/safety.md H10): exit 2, "no such target".
       if (moved && c.what != "address change" && c.what != "engine stop" && c.status == 2) {
         const auto finals = final_lines(c.output);
-        if (finals.size() == 1 && finals[0].rfind("REJECTED", 0) == 0 && finals[0].find(" not seen on ") != std::string::npos)
+        if (finals.size() == 1 && finals[0].rfind("REJECTED", 0) == 0 &&
+            finals[0].find(" not seen on ") != std::string::npos)
           continue;
       }
       if (!c.status || *c.status > 1) {
@@ -487,7 +490,8 @@ class Interleavings : public ::testing::Test {
         if (line.find("audit: command") == std::string::npos || at == std::string::npos ||
             line.find("-> COMPLETED") == std::string::npos)
           continue;
-        const double set = std::strtod(line.c_str() + at + std::string("set_parameter avionics_voltage=").size(), nullptr);
+        const double set =
+            std::strtod(line.c_str() + at + std::string("set_parameter avionics_voltage=").size(), nullptr);
         if (std::abs(set - std::stod(value)) > 0.05) continue;
         const auto t = log_line_time(line);
         if (t && *t > wait_end + kSetToAudit)
@@ -520,7 +524,8 @@ class Interleavings : public ::testing::Test {
     service_->kill();
     for (const char* verb : {"alarms", "preflight"}) {
       const auto r = through_agent(std::string("--timeout 3 ") + verb);
-      if (r.status == 0) broken("I2", std::string("[agent] pmuctl ") + verb + " exits 0 with its service killed:\n" + r.out);
+      if (r.status == 0)
+        broken("I2", std::string("[agent] pmuctl ") + verb + " exits 0 with its service killed:\n" + r.out);
     }
     service_->start();
     history_ += "  pmu-service started again\n";
@@ -547,8 +552,9 @@ TEST_F(Interleavings, RandomOperatorsKeepEveryInvariantOfTheHazardLog) {
   pmu::test::ChildOptions agent_options;
   agent_options.stdout_path = agent_options.stderr_path = dir_.path() + "/agent.log";
   // One worker: a call waits behind another, as on a ground station whose workers are busy.
-  pmu::test::Child agent({PMUCTL_PATH, "--domain", std::to_string(domain_), "agent", "--socket", socket_, "--workers", "1"},
-                         agent_options);
+  pmu::test::Child agent(
+      {PMUCTL_PATH, "--domain", std::to_string(domain_), "agent", "--socket", socket_, "--workers", "1"},
+      agent_options);
   ASSERT_TRUE(service_ready()) << service_->log();
 
   const auto end = Clock::now() + std::chrono::seconds(seconds_);

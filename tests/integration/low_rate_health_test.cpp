@@ -55,8 +55,8 @@ TEST(DdsLowRateHealth, WrittenWhenTheStateOrBusStateChangesNotForTheFrameAgeOrCo
   pmu::dds::DdsContext service_side(domain, "", "pmu-service-low-rate-health");
   DdsPublisher publisher(service_side, 3s, "uav1", 1000ms);
   pmu::dds::DdsContext client(domain, "", "low-rate-health-reader");
-  DataReader& r = client.reader(
-      client.topic(pmu::topics::kLowRateHealth, TypeSupport(new pmu::v5::HealthPubSubType())), pmu::qos_profiles::kState);
+  DataReader& r = client.reader(client.topic(pmu::topics::kLowRateHealth, TypeSupport(new pmu::v5::HealthPubSubType())),
+                                pmu::qos_profiles::kState);
 
   struct Step {
     HealthState state;
@@ -125,8 +125,8 @@ TEST(DdsLowRateHealth, PmuctlWatchLowRateShowsTheStateOfTheLowRateHealth) {
   auto holds = [](DataWriter& w) {
     PublicationMatchedStatus st;
     w.get_publication_matched_status(st);
-    return st.current_count > 0 && w.wait_for_acknowledgments(eprosima::fastrtps::Duration_t(0, 100000000)) ==
-                                       ReturnCode_t::RETCODE_OK;
+    return st.current_count > 0 &&
+           w.wait_for_acknowledgments(eprosima::fastrtps::Duration_t(0, 100000000)) == ReturnCode_t::RETCODE_OK;
   };
   pmu::v5::Voltages v;
   v.bus("sim0");

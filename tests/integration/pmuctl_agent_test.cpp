@@ -85,7 +85,7 @@ bool taken(const std::string& log, const std::string& call) {
 
 bool wait_for_socket(const std::string& path) {
   for (int i = 0; i < 200; ++i) {
-    struct stat st{};
+    struct stat st {};
     if (::lstat(path.c_str(), &st) == 0 && S_ISSOCK(st.st_mode)) return true;
     std::this_thread::sleep_for(50ms);
   }
@@ -106,8 +106,8 @@ bool connects(const std::string& path) {
 class Uav1 : public pmu::test::ConfiguredService {
  public:
   explicit Uav1(int domain)
-      : ConfiguredService(PMU_SERVICE_PATH, "domain: " + std::to_string(domain) + "\nvehicle: uav1\nqos_file: " +
-                                                PMU_QOS_FILE +
+      : ConfiguredService(PMU_SERVICE_PATH, "domain: " + std::to_string(domain) +
+                                                "\nvehicle: uav1\nqos_file: " + PMU_QOS_FILE +
                                                 "\nlog_level: info\nbuses:\n  - interface: sim\n    name: can0\n"
                                                 "    devices:\n      - address: 1\n        period: 0.5\n") {}
 };
@@ -125,7 +125,8 @@ class PmuctlAgentWithUav1 : public ::testing::Test {
 
   // The start of a pmuctl call to uav1 through the agent, ready for its options and verb.
   std::string uav1_calls() const {
-    return "PMU_AGENT_SOCKET=" + socket + " " + PMUCTL_PATH + " --domain " + std::to_string(domain) + " --vehicle uav1 ";
+    return "PMU_AGENT_SOCKET=" + socket + " " + PMUCTL_PATH + " --domain " + std::to_string(domain) +
+           " --vehicle uav1 ";
   }
 };
 
@@ -176,7 +177,8 @@ TEST_F(PmuctlAgentWithUav1, CallsGoThroughItWithTheCallersOutputStatusAndDirecto
   r = sh("PMU_AGENT_SOCKET=" + socket + " " + PMUCTL_PATH + " --domain " + std::to_string(other_domain) +
          " --timeout 1 list");
   EXPECT_TRUE(r.status == 0 || r.status == 3) << r.out;
-  EXPECT_NE(r.out.find("pmuctl: the agent on " + socket + " does not serve this call (its domain, QoS file, "
+  EXPECT_NE(r.out.find("pmuctl: the agent on " + socket +
+                       " does not serve this call (its domain, QoS file, "
                        "security or network options are not the agent's); it runs on its own"),
             std::string::npos)
       << r.out;
@@ -272,8 +274,8 @@ TEST_F(PmuctlAgentWithUav1, AListTellsTheWorkerEachVehiclesOnePmu) {
   EXPECT_NE(r.out.find("\"address\":7,"), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("\"result\":\"COMPLETED\""), std::string::npos) << r.out;
   const std::string service_log = uav1.describe();
-  EXPECT_EQ(count(service_log, "-> REJECTED: device 1 not seen on can0"), 1u)
-      << "the listed PMU was tried first\n" << service_log;
+  EXPECT_EQ(count(service_log, "-> REJECTED: device 1 not seen on can0"), 1u) << "the listed PMU was tried first\n"
+                                                                              << service_log;
 }
 
 // After a list through the agent, its worker has made the command writer of each vehicle it
@@ -288,8 +290,8 @@ TEST_F(PmuctlAgentWithUav1, AListMakesTheCommandWriterOfEachVehicleItShowed) {
         if (partition.find("uav1") != std::string::npos) return true;
     return false;
   };
-  EXPECT_TRUE(pmu::test::wait_until(uav1_command_writer, 20s, 50ms))
-      << "no command writer of uav1 after the list\n" << read_file(log);
+  EXPECT_TRUE(pmu::test::wait_until(uav1_command_writer, 20s, 50ms)) << "no command writer of uav1 after the list\n"
+                                                                     << read_file(log);
 }
 
 // docs/safety.md H6: uav1's service stops answering (SIGSTOP: as killed, but it can be let go
@@ -299,8 +301,9 @@ TEST_F(PmuctlAgentWithUav1, AListMakesTheCommandWriterOfEachVehicleItShowed) {
 TEST_F(PmuctlAgentWithUav1, ADeadServiceGetsTheAnswersOfACallOnItsOwn) {
   const std::string p = uav1_calls();
   ASSERT_TRUE(listed_through_agent(p)) << read_file(log) << uav1.describe();
-  const char* verbs[] = {"alarms", "--json alarms", "list", "energy", "preflight", "config snapshot -",
-                         "config get payload_voltage", "--json list"};
+  const char* verbs[] = {
+      "alarms",     "--json alarms", "list", "energy", "preflight", "config snapshot -", "config get payload_voltage",
+      "--json list"};
   // Every verb once while the service answers, so the workers know its writers.
   for (const char* verb : verbs) (void)sh(p + "--timeout 10 " + verb);
 
@@ -434,7 +437,8 @@ TEST_F(PmuctlAgentWithOneWorker, ACallWhoseCallerGaveUpIsNeverRun) {
   EXPECT_EQ(r.status, 124) << r.out;
   r = sh(calls() + "--timeout 2 --vehicle uav1 config set payload_voltage 20");
   EXPECT_EQ(r.status, 3) << r.out;
-  EXPECT_NE(r.out.find("pmuctl: the agent on " + socket + " did not run the call: its wait (--timeout) ended before "
+  EXPECT_NE(r.out.find("pmuctl: the agent on " + socket +
+                       " did not run the call: its wait (--timeout) ended before "
                        "one of the agent's workers was free"),
             std::string::npos)
       << r.out;
@@ -542,8 +546,8 @@ TEST(PmuctlAgent, OneAgentPerSocketAndAStaleSocketIsTakenOver) {
   }
   ASSERT_TRUE(listening) << read_file(dir.path() + "/first.log");
   // A second agent finds it taken (`timeout`: one that wrongly listened would never end).
-  const auto second =
-      sh("timeout 20 " + std::string(PMUCTL_PATH) + " --domain " + std::to_string(domain) + " agent --socket " + socket);
+  const auto second = sh("timeout 20 " + std::string(PMUCTL_PATH) + " --domain " + std::to_string(domain) +
+                         " agent --socket " + socket);
   EXPECT_EQ(second.status, 2) << second.out;
   EXPECT_NE(second.out.find("pmuctl agent: another agent listens on " + socket), std::string::npos) << second.out;
   EXPECT_TRUE(first.running()) << read_file(dir.path() + "/first.log");
@@ -576,8 +580,8 @@ TEST(PmuctlAgent, AnAgentThatEndsDuringACallLeavesNoAnswerAndNoSecondRun) {
   // Had it run the call again on its own, that run would have said there is no service.
   EXPECT_EQ(read_file(call_out).find("no pmu-service"), std::string::npos) << read_file(call_out);
   EXPECT_NE(read_file(call_out).find("pmuctl: the agent on " + socket +
-                                           " ended during the call: it may have been carried out (see the agent's "
-                                           "log), so it is not run again"),
+                                     " ended during the call: it may have been carried out (see the agent's "
+                                     "log), so it is not run again"),
             std::string::npos)
       << read_file(call_out);
 }

@@ -249,8 +249,7 @@ void expect_expiry_at_the_end_of_the_wait(const char* request_topic, const char*
     EXPECT_EQ(e, expiries.front()) << "a resend keeps the request's expiry";
     EXPECT_GT(e, epoch_ns(started));
     EXPECT_LE(e, epoch_ns(gave_up)) << "the request outlives pmuctl's wait by "
-                                     << (static_cast<double>(e) - static_cast<double>(epoch_ns(gave_up))) / 1e9
-                                     << " s";
+                                    << (static_cast<double>(e) - static_cast<double>(epoch_ns(gave_up))) / 1e9 << " s";
   }
 }
 
@@ -260,9 +259,9 @@ TEST(PmuctlExpiry, ACommandExpiresWhenPmuctlStopsWaiting) {
 }
 
 TEST(PmuctlExpiry, AnAlarmAcknowledgementExpiresWhenPmuctlStopsWaiting) {
-  expect_expiry_at_the_end_of_the_wait<pmu::v5::AlarmAckPubSubType, pmu::v5::AlarmAckReplyPubSubType,
-                                       pmu::v5::AlarmAck>(pmu::topics::kAlarmAck, pmu::topics::kAlarmAckReply,
-                                                          {"--bus", "can0", "alarms", "ack", "bus_off", "--kind", "bus"});
+  expect_expiry_at_the_end_of_the_wait<pmu::v5::AlarmAckPubSubType, pmu::v5::AlarmAckReplyPubSubType, pmu::v5::AlarmAck>(
+      pmu::topics::kAlarmAck, pmu::topics::kAlarmAckReply,
+      {"--bus", "can0", "alarms", "ack", "bus_off", "--kind", "bus"});
 }
 
 }  // namespace

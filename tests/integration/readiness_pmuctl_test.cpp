@@ -19,8 +19,10 @@ namespace {
 using namespace std::chrono_literals;
 
 std::string config(const std::string& domain, const std::string& device_1) {
-  return "domain: " + domain + "\nqos_file: " PMU_QOS_FILE
-         "\nbuses:\n  - interface: sim\n    devices:\n      - address: 1\n        period: 0.5\n" + device_1;
+  return "domain: " + domain +
+         "\nqos_file: " PMU_QOS_FILE
+         "\nbuses:\n  - interface: sim\n    devices:\n      - address: 1\n        period: 0.5\n" +
+         device_1;
 }
 
 // Runs `command` until `done` holds for its result, for at most `within`.
@@ -39,7 +41,8 @@ TEST(ReadinessOverDds, AHealthyVehicleIsReadyWithNoAlarm) {
   const std::string domain = std::to_string(pmu::test::exclusive_dds_domain());
   pmu::test::ConfiguredService service(PMU_SERVICE_PATH, config(domain, ""));
   const std::string p = std::string(PMUCTL_PATH) + " --domain " + domain + " ";
-  const auto ready = until(p + "--timeout 10 --json preflight", [](const auto& r) { return r.status == 0; }, 30s);
+  const auto ready = until(
+      p + "--timeout 10 --json preflight", [](const auto& r) { return r.status == 0; }, 30s);
   ASSERT_EQ(ready.status, 0) << ready.out << service.describe();
   const auto lines = pmu::test::json_lines(ready.out);
   ASSERT_EQ(lines.size(), 1u) << ready.out;
@@ -53,8 +56,7 @@ TEST(ReadinessOverDds, AHealthyVehicleIsReadyWithNoAlarm) {
 
 TEST(ReadinessOverDds, AHotPmuRaisesItsAlarmAndMakesTheVehicleNotReady) {
   const std::string domain = std::to_string(pmu::test::exclusive_dds_domain());
-  pmu::test::ConfiguredService service(PMU_SERVICE_PATH,
-                                       config(domain, "        sim: {internal_temperature: 95}\n"));
+  pmu::test::ConfiguredService service(PMU_SERVICE_PATH, config(domain, "        sim: {internal_temperature: 95}\n"));
   const std::string p = std::string(PMUCTL_PATH) + " --domain " + domain + " ";
   const auto alarms = until(
       p + "--timeout 10 --json alarms",
@@ -83,9 +85,10 @@ TEST(ReadinessOverDds, AHotPmuRaisesItsAlarmAndMakesTheVehicleNotReady) {
 // vehicle is not ready for want of them (input_missing, docs/safety.md H6).
 TEST(ReadinessOverDds, APmuWhoseAlarmsSeeNothingIsNotReady) {
   const std::string domain = std::to_string(pmu::test::exclusive_dds_domain());
-  pmu::test::ConfiguredService service(
-      PMU_SERVICE_PATH, config(domain, "        mode: polling\n        packets: [voltages, currents]\n"
-                                       "        sim: {internal_temperature: 95}\n"));
+  pmu::test::ConfiguredService service(PMU_SERVICE_PATH,
+                                       config(domain,
+                                              "        mode: polling\n        packets: [voltages, currents]\n"
+                                              "        sim: {internal_temperature: 95}\n"));
   const std::string p = std::string(PMUCTL_PATH) + " --domain " + domain + " ";
   const auto r = until(
       p + "--timeout 10 preflight",
@@ -101,12 +104,12 @@ TEST(ReadinessOverDds, APmuWhoseAlarmsSeeNothingIsNotReady) {
 // the alarm's own line, as `pmuctl alarms --json` prints it.
 TEST(ReadinessOverDds, WatchMarksTheHotPmusLinesWithItsAlarm) {
   const std::string domain = std::to_string(pmu::test::exclusive_dds_domain());
-  pmu::test::ConfiguredService service(PMU_SERVICE_PATH,
-                                       config(domain, "        sim: {internal_temperature: 95}\n"));
+  pmu::test::ConfiguredService service(PMU_SERVICE_PATH, config(domain, "        sim: {internal_temperature: 95}\n"));
   const std::string p = std::string(PMUCTL_PATH) + " --domain " + domain + " ";
   // After the state and age, before the values: "... sim/1 temperatures ONLINE 0.3s ALARM ... internal=95.0degC ...";
   // 1 alarm, or 2 once internal_over_temperature's on-delay is over: the critical is the worst either way.
-  const std::regex marked(" sim/1 temperatures [A-Z]+ [0-9.]+s ALARM [12] CRIT unacked \\(thermal_shutdown\\) internal=");
+  const std::regex marked(
+      " sim/1 temperatures [A-Z]+ [0-9.]+s ALARM [12] CRIT unacked \\(thermal_shutdown\\) internal=");
   const auto text = until(
       p + "--timeout 20 watch --count 15", [&marked](const auto& r) { return std::regex_search(r.out, marked); }, 30s);
   ASSERT_EQ(text.status, 0) << text.out << service.describe();
@@ -138,8 +141,7 @@ TEST(ReadinessOverDds, WatchMarksTheHotPmusLinesWithItsAlarm) {
 
 TEST(ReadinessOverDds, AnAlarmAcknowledgedFromTheGroundIsActiveAcknowledged) {
   const std::string domain = std::to_string(pmu::test::exclusive_dds_domain());
-  pmu::test::ConfiguredService service(PMU_SERVICE_PATH,
-                                       config(domain, "        sim: {internal_temperature: 95}\n"));
+  pmu::test::ConfiguredService service(PMU_SERVICE_PATH, config(domain, "        sim: {internal_temperature: 95}\n"));
   const std::string p = std::string(PMUCTL_PATH) + " --domain " + domain + " ";
   const auto raised = until(
       p + "--timeout 10 --json alarms",
@@ -187,7 +189,8 @@ TEST(ReadinessOverDds, ASettingThatDiffersFromTheBaselineMakesTheVehicleNotReady
   const std::string text = "device:\n  serial: 1001\nparameters:\n  avionics_voltage: 22.0\n";
   ASSERT_EQ(::write(fd, text.data(), text.size()), static_cast<ssize_t>(text.size()));
   ::close(fd);
-  pmu::test::ConfiguredService service(PMU_SERVICE_PATH, config(domain, std::string("        baseline: ") + path + "\n"));
+  pmu::test::ConfiguredService service(PMU_SERVICE_PATH,
+                                       config(domain, std::string("        baseline: ") + path + "\n"));
   const std::string p = std::string(PMUCTL_PATH) + " --domain " + domain + " ";
   const auto r = until(
       p + "--timeout 10 --json preflight",
@@ -206,14 +209,15 @@ TEST(ReadinessOverDds, ASettingThatDiffersFromTheBaselineMakesTheVehicleNotReady
     EXPECT_NE(reason.value("description", "").find("avionics_voltage 12.0 V->22.0 V"), std::string::npos) << r.out;
   }
   EXPECT_TRUE(found) << r.out;
-  EXPECT_EQ(r.out.find("serial_differs"), std::string::npos) << "the simulated unit at address 1 has serial 1001: " << r.out;
+  EXPECT_EQ(r.out.find("serial_differs"), std::string::npos)
+      << "the simulated unit at address 1 has serial 1001: " << r.out;
   EXPECT_NE(service.describe().find("configuration differs from baseline"), std::string::npos) << service.describe();
 }
 
 TEST(ReadinessOverDds, NothingOnTheDomainIsExitThree) {
   const std::string domain = std::to_string(pmu::test::exclusive_dds_domain());
-  const auto r = pmu::test::run_capture(std::string(PMUCTL_PATH) + " --domain " + domain + " --timeout 1 preflight",
-                                        true);
+  const auto r =
+      pmu::test::run_capture(std::string(PMUCTL_PATH) + " --domain " + domain + " --timeout 1 preflight", true);
   EXPECT_EQ(r.status, 3) << r.out;
   EXPECT_NE(r.out.find("no pmu-service on domain"), std::string::npos) << r.out;
 }

@@ -52,7 +52,8 @@ const char* const kBms = "rt/test/uav1/sim/bms_2/battery";
 const char* const kDiagnostics = "rt/diagnostics";
 
 std::string config(int domain) {
-  return "domain: " + std::to_string(domain) + "\nqos_file: " PMU_QOS_FILE
+  return "domain: " + std::to_string(domain) +
+         "\nqos_file: " PMU_QOS_FILE
          "\nvehicle: uav1\nros2:\n  enabled: true\n  namespace: /test\n"
          "buses:\n  - interface: sim\n    devices:\n      - address: 1\n"
          "        sim: {battery_a_voltage: 24.6, battery_b_voltage: 0, serial: 4321}\n"
@@ -145,8 +146,9 @@ Json number(float v) { return std::isnan(v) ? Json() : Json(v); }
 Json battery_json(const sensor_msgs::msg::BatteryState& m) {
   Json cells = Json::array();
   for (const float c : m.cell_voltage()) cells.push_back(number(c));
-  return {{"header", {{"stamp", {{"sec", m.header().stamp().sec()}, {"nanosec", m.header().stamp().nanosec()}}},
-                      {"frame_id", m.header().frame_id()}}},
+  return {{"header",
+           {{"stamp", {{"sec", m.header().stamp().sec()}, {"nanosec", m.header().stamp().nanosec()}}},
+            {"frame_id", m.header().frame_id()}}},
           {"voltage", number(m.voltage())},
           {"temperature", number(m.temperature())},
           {"current", number(m.current())},
@@ -175,8 +177,9 @@ Json diagnostics_json(const diagnostic_msgs::msg::DiagnosticArray& a) {
                       {"hardware_id", s.hardware_id()},
                       {"values", values}});
   }
-  return {{"header", {{"stamp", {{"sec", a.header().stamp().sec()}, {"nanosec", a.header().stamp().nanosec()}}},
-                      {"frame_id", a.header().frame_id()}}},
+  return {{"header",
+           {{"stamp", {{"sec", a.header().stamp().sec()}, {"nanosec", a.header().stamp().nanosec()}}},
+            {"frame_id", a.header().frame_id()}}},
           {"status", status}};
 }
 
@@ -228,7 +231,8 @@ TEST(Ros2OverDds, BatteriesAndDiagnosticsReachARos2DefaultReaderWithTheSimulator
   EXPECT_EQ(a.header().frame_id(), "test/uav1/sim/pmu_1");
   EXPECT_EQ(a.location(), "battery_a");
   EXPECT_EQ(a.serial_number(), "pmu 4321");
-  const auto now_s = std::chrono::duration_cast<std::chrono::seconds>(std::chrono::system_clock::now().time_since_epoch()).count();
+  const auto now_s =
+      std::chrono::duration_cast<std::chrono::seconds>(std::chrono::system_clock::now().time_since_epoch()).count();
   EXPECT_LT(std::abs(a.header().stamp().sec() - now_s), 30) << "the frame's receive time, on the wall clock";
   // The sign: the current of a battery charging reads positive, of one discharging negative.
   if (a.current() >= 0.1f) {
@@ -249,11 +253,14 @@ TEST(Ros2OverDds, BatteriesAndDiagnosticsReachARos2DefaultReaderWithTheSimulator
 
   // The BMS: 12 cells at 4.0 V, 80 % (0.8 here) of 20 Ah, discharging into the load.
   sensor_msgs::msg::BatteryState m;
-  ASSERT_TRUE(next<Battery>(*bms, raw, m, 30s, [](const auto& x) {
-    bool cells = x.cell_voltage().size() == 12;
-    for (const float c : x.cell_voltage()) cells = cells && !std::isnan(c);
-    return cells && !std::isnan(x.percentage()) && !std::isnan(x.current());
-  })) << battery_json(m).dump() << "\n" << service.describe();
+  ASSERT_TRUE(next<Battery>(*bms, raw, m, 30s,
+                            [](const auto& x) {
+                              bool cells = x.cell_voltage().size() == 12;
+                              for (const float c : x.cell_voltage()) cells = cells && !std::isnan(c);
+                              return cells && !std::isnan(x.percentage()) && !std::isnan(x.current());
+                            }))
+      << battery_json(m).dump() << "\n"
+      << service.describe();
   capture(kBms, "sensor_msgs/msg/BatteryState", raw, battery_json(m));
   EXPECT_NEAR(m.voltage(), 48.0, 0.01);
   for (const float c : m.cell_voltage()) EXPECT_NEAR(c, 4.0, 0.001);
@@ -327,14 +334,16 @@ TEST(Ros2OverDds, AGoneDeviceLeavesANotPresentBatteryForLateJoiners) {
   using Battery = sensor_msgs::msg::BatteryStatePubSubType;
   RawSample raw;
   sensor_msgs::msg::BatteryState m;
-  DataReader* before = ros2.reader("rt/uav1/can0/pmu_1/battery_a", reader_qos(RELIABLE_RELIABILITY_QOS, TRANSIENT_LOCAL_DURABILITY_QOS));
+  DataReader* before =
+      ros2.reader("rt/uav1/can0/pmu_1/battery_a", reader_qos(RELIABLE_RELIABILITY_QOS, TRANSIENT_LOCAL_DURABILITY_QOS));
   ASSERT_NE(before, nullptr);
   ASSERT_TRUE(next<Battery>(*before, raw, m, 10s, [](const auto&) { return true; }));
   EXPECT_TRUE(m.present());
   EXPECT_FLOAT_EQ(m.voltage(), 24.5f);
 
   publisher.on_gone(key);
-  DataReader* after = ros2.reader("rt/uav1/can0/pmu_1/battery_b", reader_qos(RELIABLE_RELIABILITY_QOS, TRANSIENT_LOCAL_DURABILITY_QOS));
+  DataReader* after =
+      ros2.reader("rt/uav1/can0/pmu_1/battery_b", reader_qos(RELIABLE_RELIABILITY_QOS, TRANSIENT_LOCAL_DURABILITY_QOS));
   ASSERT_NE(after, nullptr);
   ASSERT_TRUE(next<Battery>(*after, raw, m, 10s, [](const auto&) { return true; }));
   EXPECT_FALSE(m.present());

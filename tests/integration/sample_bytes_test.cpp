@@ -61,11 +61,12 @@ TEST(SampleBytes, ReadinessPaddingIsZerosAfterALongerSample) {
   dds::DdsContext service_side(pmu::test::exclusive_dds_domain(), "", "pmu-service-test");
   DdsPublisher publisher(service_side, 3s, "uav1");
   dds::DdsContext client(pmu::test::exclusive_dds_domain(), "", "reader-test");
-  DataReader& reader = client.reader(
-      client.topic(topics::kReadiness, TypeSupport(new RawSampleType<pmu::v5::ReadinessPubSubType>())),
-      qos_profiles::kState);
+  DataReader& reader =
+      client.reader(client.topic(topics::kReadiness, TypeSupport(new RawSampleType<pmu::v5::ReadinessPubSubType>())),
+                    qos_profiles::kState);
 
-  const auto long_one = readiness("battery_a_critical_voltage", "can_long_name", "battery A voltage critical: 18.2 V", 3);
+  const auto long_one =
+      readiness("battery_a_critical_voltage", "can_long_name", "battery A voltage critical: 18.2 V", 3);
   const auto short_one = readiness("ab", "c", "m", 3);
   // Long, long, short, short: whichever buffer the pool hands out, a short sample is
   // serialized into one that held a long one.

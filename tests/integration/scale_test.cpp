@@ -81,7 +81,7 @@ class Service {
 class Scale : public ::testing::Test {
  protected:
   void start() {
-    ::setenv("PMU_QOS_FILE", PMU_QOS_FILE, 1);  // pmuctl reads the same profiles as the service
+    ::setenv("PMU_QOS_FILE", PMU_QOS_FILE, 1);    // pmuctl reads the same profiles as the service
     domain_ = pmu::test::exclusive_dds_domain();  // this test process's own
     service_ = std::make_unique<Service>(domain_);
     ASSERT_TRUE(service_->started());

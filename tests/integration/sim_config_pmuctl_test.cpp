@@ -19,12 +19,14 @@ using namespace std::chrono_literals;
 
 TEST(SimConfigOverDds, StoppedEngineHotPmuAndSilentUnitAsConfigured) {
   const std::string domain = std::to_string(pmu::test::exclusive_dds_domain());
-  pmu::test::ConfiguredService service(PMU_SERVICE_PATH, "domain: " + domain + "\nqos_file: " PMU_QOS_FILE
-                                                         "\nbuses:\n  - interface: sim\n    devices:\n"
-                                                         "      - address: 1\n        period: 0.5\n"
-                                                         "        sim: {engine: stopped, internal_temperature: 95}\n"
-                                                         "      - address: 2\n        period: 0.5\n"
-                                                         "        sim: {silent: true}\n");
+  pmu::test::ConfiguredService service(PMU_SERVICE_PATH,
+                                       "domain: " + domain +
+                                           "\nqos_file: " PMU_QOS_FILE
+                                           "\nbuses:\n  - interface: sim\n    devices:\n"
+                                           "      - address: 1\n        period: 0.5\n"
+                                           "        sim: {engine: stopped, internal_temperature: 95}\n"
+                                           "      - address: 2\n        period: 0.5\n"
+                                           "        sim: {silent: true}\n");
   const std::string p = std::string(PMUCTL_PATH) + " --domain " + domain + " --json ";
 
   const auto watched = pmu::test::run_capture(p + "--timeout 30 --address 1 watch --count 10");

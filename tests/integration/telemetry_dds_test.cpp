@@ -52,16 +52,20 @@ bool wait_sample(DataReader& r, T& out, SampleInfo& info, std::chrono::milliseco
 
 struct Readers {
   explicit Readers(dds::DdsContext& c)
-      : voltages(c.reader(c.topic(topics::kVoltages, TypeSupport(new pmu::v5::VoltagesPubSubType())), qos_profiles::kTelemetry)),
-        currents(c.reader(c.topic(topics::kCurrents, TypeSupport(new pmu::v5::CurrentsPubSubType())), qos_profiles::kTelemetry)),
+      : voltages(c.reader(c.topic(topics::kVoltages, TypeSupport(new pmu::v5::VoltagesPubSubType())),
+                          qos_profiles::kTelemetry)),
+        currents(c.reader(c.topic(topics::kCurrents, TypeSupport(new pmu::v5::CurrentsPubSubType())),
+                          qos_profiles::kTelemetry)),
         energy(c.reader(c.topic(topics::kBatteryEnergy, TypeSupport(new pmu::v5::BatteryEnergyPubSubType())),
                         qos_profiles::kTelemetry)),
         temperatures(c.reader(c.topic(topics::kTemperatures, TypeSupport(new pmu::v5::TemperaturesPubSubType())),
                               qos_profiles::kTelemetry)),
-        status(c.reader(c.topic(topics::kStatus, TypeSupport(new pmu::v5::StatusPubSubType())), qos_profiles::kTelemetry)),
+        status(
+            c.reader(c.topic(topics::kStatus, TypeSupport(new pmu::v5::StatusPubSubType())), qos_profiles::kTelemetry)),
         config(c.reader(c.topic(topics::kConfig, TypeSupport(new pmu::v5::ConfigPubSubType())), qos_profiles::kState)),
         info(c.reader(c.topic(topics::kInfo, TypeSupport(new pmu::v5::DeviceInfoPubSubType())), qos_profiles::kState)),
-        health(c.reader(c.topic(topics::kHealth, TypeSupport(new pmu::v5::HealthPubSubType())), qos_profiles::kState)) {}
+        health(c.reader(c.topic(topics::kHealth, TypeSupport(new pmu::v5::HealthPubSubType())), qos_profiles::kState)) {
+  }
   DataReader& voltages;
   DataReader& currents;
   DataReader& energy;
@@ -147,29 +151,31 @@ TEST(DdsTelemetry, EveryTopicArrivesWithTheSimulatorsValuesAndFrameTimestamps) {
 TEST(DdsWriters, ReliableWritersHeartbeatNoMoreOftenThanTheLinkAllows) {
   const auto period_of = [](DataWriter& w) { return w.get_qos().reliable_writer_qos().times.heartbeatPeriod; };
   dds::DdsContext plain(pmu::test::exclusive_dds_domain(), "", "heartbeat-plain");
-  const auto shipped =
-      period_of(plain.writer(plain.topic(topics::kHealth, TypeSupport(new pmu::v5::HealthPubSubType())), qos_profiles::kState));
-  ASSERT_LT(shipped, eprosima::fastrtps::Duration_t(0, 900000000)) << "qos.xml's state period is not below the floor tested";
+  const auto shipped = period_of(
+      plain.writer(plain.topic(topics::kHealth, TypeSupport(new pmu::v5::HealthPubSubType())), qos_profiles::kState));
+  ASSERT_LT(shipped, eprosima::fastrtps::Duration_t(0, 900000000))
+      << "qos.xml's state period is not below the floor tested";
 
   dds::DdsContext radio(pmu::test::exclusive_dds_domain(), "", "heartbeat-radio");
   radio.heartbeat_at_least(900ms);
   auto& health =
       radio.writer(radio.topic(topics::kHealth, TypeSupport(new pmu::v5::HealthPubSubType())), qos_profiles::kState);
   EXPECT_EQ(period_of(health), eprosima::fastrtps::Duration_t(0, 900000000));
-  auto& replies = radio.writer(
-      radio.topic(topics::kCommandReply, TypeSupport(new pmu::v5::CommandReplyPubSubType())), qos_profiles::kCommand);
+  auto& replies = radio.writer(radio.topic(topics::kCommandReply, TypeSupport(new pmu::v5::CommandReplyPubSubType())),
+                               qos_profiles::kCommand);
   EXPECT_EQ(period_of(replies), eprosima::fastrtps::Duration_t(0, 900000000));
   // The rest of the profile is the profile's.
   EXPECT_EQ(health.get_qos().durability().kind, TRANSIENT_LOCAL_DURABILITY_QOS);
   EXPECT_EQ(health.get_qos().history().depth, 1);
   EXPECT_EQ(replies.get_qos().history().depth, 4096);
-  auto& voltages =
-      radio.writer(radio.topic(topics::kVoltages, TypeSupport(new pmu::v5::VoltagesPubSubType())), qos_profiles::kTelemetry);
+  auto& voltages = radio.writer(radio.topic(topics::kVoltages, TypeSupport(new pmu::v5::VoltagesPubSubType())),
+                                qos_profiles::kTelemetry);
   EXPECT_EQ(voltages.get_qos().reliability().kind, BEST_EFFORT_RELIABILITY_QOS);
   // A floor below the profile's period leaves it.
   dds::DdsContext lan(pmu::test::exclusive_dds_domain(), "", "heartbeat-lan");
   lan.heartbeat_at_least(1ms);
-  EXPECT_EQ(period_of(lan.writer(lan.topic(topics::kHealth, TypeSupport(new pmu::v5::HealthPubSubType())), qos_profiles::kState)),
+  EXPECT_EQ(period_of(lan.writer(lan.topic(topics::kHealth, TypeSupport(new pmu::v5::HealthPubSubType())),
+                                 qos_profiles::kState)),
             shipped);
 }
 
@@ -211,7 +217,8 @@ using pmu::test::run_capture;
 TEST(CrossProcess, ServiceOnSimulatedBusFeedsPmuctl) {
   const std::string domain = std::to_string(pmu::test::exclusive_dds_domain());
   pmu::test::Child service({PMU_SERVICE_PATH, "--bus", "sim", "--domain", domain, "--log-level", "warn"});
-  const auto watched = run_capture(std::string(PMUCTL_PATH) + " --domain " + domain + " watch --json --count 15 --timeout 20");
+  const auto watched =
+      run_capture(std::string(PMUCTL_PATH) + " --domain " + domain + " watch --json --count 15 --timeout 20");
   const std::string& out = watched.out;
   ASSERT_EQ(watched.status, 0) << out;
   std::set<std::string> topics;
@@ -229,7 +236,8 @@ TEST(CrossProcess, ServiceOnSimulatedBusFeedsPmuctl) {
   EXPECT_EQ(lines, 15u);
   EXPECT_EQ(topics, (std::set<std::string>{"voltages", "currents", "battery_energy", "temperatures", "status"}));
 
-  const auto listed = run_capture(std::string(PMUCTL_PATH) + " --domain " + domain + " --timeout 20 list --json");  // returns once seen
+  const auto listed =
+      run_capture(std::string(PMUCTL_PATH) + " --domain " + domain + " --timeout 20 list --json");  // returns once seen
   const std::string& list = listed.out;
   ASSERT_EQ(listed.status, 0) << list;
   const auto l = nlohmann::json::parse(list.substr(0, list.find('\n')));

@@ -65,7 +65,8 @@ class Discovery : public DomainParticipantListener {
     if (type) types_[topic.to_string()] = type;
   }
 
-  void on_participant_discovery(DomainParticipant*, eprosima::fastrtps::rtps::ParticipantDiscoveryInfo&& info) override {
+  void on_participant_discovery(DomainParticipant*,
+                                eprosima::fastrtps::rtps::ParticipantDiscoveryInfo&& info) override {
     std::lock_guard<std::mutex> lock(mutex_);
     names_[info.info.m_guid.guidPrefix] = info.info.m_participantName.to_string();
   }
@@ -171,7 +172,9 @@ pmu::test::Child start_service(int domain, const ConfigFile& config) {
 // domain, a participant of a tool that knows none of our types.
 struct ServiceAndTool {
   explicit ServiceAndTool(const std::string& extra)
-      : domain(pmu::test::exclusive_dds_domain()), config(sim_config(extra)), service(start_service(domain, config)),
+      : domain(pmu::test::exclusive_dds_domain()),
+        config(sim_config(extra)),
+        service(start_service(domain, config)),
         tool(domain) {}
   int domain;
   ConfigFile config;
@@ -181,9 +184,9 @@ struct ServiceAndTool {
 
 // Waits until the service's writers of `topics` have all been discovered (they come one by
 // one, in no fixed order), and returns the topics of its writers discovered by then.
-std::set<std::string> service_writer_topics(ToolParticipant& tool, const std::vector<std::string>& topics = {
-                                                                        "pmu/voltages", "pmu/health",
-                                                                        "pmu/command_reply"}) {
+std::set<std::string> service_writer_topics(ToolParticipant& tool,
+                                            const std::vector<std::string>& topics = {"pmu/voltages", "pmu/health",
+                                                                                      "pmu/command_reply"}) {
   std::set<std::string> found;
   EXPECT_TRUE(pmu::test::wait_until(
       [&] {
@@ -196,8 +199,8 @@ std::set<std::string> service_writer_topics(ToolParticipant& tool, const std::ve
 }
 
 // The contract's fields of pmu::v5::Voltages in order (interface.md 1.3): keys first.
-const std::vector<std::string> kVoltagesFields = {"vehicle",  "bus",       "address",   "avionics", "output_28v",
-                                                  "payload",  "servo",     "battery_a", "battery_b", "generator"};
+const std::vector<std::string> kVoltagesFields = {"vehicle", "bus",   "address",   "avionics",  "output_28v",
+                                                  "payload", "servo", "battery_a", "battery_b", "generator"};
 
 TEST(TypeObject, ReaderBuiltFromTheDiscoveredTypeDecodesVoltages) {
   ServiceAndTool run("dds_type_objects: true\n");
@@ -212,13 +215,25 @@ TEST(TypeObject, ReaderBuiltFromTheDiscoveredTypeDecodesVoltages) {
   // Type objects only of the self-contained types (dds_type_objects.hpp): a Fast DDS 2.9.1
   // participant that does not know our types, like this one, would drop the enum members of
   // Health, Command and CommandReply and crash on BatteryCells' sequence of BatteryCell.
-  const std::set<std::string> self_contained = {
-      "pmu/voltages", "pmu/currents", "pmu/battery_energy", "pmu/temperatures", "pmu/status",
-      "pmu/low_rate/voltages", "pmu/low_rate/currents", "pmu/low_rate/battery_energy", "pmu/low_rate/temperatures",
-      "pmu/low_rate/status", "pmu/config", "pmu/info", "pmu/battery", "pmu/mppt", "pmu/baseline", "pmu/bms_energy"};
+  const std::set<std::string> self_contained = {"pmu/voltages",
+                                                "pmu/currents",
+                                                "pmu/battery_energy",
+                                                "pmu/temperatures",
+                                                "pmu/status",
+                                                "pmu/low_rate/voltages",
+                                                "pmu/low_rate/currents",
+                                                "pmu/low_rate/battery_energy",
+                                                "pmu/low_rate/temperatures",
+                                                "pmu/low_rate/status",
+                                                "pmu/config",
+                                                "pmu/info",
+                                                "pmu/battery",
+                                                "pmu/mppt",
+                                                "pmu/baseline",
+                                                "pmu/bms_energy"};
   std::set<std::string> with_types;
-  EXPECT_TRUE(pmu::test::wait_until([&] { return (with_types = tool.discovery().topics_with_types()) == self_contained; },
-                                    30s));
+  EXPECT_TRUE(pmu::test::wait_until(
+      [&] { return (with_types = tool.discovery().topics_with_types()) == self_contained; }, 30s));
   // The writers without a type are announced too, and may come after the typed ones.
   (void)service_writer_topics(tool, {"pmu/health", "pmu/battery_cells", "pmu/command_reply"});
   EXPECT_EQ(tool.discovery().topics_with_types(), self_contained);

@@ -45,10 +45,12 @@ std::unique_ptr<VehicleService> vehicle_service(int domain, const std::string& v
 struct Ground {
   Ground(int domain, const std::string& name, dds::Partitions partitions)
       : dds(domain, "", name, {}, dds::Transport::Default, {}, std::move(partitions)),
-        writer(dds.writer(dds.topic(topics::kCommand, TypeSupport(new pmu::v5::CommandPubSubType())), qos_profiles::kCommand)),
+        writer(dds.writer(dds.topic(topics::kCommand, TypeSupport(new pmu::v5::CommandPubSubType())),
+                          qos_profiles::kCommand)),
         replies(dds.reader(dds.topic(topics::kCommandReply, TypeSupport(new pmu::v5::CommandReplyPubSubType())),
                            qos_profiles::kCommand)),
-        configs(dds.reader(dds.topic(topics::kConfig, TypeSupport(new pmu::v5::ConfigPubSubType())), qos_profiles::kState)),
+        configs(
+            dds.reader(dds.topic(topics::kConfig, TypeSupport(new pmu::v5::ConfigPubSubType())), qos_profiles::kState)),
         voltages(dds.reader(dds.topic(topics::kVoltages, TypeSupport(new pmu::v5::VoltagesPubSubType())),
                             qos_profiles::kTelemetry)) {}
 
@@ -111,7 +113,8 @@ struct Ground {
     return "; its pmu/config reader matched " + std::to_string(c.current_count) + " writers, its pmu/voltages reader " +
            std::to_string(v.current_count) + "; discovery reported " +
            std::to_string(dds.remote_writers().writers_of(topics::kConfig).size()) + " pmu/config writers and " +
-           std::to_string(dds.remote_writers().participants_without_writer(dds::kServiceParticipantName, topics::kConfig)) +
+           std::to_string(
+               dds.remote_writers().participants_without_writer(dds::kServiceParticipantName, topics::kConfig)) +
            " pmu-service participants without one";
   }
   static constexpr const char* kProbe = "probe-";
@@ -184,7 +187,8 @@ TEST_F(Vehicles, AGroundStationWithDefaultSettingsSeesEveryVehicleAndWhichSample
         pmu::v5::Config c;
         SampleInfo i;
         while (g.configs.take_next_sample(&c, &i) == ReturnCode_t::RETCODE_OK)
-          if (i.valid_data && c.bus().to_string() == "sim0" && c.address() == 1) config_vehicles.insert(c.vehicle().to_string());
+          if (i.valid_data && c.bus().to_string() == "sim0" && c.address() == 1)
+            config_vehicles.insert(c.vehicle().to_string());
         pmu::v5::Voltages v;
         while (g.voltages.take_next_sample(&v, &i) == ReturnCode_t::RETCODE_OK)
           if (i.valid_data) voltage_vehicles.insert(v.vehicle().to_string());

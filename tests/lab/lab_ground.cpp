@@ -74,7 +74,9 @@ double boottime() {
   return static_cast<double>(ts.tv_sec) + static_cast<double>(ts.tv_nsec) / 1e9;
 }
 
-double seconds_between(Clock::time_point a, Clock::time_point b) { return std::chrono::duration<double>(b - a).count(); }
+double seconds_between(Clock::time_point a, Clock::time_point b) {
+  return std::chrono::duration<double>(b - a).count();
+}
 
 // The service's names for its results; pmu::v5::CommandResult has the same order (static_assert
 // in service/endpoints/src/dds_commands.cpp). The names are literals, so data() ends in NUL.
@@ -94,17 +96,17 @@ struct BatchSpec {
   std::string tag = "cmd";
   long count = 1;
   int window = 8;
-  double resend = 0;      // s; 0: never
-  double timeout = 0;     // s; 0: none but the deadline
-  double deadline = 60;   // s
-  double expires_in = 0;  // s; 0: expires_at 0
-  double wait_match = 30; // s to wait for the service before the first send; 0: send at once
-  double at = 0;          // CLOCK_BOOTTIME s at which the batch starts (0: at once): the lab
-                          // schedules sends into a cut to the tenth of a second this way,
-                          // which its shell, on an emulated VM, could not
-  double rate = 15;       // new requests per second at most; 0: no cap. The service refuses
-                          // more than 20/s per PMU (policy rate_limit, burst 40); resends are
-                          // not counted there, so only new requests are paced.
+  double resend = 0;       // s; 0: never
+  double timeout = 0;      // s; 0: none but the deadline
+  double deadline = 60;    // s
+  double expires_in = 0;   // s; 0: expires_at 0
+  double wait_match = 30;  // s to wait for the service before the first send; 0: send at once
+  double at = 0;           // CLOCK_BOOTTIME s at which the batch starts (0: at once): the lab
+                           // schedules sends into a cut to the tenth of a second this way,
+                           // which its shell, on an emulated VM, could not
+  double rate = 15;        // new requests per second at most; 0: no cap. The service refuses
+                           // more than 20/s per PMU (policy rate_limit, burst 40); resends are
+                           // not counted there, so only new requests are paced.
   std::string parameter = "payload_voltage";
   std::vector<double> values{12.5, 13.5};
 };
@@ -124,13 +126,12 @@ struct Request {
 
 class Ground : public DataWriterListener, public DataReaderListener {
  public:
-  Ground(int domain, const std::string& qos_file, pmu::dds::Transport transport, std::string bus,
-         std::uint16_t address)
+  Ground(int domain, const std::string& qos_file, pmu::dds::Transport transport, std::string bus, std::uint16_t address)
       : dds_(domain, qos_file, "lab_ground", {}, transport), bus_(std::move(bus)), address_(address) {
     // The reader first: a reply can then never come before the reader exists.
-    replies_ = &dds_.reader(dds_.topic(pmu::topics::kCommandReply,
-                                       TypeSupport(new pmu::idl::Guarded<pmu::v5::CommandReplyPubSubType>())),
-                            pmu::qos_profiles::kCommand, this);
+    replies_ = &dds_.reader(
+        dds_.topic(pmu::topics::kCommandReply, TypeSupport(new pmu::idl::Guarded<pmu::v5::CommandReplyPubSubType>())),
+        pmu::qos_profiles::kCommand, this);
     writer_ = &dds_.writer(dds_.topic(pmu::topics::kCommand, TypeSupport(new pmu::v5::CommandPubSubType())),
                            pmu::qos_profiles::kCommand, this);
   }
@@ -146,14 +147,20 @@ class Ground : public DataWriterListener, public DataReaderListener {
 
   void on_publication_matched(DataWriter*, const PublicationMatchedStatus& s) override {
     writer_matched_ = s.current_count;
-    emit({{"event", "matched"}, {"endpoint", "commands"}, {"current", s.current_count},
-          {"change", s.current_count_change}, {"t", boottime()}});
+    emit({{"event", "matched"},
+          {"endpoint", "commands"},
+          {"current", s.current_count},
+          {"change", s.current_count_change},
+          {"t", boottime()}});
     wake_.notify_all();
   }
   void on_subscription_matched(DataReader*, const SubscriptionMatchedStatus& s) override {
     reader_matched_ = s.current_count;
-    emit({{"event", "matched"}, {"endpoint", "replies"}, {"current", s.current_count},
-          {"change", s.current_count_change}, {"t", boottime()}});
+    emit({{"event", "matched"},
+          {"endpoint", "replies"},
+          {"current", s.current_count},
+          {"change", s.current_count_change},
+          {"t", boottime()}});
     wake_.notify_all();
   }
   void on_data_available(DataReader* reader) override {
@@ -194,8 +201,8 @@ pmu::v5::Command Ground::make(const BatchSpec& spec, long n) const {
   c.value(spec.values[static_cast<std::size_t>(n - 1) % spec.values.size()]);
   c.confirm(false);
   if (spec.expires_in > 0) {
-    const auto at = std::chrono::system_clock::now() +
-                    std::chrono::duration_cast<std::chrono::system_clock::duration>(std::chrono::duration<double>(spec.expires_in));
+    const auto at = std::chrono::system_clock::now() + std::chrono::duration_cast<std::chrono::system_clock::duration>(
+                                                           std::chrono::duration<double>(spec.expires_in));
     c.expires_at(static_cast<std::uint64_t>(
         std::chrono::duration_cast<std::chrono::nanoseconds>(at.time_since_epoch()).count()));
   } else {
@@ -254,14 +261,17 @@ double percentile(const std::vector<double>& sorted, double p) {
 }
 
 Json Ground::run(const BatchSpec& spec) {
-  if (const double wait = spec.at - boottime(); wait > 0) std::this_thread::sleep_for(std::chrono::duration<double>(wait));
+  if (const double wait = spec.at - boottime(); wait > 0)
+    std::this_thread::sleep_for(std::chrono::duration<double>(wait));
   const auto start = Clock::now();
-  const auto deadline = start + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(spec.deadline));
+  const auto deadline =
+      start + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(spec.deadline));
   const double t_start = boottime();
   std::unique_lock<std::mutex> lock(mutex_);
   bool waited_for_match = true;
   if (spec.wait_match > 0) {
-    const auto until = start + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(spec.wait_match));
+    const auto until =
+        start + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(spec.wait_match));
     waited_for_match = wake_.wait_until(lock, until, [this] { return matched(); });
   }
   const double t_matched = boottime();
@@ -358,9 +368,12 @@ Json Ground::run(const BatchSpec& spec) {
          {"final_replies", finals},
          {"results", results},
          {"duplicates", duplicates_[spec.tag]},
-         {"rtt_ms", {{"min", ms(rtts.empty() ? 0.0 : rtts.front())}, {"p50", ms(percentile(rtts, 50))},
-                     {"p90", ms(percentile(rtts, 90))}, {"p99", ms(percentile(rtts, 99))},
-                     {"max", ms(rtts.empty() ? 0.0 : rtts.back())}}},
+         {"rtt_ms",
+          {{"min", ms(rtts.empty() ? 0.0 : rtts.front())},
+           {"p50", ms(percentile(rtts, 50))},
+           {"p90", ms(percentile(rtts, 90))},
+           {"p99", ms(percentile(rtts, 99))},
+           {"max", ms(rtts.empty() ? 0.0 : rtts.back())}}},
          {"no_reply", no_reply},
          {"client_timeouts", client_timeouts},
          {"value_mismatch", value_mismatch},
@@ -394,21 +407,35 @@ BatchSpec parse_batch_line(const std::string& line, BatchSpec spec) {
     const auto eq = word.find('=');
     if (eq == std::string::npos) throw std::invalid_argument("'" + word + "' is not key=value");
     const std::string key = word.substr(0, eq), value = word.substr(eq + 1);
-    if (key == "tag") spec.tag = value;
-    else if (key == "count") spec.count = std::stol(value);
-    else if (key == "window") spec.window = std::stoi(value);
-    else if (key == "resend") spec.resend = std::stod(value);
-    else if (key == "timeout") spec.timeout = std::stod(value);
-    else if (key == "deadline") spec.deadline = std::stod(value);
-    else if (key == "expires-in") spec.expires_in = std::stod(value);
-    else if (key == "wait-match") spec.wait_match = std::stod(value);
-    else if (key == "rate") spec.rate = std::stod(value);
-    else if (key == "at") spec.at = std::stod(value);
-    else if (key == "parameter") spec.parameter = value;
-    else if (key == "values") spec.values = parse_values(value);
-    else throw std::invalid_argument("unknown key '" + key + "'");
+    if (key == "tag")
+      spec.tag = value;
+    else if (key == "count")
+      spec.count = std::stol(value);
+    else if (key == "window")
+      spec.window = std::stoi(value);
+    else if (key == "resend")
+      spec.resend = std::stod(value);
+    else if (key == "timeout")
+      spec.timeout = std::stod(value);
+    else if (key == "deadline")
+      spec.deadline = std::stod(value);
+    else if (key == "expires-in")
+      spec.expires_in = std::stod(value);
+    else if (key == "wait-match")
+      spec.wait_match = std::stod(value);
+    else if (key == "rate")
+      spec.rate = std::stod(value);
+    else if (key == "at")
+      spec.at = std::stod(value);
+    else if (key == "parameter")
+      spec.parameter = value;
+    else if (key == "values")
+      spec.values = parse_values(value);
+    else
+      throw std::invalid_argument("unknown key '" + key + "'");
   }
-  if (spec.count < 1 || spec.window < 1 || spec.deadline <= 0) throw std::invalid_argument("count, window and deadline must be positive");
+  if (spec.count < 1 || spec.window < 1 || spec.deadline <= 0)
+    throw std::invalid_argument("count, window and deadline must be positive");
   if (spec.tag.empty() || spec.tag.size() > 40) throw std::invalid_argument("tag must be 1..40 characters");
   return spec;
 }
@@ -432,7 +459,8 @@ int main(int argc, char** argv) {
   app.add_option("--tag", spec.tag)->capture_default_str();
   app.add_option("--count", spec.count)->capture_default_str();
   app.add_option("--window", spec.window)->capture_default_str();
-  app.add_option("--resend", spec.resend, "Seconds without a final reply before a resend (0: never)")->capture_default_str();
+  app.add_option("--resend", spec.resend, "Seconds without a final reply before a resend (0: never)")
+      ->capture_default_str();
   app.add_option("--timeout", spec.timeout, "Seconds after the first send before the client gives up (0: none)")
       ->capture_default_str();
   app.add_option("--deadline", spec.deadline, "Seconds the batch may take")->capture_default_str();

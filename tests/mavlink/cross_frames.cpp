@@ -29,57 +29,88 @@ using nlohmann::json;
 json f32(float v) { return std::isnan(v) ? json("NaN") : json(static_cast<double>(v)); }
 
 json fields(const Heartbeat& m) {
-  return {{"type", m.type}, {"autopilot", m.autopilot}, {"base_mode", m.base_mode},
-          {"custom_mode", m.custom_mode}, {"system_status", m.system_status}, {"mavlink_version", m.mavlink_version}};
+  return {{"type", m.type},
+          {"autopilot", m.autopilot},
+          {"base_mode", m.base_mode},
+          {"custom_mode", m.custom_mode},
+          {"system_status", m.system_status},
+          {"mavlink_version", m.mavlink_version}};
 }
 json fields(const ParamRequestRead& m) {
-  return {{"target_system", m.target_system}, {"target_component", m.target_component},
-          {"param_id", m.param_id.substr(0, 16)}, {"param_index", m.param_index}};
+  return {{"target_system", m.target_system},
+          {"target_component", m.target_component},
+          {"param_id", m.param_id.substr(0, 16)},
+          {"param_index", m.param_index}};
 }
 json fields(const ParamRequestList& m) {
   return {{"target_system", m.target_system}, {"target_component", m.target_component}};
 }
 json fields(const ParamValue& m) {
-  return {{"param_id", m.param_id.substr(0, 16)}, {"param_value", f32(m.param_value)}, {"param_type", m.param_type},
-          {"param_count", m.param_count}, {"param_index", m.param_index}};
+  return {{"param_id", m.param_id.substr(0, 16)},
+          {"param_value", f32(m.param_value)},
+          {"param_type", m.param_type},
+          {"param_count", m.param_count},
+          {"param_index", m.param_index}};
 }
 json fields(const ParamSet& m) {
-  return {{"target_system", m.target_system}, {"target_component", m.target_component}, {"param_id", m.param_id.substr(0, 16)},
-          {"param_value", f32(m.param_value)}, {"param_type", m.param_type}};
+  return {{"target_system", m.target_system},
+          {"target_component", m.target_component},
+          {"param_id", m.param_id.substr(0, 16)},
+          {"param_value", f32(m.param_value)},
+          {"param_type", m.param_type}};
 }
 json fields(const CommandLong& m) {
-  json j = {{"target_system", m.target_system}, {"target_component", m.target_component},
-            {"command", m.command}, {"confirmation", m.confirmation}};
+  json j = {{"target_system", m.target_system},
+            {"target_component", m.target_component},
+            {"command", m.command},
+            {"confirmation", m.confirmation}};
   for (std::size_t i = 0; i < m.param.size(); ++i) j["param" + std::to_string(i + 1)] = f32(m.param[i]);
   return j;
 }
 json fields(const CommandAck& m) {
-  return {{"command", m.command}, {"result", m.result}, {"progress", m.progress},
-          {"result_param2", m.result_param2}, {"target_system", m.target_system},
+  return {{"command", m.command},
+          {"result", m.result},
+          {"progress", m.progress},
+          {"result_param2", m.result_param2},
+          {"target_system", m.target_system},
           {"target_component", m.target_component}};
 }
 json fields(const BatteryStatus& m) {
-  return {{"id", m.id}, {"battery_function", m.battery_function}, {"type", m.type},
-          {"temperature", m.temperature}, {"voltages", m.voltages}, {"current_battery", m.current_battery},
-          {"current_consumed", m.current_consumed}, {"energy_consumed", m.energy_consumed},
-          {"battery_remaining", m.battery_remaining}, {"time_remaining", m.time_remaining},
-          {"charge_state", m.charge_state}, {"voltages_ext", m.voltages_ext}, {"mode", m.mode},
+  return {{"id", m.id},
+          {"battery_function", m.battery_function},
+          {"type", m.type},
+          {"temperature", m.temperature},
+          {"voltages", m.voltages},
+          {"current_battery", m.current_battery},
+          {"current_consumed", m.current_consumed},
+          {"energy_consumed", m.energy_consumed},
+          {"battery_remaining", m.battery_remaining},
+          {"time_remaining", m.time_remaining},
+          {"charge_state", m.charge_state},
+          {"voltages_ext", m.voltages_ext},
+          {"mode", m.mode},
           {"fault_bitmask", m.fault_bitmask}};
 }
 json fields(const Statustext& m) {
-  return {{"severity", m.severity}, {"text", m.text.substr(0, Statustext::kTextLength)}, {"id", m.id}, {"chunk_seq", m.chunk_seq}};
+  return {{"severity", m.severity},
+          {"text", m.text.substr(0, Statustext::kTextLength)},
+          {"id", m.id},
+          {"chunk_seq", m.chunk_seq}};
 }
 json fields(const GeneratorStatus& m) {
-  return {{"status", std::to_string(m.status)}, {"generator_speed", m.generator_speed},
-          {"battery_current", f32(m.battery_current)}, {"load_current", f32(m.load_current)},
-          {"power_generated", f32(m.power_generated)}, {"bus_voltage", f32(m.bus_voltage)},
-          {"rectifier_temperature", m.rectifier_temperature}, {"bat_current_setpoint", f32(m.bat_current_setpoint)},
-          {"generator_temperature", m.generator_temperature}, {"runtime", m.runtime},
+  return {{"status", std::to_string(m.status)},
+          {"generator_speed", m.generator_speed},
+          {"battery_current", f32(m.battery_current)},
+          {"load_current", f32(m.load_current)},
+          {"power_generated", f32(m.power_generated)},
+          {"bus_voltage", f32(m.bus_voltage)},
+          {"rectifier_temperature", m.rectifier_temperature},
+          {"bat_current_setpoint", f32(m.bat_current_setpoint)},
+          {"generator_temperature", m.generator_temperature},
+          {"runtime", m.runtime},
           {"time_until_maintenance", m.time_until_maintenance}};
 }
-json fields(const RelayStatus& m) {
-  return {{"time_boot_ms", m.time_boot_ms}, {"on", m.on}, {"present", m.present}};
-}
+json fields(const RelayStatus& m) { return {{"time_boot_ms", m.time_boot_ms}, {"on", m.on}, {"present", m.present}}; }
 
 std::string hex(const std::vector<std::uint8_t>& bytes) {
   static const char* digits = "0123456789abcdef";

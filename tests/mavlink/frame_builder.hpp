@@ -13,8 +13,8 @@
 namespace pmu::mavlink::test {
 
 inline std::vector<std::uint8_t> raw_v2(std::uint32_t msgid, const std::vector<std::uint8_t>& payload,
-                                        std::uint8_t crc_extra, std::uint8_t incompat = 0,
-                                        std::uint8_t sysid = 1, std::uint8_t compid = 1, std::uint8_t seq = 0) {
+                                        std::uint8_t crc_extra, std::uint8_t incompat = 0, std::uint8_t sysid = 1,
+                                        std::uint8_t compid = 1, std::uint8_t seq = 0) {
   std::vector<std::uint8_t> out{0xFD,
                                 static_cast<std::uint8_t>(payload.size()),
                                 incompat,

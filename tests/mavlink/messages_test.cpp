@@ -252,9 +252,9 @@ TEST(MavlinkMessages, SenderWithoutExtensionsReadsAsZero) {
   // COMMAND_ACK and BATTERY_STATUS as a sender with the definitions before <extensions/>
   // sends them: the base payload only.
   Parser parser;
-  const auto results = parse_all(
-      parser, test::concat({raw_v2(msgid::kCommandAck, {0xDF, 0x00, mav_result::kFailed}, 143),
-                            raw_v2(msgid::kBatteryStatus, std::vector<std::uint8_t>(36, 0x01), 154)}));
+  const auto results =
+      parse_all(parser, test::concat({raw_v2(msgid::kCommandAck, {0xDF, 0x00, mav_result::kFailed}, 143),
+                                      raw_v2(msgid::kBatteryStatus, std::vector<std::uint8_t>(36, 0x01), 154)}));
   ASSERT_EQ(results.size(), 2U);
   const auto ack = decode<CommandAck>(std::get<Frame>(results[0]));
   ASSERT_TRUE(ack.has_value());

@@ -161,23 +161,39 @@ std::vector<std::uint8_t> bad_crc_frame() {
 
 std::vector<BadInputCase> bad_inputs() {
   std::vector<BadInputCase> cases;
-  cases.push_back({"garbage without start marker", {0x00, 0x11, 0x22, 0x33}, 0, RejectReason::bad_crc,
-                   {0, 0, 0, 0, 0, 4}, 0});
+  cases.push_back(
+      {"garbage without start marker", {0x00, 0x11, 0x22, 0x33}, 0, RejectReason::bad_crc, {0, 0, 0, 0, 0, 4}, 0});
   cases.push_back({"bad CRC", bad_crc_frame(), 1, RejectReason::bad_crc, {0, 1, 0, 0, 0, 20}, 0});
   // A start marker in garbage whose length byte claims a long frame: the good frames behind
   // it are found once the claimed frame fails its CRC.
-  cases.push_back({"false start marker with a long length", {0xFD, 30, 0, 0, 0, 1, 1, 0, 0, 0},
-                   1, RejectReason::bad_crc, {0, 1, 0, 0, 0, 9}, 0});
+  cases.push_back({"false start marker with a long length",
+                   {0xFD, 30, 0, 0, 0, 1, 1, 0, 0, 0},
+                   1,
+                   RejectReason::bad_crc,
+                   {0, 1, 0, 0, 0, 9},
+                   0});
   // ATTITUDE (30): no CRC_EXTRA here, skipped whole, even with a start marker inside.
-  cases.push_back({"unknown message id", raw_v2(30, {0xFD, 0x09, 0, 0, 0, 1, 1, 0, 0, 0, 1, 2, 3}, 39), 1,
-                   RejectReason::unknown_message, {0, 0, 1, 0, 0, 0}, 0});
-  cases.push_back({"unknown incompat flag", raw_v2(msgid::kHeartbeat, {1, 2, 3, 4, 5, 6, 7, 8, 9}, 50, 0x02), 1,
-                   RejectReason::unsupported_incompat_flags, {0, 0, 0, 1, 0, 20}, 0});
-  cases.push_back({"MAVLink 1 heartbeat", raw_v1(0, {0, 0, 0, 0, 2, 3, 0x51, 4, 3}, 50), 1, RejectReason::mavlink1,
-                   {0, 0, 0, 0, 1, 0}, 0});
+  cases.push_back({"unknown message id",
+                   raw_v2(30, {0xFD, 0x09, 0, 0, 0, 1, 1, 0, 0, 0, 1, 2, 3}, 39),
+                   1,
+                   RejectReason::unknown_message,
+                   {0, 0, 1, 0, 0, 0},
+                   0});
+  cases.push_back({"unknown incompat flag",
+                   raw_v2(msgid::kHeartbeat, {1, 2, 3, 4, 5, 6, 7, 8, 9}, 50, 0x02),
+                   1,
+                   RejectReason::unsupported_incompat_flags,
+                   {0, 0, 0, 1, 0, 20},
+                   0});
+  cases.push_back({"MAVLink 1 heartbeat",
+                   raw_v1(0, {0, 0, 0, 0, 2, 3, 0x51, 4, 3}, 50),
+                   1,
+                   RejectReason::mavlink1,
+                   {0, 0, 0, 0, 1, 0},
+                   0});
   // A 0xFE that is no MAVLink 1 frame (its CRC fails): garbage, one byte at a time.
-  cases.push_back({"0xFE in garbage", {0xFE, 3, 0, 1, 1, 0, 1, 2, 3, 0xEE, 0xEE}, 0, RejectReason::bad_crc,
-                   {0, 0, 0, 0, 0, 11}, 0});
+  cases.push_back(
+      {"0xFE in garbage", {0xFE, 3, 0, 1, 1, 0, 1, 2, 3, 0xEE, 0xEE}, 0, RejectReason::bad_crc, {0, 0, 0, 0, 0, 11}, 0});
   return cases;
 }
 

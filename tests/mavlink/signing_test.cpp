@@ -66,7 +66,7 @@ TEST(MavlinkSigning, SignedFrameCarriesLinkTimestampAndFlag) {
 TEST(MavlinkSigning, OutgoingTimestampsStrictlyIncrease) {
   SigningLink signer(key_of(1), 0);
   EXPECT_EQ(signer.next_timestamp(kNow), kNow);
-  EXPECT_EQ(signer.next_timestamp(kNow), kNow + 1);  // same clock reading: one more
+  EXPECT_EQ(signer.next_timestamp(kNow), kNow + 1);        // same clock reading: one more
   EXPECT_EQ(signer.next_timestamp(kNow - 500), kNow + 2);  // clock stepped back
   EXPECT_EQ(signer.next_timestamp(kNow + 100), kNow + 100);
 }
@@ -146,7 +146,8 @@ TEST(MavlinkSigning, ReplayAndStaleRules) {
     std::uint64_t replays = 0;
     std::uint64_t stale = 0;
     for (const auto& s : steps) {
-      const Frame f = signed_frame(s.sysid, s.compid, s.link, static_cast<std::uint64_t>(static_cast<std::int64_t>(kNow) + s.offset));
+      const Frame f = signed_frame(s.sysid, s.compid, s.link,
+                                   static_cast<std::uint64_t>(static_cast<std::int64_t>(kNow) + s.offset));
       EXPECT_EQ(link.verify(f, kNow), s.expected) << to_string(s.expected);
       replays += s.expected == Verdict::replayed ? 1 : 0;
       stale += s.expected == Verdict::stale ? 1 : 0;

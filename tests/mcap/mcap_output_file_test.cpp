@@ -66,8 +66,8 @@ Snapshot snapshot(const std::string& dir) {
 std::string describe(const Snapshot& s) {
   std::string out;
   for (const auto& [name, e] : s)
-    out += name + "(type " + std::to_string(e.type) + ", inode " + std::to_string(e.inode) + ", \"" + e.content +
-           "\") ";
+    out +=
+        name + "(type " + std::to_string(e.type) + ", inode " + std::to_string(e.inode) + ", \"" + e.content + "\") ";
   return out;
 }
 
@@ -110,12 +110,12 @@ enum class Then { Replaced, Streamed, StreamFull, Refused };
 
 struct Case {
   const char* kind;
-  bool root;                 // needs root (mknod of a device)
+  bool root;                                                             // needs root (mknod of a device)
   std::function<void(const std::string& dir, FifoReader& reader)> make;  // makes dir/out
-  const char* path;          // relative to dir
+  const char* path;                                                      // relative to dir
   Then then;
-  const char* written;       // the file that gets the bytes (Replaced), relative to dir
-  const char* refusal;       // part of open()'s message (Refused)
+  const char* written;  // the file that gets the bytes (Replaced), relative to dir
+  const char* refusal;  // part of open()'s message (Refused)
 };
 
 const std::string kOld = "the operator's own bytes";
@@ -154,10 +154,14 @@ const Case kCases[] = {
      [](const std::string& d, FifoReader&) { ASSERT_EQ(::mkfifo((d + "/out").c_str(), 0644), 0); }, "out",
      Then::Refused, "", "out is a FIFO that nobody reads"},
     {"character device (null)", true,
-     [](const std::string& d, FifoReader&) { ASSERT_EQ(::mknod((d + "/out").c_str(), S_IFCHR | 0666, makedev(1, 3)), 0); },
+     [](const std::string& d, FifoReader&) {
+       ASSERT_EQ(::mknod((d + "/out").c_str(), S_IFCHR | 0666, makedev(1, 3)), 0);
+     },
      "out", Then::Streamed, "", ""},
     {"character device (full)", true,
-     [](const std::string& d, FifoReader&) { ASSERT_EQ(::mknod((d + "/out").c_str(), S_IFCHR | 0666, makedev(1, 7)), 0); },
+     [](const std::string& d, FifoReader&) {
+       ASSERT_EQ(::mknod((d + "/out").c_str(), S_IFCHR | 0666, makedev(1, 7)), 0);
+     },
      "out", Then::StreamFull, "", ""},
     {"symlink to a character device", true,
      [](const std::string& d, FifoReader&) {
@@ -166,7 +170,9 @@ const Case kCases[] = {
      },
      "out", Then::Streamed, "", ""},
     {"block device", true,
-     [](const std::string& d, FifoReader&) { ASSERT_EQ(::mknod((d + "/out").c_str(), S_IFBLK | 0660, makedev(7, 0)), 0); },
+     [](const std::string& d, FifoReader&) {
+       ASSERT_EQ(::mknod((d + "/out").c_str(), S_IFBLK | 0660, makedev(7, 0)), 0);
+     },
      "out", Then::Refused, "", "out is a block device"},
     {"socket", false, [](const std::string& d, FifoReader&) { make_socket(d + "/out"); }, "out", Then::Refused, "",
      "out is a socket"},
@@ -184,14 +190,16 @@ const Case kCases[] = {
      "out", Then::Refused, "", "is a directory"},
     {"missing folder", false, [](const std::string&, FifoReader&) {}, "no/such/out", Then::Refused, "",
      "cannot create "},
-    {"folder is a file", false, [](const std::string& d, FifoReader&) { write_file(d + "/file", kOld); },
-     "file/out", Then::Refused, "", "Not a directory"},
+    {"folder is a file", false, [](const std::string& d, FifoReader&) { write_file(d + "/file", kOld); }, "file/out",
+     Then::Refused, "", "Not a directory"},
 };
 
 enum class Ending { Commit, Discard, Drop };
 
 void run_case(const Case& c, Ending ending) {
-  SCOPED_TRACE(std::string(c.kind) + (ending == Ending::Commit ? ", committed" : ending == Ending::Discard ? ", discarded" : ", dropped"));
+  SCOPED_TRACE(std::string(c.kind) + (ending == Ending::Commit    ? ", committed"
+                                      : ending == Ending::Discard ? ", discarded"
+                                                                  : ", dropped"));
   TempDir dir;
   FifoReader reader;
   c.make(dir.path, reader);
@@ -229,8 +237,10 @@ void run_case(const Case& c, Ending ending) {
     EXPECT_EQ(it->second.type, static_cast<mode_t>(S_IFREG));
     EXPECT_EQ(it->second.content, kNew);
     const auto was = before.find(c.written);
-    if (was != before.end()) after[c.written] = was->second;
-    else after.erase(it);
+    if (was != before.end())
+      after[c.written] = was->second;
+    else
+      after.erase(it);
   }
   if (c.then == Then::Streamed && std::string(c.kind).find("FIFO") != std::string::npos) {
     std::string got(2 * kNew.size() + 1, '\0');

@@ -27,7 +27,10 @@ using pmu::mcap::Bytes;
 Bytes hex(const std::string& h) {
   Bytes b;
   for (std::size_t i = 0; i + 1 < h.size();) {
-    if (h[i] == ' ') { ++i; continue; }
+    if (h[i] == ' ') {
+      ++i;
+      continue;
+    }
     b.push_back(static_cast<std::uint8_t>(std::stoul(h.substr(i, 2), nullptr, 16)));
     i += 2;
   }
@@ -51,28 +54,61 @@ struct RecordCase {
 
 const RecordCase kRecords[] = {
     {"Header: profile \"\", library \"x\"",
-     [] { Bytes b; pmu::mcap::append_header(b, "", "x"); return b; },
+     [] {
+       Bytes b;
+       pmu::mcap::append_header(b, "", "x");
+       return b;
+     },
      "01 0900000000000000 00000000 01000000 78"},
     {"Schema: id 1, name a, encoding omgidl, data \"s\"",
-     [] { Bytes b; pmu::mcap::append_schema(b, {1, "a", "omgidl", "s"}); return b; },
+     [] {
+       Bytes b;
+       pmu::mcap::append_schema(b, {1, "a", "omgidl", "s"});
+       return b;
+     },
      "03 1600000000000000 0100 01000000 61 06000000 6f6d6769646c 01000000 73"},
     {"Channel: id 2, schema 1, topic t, cdr, no metadata",
-     [] { Bytes b; pmu::mcap::append_channel(b, {2, 1, "t", "cdr", {}}); return b; },
+     [] {
+       Bytes b;
+       pmu::mcap::append_channel(b, {2, 1, "t", "cdr", {}});
+       return b;
+     },
      "04 1400000000000000 0200 0100 01000000 74 03000000 636472 00000000"},
     {"Message: channel 2, sequence 3, log 4, publish 5, data AB",
-     [] { Bytes b; const std::uint8_t d[] = {0xAB}; pmu::mcap::append_message(b, 2, 3, 4, 5, d, 1); return b; },
+     [] {
+       Bytes b;
+       const std::uint8_t d[] = {0xAB};
+       pmu::mcap::append_message(b, 2, 3, 4, 5, d, 1);
+       return b;
+     },
      "05 1700000000000000 0200 03000000 0400000000000000 0500000000000000 ab"},
     {"MessageIndex: channel 1, (7, 0)",
-     [] { Bytes b; pmu::mcap::append_message_index(b, 1, {{7, 0}}); return b; },
+     [] {
+       Bytes b;
+       pmu::mcap::append_message_index(b, 1, {{7, 0}});
+       return b;
+     },
      "07 1600000000000000 0100 10000000 0700000000000000 0000000000000000"},
     {"DataEnd: crc 0x01020304",
-     [] { Bytes b; pmu::mcap::append_data_end(b, 0x01020304); return b; },
+     [] {
+       Bytes b;
+       pmu::mcap::append_data_end(b, 0x01020304);
+       return b;
+     },
      "0f 0400000000000000 04030201"},
     {"SummaryOffset: group 0x03 at 16, 32 bytes",
-     [] { Bytes b; pmu::mcap::append_summary_offset(b, 0x03, 16, 32); return b; },
+     [] {
+       Bytes b;
+       pmu::mcap::append_summary_offset(b, 0x03, 16, 32);
+       return b;
+     },
      "0e 1100000000000000 03 1000000000000000 2000000000000000"},
     {"Footer without summary and CRC",
-     [] { Bytes b; pmu::mcap::append_footer(b, 0, 0, 0, false); return b; },
+     [] {
+       Bytes b;
+       pmu::mcap::append_footer(b, 0, 0, 0, false);
+       return b;
+     },
      "02 1400000000000000 0000000000000000 0000000000000000 00000000"},
 };
 
@@ -104,7 +140,8 @@ struct Reader {
   }
   std::string str(std::size_t& pos) const {
     const auto n = get<std::uint32_t>(pos);
-    std::string s(b.begin() + static_cast<std::ptrdiff_t>(pos + 4), b.begin() + static_cast<std::ptrdiff_t>(pos + 4 + n));
+    std::string s(b.begin() + static_cast<std::ptrdiff_t>(pos + 4),
+                  b.begin() + static_cast<std::ptrdiff_t>(pos + 4 + n));
     pos += 4 + n;
     return s;
   }
@@ -164,8 +201,9 @@ Parsed parse(const Bytes& b) {
   Parsed p;
   EXPECT_GE(b.size(), 8u);
   EXPECT_EQ(std::memcmp(b.data(), pmu::mcap::kMagic, 8), 0);
-  walk(b, 8, b.size() >= 16 && std::memcmp(b.data() + b.size() - 8, pmu::mcap::kMagic, 8) == 0 ? b.size() - 8 : b.size(),
-       p, true);
+  walk(b, 8,
+       b.size() >= 16 && std::memcmp(b.data() + b.size() - 8, pmu::mcap::kMagic, 8) == 0 ? b.size() - 8 : b.size(), p,
+       true);
   return p;
 }
 
@@ -192,12 +230,11 @@ TEST(McapWriter, RoundTripWithSummaryAndFooter) {
   EXPECT_EQ(p.messages[1].log_time, 50u);
   EXPECT_EQ(p.messages[0].data, std::string("\x01\x02", 2));
   EXPECT_TRUE(p.footer);
-  const std::vector<std::uint8_t> expected_ops = {pmu::mcap::kHeader,  pmu::mcap::kChunk,      pmu::mcap::kMessageIndex,
-                                                  pmu::mcap::kMessageIndex, pmu::mcap::kDataEnd, pmu::mcap::kSchema,
-                                                  pmu::mcap::kChannel, pmu::mcap::kChannel,    pmu::mcap::kStatistics,
-                                                  pmu::mcap::kChunkIndex, pmu::mcap::kSummaryOffset,
-                                                  pmu::mcap::kSummaryOffset, pmu::mcap::kSummaryOffset,
-                                                  pmu::mcap::kSummaryOffset, pmu::mcap::kFooter};
+  const std::vector<std::uint8_t> expected_ops = {
+      pmu::mcap::kHeader,        pmu::mcap::kChunk,         pmu::mcap::kMessageIndex,  pmu::mcap::kMessageIndex,
+      pmu::mcap::kDataEnd,       pmu::mcap::kSchema,        pmu::mcap::kChannel,       pmu::mcap::kChannel,
+      pmu::mcap::kStatistics,    pmu::mcap::kChunkIndex,    pmu::mcap::kSummaryOffset, pmu::mcap::kSummaryOffset,
+      pmu::mcap::kSummaryOffset, pmu::mcap::kSummaryOffset, pmu::mcap::kFooter};
   EXPECT_EQ(p.opcodes, expected_ops);
   // The summary starts with the Schema copy, right after DataEnd (13 bytes).
   EXPECT_EQ(sink.bytes.at(p.summary_start), pmu::mcap::kSchema);

@@ -66,7 +66,8 @@ TEST(AgentRequest, EveryMalformedRequestIsRefusedWithItsReason) {
        "the count of environment variables 'x' is not a number of the strings that follow"},
       {"a count beyond the strings", nul({"pmuctl-agent-2", "1", "call", "/", "2", "PMU_VEHICLE=a"}),
        "the count of environment variables '2' is not a number of the strings that follow"},
-      {"a variable pmuctl does not read", nul({"pmuctl-agent-2", "1", "call", "/", "1", "LD_PRELOAD=/tmp/x.so", "list"}),
+      {"a variable pmuctl does not read",
+       nul({"pmuctl-agent-2", "1", "call", "/", "1", "LD_PRELOAD=/tmp/x.so", "list"}),
        "environment entry 1 is not NAME=VALUE of a variable pmuctl reads"},
       {"an entry without =", nul({"pmuctl-agent-2", "1", "call", "/", "1", "PMU_VEHICLE", "list"}),
        "environment entry 1 is not NAME=VALUE of a variable pmuctl reads"},
@@ -88,9 +89,9 @@ TEST(AgentRequest, TooManyStringsAreRefused) {
 }
 
 TEST(AgentReply, SurvivesItsEncodingAndAnythingElseIsNotAReply) {
-  for (const AgentReply& r : {AgentReply{true, 0, "", false, ""}, AgentReply{true, 3, "", false, ""},
-                              AgentReply{false, 0, "why not", false, ""},
-                              AgentReply{false, 0, "", true, "its wait ended first"}}) {
+  for (const AgentReply& r :
+       {AgentReply{true, 0, "", false, ""}, AgentReply{true, 3, "", false, ""},
+        AgentReply{false, 0, "why not", false, ""}, AgentReply{false, 0, "", true, "its wait ended first"}}) {
     const auto back = pmu::tools::decode_reply(pmu::tools::encode_reply(r));
     ASSERT_TRUE(back);
     EXPECT_EQ(back->ran, r.ran);
@@ -114,7 +115,10 @@ TEST(AgentSocket, DefaultsToTheUsersRuntimeDirectoryElseRun) {
   EXPECT_EQ(pmu::tools::agent_socket_path(0), "/run/pmu-dds/agent-0.sock");
   ::setenv("PMU_AGENT_SOCKET", "/tmp/a.sock", 1);
   EXPECT_EQ(pmu::tools::agent_socket_path(0), "/tmp/a.sock");
-  if (saved_socket) ::setenv("PMU_AGENT_SOCKET", keep_socket.c_str(), 1); else ::unsetenv("PMU_AGENT_SOCKET");
+  if (saved_socket)
+    ::setenv("PMU_AGENT_SOCKET", keep_socket.c_str(), 1);
+  else
+    ::unsetenv("PMU_AGENT_SOCKET");
   if (saved_run) ::setenv("XDG_RUNTIME_DIR", keep_run.c_str(), 1);
 }
 

@@ -37,13 +37,13 @@ bool bind_socket(const std::string& path) {
 
 struct PathCase {
   const char* what;
-  bool needs_root;       // makes files of another user
+  bool needs_root;  // makes files of another user
   mode_t folder_mode;
-  uid_t folder_owner;    // 0: this process's user
-  const char* at_path;   // "socket", "file" or "nothing"
+  uid_t folder_owner;   // 0: this process's user
+  const char* at_path;  // "socket", "file" or "nothing"
   mode_t socket_mode;
   uid_t socket_owner;
-  const char* why;       // "" trusted; else what the message says (the folder's path follows "folder ")
+  const char* why;  // "" trusted; else what the message says (the folder's path follows "folder ")
 };
 
 TEST(AgentTrust, OnlyAFolderAndSocketOfTheCallerOrRootAreTrusted) {
@@ -141,9 +141,8 @@ TEST(AgentTrust, AListenerOfTheCallerOrRootIsTrustedOfAnotherUserNot) {
   const Listener other{listen_as(theirs, kOther)};
   fd = connect_when_listened(theirs);
   ASSERT_TRUE(fd);
-  EXPECT_EQ(pmu::tools::untrusted_peer(fd.get(), 0),
-            "the process that listens (pid " + std::to_string(other.pid) +
-                ") runs as uid 65534, not as this user (uid 0) or root");
+  EXPECT_EQ(pmu::tools::untrusted_peer(fd.get(), 0), "the process that listens (pid " + std::to_string(other.pid) +
+                                                         ") runs as uid 65534, not as this user (uid 0) or root");
 }
 
 }  // namespace

@@ -33,10 +33,14 @@ TEST(ClientBacklog, TheHeaderExample) {
 }
 
 TEST(ClientBacklog, SendsUpToTheLimitExactly) {
-  struct Case { std::size_t queued, size; bool send; };
+  struct Case {
+    std::size_t queued, size;
+    bool send;
+  };
   const Case cases[] = {
-      {0, 10, true}, {990, 10, true}, {991, 10, false}, {1000, 0, true}, {1000, 1, false},
-      {0, 5000, true},  // larger than the limit, but nothing waits: it goes
+      {0, 10, true},    {990, 10, true},
+      {991, 10, false}, {1000, 0, true},
+      {1000, 1, false}, {0, 5000, true},  // larger than the limit, but nothing waits: it goes
       {1, 5000, false}, {static_cast<std::size_t>(-1), 1, false},
   };
   for (const auto& c : cases) {

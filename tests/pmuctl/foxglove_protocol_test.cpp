@@ -43,7 +43,10 @@ TEST(FoxgloveProtocol, TimeIsOpcodeTwoAndNanosecondsLittleEndian) {
 }
 
 TEST(FoxgloveProtocol, SubprotocolIsTheFirstOfferedThatTheServerSpeaks) {
-  struct Case { std::vector<std::string> offered; std::string_view chosen; };
+  struct Case {
+    std::vector<std::string> offered;
+    std::string_view chosen;
+  };
   const Case cases[] = {
       {{"foxglove.websocket.v1"}, "foxglove.websocket.v1"},
       {{"foxglove.sdk.v1"}, "foxglove.sdk.v1"},
@@ -58,7 +61,8 @@ TEST(FoxgloveProtocol, SubprotocolIsTheFirstOfferedThatTheServerSpeaks) {
 
 TEST(FoxgloveProtocol, AdvertiseListsEveryChannelAsCdrWithOmgIdlSchema) {
   const std::string_view idl = "module pmu { struct Voltages { float avionics; }; };";
-  const json j = parsed(advertise_json({{0, "pmu/voltages", "pmu::v5::Voltages", idl}, {5, "pmu/health", "pmu::v5::Health", "x"}}));
+  const json j = parsed(
+      advertise_json({{0, "pmu/voltages", "pmu::v5::Voltages", idl}, {5, "pmu/health", "pmu::v5::Health", "x"}}));
   EXPECT_EQ(j["op"], "advertise");
   ASSERT_EQ(j["channels"].size(), 2u);
   const json& c = j["channels"][0];
@@ -73,7 +77,10 @@ TEST(FoxgloveProtocol, AdvertiseListsEveryChannelAsCdrWithOmgIdlSchema) {
 }
 
 TEST(FoxgloveProtocol, StatusCarriesLevelNumberAndMessage) {
-  struct Case { StatusLevel level; int number; };
+  struct Case {
+    StatusLevel level;
+    int number;
+  };
   for (const Case c : {Case{StatusLevel::Info, 0}, Case{StatusLevel::Warning, 1}, Case{StatusLevel::Error, 2}}) {
     const json j = parsed(status_json(c.level, "dropped 3"));
     EXPECT_EQ(j["op"], "status");
@@ -89,8 +96,8 @@ TEST(FoxgloveProtocol, MessageDataLayout) {
   // spec "Message Data": opcode 0x01, uint32 LE subscription id, uint64 LE timestamp, payload.
   const std::uint8_t payload[] = {0x00, 0x01, 0x00, 0x00, 0xAB};
   const std::string frame = message_data(7, 1700000000123456789ull, payload, sizeof payload);
-  const std::vector<std::uint8_t> want = {0x01, 0x07, 0x00, 0x00, 0x00, 0x15, 0xCD, 0x85, 0x3D, 0xFE,
-                                          0x9C, 0x97, 0x17, 0x00, 0x01, 0x00, 0x00, 0xAB};
+  const std::vector<std::uint8_t> want = {0x01, 0x07, 0x00, 0x00, 0x00, 0x15, 0xCD, 0x85, 0x3D,
+                                          0xFE, 0x9C, 0x97, 0x17, 0x00, 0x01, 0x00, 0x00, 0xAB};
   ASSERT_EQ(frame.size(), kMessageDataHeaderSize + sizeof payload);
   EXPECT_EQ(std::vector<std::uint8_t>(frame.begin(), frame.end()), want);
   // Every byte of the id and time lands where the spec says.
@@ -135,7 +142,8 @@ TEST(FoxgloveProtocol, RefusesMalformedRequestsWithAReason) {
       {"{\"op\":\"subscribe\",\"subscriptions\":[{\"channelId\":1}]}", "subscriptions[0].id is missing"},
       {"{\"op\":\"subscribe\",\"subscriptions\":[{\"id\":1,\"channelId\":1},{\"id\":2}]}",
        "subscriptions[1].channelId is missing"},
-      {"{\"op\":\"subscribe\",\"subscriptions\":[{\"id\":-1,\"channelId\":1}]}", ".id must be an integer 0..4294967295, not -1"},
+      {"{\"op\":\"subscribe\",\"subscriptions\":[{\"id\":-1,\"channelId\":1}]}",
+       ".id must be an integer 0..4294967295, not -1"},
       {"{\"op\":\"subscribe\",\"subscriptions\":[{\"id\":1.5,\"channelId\":1}]}", ".id must be an integer"},
       {"{\"op\":\"subscribe\",\"subscriptions\":[{\"id\":4294967296,\"channelId\":1}]}", ".id must be an integer"},
       {"{\"op\":\"subscribe\",\"subscriptions\":[{\"id\":\"1\",\"channelId\":1}]}", "not \"1\""},
@@ -165,7 +173,8 @@ TEST(FoxgloveProtocol, BinaryClientMessagesAreRefused) {
 
 TEST(ClientSubscriptions, SubscribeMapsChannelsToTheClientsIds) {
   ClientSubscriptions s(3);
-  EXPECT_TRUE(s.on_text(R"({"op":"subscribe","subscriptions":[{"id":10,"channelId":2},{"id":11,"channelId":0}]})").empty());
+  EXPECT_TRUE(
+      s.on_text(R"({"op":"subscribe","subscriptions":[{"id":10,"channelId":2},{"id":11,"channelId":0}]})").empty());
   EXPECT_EQ(s.subscription(2), 10u);
   EXPECT_EQ(s.subscription(0), 11u);
   EXPECT_FALSE(s.subscription(1));
@@ -202,7 +211,8 @@ TEST(ClientSubscriptions, AnswersEachRefusedPartWithAStatus) {
   EXPECT_EQ(j["message"], "no subscription 42 to end");
 
   // Good parts of a request are kept beside refused ones.
-  const auto replies = s.on_text(R"({"op":"subscribe","subscriptions":[{"id":5,"channelId":9},{"id":6,"channelId":1}]})");
+  const auto replies =
+      s.on_text(R"({"op":"subscribe","subscriptions":[{"id":5,"channelId":9},{"id":6,"channelId":1}]})");
   EXPECT_EQ(replies.size(), 1u);
   EXPECT_EQ(s.subscription(1), 6u);
   EXPECT_EQ(s.count(), 2u);
@@ -211,8 +221,9 @@ TEST(ClientSubscriptions, AnswersEachRefusedPartWithAStatus) {
 TEST(ClientSubscriptions, MalformedMessagesChangeNothingAndAreAnsweredWithAnError) {
   ClientSubscriptions s(2);
   ASSERT_TRUE(s.on_text(R"({"op":"subscribe","subscriptions":[{"id":1,"channelId":0}]})").empty());
-  for (const char* text : {"nonsense", "{\"op\":\"subscribe\",\"subscriptions\":[{\"id\":2,\"channelId\":1},{\"id\":-3}]}",
-                           "{\"op\":\"unsubscribe\",\"subscriptionIds\":[1,\"x\"]}", "{\"op\":\"setParameters\"}"}) {
+  for (const char* text :
+       {"nonsense", "{\"op\":\"subscribe\",\"subscriptions\":[{\"id\":2,\"channelId\":1},{\"id\":-3}]}",
+        "{\"op\":\"unsubscribe\",\"subscriptionIds\":[1,\"x\"]}", "{\"op\":\"setParameters\"}"}) {
     const json j = only_status(s.on_text(text));
     EXPECT_EQ(j["level"], 2) << text;
     EXPECT_FALSE(j["message"].get<std::string>().empty());

@@ -18,9 +18,18 @@ using Json = nlohmann::ordered_json;
 std::string dumped(const Json& j) { return j.dump(-1, ' ', false, Json::error_handler_t::replace) + "\n"; }
 
 TEST(JsonLine, NumbersAreFormattedAsNlohmannFormatsThem) {
-  const double table[] = {0.0,     -0.0,     1.0,      -1.0,        12.3,    16.8,   -4.0,  0.1,  1e-5,
-                          1.5e-4,  123456.7, 1e15,     1e16,        1.7e308, 5e-324, 25.2,  48.4, 1700000000.000131,
-                          1700000000.0, 0.30000000000000004, -273.15, 65535.0, 2.5e-7};
+  const double table[] = {0.0,          -0.0,
+                          1.0,          -1.0,
+                          12.3,         16.8,
+                          -4.0,         0.1,
+                          1e-5,         1.5e-4,
+                          123456.7,     1e15,
+                          1e16,         1.7e308,
+                          5e-324,       25.2,
+                          48.4,         1700000000.000131,
+                          1700000000.0, 0.30000000000000004,
+                          -273.15,      65535.0,
+                          2.5e-7};
   for (const double v : table) {
     std::string out;
     JsonLine(out).number("v", v).end();
@@ -31,7 +40,8 @@ TEST(JsonLine, NumbersAreFormattedAsNlohmannFormatsThem) {
 }
 
 TEST(JsonLine, NonFiniteNumbersAreNull) {
-  for (const double v : {std::nan(""), std::numeric_limits<double>::infinity(), -std::numeric_limits<double>::infinity()}) {
+  for (const double v :
+       {std::nan(""), std::numeric_limits<double>::infinity(), -std::numeric_limits<double>::infinity()}) {
     std::string out;
     JsonLine(out).number("v", v).end();
     EXPECT_EQ(out, "{\"v\":null}\n");

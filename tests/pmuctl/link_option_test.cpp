@@ -14,14 +14,16 @@
 namespace {
 
 pmu::dds::NetworkLookup no_lookup() {
-  return {[] { return std::vector<pmu::dds::LocalAddress>{}; }, [](const std::string&) { return std::vector<std::string>{}; }};
+  return {[] { return std::vector<pmu::dds::LocalAddress>{}; },
+          [](const std::string&) { return std::vector<std::string>{}; }};
 }
 
 // PMU_LINK set (or unset) for one case, and the other network variables unset.
 class Environment {
  public:
   explicit Environment(const char* link) {
-    for (const char* name : {"PMU_DDS_PEERS", "PMU_DISCOVERY_SERVER", "PMU_DDS_INTERFACES", "PMU_LINK"}) ::unsetenv(name);
+    for (const char* name : {"PMU_DDS_PEERS", "PMU_DISCOVERY_SERVER", "PMU_DDS_INTERFACES", "PMU_LINK"})
+      ::unsetenv(name);
     if (link) ::setenv("PMU_LINK", link, 1);
   }
   ~Environment() { ::unsetenv("PMU_LINK"); }

@@ -8,7 +8,10 @@ namespace pmu::tools {
 namespace {
 
 TEST(OriginPolicy, DefaultAllowsTheViewersLocalPagesAndNativeClients) {
-  struct Case { const char* origin; bool allowed; };
+  struct Case {
+    const char* origin;
+    bool allowed;
+  };
   const Case cases[] = {
       {"", true},  // no Origin header: not a browser
       {"https://app.foxglove.dev", true},
@@ -36,7 +39,11 @@ TEST(OriginPolicy, DefaultAllowsTheViewersLocalPagesAndNativeClients) {
 }
 
 TEST(OriginPolicy, AllowOriginAddsExactlyThatOrigin) {
-  struct Case { const char* typed; const char* allows; const char* not_allows; };
+  struct Case {
+    const char* typed;
+    const char* allows;
+    const char* not_allows;
+  };
   const Case cases[] = {
       {"https://viz.example.com:8443", "https://viz.example.com:8443", "https://viz.example.com"},
       {"https://Viz.Example.com", "https://viz.example.com", "https://viz.example.com:8443"},
@@ -64,7 +71,10 @@ TEST(OriginPolicy, StarAllowsEveryOriginNullIncluded) {
 }
 
 TEST(OriginPolicy, MalformedValuesAreRefusedNamingTheOption) {
-  struct Case { const char* typed; const char* says; };
+  struct Case {
+    const char* typed;
+    const char* says;
+  };
   const Case cases[] = {
       {"viz.example.com", "--allow-origin 'viz.example.com' is not an origin scheme://host[:port]"},
       {"https://viz.example.com/", "no path, not even a final /"},

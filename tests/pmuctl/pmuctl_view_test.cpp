@@ -103,7 +103,12 @@ TEST(PmuctlView, EveryTableValueHasItsUnit) {
       {"table 2", fields_of(voltages()), "generator", "0.4 V"},
       {"table 3", fields_of(currents()), "avionics", "1.5 A"},
       {"table 3", fields_of(currents()), "battery_a", "-2.5 A"},
-      {"table 4", fields_of([] { pmu::v5::BatteryEnergy e; e.battery_a_mah(-120); return e; }()), "battery_a_mah", "-120 mAh"},
+      {"table 4", fields_of([] {
+         pmu::v5::BatteryEnergy e;
+         e.battery_a_mah(-120);
+         return e;
+       }()),
+       "battery_a_mah", "-120 mAh"},
       {"table 5", fields_of(temperatures()), "internal", "31.0 degC"},
       {"table 5", fields_of(temperatures()), "starter", "-49.0 degC"},
       {"table 6", fields_of(status(6000)), "generator_rpm", "6000 rpm"},
@@ -169,11 +174,19 @@ TEST(PmuctlView, SentinelsAreWordsInTablesAndNullInJson) {
       {"table 6: NaN = no reading", fields_of(status(kNaN)), "generator_rpm", "no reading"},
       {"health: NaN = never", fields_of(health(kNaN)), "last_frame_age", "never"},
       {"battery: NaN received = not discharging", fields_of(battery(kNaN)), "time_to_go", "n/a (not discharging)"},
-      {"battery: time_to_go not received", fields_of([] { auto b = battery(kNaN); b.received(0xFFFF & ~(1u << 5)); return b; }()),
+      {"battery: time_to_go not received", fields_of([] {
+         auto b = battery(kNaN);
+         b.received(0xFFFF & ~(1u << 5));
+         return b;
+       }()),
        "time_to_go", "-"},
       {"battery: float not received", fields_of(none_received), "voltage", "-"},
       {"battery: integer not received", fields_of(none_received), "bms_state", "-"},
-      {"battery: NaN with its bit set", fields_of([] { auto b = battery(600); b.voltage(kNaN); return b; }()),
+      {"battery: NaN with its bit set", fields_of([] {
+         auto b = battery(600);
+         b.voltage(kNaN);
+         return b;
+       }()),
        "voltage", "-"},
       {"mppt: flag not received", fields_of(mppt_none), "pwm_enabled", "-"},
       {"mppt: raw count not received", fields_of(mppt()), "voltage_out_sw_raw", "-"},
@@ -268,9 +281,9 @@ TEST(PmuctlView, ConfigSetReadsMaskNamesAndNumbers) {
       {"outputs", "charger_a,charger_b", 0x0C, nullptr},
       {"avionics_voltage", "12.5", 12.5, nullptr},
       {"cranking_time", "0", 0, nullptr},
-      {"power_up_state", "avionics_servo,foo",
-       0, "power_up_state: unknown name 'foo' in 'avionics_servo,foo' (avionics_servo, payload, charger_a, charger_b, "
-          "battery_disconnect_detect, payload_shedding, soa_management, none, or a number 0..0x7F)"},
+      {"power_up_state", "avionics_servo,foo", 0,
+       "power_up_state: unknown name 'foo' in 'avionics_servo,foo' (avionics_servo, payload, charger_a, charger_b, "
+       "battery_disconnect_detect, payload_shedding, soa_management, none, or a number 0..0x7F)"},
       {"packets_streamed", "-1", 0,
        "packets_streamed: '-1' is not a mask (voltages, currents, battery_energy, temperatures, status, none, or a "
        "number 0..0x1F)"},
@@ -316,10 +329,10 @@ TEST(PmuctlView, WatchRowsSayHealthAndAge) {
     const char* text;
   };
   const std::vector<Row> rows = {
-      {pmu::v5::ONLINE, 0.2, "ONLINE 0.2s"},  {pmu::v5::STALE, 3.04, "STALE 3.0s"},
+      {pmu::v5::ONLINE, 0.2, "ONLINE 0.2s"},    {pmu::v5::STALE, 3.04, "STALE 3.0s"},
       {pmu::v5::OFFLINE, 9.06, "OFFLINE 9.1s"}, {pmu::v5::OFFLINE, 42, "OFFLINE 42s"},
-      {pmu::v5::OFFLINE, 720, "OFFLINE 12m"}, {pmu::v5::OFFLINE, 72000, "OFFLINE 20h"},
-      {std::nullopt, 1, "UNKNOWN 1.0s"},  {pmu::v5::ONLINE, -0.5, "ONLINE 0.0s"},
+      {pmu::v5::OFFLINE, 720, "OFFLINE 12m"},   {pmu::v5::OFFLINE, 72000, "OFFLINE 20h"},
+      {std::nullopt, 1, "UNKNOWN 1.0s"},        {pmu::v5::ONLINE, -0.5, "ONLINE 0.0s"},
   };
   for (const auto& r : rows) EXPECT_EQ(freshness(r.state, r.age), r.text);
   EXPECT_EQ(row_values(fields_of(temperatures())),
@@ -331,9 +344,10 @@ TEST(PmuctlView, WatchRowsSayHealthAndAge) {
 TEST(PmuctlView, WatchTableHasOneLinePerDeviceAndTopic) {
   pmu::v5::BatteryEnergy e;
   e.battery_a_mah(-1200), e.battery_b_mah(850);
-  const auto lines = watch_table({{"uav1/can0/1", "battery_energy", pmu::v5::ONLINE, 0.2, fields_of(e)},
-                                  {"uav1/can0/battery2", "battery_cells", std::nullopt, 1.0, fields_of(battery_cells())},
-                                  {"uav1/can0/2", "battery_energy", pmu::v5::OFFLINE, 9.06, fields_of(e)}});
+  const auto lines =
+      watch_table({{"uav1/can0/1", "battery_energy", pmu::v5::ONLINE, 0.2, fields_of(e)},
+                   {"uav1/can0/battery2", "battery_cells", std::nullopt, 1.0, fields_of(battery_cells())},
+                   {"uav1/can0/2", "battery_energy", pmu::v5::OFFLINE, 9.06, fields_of(e)}});
   const std::vector<std::string> want = {
       "battery_energy:",
       "uav1/can0/1  ONLINE   0.2s  battery_a_mah=-1200mAh battery_b_mah=850mAh",

@@ -23,7 +23,7 @@ TEST(Ros2Topics, NamesTheServiceWrites) {
       {"rt/uav1/can0/pmu_1/battery_b", "rt/uav1/can0/pmu_1/battery_b", kRos2BatteryType},
       {"/fleet/uav1/can0/bms_2/battery", "rt/fleet/uav1/can0/bms_2/battery", kRos2BatteryType},
       {"/can0/pmu_1/battery_a", "rt/can0/pmu_1/battery_a", kRos2BatteryType},  // the unnamed vehicle
-      {"diagnostics", nullptr, nullptr},  // a contract name's form
+      {"diagnostics", nullptr, nullptr},                                       // a contract name's form
       {"voltages", nullptr, nullptr},
       {"pmu/voltages", nullptr, nullptr},
       {"/uav1/can0/pmu_1/voltage", nullptr, nullptr},

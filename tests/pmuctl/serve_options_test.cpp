@@ -8,7 +8,10 @@ namespace pmu::tools {
 namespace {
 
 TEST(ServeOptions, Accepted) {
-  struct Case { const char *listen, *port, *queue, *label; std::size_t queue_bytes; };
+  struct Case {
+    const char *listen, *port, *queue, *label;
+    std::size_t queue_bytes;
+  };
   const Case cases[] = {
       {"127.0.0.1", "8765", "1024", "127.0.0.1:8765", 1024 * 1024},
       {"0.0.0.0", "1", "64", "0.0.0.0:1", 64 * 1024},
@@ -24,7 +27,9 @@ TEST(ServeOptions, Accepted) {
 }
 
 TEST(ServeOptions, RefusedWithTheOptionNamed) {
-  struct Case { const char *listen, *port, *queue, *says; };
+  struct Case {
+    const char *listen, *port, *queue, *says;
+  };
   const Case cases[] = {
       {"localhost", "8765", "1024", "--listen 'localhost' is not an IP address"},
       {"", "8765", "1024", "--listen '' is not an IP address"},
@@ -50,13 +55,19 @@ TEST(ServeOptions, RefusedWithTheOptionNamed) {
 }
 
 TEST(ServeOptions, AccessOptions) {
-  struct Case { std::vector<std::string> origins; const char *cert, *key, *says; };
+  struct Case {
+    std::vector<std::string> origins;
+    const char *cert, *key, *says;
+  };
   const Case cases[] = {
       {{}, "", "", ""},
       {{"https://viz.example.com", "*"}, "c.pem", "k.pem", ""},
       {{"viz.example.com"}, "", "", "--allow-origin 'viz.example.com' is not an origin"},
-      {{}, "c.pem", "", "--tls-cert and --tls-key go together (the certificate chain and its private key, PEM): "
-                        "--tls-key is missing"},
+      {{},
+       "c.pem",
+       "",
+       "--tls-cert and --tls-key go together (the certificate chain and its private key, PEM): "
+       "--tls-key is missing"},
       {{}, "", "k.pem", "--tls-cert is missing"},
   };
   for (const auto& c : cases) {
@@ -74,7 +85,10 @@ TEST(ServeOptions, AccessOptions) {
 }
 
 TEST(ServeOptions, LoopbackAddresses) {
-  struct Case { const char* listen; bool loopback; };
+  struct Case {
+    const char* listen;
+    bool loopback;
+  };
   for (const Case c : {Case{"127.0.0.1", true}, Case{"127.1.2.3", true}, Case{"::1", true}, Case{"0.0.0.0", false},
                        Case{"::", false}, Case{"192.168.1.5", false}, Case{"::ffff:127.0.0.1", false}}) {
     ServeOptions o;

@@ -29,12 +29,15 @@ const Case kCases[] = {
     {"one service: settled 300 ms after its burst",
      {{0, 1, 0, false}, {100, 1, 1, false}, {399, 1, 1, false}, {400, 1, 1, true}}},
     {"two services, the second heard 700 ms after the first: not settled in between",
-     {{0, 2, 0, false}, {50, 2, 1, false}, {350, 2, 1, false}, {700, 2, 1, false}, {750, 2, 2, false},
+     {{0, 2, 0, false},
+      {50, 2, 1, false},
+      {350, 2, 1, false},
+      {700, 2, 1, false},
+      {750, 2, 2, false},
       {1050, 2, 2, true}}},
     {"a second service discovered after the first was heard: the quiet time starts again",
      {{0, 1, 1, false}, {250, 2, 1, false}, {560, 2, 1, false}, {600, 2, 2, false}, {900, 2, 2, true}}},
-    {"expected but silent (no state yet): never settled",
-     {{0, 1, 0, false}, {1000, 1, 0, false}, {5000, 1, 0, false}}},
+    {"expected but silent (no state yet): never settled", {{0, 1, 0, false}, {1000, 1, 0, false}, {5000, 1, 0, false}}},
     {"nothing expected: never settled", {{0, 0, 0, false}, {5000, 0, 0, false}}},
     {"a heard service left: the rest suffices",
      {{0, 2, 2, false}, {300, 2, 2, true}, {400, 1, 2, false}, {700, 1, 2, true}}},
@@ -48,8 +51,8 @@ TEST(StateSettle, WaitsForEveryMatchedServiceAndAQuietTime) {
     for (const auto& st : c.steps) {
       const auto t = t0 + std::chrono::milliseconds(st.at_ms);
       s.observe(t, st.expected, st.heard);
-      EXPECT_EQ(s.settled(t), st.settled) << "at " << st.at_ms << " ms, expected " << st.expected << ", heard "
-                                          << st.heard;
+      EXPECT_EQ(s.settled(t), st.settled)
+          << "at " << st.at_ms << " ms, expected " << st.expected << ", heard " << st.heard;
     }
   }
 }

@@ -69,8 +69,8 @@ TEST(TargetMemory, OnlyTheServicesNotSeenOfThatDeviceSaysItIsGone) {
   const Target at{"can0", 1};
   for (const auto& r : std::initializer_list<Row>{
            {"device 1 not seen on can0", true},
-           {"device 7 not seen on can0", false},   // another device
-           {"device 1 not seen on can1", false},   // another bus
+           {"device 7 not seen on can0", false},  // another device
+           {"device 1 not seen on can1", false},  // another bus
            {"device 1 on can0 is not ready: its firmware and configuration have not been read yet", false},
            {"expired before it could be sent", false},
            {"", false},

@@ -50,7 +50,10 @@ TEST(DiagnosticsPace, AChangeIsWrittenAtOnceAndAnUnchangedReportAtMostOnceASecon
   };
   const std::vector<Case> cases{
       {"a device added is written; its unchanged reports within the second are not",
-       {{0ms, Event::Added, true}, {300ms, Event::Same, false}, {999ms, Event::Same, false}, {1000ms, Event::Same, true}}},
+       {{0ms, Event::Added, true},
+        {300ms, Event::Same, false},
+        {999ms, Event::Same, false},
+        {1000ms, Event::Same, true}}},
       {"a level change is written at once, in the middle of the second",
        {{0ms, Event::Added, true}, {400ms, Event::LevelChanged, true}, {500ms, Event::LevelChanged, true}}},
       {"a message change at the same level is written at once",
@@ -58,21 +61,30 @@ TEST(DiagnosticsPace, AChangeIsWrittenAtOnceAndAnUnchangedReportAtMostOnceASecon
       {"a device gone is written at once",
        {{0ms, Event::Added, true}, {100ms, Event::Same, false}, {150ms, Event::Gone, true}}},
       {"a change writes every device's status: the next unchanged array is a second after it",
-       {{0ms, Event::Added, true}, {600ms, Event::LevelChanged, true}, {1000ms, Event::Same, false},
-        {1599ms, Event::Same, false}, {1600ms, Event::Same, true}}},
+       {{0ms, Event::Added, true},
+        {600ms, Event::LevelChanged, true},
+        {1000ms, Event::Same, false},
+        {1599ms, Event::Same, false},
+        {1600ms, Event::Same, true}}},
       {"a second device added is a change a reader sees",
        {{0ms, Event::Added, true}, {10ms, Event::Added, true}, {20ms, Event::Same, false}}},
       {"reports a little under a second apart keep one array a second",
-       {{0ms, Event::Added, true}, {990ms, Event::Same, false}, {1980ms, Event::Same, true},
-        {2970ms, Event::Same, true}, {3960ms, Event::Same, true}, {4950ms, Event::Same, true}}},
+       {{0ms, Event::Added, true},
+        {990ms, Event::Same, false},
+        {1980ms, Event::Same, true},
+        {2970ms, Event::Same, true},
+        {3960ms, Event::Same, true},
+        {4950ms, Event::Same, true}}},
       {"after a silence the second starts again from the report that ends it, with no burst",
-       {{0ms, Event::Added, true}, {5000ms, Event::Same, true}, {5500ms, Event::Same, false},
-        {5999ms, Event::Same, false}, {6000ms, Event::Same, true}}},
+       {{0ms, Event::Added, true},
+        {5000ms, Event::Same, true},
+        {5500ms, Event::Same, false},
+        {5999ms, Event::Same, false},
+        {6000ms, Event::Same, true}}},
   };
   for (const auto& c : cases) {
     DiagnosticsPace pace;
-    for (const auto& s : c.steps)
-      EXPECT_EQ(apply(pace, s), s.written) << c.what << ", at " << s.time.count() << " ms";
+    for (const auto& s : c.steps) EXPECT_EQ(apply(pace, s), s.written) << c.what << ", at " << s.time.count() << " ms";
   }
 }
 

@@ -91,7 +91,10 @@ TEST(Ros2Qos, StateWriterMatchesRos2DefaultReader) {
 
   PublicationMatchedStatus matched;
   ASSERT_TRUE(pmu::test::wait_until(
-      [&] { return writer->get_publication_matched_status(matched) == ReturnCode_t::RETCODE_OK && matched.current_count == 1; },
+      [&] {
+        return writer->get_publication_matched_status(matched) == ReturnCode_t::RETCODE_OK &&
+               matched.current_count == 1;
+      },
       10s))
       << "the ROS 2 default reader did not match";
   OfferedIncompatibleQosStatus incompatible;

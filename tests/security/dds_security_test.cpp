@@ -63,9 +63,9 @@ using namespace eprosima::fastdds::dds;
 using namespace std::chrono_literals;
 using Clock = std::chrono::steady_clock;
 using dds::SecurityFiles;
+using security_test::allowed;
 using security_test::Pki;
 using security_test::sh;
-using security_test::allowed;
 using security_test::write_config;
 
 // ---- the service, in-process ------------------------------------------------------------
@@ -102,7 +102,8 @@ struct Client {
   }
   DataReader& config() {
     if (!config_)
-      config_ = &dds.reader(dds.topic(topics::kConfig, TypeSupport(new pmu::v5::ConfigPubSubType())), qos_profiles::kState);
+      config_ =
+          &dds.reader(dds.topic(topics::kConfig, TypeSupport(new pmu::v5::ConfigPubSubType())), qos_profiles::kState);
     return *config_;
   }
   DataWriter& commands() {
@@ -159,7 +160,8 @@ pmu::v5::Command command(const std::string& id, const std::string& bus = "sim0",
   return c;
 }
 
-std::optional<pmu::v5::CommandReply> wait_reply(DataReader& r, const std::string& id, std::chrono::milliseconds timeout) {
+std::optional<pmu::v5::CommandReply> wait_reply(DataReader& r, const std::string& id,
+                                                std::chrono::milliseconds timeout) {
   std::optional<pmu::v5::CommandReply> found;
   pmu::test::wait_until(
       [&] {
@@ -220,9 +222,9 @@ void expect_ground_station_commands(ServiceUnderTest& svc, Client& gs, const std
 // What an intruder achieved in 4 s of listening to telemetry and sending commands (switch
 // the payload off), next to a legitimate reader.
 struct Intrusion {
-  int good_samples = 0;     // telemetry the legitimate reader got meanwhile
-  int stolen_samples = 0;   // telemetry the intruder got
-  int writer_matches = 0;   // the intruder's command writer matched the service's reader
+  int good_samples = 0;        // telemetry the legitimate reader got meanwhile
+  int stolen_samples = 0;      // telemetry the intruder got
+  int writer_matches = 0;      // the intruder's command writer matched the service's reader
   std::uint64_t received = 0;  // commands the command service received
   bool outputs_changed = false;
   bool pmu_handled_something = false;
@@ -233,7 +235,7 @@ Intrusion intrude(ServiceUnderTest& svc, Client& intruder, Client& good) {
   DataReader& stolen = intruder.voltages();
   DataWriter& writer = intruder.commands();
   EXPECT_TRUE(wait_sample<pmu::v5::Voltages>(good.voltages(), 20s)) << "the legitimate reader got no telemetry: "
-                                                                   "the service is not reachable at all";
+                                                                       "the service is not reachable at all";
   EXPECT_TRUE(wait_sample<pmu::v5::Config>(good.config(), 10s)) << "no pmu/config: the service's start-up is not done";
   // Meant to let time pass (kept as it was): the intruder's discovery and handshake attempts
   // run before the "before" figures are taken; there is nothing to wait for, since it must
@@ -281,8 +283,10 @@ struct TopicInfo {
 const TopicInfo kTopics[] = {
     {topics::kVoltages, [] { return TypeSupport(new pmu::v5::VoltagesPubSubType()); }, qos_profiles::kTelemetry},
     {topics::kCurrents, [] { return TypeSupport(new pmu::v5::CurrentsPubSubType()); }, qos_profiles::kTelemetry},
-    {topics::kBatteryEnergy, [] { return TypeSupport(new pmu::v5::BatteryEnergyPubSubType()); }, qos_profiles::kTelemetry},
-    {topics::kTemperatures, [] { return TypeSupport(new pmu::v5::TemperaturesPubSubType()); }, qos_profiles::kTelemetry},
+    {topics::kBatteryEnergy, [] { return TypeSupport(new pmu::v5::BatteryEnergyPubSubType()); },
+     qos_profiles::kTelemetry},
+    {topics::kTemperatures, [] { return TypeSupport(new pmu::v5::TemperaturesPubSubType()); },
+     qos_profiles::kTelemetry},
     {topics::kStatus, [] { return TypeSupport(new pmu::v5::StatusPubSubType()); }, qos_profiles::kTelemetry},
     {topics::kConfig, [] { return TypeSupport(new pmu::v5::ConfigPubSubType()); }, qos_profiles::kState},
     {topics::kInfo, [] { return TypeSupport(new pmu::v5::DeviceInfoPubSubType()); }, qos_profiles::kState},
@@ -290,13 +294,14 @@ const TopicInfo kTopics[] = {
     {topics::kCommand, [] { return TypeSupport(new pmu::v5::CommandPubSubType()); }, qos_profiles::kCommand},
     {topics::kCommandReply, [] { return TypeSupport(new pmu::v5::CommandReplyPubSubType()); }, qos_profiles::kCommand},
     {topics::kAlarmAck, [] { return TypeSupport(new pmu::v5::AlarmAckPubSubType()); }, qos_profiles::kCommand},
-    {topics::kAlarmAckReply, [] { return TypeSupport(new pmu::v5::AlarmAckReplyPubSubType()); }, qos_profiles::kCommand},
+    {topics::kAlarmAckReply, [] { return TypeSupport(new pmu::v5::AlarmAckReplyPubSubType()); },
+     qos_profiles::kCommand},
 };
 
 TEST(Permissions, EveryIdentityMayCreateExactlyTheWritersAndReadersTheContractAllows) {
   for (const char* identity : {"pmu-service", "ground-station", "mission-computer"}) {
-    dds::DdsContext p(pmu::test::exclusive_dds_domain(), "", std::string("matrix-") + identity, Pki::get().files(identity),
-                      dds::Transport::UdpOnly);
+    dds::DdsContext p(pmu::test::exclusive_dds_domain(), "", std::string("matrix-") + identity,
+                      Pki::get().files(identity), dds::Transport::UdpOnly);
     for (const auto& t : kTopics) {
       Topic& topic = p.topic(t.name, t.type());
       for (const bool publish : {true, false}) {
@@ -381,8 +386,7 @@ TEST(SecureDds, ExpiredCertificateIsRejected) {
   for (const auto validity : {5s, 20s, 60s}) {
     const auto now = std::chrono::system_clock::now();
     expiry = now + validity;
-    const std::string expiring =
-        Pki::get().window("expiring-" + std::to_string(validity.count()), now - 60s, expiry);
+    const std::string expiring = Pki::get().window("expiring-" + std::to_string(validity.count()), now - 60s, expiry);
     try {
       intruder = std::make_unique<Client>(domain, dds::security_files_in(expiring, "ground-station"),
                                           "expired-ground-station");
@@ -495,9 +499,10 @@ TEST(SecureDds, Cve202324010WithOneCaTheSelfSignedPermissionsWouldBeAccepted) {
   EXPECT_GT(r.stolen_samples, 0);
   EXPECT_GT(r.received, 0u);
   EXPECT_TRUE(r.outputs_changed) << "the intruder's command should have switched the payload off";
-  std::printf("CVE-2023-24010 reproduced with one CA: the intruder got %d telemetry samples, the service took %llu "
-              "of its commands\n",
-              r.stolen_samples, static_cast<unsigned long long>(r.received));
+  std::printf(
+      "CVE-2023-24010 reproduced with one CA: the intruder got %d telemetry samples, the service took %llu "
+      "of its commands\n",
+      r.stolen_samples, static_cast<unsigned long long>(r.received));
 }
 
 // ---- the wire ------------------------------------------------------------------------------
@@ -690,8 +695,8 @@ TEST(ServiceProgram, UnicastDiscoveryKeepsSecurityAndServerModeIsRefusedWithIt) 
 // ---- vehicles: permissions confine an identity to some vehicles (docs/interface.md 7.1) -------
 
 pmu::test::RunResult pmuctl(const std::string& pki, const std::string& args) {
-  return sh(std::string(PMUCTL_PATH) + " --domain " + std::to_string(pmu::test::exclusive_dds_domain()) + " --security-dir " + pki + " " +
-            args);
+  return sh(std::string(PMUCTL_PATH) + " --domain " + std::to_string(pmu::test::exclusive_dds_domain()) +
+            " --security-dir " + pki + " " + args);
 }
 
 // Both vehicles' services, as processes, with the pmu-service identity of the PKI in `pki`.
@@ -746,8 +751,8 @@ TEST(SecureVehicles, TheDefaultGroundStationReadsAndCommandsEveryVehicle) {
   EXPECT_NE(r.out.find("uav1"), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("uav2"), std::string::npos) << r.out;
   for (const std::string vehicle : {"uav1", "uav2"}) {
-    r = pmuctl(Pki::get().dir(), "--identity ground-station --vehicle " + vehicle +
-                                     " --timeout 30 config set payload_voltage 23");
+    r = pmuctl(Pki::get().dir(),
+               "--identity ground-station --vehicle " + vehicle + " --timeout 30 config set payload_voltage 23");
     EXPECT_EQ(r.status, 0) << vehicle << ": " << r.out;
     EXPECT_NE(r.out.find("COMPLETED"), std::string::npos) << vehicle << ": " << r.out;
   }
@@ -775,7 +780,8 @@ TEST(SecureVehicles, VehiclesGrantTheDefaultPartitionOnlyWithAnEmptyName) {
     std::string where;
     for (const auto& p : c.partitions) where += "\"" + p + "\" ";
     SCOPED_TRACE(args + ", a pmu/command writer in " + (where.empty() ? "the default partition" : where));
-    Client gs(pmu::test::exclusive_dds_domain(), dds::security_files_in(dir, "ground-station"), "ground-station", {c.partitions, {}});
+    Client gs(pmu::test::exclusive_dds_domain(), dds::security_files_in(dir, "ground-station"), "ground-station",
+              {c.partitions, {}});
     bool created = true;
     try {
       gs.commands();

@@ -66,8 +66,8 @@ TEST(SecurityMatchGuard, AGroundStationThatFindsTwoServicesAtOnceAuthenticatesBo
   Service uav1(domain, "uav1");
   Service uav2(domain, "uav2");
   GroundStation gs(domain);
-  const bool linked = pmu::test::wait_until(
-      [&] { return gs.matched() == 2 && uav1.matched() == 1 && uav2.matched() == 1; }, 40s);
+  const bool linked =
+      pmu::test::wait_until([&] { return gs.matched() == 2 && uav1.matched() == 1 && uav2.matched() == 1; }, 40s);
   EXPECT_TRUE(linked) << "the ground station's command writer matched " << gs.matched()
                       << " of 2 services' readers (uav1 " << uav1.matched() << ", uav2 " << uav2.matched() << ")";
   EXPECT_EQ(match_overlaps(), 0) << "two threads of one participant were matching builtin endpoints at once";
@@ -80,8 +80,8 @@ TEST(SecurityMatchGuard, EveryProgramWithDdsSecurityCarriesIt) {
   for (const std::string program : {PMU_SERVICE_PATH, PMUCTL_PATH}) {
     const auto r = sh("nm -D --defined-only '" + program + "'");
     ASSERT_EQ(r.status, 0) << r.out;
-    for (const std::string name : {"SecurityManager23match_builtin_endpoints",
-                                   "SecurityManager36match_builtin_key_exchange_endpoints"})
+    for (const std::string name :
+         {"SecurityManager23match_builtin_endpoints", "SecurityManager36match_builtin_key_exchange_endpoints"})
       EXPECT_NE(r.out.find(name), std::string::npos) << program << " does not define " << name;
   }
 }

@@ -193,9 +193,8 @@ TEST(SimRobustness, EveryFrameLandsInExactlyOneCounter) {
     if (h.pmu.address() != 5) h.deliver(codec::encode_set(Parameter::CanAddress, 5, h.pmu.address()));
   }
   const Counters c = h.pmu.counters();
-  EXPECT_EQ(c.frames_in, c.handled + c.not_pmu + c.other_address + c.unknown_packet + c.wrong_length +
-                             c.malformed + c.rejected_sets + c.unsupported + c.not_commands +
-                             c.ignored_commands + c.ignored_silent);
+  EXPECT_EQ(c.frames_in, c.handled + c.not_pmu + c.other_address + c.unknown_packet + c.wrong_length + c.malformed +
+                             c.rejected_sets + c.unsupported + c.not_commands + c.ignored_commands + c.ignored_silent);
   EXPECT_GT(c.handled, 0u);
   EXPECT_GT(c.wrong_length, 0u);
   EXPECT_GT(c.rejected_sets, 0u);
@@ -210,13 +209,16 @@ TEST(SimSink, MayCallBackIntoTheModel) {
   std::unique_ptr<PmuModel> pmu;
   const TimePoint t{};
   bool asked = false;
-  pmu = std::make_unique<PmuModel>(quiet_config(), [&](const codec::CanFrame& f) {
-    out.push_back(f);
-    if (!asked) {
-      asked = true;
-      pmu->on_frame(*codec::encode_get(PacketId::Firmware, 1), t);
-    }
-  }, t);
+  pmu = std::make_unique<PmuModel>(
+      quiet_config(),
+      [&](const codec::CanFrame& f) {
+        out.push_back(f);
+        if (!asked) {
+          asked = true;
+          pmu->on_frame(*codec::encode_get(PacketId::Firmware, 1), t);
+        }
+      },
+      t);
   pmu->on_frame(*codec::encode_measurement_request(codec::group_bit::Voltages | codec::group_bit::Currents, 1), t);
   std::vector<PacketId> ids;
   for (const auto& f : out) ids.push_back(codec::parse_id(f.id, f.extended).id->packet);

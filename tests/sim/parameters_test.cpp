@@ -14,16 +14,26 @@ struct GetCase {
 };
 
 const GetCase kGets[] = {
-    {PacketId::Voltages},          {PacketId::Currents},
-    {PacketId::BatteryEnergy},     {PacketId::Temperatures},
-    {PacketId::Status},            {PacketId::AvionicsVoltage},
-    {PacketId::PayloadVoltage},    {PacketId::ServoVoltage},
-    {PacketId::BatteryVoltage},    {PacketId::PacketPeriod},
-    {PacketId::PacketsStreamed},   {PacketId::TemperatureOffset},
-    {PacketId::UpperTemperatureLimit}, {PacketId::PowerUpState},
-    {PacketId::CrankingTime},      {PacketId::CanAddress},
-    {PacketId::Outputs},           {PacketId::Generation},
-    {PacketId::Serial},            {PacketId::Firmware},
+    {PacketId::Voltages},
+    {PacketId::Currents},
+    {PacketId::BatteryEnergy},
+    {PacketId::Temperatures},
+    {PacketId::Status},
+    {PacketId::AvionicsVoltage},
+    {PacketId::PayloadVoltage},
+    {PacketId::ServoVoltage},
+    {PacketId::BatteryVoltage},
+    {PacketId::PacketPeriod},
+    {PacketId::PacketsStreamed},
+    {PacketId::TemperatureOffset},
+    {PacketId::UpperTemperatureLimit},
+    {PacketId::PowerUpState},
+    {PacketId::CrankingTime},
+    {PacketId::CanAddress},
+    {PacketId::Outputs},
+    {PacketId::Generation},
+    {PacketId::Serial},
+    {PacketId::Firmware},
 };
 
 TEST(SimGet, EachPacketAnsweredOnceFromOwnAddress) {
@@ -48,11 +58,11 @@ struct StoredCase {
   std::uint32_t raw;
 };
 const StoredCase kFactory[] = {
-    {Parameter::AvionicsVoltage, 120}, {Parameter::PayloadVoltage, 120},
-    {Parameter::ServoVoltage, 60},     {Parameter::BatteryVoltage, 252},
-    {Parameter::PacketPeriod, 10},     {Parameter::PacketsStreamed, 0x1F},
+    {Parameter::AvionicsVoltage, 120},   {Parameter::PayloadVoltage, 120},
+    {Parameter::ServoVoltage, 60},       {Parameter::BatteryVoltage, 252},
+    {Parameter::PacketPeriod, 10},       {Parameter::PacketsStreamed, 0x1F},
     {Parameter::TemperatureOffset, 128}, {Parameter::UpperTemperatureLimit, 80},
-    {Parameter::PowerUpState, 0x0F},   {Parameter::CrankingTime, 50},
+    {Parameter::PowerUpState, 0x0F},     {Parameter::CrankingTime, 50},
     {Parameter::CanAddress, 1},
 };
 
@@ -88,17 +98,28 @@ struct SetCase {
 
 // Each range's ends (tables 8..18).
 const SetCase kValidSets[] = {
-    {Parameter::AvionicsVoltage, 12.0, 120},  {Parameter::AvionicsVoltage, 24.0, 240},
-    {Parameter::PayloadVoltage, 12.0, 120},   {Parameter::PayloadVoltage, 24.0, 240},
-    {Parameter::ServoVoltage, 5.0, 50},       {Parameter::ServoVoltage, 12.0, 120},
-    {Parameter::BatteryVoltage, 20.0, 200},   {Parameter::BatteryVoltage, 25.2, 252},
-    {Parameter::PacketPeriod, 0.1, 1},        {Parameter::PacketPeriod, 25.5, 255},
-    {Parameter::PacketsStreamed, 0, 0},       {Parameter::PacketsStreamed, 0x1F, 0x1F},
-    {Parameter::TemperatureOffset, 0, 0},     {Parameter::TemperatureOffset, 255, 255},
-    {Parameter::UpperTemperatureLimit, 0, 0}, {Parameter::UpperTemperatureLimit, 255, 255},
-    {Parameter::PowerUpState, 0, 0},          {Parameter::PowerUpState, 0x7F, 0x7F},
-    {Parameter::CrankingTime, 0, 0},          {Parameter::CrankingTime, 25.5, 255},
-    {Parameter::CanAddress, 1, 1},            {Parameter::CanAddress, 2, 2},
+    {Parameter::AvionicsVoltage, 12.0, 120},
+    {Parameter::AvionicsVoltage, 24.0, 240},
+    {Parameter::PayloadVoltage, 12.0, 120},
+    {Parameter::PayloadVoltage, 24.0, 240},
+    {Parameter::ServoVoltage, 5.0, 50},
+    {Parameter::ServoVoltage, 12.0, 120},
+    {Parameter::BatteryVoltage, 20.0, 200},
+    {Parameter::BatteryVoltage, 25.2, 252},
+    {Parameter::PacketPeriod, 0.1, 1},
+    {Parameter::PacketPeriod, 25.5, 255},
+    {Parameter::PacketsStreamed, 0, 0},
+    {Parameter::PacketsStreamed, 0x1F, 0x1F},
+    {Parameter::TemperatureOffset, 0, 0},
+    {Parameter::TemperatureOffset, 255, 255},
+    {Parameter::UpperTemperatureLimit, 0, 0},
+    {Parameter::UpperTemperatureLimit, 255, 255},
+    {Parameter::PowerUpState, 0, 0},
+    {Parameter::PowerUpState, 0x7F, 0x7F},
+    {Parameter::CrankingTime, 0, 0},
+    {Parameter::CrankingTime, 25.5, 255},
+    {Parameter::CanAddress, 1, 1},
+    {Parameter::CanAddress, 2, 2},
 };
 
 TEST(SimSet, InRangeStoredWithoutReply) {
@@ -237,9 +258,19 @@ const IgnoredCase kIgnored[] = {
     {"start with data", raw_frame(PacketId::EngineStart, 1, {1}), &Counters::wrong_length},
     {"outputs set with 2 bytes", raw_frame(PacketId::Outputs, 1, {0, 0}), &Counters::wrong_length},
     {"11-bit id", with(raw_frame(PacketId::Reset, 1, {}), false, false), &Counters::not_pmu},
-    {"group 0x1F", [] { auto f = raw_frame(PacketId::Reset, 1, {}); f.id |= 1u << 24; return f; }(),
+    {"group 0x1F",
+     [] {
+       auto f = raw_frame(PacketId::Reset, 1, {});
+       f.id |= 1u << 24;
+       return f;
+     }(),
      &Counters::not_pmu},
-    {"unknown packet 0x1A", [] { auto f = raw_frame(PacketId::Reset, 1, {}); f.id = 0x1E1A0001; return f; }(),
+    {"unknown packet 0x1A",
+     [] {
+       auto f = raw_frame(PacketId::Reset, 1, {});
+       f.id = 0x1E1A0001;
+       return f;
+     }(),
      &Counters::unknown_packet},
     {"remote frame", with(raw_frame(PacketId::Reset, 1, {}), true, true), &Counters::malformed},
     {"another unit's voltages", raw_frame(PacketId::Voltages, 1, {1, 2, 3, 4, 5, 6, 7}), &Counters::not_commands},

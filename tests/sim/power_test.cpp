@@ -107,7 +107,8 @@ const ThermalCase kThermal[] = {
     {"T_U 0 forces shutdown", 0, {{-40, true}, {25, true}, {127, true}}},
     {"T_U 255 disables it", 255, {{25, false}, {127, false}, {300, false}}},
     {"above the limit, not at it", 80, {{80, false}, {80.5, true}}},
-    {"~10% hysteresis", 100,
+    {"~10% hysteresis",
+     100,
      {{99, false}, {101, true}, {95, true}, {90, true}, {89.9, false}, {95, false}, {100, false}, {100.5, true}}},
 };
 

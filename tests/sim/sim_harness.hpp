@@ -19,8 +19,7 @@ using namespace std::chrono_literals;
 using codec::PacketId;
 using codec::Parameter;
 
-constexpr codec::FirmwareVersion kFw112{1, 12}, kFw114{1, 14}, kFw115{1, 15}, kFw116{1, 16},
-    kFw117{1, 17};
+constexpr codec::FirmwareVersion kFw112{1, 12}, kFw114{1, 14}, kFw115{1, 15}, kFw116{1, 16}, kFw117{1, 17};
 
 // Streaming off, so a test sees only the frames it asks for.
 inline DeviceConfig quiet_config(std::uint16_t address = 1, codec::FirmwareVersion fw = kFw117) {
@@ -41,7 +40,12 @@ class Harness {
  public:
   explicit Harness(const DeviceConfig& config = quiet_config())
       : fw(config.firmware),
-        pmu(config, [this](const codec::CanFrame& f) { sent.push_back({now, f}); }, start) {}
+        pmu(
+            config,
+            [this](const codec::CanFrame& f) {
+              sent.push_back({now, f});
+            },
+            start) {}
   Harness(const Harness&) = delete;
   Harness& operator=(const Harness&) = delete;
 

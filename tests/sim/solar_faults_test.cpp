@@ -65,7 +65,8 @@ const GarbleCase kGarbles[] = {
     {"wrong length", Garble::WrongLength, {ErrorKind::TooShort}},
     // 0x302/0x402/MPPT: a blank subindex; 0x482 (subindex = cell): an unknown index; 0x202
     // (checks neither): too short.
-    {"unknown subindex", Garble::UnknownSubindex,
+    {"unknown subindex",
+     Garble::UnknownSubindex,
      {ErrorKind::UnknownSubindex, ErrorKind::UnknownIndex, ErrorKind::TooShort}},
 };
 

@@ -100,7 +100,8 @@ TEST(SolarFrames, BatteryOnAnotherNodeUsesItsFunctionCodes) {
   ASSERT_EQ(h.sent.size(), b.frames_per_period());
   // decode() knows only the document's ids (node 2): check the ids and bytes directly.
   std::multiset<Key> k;
-  for (const auto& s : h.sent) k.insert({static_cast<std::uint16_t>(s.frame.id), s.frame.id == 0x205 ? std::uint8_t{0} : s.frame.data[3]});
+  for (const auto& s : h.sent)
+    k.insert({static_cast<std::uint16_t>(s.frame.id), s.frame.id == 0x205 ? std::uint8_t{0} : s.frame.data[3]});
   EXPECT_EQ(k, battery_keys(5, 3));
 }
 
@@ -187,7 +188,9 @@ TEST(SolarFrames, BadConfigsThrowAtStartUp) {
       {"period 0", battery([](auto& c) { c.period = 0ms; })},
       {"capacity 0", battery([](auto& c) { c.capacity_ah = 0; })},
       {"soc 1.5", battery([](auto& c) { c.initial_soc = 1.5; })},
-      {"3 cell voltages for 12 cells", battery([](auto& c) { c.cell_voltages = {3.9, 3.9, 3.9}; })},
+      {"3 cell voltages for 12 cells", battery([](auto& c) {
+         c.cell_voltages = {3.9, 3.9, 3.9};
+       })},
       {"a negative cell voltage", battery([](auto& c) {
          c.cells = 2;
          c.cell_voltages = {3.9, -0.1};

@@ -35,8 +35,7 @@ using Key = std::pair<std::uint16_t, std::uint8_t>;
 
 class SolarHarness {
  public:
-  explicit SolarHarness(const SolarWorld& world = SolarWorld{})
-      : plant(std::make_shared<SolarPlant>(world, start)) {}
+  explicit SolarHarness(const SolarWorld& world = SolarWorld{}) : plant(std::make_shared<SolarPlant>(world, start)) {}
 
   // Arbitrary, far from the epoch: nothing may depend on the clock's origin.
   const TimePoint start = TimePoint{} + 1000h;

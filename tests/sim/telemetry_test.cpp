@@ -24,7 +24,8 @@ struct StreamCase {
 const StreamCase kStreams[] = {
     {gb::Voltages, 5, {PacketId::Voltages}},
     {gb::Currents | gb::Status, 10, {PacketId::Currents, PacketId::Status}},
-    {gb::All, 1,
+    {gb::All,
+     1,
      {PacketId::Voltages, PacketId::Currents, PacketId::BatteryEnergy, PacketId::Temperatures, PacketId::Status}},
     {gb::BatteryEnergy | gb::Temperatures, 25, {PacketId::BatteryEnergy, PacketId::Temperatures}},
     {0, 3, {}},
@@ -63,14 +64,12 @@ TEST(SimStreaming, BurstsAtEachPeriodFromPowerUp) {
   ASSERT_EQ(h.sent.size(), 15u);
   EXPECT_LT(h.sent[5].at - (h.start + 2s), 7ms);
   EXPECT_LT(h.sent[10].at - (h.start + 3s), 7ms);
-  EXPECT_EQ(packets(h.take()), (std::vector<PacketId>{PacketId::Voltages, PacketId::Currents,
-                                                      PacketId::BatteryEnergy, PacketId::Temperatures,
-                                                      PacketId::Status, PacketId::Voltages,
-                                                      PacketId::Currents, PacketId::BatteryEnergy,
-                                                      PacketId::Temperatures, PacketId::Status,
-                                                      PacketId::Voltages, PacketId::Currents,
-                                                      PacketId::BatteryEnergy, PacketId::Temperatures,
-                                                      PacketId::Status}));
+  EXPECT_EQ(
+      packets(h.take()),
+      (std::vector<PacketId>{PacketId::Voltages, PacketId::Currents, PacketId::BatteryEnergy, PacketId::Temperatures,
+                             PacketId::Status, PacketId::Voltages, PacketId::Currents, PacketId::BatteryEnergy,
+                             PacketId::Temperatures, PacketId::Status, PacketId::Voltages, PacketId::Currents,
+                             PacketId::BatteryEnergy, PacketId::Temperatures, PacketId::Status}));
 }
 
 TEST(SimStreaming, NewPeriodStartsWhenSet) {
@@ -145,9 +144,8 @@ struct Bit6Case {
 };
 
 const Bit6Case kBit6[] = {
-    {kFw112, true, false, true},  {kFw112, false, true, false},
-    {kFw115, true, false, true},  {kFw115, false, true, false},
-    {kFw116, true, false, false}, {kFw116, false, true, true},
+    {kFw112, true, false, true},  {kFw112, false, true, false},  {kFw115, true, false, true},
+    {kFw115, false, true, false}, {kFw116, true, false, false},  {kFw116, false, true, true},
     {kFw117, false, true, true},  {kFw117, false, false, false},
 };
 
@@ -314,14 +312,14 @@ TEST(SimMeasurements, GeneratorFollowsEngineAndGeneration) {
 TEST(SimMeasurements, ClampedIntoFieldRange) {
   Harness h;
   Plant p;
-  p.battery_a_voltage = 30.0;       // table 2: 0..25.0
-  p.battery_b_voltage = -1.0;       // below 0
-  p.output_28v_load = -20.0;        // table 3: -12.5..12.5
-  p.avionics_load = 14.0;           // 0..10.0
-  p.internal_temperature = -200.0;  // table 5: -127..127 and "no sensor"
-  p.battery_a_temperature = -128.0; // a real -128 is not "no sensor": -127
+  p.battery_a_voltage = 30.0;        // table 2: 0..25.0
+  p.battery_b_voltage = -1.0;        // below 0
+  p.output_28v_load = -20.0;         // table 3: -12.5..12.5
+  p.avionics_load = 14.0;            // 0..10.0
+  p.internal_temperature = -200.0;   // table 5: -127..127 and "no sensor"
+  p.battery_a_temperature = -128.0;  // a real -128 is not "no sensor": -127
   p.battery_b_temperature = 300.0;
-  p.starter_temperature = -60.0;    // -49..127
+  p.starter_temperature = -60.0;  // -49..127
   p.engine_rpm = 65535;
   h.pmu.set_plant(p, h.now);
   h.pmu.set_engine_running(true, h.now);

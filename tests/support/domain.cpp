@@ -28,7 +28,7 @@ int take_one() {
     if (fd < 0) continue;
     if (::flock(fd, LOCK_EX | LOCK_NB) == 0) {
       if (dds_discovery_port_free(d)) return d;  // fd stays open: the lock stays held
-      ::flock(fd, LOCK_UN);        // in use by someone who does not lock: leave it alone
+      ::flock(fd, LOCK_UN);                      // in use by someone who does not lock: leave it alone
     }
     ::close(fd);
   }

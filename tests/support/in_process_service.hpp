@@ -26,9 +26,9 @@ namespace pmu::test {
 class InProcessService {
  public:
   struct Options {
-    std::string vehicle;             // "" = the unnamed vehicle
-    std::string bus_name = "sim0";   // the `bus` key of every sample
-    dds::SecurityFiles security;     // empty: no DDS-Security
+    std::string vehicle;            // "" = the unnamed vehicle
+    std::string bus_name = "sim0";  // the `bus` key of every sample
+    dds::SecurityFiles security;    // empty: no DDS-Security
     dds::Transport transport = dds::Transport::Default;
     // A pause between creating the participant and the command endpoint: discovery of the
     // peers already on the domain is then over before the endpoint exists, as it can be in

@@ -45,16 +45,16 @@ class Pki {
     static Pki pki;
     return pki;
   }
-  const std::string& dir() const { return dir_; }       // make_pki.sh's output
-  const std::string& root() const { return root_; }     // the temporary folder around it
+  const std::string& dir() const { return dir_; }    // make_pki.sh's output
+  const std::string& root() const { return root_; }  // the temporary folder around it
   SecurityFiles files(const std::string& identity) const { return dds::security_files_in(dir_, identity); }
 
   // A variant of make_variants.sh (foreign, selfsigned, window START END), made on first use.
   std::string variant(const std::string& name, const std::string& args) {
     const std::string out = root_ + "/" + name;
     if (made_.insert(name).second) {
-      const auto r = sh(std::string("bash ") + PMU_SOURCE_DIR + "/tests/security/make_variants.sh " + args + " " + dir_ +
-                        " " + out + extra_.at(name));
+      const auto r = sh(std::string("bash ") + PMU_SOURCE_DIR + "/tests/security/make_variants.sh " + args + " " +
+                        dir_ + " " + out + extra_.at(name));
       if (r.status != 0) ADD_FAILURE() << "make_variants.sh " << args << ": " << r.out;
     }
     return out;
@@ -106,7 +106,8 @@ inline std::string write_config(const std::string& name, const SecurityFiles& f,
                                 const std::string& vehicle = "") {
   const std::string path = Pki::get().root() + "/" + name + ".yaml";
   std::ofstream out(path);
-  out << "domain: " << pmu::test::exclusive_dds_domain() << "\n" << (vehicle.empty() ? "" : "vehicle: " + vehicle + "\n")
+  out << "domain: " << pmu::test::exclusive_dds_domain() << "\n"
+      << (vehicle.empty() ? "" : "vehicle: " + vehicle + "\n")
       << "buses:\n  - interface: sim\n    name: sim0\n    devices:\n"
       << "      - address: 1\n        period: 0.5\nsecurity:\n"
       << "  identity_ca: " << f.identity_ca << "\n  identity_certificate: " << f.identity_certificate
@@ -117,18 +118,54 @@ inline std::string write_config(const std::string& name, const SecurityFiles& f,
 }
 
 // The contract's topics (interface.md sections 1.2, 1.4, 1.5, 1.6, 1.7, 1.8 and 1.9).
-inline const std::set<std::string> kTelemetryAndState = {
-    "pmu/voltages",          "pmu/currents",          "pmu/battery_energy",          "pmu/temperatures",
-    "pmu/status",            "pmu/low_rate/voltages", "pmu/low_rate/currents",       "pmu/low_rate/battery_energy",
-    "pmu/low_rate/temperatures", "pmu/low_rate/status", "pmu/battery", "pmu/battery_cells", "pmu/mppt",
-    "pmu/config",            "pmu/info",              "pmu/health",                  "pmu/low_rate/health", "pmu/alarms",
-    "pmu/readiness",         "pmu/energy",            "pmu/baseline", "pmu/bms_energy"};
-inline const char* const kContractTopics[] = {
-    "pmu/voltages",          "pmu/currents",          "pmu/battery_energy",          "pmu/temperatures",
-    "pmu/status",            "pmu/low_rate/voltages", "pmu/low_rate/currents",       "pmu/low_rate/battery_energy",
-    "pmu/low_rate/temperatures", "pmu/low_rate/status", "pmu/battery", "pmu/battery_cells", "pmu/mppt",
-    "pmu/config",            "pmu/info",              "pmu/health",            "pmu/low_rate/health", "pmu/alarms",  "pmu/readiness", "pmu/energy", "pmu/baseline", "pmu/bms_energy", "pmu/command",
-    "pmu/command_reply",     "pmu/alarm_ack",         "pmu/alarm_ack_reply"};
+inline const std::set<std::string> kTelemetryAndState = {"pmu/voltages",
+                                                         "pmu/currents",
+                                                         "pmu/battery_energy",
+                                                         "pmu/temperatures",
+                                                         "pmu/status",
+                                                         "pmu/low_rate/voltages",
+                                                         "pmu/low_rate/currents",
+                                                         "pmu/low_rate/battery_energy",
+                                                         "pmu/low_rate/temperatures",
+                                                         "pmu/low_rate/status",
+                                                         "pmu/battery",
+                                                         "pmu/battery_cells",
+                                                         "pmu/mppt",
+                                                         "pmu/config",
+                                                         "pmu/info",
+                                                         "pmu/health",
+                                                         "pmu/low_rate/health",
+                                                         "pmu/alarms",
+                                                         "pmu/readiness",
+                                                         "pmu/energy",
+                                                         "pmu/baseline",
+                                                         "pmu/bms_energy"};
+inline const char* const kContractTopics[] = {"pmu/voltages",
+                                              "pmu/currents",
+                                              "pmu/battery_energy",
+                                              "pmu/temperatures",
+                                              "pmu/status",
+                                              "pmu/low_rate/voltages",
+                                              "pmu/low_rate/currents",
+                                              "pmu/low_rate/battery_energy",
+                                              "pmu/low_rate/temperatures",
+                                              "pmu/low_rate/status",
+                                              "pmu/battery",
+                                              "pmu/battery_cells",
+                                              "pmu/mppt",
+                                              "pmu/config",
+                                              "pmu/info",
+                                              "pmu/health",
+                                              "pmu/low_rate/health",
+                                              "pmu/alarms",
+                                              "pmu/readiness",
+                                              "pmu/energy",
+                                              "pmu/baseline",
+                                              "pmu/bms_energy",
+                                              "pmu/command",
+                                              "pmu/command_reply",
+                                              "pmu/alarm_ack",
+                                              "pmu/alarm_ack_reply"};
 
 // Only the ground station commands and acknowledges alarms; the service publishes telemetry,
 // state and replies; the mission computer only reads telemetry and state.

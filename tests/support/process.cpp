@@ -75,8 +75,7 @@ Child::~Child() {
   if (pid_ > 0 && !status_) (void)stop(stop_grace_);
 }
 
-Child::Child(Child&& other) noexcept
-    : pid_(other.pid_), status_(other.status_), stop_grace_(other.stop_grace_) {
+Child::Child(Child&& other) noexcept : pid_(other.pid_), status_(other.status_), stop_grace_(other.stop_grace_) {
   other.pid_ = -1;
   other.status_.reset();
 }

@@ -29,9 +29,9 @@
 namespace pmu::test {
 
 struct ChildOptions {
-  std::vector<std::string> env;  // "NAME=value", added to (or replacing in) this process's environment
-  std::string stdout_path;       // empty: inherited
-  std::string stderr_path;       // empty: inherited; same as stdout_path: both into one file
+  std::vector<std::string> env;                 // "NAME=value", added to (or replacing in) this process's environment
+  std::string stdout_path;                      // empty: inherited
+  std::string stderr_path;                      // empty: inherited; same as stdout_path: both into one file
   std::chrono::milliseconds stop_grace{10000};  // SIGTERM -> SIGKILL in the destructor
 };
 

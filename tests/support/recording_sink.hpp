@@ -39,7 +39,8 @@ class RecordingSink final : public StateSink {
   void on_battery(const DeviceKey& k, const BatteryState& b, std::chrono::system_clock::time_point t) override {
     batteries.push_back({k, b, t});
   }
-  void on_battery_cells(const DeviceKey& k, const BatteryCellsState& c, std::chrono::system_clock::time_point t) override {
+  void on_battery_cells(const DeviceKey& k, const BatteryCellsState& c,
+                        std::chrono::system_clock::time_point t) override {
     cells.push_back({k, c, t});
   }
   void on_mppt(const DeviceKey& k, const MpptState& m, std::chrono::system_clock::time_point t) override {
@@ -61,7 +62,8 @@ class RecordingSink final : public StateSink {
     energy::BmsFigures figures;
     std::chrono::system_clock::time_point at;
   };
-  void on_bms_energy(const DeviceKey& k, const energy::BmsFigures& f, std::chrono::system_clock::time_point at) override {
+  void on_bms_energy(const DeviceKey& k, const energy::BmsFigures& f,
+                     std::chrono::system_clock::time_point at) override {
     bms_energy.push_back({k, f, at});
   }
 

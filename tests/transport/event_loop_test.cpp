@@ -44,7 +44,9 @@ class Signal {
 };
 
 bool readable(int fd) {
-  struct pollfd p {fd, POLLIN, 0};
+  struct pollfd p {
+    fd, POLLIN, 0
+  };
   return ::poll(&p, 1, 0) == 1 && (p.revents & POLLIN) != 0;
 }
 
@@ -158,8 +160,7 @@ TEST_F(Loop, AnFdUnwatchedAndWatchedAgainInOneTurnGetsOnlyTheNewCallback) {
                         [&](std::uint32_t) {
                           trigger.consume();
                           loop_.unwatch(s.fd());
-                          loop_.watch(s.fd(), EventLoop::kReadable,
-                                      [&](std::uint32_t) { calls.push_back("new"); });
+                          loop_.watch(s.fd(), EventLoop::kReadable, [&](std::uint32_t) { calls.push_back("new"); });
                         }),
             0);
   trigger.raise();
@@ -289,9 +290,8 @@ TEST_F(Loop, TimersFireInDeadlineOrderWhenTheClockPassesThem) {
 TEST_F(Loop, PeriodicTimerKeepsItsRateAndSkipsWhatALateLoopMissed) {
   const auto t0 = clock_.steady_now();
   std::vector<milliseconds> fired;
-  loop_.add_timer(t0, 10ms, [&](EventLoop::TimePoint now) {
-    fired.push_back(std::chrono::duration_cast<milliseconds>(now - t0));
-  });
+  loop_.add_timer(
+      t0, 10ms, [&](EventLoop::TimePoint now) { fired.push_back(std::chrono::duration_cast<milliseconds>(now - t0)); });
   loop_.run_once(0ms);  // due at once
   clock_.advance(4ms);
   loop_.run_once(0ms);  // t0 + 4: not yet

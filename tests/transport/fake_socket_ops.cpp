@@ -13,8 +13,7 @@ int FakeSocketOps::open_can_raw() {
   ++opens;
   if (!can_supported) return -EAFNOSUPPORT;
   int ends[2];
-  if (::socketpair(AF_UNIX, SOCK_SEQPACKET | SOCK_NONBLOCK | SOCK_CLOEXEC, 0, ends) != 0)
-    return -errno;
+  if (::socketpair(AF_UNIX, SOCK_SEQPACKET | SOCK_NONBLOCK | SOCK_CLOEXEC, 0, ends) != 0) return -errno;
   peers.emplace_back(ends[1]);
   return ends[0];
 }

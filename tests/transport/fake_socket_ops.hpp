@@ -30,10 +30,10 @@ class FakeSocketOps final : public SocketOps {
   explicit FakeSocketOps(ManualClock* clock = nullptr) : clock_(clock) {}
 
   // --- the emulated CAN interfaces ---
-  bool can_supported = true;              // false: open_can_raw() fails with EAFNOSUPPORT
-  std::map<std::string, int> interfaces;  // name -> ifindex; other names give ENODEV
-  bool link_up = true;                    // what interface_up() reports
-  bool allow_receive_buffer_force = true; // false: SO_RCVBUFFORCE fails with EPERM
+  bool can_supported = true;               // false: open_can_raw() fails with EAFNOSUPPORT
+  std::map<std::string, int> interfaces;   // name -> ifindex; other names give ENODEV
+  bool link_up = true;                     // what interface_up() reports
+  bool allow_receive_buffer_force = true;  // false: SO_RCVBUFFORCE fails with EPERM
 
   // --- recorded ---
   std::vector<UniqueFd> peers;  // the test's end of every socket open_can_raw() made

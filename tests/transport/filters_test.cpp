@@ -27,22 +27,17 @@ struct FilterCase {
 // Protocol v1.9 section 4 (the PMU's group 0x1E); solar-boat CANopen document (battery
 // 0x202/0x302/0x402/0x482, MPPT 0x4E6 + 8n, n = 0..7, two ids each).
 constexpr FilterCase kCases[] = {
-    {0x1E000001, true, true, true},    // voltages, address 1
-    {0x1E31FFFF, true, true, true},    // firmware, broadcast
-    {0x1EFFFFFF, true, true, true},    // unknown packet: still the PMU's group (codec decides)
-    {0x1F000001, true, false, false},  // group 0x1F
-    {0x0E000001, true, false, false},  // group 0x0E
-    {0x0000001E, false, false, false}, // 11-bit: never a PMU frame
-    {0x202, false, false, true},
-    {0x302, false, false, true},
-    {0x402, false, false, true},
-    {0x482, false, false, true},
-    {0x203, false, false, false},
-    {0x202, true, false, false},       // an extended 0x202 is not the battery
-    {0x4E5, false, false, false},
-    {0x4E6, false, false, true},
-    {0x51F, false, false, true},
-    {0x520, false, false, false},
+    {0x1E000001, true, true, true},     // voltages, address 1
+    {0x1E31FFFF, true, true, true},     // firmware, broadcast
+    {0x1EFFFFFF, true, true, true},     // unknown packet: still the PMU's group (codec decides)
+    {0x1F000001, true, false, false},   // group 0x1F
+    {0x0E000001, true, false, false},   // group 0x0E
+    {0x0000001E, false, false, false},  // 11-bit: never a PMU frame
+    {0x202, false, false, true},       {0x302, false, false, true},
+    {0x402, false, false, true},       {0x482, false, false, true},
+    {0x203, false, false, false},      {0x202, true, false, false},  // an extended 0x202 is not the battery
+    {0x4E5, false, false, false},      {0x4E6, false, false, true},
+    {0x51F, false, false, true},       {0x520, false, false, false},
 };
 
 TEST(Filters, WorkedExamples) {

@@ -193,13 +193,10 @@ TEST(SimThreads, EchoAcrossThreadsThroughEventLoops) {
   Echo echo;
   echo.bus = device.get();
   EventLoop device_loop{clock, "device"};
-  ASSERT_EQ(device_loop.watch(device->fd(), EventLoop::kReadable,
-                              [&](std::uint32_t) { device->drain(echo); }),
-            0);
+  ASSERT_EQ(device_loop.watch(device->fd(), EventLoop::kReadable, [&](std::uint32_t) { device->drain(echo); }), 0);
   RecordingHandler replies;
   EventLoop service_loop{clock, "service"};
-  ASSERT_EQ(service_loop.watch(service->fd(), EventLoop::kReadable,
-                               [&](std::uint32_t) { service->drain(replies); }),
+  ASSERT_EQ(service_loop.watch(service->fd(), EventLoop::kReadable, [&](std::uint32_t) { service->drain(replies); }),
             0);
   std::thread device_thread([&] { device_loop.run(); });
 

@@ -151,8 +151,7 @@ TEST_F(AdoptedBus, EnetdownReportsDownKeepsTheSocketAndResumesOnTraffic) {
   bus->drain(handler_);
   EXPECT_EQ(bus->state(), BusState::Down);
   EXPECT_TRUE(bus->has_socket()) << "ENETDOWN keeps the socket: it works again on link up";
-  ASSERT_EQ(handler_.kinds(),
-            (std::vector<BusEventKind>{BusEventKind::SocketError, BusEventKind::StateChanged}));
+  ASSERT_EQ(handler_.kinds(), (std::vector<BusEventKind>{BusEventKind::SocketError, BusEventKind::StateChanged}));
   EXPECT_EQ(handler_.events[0].error, ENETDOWN);
   EXPECT_EQ(handler_.events[1].state, BusState::Down);
   EXPECT_TRUE(handler_.frames.empty());
@@ -295,8 +294,7 @@ TEST_F(AdoptedBus, PeerClosingEndsTheBusInsteadOfSpinning) {
   EXPECT_EQ(bus->state(), BusState::Down);
   EXPECT_FALSE(bus->has_socket());
   EXPECT_FALSE(readable(bus->fd())) << "a dead fd left registered would wake the loop forever";
-  EXPECT_EQ(bus->send(pmu_frame(PacketId::Voltages, 1), milliseconds{0}).status,
-            SendStatus::NoDevice);
+  EXPECT_EQ(bus->send(pmu_frame(PacketId::Voltages, 1), milliseconds{0}).status, SendStatus::NoDevice);
   // An adopted fd has no interface to reopen.
   bus->maintain(clock_.steady_now() + std::chrono::hours{1});
   EXPECT_FALSE(bus->has_socket());

@@ -55,8 +55,7 @@ TEST_F(OpenedBus, InstallsFiltersErrorMaskAndBindsToTheInterface) {
   EXPECT_EQ(fake_.kernel_filters[0].can_id, 0x1E000000u | CAN_EFF_FLAG);
   EXPECT_EQ(fake_.kernel_filters[0].can_mask, 0x1F000000u | CAN_EFF_FLAG);
   EXPECT_EQ(fake_.error_mask,
-            static_cast<can_err_mask_t>(CAN_ERR_CRTL | CAN_ERR_BUSOFF | CAN_ERR_RESTARTED |
-                                        CAN_ERR_TX_TIMEOUT));
+            static_cast<can_err_mask_t>(CAN_ERR_CRTL | CAN_ERR_BUSOFF | CAN_ERR_RESTARTED | CAN_ERR_TX_TIMEOUT));
   EXPECT_EQ(fake_.bound_ifindex, 7);
   const SocketCanReport& report = bus->report();
   EXPECT_TRUE(report.kernel_filters);
@@ -117,8 +116,7 @@ TEST_F(OpenedBus, MissingInterfaceStartsDownAndBindsWhenItAppears) {
   write_frame(peer(), pmu_raw(PacketId::Currents, 4));
   ASSERT_TRUE(readable(bus->fd()));
   bus->drain(handler_);
-  ASSERT_EQ(handler_.kinds(),
-            (std::vector<BusEventKind>{BusEventKind::Reopened, BusEventKind::StateChanged}));
+  ASSERT_EQ(handler_.kinds(), (std::vector<BusEventKind>{BusEventKind::Reopened, BusEventKind::StateChanged}));
   EXPECT_EQ(handler_.events[1].previous, BusState::Down);
   EXPECT_EQ(handler_.events[1].state, BusState::Up);
   ASSERT_EQ(handler_.frames.size(), 1u);
@@ -132,14 +130,13 @@ TEST_F(OpenedBus, KernelWithoutCanIsAStartupErrorNamingTheInterface) {
     FAIL() << "expected std::system_error";
   } catch (const std::system_error& e) {
     EXPECT_EQ(e.code().value(), EAFNOSUPPORT);
-    EXPECT_EQ(std::string(e.what()), std::string("can0: socket(PF_CAN, SOCK_RAW, CAN_RAW): ") +
-                                         std::strerror(EAFNOSUPPORT));
+    EXPECT_EQ(std::string(e.what()),
+              std::string("can0: socket(PF_CAN, SOCK_RAW, CAN_RAW): ") + std::strerror(EAFNOSUPPORT));
   }
 }
 
 TEST_F(OpenedBus, OverlongInterfaceNameIsRefused) {
-  EXPECT_THROW(SocketCanBus::open("a-name-longer-than-ifnamsiz", {}, clock_, fake_),
-               std::system_error);
+  EXPECT_THROW(SocketCanBus::open("a-name-longer-than-ifnamsiz", {}, clock_, fake_), std::system_error);
   EXPECT_EQ(fake_.opens, 0);
 }
 
@@ -160,8 +157,7 @@ TEST_F(OpenedBus, EnodevClosesTheSocketAndMaintainReopensWhenTheInterfaceReturns
   bus->drain(handler_);
   EXPECT_EQ(bus->state(), BusState::Down);
   EXPECT_FALSE(bus->has_socket());
-  ASSERT_EQ(handler_.kinds(),
-            (std::vector<BusEventKind>{BusEventKind::SocketError, BusEventKind::StateChanged}));
+  ASSERT_EQ(handler_.kinds(), (std::vector<BusEventKind>{BusEventKind::SocketError, BusEventKind::StateChanged}));
   EXPECT_EQ(handler_.events[0].error, ENODEV);
   EXPECT_EQ(bus->send(pmu_frame(PacketId::Voltages, 1), milliseconds{10}).status, SendStatus::NoDevice);
   EXPECT_TRUE(fake_.poll_timeouts.empty()) << "a missing device is not waited for";
@@ -188,8 +184,7 @@ TEST_F(OpenedBus, EnodevClosesTheSocketAndMaintainReopensWhenTheInterfaceReturns
   write_frame(peer(), pmu_raw(PacketId::Currents, 4));
   ASSERT_TRUE(readable(bus->fd()));
   bus->drain(handler_);
-  ASSERT_EQ(handler_.kinds(),
-            (std::vector<BusEventKind>{BusEventKind::Reopened, BusEventKind::StateChanged}));
+  ASSERT_EQ(handler_.kinds(), (std::vector<BusEventKind>{BusEventKind::Reopened, BusEventKind::StateChanged}));
   EXPECT_EQ(handler_.events[1].state, BusState::Up);
   ASSERT_EQ(handler_.frames.size(), 1u);
   EXPECT_EQ(handler_.frames[0].frame.id, codec::make_id(PacketId::Currents, 4));
@@ -288,7 +283,9 @@ TEST(RealSocketCan, FramesCrossAVirtualCanInterface) {
   ASSERT_TRUE(sender->send(foreign, milliseconds{100}).ok());
   ASSERT_TRUE(sender->send(pmu_frame(PacketId::Voltages, 1), milliseconds{100}).ok());
 
-  struct pollfd ready {receiver->fd(), POLLIN, 0};
+  struct pollfd ready {
+    receiver->fd(), POLLIN, 0
+  };
   ASSERT_EQ(::poll(&ready, 1, 1000), 1);
   RecordingHandler handler;
   receiver->drain(handler);

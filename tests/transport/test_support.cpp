@@ -36,8 +36,7 @@ struct can_frame with_data(canid_t id, const std::vector<std::uint8_t>& data) {
 }
 }  // namespace
 
-codec::CanFrame pmu_frame(codec::PacketId packet, std::uint16_t address,
-                          std::vector<std::uint8_t> data) {
+codec::CanFrame pmu_frame(codec::PacketId packet, std::uint16_t address, std::vector<std::uint8_t> data) {
   codec::CanFrame frame;
   frame.id = codec::make_id(packet, address);
   frame.extended = true;
@@ -46,8 +45,7 @@ codec::CanFrame pmu_frame(codec::PacketId packet, std::uint16_t address,
   return frame;
 }
 
-struct can_frame pmu_raw(codec::PacketId packet, std::uint16_t address,
-                         std::vector<std::uint8_t> data) {
+struct can_frame pmu_raw(codec::PacketId packet, std::uint16_t address, std::vector<std::uint8_t> data) {
   return with_data(codec::make_id(packet, address) | CAN_EFF_FLAG, data);
 }
 
@@ -77,14 +75,17 @@ std::optional<struct can_frame> read_frame(int fd) {
 }
 
 bool readable(int fd) {
-  struct pollfd p {fd, POLLIN, 0};
+  struct pollfd p {
+    fd, POLLIN, 0
+  };
   return ::poll(&p, 1, 0) == 1 && (p.revents & POLLIN) != 0;
 }
 
 std::optional<std::string> socket_options_missing() {
   const SocketPair pair = make_socket_pair();
   const int on = 1;
-  for (const auto& [option, name] : {std::pair{SO_TIMESTAMPNS, "SO_TIMESTAMPNS"}, std::pair{SO_RXQ_OVFL, "SO_RXQ_OVFL"}}) {
+  for (const auto& [option, name] :
+       {std::pair{SO_TIMESTAMPNS, "SO_TIMESTAMPNS"}, std::pair{SO_RXQ_OVFL, "SO_RXQ_OVFL"}}) {
     if (::setsockopt(pair.bus_end.get(), SOL_SOCKET, option, &on, sizeof(on)) != 0)
       return std::string("setsockopt(") + name + "): " + std::strerror(errno) +
              " (qemu-user does not translate it; the native builds run this test)";

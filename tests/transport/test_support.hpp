@@ -43,20 +43,16 @@ struct SocketPair {
 SocketPair make_socket_pair();
 
 // A PMU frame as the codec sees it.
-codec::CanFrame pmu_frame(codec::PacketId packet, std::uint16_t address,
-                          std::vector<std::uint8_t> data = {});
+codec::CanFrame pmu_frame(codec::PacketId packet, std::uint16_t address, std::vector<std::uint8_t> data = {});
 
 // A PMU frame as the kernel would deliver it: extended id, flag set.
-struct can_frame pmu_raw(codec::PacketId packet, std::uint16_t address,
-                         std::vector<std::uint8_t> data = {});
+struct can_frame pmu_raw(codec::PacketId packet, std::uint16_t address, std::vector<std::uint8_t> data = {});
 struct can_frame standard_raw(canid_t id, std::vector<std::uint8_t> data = {});
 // A controller error frame: CAN_ERR_FLAG | error_class, data[1] = controller status.
 struct can_frame error_raw(canid_t error_class, std::uint8_t controller_status = 0);
 
 void write_record(int fd, const void* data, std::size_t size);
-inline void write_frame(int fd, const struct can_frame& frame) {
-  write_record(fd, &frame, sizeof(frame));
-}
+inline void write_frame(int fd, const struct can_frame& frame) { write_record(fd, &frame, sizeof(frame)); }
 // The next record on `fd`, or nullopt when none is waiting.
 std::optional<struct can_frame> read_frame(int fd);
 

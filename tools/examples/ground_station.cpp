@@ -95,8 +95,8 @@ bool command(Link& l, pmu::v5::CommandKind kind, const char* what, const char* p
     while (l.replies->take_next_sample(&r, &info) == ReturnCode_t::RETCODE_OK) {
       if (!info.valid_data || r.request_id().to_string() != id || r.result() == pmu::v5::IN_PROGRESS) continue;
       const bool ok = r.result() == pmu::v5::COMPLETED;
-      std::printf("%-36s %s%s%s\n", what, ok ? "COMPLETED" : "NOT COMPLETED",
-                  r.reason().size() ? ": " : "", r.reason().c_str());
+      std::printf("%-36s %s%s%s\n", what, ok ? "COMPLETED" : "NOT COMPLETED", r.reason().size() ? ": " : "",
+                  r.reason().c_str());
       return ok;
     }
     std::this_thread::sleep_for(5ms);

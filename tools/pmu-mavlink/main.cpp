@@ -49,7 +49,8 @@ int main(int argc, char** argv) {
   app.add_option("--identity", identity, "DDS-Security identity in that folder");
   app.add_option("--battery-id-pmu", pmu_id, "BATTERY_STATUS id of the first PMU's battery A (default 10)")
       ->check(CLI::Range(0, 253));
-  app.add_option("--battery-id-bms", bms_id, "BATTERY_STATUS id of the first BMS (default 20)")->check(CLI::Range(0, 254));
+  app.add_option("--battery-id-bms", bms_id, "BATTERY_STATUS id of the first BMS (default 20)")
+      ->check(CLI::Range(0, 254));
   app.add_option("--rate", rates, "NAME=HZ: heartbeat, battery_status, generator_status (0: off)");
   CLI11_PARSE(app, argc, argv);
 
@@ -100,8 +101,8 @@ int main(int argc, char** argv) {
     options.domain = settings.domain;
     const auto issues = pmu::dds::check_security_files(security, options);
     for (const auto& i : issues)
-      std::fprintf(stderr, "pmu-mavlink: %s%s\n", i.level == pmu::dds::SecurityIssue::Level::Error ? "" : "warning: ",
-                   i.message.c_str());
+      std::fprintf(stderr, "pmu-mavlink: %s%s\n",
+                   i.level == pmu::dds::SecurityIssue::Level::Error ? "" : "warning: ", i.message.c_str());
     if (pmu::dds::has_errors(issues)) return 2;
   }
 
@@ -138,8 +139,9 @@ int main(int argc, char** argv) {
   ::sigaction(SIGTERM, &sa, nullptr);
   std::signal(SIGPIPE, SIG_IGN);
 
-  for (const auto& e : endpoints) std::fprintf(stderr, "pmu-mavlink: %s, component %u\n", e->describe().c_str(),
-                                               static_cast<unsigned>(settings.component_id));
+  for (const auto& e : endpoints)
+    std::fprintf(stderr, "pmu-mavlink: %s, component %u\n", e->describe().c_str(),
+                 static_cast<unsigned>(settings.component_id));
   int status = 0;
   std::vector<pollfd> fds;
   for (const auto& e : endpoints) fds.push_back({e->fd(), POLLIN, 0});

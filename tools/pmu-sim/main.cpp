@@ -65,7 +65,8 @@ void add_solar_devices(pmu::sim::BusRunner& runner, const SimOptions& o, pmu::tr
     if (o.sun) plant.set_irradiance(*o.sun, clock.steady_now());
   };
   if (!o.batteries.empty())
-    runner.with_battery(static_cast<std::uint8_t>(o.batteries.front()), [&](pmu::sim::BatteryModel& b) { world(b.plant()); });
+    runner.with_battery(static_cast<std::uint8_t>(o.batteries.front()),
+                        [&](pmu::sim::BatteryModel& b) { world(b.plant()); });
   else if (!o.mppts.empty())
     runner.with_mppt(static_cast<std::uint8_t>(o.mppts.front()), [&](pmu::sim::MpptModel& m) { world(m.plant()); });
 }
@@ -80,8 +81,8 @@ int run_bench(const SimOptions& o) {
     pmu::sim::BusRunner runner(pmu::transport::SocketCanBus::open(o.iface, options, clock), clock);
     add_pmus(runner, o, clock);
     add_solar_devices(runner, o, clock);
-    std::fprintf(stderr, "pmu-sim: %zu PMU(s), %zu battery(ies), %zu MPPT(s) on %s, firmware %s\n",
-                 o.addresses.size(), o.batteries.size(), o.mppts.size(), o.iface.c_str(), o.firmware_text.c_str());
+    std::fprintf(stderr, "pmu-sim: %zu PMU(s), %zu battery(ies), %zu MPPT(s) on %s, firmware %s\n", o.addresses.size(),
+                 o.batteries.size(), o.mppts.size(), o.iface.c_str(), o.firmware_text.c_str());
     runner.start();
     stop.wait();
     runner.stop();

@@ -47,7 +47,8 @@ std::optional<std::optional<pmu::sim::Duration>> engine_starts_after_of(const st
   char* end = nullptr;
   const double s = std::strtod(text.c_str(), &end);
   if (text.empty() || end != text.c_str() + text.size() || !std::isfinite(s) || s < 0 || s > 3600) return std::nullopt;
-  return std::optional<pmu::sim::Duration>{std::chrono::duration_cast<pmu::sim::Duration>(std::chrono::duration<double>(s))};
+  return std::optional<pmu::sim::Duration>{
+      std::chrono::duration_cast<pmu::sim::Duration>(std::chrono::duration<double>(s))};
 }
 
 pmu::sim::Garble garble_of(const std::string& name) {
@@ -100,15 +101,17 @@ void add_pmu_options(CLI::App& app, SimOptions& o, GivenText& given) {
 
 void add_solar_options(CLI::App& app, SimOptions& o, GivenText& given) {
   app.add_flag("--no-pmu", given.no_pmu, "No PMU: only the batteries and MPPTs given")->excludes("--address");
-  app.add_option("--battery", o.batteries, "Also play an MG battery's BMS with this CANopen node id (repeat; 2 gives the "
-                                           "document's ids 0x202/0x302/0x402/0x482)")
+  app.add_option("--battery", o.batteries,
+                 "Also play an MG battery's BMS with this CANopen node id (repeat; 2 gives the "
+                 "document's ids 0x202/0x302/0x402/0x482)")
       ->check(CLI::Range(1, 127));
   app.add_option("--mppt", o.mppts, "Also play an MPPT with this device id (repeat; COB-ID 0x4E6 + 8 * id)")
       ->check(CLI::Range(0, 7));
   given.cells_option =
       app.add_option("--cells", o.cells, "Cells in series of each battery (default 12)")->check(CLI::Range(1, 15));
-  app.add_option("--battery-period", o.battery_period_ms, "Milliseconds in which a battery sends all its values "
-                                                          "(default 1000)")
+  app.add_option("--battery-period", o.battery_period_ms,
+                 "Milliseconds in which a battery sends all its values "
+                 "(default 1000)")
       ->check(CLI::Range(1, 3600000));
   app.add_option("--mppt-period", o.mppt_period_ms, "Milliseconds in which an MPPT sends all its values (default 1000)")
       ->check(CLI::Range(1, 3600000));
@@ -116,9 +119,9 @@ void add_solar_options(CLI::App& app, SimOptions& o, GivenText& given) {
   app.add_option("--sun", o.sun, "Fixed irradiance in W/m2 (default: a slow cycle, 300..900 over 10 minutes)")
       ->check(CLI::Range(0.0, 1500.0));
   // A world option for a device that is not played would do nothing without saying so.
-  for (const char* pmu_option : {"--engine", "--engine-starts-after", "--internal-temperature", "--battery-a-voltage",
-                                  "--battery-b-voltage", "--starter-ready", "--soa-shutdown", "--payload-shed",
-                                  "--silent", "--ignores-set"})
+  for (const char* pmu_option :
+       {"--engine", "--engine-starts-after", "--internal-temperature", "--battery-a-voltage", "--battery-b-voltage",
+        "--starter-ready", "--soa-shutdown", "--payload-shed", "--silent", "--ignores-set"})
     app.get_option("--no-pmu")->excludes(pmu_option);
   auto* battery_opt = app.get_option("--battery");
   auto* mppt_opt = app.get_option("--mppt");
@@ -126,11 +129,11 @@ void add_solar_options(CLI::App& app, SimOptions& o, GivenText& given) {
       ->check(range(0, 100))
       ->needs(battery_opt);
   app.add_option("--cell-voltages", o.cell_voltages,
-                     "Fixed cell voltages in V, 0..5, cell 1 first, comma-separated, one per cell (they set --cells); "
-                     "default: the cells follow the charge")
-          ->delimiter(',')
-          ->check(range(0, 5))
-          ->needs(battery_opt);
+                 "Fixed cell voltages in V, 0..5, cell 1 first, comma-separated, one per cell (they set --cells); "
+                 "default: the cells follow the charge")
+      ->delimiter(',')
+      ->check(range(0, 5))
+      ->needs(battery_opt);
   app.add_option("--battery-garble", given.battery_garble,
                  "Spoil every battery frame: none (default), wrong_length or unknown_subindex")
       ->check(CLI::IsMember({"none", "wrong_length", "unknown_subindex"}))
@@ -139,7 +142,8 @@ void add_solar_options(CLI::App& app, SimOptions& o, GivenText& given) {
   app.add_option("--panels", o.panels, "Panels on channels 1..N of each MPPT, 0..4 (default 4)")
       ->check(CLI::Range(0, 4))
       ->needs(mppt_opt);
-  app.add_option("--mppt-garble", given.mppt_garble, "Spoil every MPPT frame: none (default), wrong_length or unknown_subindex")
+  app.add_option("--mppt-garble", given.mppt_garble,
+                 "Spoil every MPPT frame: none (default), wrong_length or unknown_subindex")
       ->check(CLI::IsMember({"none", "wrong_length", "unknown_subindex"}))
       ->needs(mppt_opt);
   app.add_flag("--mppt-silent", o.mppt_silent, "The MPPTs send nothing")->needs(mppt_opt);
@@ -163,8 +167,9 @@ bool take_given(SimOptions& o, const GivenText& given) {
   // Every argument is checked before the bus is opened (interface.md 3.3): the model would
   // refuse this firmware only once the bus is open.
   if (!pmu::codec::is_described(*fw)) {
-    std::fprintf(stderr, "pmu-sim: --firmware %s: the simulator is firmware %s..%s (the versions the protocol "
-                         "documents describe)\n",
+    std::fprintf(stderr,
+                 "pmu-sim: --firmware %s: the simulator is firmware %s..%s (the versions the protocol "
+                 "documents describe)\n",
                  given.firmware.c_str(), pmu::codec::to_string(pmu::codec::kOldestDescribedFirmware).c_str(),
                  pmu::codec::to_string(pmu::codec::kCurrentFirmware).c_str());
     return false;

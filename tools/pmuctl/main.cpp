@@ -49,9 +49,8 @@ struct AgentCall {
 };
 
 std::uint64_t epoch_ns_now() {
-  return static_cast<std::uint64_t>(std::chrono::duration_cast<std::chrono::nanoseconds>(
-                                        std::chrono::system_clock::now().time_since_epoch())
-                                        .count());
+  return static_cast<std::uint64_t>(
+      std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::system_clock::now().time_since_epoch()).count());
 }
 
 // CLI11 reads "-inf" or "-nan" as short options (-i...), so `config set avionics_voltage -inf`
@@ -60,7 +59,8 @@ std::uint64_t epoch_ns_now() {
 const char* infinite_argument(int argc, char** argv) {
   for (int i = 1; i < argc; ++i) {
     char* end = nullptr;
-    const double v = argv[i][0] == '-' && std::isalpha(static_cast<unsigned char>(argv[i][1])) ? std::strtod(argv[i], &end) : 0;
+    const double v =
+        argv[i][0] == '-' && std::isalpha(static_cast<unsigned char>(argv[i][1])) ? std::strtod(argv[i], &end) : 0;
     if (end && *end == '\0' && !std::isfinite(v)) return argv[i];
   }
   return nullptr;
@@ -74,19 +74,24 @@ class AgentVerb : public pmu::tools::Verb {
  public:
   explicit AgentVerb(CLI::App& app) {
     agent_ = app.add_subcommand(
-        "agent", "Keep this host's DDS participants for the pmuctl calls made on it (a ground station on a radio "
-                 "link) until Ctrl-C or SIGTERM");
-    agent_->add_option("--socket", socket_,
-                       "The socket calls find it at (default: $PMU_AGENT_SOCKET, else $XDG_RUNTIME_DIR/pmu-dds/"
-                       "agent-DOMAIN.sock, else /run/pmu-dds/agent-DOMAIN.sock)")
+        "agent",
+        "Keep this host's DDS participants for the pmuctl calls made on it (a ground station on a radio "
+        "link) until Ctrl-C or SIGTERM");
+    agent_
+        ->add_option("--socket", socket_,
+                     "The socket calls find it at (default: $PMU_AGENT_SOCKET, else $XDG_RUNTIME_DIR/pmu-dds/"
+                     "agent-DOMAIN.sock, else /run/pmu-dds/agent-DOMAIN.sock)")
         ->type_name("PATH");
-    workers_option_ = agent_->add_option("--workers", workers_,
-                      "Calls served at once, each by a process with its own DDS participant (default 4; 1 with --link "
-                      "radio without a Discovery Server), besides one "
-                      "for engine stops, which never wait. Calls go to the first while it keeps up; the next takes "
-                      "one when all before it have been on theirs for 5 s, so a call that waits for a silent "
-                      "aircraft holds up no other for longer")
-        ->check(CLI::Range(1, 16));
+    workers_option_ =
+        agent_
+            ->add_option(
+                "--workers", workers_,
+                "Calls served at once, each by a process with its own DDS participant (default 4; 1 with --link "
+                "radio without a Discovery Server), besides one "
+                "for engine stops, which never wait. Calls go to the first while it keeps up; the next takes "
+                "one when all before it have been on theirs for 5 s, so a call that waits for a silent "
+                "aircraft holds up no other for longer")
+            ->check(CLI::Range(1, 16));
   }
   bool chosen() const override { return agent_->parsed(); }
   // It runs other calls until stopped.
@@ -149,10 +154,12 @@ int run_cli(int argc, char** argv, const AgentCall* served) {
   verbs.push_back(pmu::tools::add_serve_verb(app));
 
   if (const char* infinite = infinite_argument(argc, argv)) {
-    const bool json_asked = std::any_of(argv + 1, argv + argc, [](const char* a) { return std::strcmp(a, "--json") == 0; });
+    const bool json_asked =
+        std::any_of(argv + 1, argv + argc, [](const char* a) { return std::strcmp(a, "--json") == 0; });
     return pmu::tools::fail(json_asked, pmu::tools::ExitStatus::BadUsage,
-                            std::string("'") + infinite + "' is not a finite number (a value is a number in the "
-                            "parameter's unit)");
+                            std::string("'") + infinite +
+                                "' is not a finite number (a value is a number in the "
+                                "parameter's unit)");
   }
   try {
     app.parse(argc, argv);
@@ -181,7 +188,8 @@ int run_cli(int argc, char** argv, const AgentCall* served) {
   const bool engine_stop = kind == pmu::v5::ENGINE_STOP;
   // The caller's wait: --timeout, else the verb's default (pmuctl(1)), from the call's start.
   const double wait = g.timeout.value_or(verb->reads_state() ? 3.0 : 5.0);
-  g.deadline = began + std::chrono::duration_cast<std::chrono::steady_clock::duration>(std::chrono::duration<double>(wait));
+  g.deadline =
+      began + std::chrono::duration_cast<std::chrono::steady_clock::duration>(std::chrono::duration<double>(wait));
   g.deadline_ns = began_ns + static_cast<std::uint64_t>(wait * 1e9);
   if (served) {
     if (!agent_serves) {
@@ -202,7 +210,8 @@ int run_cli(int argc, char** argv, const AgentCall* served) {
     const std::uint64_t now_ns = epoch_ns_now();
     g.deadline_ns = served->request.deadline_ns;
     const auto left = std::chrono::nanoseconds(g.deadline_ns > now_ns ? g.deadline_ns - now_ns : 0);
-    g.deadline = std::chrono::steady_clock::now() + std::chrono::duration_cast<std::chrono::steady_clock::duration>(left);
+    g.deadline =
+        std::chrono::steady_clock::now() + std::chrono::duration_cast<std::chrono::steady_clock::duration>(left);
     if (left.count() == 0)
       return pmu::tools::fail(g, pmu::tools::ExitStatus::NoAnswer,
                               "the call's wait (--timeout) ended before the agent could run it: not run");
@@ -218,9 +227,10 @@ int run_cli(int argc, char** argv, const AgentCall* served) {
     // A partition is a vehicle (pmu/dds_settings/vehicle.hpp): say it in the operator's terms.
     std::fprintf(stderr, "pmuctl: %s\n", e.what());
     if (!g.vehicle)
-      std::fprintf(stderr, "pmuctl: without --vehicle pmuctl reads every vehicle (partitions \"\" and \"*\") and "
-                           "commands the unnamed vehicle; this identity is confined to some vehicles: name one "
-                           "of them with --vehicle\n");
+      std::fprintf(stderr,
+                   "pmuctl: without --vehicle pmuctl reads every vehicle (partitions \"\" and \"*\") and "
+                   "commands the unnamed vehicle; this identity is confined to some vehicles: name one "
+                   "of them with --vehicle\n");
     else
       std::fprintf(stderr, "pmuctl: %s is not one of this identity's vehicles\n",
                    g.vehicle->empty() ? "the unnamed vehicle" : ("vehicle " + *g.vehicle).c_str());

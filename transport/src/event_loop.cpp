@@ -44,8 +44,8 @@ int EventLoop::watch(int fd, std::uint32_t events, FdCallback callback) {
 }
 
 int EventLoop::unwatch(int fd) noexcept {
-  const auto found = std::find_if(watches_.begin(), watches_.end(),
-                                  [fd](const Watch& w) { return w.fd == fd && !w.removed; });
+  const auto found =
+      std::find_if(watches_.begin(), watches_.end(), [fd](const Watch& w) { return w.fd == fd && !w.removed; });
   if (found == watches_.end()) return ENOENT;
   // The fd may already be closed by a careless owner; the registration is gone then too.
   ::epoll_ctl(epoll_.get(), EPOLL_CTL_DEL, fd, nullptr);
@@ -76,11 +76,9 @@ void EventLoop::post_urgent(Work work) {
 
 void EventLoop::wake() noexcept { detail::signal_eventfd(wake_.get()); }
 
-EventLoop::TimerId EventLoop::add_timer(TimePoint deadline, std::chrono::nanoseconds period,
-                                        TimerCallback callback) {
+EventLoop::TimerId EventLoop::add_timer(TimePoint deadline, std::chrono::nanoseconds period, TimerCallback callback) {
   const TimerId id = next_timer_id_++;
-  timers_.push_back(Timer{id, deadline, std::max(period, std::chrono::nanoseconds{0}),
-                          std::move(callback)});
+  timers_.push_back(Timer{id, deadline, std::max(period, std::chrono::nanoseconds{0}), std::move(callback)});
   return id;
 }
 
@@ -136,8 +134,7 @@ int EventLoop::wait_ms(std::chrono::milliseconds max_wait) const noexcept {
 
 std::size_t EventLoop::run_once(std::chrono::milliseconds max_wait) {
   ++turn_;
-  const int ready = ::epoll_wait(epoll_.get(), ready_.data(), static_cast<int>(ready_.size()),
-                                 wait_ms(max_wait));
+  const int ready = ::epoll_wait(epoll_.get(), ready_.data(), static_cast<int>(ready_.size()), wait_ms(max_wait));
   std::size_t called = 0;
   bool woken = false;
   dispatching_ = true;

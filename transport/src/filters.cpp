@@ -11,9 +11,7 @@ constexpr std::uint32_t kExact11 = 0x7FFu;
 
 }  // namespace
 
-IdFilter pmu_filter() noexcept {
-  return IdFilter{std::uint32_t{codec::kGroupId} << 24, kGroupMask, true};
-}
+IdFilter pmu_filter() noexcept { return IdFilter{std::uint32_t{codec::kGroupId} << 24, kGroupMask, true}; }
 
 std::vector<IdFilter> canopen_filters() {
   // The codec's COB-IDs (canopen.hpp): each battery id exactly, then the MPPT range as the

@@ -6,8 +6,7 @@ namespace pmu::transport {
 
 struct can_frame to_linux(const codec::CanFrame& frame) noexcept {
   struct can_frame raw {};
-  raw.can_id = frame.extended ? ((frame.id & CAN_EFF_MASK) | CAN_EFF_FLAG)
-                              : (frame.id & CAN_SFF_MASK);
+  raw.can_id = frame.extended ? ((frame.id & CAN_EFF_MASK) | CAN_EFF_FLAG) : (frame.id & CAN_SFF_MASK);
   if (frame.remote) raw.can_id |= CAN_RTR_FLAG;
   raw.len = std::min(frame.length, codec::kMaxDataLength);
   std::copy_n(frame.data.begin(), raw.len, raw.data);

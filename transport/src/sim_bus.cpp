@@ -23,8 +23,7 @@ struct SimShared {
 
 }  // namespace detail
 
-SimulatedNetwork::SimulatedNetwork(const Clock& clock)
-    : shared_(std::make_shared<detail::SimShared>(clock)) {}
+SimulatedNetwork::SimulatedNetwork(const Clock& clock) : shared_(std::make_shared<detail::SimShared>(clock)) {}
 
 SimulatedNetwork::~SimulatedNetwork() = default;
 
@@ -62,8 +61,7 @@ std::size_t SimulatedNetwork::endpoint_count() const {
   return shared_->endpoints.size();
 }
 
-SimBus::SimBus(Private, std::shared_ptr<detail::SimShared> shared, std::string name,
-               SimBusOptions options)
+SimBus::SimBus(Private, std::shared_ptr<detail::SimShared> shared, std::string name, SimBusOptions options)
     : shared_(std::move(shared)),
       name_(std::move(name)),
       options_(std::move(options)),

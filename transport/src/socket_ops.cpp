@@ -48,9 +48,7 @@ class SystemSocketOps final : public SocketOps {
     address.can_ifindex = ifindex;
     // sockaddr_can is one of the sockaddr family types bind() is declared to take; the
     // cast is the API's, not a reinterpretation of our data.
-    return ::bind(fd, reinterpret_cast<const struct sockaddr*>(&address), sizeof(address)) == 0
-               ? 0
-               : failed();
+    return ::bind(fd, reinterpret_cast<const struct sockaddr*>(&address), sizeof(address)) == 0 ? 0 : failed();
   }
 
   int receive(int fd, struct mmsghdr* messages, unsigned int count) override {

@@ -18,8 +18,7 @@ namespace {
 
 // Error frames that change or explain the bus state. CAN_ERR_BUSERROR, CAN_ERR_PROT and
 // CAN_ERR_ACK are left out: they arrive once per failed frame and can flood.
-constexpr can_err_mask_t kErrorMask =
-    CAN_ERR_TX_TIMEOUT | CAN_ERR_CRTL | CAN_ERR_BUSOFF | CAN_ERR_RESTARTED;
+constexpr can_err_mask_t kErrorMask = CAN_ERR_TX_TIMEOUT | CAN_ERR_CRTL | CAN_ERR_BUSOFF | CAN_ERR_RESTARTED;
 
 // POLLOUT reports room in the socket buffer; ENOBUFS is about the device queue, which no
 // fd announces, so after a POLLOUT that did not help we pause this long before retrying.
@@ -35,10 +34,8 @@ std::optional<BusState> state_from_error_frame(const struct can_frame& raw) noex
   if ((raw.can_id & CAN_ERR_BUSOFF) != 0) return BusState::BusOff;
   if ((raw.can_id & CAN_ERR_CRTL) != 0) {
     const std::uint8_t status = raw.data[1];
-    if ((status & (CAN_ERR_CRTL_RX_PASSIVE | CAN_ERR_CRTL_TX_PASSIVE)) != 0)
-      return BusState::ErrorPassive;
-    if ((status & (CAN_ERR_CRTL_RX_WARNING | CAN_ERR_CRTL_TX_WARNING)) != 0)
-      return BusState::ErrorWarning;
+    if ((status & (CAN_ERR_CRTL_RX_PASSIVE | CAN_ERR_CRTL_TX_PASSIVE)) != 0) return BusState::ErrorPassive;
+    if ((status & (CAN_ERR_CRTL_RX_WARNING | CAN_ERR_CRTL_TX_WARNING)) != 0) return BusState::ErrorWarning;
     if ((status & CAN_ERR_CRTL_ACTIVE) != 0) return BusState::Up;
   }
   if ((raw.can_id & CAN_ERR_RESTARTED) != 0) return BusState::Up;
@@ -64,8 +61,8 @@ struct SetupFailure {
 // Applies the socket options. `can_socket`: the fd is AF_CAN, so the CAN_RAW options must
 // succeed and any failure is returned; otherwise (an adopted fd) every option is best
 // effort and `report` records what took.
-std::optional<SetupFailure> configure(SocketOps& ops, int fd, const SocketCanOptions& options,
-                                      bool can_socket, SocketCanReport& report) {
+std::optional<SetupFailure> configure(SocketOps& ops, int fd, const SocketCanOptions& options, bool can_socket,
+                                      SocketCanReport& report) {
   report = SocketCanReport{};
 
   std::vector<struct can_filter> filters;
@@ -77,12 +74,10 @@ std::optional<SetupFailure> configure(SocketOps& ops, int fd, const SocketCanOpt
   // No filter list means "everything", which is also the kernel's default.
   int rc = filters.empty() ? 0
                            : ops.set_option(fd, SOL_CAN_RAW, CAN_RAW_FILTER, filters.data(),
-                                            static_cast<socklen_t>(filters.size() *
-                                                                   sizeof(struct can_filter)));
+                                            static_cast<socklen_t>(filters.size() * sizeof(struct can_filter)));
   if (rc < 0 && can_socket) return SetupFailure{-rc, "setsockopt(CAN_RAW_FILTER)"};
   const can_err_mask_t error_mask = kErrorMask;
-  const int rc_err =
-      ops.set_option(fd, SOL_CAN_RAW, CAN_RAW_ERR_FILTER, &error_mask, sizeof(error_mask));
+  const int rc_err = ops.set_option(fd, SOL_CAN_RAW, CAN_RAW_ERR_FILTER, &error_mask, sizeof(error_mask));
   if (rc_err < 0 && can_socket) return SetupFailure{-rc_err, "setsockopt(CAN_RAW_ERR_FILTER)"};
   report.kernel_filters = rc == 0 && rc_err == 0;
 
@@ -97,15 +92,12 @@ std::optional<SetupFailure> configure(SocketOps& ops, int fd, const SocketCanOpt
   // SO_RCVBUF at net.core.rmem_max, and we run with what we get and say so.
   if (options.receive_buffer_bytes > 0) {
     const int wanted = options.receive_buffer_bytes;
-    report.receive_buffer_forced =
-        ops.set_option(fd, SOL_SOCKET, SO_RCVBUFFORCE, &wanted, sizeof(wanted)) == 0;
-    if (!report.receive_buffer_forced)
-      ops.set_option(fd, SOL_SOCKET, SO_RCVBUF, &wanted, sizeof(wanted));
+    report.receive_buffer_forced = ops.set_option(fd, SOL_SOCKET, SO_RCVBUFFORCE, &wanted, sizeof(wanted)) == 0;
+    if (!report.receive_buffer_forced) ops.set_option(fd, SOL_SOCKET, SO_RCVBUF, &wanted, sizeof(wanted));
   }
   int obtained = 0;
   socklen_t size = sizeof(obtained);
-  if (ops.get_option(fd, SOL_SOCKET, SO_RCVBUF, &obtained, &size) == 0)
-    report.receive_buffer_bytes = obtained;
+  if (ops.get_option(fd, SOL_SOCKET, SO_RCVBUF, &obtained, &size) == 0) report.receive_buffer_bytes = obtained;
   return std::nullopt;
 }
 
@@ -121,8 +113,8 @@ struct SocketCanBus::Delivery {
   }
 };
 
-SocketCanBus::SocketCanBus(Private, std::string name, std::string interface,
-                           const SocketCanOptions& options, const Clock& clock, SocketOps& ops)
+SocketCanBus::SocketCanBus(Private, std::string name, std::string interface, const SocketCanOptions& options,
+                           const Clock& clock, SocketOps& ops)
     : name_(std::move(name)),
       interface_(std::move(interface)),
       options_(options),
@@ -132,11 +124,9 @@ SocketCanBus::SocketCanBus(Private, std::string name, std::string interface,
 
 SocketCanBus::~SocketCanBus() = default;
 
-std::unique_ptr<SocketCanBus> SocketCanBus::open(const std::string& interface,
-                                                 const SocketCanOptions& options,
+std::unique_ptr<SocketCanBus> SocketCanBus::open(const std::string& interface, const SocketCanOptions& options,
                                                  const Clock& clock, SocketOps& ops) {
-  if (interface.empty() || interface.size() >= IFNAMSIZ)
-    throw_setup(EINVAL, interface, "not a valid interface name");
+  if (interface.empty() || interface.size() >= IFNAMSIZ) throw_setup(EINVAL, interface, "not a valid interface name");
   auto bus = std::make_unique<SocketCanBus>(Private{}, interface, interface, options, clock, ops);
   Opened opened = bus->open_bound_socket();
   if (opened.error == ENODEV) {
@@ -157,8 +147,7 @@ std::unique_ptr<SocketCanBus> SocketCanBus::open(const std::string& interface,
   return bus;
 }
 
-std::unique_ptr<SocketCanBus> SocketCanBus::adopt(UniqueFd fd, const std::string& name,
-                                                  const SocketCanOptions& options,
+std::unique_ptr<SocketCanBus> SocketCanBus::adopt(UniqueFd fd, const std::string& name, const SocketCanOptions& options,
                                                   const Clock& clock, SocketOps& ops) {
   if (!fd) throw_setup(EBADF, name, "adopt");
   int type = 0;
@@ -168,8 +157,7 @@ std::unique_ptr<SocketCanBus> SocketCanBus::adopt(UniqueFd fd, const std::string
     throw_setup(-rc, name, "adopt: getsockopt(SO_TYPE)");
   auto bus = std::make_unique<SocketCanBus>(Private{}, name, std::string{}, options, clock, ops);
   configure(ops, fd.get(), options, false, bus->report_);
-  if (const int error = bus->attach_socket(std::move(fd)); error != 0)
-    throw_setup(error, name, "epoll_ctl(socket)");
+  if (const int error = bus->attach_socket(std::move(fd)); error != 0) throw_setup(error, name, "epoll_ctl(socket)");
   return bus;
 }
 
@@ -205,8 +193,7 @@ SocketCanBus::Opened SocketCanBus::open_bound_socket() {
 int SocketCanBus::attach_socket(UniqueFd socket) {
   // No callback: drain() reads the socket itself on every call, so the loop only has to
   // make fd() readable while frames wait.
-  if (const int error = loop_.watch(socket.get(), EventLoop::kReadable, {}); error != 0)
-    return error;
+  if (const int error = loop_.watch(socket.get(), EventLoop::kReadable, {}); error != 0) return error;
   socket_ = std::move(socket);
   last_kernel_drops_ = 0;  // the running total starts again with each socket
   return 0;
@@ -325,8 +312,7 @@ void SocketCanBus::handle_record(std::size_t index, Delivery& out) {
     return;
   }
   std::optional<std::chrono::system_clock::time_point> kernel_time;
-  for (struct cmsghdr* c = CMSG_FIRSTHDR(&message.msg_hdr); c != nullptr;
-       c = CMSG_NXTHDR(&message.msg_hdr, c)) {
+  for (struct cmsghdr* c = CMSG_FIRSTHDR(&message.msg_hdr); c != nullptr; c = CMSG_NXTHDR(&message.msg_hdr, c)) {
     if (c->cmsg_level != SOL_SOCKET) continue;
     if (c->cmsg_type == SCM_TIMESTAMPNS && c->cmsg_len >= CMSG_LEN(sizeof(struct timespec))) {
       struct timespec ts {};
@@ -364,14 +350,13 @@ void SocketCanBus::handle_record(std::size_t index, Delivery& out) {
   out.handler.on_frame(ReceivedFrame{*frame, time, kernel_time.has_value()});
 }
 
-void SocketCanBus::handle_error_frame(const struct can_frame& raw,
-                                      std::chrono::system_clock::time_point time, Delivery& out) {
+void SocketCanBus::handle_error_frame(const struct can_frame& raw, std::chrono::system_clock::time_point time,
+                                      Delivery& out) {
   ++counters_.error_frames;
   BusEvent event = make_event(BusEventKind::ErrorFrame);
   event.time = time;
   event.error_class = raw.can_id & CAN_ERR_MASK;
-  std::copy_n(raw.data, std::min<std::size_t>(raw.len, event.error_data.size()),
-              event.error_data.begin());
+  std::copy_n(raw.data, std::min<std::size_t>(raw.len, event.error_data.size()), event.error_data.begin());
   emit(event, &out);
   if (const auto next = state_from_error_frame(raw)) set_state(*next, &out);
 }
@@ -402,28 +387,23 @@ SendResult SocketCanBus::send(const codec::CanFrame& frame, std::chrono::millise
     // A short write of a datagram cannot happen on CAN_RAW; treat it as an I/O error.
     const int error = sent < 0 ? static_cast<int>(-sent) : EIO;
     switch (error) {
-      case EINTR:
-        continue;
+      case EINTR: continue;
       case ENOBUFS:
       case EAGAIN: {
         const auto now = clock_.steady_now();
         if (now >= deadline) return fail_send(SendStatus::Timeout, error);
         const auto left = std::chrono::ceil<std::chrono::milliseconds>(deadline - now);
         const int wait_ms = static_cast<int>(std::max<decltype(left.count())>(left.count(), 1));
-        struct pollfd writable {socket_.get(), POLLOUT, 0};
+        struct pollfd writable {
+          socket_.get(), POLLOUT, 0
+        };
         const int ready = ops_.poll(&writable, 1, wait_ms);
-        if (ready > 0 && error == ENOBUFS)
-          ops_.poll(nullptr, 0, std::min(wait_ms, kNoBufferPauseMs));
+        if (ready > 0 && error == ENOBUFS) ops_.poll(nullptr, 0, std::min(wait_ms, kNoBufferPauseMs));
         continue;
       }
-      case ENETDOWN:
-        set_state(BusState::Down, nullptr);
-        return fail_send(SendStatus::Down, error);
-      case ENODEV:
-        lose_socket(error, nullptr);
-        return fail_send(SendStatus::NoDevice, error);
-      default:
-        return fail_send(SendStatus::Error, error);
+      case ENETDOWN: set_state(BusState::Down, nullptr); return fail_send(SendStatus::Down, error);
+      case ENODEV: lose_socket(error, nullptr); return fail_send(SendStatus::NoDevice, error);
+      default: return fail_send(SendStatus::Error, error);
     }
   }
 }

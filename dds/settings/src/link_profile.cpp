@@ -29,10 +29,8 @@ std::optional<LinkProfile> parse_link_profile(std::string_view text) {
 
 const char* to_string(LinkProfile profile) noexcept {
   switch (profile) {
-    case LinkProfile::None:
-      return "none";
-    case LinkProfile::Radio:
-      return "radio";
+    case LinkProfile::None: return "none";
+    case LinkProfile::Radio: return "radio";
   }
   return "none";
 }

@@ -144,7 +144,8 @@ std::string parse_interface(std::string_view text, Address& out) {
   } else if (text.size() > kMaxInterfaceName || text == "." || text == ".." ||
              std::any_of(text.begin(), text.end(),
                          [](char c) { return c == '/' || c == ':' || std::isspace(static_cast<unsigned char>(c)); })) {
-    return "'" + std::string(text) + "' is not an interface name (1..15 characters, no '/', ':' or space) "
+    return "'" + std::string(text) +
+           "' is not an interface name (1..15 characters, no '/', ':' or space) "
            "or an IPv4 address";
   }
   out.host = std::string(text);

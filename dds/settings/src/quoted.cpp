@@ -13,7 +13,11 @@ bool continuation(unsigned char ch) { return (ch & 0xC0) == 0x80; }
 // The length of the UTF-8 sequence at `at`, or 0 when none starts there.
 std::size_t sequence_length(std::string_view s, std::size_t at) {
   const auto lead = static_cast<unsigned char>(s[at]);
-  const std::size_t n = lead < 0x80 ? 1 : (lead & 0xE0) == 0xC0 ? 2 : (lead & 0xF0) == 0xE0 ? 3 : (lead & 0xF8) == 0xF0 ? 4 : 0;
+  const std::size_t n = lead < 0x80             ? 1
+                        : (lead & 0xE0) == 0xC0 ? 2
+                        : (lead & 0xF0) == 0xE0 ? 3
+                        : (lead & 0xF8) == 0xF0 ? 4
+                                                : 0;
   if (n == 0 || at + n > s.size()) return 0;
   for (std::size_t i = 1; i < n; ++i)
     if (!continuation(static_cast<unsigned char>(s[at + i]))) return 0;

@@ -62,8 +62,8 @@ std::string ros2_device_token(Ros2Device kind, std::uint16_t address) {
   return prefix + std::to_string(address);
 }
 
-std::string ros2_device_namespace(std::string_view ns, std::string_view vehicle, std::string_view bus,
-                                  Ros2Device kind, std::uint16_t address) {
+std::string ros2_device_namespace(std::string_view ns, std::string_view vehicle, std::string_view bus, Ros2Device kind,
+                                  std::uint16_t address) {
   using namespace ros2_names;
   std::string path = absolute(ns);
   append_token(path, ros2_token(vehicle));

@@ -82,12 +82,9 @@ AckResult Alarm::acknowledge(Time now) noexcept {
     case AlarmState::ActiveUnacknowledged:
       set_state(AlarmState::ActiveAcknowledged, now);
       return AckResult::Acknowledged;
-    case AlarmState::ClearedUnacknowledged:
-      set_state(AlarmState::Normal, now);
-      return AckResult::Acknowledged;
+    case AlarmState::ClearedUnacknowledged: set_state(AlarmState::Normal, now); return AckResult::Acknowledged;
     case AlarmState::Normal:
-    case AlarmState::ActiveAcknowledged:
-      break;
+    case AlarmState::ActiveAcknowledged: break;
   }
   return AckResult::NothingToAcknowledge;
 }

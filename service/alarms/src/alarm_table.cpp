@@ -37,10 +37,12 @@ constexpr std::array<AlarmSpec, kCodeCount> kTable{{
      Documented, kStatus},
     // v1.9 5.5 table 6, flag register 0 bit 6, from firmware 1.16 (6.8; before it the bit is
     // the start button, so only a Status whose interpretation says SoaShutdown feeds this).
-    {Code::SoaShutdown, "soa_shutdown", "SOA shutdown", Pmu, Critical, Flag, 0, "", 0, 0, 0ms, 0ms, Documented, kStatus},
+    {Code::SoaShutdown, "soa_shutdown", "SOA shutdown", Pmu, Critical, Flag, 0, "", 0, 0, 0ms, 0ms, Documented,
+     kStatus},
     // v1.9 5.5 table 6, flag register 0 bit 7. The aircraft still flies without its payload,
     // so a warning. The off-delay keeps a PMU that sheds and restores in turn to one alarm.
-    {Code::PayloadShed, "payload_shed", "payload shed", Pmu, Warning, Flag, 0, "", 0, 0, 0ms, 5000ms, Documented, kStatus},
+    {Code::PayloadShed, "payload_shed", "payload shed", Pmu, Warning, Flag, 0, "", 0, 0, 0ms, 5000ms, Documented,
+     kStatus},
     // Battery voltages (v1.9 table 2: 0..25.0 V in 0.1 V steps). V_B may be set from 20.0 to
     // 25.2 V (5.10 table 11), and 25.2 V = 6 x 4.2 V: the PMU is built for a 6S Li-ion pack.
     // Absolute values for that pack, not a fraction of the stored V_B: V_B is the charging
@@ -52,12 +54,12 @@ constexpr std::array<AlarmSpec, kCodeCount> kTable{{
     // battery disables the other battery's rows there.
     {Code::BatteryALowVoltage, "battery_a_low_voltage", "battery A", Pmu, Warning, Below, 21.0, "V", 1, 0.3, 10000ms,
      10000ms, Chosen, kVoltages},
-    {Code::BatteryACriticalVoltage, "battery_a_critical_voltage", "battery A", Pmu, Critical, Below, 19.8, "V", 1,
-     0.3, 10000ms, 10000ms, Chosen, kVoltages},
+    {Code::BatteryACriticalVoltage, "battery_a_critical_voltage", "battery A", Pmu, Critical, Below, 19.8, "V", 1, 0.3,
+     10000ms, 10000ms, Chosen, kVoltages},
     {Code::BatteryBLowVoltage, "battery_b_low_voltage", "battery B", Pmu, Warning, Below, 21.0, "V", 1, 0.3, 10000ms,
      10000ms, Chosen, kVoltages},
-    {Code::BatteryBCriticalVoltage, "battery_b_critical_voltage", "battery B", Pmu, Critical, Below, 19.8, "V", 1,
-     0.3, 10000ms, 10000ms, Chosen, kVoltages},
+    {Code::BatteryBCriticalVoltage, "battery_b_critical_voltage", "battery B", Pmu, Critical, Below, 19.8, "V", 1, 0.3,
+     10000ms, 10000ms, Chosen, kVoltages},
     // Temperatures (v1.9 table 5, 1 degC steps). The document gives the ranges, no ratings.
     // Deadbands are 10 % of the limit, the hysteresis the PMU itself applies to T_U (5.14).
     // Temperatures move slowly: a single reading over the limit is noise, so 5 s on and 10 s
@@ -65,29 +67,29 @@ constexpr std::array<AlarmSpec, kCodeCount> kTable{{
     // and thermal_shutdown reports it; this warns before it, 15 degC under the 85 degC
     // industrial rating of electronics, as the sensor sits inside the case. A unit whose T_U
     // is lower sets this limit a few degrees under its T_U.
-    {Code::InternalOverTemperature, "internal_over_temperature", "PMU internal", Pmu, Warning, Above, 70, "degC", 0,
-     7, 5000ms, 10000ms, Chosen, kTemperatures},
+    {Code::InternalOverTemperature, "internal_over_temperature", "PMU internal", Pmu, Warning, Above, 70, "degC", 0, 7,
+     5000ms, 10000ms, Chosen, kTemperatures},
     // The starter module (table 5: -49..127 degC) heats while cranking: 85 degC, the top of
     // the industrial range (-40..85 degC) such modules are rated for.
     {Code::StarterOverTemperature, "starter_over_temperature", "starter", Pmu, Warning, Above, 85, "degC", 0, 8.5,
      5000ms, 10000ms, Chosen, kTemperatures},
     // The generator is a BLDC motor (table 5); 100 degC stays under the 120 degC at which
     // common (H grade) NdFeB magnets start to lose strength for good.
-    {Code::GeneratorOverTemperature, "generator_over_temperature", "generator", Pmu, Warning, Above, 100, "degC", 0,
-     10, 5000ms, 10000ms, Chosen, kTemperatures},
+    {Code::GeneratorOverTemperature, "generator_over_temperature", "generator", Pmu, Warning, Above, 100, "degC", 0, 10,
+     5000ms, 10000ms, Chosen, kTemperatures},
     // Li-ion cells are commonly rated for discharge up to 60 degC; past it they age fast and
     // come nearer to thermal runaway, hence critical.
-    {Code::BatteryAOverTemperature, "battery_a_over_temperature", "battery A", Pmu, Critical, Above, 60, "degC", 0,
-     6, 5000ms, 10000ms, Chosen, kTemperatures},
-    {Code::BatteryBOverTemperature, "battery_b_over_temperature", "battery B", Pmu, Critical, Above, 60, "degC", 0,
-     6, 5000ms, 10000ms, Chosen, kTemperatures},
+    {Code::BatteryAOverTemperature, "battery_a_over_temperature", "battery A", Pmu, Critical, Above, 60, "degC", 0, 6,
+     5000ms, 10000ms, Chosen, kTemperatures},
+    {Code::BatteryBOverTemperature, "battery_b_over_temperature", "battery B", Pmu, Critical, Above, 60, "degC", 0, 6,
+     5000ms, 10000ms, Chosen, kTemperatures},
     // The PMU reports no such fault: the PMU's session raises the flag while generation is
     // enabled (table 6, flag register 0 bit 4) and the engine is at its running speed (the
     // unit's engine.running_rpm) but the generator voltage (table 2) is below V_B, so it
     // cannot charge. 10 s on as for the battery voltages: while the engine comes up to speed
     // the voltage lags.
-    {Code::GeneratorNotProducing, "generator_not_producing", "generator not producing", Pmu, Warning, Flag, 0, "", 0,
-     0, 10000ms, 5000ms, Chosen, kVoltages | kStatus},
+    {Code::GeneratorNotProducing, "generator_not_producing", "generator not producing", Pmu, Warning, Flag, 0, "", 0, 0,
+     10000ms, 5000ms, Chosen, kVoltages | kStatus},
     // The PMU's session raises the flag when the generator speed (table 6) falls below the
     // unit's engine.running_rpm, having been at it, with no engine stop command (0x25) sent.
     // 1 s on: two or more status packets at the service's
@@ -98,11 +100,14 @@ constexpr std::array<AlarmSpec, kCodeCount> kTable{{
     // State of charge (0x302 0x2005 0x05, 1 %/LSB). PX4's BAT_LOW_THR (15 %) and BAT_CRIT_THR
     // (7 %); its BAT_EMERGEN_THR (5 %) is an action, not an alarm, so it has no row. Deadband
     // 2 % so a reading that flips by one step does not clear it; 10 s as ArduPilot's timer.
-    {Code::BmsLowSoc, "bms_low_soc", "SOC", Battery, Warning, Below, 15, "%", 0, 2, 10000ms, 10000ms, Chosen, kNoPacket},
-    {Code::BmsCriticalSoc, "bms_critical_soc", "SOC", Battery, Critical, Below, 7, "%", 0, 2, 10000ms, 10000ms, Chosen, kNoPacket},
+    {Code::BmsLowSoc, "bms_low_soc", "SOC", Battery, Warning, Below, 15, "%", 0, 2, 10000ms, 10000ms, Chosen,
+     kNoPacket},
+    {Code::BmsCriticalSoc, "bms_critical_soc", "SOC", Battery, Critical, Below, 7, "%", 0, 2, 10000ms, 10000ms, Chosen,
+     kNoPacket},
     // Lowest cell voltage (0x402 0x2005 0x0D, 1 mV/LSB): 3.30 V, the per-cell level of
     // battery_*_critical_voltage; one weak cell gets there before the pack does.
-    {Code::CellLow, "cell_low", "cell", Battery, Warning, Below, 3.30, "V", 2, 0.05, 10000ms, 10000ms, Chosen, kNoPacket},
+    {Code::CellLow, "cell_low", "cell", Battery, Warning, Below, 3.30, "V", 2, 0.05, 10000ms, 10000ms, Chosen,
+     kNoPacket},
     // Highest minus lowest cell voltage (0x402 0x0C - 0x0D). 0.10 V: well past what a
     // balancing BMS leaves. Imbalance builds over many cycles, while a load step spreads the
     // cells for a moment, so 30 s each way.
@@ -120,7 +125,8 @@ constexpr std::array<AlarmSpec, kCodeCount> kTable{{
     // The service's health (STALE / OFFLINE from frame age, docs/interface.md) already waits
     // its configured number of periods, so no delays here.
     {Code::DeviceStale, "device_stale", "device stale", Any, Warning, Flag, 0, "", 0, 0, 0ms, 0ms, Chosen, kNoPacket},
-    {Code::DeviceOffline, "device_offline", "device offline", Any, Critical, Flag, 0, "", 0, 0, 0ms, 0ms, Chosen, kNoPacket},
+    {Code::DeviceOffline, "device_offline", "device offline", Any, Critical, Flag, 0, "", 0, 0, 0ms, 0ms, Chosen,
+     kNoPacket},
     // The bus's state from the CAN controller (error counters over 127: error passive; over
     // 255: bus off). The counters fall by one a good frame, so a bus near 127 flips; 5 s off.
     {Code::BusErrorPassive, "bus_error_passive", "bus error passive", Bus, Warning, Flag, 0, "", 0, 0, 0ms, 5000ms,

@@ -76,8 +76,7 @@ codec::Result<std::vector<AlarmConfig>, std::string> resolve(DeviceKind kind, co
   for (const auto& row : alarm_table()) {
     const AlarmOverride& o = settings[row.code];
     if (!applies_to(row, kind)) {
-      if (!o.empty())
-        return Unexpected{std::string(row.name) + ": not an alarm of a " + std::string(to_string(kind))};
+      if (!o.empty()) return Unexpected{std::string(row.name) + ": not an alarm of a " + std::string(to_string(kind))};
       continue;
     }
     auto c = resolve(row.code, o);

@@ -67,9 +67,10 @@ std::unique_ptr<transport::CanBus> open_bus(const service::BusConfig& bus, const
                                                   options, clock)
                  : transport::SocketCanBus::open(bus.interface, options, clock);
     if (!b->has_socket()) {
-      spdlog::warn("{}: interface {} does not exist yet: waiting for it (pmu/health bus_state DOWN), bound when it "
-                   "appears",
-                   bus.name, bus.interface);
+      spdlog::warn(
+          "{}: interface {} does not exist yet: waiting for it (pmu/health bus_state DOWN), bound when it "
+          "appears",
+          bus.name, bus.interface);
       return b;
     }
     const auto& r = b->report();
@@ -114,8 +115,9 @@ int run(const service::Config& cfg, const pmu::dds::ResolvedNetwork& network) {
 
   spdlog::info("DDS: {}", network.summary);
   const auto partitions = pmu::dds::vehicle_partitions(cfg.vehicle);
-  pmu::dds::DdsContext participant(cfg.domain, cfg.qos_file, pmu::dds::kServiceParticipantName, cfg.security.files, cfg.dds_transport,
-                                   network, {partitions, partitions}, cfg.dds_statistics, cfg.dds_type_objects);
+  pmu::dds::DdsContext participant(cfg.domain, cfg.qos_file, pmu::dds::kServiceParticipantName, cfg.security.files,
+                                   cfg.dds_transport, network, {partitions, partitions}, cfg.dds_statistics,
+                                   cfg.dds_type_objects);
   // The link's values (link_profile.hpp): the participant took them from `network`.
   if (network.link.profile != pmu::dds::LinkProfile::None || network.link.round_trip.set())
     for (const auto& line : network.link.explain()) spdlog::info("DDS: {}", line);
@@ -166,7 +168,8 @@ int run(const service::Config& cfg, const pmu::dds::ResolvedNetwork& network) {
   std::vector<BusRuntime> buses(cfg.buses.size());
   for (std::size_t i = 0; i < cfg.buses.size(); ++i) {
     auto bus = open_bus(cfg.buses[i], clock, buses[i]);
-    buses[i].worker = std::make_unique<service::BusWorker>(cfg.buses[i], std::move(bus), clock, cfg.timeouts, state_sink);
+    buses[i].worker =
+        std::make_unique<service::BusWorker>(cfg.buses[i], std::move(bus), clock, cfg.timeouts, state_sink);
     // Only a device from the config file has an `address:` that can go stale.
     buses[i].worker->on_moved([&moved](const service::BusWorker::Moved& m) {
       if (!m.config_line.empty()) moved.record(m.bus, m.first, m.to, m.serial);
@@ -310,7 +313,8 @@ int main(int argc, char** argv) {
   std::optional<int> domain;
   bool check_only = false;
   app.add_option("--config", config_path, std::string("YAML config file (default ") + kDefaultConfig + ")");
-  app.add_option("--bus", bus_spec, "sim (built-in simulated PMU) or socketcan:IFACE; replaces the config's buses "
+  app.add_option("--bus", bus_spec,
+                 "sim (built-in simulated PMU) or socketcan:IFACE; replaces the config's buses "
                  "(fd:N: an inherited fd carrying struct can_frame records, for benchmarks)");
   app.add_option("--domain", domain, "DDS domain id (0..232)")->check(CLI::Range(0, 232));
   app.add_option("--log-level", log_level, "trace, debug, info, warn, error, critical or off");
@@ -327,7 +331,8 @@ int main(int argc, char** argv) {
   try {
     if (!config_path.empty()) {
       cfg = service::load_config(config_path);
-    } else if (bus_spec.empty() || ::access(kDefaultConfig, R_OK) == 0) {  // no open: a FIFO would block; load_config refuses one
+    } else if (bus_spec.empty() ||
+               ::access(kDefaultConfig, R_OK) == 0) {  // no open: a FIFO would block; load_config refuses one
       cfg = service::load_config(kDefaultConfig);
     } else {
       cfg = service::default_sim_config();

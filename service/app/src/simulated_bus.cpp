@@ -92,7 +92,9 @@ SimulatedBus make_simulated_bus(const BusConfig& bus, const transport::Clock& cl
     if (settings.cells) c.cells = *settings.cells;
     c.cell_voltages = settings.cell_voltages;
     s.simulator->add_battery(c);
-    s.simulator->with_battery(c.node, [&](sim::BatteryModel& m) { m.set_faults({settings.silent, garble_of(settings.garble)}); });
+    s.simulator->with_battery(c.node, [&](sim::BatteryModel& m) {
+      m.set_faults({settings.silent, garble_of(settings.garble)});
+    });
     spdlog::info("{}: built-in simulated battery (BMS) at node {}", bus.name, battery.node);
   }
   for (const auto& mppt : bus.mppts) {
@@ -102,7 +104,9 @@ SimulatedBus make_simulated_bus(const BusConfig& bus, const transport::Clock& cl
     const auto settings = settings_of(bus.sim.mppts, mppt.device);
     if (settings.panels) c.panels = *settings.panels;
     s.simulator->add_mppt(c);
-    s.simulator->with_mppt(c.device, [&](sim::MpptModel& m) { m.set_faults({settings.silent, garble_of(settings.garble)}); });
+    s.simulator->with_mppt(c.device, [&](sim::MpptModel& m) {
+      m.set_faults({settings.silent, garble_of(settings.garble)});
+    });
     spdlog::info("{}: built-in simulated MPPT, device {}", bus.name, mppt.device);
   }
   s.service_end = s.network->attach(bus.name);

@@ -41,8 +41,7 @@ std::vector<Change> apply_plan(const std::vector<Difference>& diffs, const servi
   for (const auto& d : diffs) {
     service::CommandRequest r;
     r.action = action_for(d.setting, d.file);
-    out.push_back({d.setting, d.device.value_or(0), d.file, d.line,
-                   service::confirm_rule_for(r, device)});
+    out.push_back({d.setting, d.device.value_or(0), d.file, d.line, service::confirm_rule_for(r, device)});
   }
   std::stable_sort(out.begin(), out.end(),
                    [](const Change& a, const Change& b) { return apply_rank(a.setting) < apply_rank(b.setting); });

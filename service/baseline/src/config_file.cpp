@@ -288,7 +288,8 @@ std::string write_config_file(const Header& h, const Settings& settings) {
     else
       value = value_text(setting_of(p), *raw).substr(0, value_text(setting_of(p), *raw).find(' '));
     std::string line = "  " + std::string(spec.name) + ": " + value;
-    if (!spec.unit.empty()) line += std::string(line.size() < 34 ? 34 - line.size() : 1, ' ') + "# " + std::string(spec.unit);
+    if (!spec.unit.empty())
+      line += std::string(line.size() < 34 ? 34 - line.size() : 1, ' ') + "# " + std::string(spec.unit);
     out += line + "\n";
   }
   if (const auto& o = settings[Setting::Outputs]) out += "outputs: " + mask_yaml(codec::kOutputNames, *o) + "\n";

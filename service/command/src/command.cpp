@@ -14,9 +14,18 @@ namespace {
 
 using Reject = codec::Unexpected<std::string>;
 
-constexpr std::array<std::string_view, kCommandKindCount> kKindNames{
-    "get", "set_parameter", "set_outputs", "enable_outputs", "disable_outputs", "set_generation",
-    "request_measurements", "engine_start", "engine_stop", "reset", "get_serial", "get_firmware"};
+constexpr std::array<std::string_view, kCommandKindCount> kKindNames{"get",
+                                                                     "set_parameter",
+                                                                     "set_outputs",
+                                                                     "enable_outputs",
+                                                                     "disable_outputs",
+                                                                     "set_generation",
+                                                                     "request_measurements",
+                                                                     "engine_start",
+                                                                     "engine_stop",
+                                                                     "reset",
+                                                                     "get_serial",
+                                                                     "get_firmware"};
 
 std::string quoted(std::string_view text) { return "'" + printable(text) + "'"; }
 
@@ -201,9 +210,9 @@ std::uint64_t content_fingerprint(const CommandSample& s) noexcept {
 codec::Result<CommandRequest, std::string> parse_command(const CommandSample& s, const Now& now,
                                                          const Lifetimes& lifetimes) {
   if (s.request_id.empty()) return Reject{std::string("request_id is empty")};
-  for (const auto& check : {within(s.request_id, kMaxRequestIdLength, "request_id"),
-                            within(s.bus, kMaxBusNameLength, "bus"),
-                            within(s.parameter, kMaxParameterLength, "parameter")})
+  for (const auto& check :
+       {within(s.request_id, kMaxRequestIdLength, "request_id"), within(s.bus, kMaxBusNameLength, "bus"),
+        within(s.parameter, kMaxParameterLength, "parameter")})
     if (!check) return Reject{check.error()};
   if (s.kind >= kCommandKindCount) return Reject{"unknown command kind " + std::to_string(s.kind)};
   const auto kind = static_cast<CommandKind>(s.kind);

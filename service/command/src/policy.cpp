@@ -10,8 +10,8 @@ namespace pmu::service {
 namespace {
 
 constexpr std::array<std::string_view, kConfirmRuleCount> kRuleNames{
-    "disable_avionics", "reset", "engine_start", "set_can_address", "thermal_shutdown", "power_up_avionics_off",
-    "stop_streaming", "blind_monitoring"};
+    "disable_avionics",      "reset",          "engine_start",    "set_can_address", "thermal_shutdown",
+    "power_up_avionics_off", "stop_streaming", "blind_monitoring"};
 
 // What each rule protects against, for the DENIED reason.
 constexpr std::array<std::string_view, kConfirmRuleCount> kRuleWhy{

@@ -43,8 +43,7 @@ void check(const std::string& source, const YAML::Node& at, alarms::Code code, c
 alarms::AlarmOverride parse_override(const std::string& source, const YAML::Node& n, alarms::Code code) {
   const std::string name(alarms::to_string(code));
   if (n.IsNull()) return {};
-  if (!n.IsMap())
-    fail(source, n, name + " must be a mapping, e.g. {limit: 20.5, on_delay: 10}");
+  if (!n.IsMap()) fail(source, n, name + " must be a mapping, e.g. {limit: 20.5, on_delay: 10}");
   alarms::AlarmOverride o;
   for (const auto& kv : n) {
     const auto key = kv.first.Scalar();

@@ -21,8 +21,9 @@ void read_baseline(const YAML::Node& n, const std::string& source, DeviceConfig&
   if (!n.IsScalar() || n.Scalar().empty()) refuse(n, source, "baseline must be the path of a PMU configuration file");
   d.baseline_file = n.Scalar();
   if (d.baseline_file.size() > baseline::kMaxPathBytes)
-    refuse(n, source, "baseline: the path is " + std::to_string(d.baseline_file.size()) + " bytes long; at most " +
-                          std::to_string(baseline::kMaxPathBytes) + " (pmu/baseline carries it)");
+    refuse(n, source,
+           "baseline: the path is " + std::to_string(d.baseline_file.size()) + " bytes long; at most " +
+               std::to_string(baseline::kMaxPathBytes) + " (pmu/baseline carries it)");
   // Relative to the config file, as qos_file: systemd runs the service in /.
   d.baseline_path = d.baseline_file.front() == '/' ? d.baseline_file : folder_of(source) + d.baseline_file;
   // Regular and bounded: /dev/zero or a FIFO named here must not stop the start (docs/safety.md H12).

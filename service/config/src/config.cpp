@@ -85,12 +85,13 @@ struct Ctx {
     // yaml-cpp reads 010 as octal 8 and 0x10 as 16 (YAML 1.1), so an address written with
     // a leading zero would silently name another device: only plain decimal is taken.
     if (n.IsScalar() && !codec::is_plain_decimal(n.Scalar()))
-      fail(n, std::string(name) + " must be a decimal integer (digits, optionally after '-'; no leading 0, '+', "
-                                  "0x, 0o, exponent or fraction), not " + quoted(n.Scalar()));
+      fail(n, std::string(name) +
+                  " must be a decimal integer (digits, optionally after '-'; no leading 0, '+', "
+                  "0x, 0o, exponent or fraction), not " +
+                  quoted(n.Scalar()));
     const auto v = scalar<long>(n, name, "an integer");
     if (v < lo || v > hi)
-      fail(n, std::string(name) + " " + n.Scalar() + " out of range " + std::to_string(lo) + ".." +
-                  std::to_string(hi));
+      fail(n, std::string(name) + " " + n.Scalar() + " out of range " + std::to_string(lo) + ".." + std::to_string(hi));
     return v;
   }
 
@@ -104,7 +105,8 @@ std::uint8_t parse_groups(const Ctx& c, const YAML::Node& n) {
     const auto name = c.scalar<std::string>(item, "packet", "a name");
     const auto bit = codec::bit_named(codec::kGroupNames, name);
     if (!bit)
-      c.fail(item, "unknown packet " + quoted(name) + " (known: " + codec::names_of(codec::kGroupNames, 0xFF, ", ") + ")");
+      c.fail(item,
+             "unknown packet " + quoted(name) + " (known: " + codec::names_of(codec::kGroupNames, 0xFF, ", ") + ")");
     mask = static_cast<std::uint8_t>(mask | *bit);
   }
   if (mask == 0) c.fail(n, "packets must name at least one packet");
@@ -116,7 +118,8 @@ std::chrono::milliseconds period_of(const Ctx& c, const YAML::Node& n, const cha
   // same rule.
   constexpr auto pp = codec::Parameter::PacketPeriod;
   const auto& spec = codec::spec_of(pp);
-  const double s = c.number(n, name, codec::parameter_value(pp, spec.raw_min), codec::parameter_value(pp, spec.raw_max));
+  const double s =
+      c.number(n, name, codec::parameter_value(pp, spec.raw_min), codec::parameter_value(pp, spec.raw_max));
   const double raw = s * spec.divisor;
   if (std::fabs(raw - std::round(raw)) > 1e-6) {
     std::ostringstream m;
@@ -135,7 +138,7 @@ void refuse_sim_on_real_bus(const Ctx& c, const YAML::Node& owner, const std::st
   for (const auto& kv : owner)
     if (kv.first.Scalar() == "sim")
       c.fail(kv.first, "sim: sets up the built-in simulator, but this bus has interface " + quoted(interface) +
-                             ", not sim (remove sim:, or set interface: sim)");
+                           ", not sim (remove sim:, or set interface: sim)");
 }
 
 bool sim_bool(const Ctx& c, const YAML::Node& n, const char* name) { return c.scalar<bool>(n, name, "true or false"); }
@@ -176,9 +179,9 @@ codec::FirmwareVersion firmware_of(const Ctx& c, const YAML::Node& n, const char
 }
 
 PmuSimSettings parse_pmu_sim(const Ctx& c, const YAML::Node& n) {
-  c.only_keys(n, "the PMU's sim", {"engine", "engine_starts_after", "internal_temperature", "battery_a_voltage",
-                                   "battery_b_voltage", "starter_ready", "silent", "soa_shutdown", "payload_shed",
-                                   "firmware", "serial", "ignores_set"});
+  c.only_keys(n, "the PMU's sim",
+              {"engine", "engine_starts_after", "internal_temperature", "battery_a_voltage", "battery_b_voltage",
+               "starter_ready", "silent", "soa_shutdown", "payload_shed", "firmware", "serial", "ignores_set"});
   PmuSimSettings s;
   if (const auto v = n["engine"]) {
     const auto e = c.scalar<std::string>(v, "engine", "running or stopped");
@@ -212,8 +215,8 @@ PmuSimSettings parse_pmu_sim(const Ctx& c, const YAML::Node& n) {
     // rather than by the model when the service starts (interface.md 4.4).
     if (!codec::is_described(*s.firmware))
       c.fail(v, "firmware " + quoted(v.Scalar()) + ": the simulator is firmware " +
-                    codec::to_string(codec::kOldestDescribedFirmware) + ".." + codec::to_string(codec::kCurrentFirmware) +
-                    " (the versions the protocol documents describe)");
+                    codec::to_string(codec::kOldestDescribedFirmware) + ".." +
+                    codec::to_string(codec::kCurrentFirmware) + " (the versions the protocol documents describe)");
   }
   if (const auto v = n["serial"]) s.serial = static_cast<std::uint16_t>(c.integer(v, "serial", 0, 65535));
   if (const auto v = n["ignores_set"]) {
@@ -269,7 +272,8 @@ void parse_device_settings(const Ctx& c, const YAML::Node& n, DeviceConfig& d) {
   }
   if (const auto p = n["period"]) d.period = period_of(c, p, "period");
   if (const auto p = n["packets"]) d.groups = parse_groups(c, p);
-  if (const auto p = n["configure_streaming"]) d.configure_streaming = c.scalar<bool>(p, "configure_streaming", "true or false");
+  if (const auto p = n["configure_streaming"])
+    d.configure_streaming = c.scalar<bool>(p, "configure_streaming", "true or false");
   // Table 6 carries the speed in 16 bits; a hold past the longest cranking time (25.5 s)
   // could never be met within one start.
   if (const auto p = n["engine_running_rpm"])
@@ -281,8 +285,9 @@ void parse_device_settings(const Ctx& c, const YAML::Node& n, DeviceConfig& d) {
 }
 
 DeviceConfig parse_device(const Ctx& c, const YAML::Node& n, BusConfig& b) {
-  c.only_keys(n, "device", {"address", "mode", "period", "packets", "configure_streaming", "engine_running_rpm",
-                            "engine_running_hold", "min_firmware", "sim", "alarms", "baseline"});
+  c.only_keys(n, "device",
+              {"address", "mode", "period", "packets", "configure_streaming", "engine_running_rpm",
+               "engine_running_hold", "min_firmware", "sim", "alarms", "baseline"});
   refuse_sim_on_real_bus(c, n, b.interface);
   DeviceConfig d;
   const auto a = n["address"];
@@ -353,8 +358,9 @@ void parse_mppts(const Ctx& c, const YAML::Node& n, BusConfig& b) {
 }
 
 BusConfig parse_bus(const Ctx& c, const YAML::Node& n) {
-  c.only_keys(n, "bus", {"name", "interface", "bitrate", "devices", "discover", "batteries", "mppts", "listen_canopen",
-                         "alarms"});
+  c.only_keys(
+      n, "bus",
+      {"name", "interface", "bitrate", "devices", "discover", "batteries", "mppts", "listen_canopen", "alarms"});
   BusConfig b;
   b.source_line = c.line_of(n);
   const auto iface = n["interface"];
@@ -405,7 +411,8 @@ BusConfig parse_bus(const Ctx& c, const YAML::Node& n) {
 
 void parse_timeouts(const Ctx& c, const YAML::Node& n, Timeouts& t) {
   c.only_keys(n, "timeouts", {"reply", "retries", "stale_periods", "offline_periods", "send"});
-  if (const auto v = n["reply"]) t.reply = std::chrono::milliseconds(std::lround(c.number(v, "reply", 0.01, 10) * 1000));
+  if (const auto v = n["reply"])
+    t.reply = std::chrono::milliseconds(std::lround(c.number(v, "reply", 0.01, 10) * 1000));
   if (const auto v = n["retries"]) t.retries = static_cast<unsigned>(c.integer(v, "retries", 0, 10));
   if (const auto v = n["stale_periods"]) t.stale_periods = c.number(v, "stale_periods", 1.5, 100);
   if (const auto v = n["offline_periods"]) t.offline_periods = c.number(v, "offline_periods", 2, 1000);
@@ -450,16 +457,14 @@ void parse_link(const Ctx& c, const YAML::Node& n, dds::LinkSettings& link) {
 }
 
 void parse_policy(const Ctx& c, const YAML::Node& n, PolicyConfig& p) {
-  c.only_keys(n, "policy", {"confirm", "deny", "rate_limit", "burst", "command_lifetime",
-                                "max_command_lifetime"});
+  c.only_keys(n, "policy", {"confirm", "deny", "rate_limit", "burst", "command_lifetime", "max_command_lifetime"});
   if (const auto v = n["confirm"]) {
     if (!v.IsSequence()) c.fail(v, "confirm must be a list of rule names (may be empty: [])");
     p.confirm.fill(false);
     for (const auto& item : v) {
       const auto name = c.scalar<std::string>(item, "confirm rule", "a name");
       const auto rule = confirm_rule_from_name(name);
-      if (!rule)
-        c.fail(item, "unknown confirm rule " + quoted(name) + " (known: " + confirm_rule_names() + ")");
+      if (!rule) c.fail(item, "unknown confirm rule " + quoted(name) + " (known: " + confirm_rule_names() + ")");
       p.confirm[static_cast<std::size_t>(*rule)] = true;
     }
   }
@@ -505,7 +510,8 @@ std::string credential_path(const Ctx& c, const YAML::Node& at, const char* key,
   if (!c.env.credentials_directory || c.env.credentials_directory->empty())
     c.fail(at, std::string(key) + ": credential:" + name +
                    " needs $CREDENTIALS_DIRECTORY, which is not set: the service was not started by systemd with "
-                   "LoadCredential=" + name + ":PATH (deploy/security/README.md)");
+                   "LoadCredential=" +
+                   name + ":PATH (deploy/security/README.md)");
   std::string dir = *c.env.credentials_directory;
   if (dir.back() != '/') dir += '/';
   return dir + name;
@@ -515,8 +521,9 @@ std::string credential_path(const Ctx& c, const YAML::Node& at, const char* key,
 // or credential:NAME.
 void parse_security(const Ctx& c, const YAML::Node& key, const YAML::Node& n, SecurityConfig& sec) {
   if (!n.IsMap()) c.fail(key, "security must be a mapping of the six files (see deploy/security/README.md)");
-  c.only_keys(n, "security", {"identity_ca", "identity_certificate", "private_key", "permissions_ca", "governance",
-                              "permissions", "warn_days"});
+  c.only_keys(n, "security",
+              {"identity_ca", "identity_certificate", "private_key", "permissions_ca", "governance", "permissions",
+               "warn_days"});
   sec.source_line = c.line_of(key);
   const std::string base = config_folder(c.source);
   std::string missing;
@@ -537,7 +544,8 @@ void parse_security(const Ctx& c, const YAML::Node& key, const YAML::Node& n, Se
     sec.key_lines[ref.key] = c.line_of(v);
   }
   if (!missing.empty())
-    c.fail(key, "security needs all six files: " + missing + " missing (or remove the section to run without security)");
+    c.fail(key,
+           "security needs all six files: " + missing + " missing (or remove the section to run without security)");
   if (const auto v = n["warn_days"]) sec.warn_days = static_cast<int>(c.integer(v, "warn_days", 0, 3650));
 }
 
@@ -570,8 +578,7 @@ std::vector<dds::Address> parse_address_list(const Ctx& c, const YAML::Node& n, 
     out.push_back(std::move(a));
   }
   if (std::all_of(out.begin(), out.end(), [](const dds::Address& a) { return a.host.empty(); }))
-    c.fail(n, key + " must name at least one " + what + " (an empty entry only leaves its id unused), e.g. " +
-                  example);
+    c.fail(n, key + " must name at least one " + what + " (an empty entry only leaves its id unused), e.g. " + example);
   return out;
 }
 
@@ -615,21 +622,25 @@ void parse_discovery(const Ctx& c, const YAML::Node& key, const YAML::Node& n, d
       c.fail(s[dds::kMaxServers], "more than " + std::to_string(dds::kMaxServers) + " servers (server ids are 0..255)");
   }
   if (net.mode == dds::DiscoveryMode::Unicast && net.peers.empty())
-    c.fail(at, "discovery mode unicast needs peers: a list of IPv4 addresses or host names, each with an optional "
-               ":PORT");
+    c.fail(at,
+           "discovery mode unicast needs peers: a list of IPv4 addresses or host names, each with an optional "
+           ":PORT");
   if (net.mode == dds::DiscoveryMode::Server && net.servers.empty())
-    c.fail(at, "discovery mode server needs servers: the Discovery Servers' ADDRESS[:PORT] (port 11811 if none), "
-               "in server id order");
+    c.fail(at,
+           "discovery mode server needs servers: the Discovery Servers' ADDRESS[:PORT] (port 11811 if none), "
+           "in server id order");
   if (net.mode != dds::DiscoveryMode::Multicast && transport == dds::Transport::ShmOnly)
-    c.fail(at, "discovery mode " + mode_name + " reaches other hosts over UDP, but dds_transport is shm "
-               "(shared memory only): set dds_transport to udp or default");
+    c.fail(at, "discovery mode " + mode_name +
+                   " reaches other hosts over UDP, but dds_transport is shm "
+                   "(shared memory only): set dds_transport to udp or default");
 }
 
 void parse_interfaces(const Ctx& c, const YAML::Node& key, const YAML::Node& n, dds::Transport transport,
                       dds::NetworkConfig& net) {
   if (transport == dds::Transport::ShmOnly)
-    c.fail(key, "interfaces restrict DDS over UDP, but dds_transport is shm (shared memory only, no network): "
-              "set dds_transport to udp or default, or remove interfaces");
+    c.fail(key,
+           "interfaces restrict DDS over UDP, but dds_transport is shm (shared memory only, no network): "
+           "set dds_transport to udp or default, or remove interfaces");
   // A bare `interfaces:` has no position of its own: report the key's line.
   net.interfaces = parse_address_list(c, n.IsNull() ? key : n, "interfaces", "interface", "[eth1, 192.168.10.1]");
 }
@@ -641,8 +652,8 @@ std::vector<std::string> parse_statistics(const Ctx& c, const YAML::Node& key, c
   const auto& known = dds::statistics_topic_names();
   if (n.IsScalar() && n.Scalar() == "all") return known;
   if (n.IsNull()) c.fail(key, "dds_statistics must be all or a list of statistics topic names (may be empty: [])");
-  if (!n.IsSequence()) c.fail(n, "dds_statistics must be all or a list of statistics topic names, e.g. [" +
-                                     known.front() + "]");
+  if (!n.IsSequence())
+    c.fail(n, "dds_statistics must be all or a list of statistics topic names, e.g. [" + known.front() + "]");
   std::vector<std::string> topics;
   for (const auto& item : n) {
     const auto name = c.scalar<std::string>(item, "statistics topic", "a name");
@@ -727,10 +738,10 @@ Config parse_config(const std::string& text, const std::string& source, const Co
   if (root.IsNull()) throw ConfigError(source + ":1: the file is empty");
   // Before any key is read: yaml-cpp keeps both of two equal keys, and n["key"] finds the first.
   refuse_duplicate_keys(c, root);
-  c.only_keys(root, "the top level", {"domain", "vehicle", "low_rate_period", "qos_file", "dds_transport", "log_level",
-                                      "buses", "timeouts", "policy", "security", "discovery", "interfaces",
-                                      "canopen_publish_period", "dds_statistics", "dds_type_objects",
-                                      "also_serve_contract", "ros2", "link"});
+  c.only_keys(root, "the top level",
+              {"domain", "vehicle", "low_rate_period", "qos_file", "dds_transport", "log_level", "buses", "timeouts",
+               "policy", "security", "discovery", "interfaces", "canopen_publish_period", "dds_statistics",
+               "dds_type_objects", "also_serve_contract", "ros2", "link"});
   if (const auto v = root["domain"]) cfg.domain = static_cast<int>(c.integer(v, "domain", 0, 232));
   if (const auto v = root["vehicle"]) {
     // `vehicle:` with nothing after it is YAML null: the unnamed vehicle, like no key.
@@ -741,7 +752,8 @@ Config parse_config(const std::string& text, const std::string& source, const Co
   if (const auto v = root["low_rate_period"]) {
     // 0 turns the low-rate topics off; below 0.1 s they would be no slower than a PMU streams.
     const double p = c.number(v, "low_rate_period", 0, 3600);
-    if (p != 0 && p < 0.1) c.fail(v, "low_rate_period " + v.Scalar() + " is below 0.1 s (0 turns the low-rate topics off)");
+    if (p != 0 && p < 0.1)
+      c.fail(v, "low_rate_period " + v.Scalar() + " is below 0.1 s (0 turns the low-rate topics off)");
     cfg.low_rate_period = std::chrono::milliseconds(std::lround(p * 1000));
   }
   std::chrono::milliseconds canopen_publish_period = BusConfig{}.canopen_publish_period;
@@ -765,7 +777,8 @@ Config parse_config(const std::string& text, const std::string& source, const Co
     else if (t != "default")
       c.fail(v, "dds_transport " + quoted(t) + " is not one of default, udp, shm");
   }
-  if (const auto v = root["dds_type_objects"]) cfg.dds_type_objects = c.scalar<bool>(v, "dds_type_objects", "true or false");
+  if (const auto v = root["dds_type_objects"])
+    cfg.dds_type_objects = c.scalar<bool>(v, "dds_type_objects", "true or false");
   if (const auto v = root["also_serve_contract"]) {
     // One step back only: the service writes the previous contract's names, and converts the
     // types whose layout or meaning changed (dds/include/pmu/dds/previous_contract.hpp).
@@ -835,8 +848,8 @@ Config parse_config(const std::string& text, const std::string& source, const Co
     if (!names.insert(b.name).second) c.fail(bn, "bus name " + quoted(b.name) + " appears twice");
     // ROS 2 names allow fewer characters than bus names: two buses must not share one.
     if (cfg.ros2.enabled && !ros2_names.emplace(dds::ros2_token(b.name), b.name).second)
-      c.fail(bn, "bus names " + quoted(ros2_names[dds::ros2_token(b.name)]) + " and " + quoted(b.name) +
-                     " are both " + quoted(dds::ros2_token(b.name)) + " in ROS 2 topic names (ros2 enabled); rename one");
+      c.fail(bn, "bus names " + quoted(ros2_names[dds::ros2_token(b.name)]) + " and " + quoted(b.name) + " are both " +
+                     quoted(dds::ros2_token(b.name)) + " in ROS 2 topic names (ros2 enabled); rename one");
     if (b.interface != "sim" && !interfaces.insert(b.interface).second)
       c.fail(bn, "interface " + quoted(b.interface) + " is used by two buses (the service owns each bus alone)");
     cfg.buses.push_back(std::move(b));

@@ -32,9 +32,14 @@ std::string where(const AlarmAckSample& s) {
 
 AlarmAckReplyData reply_to(const AlarmAckSample& s, AckReplyResult result, std::string reason,
                            alarms::AlarmState state = alarms::AlarmState::Normal) {
-  return {s.request_id.substr(0, kMaxRequestIdLength), s.bus.substr(0, kMaxBusNameLength),
-          kind_of(s.kind) ? s.kind : 0, s.device, s.code.substr(0, kMaxAlarmCodeLength), result,
-          reason.substr(0, kMaxAckReasonLength), state};
+  return {s.request_id.substr(0, kMaxRequestIdLength),
+          s.bus.substr(0, kMaxBusNameLength),
+          kind_of(s.kind) ? s.kind : 0,
+          s.device,
+          s.code.substr(0, kMaxAlarmCodeLength),
+          result,
+          reason.substr(0, kMaxAckReasonLength),
+          state};
 }
 
 }  // namespace
@@ -87,7 +92,8 @@ void AlarmAckService::submit(const AlarmAckSample& s) {
   if (!parsed) return finish(key, s, reply_to(s, AckReplyResult::Rejected, parsed.error()));
   const AlarmAckRequest r = *parsed;
   for (auto* w : workers_)
-    if (w->config().name == r.bus) return w->post([this, w, r, s] {
+    if (w->config().name == r.bus)
+      return w->post([this, w, r, s] {
         if (clock_.steady_now() > r.expires)
           return finish(sender_key(r.sender, r.request_id), s,
                         reply_to(s, AckReplyResult::Rejected, "expired before the bus worker took it"));
@@ -159,8 +165,14 @@ void AlarmAckService::apply(BusWorker& worker, const AlarmAckRequest& r) {
   }
   const alarms::Alarm* alarm = set ? set->find(r.code) : nullptr;
   const auto state = alarm ? alarm->state() : alarms::AlarmState::Normal;
-  AlarmAckSample asked{r.sender, r.request_id, vehicle_, r.bus, static_cast<std::int64_t>(r.kind), r.device,
-                       std::string(alarms::to_string(r.code)), 0};
+  AlarmAckSample asked{r.sender,
+                       r.request_id,
+                       vehicle_,
+                       r.bus,
+                       static_cast<std::int64_t>(r.kind),
+                       r.device,
+                       std::string(alarms::to_string(r.code)),
+                       0};
   const std::string key = sender_key(r.sender, r.request_id);
   switch (done) {
     case alarms::AckResult::Acknowledged:

@@ -53,8 +53,8 @@ struct Table {
     }
     // The audit line and the reply say both addresses: the operator's next command uses the new one.
     const std::string done = moves ? "moved from address " + std::to_string(a) + " to " + std::to_string(raw) +
-                                       ": address it as " + std::to_string(raw) + " from now on"
-                                 : std::string();
+                                         ": address it as " + std::to_string(raw) + " from now on"
+                                   : std::string();
     p.check = [param, raw, done](const codec::PmuMessage* m) -> Verdict {
       const auto* got = std::get_if<codec::ParameterValue>(&m->payload);
       const double want = codec::parameter_value(param, raw);
@@ -146,8 +146,8 @@ struct Table {
       const auto* f = std::get_if<codec::FirmwareInfo>(&m->payload);
       if (!f) return {CommandResult::Failed, "the answer carries no firmware version", {}, ""};
       char buf[64];
-      std::snprintf(buf, sizeof buf, "%u.%u built %04u-%02u-%02u", f->firmware_major, f->firmware_minor,
-                    f->build_year, f->build_month, f->build_day);
+      std::snprintf(buf, sizeof buf, "%u.%u built %04u-%02u-%02u", f->firmware_major, f->firmware_minor, f->build_year,
+                    f->build_month, f->build_day);
       return {CommandResult::Completed, "", f->firmware_major + f->firmware_minor / 100.0, buf};
     };
     return p;

@@ -15,9 +15,11 @@ namespace {
 
 class Run : public std::enable_shared_from_this<Run> {
  public:
-  Run(DeviceSession& session, const CommandRequest& request, CommandPlan plan, const Timeouts& timeouts,
-      ReplyFn reply)
-      : session_(session), request_(request), plan_(std::move(plan)), retries_(timeouts.retries),
+  Run(DeviceSession& session, const CommandRequest& request, CommandPlan plan, const Timeouts& timeouts, ReplyFn reply)
+      : session_(session),
+        request_(request),
+        plan_(std::move(plan)),
+        retries_(timeouts.retries),
         reply_(std::move(reply)) {}
 
   // Step 0: the command's own frame.

@@ -277,7 +277,7 @@ std::optional<CommandService::Refusal> CommandService::check_hold(const CommandR
 }
 
 std::optional<CommandService::Refusal> CommandService::check_device(BusWorker& worker, const DeviceSession* session,
-                                                                  const CommandRequest& r) {
+                                                                    const CommandRequest& r) {
   const std::string device = "device " + std::to_string(r.address);
   if (!session) return Refusal{CommandResult::Rejected, device_not_seen_reason(r.address, r.bus)};
   // Firmware decides what a command may do; a stop needs nothing read.

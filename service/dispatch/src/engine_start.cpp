@@ -40,16 +40,16 @@ std::optional<std::string> refuse_start(const codec::Status& s, std::optional<co
   return std::nullopt;
 }
 
-EngineStartWatch::EngineStartWatch(const EngineSettings& engine, const EngineStartTiming& timing,
-                                   double cranking_time, SteadyTime sent)
-    : engine_(engine), timing_(timing), cranking_time_(cranking_time > 0 ? cranking_time : kLongestCrankingTime),
+EngineStartWatch::EngineStartWatch(const EngineSettings& engine, const EngineStartTiming& timing, double cranking_time,
+                                   SteadyTime sent)
+    : engine_(engine),
+      timing_(timing),
+      cranking_time_(cranking_time > 0 ? cranking_time : kLongestCrankingTime),
       sent_(sent),
       deadline_(sent + duration_cast<SteadyTime::duration>(duration<double>(cranking_time_)) + engine.running_hold +
                 timing.margin) {}
 
-double EngineStartWatch::seconds_since_sent(SteadyTime now) const {
-  return duration<double>(now - sent_).count();
-}
+double EngineStartWatch::seconds_since_sent(SteadyTime now) const { return duration<double>(now - sent_).count(); }
 
 std::optional<Verdict> EngineStartWatch::on_rpm(std::uint16_t rpm, SteadyTime now) {
   const std::uint16_t speed = rpm == kNoReading ? 0 : rpm;
@@ -63,8 +63,8 @@ std::optional<Verdict> EngineStartWatch::on_rpm(std::uint16_t rpm, SteadyTime no
   if (now - *running_since_ < engine_.running_hold) return std::nullopt;
   return Verdict{CommandResult::Completed,
                  "engine running: " + std::to_string(speed) + " rpm for " +
-                     tenths(duration<double>(now - *running_since_).count()) + " s, " + tenths(seconds_since_sent(now)) +
-                     " s after the start",
+                     tenths(duration<double>(now - *running_since_).count()) + " s, " +
+                     tenths(seconds_since_sent(now)) + " s after the start",
                  static_cast<double>(speed), std::to_string(speed)};
 }
 
@@ -81,7 +81,8 @@ std::optional<Verdict> EngineStartWatch::progress(SteadyTime now) {
   last_progress_ = now;
   const char* phase = running_since_ ? "running, holding" : "cranking";
   Verdict v{CommandResult::InProgress,
-            std::string(phase) + ": " + tenths(seconds_since_sent(now)) + " s of up to " + tenths(cranking_time_) + " s",
+            std::string(phase) + ": " + tenths(seconds_since_sent(now)) + " s of up to " + tenths(cranking_time_) +
+                " s",
             std::nullopt, ""};
   if (read_any_) {
     v.reason += ", " + std::to_string(last_rpm_) + " rpm";
@@ -92,8 +93,8 @@ std::optional<Verdict> EngineStartWatch::progress(SteadyTime now) {
 
 Verdict EngineStartWatch::cancelled(const std::string& stop_request_id, SteadyTime now) const {
   return {CommandResult::Failed,
-          "cancelled by engine stop (request " + stop_request_id + ") " +
-              "after " + tenths(seconds_since_sent(now)) + " s at rpm " + std::to_string(last_rpm_),
+          "cancelled by engine stop (request " + stop_request_id + ") " + "after " + tenths(seconds_since_sent(now)) +
+              " s at rpm " + std::to_string(last_rpm_),
           static_cast<double>(last_rpm_), ""};
 }
 
@@ -103,17 +104,21 @@ namespace {
 // engine-start slot; every path ends in conclude(), once.
 class StartRun : public std::enable_shared_from_this<StartRun> {
  public:
-  StartRun(DeviceSession& session, const CommandRequest& request, const DeviceFacts& device,
-           const Timeouts& timeouts, const EngineStartTiming& timing, ReplyFn reply)
-      : session_(session), request_(request), device_(device), timing_(timing), retries_(timeouts.retries),
+  StartRun(DeviceSession& session, const CommandRequest& request, const DeviceFacts& device, const Timeouts& timeouts,
+           const EngineStartTiming& timing, ReplyFn reply)
+      : session_(session),
+        request_(request),
+        device_(device),
+        timing_(timing),
+        retries_(timeouts.retries),
         reply_(std::move(reply)) {}
 
   void start(SteadyTime now) {
     std::weak_ptr<StartRun> weak = shared_from_this();
-    session_.set_engine_start(DeviceSession::EngineStartInProgress{
-        request_.request_id, [weak](const std::string& stop_id, SteadyTime at) {
-          if (auto self = weak.lock()) self->on_stop(stop_id, at);
-        }});
+    session_.set_engine_start(
+        DeviceSession::EngineStartInProgress{request_.request_id, [weak](const std::string& stop_id, SteadyTime at) {
+                                               if (auto self = weak.lock()) self->on_stop(stop_id, at);
+                                             }});
     // Step 0, the check: a fresh 0x04, behind the device's queue and bound by the expiry.
     // Every frame of the start goes to the unit's address when it is made (a move readdresses
     // those queued): the start verifies this unit wherever it answers (docs/safety.md H10).
@@ -200,14 +205,18 @@ class StartRun : public std::enable_shared_from_this<StartRun> {
     if (watch_)
       conclude(watch_->cancelled(stop_id, now));
     else
-      conclude({CommandResult::Failed, "cancelled by engine stop (request " + stop_id + ") before the start was sent",
-                {}, ""});
+      conclude({CommandResult::Failed,
+                "cancelled by engine stop (request " + stop_id + ") before the start was sent",
+                {},
+                ""});
   }
 
   // The unit's CT should have ended the cranking; a CT of 0 never does, and a starter left
   // turning an engine that will not fire is what the stop exists for (v1.9 5.23). Sent at
   // once to where the unit is now, as an ENGINE_STOP is (docs/safety.md H4, H5).
-  void stop_cranking() { (void)session_.send_urgent(*codec::encode_engine_stop(session_.key().address), session_.now()); }
+  void stop_cranking() {
+    (void)session_.send_urgent(*codec::encode_engine_stop(session_.key().address), session_.now());
+  }
 
   void report_progress(SteadyTime now) {
     if (auto v = watch_->progress(now)) send(*v);
@@ -217,7 +226,9 @@ class StartRun : public std::enable_shared_from_this<StartRun> {
     switch (o.status) {
       case RequestStatus::Answered:
       case RequestStatus::Sent: return true;
-      case RequestStatus::Expired: conclude({CommandResult::Rejected, "expired before it could be sent", {}, ""}); break;
+      case RequestStatus::Expired:
+        conclude({CommandResult::Rejected, "expired before it could be sent", {}, ""});
+        break;
       case RequestStatus::SendFailed:
         conclude({CommandResult::Failed,
                   std::string("bus refused the ") + what + ": " + std::string(transport::to_string(o.send.status)),

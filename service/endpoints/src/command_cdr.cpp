@@ -16,8 +16,8 @@ using eprosima::fastrtps::rtps::SerializedPayload_t;
 // Field order and types of idl/command.idl; a boolean is one byte on the wire.
 template <class Stream, class Sample>
 void fields(Stream& cdr, Sample& s) {
-  cdr & s.request_id & s.vehicle & s.bus & s.address & s.kind & s.parameter & s.value & s.outputs & s.enable & s.groups &
-      s.expires_at & s.confirm;
+  cdr& s.request_id& s.vehicle& s.bus& s.address& s.kind& s.parameter& s.value& s.outputs& s.enable& s.groups& s
+      .expires_at& s.confirm;
 }
 
 struct In {

@@ -66,8 +66,13 @@ struct DdsAlarmAckEndpoint::Impl final : public DataReaderListener {
     // such sample sat at the head of the history.
     while (r->take_next_sample(&s, &info) == ReturnCode_t::RETCODE_OK) {
       if (!info.valid_data) continue;
-      AlarmAckSample sample{writer_guid_text(info), s.request_id().to_string(), s.vehicle().to_string(), s.bus().to_string(),
-                            static_cast<std::int64_t>(static_cast<std::uint32_t>(s.kind())), s.device(), s.code().to_string(),
+      AlarmAckSample sample{writer_guid_text(info),
+                            s.request_id().to_string(),
+                            s.vehicle().to_string(),
+                            s.bus().to_string(),
+                            static_cast<std::int64_t>(static_cast<std::uint32_t>(s.kind())),
+                            s.device(),
+                            s.code().to_string(),
                             s.expires_at()};
       const auto partitions = dds.remote_writers().partitions_of(info);
       if (partitions && dds::partitions_address_only(*partitions, vehicle)) {
@@ -78,17 +83,19 @@ struct DdsAlarmAckEndpoint::Impl final : public DataReaderListener {
       // service's to answer.
       const auto total = not_ours.fetch_add(1, std::memory_order_relaxed) + 1;
       if (not_ours_reports.allow(LogThrottle::Clock::now()))
-        spdlog::warn("audit: alarm ack {} from {} was not written in this vehicle's partition alone: not applied, "
-                     "not answered ({} since start)",
-                     printable(sample.request_id), printable(sample.sender), total);
+        spdlog::warn(
+            "audit: alarm ack {} from {} was not written in this vehicle's partition alone: not applied, "
+            "not answered ({} since start)",
+            printable(sample.request_id), printable(sample.sender), total);
     }
     // Without a readable request id there is nothing to answer: counted, logged now and then
     // so a flood cannot fill the journal.
     const auto malformed = type ? type->malformed() : 0;
     if (malformed != malformed_logged && malformed_reports.allow(LogThrottle::Clock::now())) {
-      spdlog::warn("pmu/alarm_ack: dropped {} sample(s) that are not a pmu::v5::AlarmAck as idl/alarms.idl "
-                   "defines it ({} since start); no reply is possible without a readable request_id",
-                   malformed - malformed_logged, malformed);
+      spdlog::warn(
+          "pmu/alarm_ack: dropped {} sample(s) that are not a pmu::v5::AlarmAck as idl/alarms.idl "
+          "defines it ({} since start); no reply is possible without a readable request_id",
+          malformed - malformed_logged, malformed);
       malformed_logged = malformed;
     }
   }
@@ -120,9 +127,10 @@ DdsAlarmAckEndpoint::DdsAlarmAckEndpoint(dds::DdsContext& dds, std::string vehic
                                 qos_profiles::kCommand);
   } catch (const dds::DdsError& e) {
     if (!dds.secure()) throw;
-    spdlog::error("{} and {} are not served, alarms cannot be acknowledged over DDS: {}; the DDS-Security "
-                  "permissions were made before they existed (deploy/security/make_pki.sh makes them with them)",
-                  topics::kAlarmAck, topics::kAlarmAckReply, e.what());
+    spdlog::error(
+        "{} and {} are not served, alarms cannot be acknowledged over DDS: {}; the DDS-Security "
+        "permissions were made before they existed (deploy/security/make_pki.sh makes them with them)",
+        topics::kAlarmAck, topics::kAlarmAckReply, e.what());
   }
 }
 
@@ -139,14 +147,14 @@ void DdsAlarmAckEndpoint::start(AlarmAckService& service) {
   try {
     auto* type = new idl::Guarded<pmu::v5::AlarmAckPubSubType>();
     impl_->type = type;
-    impl_->reader = &impl_->dds.reader(
-        impl_->dds.topic(topics::kAlarmAck, TypeSupport(type)), qos_profiles::kCommand,
-        impl_.get());
+    impl_->reader =
+        &impl_->dds.reader(impl_->dds.topic(topics::kAlarmAck, TypeSupport(type)), qos_profiles::kCommand, impl_.get());
   } catch (const dds::DdsError& e) {
     if (!impl_->dds.secure()) throw;
-    spdlog::error("{} is not read, alarms cannot be acknowledged over DDS: {}; the DDS-Security permissions "
-                  "were made before it existed (deploy/security/make_pki.sh makes them with it)",
-                  topics::kAlarmAck, e.what());
+    spdlog::error(
+        "{} is not read, alarms cannot be acknowledged over DDS: {}; the DDS-Security permissions "
+        "were made before it existed (deploy/security/make_pki.sh makes them with it)",
+        topics::kAlarmAck, e.what());
   }
 }
 
@@ -160,8 +168,6 @@ void DdsAlarmAckEndpoint::stop() {
 
 void DdsAlarmAckEndpoint::publish(const AlarmAckReplyData& reply) { impl_->publish(reply); }
 
-std::uint64_t DdsAlarmAckEndpoint::not_ours() const noexcept {
-  return impl_->not_ours.load(std::memory_order_relaxed);
-}
+std::uint64_t DdsAlarmAckEndpoint::not_ours() const noexcept { return impl_->not_ours.load(std::memory_order_relaxed); }
 
 }  // namespace pmu::service

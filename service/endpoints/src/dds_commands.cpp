@@ -80,10 +80,11 @@ struct DdsCommandEndpoint::Impl final : public DataReaderListener {
     }
     const auto total = not_ours.fetch_add(1, std::memory_order_relaxed) + 1;
     if (const auto held = not_ours_reports.allow(LogThrottle::Clock::now()))
-      spdlog::warn("audit: command {} from {} {}; this service is vehicle '{}': not executed, not answered "
-                   "({} such command(s) since start{})",
-                   printable(s.request_id), printable(s.sender), why, printable(vehicle), total,
-                   *held ? ", " + std::to_string(*held) + " not logged since the last message" : std::string());
+      spdlog::warn(
+          "audit: command {} from {} {}; this service is vehicle '{}': not executed, not answered "
+          "({} such command(s) since start{})",
+          printable(s.request_id), printable(s.sender), why, printable(vehicle), total,
+          *held ? ", " + std::to_string(*held) + " not logged since the last message" : std::string());
     return false;
   }
 
@@ -109,9 +110,10 @@ struct DdsCommandEndpoint::Impl final : public DataReaderListener {
     const auto now = std::chrono::steady_clock::now();
     if (total == malformed_logged || now < next_malformed_log) return;
     next_malformed_log = now + kMalformedLogInterval;
-    spdlog::warn("pmu/command: dropped {} sample(s) that are not a pmu::v5::Command as idl/command.idl defines it "
-                 "({} since start); no reply is possible without a readable request_id",
-                 total - malformed_logged, total);
+    spdlog::warn(
+        "pmu/command: dropped {} sample(s) that are not a pmu::v5::Command as idl/command.idl defines it "
+        "({} since start); no reply is possible without a readable request_id",
+        total - malformed_logged, total);
     malformed_logged = total;
   }
 
@@ -152,9 +154,7 @@ void DdsCommandEndpoint::stop() {
   if (impl_->reader) impl_->reader->set_listener(nullptr);
 }
 
-DdsCommandEndpoint::~DdsCommandEndpoint() {
-  stop();
-}
+DdsCommandEndpoint::~DdsCommandEndpoint() { stop(); }
 
 void DdsCommandEndpoint::start(CommandService& service) {
   {
@@ -163,15 +163,13 @@ void DdsCommandEndpoint::start(CommandService& service) {
   }
   auto* type = new CommandSampleType();
   impl_->type = type;
-  impl_->reader = &impl_->dds.reader(impl_->dds.topic(topics::kCommand, TypeSupport(type)), qos_profiles::kCommand,
-                                     impl_.get());
+  impl_->reader =
+      &impl_->dds.reader(impl_->dds.topic(topics::kCommand, TypeSupport(type)), qos_profiles::kCommand, impl_.get());
 }
 
 void DdsCommandEndpoint::publish(const CommandReplyData& reply) { impl_->publish(reply); }
 
-std::uint64_t DdsCommandEndpoint::not_ours() const noexcept {
-  return impl_->not_ours.load(std::memory_order_relaxed);
-}
+std::uint64_t DdsCommandEndpoint::not_ours() const noexcept { return impl_->not_ours.load(std::memory_order_relaxed); }
 
 std::uint64_t DdsCommandEndpoint::malformed() const noexcept { return impl_->type ? impl_->type->malformed() : 0; }
 

@@ -110,7 +110,8 @@ struct DdsPublisher::Writers {
   // pmu/low_rate/health: null when the low-rate topics are off. `low_health_last`: the state
   // and bus state last written there, per device.
   DataWriter* low_health = nullptr;
-  std::map<std::tuple<std::string, DeviceKind, std::uint16_t>, std::pair<HealthState, transport::BusState>> low_health_last;
+  std::map<std::tuple<std::string, DeviceKind, std::uint16_t>, std::pair<HealthState, transport::BusState>>
+      low_health_last;
   // Null when the service serves no battery or MPPT (not offered).
   DataWriter* battery = nullptr;
   DataWriter* battery_cells = nullptr;
@@ -182,9 +183,10 @@ DdsPublisher::DdsPublisher(dds::DdsContext& dds, std::chrono::milliseconds telem
       return &dds.writer(dds.topic(name, type), profile);
     } catch (const dds::DdsError& e) {
       if (!dds.secure()) throw;
-      spdlog::error("{} is not published: {}; the DDS-Security permissions were made before it existed "
-                    "(deploy/security/make_pki.sh makes them with it)",
-                    name, e.what());
+      spdlog::error(
+          "{} is not published: {}; the DDS-Security permissions were made before it existed "
+          "(deploy/security/make_pki.sh makes them with it)",
+          name, e.what());
       return nullptr;
     }
   };
@@ -211,11 +213,12 @@ bool DdsPublisher::admit(const DeviceKey& key) {
   const auto refused = refused_.fetch_add(1, std::memory_order_relaxed) + 1;
   failures_.fetch_add(1, std::memory_order_relaxed);
   if (const auto held = w_->refusal_reports.allow(LogThrottle::Clock::now()))
-    spdlog::error("{}/{}: not published on DDS: this service already publishes {} PMUs, the capacity its DDS "
-                  "writers are sized for (kMaxDevicesPerService); {} sample(s) of PMUs over capacity not "
-                  "published so far{}",
-                  key.bus, key.address, dds::kMaxDevicesPerService, refused,
-                  *held ? " (" + std::to_string(*held) + " such messages held back)" : std::string());
+    spdlog::error(
+        "{}/{}: not published on DDS: this service already publishes {} PMUs, the capacity its DDS "
+        "writers are sized for (kMaxDevicesPerService); {} sample(s) of PMUs over capacity not "
+        "published so far{}",
+        key.bus, key.address, dds::kMaxDevicesPerService, refused,
+        *held ? " (" + std::to_string(*held) + " such messages held back)" : std::string());
   return false;
 }
 
@@ -226,8 +229,8 @@ void DdsPublisher::count(bool ok, const char* topic, const DeviceKey& key, const
   }
   const auto total = failures_.fetch_add(1, std::memory_order_relaxed) + 1;
   if (const auto held = w_->failure_reports.allow(LogThrottle::Clock::now()))
-    spdlog::warn("{}/{}: DDS write to {} failed ({}); {} sample(s) not published so far{}", key.bus, key.address,
-                 topic, reason, total,
+    spdlog::warn("{}/{}: DDS write to {} failed ({}); {} sample(s) not published so far{}", key.bus, key.address, topic,
+                 reason, total,
                  *held ? " (" + std::to_string(*held) + " failures not logged since the last message)" : std::string());
 }
 
@@ -246,7 +249,8 @@ void DdsPublisher::dispose_baseline(const DeviceKey& key) {
   s.bus(key.bus);
   s.address(key.address);
   const InstanceHandle_t handle = w_->baseline->register_instance(&s);
-  const ReturnCode_t rc = handle == HANDLE_NIL ? ReturnCode_t::RETCODE_OUT_OF_RESOURCES : w_->baseline->dispose(&s, handle);
+  const ReturnCode_t rc =
+      handle == HANDLE_NIL ? ReturnCode_t::RETCODE_OUT_OF_RESOURCES : w_->baseline->dispose(&s, handle);
   // A failure is a sample not published; a disposal is no sample of the PMU's own.
   if (rc != ReturnCode_t::RETCODE_OK) count(false, topics::kBaseline, key, why(rc));
 }
@@ -327,7 +331,8 @@ void DdsPublisher::on_config(const DeviceKey& key, const ConfigState& c) {
   s.upper_temperature_limit(raw8(Parameter::UpperTemperatureLimit));
   s.power_up_state(raw8(Parameter::PowerUpState));
   s.cranking_time(idl_float(c.value(Parameter::CrankingTime)));
-  s.can_address(static_cast<std::uint16_t>(c.raw[static_cast<std::size_t>(Parameter::CanAddress)].value_or(key.address)));
+  s.can_address(
+      static_cast<std::uint16_t>(c.raw[static_cast<std::size_t>(Parameter::CanAddress)].value_or(key.address)));
   s.outputs(c.outputs.value_or(0));
   s.generation_enabled(c.generation_enabled.value_or(false));
   std::lock_guard<std::mutex> lock(w_->mutex);
@@ -346,7 +351,8 @@ void DdsPublisher::on_info(const DeviceKey& key, const InfoState& i) {
   s.build_month(i.firmware.build_month);
   s.build_day(i.firmware.build_day);
   for (const auto feature : codec::kAllFeatures)
-    if (codec::supports(i.firmware.version(), feature)) s.features().emplace_back(std::string(codec::feature_name(feature)));
+    if (codec::supports(i.firmware.version(), feature))
+      s.features().emplace_back(std::string(codec::feature_name(feature)));
   std::lock_guard<std::mutex> lock(w_->mutex);
   if (!admit(key)) return;
   count(w_->info->write(&s), topics::kInfo, key, "write returned false");
@@ -440,7 +446,8 @@ void DdsPublisher::write_at(DataWriter* writer, void* sample, const DeviceKey& k
   count(rc == ReturnCode_t::RETCODE_OK, writer->get_topic()->get_name().c_str(), key, why(rc));
 }
 
-void DdsPublisher::on_battery(const DeviceKey& key, const BatteryState& b, std::chrono::system_clock::time_point newest) {
+void DdsPublisher::on_battery(const DeviceKey& key, const BatteryState& b,
+                              std::chrono::system_clock::time_point newest) {
   pmu::v5::Battery s;
   s.vehicle(w_->vehicle);
   s.bus(key.bus);
@@ -558,8 +565,8 @@ void DdsPublisher::on_alarm(const AlarmReport& a) {
   s.state(state_of(a.state));
   s.value(flag ? std::numeric_limits<float>::quiet_NaN() : static_cast<float>(a.value));
   s.limit(flag ? std::numeric_limits<float>::quiet_NaN() : static_cast<float>(a.limit));
-  s.since(static_cast<std::uint64_t>(
-      std::max<std::int64_t>(0, std::chrono::duration_cast<std::chrono::nanoseconds>(a.since.time_since_epoch()).count())));
+  s.since(static_cast<std::uint64_t>(std::max<std::int64_t>(
+      0, std::chrono::duration_cast<std::chrono::nanoseconds>(a.since.time_since_epoch()).count())));
   s.message(a.message.substr(0, alarms::kMaxMessageLength));
   const DeviceKey key{a.bus, a.device, DeviceKind::Pmu};
   std::lock_guard<std::mutex> lock(w_->mutex);
@@ -571,8 +578,8 @@ void DdsPublisher::on_readiness(const ReadinessReport& r) {
   s.vehicle(w_->vehicle);
   s.ready(r.ready);
   s.level(!r.ready ? pmu::v5::LEVEL_NOT_READY : r.warnings() ? pmu::v5::LEVEL_WARNING : pmu::v5::LEVEL_READY);
-  s.since(static_cast<std::uint64_t>(
-      std::max<std::int64_t>(0, std::chrono::duration_cast<std::chrono::nanoseconds>(r.since.time_since_epoch()).count())));
+  s.since(static_cast<std::uint64_t>(std::max<std::int64_t>(
+      0, std::chrono::duration_cast<std::chrono::nanoseconds>(r.since.time_since_epoch()).count())));
   constexpr std::size_t kCarried = 64;  // the IDL's bound; reasons_total counts the rest
   for (std::size_t i = 0; i < r.reasons.size() && i < kCarried; ++i) {
     const auto& x = r.reasons[i];

@@ -13,9 +13,9 @@
 
 namespace pmu::service {
 
+using dds::Ros2Device;
 using eprosima::fastdds::dds::DataWriter;
 using eprosima::fastdds::dds::DataWriterQos;
-using dds::Ros2Device;
 
 namespace ros2_publisher {
 
@@ -96,9 +96,11 @@ struct Ros2Publisher::State {
   }
   DataWriter* battery_writer(const DeviceKey& k, const char* leaf) {
     const std::string ros_name =
-        dds::ros2_device_namespace(settings.name_space, vehicle, k.bus, ros2_publisher::ros2_kind(k.kind), k.address) + "/" + leaf;
+        dds::ros2_device_namespace(settings.name_space, vehicle, k.bus, ros2_publisher::ros2_kind(k.kind), k.address) +
+        "/" + leaf;
     try {
-      auto& topic = dds.topic(dds::ros2_dds_topic(ros_name), dds::zero_padded<sensor_msgs::msg::BatteryStatePubSubType>());
+      auto& topic =
+          dds.topic(dds::ros2_dds_topic(ros_name), dds::zero_padded<sensor_msgs::msg::BatteryStatePubSubType>());
       return &dds.default_partition_writer(topic, ros2_writer_qos());
     } catch (const dds::DdsError& e) {
       failed(ros_name.c_str(), e.what());
@@ -209,7 +211,8 @@ void Ros2Publisher::on_health(const DeviceKey& key, const HealthReport& health) 
   v.name = s_->name_of(key);
   switch (key.kind) {
     case DeviceKind::Pmu:
-      v.hardware_id = d.serial ? "pmu serial " + std::to_string(*d.serial) : "pmu at address " + std::to_string(key.address);
+      v.hardware_id =
+          d.serial ? "pmu serial " + std::to_string(*d.serial) : "pmu at address " + std::to_string(key.address);
       if (!d.firmware.empty()) v.extra.emplace_back("firmware", d.firmware);
       if (d.serial) v.extra.emplace_back("serial_number", std::to_string(*d.serial));
       break;
@@ -224,8 +227,8 @@ void Ros2Publisher::on_health(const DeviceKey& key, const HealthReport& health) 
   const auto k = ros2_publisher::key_of(key);
   if (auto it = s_->statuses.find(k); it != s_->statuses.end())
     before = ShownStatus{it->second.level(), it->second.message()};
-  const bool write = s_->diagnostics_pace.on_report(before, ShownStatus{status.level(), status.message()},
-                                                    s_->clock.steady_now());
+  const bool write =
+      s_->diagnostics_pace.on_report(before, ShownStatus{status.level(), status.message()}, s_->clock.steady_now());
   s_->statuses[k] = std::move(status);
   if (write) s_->write_diagnostics();
 }

@@ -45,8 +45,9 @@ void check_qos(const Config& cfg, StartupCheck& out) {
     out.qos_file = dds::default_qos_file();
     if (out.qos_file.empty()) {
       out.errors.push_back(cfg.source + ":1: no QoS profile file: no qos_file here, $PMU_QOS_FILE unset, and neither " +
-                           PMU_SYSCONFDIR "/qos.xml nor " PMU_DATADIR "/qos.xml exists (install deploy/qos.xml, "
-                           "or set qos_file or PMU_QOS_FILE)");
+                           PMU_SYSCONFDIR "/qos.xml nor " PMU_DATADIR
+                                          "/qos.xml exists (install deploy/qos.xml, "
+                                          "or set qos_file or PMU_QOS_FILE)");
       return;
     }
     if (const char* env = std::getenv("PMU_QOS_FILE"); env && *env) where = "$PMU_QOS_FILE: ";

@@ -19,7 +19,8 @@ void VoltageTrendEndurance::add(Time t, double volts, double amps) {
   if (!window_.empty()) {
     if (t == window_.back().t) return;
     const double mean = mean_amps();
-    if (t < window_.back().t || t - window_.back().t > max_gap_ || std::abs(amps - mean) > std::max(kLoadStep, 0.25 * std::abs(mean)))
+    if (t < window_.back().t || t - window_.back().t > max_gap_ ||
+        std::abs(amps - mean) > std::max(kLoadStep, 0.25 * std::abs(mean)))
       window_.clear();
   }
   window_.push_back({t, volts, amps});

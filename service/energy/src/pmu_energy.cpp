@@ -16,9 +16,7 @@ bool PmuEnergy::fresh(const std::optional<Time>& at, Time now) const noexcept {
   return at && now - *at <= max_gap_ && *at - now <= max_gap_;
 }
 
-void PmuEnergy::on_voltages(Time received, const codec::Voltages& v) noexcept {
-  volts_ = {received, v};
-}
+void PmuEnergy::on_voltages(Time received, const codec::Voltages& v) noexcept { volts_ = {received, v}; }
 
 void PmuEnergy::on_currents(Time received, const codec::Currents& c) {
   amps_ = {received, c};
@@ -44,8 +42,8 @@ Figures PmuEnergy::figures(Time now) const noexcept {
   f.servo_power = power(&codec::Voltages::servo, &codec::Currents::servo);
   f.battery_a.power = power(&codec::Voltages::battery_a, &codec::Currents::battery_a);
   f.battery_b.power = power(&codec::Voltages::battery_b, &codec::Currents::battery_b);
-  f.generator_power = f.avionics_power + f.output_28v_power + f.payload_power + f.servo_power + f.battery_a.power +
-                      f.battery_b.power;
+  f.generator_power =
+      f.avionics_power + f.output_28v_power + f.payload_power + f.servo_power + f.battery_a.power + f.battery_b.power;
   f.battery_a.used_wh = out_of_a_.watt_hours();
   f.battery_b.used_wh = out_of_b_.watt_hours();
   f.battery_a.integrated_s = out_of_a_.integrated_s();

@@ -42,7 +42,8 @@ std::string drift_message(const std::vector<baseline::Difference>& diffs) {
   for (const char* lead : {"config differs: ", "differs: "}) {
     for (std::size_t shown = diffs.size(); shown > 0; --shown) {
       std::string m = lead;
-      for (std::size_t i = 0; i < shown; ++i) m += (i ? ", " : "") + std::string(baseline::setting_name(diffs[i].setting));
+      for (std::size_t i = 0; i < shown; ++i)
+        m += (i ? ", " : "") + std::string(baseline::setting_name(diffs[i].setting));
       if (shown < diffs.size()) m += " +" + std::to_string(diffs.size() - shown) + " more";
       if (m.size() <= kMessage) return m;
     }
@@ -77,8 +78,8 @@ std::string drift_description(const std::vector<baseline::Difference>& diffs, co
     const std::string more = left ? "; +" + std::to_string(left) + " more" : "";
     const std::size_t used = (items.empty() ? 0 : items.size() + 2) + more.size() + fix.size();
     const std::size_t room = used < kDescription ? kDescription - used : 0;
-    std::string item = setting + " " + baseline::value_text(d.setting, *d.device) + "->" +
-                       baseline::value_text(d.setting, d.file);
+    std::string item =
+        setting + " " + baseline::value_text(d.setting, *d.device) + "->" + baseline::value_text(d.setting, d.file);
     if (item.size() > room)
       item = setting + " " + compact_value(d.setting, *d.device) + "->" + compact_value(d.setting, d.file);
     if (item.size() > room) break;
@@ -97,8 +98,7 @@ std::string drift_description(const std::vector<baseline::Difference>& diffs, co
 // the service does not have fresh. An alarm without its input neither raises nor clears, so
 // it would stay NORMAL and look like all clear (docs/safety.md H6, H3).
 void missing_inputs(const std::string& bus, DeviceKind kind, std::uint16_t address, const std::string& name,
-                    const DeviceView& d, std::chrono::steady_clock::time_point now,
-                    std::vector<ReadinessReason>& out) {
+                    const DeviceView& d, std::chrono::steady_clock::time_point now, std::vector<ReadinessReason>& out) {
   for (std::size_t i = 0; i < codec::kGroupNames.size(); ++i) {
     const auto& packet = codec::kGroupNames[i];
     if (!(d.packets_needed & packet.bit)) continue;
@@ -107,10 +107,11 @@ void missing_inputs(const std::string& bus, DeviceKind kind, std::uint16_t addre
     std::string description;
     if (!(d.packets_monitored & packet.bit)) {
       what = "not monitored";
-      description = d.streaming ? "The PMU does not stream it, so its alarms cannot be judged: add it to packets_streamed "
-                                  "(pmuctl config set)."
-                                : "The service does not poll it, so its alarms cannot be judged: add it to the "
-                                  "device's packets: in the service's config.";
+      description = d.streaming
+                        ? "The PMU does not stream it, so its alarms cannot be judged: add it to packets_streamed "
+                          "(pmuctl config set)."
+                        : "The service does not poll it, so its alarms cannot be judged: add it to the "
+                          "device's packets: in the service's config.";
     } else if (!at || now - *at > d.max_age) {
       what = at ? "stale" : "not received";
       description = d.streaming ? "Its alarms cannot be judged without it: check packet_period and packets_streamed "
@@ -197,7 +198,7 @@ std::vector<ReadinessReason> readiness_reasons(const ReadinessInput& in) {
     if (a.state == alarms::AlarmState::Normal) continue;
     const bool waiting = a.state == alarms::AlarmState::ClearedUnacknowledged;
     std::string description = waiting ? "Cleared; a critical alarm blocks until acknowledged: pmuctl alarms ack " +
-                                                std::string(alarms::to_string(a.code)) + "."
+                                            std::string(alarms::to_string(a.code)) + "."
                                       : "Active: see pmuctl alarms for its value and limit.";
     out.push_back({std::string(alarms::to_string(a.code)), a.severity, a.bus, a.source, a.device,
                    bounded(waiting ? a.message + " (unacknowledged)" : a.message, 42), std::move(description)});

@@ -26,12 +26,9 @@
 namespace pmu::dds {
 
 const SecurityFileRef kSecurityFileKeys[6] = {
-    {"identity_ca", &SecurityFiles::identity_ca},
-    {"identity_certificate", &SecurityFiles::identity_certificate},
-    {"private_key", &SecurityFiles::private_key},
-    {"permissions_ca", &SecurityFiles::permissions_ca},
-    {"governance", &SecurityFiles::governance},
-    {"permissions", &SecurityFiles::permissions},
+    {"identity_ca", &SecurityFiles::identity_ca}, {"identity_certificate", &SecurityFiles::identity_certificate},
+    {"private_key", &SecurityFiles::private_key}, {"permissions_ca", &SecurityFiles::permissions_ca},
+    {"governance", &SecurityFiles::governance},   {"permissions", &SecurityFiles::permissions},
 };
 
 bool SecurityFiles::empty() const noexcept {
@@ -76,7 +73,7 @@ using Pkcs7 = std::unique_ptr<PKCS7, Deleter<PKCS7, PKCS7_free>>;
 using Asn1Time = std::unique_ptr<ASN1_TIME, Deleter<ASN1_TIME, ASN1_STRING_free>>;
 
 struct CertStack {
-  STACK_OF(X509)* s = sk_X509_new_null();
+  STACK_OF(X509) * s = sk_X509_new_null();
   ~CertStack() { sk_X509_free(s); }  // the certificates belong to their own owners
   CertStack() = default;
   CertStack(const CertStack&) = delete;
@@ -124,8 +121,9 @@ class Checker {
     bool complete = true;
     for (const auto& r : kSecurityFileKeys) {
       if ((files_.*r.path).empty()) {
-        error(r.key, std::string(r.key) + " is not set (security needs all six files: identity_ca, "
-                                          "identity_certificate, private_key, permissions_ca, governance, permissions)");
+        error(r.key, std::string(r.key) +
+                         " is not set (security needs all six files: identity_ca, "
+                         "identity_certificate, private_key, permissions_ca, governance, permissions)");
         complete = false;
       }
     }
@@ -144,8 +142,8 @@ class Checker {
     if (identity_ca && identity) check_issued_by(identity.get(), identity_ca.get());
     if (identity && key && X509_check_private_key(identity.get(), key.get()) != 1) {
       ERR_clear_error();
-      error("private_key", files_.private_key + ": is not the key of identity_certificate " +
-                               files_.identity_certificate);
+      error("private_key",
+            files_.private_key + ": is not the key of identity_certificate " + files_.identity_certificate);
     }
     if (identity_ca && permissions_ca) check_separate_cas(identity_ca.get(), identity.get(), permissions_ca.get());
     if (permissions_ca) {
@@ -231,7 +229,8 @@ class Checker {
     if (!file.ok()) return Bio(nullptr);
     // BIO_new_mem_buf keeps a pointer only: the BIO gets its own copy.
     Bio bio(BIO_new(BIO_s_mem()));
-    if (bio && BIO_write(bio.get(), file.text.data(), static_cast<int>(file.text.size())) != static_cast<int>(file.text.size()))
+    if (bio && BIO_write(bio.get(), file.text.data(), static_cast<int>(file.text.size())) !=
+                   static_cast<int>(file.text.size()))
       bio.reset();
     // Its end is the end of the file, as a file BIO's: S/MIME's reader stops at it, not retries.
     if (bio) BIO_set_mem_eof_return(bio.get(), 0);
@@ -304,8 +303,8 @@ class Checker {
     }
     if (identity && X509_check_issued(permissions_ca, identity) == X509_V_OK &&
         X509_verify(identity, X509_get0_pubkey(permissions_ca)) == 1) {
-      error("permissions_ca", files_.permissions_ca + ": also issued identity_certificate " +
-                                  files_.identity_certificate + why);
+      error("permissions_ca",
+            files_.permissions_ca + ": also issued identity_certificate " + files_.identity_certificate + why);
     }
     ERR_clear_error();
   }
@@ -466,8 +465,8 @@ class Checker {
         for (auto* r = g->FirstChildElement("allow_rule"); r && !allowed; r = r->NextSiblingElement("allow_rule"))
           allowed = covers(r->FirstChildElement("domains"), *o_.domain);
         if (!allowed)
-          error("permissions", files_.permissions + ": " + grant + " allows nothing on DDS domain " +
-                                   std::to_string(*o_.domain));
+          error("permissions",
+                files_.permissions + ": " + grant + " allows nothing on DDS domain " + std::to_string(*o_.domain));
       }
       return;
     }

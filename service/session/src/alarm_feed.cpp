@@ -18,7 +18,10 @@ alarms::AlarmSet make_set(const std::string& who, alarms::DeviceKind kind, const
 
 AlarmFeed::AlarmFeed(std::string bus, alarms::DeviceKind source, std::uint16_t device,
                      const alarms::DeviceSettings& settings, StateSink& sink)
-    : bus_(std::move(bus)), source_(source), device_(device), sink_(sink),
+    : bus_(std::move(bus)),
+      source_(source),
+      device_(device),
+      sink_(sink),
       set_(make_set(bus_ + "/" + std::string(alarms::to_string(source)) + std::to_string(device), source, settings)) {}
 
 void AlarmFeed::observe(alarms::Code code, double value, SteadyTime now, WallTime wall) {
@@ -58,7 +61,8 @@ void AlarmFeed::report(const alarms::Alarm& a) {
   r.severity = a.severity();
   r.state = a.state();
   // A flag's input is 1 or 0, which says nothing the state does not.
-  r.value = a.config().spec().condition == alarms::Condition::Flag ? std::numeric_limits<double>::quiet_NaN() : a.value();
+  r.value =
+      a.config().spec().condition == alarms::Condition::Flag ? std::numeric_limits<double>::quiet_NaN() : a.value();
   r.limit = a.limit();
   r.since = since_[static_cast<std::size_t>(a.code())];
   r.message = std::string(a.message());

@@ -18,9 +18,9 @@ constexpr milliseconds kTick{20};  // session timers need no finer grain than th
 constexpr milliseconds kMaintainInterval{250};
 constexpr milliseconds kDiscoveryInterval{10000};
 constexpr milliseconds kHeardCanOpenPeriod{1000};  // listen_canopen: a device not in the config
-constexpr milliseconds kAskInterval{1000};        // serial gets to one unserved address
-constexpr milliseconds kSearchInterval{10000};    // broadcast serial requests while a known PMU is OFFLINE
-constexpr std::size_t kMaxAsked = 64;             // unserved addresses remembered
+constexpr milliseconds kAskInterval{1000};         // serial gets to one unserved address
+constexpr milliseconds kSearchInterval{10000};     // broadcast serial requests while a known PMU is OFFLINE
+constexpr std::size_t kMaxAsked = 64;              // unserved addresses remembered
 
 bool silent(HealthState s, HealthState at_least) noexcept {
   if (at_least == HealthState::Offline) return s == HealthState::Offline;
@@ -31,16 +31,18 @@ bool silent(HealthState s, HealthState at_least) noexcept {
 void log_move(const BusWorker::Moved& m) {
   const std::string serial = m.serial ? " (serial " + std::to_string(*m.serial) + ")" : std::string();
   if (m.config_line.empty())
-    spdlog::info("{}: PMU{} moved from address {} to {}; it is not in a config file (discovered or built in): "
-                 "nothing to change",
-                 m.bus, serial, m.from, m.to);
+    spdlog::info(
+        "{}: PMU{} moved from address {} to {}; it is not in a config file (discovered or built in): "
+        "nothing to change",
+        m.bus, serial, m.from, m.to);
   else if (m.to == m.first)
-    spdlog::info("{}: PMU{} moved from address {} back to {}, its address in the config ({}): nothing to change",
-                 m.bus, serial, m.from, m.to, m.config_line);
+    spdlog::info("{}: PMU{} moved from address {} back to {}, its address in the config ({}): nothing to change", m.bus,
+                 serial, m.from, m.to, m.config_line);
   else
-    spdlog::warn("{}: PMU{} moved from address {} to {}: the config is stale: {}: change `address: {}` to "
-                 "`address: {}`",
-                 m.bus, serial, m.from, m.to, m.config_line, m.first, m.to);
+    spdlog::warn(
+        "{}: PMU{} moved from address {} to {}: the config is stale: {}: change `address: {}` to "
+        "`address: {}`",
+        m.bus, serial, m.from, m.to, m.config_line, m.first, m.to);
 }
 
 }  // namespace
@@ -61,7 +63,8 @@ BusWorker::BusWorker(BusConfig config, std::unique_ptr<transport::CanBus> bus, c
   for (const auto& d : config_.devices) add_session(d);
   for (const auto& b : config_.batteries)
     add_canopen_session({config_.name, b.node, DeviceKind::Battery}, b.period, b.alarms);
-  for (const auto& m : config_.mppts) add_canopen_session({config_.name, m.device, DeviceKind::Mppt}, m.period, m.alarms);
+  for (const auto& m : config_.mppts)
+    add_canopen_session({config_.name, m.device, DeviceKind::Mppt}, m.period, m.alarms);
   feed_bus_alarms(bus_->state());
   // Both due at the first turn. Of two timers due together the one added first fires first:
   // discovery before maintenance, their order when they were checks at the end of a turn.
@@ -149,7 +152,7 @@ void BusWorker::on_frame(const transport::ReceivedFrame& rx) {
       if (candidate->alias() == address) s = candidate.get();
   }
   if (!s) s = on_stranger(*id.id, rx);
-  if (!s) return;  // a PMU the config does not serve
+  if (!s) return;                                    // a PMU the config does not serve
   s->on_frame(*id.id, rx.frame, now, rx.timestamp);  // the id is parsed here only
 }
 
@@ -213,15 +216,17 @@ DeviceSession* BusWorker::on_stranger(const codec::PmuId& id, const transport::R
     if (DeviceSession* known = session_with_serial(sn->serial_number)) {
       const auto was = known->key().address;
       if (!silent(known->health().state, HealthState::Stale)) {
-        spdlog::warn("{}: serial {} answers at address {} while address {} with that serial still speaks: two "
-                     "units report one serial; address {} is not served",
-                     config_.name, sn->serial_number, address, was, address);
+        spdlog::warn(
+            "{}: serial {} answers at address {} while address {} with that serial still speaks: two "
+            "units report one serial; address {} is not served",
+            config_.name, sn->serial_number, address, was, address);
         return nullptr;
       }
-      spdlog::warn("{}: the PMU of serial {} (address {}, {} for {:.1f} s) answers at address {}: the same unit, "
-                   "moved; served as {}/{} from now on",
-                   config_.name, sn->serial_number, was, to_string(known->health().state),
-                   known->health().last_frame_age, address, config_.name, address);
+      spdlog::warn(
+          "{}: the PMU of serial {} (address {}, {} for {:.1f} s) answers at address {}: the same unit, "
+          "moved; served as {}/{} from now on",
+          config_.name, sn->serial_number, was, to_string(known->health().state), known->health().last_frame_age,
+          address, config_.name, address);
       asked_.erase(address);
       known->move_to(address, DeviceSession::MoveCause::ByItself, now);
       return nullptr;  // move_to took this answer as the frame heard
@@ -338,7 +343,9 @@ void BusWorker::rekey_moved_sessions() {
   }
 }
 
-void BusWorker::run() { loop_.run(kTick, [this] { end_turn(); }); }
+void BusWorker::run() {
+  loop_.run(kTick, [this] { end_turn(); });
+}
 
 void BusWorker::stop() { loop_.stop(); }
 

@@ -38,7 +38,11 @@ std::optional<DeviceKey> canopen_device(const std::string& bus, const codec::Can
 CanOpenSession::CanOpenSession(DeviceKey key, std::chrono::milliseconds period,
                                std::chrono::milliseconds publish_period, const Timeouts& timeouts, StateSink& sink,
                                SteadyTime now, const alarms::DeviceSettings& alarms)
-    : key_(std::move(key)), period_(period), publish_period_(publish_period), sink_(sink), health_(now, timeouts),
+    : key_(std::move(key)),
+      period_(period),
+      publish_period_(publish_period),
+      sink_(sink),
+      health_(now, timeouts),
       alarms_(key_.bus, alarm_kind(key_.kind), key_.address, alarms, sink) {}
 
 void CanOpenSession::on_frame(const codec::CanFrame& frame, SteadyTime now, WallTime received) {
@@ -122,9 +126,9 @@ void CanOpenSession::update_health(SteadyTime now, bool force) {
   const auto u = health_.update(now, period_, force);
   const auto& report = health_.report();
   if (u.changed && report.state != HealthState::Unknown)
-    spdlog::log(report.state == HealthState::Online ? spdlog::level::info : spdlog::level::warn,
-                "{}/{}{}: {} ({})", key_.bus, to_string(key_.kind), key_.address,
-                to_string(report.state), last_frame_text(report.last_frame_age));
+    spdlog::log(report.state == HealthState::Online ? spdlog::level::info : spdlog::level::warn, "{}/{}{}: {} ({})",
+                key_.bus, to_string(key_.kind), key_.address, to_string(report.state),
+                last_frame_text(report.last_frame_age));
   if (u.publish) sink_.on_health(key_, report);
 }
 

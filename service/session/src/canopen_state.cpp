@@ -35,14 +35,16 @@ Applied apply(const codec::canopen::CanOpenMessage& m, BatteryState& battery, Ba
     }
     return a;
   }
-  for (std::uint8_t i = 0; i < m.field_count && i < m.fields.size(); ++i) a.battery |= store(kBatteryValues, battery, m.fields[i]);
+  for (std::uint8_t i = 0; i < m.field_count && i < m.fields.size(); ++i)
+    a.battery |= store(kBatteryValues, battery, m.fields[i]);
   return a;
 }
 
 Applied apply(const codec::canopen::CanOpenMessage& m, MpptState& mppt) noexcept {
   Applied a;
   if (m.source != codec::canopen::Source::Mppt) return a;
-  for (std::uint8_t i = 0; i < m.field_count && i < m.fields.size(); ++i) a.mppt |= store(kMpptValues, mppt, m.fields[i]);
+  for (std::uint8_t i = 0; i < m.field_count && i < m.fields.size(); ++i)
+    a.mppt |= store(kMpptValues, mppt, m.fields[i]);
   return a;
 }
 

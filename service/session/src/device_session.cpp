@@ -32,9 +32,13 @@ double battery_volts(double measured) noexcept { return measured < kBatteryPrese
 
 }  // namespace
 
-DeviceSession::DeviceSession(DeviceKey key, DeviceConfig device, const Timeouts& timeouts, StateSink& sink,
-                             SendFn send, SteadyTime now)
-    : key_(std::move(key)), settings_(device), timeouts_(timeouts), sink_(sink), send_(std::move(send)),
+DeviceSession::DeviceSession(DeviceKey key, DeviceConfig device, const Timeouts& timeouts, StateSink& sink, SendFn send,
+                             SteadyTime now)
+    : key_(std::move(key)),
+      settings_(device),
+      timeouts_(timeouts),
+      sink_(sink),
+      send_(std::move(send)),
       health_(now, timeouts),
       queue_([this](const codec::CanFrame& f) { return send_one(f); }, timeouts.reply),
       alarms_(key_.bus, alarms::DeviceKind::Pmu, key_.address, device.alarms, sink) {
@@ -150,8 +154,7 @@ DeviceSession::UrgentSent DeviceSession::send_urgent(const codec::CanFrame& fram
   return out;
 }
 
-void DeviceSession::on_frame(const codec::PmuId& id, const codec::CanFrame& frame, SteadyTime now,
-                             WallTime received) {
+void DeviceSession::on_frame(const codec::PmuId& id, const codec::CanFrame& frame, SteadyTime now, WallTime received) {
   now_ = now;
   last_heard_ = now;
   const bool was_offline = health_.offline();
@@ -207,16 +210,17 @@ void DeviceSession::move_to(std::uint16_t address, MoveCause cause, SteadyTime n
   queue_.readdress(old.address, address);
   if (cause == MoveCause::ByItself) {
     // A stop sent since it was last heard at the old address went where it no longer was.
-    const bool stop_missed = last_stop_ && (!last_heard_ || *last_stop_ >= *last_heard_) &&
-                             now - *last_stop_ <= kStopFollowsFor;
+    const bool stop_missed =
+        last_stop_ && (!last_heard_ || *last_stop_ >= *last_heard_) && now - *last_stop_ <= kStopFollowsFor;
     if (health_.offline()) health_.on_reconnect();
     health_.on_frame(now);  // its serial answer, which the bus worker took as the evidence
     last_heard_ = now;
     if (stop_missed) {
       const auto sent = send_urgent(*codec::encode_engine_stop(address), now);
-      spdlog::warn("{}/{}: an engine stop was sent to address {} after the unit was last heard there: sent again "
-                   "at its new address ({})",
-                   key_.bus, address, old.address, transport::to_string(sent.result.status));
+      spdlog::warn(
+          "{}/{}: an engine stop was sent to address {} after the unit was last heard there: sent again "
+          "at its new address ({})",
+          key_.bus, address, old.address, transport::to_string(sent.result.status));
     }
     start_reading(now);
   }
@@ -244,7 +248,9 @@ void DeviceSession::tick(SteadyTime now, WallTime wall) {
   alarms_.tick(now, wall);
 }
 
-void DeviceSession::at(SteadyTime when, std::function<void(SteadyTime)> fn) { timers_.push_back({when, std::move(fn)}); }
+void DeviceSession::at(SteadyTime when, std::function<void(SteadyTime)> fn) {
+  timers_.push_back({when, std::move(fn)});
+}
 
 void DeviceSession::run_timers(SteadyTime now) {
   // A timer's function may add timers: take the due ones out first, then call them.
@@ -300,9 +306,8 @@ void DeviceSession::update_health(SteadyTime now, bool force) {
   const auto u = health_.update(now, period(), force);
   const auto& report = health_.report();
   if (u.changed && report.state != HealthState::Unknown)
-    spdlog::log(report.state == HealthState::Online ? spdlog::level::info : spdlog::level::warn,
-                "{}/{}: {} ({})", key_.bus, key_.address, to_string(report.state),
-                last_frame_text(report.last_frame_age));
+    spdlog::log(report.state == HealthState::Online ? spdlog::level::info : spdlog::level::warn, "{}/{}: {} ({})",
+                key_.bus, key_.address, to_string(report.state), last_frame_text(report.last_frame_age));
   if (u.publish) sink_.on_health(key_, report);
 }
 

@@ -36,7 +36,9 @@ const char* to_string(DeviceKind k) noexcept {
 }
 
 HealthTracker::HealthTracker(std::chrono::steady_clock::time_point created, const Timeouts& timeouts) noexcept
-    : stale_periods_(timeouts.stale_periods), offline_periods_(timeouts.offline_periods), created_(created),
+    : stale_periods_(timeouts.stale_periods),
+      offline_periods_(timeouts.offline_periods),
+      created_(created),
       next_publish_(created) {}
 
 void HealthTracker::on_frame(std::chrono::steady_clock::time_point now) noexcept {
@@ -55,8 +57,8 @@ void HealthTracker::on_bus_counters(const transport::BusCounters& c) noexcept {
   report_.rx_dropped = c.rx_drops;
 }
 
-HealthTracker::Update HealthTracker::update(std::chrono::steady_clock::time_point now,
-                                            std::chrono::milliseconds period, bool force) noexcept {
+HealthTracker::Update HealthTracker::update(std::chrono::steady_clock::time_point now, std::chrono::milliseconds period,
+                                            bool force) noexcept {
   using Seconds = std::chrono::duration<double>;
   HealthState state = HealthState::Unknown;
   const double p = Seconds(period).count();

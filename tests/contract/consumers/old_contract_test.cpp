@@ -131,7 +131,8 @@ void expect_matched_nothing(const ConsumerRun& run, const std::string& service_t
   // the verdict on them, not a run that ended too early.
   std::vector<std::pair<std::string, std::string>> endpoints{
       {"pmu/health", "Health"}, {"pmu/config", "Config"}, {"pmu/voltages", "Voltages"}, {"pmu/status", "Status"}};
-  if (commands) endpoints.insert(endpoints.end(), {{"pmu/command_reply", "CommandReply"}, {"reader:pmu/command", "Command"}});
+  if (commands)
+    endpoints.insert(endpoints.end(), {{"pmu/command_reply", "CommandReply"}, {"reader:pmu/command", "Command"}});
   for (const auto& [topic, type] : endpoints) {
     const Json found = run.final["discovered"].value(topic, Json());
     EXPECT_TRUE(found.is_array() && !found.empty()) << topic << ": " << run.out;
@@ -152,8 +153,9 @@ TEST(OldContractConsumers, MatchNothingOfAServiceOfV5AloneWhichV5Reads) {
   for (const char* path : {OLD_CONSUMER_V4_PATH, OLD_CONSUMER_V3_PATH, OLD_CONSUMER_V2_PATH}) {
     SCOPED_TRACE(path);
     const bool commands = std::string(path) != OLD_CONSUMER_V2_PATH;
-    const auto run = run_consumer(path, domain, std::string("--seconds 90 --until discovered --linger 2") +
-                                                    (commands ? " --command GET_SERIAL" : ""));
+    const auto run = run_consumer(path, domain,
+                                  std::string("--seconds 90 --until discovered --linger 2") +
+                                      (commands ? " --command GET_SERIAL" : ""));
     expect_matched_nothing(run, "pmu::v5::", commands);
     EXPECT_TRUE(has(run.final["discovered"].value("pmu/health", Json()), "pmu::v5::Health")) << run.out;
     // What a tool of any contract can read without matching: the participant's property.
@@ -191,10 +193,12 @@ TEST(OldContractConsumers, V4ConsumerReadsEveryFieldOfAServiceThatAlsoServesV4) 
   ASSERT_TRUE(silent.is_object()) << service.describe();
   EXPECT_TRUE(silent["values"]["last_frame_age"].is_null()) << silent.dump();
 
-  const auto run = run_consumer(OLD_CONSUMER_V4_PATH, domain, "--seconds 90 --until decoded --linger 2 --command GET_SERIAL");
+  const auto run =
+      run_consumer(OLD_CONSUMER_V4_PATH, domain, "--seconds 90 --until decoded --linger 2 --command GET_SERIAL");
   const Json after = v5_state(domain, "health", "health");
   ASSERT_TRUE(run.final.is_object() && after.is_object()) << run.out << "\n" << service.describe();
-  for (const char* topic : {"pmu/health", "pmu/config", "pmu/voltages", "pmu/status", "pmu/command", "pmu/command_reply"})
+  for (const char* topic :
+       {"pmu/health", "pmu/config", "pmu/voltages", "pmu/status", "pmu/command", "pmu/command_reply"})
     EXPECT_EQ(run.final["matched"].value(topic, -1), 1) << topic << ": the v4 participant's alone; " << run.out;
   // Two participants named pmu-service, each announcing the contract it serves.
   EXPECT_EQ(run.final["service_contracts"], Json::array({"4", "5"})) << run.out;
@@ -266,8 +270,9 @@ TEST(OldContractConsumers, V3AndV2ConsumersMatchNothingOfAServiceThatAlsoServesV
   for (const char* path : {OLD_CONSUMER_V3_PATH, OLD_CONSUMER_V2_PATH}) {
     SCOPED_TRACE(path);
     const bool commands = std::string(path) == OLD_CONSUMER_V3_PATH;
-    const auto run = run_consumer(path, domain, std::string("--seconds 90 --until discovered --linger 2") +
-                                                    (commands ? " --command GET_SERIAL" : ""));
+    const auto run = run_consumer(path, domain,
+                                  std::string("--seconds 90 --until discovered --linger 2") +
+                                      (commands ? " --command GET_SERIAL" : ""));
     // Whichever of the service's two participants discovery reported first: their names are
     // versioned, the client's are not.
     expect_matched_nothing(run, "pmu::v", commands);

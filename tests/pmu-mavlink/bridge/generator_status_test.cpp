@@ -86,7 +86,8 @@ TEST(GeneratorStatus, EveryUnknownIsTheSentinel) {
   stale.online = false;
   PmuView nothing;
   nothing.online = true;
-  const std::pair<const char*, PmuView> cases[] = {{"NaN", nan_values}, {"not ONLINE (H7)", stale}, {"no sample yet", nothing}};
+  const std::pair<const char*, PmuView> cases[] = {
+      {"NaN", nan_values}, {"not ONLINE (H7)", stale}, {"no sample yet", nothing}};
   for (const auto& [name, view] : cases) {
     const auto m = generator_status(view);
     EXPECT_EQ(m.generator_speed, UINT16_MAX) << name;

@@ -34,10 +34,14 @@ TEST(EndpointAddress, Udp) {
     const char* host;
     int port;
   };
-  const Case cases[] = {{"127.0.0.1:14550", true, "127.0.0.1", 14550}, {"gcs.local:1", true, "gcs.local", 1},
-                        {"[::1]:14550", true, "::1", 14550},           {"::1:14550", false, "", 0},
-                        {"127.0.0.1", false, "", 0},                  {":14550", false, "", 0},
-                        {"host:0", false, "", 0},                     {"host:65536", false, "", 0},
+  const Case cases[] = {{"127.0.0.1:14550", true, "127.0.0.1", 14550},
+                        {"gcs.local:1", true, "gcs.local", 1},
+                        {"[::1]:14550", true, "::1", 14550},
+                        {"::1:14550", false, "", 0},
+                        {"127.0.0.1", false, "", 0},
+                        {":14550", false, "", 0},
+                        {"host:0", false, "", 0},
+                        {"host:65536", false, "", 0},
                         {"host:port", false, "", 0}};
   for (const auto& c : cases) {
     const auto r = parse_udp_address(c.text);

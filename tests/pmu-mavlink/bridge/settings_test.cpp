@@ -21,16 +21,17 @@ TEST(Settings, Defaults) {
 
 TEST(Settings, EveryKey) {
   Settings s;
-  read_settings("udp: 127.0.0.1:14550\n"
-                "serial: /dev/ttyAMA0:57600\n"
-                "system_id: 3\n"
-                "component_id: 191\n"
-                "domain: 7\n"
-                "vehicle: uav1\n"
-                "qos_file: /etc/pmu-dds/qos.xml\n"
-                "battery_ids: {pmu: 30, bms: 40}\n"
-                "rates: {battery_status: 1, generator_status: 0, heartbeat: 2}\n",
-                "m.yaml", s);
+  read_settings(
+      "udp: 127.0.0.1:14550\n"
+      "serial: /dev/ttyAMA0:57600\n"
+      "system_id: 3\n"
+      "component_id: 191\n"
+      "domain: 7\n"
+      "vehicle: uav1\n"
+      "qos_file: /etc/pmu-dds/qos.xml\n"
+      "battery_ids: {pmu: 30, bms: 40}\n"
+      "rates: {battery_status: 1, generator_status: 0, heartbeat: 2}\n",
+      "m.yaml", s);
   ASSERT_TRUE(s.udp);
   EXPECT_EQ(s.udp->port, 14550);
   ASSERT_TRUE(s.serial);
@@ -75,8 +76,7 @@ TEST(Settings, RateOption) {
   Settings s;
   EXPECT_FALSE(apply_rate_option("battery_status=0.2", s));
   EXPECT_EQ(s.intervals.at(id::kBatteryStatus), 5s);
-  for (const char* bad : {"battery_status", "battery_status=fast", "battery_status=-1", "efi_status=1",
-                          "heartbeat=1x"})
+  for (const char* bad : {"battery_status", "battery_status=fast", "battery_status=-1", "efi_status=1", "heartbeat=1x"})
     EXPECT_TRUE(apply_rate_option(bad, s)) << bad;
 }
 

@@ -19,8 +19,8 @@ struct Case {
 
 TEST(WireUnits, Millivolts) {
   const Case cases[] = {{"nan is not provided", kNaN, 65535}, {"inf is not provided", kInf, 65535},
-                        {"zero volts is 0 mV", 0.0F, 0},       {"24.05 V", 24.05F, 24050},
-                        {"negative clamps to 0", -1.0F, 0},    {"too high stays below the sentinel", 70.0F, 65534}};
+                        {"zero volts is 0 mV", 0.0F, 0},      {"24.05 V", 24.05F, 24050},
+                        {"negative clamps to 0", -1.0F, 0},   {"too high stays below the sentinel", 70.0F, 65534}};
   for (const auto& c : cases) EXPECT_EQ(millivolts(c.in), c.out) << c.name;
 }
 

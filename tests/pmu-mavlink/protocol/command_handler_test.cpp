@@ -64,13 +64,17 @@ TEST(CommandMeaning, EachCommandIsTheServiceCommandItMeans) {
   using service::CommandKind;
   const Case cases[] = {
       {"start", start(), static_cast<std::size_t>(CommandKind::EngineStart), 0},
-      {"stop PMU 2", command(cmd::kDoEngineControl, {0, 0, 0, 0, 0, 0, 2}), static_cast<std::size_t>(CommandKind::EngineStop), 1},
+      {"stop PMU 2", command(cmd::kDoEngineControl, {0, 0, 0, 0, 0, 0, 2}),
+       static_cast<std::size_t>(CommandKind::EngineStop), 1},
       {"payload on", command(cmd::kDoSetRelay, {1, 1}), static_cast<std::size_t>(CommandKind::EnableOutputs), 0},
       {"charger_b off", command(cmd::kDoSetRelay, {3, 0}), static_cast<std::size_t>(CommandKind::DisableOutputs), 0},
       {"avionics off", command(cmd::kDoSetRelay, {0, 0}), static_cast<std::size_t>(CommandKind::DisableOutputs), 0},
-      {"generation off", command(cmd::kDoSetRelay, {4, 0, 0, 0, 0, 0, 1}), static_cast<std::size_t>(CommandKind::SetGeneration), 0},
-      {"reset", command(cmd::kPreflightRebootShutdown, {0, 0, 1, 180}), static_cast<std::size_t>(CommandKind::Reset), 0},
-      {"reset all components", command(cmd::kPreflightRebootShutdown, {0, 0, 1, 0}), static_cast<std::size_t>(CommandKind::Reset), 0},
+      {"generation off", command(cmd::kDoSetRelay, {4, 0, 0, 0, 0, 0, 1}),
+       static_cast<std::size_t>(CommandKind::SetGeneration), 0},
+      {"reset", command(cmd::kPreflightRebootShutdown, {0, 0, 1, 180}), static_cast<std::size_t>(CommandKind::Reset),
+       0},
+      {"reset all components", command(cmd::kPreflightRebootShutdown, {0, 0, 1, 0}),
+       static_cast<std::size_t>(CommandKind::Reset), 0},
   };
   for (const auto& c : cases) {
     SCOPED_TRACE(c.what);

@@ -93,9 +93,8 @@ TEST(ParamList, SendsEveryKnownParameterOnceAtThePace) {
   // 10 a second, at most two at once after a quiet while: 26 take 2.4 s or more.
   EXPECT_GE(sent.back().first - sent.front().first, 2400ms);
   for (auto t = t0; t < t0 + 4000ms; t += 1000ms) {
-    const auto in_second = std::count_if(sent.begin(), sent.end(), [&](const auto& e) {
-      return e.first >= t && e.first < t + 1000ms;
-    });
+    const auto in_second =
+        std::count_if(sent.begin(), sent.end(), [&](const auto& e) { return e.first >= t && e.first < t + 1000ms; });
     EXPECT_LE(in_second, 11) << "second at " << (t - t0).count();
   }
   EXPECT_EQ(s.counters().values_sent, 2 * kSettingCount);
@@ -225,15 +224,14 @@ TEST_P(ParamSetReply, ExactlyOneParamValueWithTheDevicesValueAfterTheSet) {
   EXPECT_EQ(s.counters().replies_unmatched, 1U);
 }
 
-INSTANTIATE_TEST_SUITE_P(
-    Results, ParamSetReply,
-    testing::Values(SetCase{"completed", CommandResult::Completed, 20.0F, false},
-                    SetCase{"denied", CommandResult::Denied, 24.0F, true},
-                    SetCase{"rejected", CommandResult::Rejected, 24.0F, true},
-                    SetCase{"failed", CommandResult::Failed, 24.0F, true},
-                    SetCase{"timeout", CommandResult::Timeout, 24.0F, true},
-                    SetCase{"unsupported", CommandResult::Unsupported, 24.0F, true}),
-    [](const auto& test_info) { return std::string(test_info.param.name); });
+INSTANTIATE_TEST_SUITE_P(Results, ParamSetReply,
+                         testing::Values(SetCase{"completed", CommandResult::Completed, 20.0F, false},
+                                         SetCase{"denied", CommandResult::Denied, 24.0F, true},
+                                         SetCase{"rejected", CommandResult::Rejected, 24.0F, true},
+                                         SetCase{"failed", CommandResult::Failed, 24.0F, true},
+                                         SetCase{"timeout", CommandResult::Timeout, 24.0F, true},
+                                         SetCase{"unsupported", CommandResult::Unsupported, 24.0F, true}),
+                         [](const auto& test_info) { return std::string(test_info.param.name); });
 
 TEST(ParamSet, NoReplyFromTheServiceIsAnsweredOnceWithTheOldValueAtTheTimeout) {
   auto s = server(1);
@@ -270,14 +268,13 @@ TEST(ParamSet, RefusedHereWithTheOldValueAndAReasonAndNothingSent) {
     float expected;
     const char* why;
   };
-  for (const auto& c : {Case{"PMU1_AVION_V", 30.0F, 9, 24.0F, "out of range"},
-                        Case{"PMU1_AVION_V", 23.05F, 9, 24.0F, "multiple"},
-                        Case{"PMU1_AVION_V", 20.0F, 6, 24.0F, "REAL32"},
-                        Case{"PMU1_CAN_ADDR", 7.0F, 9, 1.0F, "read-only"},
-                        Case{"PMU1_TEMP_UPPER", 0.0F, 9, 80.0F, "rule thermal_shutdown"},
-                        Case{"PMU1_POWERUP", 2.0F, 9, 3.0F, "rule power_up_avionics_off"},
-                        Case{"PMU1_PKT_STREAM", 0.0F, 9, 31.0F, "rule stop_streaming"},
-                        Case{"PMU1_OUTPUTS", 2.0F, 9, 3.0F, "rule disable_avionics"}}) {
+  for (const auto& c :
+       {Case{"PMU1_AVION_V", 30.0F, 9, 24.0F, "out of range"}, Case{"PMU1_AVION_V", 23.05F, 9, 24.0F, "multiple"},
+        Case{"PMU1_AVION_V", 20.0F, 6, 24.0F, "REAL32"}, Case{"PMU1_CAN_ADDR", 7.0F, 9, 1.0F, "read-only"},
+        Case{"PMU1_TEMP_UPPER", 0.0F, 9, 80.0F, "rule thermal_shutdown"},
+        Case{"PMU1_POWERUP", 2.0F, 9, 3.0F, "rule power_up_avionics_off"},
+        Case{"PMU1_PKT_STREAM", 0.0F, 9, 31.0F, "rule stop_streaming"},
+        Case{"PMU1_OUTPUTS", 2.0F, 9, 3.0F, "rule disable_avionics"}}) {
     SCOPED_TRACE(c.name);
     auto s = server(1);
     auto m = set_of(c.name, c.value);

@@ -83,13 +83,13 @@ TEST(ParamTable, ValuesOutOfRangeOffStepOrNotANumberAreRefused) {
     Setting setting;
     float value;
   };
-  for (const auto& c : {Case{Setting::AvionicsVoltage, 30.0F}, Case{Setting::AvionicsVoltage, 11.9F},
-                        Case{Setting::AvionicsVoltage, 23.05F}, Case{Setting::AvionicsVoltage, std::numeric_limits<float>::quiet_NaN()},
-                        Case{Setting::PacketPeriod, 0.0F}, Case{Setting::PacketsStreamed, 0x20},
-                        Case{Setting::PacketsStreamed, 1.5F}, Case{Setting::Outputs, 16.0F},
-                        Case{Setting::Outputs, -1.0F}, Case{Setting::GenerationEnabled, 2.0F},
-                        Case{Setting::GenerationEnabled, 0.5F}, Case{Setting::CanAddress, 65535.0F},
-                        Case{Setting::UpperTemperatureLimit, std::numeric_limits<float>::infinity()}}) {
+  for (const auto& c :
+       {Case{Setting::AvionicsVoltage, 30.0F}, Case{Setting::AvionicsVoltage, 11.9F},
+        Case{Setting::AvionicsVoltage, 23.05F}, Case{Setting::AvionicsVoltage, std::numeric_limits<float>::quiet_NaN()},
+        Case{Setting::PacketPeriod, 0.0F}, Case{Setting::PacketsStreamed, 0x20}, Case{Setting::PacketsStreamed, 1.5F},
+        Case{Setting::Outputs, 16.0F}, Case{Setting::Outputs, -1.0F}, Case{Setting::GenerationEnabled, 2.0F},
+        Case{Setting::GenerationEnabled, 0.5F}, Case{Setting::CanAddress, 65535.0F},
+        Case{Setting::UpperTemperatureLimit, std::numeric_limits<float>::infinity()}}) {
     const auto r = from_real32(c.setting, c.value);
     EXPECT_FALSE(r) << spec_of(c.setting).suffix << " " << c.value;
     if (!r) {

@@ -185,8 +185,7 @@ TEST_P(AlarmEveryCode, ClearsAfterTheOffDelay) {
   }
   EXPECT_EQ(a.since(), t1 + off());
   EXPECT_DOUBLE_EQ(a.value(), clearing(spec()));
-  EXPECT_EQ(a.state(), spec().severity == Severity::Critical ? AlarmState::ClearedUnacknowledged
-                                                              : AlarmState::Normal);
+  EXPECT_EQ(a.state(), spec().severity == Severity::Critical ? AlarmState::ClearedUnacknowledged : AlarmState::Normal);
   EXPECT_LE(a.message().size(), kMaxMessageLength);
 }
 
@@ -461,8 +460,7 @@ TEST(AlarmSettings, EachBadFieldIsNamedWithItsCode) {
        "battery_a_low_voltage: deadband -0.5 is negative"},
       {"NaN deadband", Code::CellLow, with(&AlarmOverride::deadband, kNaN),
        "cell_low: deadband is not a finite number"},
-      {"NaN limit", Code::BmsLowSoc, with(&AlarmOverride::limit, kNaN),
-       "bms_low_soc: limit is not a finite number"},
+      {"NaN limit", Code::BmsLowSoc, with(&AlarmOverride::limit, kNaN), "bms_low_soc: limit is not a finite number"},
       {"infinite limit", Code::BmsLowSoc, with(&AlarmOverride::limit, -inf),
        "bms_low_soc: limit is not a finite number"},
       {"negative on-delay", Code::DeviceStale, with(&AlarmOverride::on_delay_s, -1.0),
@@ -512,16 +510,24 @@ std::vector<Code> codes_of(const AlarmSet& set) {
 }
 
 TEST(AlarmSet, HoldsTheRowsOfItsKind) {
-  const std::vector<Code> pmu{Code::ThermalShutdown,          Code::SoaShutdown,
-                              Code::PayloadShed,              Code::BatteryALowVoltage,
-                              Code::BatteryACriticalVoltage,  Code::BatteryBLowVoltage,
-                              Code::BatteryBCriticalVoltage,  Code::InternalOverTemperature,
-                              Code::StarterOverTemperature,   Code::GeneratorOverTemperature,
-                              Code::BatteryAOverTemperature,  Code::BatteryBOverTemperature,
-                              Code::GeneratorNotProducing,    Code::UncommandedEngineStop,
-                              Code::DeviceStale,              Code::DeviceOffline};
-  const std::vector<Code> battery{Code::BmsLowSoc,          Code::BmsCriticalSoc, Code::CellLow,
-                                  Code::CellImbalance,      Code::BmsOverTemperature, Code::DeviceStale,
+  const std::vector<Code> pmu{Code::ThermalShutdown,
+                              Code::SoaShutdown,
+                              Code::PayloadShed,
+                              Code::BatteryALowVoltage,
+                              Code::BatteryACriticalVoltage,
+                              Code::BatteryBLowVoltage,
+                              Code::BatteryBCriticalVoltage,
+                              Code::InternalOverTemperature,
+                              Code::StarterOverTemperature,
+                              Code::GeneratorOverTemperature,
+                              Code::BatteryAOverTemperature,
+                              Code::BatteryBOverTemperature,
+                              Code::GeneratorNotProducing,
+                              Code::UncommandedEngineStop,
+                              Code::DeviceStale,
+                              Code::DeviceOffline};
+  const std::vector<Code> battery{Code::BmsLowSoc,     Code::BmsCriticalSoc,     Code::CellLow,
+                                  Code::CellImbalance, Code::BmsOverTemperature, Code::DeviceStale,
                                   Code::DeviceOffline};
   const std::vector<Code> mppt{Code::MpptFault, Code::DeviceStale, Code::DeviceOffline};
   const std::vector<Code> bus{Code::BusErrorPassive, Code::BusOff};

@@ -25,8 +25,8 @@ class SimulatedService {
  public:
   explicit SimulatedService(const std::string& yaml) : config_(parse_config(yaml, "sim.yaml")) {
     sim_ = make_simulated_bus(config_.buses.at(0), clock_);
-    worker_ = std::make_unique<BusWorker>(config_.buses.at(0), std::move(sim_.service_end), clock_, config_.timeouts,
-                                          sink);
+    worker_ =
+        std::make_unique<BusWorker>(config_.buses.at(0), std::move(sim_.service_end), clock_, config_.timeouts, sink);
   }
   ~SimulatedService() { worker_.reset(); }  // before the network its end is on
   SimulatedService(const SimulatedService&) = delete;
@@ -78,7 +78,8 @@ struct PmuCase {
 // Each setting against what the service reads from the unit after 3 s of streaming, beside
 // the same reading without it.
 const PmuCase kPmuCases[] = {
-    {"", [](const SimulatedService& s) {
+    {"",
+     [](const SimulatedService& s) {
        ASSERT_NE(s.last<codec::Status>(), nullptr);
        EXPECT_EQ(s.last<codec::Status>()->generator_rpm, 6000) << "running by default";
        EXPECT_FALSE(s.last<codec::Status>()->thermal_shutdown);
@@ -87,39 +88,46 @@ const PmuCase kPmuCases[] = {
        EXPECT_FALSE(s.last<codec::Status>()->payload_shed);
        EXPECT_NEAR(s.last<codec::Voltages>()->battery_a, 22.2, 0.05);
      }},
-    {"engine: stopped", [](const SimulatedService& s) {
+    {"engine: stopped",
+     [](const SimulatedService& s) {
        ASSERT_NE(s.last<codec::Status>(), nullptr);
        EXPECT_EQ(s.last<codec::Status>()->generator_rpm, 0);
        EXPECT_EQ(s.last<codec::Voltages>()->generator, 0);
      }},
-    {"engine: running", [](const SimulatedService& s) {
+    {"engine: running",
+     [](const SimulatedService& s) {
        ASSERT_NE(s.last<codec::Status>(), nullptr);
        EXPECT_EQ(s.last<codec::Status>()->generator_rpm, 6000);
      }},
     // T_U is 80 degC from the factory (sim/README.md).
-    {"internal_temperature: 95", [](const SimulatedService& s) {
+    {"internal_temperature: 95",
+     [](const SimulatedService& s) {
        ASSERT_NE(s.last<codec::Status>(), nullptr);
        EXPECT_TRUE(s.last<codec::Status>()->thermal_shutdown);
        EXPECT_EQ(s.last<codec::Status>()->generator_rpm, 6000) << "the engine runs; the PMU stops using it";
        EXPECT_EQ(s.last<codec::Temperatures>()->internal, 95);
      }},
-    {"internal_temperature: 79", [](const SimulatedService& s) {
+    {"internal_temperature: 79",
+     [](const SimulatedService& s) {
        ASSERT_NE(s.last<codec::Status>(), nullptr);
        EXPECT_FALSE(s.last<codec::Status>()->thermal_shutdown);
        EXPECT_EQ(s.last<codec::Temperatures>()->internal, 79);
      }},
-    {"battery_a_voltage: 19.5, battery_b_voltage: 0", [](const SimulatedService& s) {
+    {"battery_a_voltage: 19.5, battery_b_voltage: 0",
+     [](const SimulatedService& s) {
        ASSERT_NE(s.last<codec::Voltages>(), nullptr);
        EXPECT_NEAR(s.last<codec::Voltages>()->battery_a, 19.5, 0.05);
        EXPECT_EQ(s.last<codec::Voltages>()->battery_b, 0);
      }},
-    {"starter_ready: false, soa_shutdown: true, payload_shed: true", [](const SimulatedService& s) {
+    {"starter_ready: false, soa_shutdown: true, payload_shed: true",
+     [](const SimulatedService& s) {
        ASSERT_NE(s.last<codec::Status>(), nullptr);
        EXPECT_FALSE(s.last<codec::Status>()->starter_ready);
        EXPECT_TRUE(s.last<codec::Status>()->soa_shutdown);
        EXPECT_TRUE(s.last<codec::Status>()->payload_shed);
      }},
-    {"firmware: \"1.14\", serial: 4242", [](const SimulatedService& s) {
+    {"firmware: \"1.14\", serial: 4242",
+     [](const SimulatedService& s) {
        ASSERT_FALSE(s.sink.infos.empty());
        EXPECT_EQ(s.sink.infos.back().second.serial_number, 4242);
        EXPECT_EQ(s.sink.infos.back().second.firmware.version(), (codec::FirmwareVersion{1, 14}));

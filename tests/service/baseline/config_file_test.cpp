@@ -209,7 +209,8 @@ TEST(ConfigFile, MalformedFilesAreRefusedAtTheirLine) {
 }
 
 TEST(ConfigDiff, ItemByItemInUnits) {
-  const auto f = read_config_file("parameters:\n  avionics_voltage: 22.0\n  cranking_time: 5.0\noutputs: [avionics_servo]\n");
+  const auto f =
+      read_config_file("parameters:\n  avionics_voltage: 22.0\n  cranking_time: 5.0\noutputs: [avionics_servo]\n");
   ASSERT_TRUE(f.ok());
   Settings device = full_settings();
   device[Setting::CrankingTime].reset();  // not read
@@ -261,7 +262,8 @@ TEST(ApplyPlan, SafeOrderAndTheConfirmRules) {
     return u;
   };
   ASSERT_TRUE(silent.ok());
-  EXPECT_EQ(apply_plan(differences(device, *silent), streaming_or_not(true))[0].confirm, service::ConfirmRule::StopStreaming);
+  EXPECT_EQ(apply_plan(differences(device, *silent), streaming_or_not(true))[0].confirm,
+            service::ConfirmRule::StopStreaming);
   EXPECT_EQ(apply_plan(differences(device, *silent), streaming_or_not(false))[0].confirm, std::nullopt);
 }
 

@@ -88,10 +88,10 @@ TEST(Policy, StopStreamingOnlyForADeviceTheServiceListensTo) {
   PolicyConfig off;
   off.confirm[static_cast<std::size_t>(ConfirmRule::StopStreaming)] = false;
   EXPECT_TRUE(check_policy(ps0, off, streaming_or_not(true)).allowed());
-  EXPECT_EQ(parse_config("policy:\n  confirm: [stop_streaming]\nbuses:\n  - interface: can0\n    discover: true\n",
-                         "p.yaml")
-                .policy.confirm,
-            (std::array<bool, kConfirmRuleCount>{false, false, false, false, false, false, true, false}));
+  EXPECT_EQ(
+      parse_config("policy:\n  confirm: [stop_streaming]\nbuses:\n  - interface: can0\n    discover: true\n", "p.yaml")
+          .policy.confirm,
+      (std::array<bool, kConfirmRuleCount>{false, false, false, false, false, false, true, false}));
   EXPECT_EQ(parse_config("policy:\n  confirm: [blind_monitoring]\nbuses:\n  - interface: can0\n    discover: true\n",
                          "p.yaml")
                 .policy.confirm,
@@ -227,7 +227,8 @@ TEST(Policy, EngineStopCannotBeDeniedByConfig) {
   } catch (const ConfigError& e) {
     EXPECT_EQ(std::string(e.what()), "p.yaml:2: engine_stop cannot be denied: it is the safety stop");
   }
-  EXPECT_THROW((void)parse_config("policy:\n  confirm: [everything]\nbuses:\n  - interface: can0\n    discover: true\n", "p.yaml"),
+  EXPECT_THROW((void)parse_config("policy:\n  confirm: [everything]\nbuses:\n  - interface: can0\n    discover: true\n",
+                                  "p.yaml"),
                ConfigError);
 }
 

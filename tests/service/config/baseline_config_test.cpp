@@ -94,14 +94,16 @@ TEST(BaselineConfig, AFileThatCannotServeIsRefusedAtTheConfigsLine) {
        source + ":5: baseline " + p + "none.yaml cannot be read: No such file or directory"},
       {"a folder", "        baseline: .\n", source + ":5: baseline " + p + ". cannot be read: it is a directory"},
       {"a value out of range", "        baseline: bad.yaml\n",
-       source + ":5: baseline refused: " + p + "bad.yaml:3: value 99.0 V out of range 12.0..24.0 V for payload_voltage"},
+       source + ":5: baseline refused: " + p +
+           "bad.yaml:3: value 99.0 V out of range 12.0..24.0 V for payload_voltage"},
       {"an empty file", "        baseline: empty.yaml\n",
        source + ":5: baseline refused: " + p + "empty.yaml:1: the file is empty"},
       {"a bit the configured minimum firmware lacks", "        min_firmware: \"1.12\"\n        baseline: s0.yaml\n",
        source + ":6: baseline refused: " + p + "s0.yaml:2: "},
       {"a bit its own min_firmware pin lacks", "        baseline: pinned.yaml\n",
        source + ":5: baseline refused: " + p + "pinned.yaml:4: "},
-      {"not a path", "        baseline: [a, b]\n", source + ":5: baseline must be the path of a PMU configuration file"},
+      {"not a path", "        baseline: [a, b]\n",
+       source + ":5: baseline must be the path of a PMU configuration file"},
       {"too long", "        baseline: " + std::string(256, 'x') + "\n",
        source + ":5: baseline: the path is 256 bytes long; at most 255"},
   };

@@ -259,9 +259,11 @@ TEST(Config, BatteryCapacityIsOptionalAndMoreThanZeroAh) {
 const char* const kBus = "buses:\n  - interface: can0\n    discover: true\n";
 
 const BadCase kBadNetwork[] = {
-    {"discovery: unicast\n", "bad.yaml:4: discovery must be a mapping: mode (multicast, unicast or server), peers, servers"},
+    {"discovery: unicast\n",
+     "bad.yaml:4: discovery must be a mapping: mode (multicast, unicast or server), peers, servers"},
     {"discovery:\n", "bad.yaml:4: discovery must be a mapping: mode (multicast, unicast or server), peers, servers"},
-    {"discovery:\n  mode: broadcast\n", "bad.yaml:5: discovery mode 'broadcast' is not one of multicast, unicast, server"},
+    {"discovery:\n  mode: broadcast\n",
+     "bad.yaml:5: discovery mode 'broadcast' is not one of multicast, unicast, server"},
     {"discovery:\n  mode:\n  peers: [10.0.0.1]\n", "bad.yaml:5: discovery mode must be multicast, unicast or server"},
     {"discovery:\n  mode: [unicast]\n", "bad.yaml:5: discovery mode must be multicast, unicast or server"},
     {"discovery:\n  mode: unicast\n  peer: [10.0.0.1]\n",
@@ -280,8 +282,9 @@ const BadCase kBadNetwork[] = {
     {"discovery:\n  mode: server\n",
      "bad.yaml:5: discovery mode server needs servers: the Discovery Servers' ADDRESS[:PORT] (port 11811 if none), in "
      "server id order"},
-    {"discovery:\n  mode: unicast\n  peers: []\n", "bad.yaml:6: peers must name at least one peer, e.g. [192.168.10.2, "
-                                                  "\"10.0.0.7:7412\", gcs.local]"},
+    {"discovery:\n  mode: unicast\n  peers: []\n",
+     "bad.yaml:6: peers must name at least one peer, e.g. [192.168.10.2, "
+     "\"10.0.0.7:7412\", gcs.local]"},
     {"discovery:\n  mode: unicast\n  peers:\n",
      "bad.yaml:6: peers must be a list, e.g. [192.168.10.2, \"10.0.0.7:7412\", gcs.local]"},
     {"discovery:\n  mode: unicast\n  peers: 10.0.0.1\n",
@@ -415,8 +418,9 @@ TEST(ConfigNetwork, UnicastPeersWithAndWithoutPortsAndTheirLines) {
 }
 
 TEST(ConfigNetwork, ServersInIdOrder) {
-  const Config c = parse_config(std::string(kBus) + "discovery:\n  mode: server\n  servers:\n    - \"10.0.0.1:11811\"\n"
-                                                    "    - ds2.local\n",
+  const Config c = parse_config(std::string(kBus) +
+                                    "discovery:\n  mode: server\n  servers:\n    - \"10.0.0.1:11811\"\n"
+                                    "    - ds2.local\n",
                                 "s.yaml");
   ASSERT_EQ(c.network.servers.size(), 2u);
   EXPECT_EQ(c.network.mode, dds::DiscoveryMode::Server);
@@ -430,8 +434,8 @@ TEST(ConfigNetwork, ServersInIdOrder) {
 // A client of the server with id 1 alone (a Discovery Server on each mission computer, the
 // ground station a client of all of them in id order).
 TEST(ConfigNetwork, AnEmptyServerEntryLeavesItsIdUnused) {
-  const Config c = parse_config(std::string(kBus) + "discovery:\n  mode: server\n  servers: [\"\", \"10.0.0.2\"]\n",
-                                "s.yaml");
+  const Config c =
+      parse_config(std::string(kBus) + "discovery:\n  mode: server\n  servers: [\"\", \"10.0.0.2\"]\n", "s.yaml");
   ASSERT_EQ(c.network.servers.size(), 2u);
   EXPECT_EQ(c.network.servers[0].host, "");
   EXPECT_EQ(c.network.servers[1].host, "10.0.0.2");
@@ -545,7 +549,8 @@ TEST(Config, SecurityFileFromASystemdCredential) {
     ConfigEnvironment env;
     std::string error;
   } bad[] = {
-      {"credential:k.pem", {},
+      {"credential:k.pem",
+       {},
        "a.yaml:7: private_key: credential:k.pem needs $CREDENTIALS_DIRECTORY, which is not set: the service was not "
        "started by systemd with LoadCredential=k.pem:PATH (deploy/security/README.md)"},
       {"'credential:'", systemd,
@@ -684,13 +689,17 @@ TEST(Config, IntegersAreDecimalOnly) {
     expect_refused("buses:\n  - interface: can0\n    devices:\n      - address: " + std::string(v) + "\n",
                    "bad.yaml:4: address" + rule + "'" + v + "'");
   }
-  expect_refused("domain: 010\nbuses:\n  - interface: can0\n    discover: true\n", "bad.yaml:1: domain" + rule + "'010'");
-  expect_refused("buses:\n  - interface: can0\n    mppts:\n      - device: 0x1\n", "bad.yaml:4: device" + rule + "'0x1'");
-  expect_refused("buses:\n  - interface: can0\n    bitrate: 5e5\n    discover: true\n", "bad.yaml:3: bitrate" + rule + "'5e5'");
+  expect_refused("domain: 010\nbuses:\n  - interface: can0\n    discover: true\n",
+                 "bad.yaml:1: domain" + rule + "'010'");
+  expect_refused("buses:\n  - interface: can0\n    mppts:\n      - device: 0x1\n",
+                 "bad.yaml:4: device" + rule + "'0x1'");
+  expect_refused("buses:\n  - interface: can0\n    bitrate: 5e5\n    discover: true\n",
+                 "bad.yaml:3: bitrate" + rule + "'5e5'");
   // Accepted: 0, and decimal as written (quoted too); a negative one is out of range, not misread.
   for (const char* v : {"0", "8", "10", "65534", "\"10\""}) {
     SCOPED_TRACE(v);
-    const Config c = parse_config("buses:\n  - interface: can0\n    devices:\n      - address: " + std::string(v) + "\n", "a.yaml");
+    const Config c =
+        parse_config("buses:\n  - interface: can0\n    devices:\n      - address: " + std::string(v) + "\n", "a.yaml");
     EXPECT_EQ(c.buses[0].devices[0].address, std::stoi(std::string(v[0] == '"' ? v + 1 : v)));
   }
   expect_refused("buses:\n  - interface: can0\n    devices:\n      - address: -1\n",
@@ -703,26 +712,31 @@ TEST(Config, IntegersAreDecimalOnly) {
 // prefix cut at a character boundary with the length: never half a UTF-8 character, never a
 // megabyte in a message.
 TEST(Config, NameLimitsAreBytesAndLongValuesAreShownShort) {
-  expect_refused("buses:\n  - interface: can0\n    name: \xC3\xA9t\xC3\xA9-\xC3\xA9t\xC3\xA9-\xC3\xA9t\xC3\xA9\n    discover: true\n",
-                 "bad.yaml:3: bus name '\xC3\xA9t\xC3\xA9-\xC3\xA9t\xC3\xA9-\xC3\xA9t\xC3\xA9' must be 1..15 bytes (it is a "
-                 "DDS key, string<15>)");
+  expect_refused(
+      "buses:\n  - interface: can0\n    name: \xC3\xA9t\xC3\xA9-\xC3\xA9t\xC3\xA9-\xC3\xA9t\xC3\xA9\n    discover: true\n",
+      "bad.yaml:3: bus name '\xC3\xA9t\xC3\xA9-\xC3\xA9t\xC3\xA9-\xC3\xA9t\xC3\xA9' must be 1..15 bytes (it is a "
+      "DDS key, string<15>)");
   // 1 + 13 x 3 bytes: the 24-byte prefix holds 'a' and 7 euro signs; the 8th would be cut.
   std::string euros = "a";
   for (int i = 0; i < 13; ++i) euros += "\xE2\x82\xAC";
   std::string shown = "a";
   for (int i = 0; i < 7; ++i) shown += "\xE2\x82\xAC";
   expect_refused("buses:\n  - interface: can0\n    name: " + euros + "\n    discover: true\n",
-                 "bad.yaml:3: bus name '" + shown + "...' (40 bytes) must be 1..15 bytes (it is a DDS key, string<15>)");
+                 "bad.yaml:3: bus name '" + shown +
+                     "...' (40 bytes) must be 1..15 bytes (it is a DDS key, string<15>)");
   const std::string huge(1000000, 'v');
   expect_refused("vehicle: " + huge + "\nbuses:\n  - interface: can0\n    discover: true\n",
-                 "bad.yaml:1: vehicle '" + std::string(24, 'v') + "...' (1000000 bytes) is 1000000 bytes; a vehicle "
-                 "name has at most 15 (it is a DDS key, string<15>)");
+                 "bad.yaml:1: vehicle '" + std::string(24, 'v') +
+                     "...' (1000000 bytes) is 1000000 bytes; a vehicle "
+                     "name has at most 15 (it is a DDS key, string<15>)");
   expect_refused("log_level: " + huge + "\nbuses:\n  - interface: can0\n    discover: true\n",
-                 "bad.yaml:1: log_level '" + std::string(24, 'v') + "...' (1000000 bytes) is not one of trace, debug, "
-                 "info, warn, error, critical, off");
-  expect_refused("vehicle: uav\xC3\xA9\nbuses:\n  - interface: can0\n    discover: true\n",
-                 "bad.yaml:1: vehicle 'uav\xC3\xA9' contains '\xC3\xA9'; a vehicle name is letters, digits, '_', '-' and "
-                 "'.' (it is also a DDS partition name, where other characters are patterns)");
+                 "bad.yaml:1: log_level '" + std::string(24, 'v') +
+                     "...' (1000000 bytes) is not one of trace, debug, "
+                     "info, warn, error, critical, off");
+  expect_refused(
+      "vehicle: uav\xC3\xA9\nbuses:\n  - interface: can0\n    discover: true\n",
+      "bad.yaml:1: vehicle 'uav\xC3\xA9' contains '\xC3\xA9'; a vehicle name is letters, digits, '_', '-' and "
+      "'.' (it is also a DDS partition name, where other characters are patterns)");
   expect_refused("vehicle: \"uav\\t1\"\nbuses:\n  - interface: can0\n    discover: true\n",
                  "bad.yaml:1: vehicle 'uav\\x091' contains byte 0x09; a vehicle name is letters, digits, '_', '-' and "
                  "'.' (it is also a DDS partition name, where other characters are patterns)");
@@ -866,9 +880,11 @@ TEST(ConfigStatistics, OffUnlessNamedAllOrAList) {
             dds::statistics_topic_names());
   EXPECT_EQ(dds::statistics_topic_names().size(), 17u) << "every topic of Fast DDS 2.9.1's topic_names.hpp";
   const Config c = parse_config(std::string("dds_statistics:\n  - _fastdds_statistics_history2history_latency\n"
-                                            "  - _fastdds_statistics_physical_data\n") + kBus, "s.yaml");
+                                            "  - _fastdds_statistics_physical_data\n") +
+                                    kBus,
+                                "s.yaml");
   EXPECT_EQ(c.dds_statistics, (std::vector<std::string>{"_fastdds_statistics_history2history_latency",
-                                                         "_fastdds_statistics_physical_data"}));
+                                                        "_fastdds_statistics_physical_data"}));
   EXPECT_EQ(dds::statistics_property(c.dds_statistics),
             "_fastdds_statistics_history2history_latency;_fastdds_statistics_physical_data");
 }
@@ -907,14 +923,17 @@ TEST(Config, BusOverride) {
   EXPECT_THROW(override_bus(c, "can0"), ConfigError);
   EXPECT_THROW(override_bus(c, "socketcan:"), ConfigError);
   EXPECT_EQ(c.dds_transport, dds::Transport::Default);
-  EXPECT_EQ(parse_config("dds_transport: udp\nbuses:\n  - interface: can0\n    discover: true\n", "u.yaml").dds_transport,
-            dds::Transport::UdpOnly);
-  EXPECT_EQ(parse_config("dds_transport: shm\nbuses:\n  - interface: can0\n    discover: true\n", "s.yaml").dds_transport,
-            dds::Transport::ShmOnly);
+  EXPECT_EQ(
+      parse_config("dds_transport: udp\nbuses:\n  - interface: can0\n    discover: true\n", "u.yaml").dds_transport,
+      dds::Transport::UdpOnly);
+  EXPECT_EQ(
+      parse_config("dds_transport: shm\nbuses:\n  - interface: can0\n    discover: true\n", "s.yaml").dds_transport,
+      dds::Transport::ShmOnly);
   override_bus(c, "fd:5");
   EXPECT_EQ(c.buses[0].interface, "fd:5");
   EXPECT_EQ(c.buses[0].name, "fd5");
-  for (const char* bad : {"fd:", "fd:2", "fd:x", "fd:5x", "fd:-4"}) EXPECT_THROW(override_bus(c, bad), ConfigError) << bad;
+  for (const char* bad : {"fd:", "fd:2", "fd:x", "fd:5x", "fd:-4"})
+    EXPECT_THROW(override_bus(c, bad), ConfigError) << bad;
   const Config d = default_sim_config();
   ASSERT_EQ(d.buses.size(), 1u);
   EXPECT_EQ(d.buses[0].devices.at(0).address, 1);

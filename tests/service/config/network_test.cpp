@@ -139,8 +139,8 @@ TEST(NetworkResolve, TheRadioProfileLimitsTheAgentsWorkersOnlyWithoutADiscoveryS
     EXPECT_EQ(r.link.agent_workers, k.workers);
     EXPECT_EQ(r.link.round_trip.value.count(), 700) << "the rest of the profile holds";
     const auto lines = r.link.explain();
-    const bool says_workers = std::any_of(lines.begin(), lines.end(),
-                                          [](const std::string& l) { return l.find("agent runs") != std::string::npos; });
+    const bool says_workers = std::any_of(
+        lines.begin(), lines.end(), [](const std::string& l) { return l.find("agent runs") != std::string::npos; });
     EXPECT_EQ(says_workers, k.workers > 0);
   }
 }
@@ -166,8 +166,9 @@ TEST(NetworkResolve, InterfaceNamesBecomeTheirAddresses) {
   c.interfaces = {interface("eth1"), interface("10.1.1.5"), interface("lo"), interface("127.0.0.1")};
   const ResolvedNetwork r = resolve_network(c, fake_lookup());
   EXPECT_EQ(r.interface_addresses, (std::vector<std::string>{"192.168.10.1", "192.168.11.1", "10.1.1.5", "127.0.0.1"}));
-  EXPECT_EQ(r.summary, "multicast discovery; DDS over UDP only on 192.168.10.1, 192.168.11.1 (eth1), 10.1.1.5 (wlan0), "
-                       "127.0.0.1 (lo)");
+  EXPECT_EQ(r.summary,
+            "multicast discovery; DDS over UDP only on 192.168.10.1, 192.168.11.1 (eth1), 10.1.1.5 (wlan0), "
+            "127.0.0.1 (lo)");
 }
 
 TEST(NetworkResolve, LoopbackIsAlwaysAllowedSoSameHostParticipantsMeet) {
@@ -175,8 +176,9 @@ TEST(NetworkResolve, LoopbackIsAlwaysAllowedSoSameHostParticipantsMeet) {
   c.interfaces = {interface("eth1")};
   const ResolvedNetwork r = resolve_network(c, fake_lookup());
   EXPECT_EQ(r.interface_addresses, (std::vector<std::string>{"192.168.10.1", "192.168.11.1", "127.0.0.1"}));
-  EXPECT_EQ(r.summary, "multicast discovery; DDS over UDP only on 192.168.10.1, 192.168.11.1 (eth1) and loopback "
-                       "(127.0.0.1)");
+  EXPECT_EQ(r.summary,
+            "multicast discovery; DDS over UDP only on 192.168.10.1, 192.168.11.1 (eth1) and loopback "
+            "(127.0.0.1)");
 }
 
 TEST(NetworkResolve, WhatCannotBeFoundIsAStartupErrorAtItsLine) {
@@ -190,12 +192,14 @@ TEST(NetworkResolve, WhatCannotBeFoundIsAStartupErrorAtItsLine) {
   };
   NetworkConfig c;
   c.interfaces = {interface("eth7", "/etc/pmu-dds/pmu-service.yaml:12")};
-  EXPECT_EQ(message(c), "/etc/pmu-dds/pmu-service.yaml:12: interface 'eth7': no such interface, or it has no IPv4 "
-                        "address (this machine: eth1 192.168.10.1, eth1 192.168.11.1, lo 127.0.0.1, wlan0 10.1.1.5)");
+  EXPECT_EQ(message(c),
+            "/etc/pmu-dds/pmu-service.yaml:12: interface 'eth7': no such interface, or it has no IPv4 "
+            "address (this machine: eth1 192.168.10.1, eth1 192.168.11.1, lo 127.0.0.1, wlan0 10.1.1.5)");
   // Fast DDS 2.9 would silently drop an address no interface has, and bind nowhere useful.
   c.interfaces = {interface("192.168.99.1", "--interface")};
-  EXPECT_EQ(message(c), "--interface: interface '192.168.99.1': no interface of this machine has this address (this "
-                        "machine: eth1 192.168.10.1, eth1 192.168.11.1, lo 127.0.0.1, wlan0 10.1.1.5)");
+  EXPECT_EQ(message(c),
+            "--interface: interface '192.168.99.1': no interface of this machine has this address (this "
+            "machine: eth1 192.168.10.1, eth1 192.168.11.1, lo 127.0.0.1, wlan0 10.1.1.5)");
   NetworkConfig u;
   u.mode = DiscoveryMode::Unicast;
   u.peers = {address("nowhere.invalid:7412", "PMU_DDS_PEERS")};
@@ -205,8 +209,9 @@ TEST(NetworkResolve, WhatCannotBeFoundIsAStartupErrorAtItsLine) {
   NetworkConfig s;
   s.mode = DiscoveryMode::Server;
   s.servers = {address("10.0.0.1"), address("nowhere.invalid", "f.yaml:8")};
-  EXPECT_EQ(message(s), "f.yaml:8: server 'nowhere.invalid': host name 'nowhere.invalid' does not resolve to an IPv4 "
-                        "address");
+  EXPECT_EQ(message(s),
+            "f.yaml:8: server 'nowhere.invalid': host name 'nowhere.invalid' does not resolve to an IPv4 "
+            "address");
 }
 
 }  // namespace

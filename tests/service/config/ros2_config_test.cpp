@@ -43,7 +43,7 @@ TEST(Ros2Names, VehicleAndBusBecomeTokens) {
     const char* token;
   };
   const Case cases[] = {{"uav1", "uav1"}, {"uav-1", "uav_1"}, {"uav.1", "uav_1"}, {"1st", "_1st"},
-                        {"can0", "can0"}, {"", ""},          {"A_b", "A_b"}};
+                        {"can0", "can0"}, {"", ""},           {"A_b", "A_b"}};
   for (const auto& c : cases) EXPECT_EQ(dds::ros2_token(c.text), c.token) << c.text;
 }
 
@@ -97,9 +97,10 @@ TEST(Ros2Config, EveryBadValueIsRefusedWithItsLine) {
     }
   }
   // Without ros2 the two bus names are fine: they differ.
-  EXPECT_NO_THROW((void)parse_config("buses:\n  - name: can-0\n    interface: can0\n    discover: true\n"
-                                     "  - name: can_0\n    interface: can1\n    discover: true\n",
-                                     "ok.yaml"));
+  EXPECT_NO_THROW(
+      (void)parse_config("buses:\n  - name: can-0\n    interface: can0\n    discover: true\n"
+                         "  - name: can_0\n    interface: can1\n    discover: true\n",
+                         "ok.yaml"));
 }
 
 }  // namespace

@@ -192,8 +192,7 @@ const BadCase kBadBattery[] = {
     {"          cell_voltages: [3.9, x]\n", "bad.yaml:6: cell voltage must be a number, not 'x'"},
     {"          cells: 3\n          cell_voltages: [3.9, 3.9]\n",
      "bad.yaml:7: cell_voltages has 2 voltages but cells is 3 (give one per cell, or leave cells out)"},
-    {"          garble: always\n",
-     "bad.yaml:6: garble must be none, wrong_length or unknown_subindex, not 'always'"},
+    {"          garble: always\n", "bad.yaml:6: garble must be none, wrong_length or unknown_subindex, not 'always'"},
     {"          silent: no way\n", "bad.yaml:6: silent must be true or false, not 'no way'"},
 };
 

@@ -24,11 +24,10 @@ class Moves {
   explicit Moves(std::vector<DeviceConfig> devices = {device(1)}, std::vector<sim::DeviceConfig> pmus = {pmu(1)},
                  bool discover = false)
       : h(sim_bus(std::move(devices), discover), std::move(pmus)),
-        service({&h.worker()}, PolicyConfig{}, Timeouts{}, h.clock(),
-                [this](const CommandReplyData& r) {
-                  replies.push_back(r);
-                  if (at_reply) at_reply();
-                }) {
+        service({&h.worker()}, PolicyConfig{}, Timeouts{}, h.clock(), [this](const CommandReplyData& r) {
+          replies.push_back(r);
+          if (at_reply) at_reply();
+        }) {
     h.worker().on_moved([this](const BusWorker::Moved& m) { moved.push_back(m); });
     h.run_for(2s);
   }

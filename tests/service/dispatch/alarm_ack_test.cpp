@@ -52,10 +52,12 @@ const BadSample kBad[] = {
      "code thermal_shutdown is not an alarm of a battery"},
     {"a bus code for a PMU", [](AlarmAckSample& s, std::uint64_t) { s.code = "bus_off"; },
      "code bus_off is not an alarm of a pmu"},
-    {"a bus alarm with a device", [](AlarmAckSample& s, std::uint64_t) {
+    {"a bus alarm with a device",
+     [](AlarmAckSample& s, std::uint64_t) {
        s.kind = 3;
        s.code = "bus_off";
-     }, "device must be 0 for a bus alarm"},
+     },
+     "device must be 0 for a bus alarm"},
     {"expired", [](AlarmAckSample& s, std::uint64_t now) { s.expires_at = now - 2000000000; },
      "expires_at: expired 2000 ms ago"},
 };
@@ -89,9 +91,10 @@ TEST(AlarmAckParse, AGoodSampleGivesTheTypedRequest) {
 
 // A simulated PMU at address 1 streaming every 0.5 s, and the service's acknowledgements.
 struct Acks {
-  Acks() : h(sim_bus({device(1, TelemetryMode::Streaming, 500ms)}), {pmu(1, codec::kCurrentFirmware, 5)}),
-           service({&h.worker()}, "", Lifetimes{}, h.clock(),
-                   [this](const AlarmAckReplyData& r) { replies.push_back(r); }) {
+  Acks()
+      : h(sim_bus({device(1, TelemetryMode::Streaming, 500ms)}), {pmu(1, codec::kCurrentFirmware, 5)}),
+        service({&h.worker()}, "", Lifetimes{}, h.clock(),
+                [this](const AlarmAckReplyData& r) { replies.push_back(r); }) {
     h.run_for(2s);
   }
   void plant(const std::function<void(sim::Plant&)>& change) {

@@ -125,22 +125,21 @@ TEST(CommandPlan, TheCheckTurnsTheAnswerIntoTheReply) {
   const CheckCase cases[] = {
       {"get a parameter", action::Get{PacketId::AvionicsVoltage}, answer(PacketId::AvionicsVoltage, {120}),
        CommandResult::Completed, "", 12.0, ""},
-      {"get outputs", action::Get{PacketId::Outputs}, answer(PacketId::Outputs, {0x05}), CommandResult::Completed,
-       "", 5.0, "avionics_servo,charger_a"},
-      {"get generation", action::Get{PacketId::Generation}, answer(PacketId::Generation, {1}),
-       CommandResult::Completed, "", 1.0, "on"},
+      {"get outputs", action::Get{PacketId::Outputs}, answer(PacketId::Outputs, {0x05}), CommandResult::Completed, "",
+       5.0, "avionics_servo,charger_a"},
+      {"get generation", action::Get{PacketId::Generation}, answer(PacketId::Generation, {1}), CommandResult::Completed,
+       "", 1.0, "on"},
       {"get telemetry", action::Get{PacketId::Currents}, answer(codec::encode_currents(codec::Currents{}, 1)),
        CommandResult::Completed, "published on pmu/currents", std::nullopt, ""},
       {"set read back equal", action::SetParameter{codec::Parameter::AvionicsVoltage, 240},
        answer(PacketId::AvionicsVoltage, {240}), CommandResult::Completed, "", 24.0, ""},
       {"set read back different", action::SetParameter{codec::Parameter::AvionicsVoltage, 240},
-       answer(PacketId::AvionicsVoltage, {120}), CommandResult::Failed, "device reports 12 after the set, not 24",
-       12.0, ""},
+       answer(PacketId::AvionicsVoltage, {120}), CommandResult::Failed, "device reports 12 after the set, not 24", 12.0,
+       ""},
       {"set outputs equal", action::SetOutputs{0x03}, answer(PacketId::Outputs, {0x03}), CommandResult::Completed, "",
        3.0, "on: avionics_servo,payload"},
       {"set outputs more on", action::SetOutputs{0x03}, answer(PacketId::Outputs, {0x07}), CommandResult::Failed,
-       "outputs on after the command: avionics_servo,payload,charger_a", 7.0,
-       "on: avionics_servo,payload,charger_a"},
+       "outputs on after the command: avionics_servo,payload,charger_a", 7.0, "on: avionics_servo,payload,charger_a"},
       {"enable: others may stay on", action::EnableOutputs{0x02}, answer(PacketId::Outputs, {0x03}),
        CommandResult::Completed, "", 3.0, "on: avionics_servo,payload"},
       {"enable: still off", action::EnableOutputs{0x02}, answer(PacketId::Outputs, {0x01}), CommandResult::Failed,
@@ -162,8 +161,8 @@ TEST(CommandPlan, TheCheckTurnsTheAnswerIntoTheReply) {
        std::nullopt, ""},
       {"serial", action::GetSerial{}, answer(codec::encode_serial(4001, 1)), CommandResult::Completed, "", 4001.0,
        "4001"},
-      {"firmware", action::GetFirmware{}, answer(codec::encode_firmware(firmware_1_14(), 1)),
-       CommandResult::Completed, "", 1.14, "1.14 built 2025-03-09"},
+      {"firmware", action::GetFirmware{}, answer(codec::encode_firmware(firmware_1_14(), 1)), CommandResult::Completed,
+       "", 1.14, "1.14 built 2025-03-09"},
   };
   for (const auto& c : cases) {
     SCOPED_TRACE(c.name);
@@ -197,8 +196,8 @@ TEST(CommandRun, AnotherCommandsFailureLeavesAQueuedAddressChangesAliasAlone) {
   DeviceConfig dc;
   dc.address = 1;
   Timeouts timeouts;
-  DeviceSession s({"can0", 1}, dc, timeouts, sink, [](const codec::CanFrame&) { return transport::SendResult{}; },
-                  start);
+  DeviceSession s(
+      {"can0", 1}, dc, timeouts, sink, [](const codec::CanFrame&) { return transport::SendResult{}; }, start);
   auto t = start;
   for (int i = 0; i < 100 && s.queued() > 0; ++i) s.tick(t += 100ms, {});  // a silent device: the reading round fails
   ASSERT_EQ(s.queued(), 0u);

@@ -29,7 +29,8 @@ class Commands {
   explicit Commands(std::vector<sim::DeviceConfig> pmus, PolicyConfig policy = {}, Timeouts timeouts = {},
                     std::vector<DeviceConfig> devices = {device(1)})
       : h(sim_bus(devices), std::move(pmus), timeouts),
-        service({&h.worker()}, policy, timeouts, h.clock(), [this](const CommandReplyData& r) { replies.push_back(r); }) {
+        service({&h.worker()}, policy, timeouts, h.clock(),
+                [this](const CommandReplyData& r) { replies.push_back(r); }) {
     h.run_for(300ms);  // start-up reading done
     h.clear_sent();
   }
@@ -166,9 +167,13 @@ TEST(Commands, EveryKindPutsTheSpecsFramesOnTheBusAndTheResultShowsUp) {
          EXPECT_TRUE(r.has_value);
          EXPECT_DOUBLE_EQ(r.value, 12.0);
        }},
-      {"get serial", [](Commands& c) { return c.req(CommandKind::GetSerial); }, {pmu_frame(0x30, 1, {})},
+      {"get serial",
+       [](Commands& c) { return c.req(CommandKind::GetSerial); },
+       {pmu_frame(0x30, 1, {})},
        [](Commands&, const CommandReplyData& r) { EXPECT_EQ(r.value, 4001); }},
-      {"get firmware", [](Commands& c) { return c.req(CommandKind::GetFirmware); }, {pmu_frame(0x31, 1, {})},
+      {"get firmware",
+       [](Commands& c) { return c.req(CommandKind::GetFirmware); },
+       {pmu_frame(0x31, 1, {})},
        [](Commands&, const CommandReplyData& r) { EXPECT_EQ(r.value_text, "1.17 built 2023-06-15"); }},
   };
   for (const auto& hc : cases) {
@@ -237,11 +242,13 @@ TEST(Commands, InvalidRequestsAreRefusedWithAReasonAndNothingIsSent) {
        CommandResult::Rejected, "unknown output bits 0x10"},
       {"enable nothing", [](Commands& c) { return c.req(CommandKind::EnableOutputs); }, CommandResult::Rejected,
        "no output named"},
-      {"unknown get", [](Commands& c) {
+      {"unknown get",
+       [](Commands& c) {
          auto r = c.req(CommandKind::Get);
          r.parameter = "volts";
          return r;
-       }, CommandResult::Rejected, "unknown parameter 'volts'"},
+       },
+       CommandResult::Rejected, "unknown parameter 'volts'"},
       {"expired",
        [](Commands& c) {
          auto r = c.req(CommandKind::GetSerial);
@@ -278,8 +285,8 @@ TEST(Commands, InvalidRequestsAreRefusedWithAReasonAndNothingIsSent) {
        "rule reset"},
       {"engine start without confirm", [](Commands& c) { return c.req(CommandKind::EngineStart); },
        CommandResult::Denied, "rule engine_start"},
-      {"can address without confirm", [](Commands& c) { return set_param(c, "can_address", 9); },
-       CommandResult::Denied, "rule set_can_address"},
+      {"can address without confirm", [](Commands& c) { return set_param(c, "can_address", 9); }, CommandResult::Denied,
+       "rule set_can_address"},
       {"T_U = 0 without confirm", [](Commands& c) { return set_param(c, "upper_temperature_limit", 0); },
        CommandResult::Denied, "rule thermal_shutdown"},
       {"S0 without avionics, no confirm", [](Commands& c) { return set_param(c, "power_up_state", 0x0E); },
@@ -291,16 +298,20 @@ TEST(Commands, InvalidRequestsAreRefusedWithAReasonAndNothingIsSent) {
        CommandResult::Denied, "rule thermal_shutdown"},
       {"S0 -0.0004 without confirm", [](Commands& c) { return set_param(c, "power_up_state", -0.0004); },
        CommandResult::Denied, "rule power_up_avionics_off"},
-      {"kind from a newer client", [](Commands& c) {
+      {"kind from a newer client",
+       [](Commands& c) {
          auto r = c.req(CommandKind::Get);
          r.kind = 99;
          return r;
-       }, CommandResult::Rejected, "unknown command kind 99"},
-      {"a boolean byte of 2", [](Commands& c) {
+       },
+       CommandResult::Rejected, "unknown command kind 99"},
+      {"a boolean byte of 2",
+       [](Commands& c) {
          auto r = c.req(CommandKind::EngineStart);
          r.confirm = 2;
          return r;
-       }, CommandResult::Rejected, "confirm is not a boolean"},
+       },
+       CommandResult::Rejected, "confirm is not a boolean"},
   };
   for (const auto& rc : cases) {
     SCOPED_TRACE(rc.what);
@@ -589,9 +600,7 @@ TEST(Commands, BurstOf1000MixedCommandsFromTwoSendersGetsExactly1000Replies) {
         r.kind = wire(CommandKind::Get);
         r.parameter = "outputs";
         break;
-      default:
-        r.kind = wire(CommandKind::RequestMeasurements);
-        r.groups = static_cast<std::uint8_t>(1 + rng() % 31);
+      default: r.kind = wire(CommandKind::RequestMeasurements); r.groups = static_cast<std::uint8_t>(1 + rng() % 31);
     }
     all.push_back(r);
   }
@@ -713,8 +722,9 @@ TEST(Commands, EveryCommandAndItsResultIsInTheAuditTrail) {
                       "COMPLETED"),
             std::string::npos)
       << text;
-  EXPECT_NE(text.find("audit: command t-1 from ground-station-7: set_parameter avionics_voltage=20 to sim0/1 -> COMPLETED"),
-            std::string::npos)
+  EXPECT_NE(
+      text.find("audit: command t-1 from ground-station-7: set_parameter avionics_voltage=20 to sim0/1 -> COMPLETED"),
+      std::string::npos)
       << text;
   EXPECT_NE(text.find("audit: command t-2 from ground-station-7: reset to sim0/1 -> DENIED: reset resets the PMU"),
             std::string::npos)

@@ -37,15 +37,13 @@ class Service {
     if (!apply.empty()) s.groups = hold_bits;
     return s;
   }
-  CommandSample set(const std::string& sender, const std::string& apply = "",
-                    std::uint8_t hold_bits = hold_bit::Hold) {
+  CommandSample set(const std::string& sender, const std::string& apply = "", std::uint8_t hold_bits = hold_bit::Hold) {
     auto s = req(CommandKind::SetParameter, sender, apply, hold_bits);
     s.parameter = "payload_voltage";
     s.value = 13.0 + static_cast<double>(next_ % 10);
     return s;
   }
-  CommandSample get(const std::string& sender, const std::string& apply = "",
-                    std::uint8_t hold_bits = hold_bit::Hold) {
+  CommandSample get(const std::string& sender, const std::string& apply = "", std::uint8_t hold_bits = hold_bit::Hold) {
     auto s = req(CommandKind::Get, sender, apply, hold_bits);
     s.parameter = "outputs";
     return s;
@@ -71,11 +69,11 @@ const std::string kApply = "pmuctl-gs1-4242-1765000000000000000";
 const std::string kA = "sender-a";
 const std::string kB = "sender-b";
 
-void expect_denied_by_holder(const CommandReplyData& r, const std::string& holder_id,
-                             const std::string& holder = kA) {
+void expect_denied_by_holder(const CommandReplyData& r, const std::string& holder_id, const std::string& holder = kA) {
   EXPECT_EQ(r.result, CommandResult::Denied) << r.reason;
-  EXPECT_NE(r.reason.find("configuration of sim0/1 held by an apply from " + holder + " (request id " + holder_id + ")"),
-            std::string::npos)
+  EXPECT_NE(
+      r.reason.find("configuration of sim0/1 held by an apply from " + holder + " (request id " + holder_id + ")"),
+      std::string::npos)
       << r.reason;
   EXPECT_TRUE(std::regex_search(r.reason, std::regex(R"(for another [0-9]+\.[0-9] s)"))) << r.reason;
 }
@@ -90,18 +88,54 @@ TEST(ConfigHold, AnotherWritersChangesAreDeniedNamingTheHolderAndReadsAndStopsRu
   };
   const Case cases[] = {
       {"set_parameter", [](Service& s) { return s.set(kB); }, true},
-      {"set_outputs", [](Service& s) { auto c = s.req(CommandKind::SetOutputs, kB); c.outputs = 0x03; return c; }, true},
-      {"enable_outputs", [](Service& s) { auto c = s.req(CommandKind::EnableOutputs, kB); c.outputs = 0x02; return c; }, true},
-      {"disable_outputs", [](Service& s) { auto c = s.req(CommandKind::DisableOutputs, kB); c.outputs = 0x02; return c; }, true},
-      {"set_generation", [](Service& s) { auto c = s.req(CommandKind::SetGeneration, kB); c.enable = 1; return c; }, true},
-      {"reset", [](Service& s) { auto c = s.req(CommandKind::Reset, kB); c.confirm = 1; return c; }, true},
+      {"set_outputs",
+       [](Service& s) {
+         auto c = s.req(CommandKind::SetOutputs, kB);
+         c.outputs = 0x03;
+         return c;
+       },
+       true},
+      {"enable_outputs",
+       [](Service& s) {
+         auto c = s.req(CommandKind::EnableOutputs, kB);
+         c.outputs = 0x02;
+         return c;
+       },
+       true},
+      {"disable_outputs",
+       [](Service& s) {
+         auto c = s.req(CommandKind::DisableOutputs, kB);
+         c.outputs = 0x02;
+         return c;
+       },
+       true},
+      {"set_generation",
+       [](Service& s) {
+         auto c = s.req(CommandKind::SetGeneration, kB);
+         c.enable = 1;
+         return c;
+       },
+       true},
+      {"reset",
+       [](Service& s) {
+         auto c = s.req(CommandKind::Reset, kB);
+         c.confirm = 1;
+         return c;
+       },
+       true},
       // Another apply (another sender, or the same sender's other apply) cannot take it.
       {"another apply's get", [](Service& s) { return s.get(kB, "pmuctl-gs2-77-1"); }, true},
       {"the same sender's other apply", [](Service& s) { return s.set(kA, "pmuctl-gs1-4242-2"); }, true},
       // The holder's sender without the hold bits is not the apply.
       {"the holder's sender, not holding", [](Service& s) { return s.set(kA); }, true},
       {"get", [](Service& s) { return s.get(kB); }, false},
-      {"request_measurements", [](Service& s) { auto c = s.req(CommandKind::RequestMeasurements, kB); c.groups = 0x01; return c; }, false},
+      {"request_measurements",
+       [](Service& s) {
+         auto c = s.req(CommandKind::RequestMeasurements, kB);
+         c.groups = 0x01;
+         return c;
+       },
+       false},
       {"get_serial", [](Service& s) { return s.req(CommandKind::GetSerial, kB); }, false},
       {"get_firmware", [](Service& s) { return s.req(CommandKind::GetFirmware, kB); }, false},
       {"engine_stop", [](Service& s) { return s.req(CommandKind::EngineStop, kB); }, false},

@@ -97,8 +97,7 @@ TEST(InputsOfTheRules, APmuPolledWithoutStatusAndTemperaturesIsNotReady) {
   ASSERT_TRUE(v.h.worker().session(1)->ready());
   EXPECT_EQ(v.h.worker().session(1)->health().state, HealthState::Online);
   EXPECT_FALSE(v.tracker.current().ready);
-  EXPECT_EQ(v.missing(),
-            (std::vector<std::string>{"PMU 1 status not monitored", "PMU 1 temperatures not monitored"}));
+  EXPECT_EQ(v.missing(), (std::vector<std::string>{"PMU 1 status not monitored", "PMU 1 temperatures not monitored"}));
 
   Vehicle all(polled(codec::group_bit::All), 35);
   all.run_for(std::chrono::milliseconds(3000));
@@ -125,8 +124,7 @@ TEST(InputsOfTheRules, DroppingAPacketTheRulesReadNeedsConfirmAndMakesItNotReady
   r = v.set("packets_streamed", codec::group_bit::Voltages, true);
   ASSERT_EQ(r.result, CommandResult::Completed) << r.reason;
   EXPECT_FALSE(v.tracker.current().ready);
-  EXPECT_EQ(v.missing(),
-            (std::vector<std::string>{"PMU 1 status not monitored", "PMU 1 temperatures not monitored"}));
+  EXPECT_EQ(v.missing(), (std::vector<std::string>{"PMU 1 status not monitored", "PMU 1 temperatures not monitored"}));
 
   // The last temperature (35 degC) is still fresh: T_U 1 is at or below it.
   r = v.set("upper_temperature_limit", 1);

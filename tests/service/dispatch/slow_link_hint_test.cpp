@@ -27,15 +27,21 @@ struct Case {
 
 TEST(SlowLinkHint, SaysItOnceAfterLateResendsOfTwoSenders) {
   const Case cases[] = {
-      {"two senders, each a reply out for most of a second", false, {{"a", milliseconds(900), false}, {"b", milliseconds(800), true}}},
+      {"two senders, each a reply out for most of a second",
+       false,
+       {{"a", milliseconds(900), false}, {"b", milliseconds(800), true}}},
       {"at the threshold counts", false, {{"a", milliseconds(300), false}, {"b", milliseconds(300), true}}},
-      {"once only", false,
+      {"once only",
+       false,
        {{"a", milliseconds(900), false}, {"b", milliseconds(900), true}, {"c", milliseconds(900), false}}},
-      {"one sender's late resends are one client's late match", false,
+      {"one sender's late resends are one client's late match",
+       false,
        {{"a", milliseconds(900), false}, {"a", milliseconds(900), false}, {"a", milliseconds(2000), false}}},
-      {"a resend soon after its reply: the service was slow, not the link", false,
+      {"a resend soon after its reply: the service was slow, not the link",
+       false,
        {{"a", milliseconds(299), false}, {"b", milliseconds(100), false}, {"c", milliseconds(0), false}}},
-      {"the early ones do not count towards the two", false,
+      {"the early ones do not count towards the two",
+       false,
        {{"a", milliseconds(100), false}, {"b", milliseconds(900), false}, {"a", milliseconds(900), true}}},
       {"a configured link never hints", true, {{"a", milliseconds(900), false}, {"b", milliseconds(900), false}}},
   };

@@ -57,8 +57,9 @@ TEST(StartupCheck, TheShippedQosFileHasEveryProfileTheServiceUses) {
 TEST(StartupCheck, MissingQosFileIsNamedAtTheConfigLine) {
   const auto c = check(std::string(kBus) + "qos_file: /nonexistent/qos.xml\n", "/etc/pmu-dds/pmu-service.yaml");
   ASSERT_EQ(c.errors.size(), 1u);
-  EXPECT_EQ(c.errors[0],
-            "/etc/pmu-dds/pmu-service.yaml:4: qos_file: /nonexistent/qos.xml: cannot be read: No such file or directory");
+  EXPECT_EQ(
+      c.errors[0],
+      "/etc/pmu-dds/pmu-service.yaml:4: qos_file: /nonexistent/qos.xml: cannot be read: No such file or directory");
 }
 
 TEST(StartupCheck, QosFileThatIsADirectory) {
@@ -88,8 +89,9 @@ TEST(StartupCheck, QosFileThatIsADeviceOrAFifo) {
 
 TEST(StartupCheck, MalformedQosFileIsNamedAtItsOwnLine) {
   const std::string dir = scratch("malformed");
-  const std::string qos = write(dir + "/qos.xml", "<dds>\n  <profiles>\n    <data_writer profile_name=\"telemetry\">\n"
-                                                  "  </profiles>\n</dds>\n");
+  const std::string qos = write(dir + "/qos.xml",
+                                "<dds>\n  <profiles>\n    <data_writer profile_name=\"telemetry\">\n"
+                                "  </profiles>\n</dds>\n");
   const auto c = check("qos_file: qos.xml\n" + std::string(kBus), dir + "/pmu-service.yaml");
   ASSERT_EQ(c.errors.size(), 1u);
   // tinyxml2 names the element left open, at its line.
@@ -100,7 +102,8 @@ TEST(StartupCheck, MalformedQosFileIsNamedAtItsOwnLine) {
 
 TEST(StartupCheck, AMissingProfileIsNamed) {
   const std::string dir = scratch("profile");
-  const std::string qos = edited_qos(dir, "<data_reader profile_name=\"command\">", "<data_reader profile_name=\"commands\">");
+  const std::string qos =
+      edited_qos(dir, "<data_reader profile_name=\"command\">", "<data_reader profile_name=\"commands\">");
   const auto c = check("qos_file: " + qos + "\n" + kBus, "a.yaml");
   ASSERT_EQ(c.errors.size(), 1u);
   EXPECT_EQ(c.errors[0], "a.yaml:1: qos_file: " + qos +
@@ -157,8 +160,8 @@ TEST(StartupCheck, NoQosFileAnywhere) {
 // start runs the check first. (The start stops before any bus or participant is opened.)
 TEST(StartupCheck, CheckConfigAndTheStartRefuseTheSameQosFileTheSameWay) {
   const std::string dir = scratch("program");
-  const std::string cfg = write(dir + "/pmu-service.yaml",
-                                "domain: 170\nqos_file: /nonexistent/qos.xml\n" + std::string(kBus));
+  const std::string cfg =
+      write(dir + "/pmu-service.yaml", "domain: 170\nqos_file: /nonexistent/qos.xml\n" + std::string(kBus));
   const std::string expected = cfg + ":2: qos_file: /nonexistent/qos.xml: cannot be read: No such file or directory";
   for (const std::string extra : {" --check-config", ""}) {
     SCOPED_TRACE(extra);

@@ -95,10 +95,10 @@ TEST(BmsEnergyUsed, TrapezoidsOutOfTheBatteryAndNothingAcrossAGap) {
       // 0.2 s x 240 W, then 0.8 s x (240 + 480) / 2, then 1 s x 480 W
       {"irregular intervals and a load step",
        {{0, 48, -5, 80}, {0.2, 48, -5, 80}, {1.0, 48, -10, 80}, {2.0, 48, -10, 80}},
-       48 + 288 + 480, 2},
+       48 + 288 + 480,
+       2},
       // 2 s x 240 W, then 5 s > 3 s left out, then 1 s x 240 W
-      {"a gap longer than the STALE time", {{0, 48, -5, 80}, {2, 48, -5, 80}, {7, 48, -5, 80}, {8, 48, -5, 80}},
-       720, 3},
+      {"a gap longer than the STALE time", {{0, 48, -5, 80}, {2, 48, -5, 80}, {7, 48, -5, 80}, {8, 48, -5, 80}}, 720, 3},
       // The current unknown at 1: neither 0..1 nor 1..2 is known
       {"an unknown current", {{0, 48, -5, 80}, {1, 48, kNaN, 80}, {2, 48, -5, 80}, {3, 48, -5, 80}}, 240, 1},
   };
@@ -156,17 +156,16 @@ TEST(BmsEnergyEndurance, StateOfChargeAboveTheCriticalOverTheFilteredDischarge) 
       {"a steady discharge", k20Ah, steady(0, 61, 48, -5, 80), 14.6 / 5 * 3600},
       {"the configured critical state of charge", {20, 20}, steady(0, 61, 48, -5, 80), 12.0 / 5 * 3600},
       // The mean of 150 s at -2 A and 150 s at -6 A (as in MeanCurrentTest)
-      {"the filtered current, not the latest",
-       k20Ah, steady(0, 150, 48, -2, 80) + steady(150, 151, 48, -6, 80), 14.6 / (1202.0 / 300) * 3600},
-      {"the latest state of charge", k20Ah, steady(0, 30, 48, -5, 80) + steady(30, 31, 48, -5, 79),
-       14.4 / 5 * 3600},
+      {"the filtered current, not the latest", k20Ah, steady(0, 150, 48, -2, 80) + steady(150, 151, 48, -6, 80),
+       14.6 / (1202.0 / 300) * 3600},
+      {"the latest state of charge", k20Ah, steady(0, 30, 48, -5, 80) + steady(30, 31, 48, -5, 79), 14.4 / 5 * 3600},
       {"at the critical state of charge: 0", k20Ah, steady(0, 10, 48, -5, 7), 0},
       {"below it: 0", k20Ah, steady(0, 10, 48, -5, 3), 0},
       {"capacity not configured", {kNaN, 7}, steady(0, 61, 48, -5, 80), kNaN},
       {"charging", k20Ah, steady(0, 61, 50, 3, 80), kNaN},
       {"idle: a BMS's own draw", k20Ah, steady(0, 61, 48, -0.05, 80), kNaN},
-      {"charging on average, though discharging now", k20Ah,
-       steady(0, 200, 50, 3, 80) + steady(200, 101, 48, -1, 80), kNaN},
+      {"charging on average, though discharging now", k20Ah, steady(0, 200, 50, 3, 80) + steady(200, 101, 48, -1, 80),
+       kNaN},
       {"state of charge not received", k20Ah, steady(0, 61, 48, -5, kNaN), kNaN},
       {"current not received", k20Ah, steady(0, 61, 48, kNaN, 80), kNaN},
   };

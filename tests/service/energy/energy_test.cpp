@@ -49,8 +49,8 @@ TEST(EnergyPower, EachRailIsVoltsTimesAmpsAndNaNPropagates) {
   const Row rows[] = {
       // Generator off: the outputs take 12 + 33 + 24 + 3 = 72 W, the batteries give 66 W
       // (negative: out of them); the 6 W left is what the balance cannot place.
-      {"batteries feed the outputs", volts(12, 22, 12, 6, 22, 22), amps(1, 1.5, 2, 0.5, -1.5, -1.5), 12, 33, 24, 3,
-       -33, -33, 6},
+      {"batteries feed the outputs", volts(12, 22, 12, 6, 22, 22), amps(1, 1.5, 2, 0.5, -1.5, -1.5), 12, 33, 24, 3, -33,
+       -33, 6},
       {"generator charges both", volts(12, 28, 12, 6, 24, 23), amps(1, 1, 2, 0.5, 2, 1), 12, 28, 24, 3, 48, 23, 138},
       {"28 V current negative: fed from outside", volts(12, 28, 0, 6, 24, 24), amps(1, -2, 0, 0.5, 0, 0), 12, -56, 0, 3,
        0, 0, -41},
@@ -227,7 +227,7 @@ TEST(Endurance, ALoadStepOrAGapStartsTheTrendAgain) {
 
 TEST(EnergyReport, AtMostOncePerSecondOfReceiveTime) {
   PmuEnergy e({19.8, 19.8}, 3s);
-  std::vector<long> reported;  // ms
+  std::vector<long> reported;                // ms
   for (long ms = 0; ms < 3500; ms += 100) {  // 10 Hz for 3.5 s, currents first
     e.on_currents(t0 + std::chrono::milliseconds(ms), amps(1, 1, 2, 0.5, -1, -1));
     if (e.report(t0 + std::chrono::milliseconds(ms))) reported.push_back(ms);

@@ -67,9 +67,7 @@ TEST(EnergyTracker, EnduranceRunsToTheCriticalVoltageTheAlarmUses) {
     std::uint16_t address;
     double critical;  // V: the config's, else the table's battery_a_critical_voltage
   };
-  const Row rows[] = {{1, 20.5},
-                      {2, alarms::spec_of(alarms::Code::BatteryACriticalVoltage).limit},
-                      {7, 21.0}};
+  const Row rows[] = {{1, 20.5}, {2, alarms::spec_of(alarms::Code::BatteryACriticalVoltage).limit}, {7, 21.0}};
   for (const auto& r : rows) {
     SCOPED_TRACE(r.address);
     RecordingSink sink;
@@ -112,8 +110,8 @@ TEST(EnergyTracker, HandsOnOnceEachEventItDerivesNothingFrom) {
   tracker.on_energy(pmu, energy::Figures{}, t0);
   tracker.on_bms_energy(DeviceKey{"can0", 2, DeviceKind::Battery}, energy::BmsFigures{}, t0);
   const std::pair<const char*, std::size_t> handed_on[] = {
-      {"config", sink.configs.size()},   {"info", sink.infos.size()},       {"health", sink.healths.size()},
-      {"cells", sink.cells.size()},      {"mppt", sink.mppts.size()},       {"alarm", sink.alarms.size()},
+      {"config", sink.configs.size()},      {"info", sink.infos.size()},    {"health", sink.healths.size()},
+      {"cells", sink.cells.size()},         {"mppt", sink.mppts.size()},    {"alarm", sink.alarms.size()},
       {"readiness", sink.readiness.size()}, {"energy", sink.energy.size()}, {"bms_energy", sink.bms_energy.size()},
   };
   for (const auto& [event, count] : handed_on) EXPECT_EQ(count, 1u) << event;
@@ -164,9 +162,9 @@ TEST(EnergyTracker, BatteryFiguresUseItsCapacityAndCriticalStateOfCharge) {
     const char* bus;
     double capacity_ah, critical;  // the config's, or none and the table's bms_critical_soc
   };
-  const Row rows[] = {{"can0", 20, 10},
-                      {"can1", std::numeric_limits<double>::quiet_NaN(),
-                       alarms::spec_of(alarms::Code::BmsCriticalSoc).limit}};
+  const Row rows[] = {
+      {"can0", 20, 10},
+      {"can1", std::numeric_limits<double>::quiet_NaN(), alarms::spec_of(alarms::Code::BmsCriticalSoc).limit}};
   for (const auto& r : rows) {
     SCOPED_TRACE(r.bus);
     RecordingSink sink;

@@ -93,8 +93,8 @@ TEST(BoundedFile, AFileThatCannotBeOpenedSaysWhy) {
 }
 
 TEST(BoundedFile, ABoundIsSaidInItsLargestWholeUnit) {
-  const std::pair<std::size_t, const char*> cases[] = {
-      {1, "1 byte"}, {100, "100 bytes"}, {1024, "1 KiB"}, {1536, "1536 bytes"}, {65536, "64 KiB"}, {1u << 20, "1 MiB"}};
+  const std::pair<std::size_t, const char*> cases[] = {{1, "1 byte"},        {100, "100 bytes"}, {1024, "1 KiB"},
+                                                       {1536, "1536 bytes"}, {65536, "64 KiB"},  {1u << 20, "1 MiB"}};
   for (const auto& [bytes, text] : cases) EXPECT_EQ(size_text(bytes), text) << bytes;
 }
 

@@ -177,7 +177,8 @@ TEST(BaselineDrift, ComparedAgainAfterAReconnect) {
   EXPECT_EQ(w.sink.last_health(1)->reconnects, 1u);
   EXPECT_EQ(w.reason("device_not_online"), nullptr);
   ASSERT_NE(w.reason("config_differs"), nullptr);
-  EXPECT_EQ(w.reason("config_differs")->description, "avionics_voltage 24.0 V->12.0 V. pmuctl config diff / apply pmu1.yaml");
+  EXPECT_EQ(w.reason("config_differs")->description,
+            "avionics_voltage 24.0 V->12.0 V. pmuctl config diff / apply pmu1.yaml");
   EXPECT_EQ(log.count("configuration differs from baseline /etc/pmu-dds/pmu1.yaml: avionics_voltage device 24.0 V, "
                       "baseline 12.0 V"),
             1u)

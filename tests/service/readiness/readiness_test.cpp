@@ -49,44 +49,91 @@ TEST(ReadinessRules, EachSituationGivesItsReasonsWorstFirst) {
       {"everything online", {{{Key{"can0", DeviceKind::Pmu, 1}, online()}}, {}}, true, {}},
       {"a PMU not online",
        {{{Key{"can0", DeviceKind::Pmu, 1}, online()},
-         {Key{"can0", DeviceKind::Pmu, 2}, [] { auto d = online(); d.state = HealthState::Offline; return d; }()}},
+         {Key{"can0", DeviceKind::Pmu, 2},
+          [] {
+            auto d = online();
+            d.state = HealthState::Offline;
+            return d;
+          }()}},
         {}},
        false,
        {"device_not_online"}},
       {"never heard (UNKNOWN) is not online",
-       {{{Key{"can0", DeviceKind::Battery, 2}, [] { auto d = online(std::nullopt); d.state = HealthState::Unknown; return d; }()}}, {}},
+       {{{Key{"can0", DeviceKind::Battery, 2},
+          [] {
+            auto d = online(std::nullopt);
+            d.state = HealthState::Unknown;
+            return d;
+          }()}},
+        {}},
        false,
        {"device_not_online"}},
       {"bus error-passive: once per bus",
-       {{{Key{"can0", DeviceKind::Pmu, 1}, [] { auto d = online(); d.bus_state = transport::BusState::ErrorPassive; return d; }()},
-         {Key{"can0", DeviceKind::Pmu, 2}, [] { auto d = online(); d.bus_state = transport::BusState::ErrorPassive; return d; }()}},
+       {{{Key{"can0", DeviceKind::Pmu, 1},
+          [] {
+            auto d = online();
+            d.bus_state = transport::BusState::ErrorPassive;
+            return d;
+          }()},
+         {Key{"can0", DeviceKind::Pmu, 2},
+          [] {
+            auto d = online();
+            d.bus_state = transport::BusState::ErrorPassive;
+            return d;
+          }()}},
         {}},
        false,
        {"bus_not_up"}},
       {"bus error-warning is a warning",
-       {{{Key{"can0", DeviceKind::Pmu, 1}, [] { auto d = online(); d.bus_state = transport::BusState::ErrorWarning; return d; }()}}, {}},
+       {{{Key{"can0", DeviceKind::Pmu, 1},
+          [] {
+            auto d = online();
+            d.bus_state = transport::BusState::ErrorWarning;
+            return d;
+          }()}},
+        {}},
        true,
        {"bus_not_up"}},
-      {"firmware below the minimum", {{{Key{"can0", DeviceKind::Pmu, 1}, online(codec::FirmwareVersion{1, 12}, codec::FirmwareVersion{1, 14})}}, {}},
-       false, {"firmware_below_minimum"}},
-      {"firmware at the minimum", {{{Key{"can0", DeviceKind::Pmu, 1}, online(codec::FirmwareVersion{1, 14}, codec::FirmwareVersion{1, 14})}}, {}},
-       true, {}},
-      {"firmware not read yet is not judged", {{{Key{"can0", DeviceKind::Pmu, 1}, online(std::nullopt, codec::FirmwareVersion{1, 14})}}, {}},
-       true, {}},
-      {"an active critical alarm", {{{Key{"can0", DeviceKind::Pmu, 1}, online()}}, {alarm(Code::ThermalShutdown, AlarmState::ActiveUnacknowledged)}},
-       false, {"thermal_shutdown"}},
-      {"an acknowledged critical still active", {{{Key{"can0", DeviceKind::Pmu, 1}, online()}}, {alarm(Code::ThermalShutdown, AlarmState::ActiveAcknowledged)}},
-       false, {"thermal_shutdown"}},
-      {"a critical cleared but not acknowledged", {{{Key{"can0", DeviceKind::Pmu, 1}, online()}}, {alarm(Code::ThermalShutdown, AlarmState::ClearedUnacknowledged)}},
-       false, {"thermal_shutdown"}},
-      {"a critical back to NORMAL", {{{Key{"can0", DeviceKind::Pmu, 1}, online()}}, {alarm(Code::ThermalShutdown, AlarmState::Normal)}},
-       true, {}},
-      {"an active warning lets it fly", {{{Key{"can0", DeviceKind::Pmu, 1}, online()}}, {alarm(Code::PayloadShed, AlarmState::ActiveUnacknowledged)}},
-       true, {"payload_shed"}},
+      {"firmware below the minimum",
+       {{{Key{"can0", DeviceKind::Pmu, 1}, online(codec::FirmwareVersion{1, 12}, codec::FirmwareVersion{1, 14})}}, {}},
+       false,
+       {"firmware_below_minimum"}},
+      {"firmware at the minimum",
+       {{{Key{"can0", DeviceKind::Pmu, 1}, online(codec::FirmwareVersion{1, 14}, codec::FirmwareVersion{1, 14})}}, {}},
+       true,
+       {}},
+      {"firmware not read yet is not judged",
+       {{{Key{"can0", DeviceKind::Pmu, 1}, online(std::nullopt, codec::FirmwareVersion{1, 14})}}, {}},
+       true,
+       {}},
+      {"an active critical alarm",
+       {{{Key{"can0", DeviceKind::Pmu, 1}, online()}},
+        {alarm(Code::ThermalShutdown, AlarmState::ActiveUnacknowledged)}},
+       false,
+       {"thermal_shutdown"}},
+      {"an acknowledged critical still active",
+       {{{Key{"can0", DeviceKind::Pmu, 1}, online()}}, {alarm(Code::ThermalShutdown, AlarmState::ActiveAcknowledged)}},
+       false,
+       {"thermal_shutdown"}},
+      {"a critical cleared but not acknowledged",
+       {{{Key{"can0", DeviceKind::Pmu, 1}, online()}},
+        {alarm(Code::ThermalShutdown, AlarmState::ClearedUnacknowledged)}},
+       false,
+       {"thermal_shutdown"}},
+      {"a critical back to NORMAL",
+       {{{Key{"can0", DeviceKind::Pmu, 1}, online()}}, {alarm(Code::ThermalShutdown, AlarmState::Normal)}},
+       true,
+       {}},
+      {"an active warning lets it fly",
+       {{{Key{"can0", DeviceKind::Pmu, 1}, online()}}, {alarm(Code::PayloadShed, AlarmState::ActiveUnacknowledged)}},
+       true,
+       {"payload_shed"}},
       {"critical before warning, whatever the device",
        {{{Key{"can0", DeviceKind::Pmu, 1}, online()}},
-        {alarm(Code::PayloadShed, AlarmState::ActiveUnacknowledged, 1), alarm(Code::ThermalShutdown, AlarmState::ActiveUnacknowledged, 9)}},
-       false, {"thermal_shutdown", "payload_shed"}},
+        {alarm(Code::PayloadShed, AlarmState::ActiveUnacknowledged, 1),
+         alarm(Code::ThermalShutdown, AlarmState::ActiveUnacknowledged, 9)}},
+       false,
+       {"thermal_shutdown", "payload_shed"}},
   };
   for (const auto& c : cases) {
     SCOPED_TRACE(c.what);
@@ -157,20 +204,31 @@ TEST(ReadinessRules, APacketTheRulesReadThatIsNotFreshIsNotReady) {
   const Case cases[] = {
       {"everything the rules read, fresh", fed(V | C | T | S, V | C | T | S), DeviceKind::Pmu, {}},
       {"fresh at the limit of its age", fed(V | T | S, V | T | S, 3000ms), DeviceKind::Pmu, {}},
-      {"polled for voltages and currents only", fed(V | C, V | C, 0ms, false), DeviceKind::Pmu,
+      {"polled for voltages and currents only",
+       fed(V | C, V | C, 0ms, false),
+       DeviceKind::Pmu,
        {"PMU 1 status not monitored", "PMU 1 temperatures not monitored"}},
-      {"streaming voltages only", fed(V, V), DeviceKind::Pmu,
+      {"streaming voltages only",
+       fed(V, V),
+       DeviceKind::Pmu,
        {"PMU 1 status not monitored", "PMU 1 temperatures not monitored"}},
       {"temperatures never came", fed(V | T | S, V | S), DeviceKind::Pmu, {"PMU 1 temperatures not received"}},
-      {"status stale", [] {
+      {"status stale",
+       [] {
          auto d = fed(V | T | S, V | T);
          d.received[4] = t0 - 3001ms;
          return d;
-       }(), DeviceKind::Pmu, {"PMU 1 status stale"}},
-      {"nothing came", fed(V | T | S, 0), DeviceKind::Pmu,
+       }(),
+       DeviceKind::Pmu,
+       {"PMU 1 status stale"}},
+      {"nothing came",
+       fed(V | T | S, 0),
+       DeviceKind::Pmu,
        {"PMU 1 status not received", "PMU 1 temperatures not received", "PMU 1 voltages not received"}},
       {"currents are read by no rule", fed(V | T | S, V | T | S), DeviceKind::Pmu, {}},
-      {"a PMU not online says that alone", with_state(fed(V, V), HealthState::Stale), DeviceKind::Pmu,
+      {"a PMU not online says that alone",
+       with_state(fed(V, V), HealthState::Stale),
+       DeviceKind::Pmu,
        {"PMU 1 on can0 STALE"}},
       {"a battery reads no PMU packet", online(std::nullopt), DeviceKind::Battery, {}},
   };
@@ -259,39 +317,54 @@ TEST(ReadinessRules, ABaselineMakesDriftAReplacedUnitAndItsFirmwarePinReasons) {
   };
   const Case cases[] = {
       {"every setting as the file says", pinned_pmu("parameters:\n  avionics_voltage: 12.0\noutputs: 15\n"), {}, ""},
-      {"12.04 V is the 12.0 V the wire carries",
-       pinned_pmu("parameters:\n  avionics_voltage: 12.04\n"), {}, ""},
-      {"one setting differs", pinned_pmu("parameters:\n  avionics_voltage: 22.0\n"), {"config_differs"},
+      {"12.04 V is the 12.0 V the wire carries", pinned_pmu("parameters:\n  avionics_voltage: 12.04\n"), {}, ""},
+      {"one setting differs",
+       pinned_pmu("parameters:\n  avionics_voltage: 22.0\n"),
+       {"config_differs"},
        "config differs: avionics_voltage"},
       {"three differ: the names that fit, and how many more",
        pinned_pmu("parameters:\n  avionics_voltage: 22.0\n  payload_voltage: 20.0\n  servo_voltage: 7.0\n"),
-       {"config_differs"}, "config differs: avionics_voltage +2 more"},
+       {"config_differs"},
+       "config differs: avionics_voltage +2 more"},
       {"a long name with a count takes the shorter lead",
-       pinned_pmu("parameters:\n  upper_temperature_limit: 85\n  cranking_time: 3.0\n"), {"config_differs"},
+       pinned_pmu("parameters:\n  upper_temperature_limit: 85\n  cranking_time: 3.0\n"),
+       {"config_differs"},
        "differs: upper_temperature_limit +1 more"},
-      {"outputs and generation are settings too", pinned_pmu("outputs: [avionics_servo]\ngeneration_enabled: false\n"),
-       {"config_differs"}, "config differs: outputs +1 more"},
+      {"outputs and generation are settings too",
+       pinned_pmu("outputs: [avionics_servo]\ngeneration_enabled: false\n"),
+       {"config_differs"},
+       "config differs: outputs +1 more"},
       {"a setting not read yet is no drift",
-       unread(pinned_pmu("parameters:\n  avionics_voltage: 22.0\n"), baseline::Setting::AvionicsVoltage), {}, ""},
-      {"nothing read yet is no drift", [] {
+       unread(pinned_pmu("parameters:\n  avionics_voltage: 22.0\n"), baseline::Setting::AvionicsVoltage),
+       {},
+       ""},
+      {"nothing read yet is no drift",
+       [] {
          auto d = pinned_pmu("parameters:\n  avionics_voltage: 22.0\n");
          d.settings = {};
          return d;
-       }(), {}, ""},
-      {"another unit's serial", pinned_pmu("device:\n  serial: 1002\n"), {"serial_differs"},
+       }(),
+       {},
+       ""},
+      {"another unit's serial",
+       pinned_pmu("device:\n  serial: 1002\n"),
+       {"serial_differs"},
        "PMU 1 serial 1001, baseline 1002"},
       {"the serial not read yet is not judged", serial(pinned_pmu("device:\n  serial: 1002\n"), std::nullopt), {}, ""},
       {"the serial it pins", pinned_pmu("device:\n  serial: 1001\n"), {}, ""},
       {"the baseline's firmware pin is above the unit's",
-       firmware(pinned_pmu("device:\n  min_firmware: \"1.16\"\n"), 15, std::nullopt), {"firmware_below_minimum"},
+       firmware(pinned_pmu("device:\n  min_firmware: \"1.16\"\n"), 15, std::nullopt),
+       {"firmware_below_minimum"},
        "PMU 1 firmware 1.15 < 1.16"},
       {"the higher of the pin and the config's min_firmware: the config's",
-       firmware(pinned_pmu("device:\n  min_firmware: \"1.12\"\n"), 15, 16), {"firmware_below_minimum"},
+       firmware(pinned_pmu("device:\n  min_firmware: \"1.12\"\n"), 15, 16),
+       {"firmware_below_minimum"},
        "PMU 1 firmware 1.15 < 1.16"},
       {"the pin met", firmware(pinned_pmu("device:\n  min_firmware: \"1.15\"\n"), 15, 12), {}, ""},
       {"a replaced unit that also differs: both",
        pinned_pmu("device:\n  serial: 7\nparameters:\n  avionics_voltage: 22.0\n"),
-       {"config_differs", "serial_differs"}, ""},
+       {"config_differs", "serial_differs"},
+       ""},
   };
   for (const auto& c : cases) {
     SCOPED_TRACE(c.what);
@@ -334,8 +407,9 @@ TEST(ReadinessRules, DriftTextsFitTheirBoundsAndSayHowToFix) {
   in.devices[Key{"can0", DeviceKind::Pmu, 1}] = pinned_pmu("outputs: [payload]\n");
   const auto one = readiness_reasons(in);
   ASSERT_EQ(one.size(), 1u);
-  EXPECT_EQ(one[0].description,
-            "outputs avionics_servo,payload,charger_a,charger_b (0x0F)->payload (0x02). pmuctl config diff / apply pmu1.yaml");
+  EXPECT_EQ(
+      one[0].description,
+      "outputs avionics_servo,payload,charger_a,charger_b (0x0F)->payload (0x02). pmuctl config diff / apply pmu1.yaml");
 
   // A mask whose names do not fit is said by its numbers: the values are always shown.
   struct Case {
@@ -346,7 +420,8 @@ TEST(ReadinessRules, DriftTextsFitTheirBoundsAndSayHowToFix) {
   const Case masks[] = {
       {"outputs alone", "outputs: [avionics_servo, payload, charger_a]\n",
        "outputs 0x0F->0x07. pmuctl config diff / apply pmu1.yaml"},
-      {"power_up_state alone", "parameters:\n  power_up_state: [avionics_servo, payload, charger_a, "
+      {"power_up_state alone",
+       "parameters:\n  power_up_state: [avionics_servo, payload, charger_a, "
        "battery_disconnect_detect, payload_shedding, soa_management]\n",
        "power_up_state 0x0F->0x77. pmuctl config diff / apply pmu1.yaml"},
       {"a mask after a value", "parameters:\n  avionics_voltage: 22.0\noutputs: [avionics_servo, payload, charger_a]\n",
@@ -418,7 +493,7 @@ TEST(ReadinessTracker, HandsOnOnceEachEventItDoesNotWatch) {
   t.on_energy(DeviceKey{"can0", 1, DeviceKind::Pmu}, energy::Figures{}, at);
   t.on_bms_energy(DeviceKey{"can0", 2, DeviceKind::Battery}, energy::BmsFigures{}, at);
   const std::pair<const char*, std::size_t> handed_on[] = {
-      {"battery", next.batteries.size()}, {"cells", next.cells.size()},   {"mppt", next.mppts.size()},
+      {"battery", next.batteries.size()},   {"cells", next.cells.size()},   {"mppt", next.mppts.size()},
       {"readiness", next.readiness.size()}, {"energy", next.energy.size()}, {"bms_energy", next.bms_energy.size()},
   };
   for (const auto& [event, count] : handed_on) EXPECT_EQ(count, 1u) << event;
@@ -510,9 +585,9 @@ TEST(ReadinessTracker, APmuIsReadyOnlyWhileThePacketsItsAlarmsReadComeFresh) {
   t.on_health(pmu1, health(HealthState::Online));
   t.on_health(pmu2, health(HealthState::Online));
   EXPECT_FALSE(t.current().ready);
-  EXPECT_EQ(messages_of(t.current(), 1), (std::vector<std::string>{"PMU 1 status not received",
-                                                                   "PMU 1 temperatures not received",
-                                                                   "PMU 1 voltages not received"}));
+  EXPECT_EQ(messages_of(t.current(), 1),
+            (std::vector<std::string>{"PMU 1 status not received", "PMU 1 temperatures not received",
+                                      "PMU 1 voltages not received"}));
 
   feed(t, pmu1, {kVoltages, kCurrents, kTemperatures, kStatus});
   feed(t, pmu2, {kVoltages, kCurrents});
@@ -546,8 +621,8 @@ TEST(ReadinessTracker, APmuIsReadyOnlyWhileThePacketsItsAlarmsReadComeFresh) {
   EXPECT_TRUE(messages_of(t.current(), 1).empty());
   clock.advance(1001ms);
   t.on_health(pmu1, health(HealthState::Online));
-  EXPECT_EQ(messages_of(t.current(), 1), (std::vector<std::string>{"PMU 1 status stale", "PMU 1 temperatures stale",
-                                                                   "PMU 1 voltages stale"}));
+  EXPECT_EQ(messages_of(t.current(), 1),
+            (std::vector<std::string>{"PMU 1 status stale", "PMU 1 temperatures stale", "PMU 1 voltages stale"}));
 }
 
 }  // namespace

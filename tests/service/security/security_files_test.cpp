@@ -117,8 +117,8 @@ void expect_error(const std::vector<dds::SecurityIssue>& issues, const std::stri
   ASSERT_TRUE(dds::has_errors(issues)) << describe(issues);
   bool found = false;
   for (const auto& i : issues)
-    found = found || (i.level == dds::SecurityIssue::Level::Error && i.key == key &&
-                      i.message.find(text) != std::string::npos);
+    found = found ||
+            (i.level == dds::SecurityIssue::Level::Error && i.key == key && i.message.find(text) != std::string::npos);
   EXPECT_TRUE(found) << "expected an error for " << key << " containing '" << text << "', got:\n" << describe(issues);
 }
 
@@ -234,7 +234,8 @@ TEST(StartupCheck, DomainOutsideGovernanceAndPermissions) {
   dds::SecurityCheckOptions o;
   o.domain = pmu::test::exclusive_dds_domain() + 1;
   const auto issues = dds::check_security_files(Pki::get().files("pmu-service"), o);
-  expect_error(issues, "governance", "has no domain_rule for DDS domain " + std::to_string(pmu::test::exclusive_dds_domain() + 1));
+  expect_error(issues, "governance",
+               "has no domain_rule for DDS domain " + std::to_string(pmu::test::exclusive_dds_domain() + 1));
   expect_error(issues, "permissions", "allows nothing on DDS domain");
 }
 
@@ -304,7 +305,8 @@ void expect_grant(const std::string& dir, const std::string& identity, const std
 // <partitions> would allow the default partition alone, and pmuctl, which reads every
 // vehicle in partitions "" and "*", could not start.
 TEST(PermissionsDocuments, EveryRuleGrantsEveryVehicleByDefault) {
-  for (const char* id : {"pmu-service", "ground-station", "mission-computer"}) expect_grant(Pki::get().dir(), id, id, {"*"});
+  for (const char* id : {"pmu-service", "ground-station", "mission-computer"})
+    expect_grant(Pki::get().dir(), id, id, {"*"});
   const auto g = dds::topic_grant(Pki::get().files("ground-station"), "pmu/command_reply", false);
   ASSERT_TRUE(g.has_value());
   EXPECT_TRUE(g->allowed);
@@ -379,10 +381,10 @@ TEST(PartitionNotGranted, ComparesLikeFastDds) {
     std::optional<std::string> refused;
   };
   const Case cases[] = {
-      {{}, {"*"}, std::nullopt},          {{"", "*"}, {"*"}, std::nullopt},   {{"uav1"}, {"*"}, std::nullopt},
-      {{"uav1"}, {"uav1"}, std::nullopt}, {{}, {""}, std::nullopt},           {{}, {"uav1"}, ""},
-      {{"", "*"}, {"uav1"}, ""},          {{"*"}, {"uav1"}, "*"},             {{"uav2"}, {"uav1"}, "uav2"},
-      {{"uav?"}, {"uav1"}, "uav?"},       {{"uav1"}, {""}, "uav1"},           {{"uav2"}, {"uav1", "uav2"}, std::nullopt},
+      {{}, {"*"}, std::nullopt},          {{"", "*"}, {"*"}, std::nullopt}, {{"uav1"}, {"*"}, std::nullopt},
+      {{"uav1"}, {"uav1"}, std::nullopt}, {{}, {""}, std::nullopt},         {{}, {"uav1"}, ""},
+      {{"", "*"}, {"uav1"}, ""},          {{"*"}, {"uav1"}, "*"},           {{"uav2"}, {"uav1"}, "uav2"},
+      {{"uav?"}, {"uav1"}, "uav?"},       {{"uav1"}, {""}, "uav1"},         {{"uav2"}, {"uav1", "uav2"}, std::nullopt},
   };
   for (const auto& c : cases) {
     std::string asked;

@@ -24,9 +24,9 @@ std::optional<AlarmState> last(const RecordingSink& sink, Code code, alarms::Dev
 
 // What the BMS reports; sent whole once a second.
 struct Bms {
-  int soc = 80;                // %
+  int soc = 80;                                     // %
   std::uint16_t cell_high = 3950, cell_low = 3900;  // mV
-  int cell_temperature_high = 25;  // degC
+  int cell_temperature_high = 25;                   // degC
 };
 
 struct BatteryBench {
@@ -40,8 +40,10 @@ struct BatteryBench {
     auto u8 = [](int v) { return static_cast<std::uint8_t>(v); };
     ASSERT_TRUE(node->send(canopen_frame(0x302, 0x2005, 0x05, {u8(bms.soc)}), 0ms).ok());
     ASSERT_TRUE(node->send(canopen_frame(0x402, 0x2005, 0x09, {u8(bms.cell_temperature_high)}), 0ms).ok());
-    ASSERT_TRUE(node->send(canopen_frame(0x402, 0x2005, 0x0C, {u8(bms.cell_high & 0xFF), u8(bms.cell_high >> 8)}), 0ms).ok());
-    ASSERT_TRUE(node->send(canopen_frame(0x402, 0x2005, 0x0D, {u8(bms.cell_low & 0xFF), u8(bms.cell_low >> 8)}), 0ms).ok());
+    ASSERT_TRUE(
+        node->send(canopen_frame(0x402, 0x2005, 0x0C, {u8(bms.cell_high & 0xFF), u8(bms.cell_high >> 8)}), 0ms).ok());
+    ASSERT_TRUE(
+        node->send(canopen_frame(0x402, 0x2005, 0x0D, {u8(bms.cell_low & 0xFF), u8(bms.cell_low >> 8)}), 0ms).ok());
   }
   // `total` of BMS life, its frames once a second from the start.
   void run_for(std::chrono::milliseconds total) {

@@ -31,10 +31,10 @@ struct Row {
 
 // "Battery (MG) CAN-format": index, subindex, type and resolution of each value.
 const Row kBatteryRows[] = {
-    {"0x302 0x2005/0x01 uint16 1 mV", 0x302, 0x2005, 0x01, {0x39, 0x30}, "voltage", 12.345},          // 12345 mV
-    {"0x302 0x2005/0x02 int16 10 mA", 0x302, 0x2005, 0x02, {0x2E, 0xFB}, "current", -12.34},          // -1234
-    {"0x302 0x2005/0x03 int16 10 mA", 0x302, 0x2005, 0x03, {0xF4, 0x01}, "current_discharge", 5.0},   // 500
-    {"0x302 0x2005/0x04 int16 10 mA", 0x302, 0x2005, 0x04, {0xFA, 0x00}, "current_charge", 2.5},      // 250
+    {"0x302 0x2005/0x01 uint16 1 mV", 0x302, 0x2005, 0x01, {0x39, 0x30}, "voltage", 12.345},         // 12345 mV
+    {"0x302 0x2005/0x02 int16 10 mA", 0x302, 0x2005, 0x02, {0x2E, 0xFB}, "current", -12.34},         // -1234
+    {"0x302 0x2005/0x03 int16 10 mA", 0x302, 0x2005, 0x03, {0xF4, 0x01}, "current_discharge", 5.0},  // 500
+    {"0x302 0x2005/0x04 int16 10 mA", 0x302, 0x2005, 0x04, {0xFA, 0x00}, "current_charge", 2.5},     // 250
     {"0x302 0x2005/0x05 int8 1 %", 0x302, 0x2005, 0x05, {0x57}, "state_of_charge", 87},
     {"0x302 0x2005/0x07 uint16 1 min", 0x302, 0x2005, 0x07, {0x5F, 0x00}, "time_to_go", 95 * 60.0},  // s
     {"0x402 0x2005/0x09 int8 1 degC", 0x402, 0x2005, 0x09, {0xFB}, "cell_temperature_high", -5},
@@ -152,10 +152,10 @@ TEST(CanOpenSession, DevicesAreFoundByTheirCobIds) {
     bool extended;
     std::optional<DeviceKey> key;
   } cases[] = {
-      {0x202, false, battery_key()},  {0x302, false, battery_key()},  {0x402, false, battery_key()},
-      {0x482, false, battery_key()},  {0x4E6, false, mppt_key(0)},    {0x4E7, false, mppt_key(0)},
-      {0x4E8, false, std::nullopt},   {0x51E, false, mppt_key(7)},    {0x51F, false, mppt_key(7)},
-      {0x4E5, false, std::nullopt},   {0x203, false, std::nullopt},   {0x302, true, std::nullopt},
+      {0x202, false, battery_key()}, {0x302, false, battery_key()}, {0x402, false, battery_key()},
+      {0x482, false, battery_key()}, {0x4E6, false, mppt_key(0)},   {0x4E7, false, mppt_key(0)},
+      {0x4E8, false, std::nullopt},  {0x51E, false, mppt_key(7)},   {0x51F, false, mppt_key(7)},
+      {0x4E5, false, std::nullopt},  {0x203, false, std::nullopt},  {0x302, true, std::nullopt},
   };
   for (const auto& c : cases) {
     codec::CanFrame f;
@@ -168,7 +168,7 @@ TEST(CanOpenSession, DevicesAreFoundByTheirCobIds) {
 TEST(CanOpenSession, CellVoltagesGoToTheirOwnTopicByCellNumber) {
   RecordingSink sink;
   CanOpenSession s(battery_key(), 1s, 200ms, thresholds(), sink, t0);
-  s.on_frame(canopen_frame(0x482, 0x2000, 1, {0xE5, 0x0C}), t0, w0);        // cell 1: 3301 mV
+  s.on_frame(canopen_frame(0x482, 0x2000, 1, {0xE5, 0x0C}), t0, w0);         // cell 1: 3301 mV
   s.on_frame(canopen_frame(0x482, 0x2000, 12, {0xE7, 0x0C}), t0, w0 + 1ms);  // cell 12: 3303 mV
   s.tick(t0, {});
   EXPECT_TRUE(sink.batteries.empty()) << "cells are not battery values";

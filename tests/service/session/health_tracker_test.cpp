@@ -26,10 +26,10 @@ TEST(HealthTracker, TheAgeOfTheLastFrameGivesTheState) {
     HealthState state;
   };
   const Case cases[] = {
-      {0ms, 1000ms, HealthState::Online},     {3000ms, 1000ms, HealthState::Online},
-      {3001ms, 1000ms, HealthState::Stale},   {10000ms, 1000ms, HealthState::Stale},
+      {0ms, 1000ms, HealthState::Online},      {3000ms, 1000ms, HealthState::Online},
+      {3001ms, 1000ms, HealthState::Stale},    {10000ms, 1000ms, HealthState::Stale},
       {10001ms, 1000ms, HealthState::Offline}, {1600ms, 500ms, HealthState::Stale},
-      {5001ms, 500ms, HealthState::Offline},  {29000ms, 3000ms, HealthState::Stale},
+      {5001ms, 500ms, HealthState::Offline},   {29000ms, 3000ms, HealthState::Stale},
   };
   for (const auto& c : cases) {
     SCOPED_TRACE(testing::Message() << c.age.count() << " ms at period " << c.period.count() << " ms");
@@ -101,8 +101,10 @@ TEST(HealthTracker, CountersAndBusStateTravelInTheReport) {
 
 // The log's words for the age: a device never heard (age -1) has none to print.
 TEST(HealthTracker, TheLastFrameInWords) {
-  const std::pair<double, const char*> cases[] = {
-      {-1, "no frame yet"}, {0.04, "last frame 0.0 s ago"}, {3.5, "last frame 3.5 s ago"}, {61.26, "last frame 61.3 s ago"}};
+  const std::pair<double, const char*> cases[] = {{-1, "no frame yet"},
+                                                  {0.04, "last frame 0.0 s ago"},
+                                                  {3.5, "last frame 3.5 s ago"},
+                                                  {61.26, "last frame 61.3 s ago"}};
   for (const auto& [age, text] : cases) EXPECT_EQ(last_frame_text(age), text) << age;
 }
 

@@ -127,8 +127,8 @@ TEST(MovedAddresses, StoreRecordsMovesDropsThemWhenBackAndForgetsFixedConfigs) {
   }
   {
     // The operator fixed the config (address 8 now): the record of address 1 goes at start.
-    const Config fixed = parse_config(
-        "buses:\n  - interface: can0\n    devices:\n      - address: 8\n      - address: 2\n", "c.yaml");
+    const Config fixed =
+        parse_config("buses:\n  - interface: can0\n    devices:\n      - address: 8\n      - address: 2\n", "c.yaml");
     MovedAddressStore store(path, fixed);
     EXPECT_TRUE(store.moves().empty());
     EXPECT_TRUE(read_moved_addresses(path).moves.empty());

@@ -40,8 +40,8 @@ TEST(Session, StartUpReadsIdentityAndEveryParameterThenPublishesInfoAndConfig) {
 TEST(Session, StreamedTelemetryIsPublishedAtThePacketPeriod) {
   Harness h(sim_bus({device(1)}), {pmu(1, codec::kCurrentFirmware, 5)});  // PP 0.5 s
   h.run_for(5000ms);
-  for (auto p : {PacketId::Voltages, PacketId::Currents, PacketId::BatteryEnergy, PacketId::Temperatures,
-                 PacketId::Status}) {
+  for (auto p :
+       {PacketId::Voltages, PacketId::Currents, PacketId::BatteryEnergy, PacketId::Temperatures, PacketId::Status}) {
     const auto n = h.sink.count(p, 1);
     EXPECT_GE(n, 9u) << codec::packet_name(p);
     EXPECT_LE(n, 11u) << codec::packet_name(p);
@@ -188,8 +188,8 @@ TEST(Session, TelemetryCarriesTheFrameReceiveTime) {
 TEST(Session, TelemetryBetweenSerialAndFirmwareRepliesDecodesTheExternalSensors) {
   RecordingSink sink;
   const auto t0 = std::chrono::steady_clock::time_point{} + 1h;
-  DeviceSession s({"sim0", 1}, device(1), Timeouts{}, sink, [](const codec::CanFrame&) { return transport::SendResult{}; },
-                  t0);
+  DeviceSession s(
+      {"sim0", 1}, device(1), Timeouts{}, sink, [](const codec::CanFrame&) { return transport::SendResult{}; }, t0);
   const auto deliver = [&s](const codec::CanFrame& f, SteadyTime t) {
     s.on_frame(*codec::parse_id(f.id, f.extended).id, f, t, {});
   };

@@ -105,8 +105,9 @@ std::string OutputFile::open(const std::string& path) {
     case S_IFBLK:
       return shown() + " is a block device: writing it would overwrite the file system it holds; name a file on it";
     case S_IFSOCK:
-      return shown() + " is a socket, which open(2) cannot write: write to standard output (-) and pipe that "
-                       "into the socket (socat - UNIX-CONNECT:PATH)";
+      return shown() +
+             " is a socket, which open(2) cannot write: write to standard output (-) and pipe that "
+             "into the socket (socat - UNIX-CONNECT:PATH)";
     default: return shown() + " is not a file, FIFO or character device";
   }
 }

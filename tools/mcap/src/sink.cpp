@@ -39,8 +39,7 @@ FileSink::~FileSink() {
   if (fd_ >= 0) ::close(fd_);
 }
 
-FileSink::FileSink(FileSink&& o) noexcept
-    : fd_(std::exchange(o.fd_, -1)), own_(o.own_), can_reserve_(o.can_reserve_) {}
+FileSink::FileSink(FileSink&& o) noexcept : fd_(std::exchange(o.fd_, -1)), own_(o.own_), can_reserve_(o.can_reserve_) {}
 
 FileSink& FileSink::operator=(FileSink&& o) noexcept {
   if (this != &o) {

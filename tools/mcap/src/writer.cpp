@@ -20,8 +20,10 @@ bool Writer::emit(const Bytes& block, bool data_section, bool reserve_ending) {
   }
   if (const int e = sink_.write(block.data(), block.size()); e != 0) {
     error_ = e;
-    if (sink_.truncate(offset_) != 0) torn_ = true;  // the file ends at the last complete block again
-    else if (reserve_ending) sink_.reserve(offset_, ending);  // truncating freed what was reserved past the end
+    if (sink_.truncate(offset_) != 0)
+      torn_ = true;  // the file ends at the last complete block again
+    else if (reserve_ending)
+      sink_.reserve(offset_, ending);  // truncating freed what was reserved past the end
     return false;
   }
   if (data_section) data_crc_ = crc32(data_crc_, block.data(), block.size());
@@ -135,15 +137,21 @@ Bytes Writer::summary_and_footer() {
     append_all();
     if (b.size() > begin) groups.emplace_back(op, offset_ + begin, b.size() - begin);
   };
-  group(kSchema, [&] { for (const auto& s : schemas_) append_schema(b, s); });
-  group(kChannel, [&] { for (const auto& c : channels_) append_channel(b, c); });
+  group(kSchema, [&] {
+    for (const auto& s : schemas_) append_schema(b, s);
+  });
+  group(kChannel, [&] {
+    for (const auto& c : channels_) append_channel(b, c);
+  });
   group(kStatistics, [&] {
     stats_.schema_count = static_cast<std::uint16_t>(schemas_.size());
     stats_.channel_count = static_cast<std::uint32_t>(channels_.size());
     stats_.channel_message_counts.assign(channel_counts_.begin(), channel_counts_.end());
     append_statistics(b, stats_);
   });
-  group(kChunkIndex, [&] { for (const auto& c : chunk_indexes_) append_chunk_index(b, c); });
+  group(kChunkIndex, [&] {
+    for (const auto& c : chunk_indexes_) append_chunk_index(b, c);
+  });
   const std::uint64_t summary_offset_start = offset_ + b.size();
   for (const auto& [op, start, length] : groups) append_summary_offset(b, op, start, length);
   const std::uint32_t crc = crc32(0, b.data() + summary_at, b.size() - summary_at);

@@ -22,8 +22,8 @@ struct LinkCounters {
   std::uint64_t bytes_in = 0;
   std::uint64_t bytes_out = 0;
   std::uint64_t frames_out = 0;
-  std::uint64_t send_failures = 0;   // a frame not sent whole: buffer full, peer unreachable
-  std::uint64_t read_failures = 0;   // a read that failed (e.g. ICMP "port unreachable" on UDP)
+  std::uint64_t send_failures = 0;      // a frame not sent whole: buffer full, peer unreachable
+  std::uint64_t read_failures = 0;      // a read that failed (e.g. ICMP "port unreachable" on UDP)
   std::uint64_t foreign_datagrams = 0;  // UDP: a datagram from another address, dropped
 };
 

@@ -12,7 +12,8 @@ namespace {
 constexpr std::array<std::uint32_t, 9> kBauds{9600, 19200, 38400, 57600, 115200, 230400, 460800, 500000, 921600};
 
 bool all_digits(const std::string& s) {
-  return !s.empty() && s.size() <= 9 && std::all_of(s.begin(), s.end(), [](unsigned char c) { return std::isdigit(c); });
+  return !s.empty() && s.size() <= 9 &&
+         std::all_of(s.begin(), s.end(), [](unsigned char c) { return std::isdigit(c); });
 }
 
 }  // namespace
@@ -39,7 +40,8 @@ std::variant<SerialAddress, std::string> parse_serial_address(const std::string&
   const std::string baud = text.substr(colon + 1);
   if (!all_digits(baud) ||
       std::find(kBauds.begin(), kBauds.end(), static_cast<std::uint32_t>(std::stoul(baud))) == kBauds.end())
-    return "'" + text + "': the baud rate must be one of 9600, 19200, 38400, 57600, 115200, 230400, 460800, 500000, 921600";
+    return "'" + text +
+           "': the baud rate must be one of 9600, 19200, 38400, 57600, 115200, 230400, 460800, 500000, 921600";
   return SerialAddress{text.substr(0, colon), static_cast<std::uint32_t>(std::stoul(baud))};
 }
 

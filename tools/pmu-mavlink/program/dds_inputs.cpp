@@ -68,15 +68,24 @@ DdsInputs::DdsInputs(pmu::dds::DdsContext& dds)
 
 void DdsInputs::take() {
   auto none = [](const auto&) {};
-  take_all<pmu::v5::Voltages>(voltages_, [&](const auto& s) { pmus_[pmu_key(s)].voltages = s; }, none);
-  take_all<pmu::v5::Currents>(currents_, [&](const auto& s) { pmus_[pmu_key(s)].currents = s; }, none);
-  take_all<pmu::v5::BatteryEnergy>(battery_energy_, [&](const auto& s) { pmus_[pmu_key(s)].battery_energy = s; }, none);
-  take_all<pmu::v5::Temperatures>(temperatures_, [&](const auto& s) { pmus_[pmu_key(s)].temperatures = s; }, none);
-  take_all<pmu::v5::Status>(status_, [&](const auto& s) { pmus_[pmu_key(s)].status = s; }, none);
-  take_all<pmu::v5::Energy>(energy_, [&](const auto& s) { pmus_[pmu_key(s)].energy = s; }, none);
-  take_all<pmu::v5::Battery>(battery_, [&](const auto& s) { batteries_[bms_key(s)].battery = s; }, none);
-  take_all<pmu::v5::BatteryCells>(cells_, [&](const auto& s) { batteries_[bms_key(s)].cells = s; }, none);
-  take_all<pmu::v5::BmsEnergy>(bms_energy_, [&](const auto& s) { batteries_[bms_key(s)].energy = s; }, none);
+  take_all<pmu::v5::Voltages>(
+      voltages_, [&](const auto& s) { pmus_[pmu_key(s)].voltages = s; }, none);
+  take_all<pmu::v5::Currents>(
+      currents_, [&](const auto& s) { pmus_[pmu_key(s)].currents = s; }, none);
+  take_all<pmu::v5::BatteryEnergy>(
+      battery_energy_, [&](const auto& s) { pmus_[pmu_key(s)].battery_energy = s; }, none);
+  take_all<pmu::v5::Temperatures>(
+      temperatures_, [&](const auto& s) { pmus_[pmu_key(s)].temperatures = s; }, none);
+  take_all<pmu::v5::Status>(
+      status_, [&](const auto& s) { pmus_[pmu_key(s)].status = s; }, none);
+  take_all<pmu::v5::Energy>(
+      energy_, [&](const auto& s) { pmus_[pmu_key(s)].energy = s; }, none);
+  take_all<pmu::v5::Battery>(
+      battery_, [&](const auto& s) { batteries_[bms_key(s)].battery = s; }, none);
+  take_all<pmu::v5::BatteryCells>(
+      cells_, [&](const auto& s) { batteries_[bms_key(s)].cells = s; }, none);
+  take_all<pmu::v5::BmsEnergy>(
+      bms_energy_, [&](const auto& s) { batteries_[bms_key(s)].energy = s; }, none);
   // Health decides what is shown as live (docs/safety.md H7); a device whose health instance
   // is disposed (it moved to another address, interface.md 2.6) is dropped with its values.
   take_all<pmu::v5::Health>(
@@ -94,9 +103,15 @@ void DdsInputs::take() {
       });
   alarms_.clear();
   take_all<pmu::v5::Alarm>(
-      alarm_reader_, [&](const pmu::v5::Alarm& a) { alarms_.push_back({a, false}); },
-      [&](const pmu::v5::Alarm& a) { alarms_.push_back({a, true}); });
-  take_all<pmu::v5::Readiness>(readiness_reader_, [&](const pmu::v5::Readiness& r) { readiness_ = r; }, none);
+      alarm_reader_,
+      [&](const pmu::v5::Alarm& a) {
+        alarms_.push_back({a, false});
+      },
+      [&](const pmu::v5::Alarm& a) {
+        alarms_.push_back({a, true});
+      });
+  take_all<pmu::v5::Readiness>(
+      readiness_reader_, [&](const pmu::v5::Readiness& r) { readiness_ = r; }, none);
 }
 
 }  // namespace pmu::mavlink_bridge

@@ -32,7 +32,8 @@ struct Ctx {
       used = 0;
     }
     if (used != s.size() || s.empty() || v < lo || v > hi)
-      fail(n, std::string(name) + ": '" + s + "' is not a whole number " + std::to_string(lo) + ".." + std::to_string(hi));
+      fail(n,
+           std::string(name) + ": '" + s + "' is not a whole number " + std::to_string(lo) + ".." + std::to_string(hi));
     return v;
   }
 
@@ -45,7 +46,8 @@ struct Ctx {
     } catch (const std::exception&) {
       used = 0;
     }
-    if (used != s.size() || s.empty() || !std::isfinite(v)) fail(n, std::string(name) + ": '" + s + "' is not a number");
+    if (used != s.size() || s.empty() || !std::isfinite(v))
+      fail(n, std::string(name) + ": '" + s + "' is not a number");
     return v;
   }
 };

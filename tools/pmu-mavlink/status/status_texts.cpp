@@ -13,11 +13,9 @@ std::uint8_t alarm_severity(const pmu::v5::Alarm& alarm) noexcept {
   switch (alarm.state()) {
     case pmu::v5::ALARM_ACTIVE_UNACKNOWLEDGED:
     case pmu::v5::ALARM_ACTIVE_ACKNOWLEDGED:
-      return alarm.severity() == pmu::v5::SEVERITY_CRITICAL ? nm::mav_severity::kCritical
-                                                              : nm::mav_severity::kWarning;
+      return alarm.severity() == pmu::v5::SEVERITY_CRITICAL ? nm::mav_severity::kCritical : nm::mav_severity::kWarning;
     case pmu::v5::ALARM_CLEARED_UNACKNOWLEDGED:
-    case pmu::v5::ALARM_NORMAL:
-      break;
+    case pmu::v5::ALARM_NORMAL: break;
   }
   return nm::mav_severity::kNotice;
 }
@@ -25,8 +23,8 @@ std::uint8_t alarm_severity(const pmu::v5::Alarm& alarm) noexcept {
 nm::Statustext alarm_text(const pmu::v5::Alarm& alarm) {
   nm::Statustext t;
   t.severity = alarm_severity(alarm);
-  const std::string message = alarm.message().to_string().empty() ? alarm.code().to_string()
-                                                                   : alarm.message().to_string();
+  const std::string message =
+      alarm.message().to_string().empty() ? alarm.code().to_string() : alarm.message().to_string();
   switch (alarm.state()) {
     case pmu::v5::ALARM_ACTIVE_UNACKNOWLEDGED: t.text = "PMU: " + message; break;
     case pmu::v5::ALARM_ACTIVE_ACKNOWLEDGED: t.text = "PMU: " + message + " acked"; break;

@@ -87,8 +87,8 @@ nm::BatteryStatus bms_battery_status(const BmsView& bms, std::uint8_t id) {
     m.current_battery = centiamperes(-b.current());
     m.charge_state = charge_state(b.current());
     m.temperature = centidegrees(b.cell_temperature_high());
-    m.battery_remaining = static_cast<std::int8_t>(
-        scaled_or(b.state_of_charge(), 1.0F, 0, 100, nm::not_provided::kBatteryRemaining));
+    m.battery_remaining =
+        static_cast<std::int8_t>(scaled_or(b.state_of_charge(), 1.0F, 0, 100, nm::not_provided::kBatteryRemaining));
   }
   if (bms.energy) {
     m.energy_consumed = hectojoules(bms.energy->used_wh());

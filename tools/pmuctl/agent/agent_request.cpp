@@ -74,7 +74,8 @@ std::optional<AgentRequest> decode_request(std::string_view bytes, std::string& 
   const auto count = parts[4];
   const auto [ptr, ec] = std::from_chars(count.data(), count.data() + count.size(), n);
   if (ec != std::errc() || ptr != count.data() + count.size() || n > parts.size() - kHeader) {
-    error = "the count of environment variables '" + std::string(count) + "' is not a number of the strings that follow";
+    error =
+        "the count of environment variables '" + std::string(count) + "' is not a number of the strings that follow";
     return std::nullopt;
   }
   for (std::size_t i = 0; i < n; ++i) {

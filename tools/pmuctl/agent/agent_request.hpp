@@ -24,8 +24,8 @@ namespace pmu::tools {
 // The variables a call reads (pmuctl(1), ENVIRONMENT). A call sends those it has set; the
 // agent runs it with exactly those set and the others unset.
 inline constexpr const char* kAgentEnvironment[] = {
-    "PMU_VEHICLE",          "PMU_QOS_FILE",       "PMU_SECURITY_DIR",  "PMU_SECURITY_IDENTITY",
-    "PMU_DDS_PEERS",        "PMU_DISCOVERY_SERVER", "PMU_DDS_INTERFACES", "PMU_LINK",
+    "PMU_VEHICLE",   "PMU_QOS_FILE",         "PMU_SECURITY_DIR",   "PMU_SECURITY_IDENTITY",
+    "PMU_DDS_PEERS", "PMU_DISCOVERY_SERVER", "PMU_DDS_INTERFACES", "PMU_LINK",
 };
 
 struct AgentRequest {

@@ -152,7 +152,7 @@ UniqueFd listen_at(const std::string& path, UniqueFd& lock) {
     return UniqueFd();
   }
   // Nothing listens: a socket file left by an agent that was killed is taken over.
-  struct stat st{};
+  struct stat st {};
   if (::lstat(path.c_str(), &st) == 0) {
     if (!S_ISSOCK(st.st_mode)) {
       std::fprintf(stderr, "pmuctl agent: %s exists and is not a socket: not replaced\n", path.c_str());
@@ -220,15 +220,15 @@ void serve_calls(int channel, const GlobalOptions& settings, const AgentCallRunn
 // A call accepted and read by the agent, waiting for a worker.
 struct Waiting {
   UniqueFd connection;
-  std::string bytes;            // the request as it came, handed on to the worker
-  std::vector<UniqueFd> fds;    // the caller's stdin, stdout, stderr
+  std::string bytes;          // the request as it came, handed on to the worker
+  std::vector<UniqueFd> fds;  // the caller's stdin, stdout, stderr
   AgentRequest request;
   pid_t pid = 0;
 };
 
 struct Worker {
   pid_t pid = -1;
-  UniqueFd channel;                                   // the agent's end of the worker's socketpair
+  UniqueFd channel;                                                 // the agent's end of the worker's socketpair
   std::optional<std::chrono::steady_clock::time_point> busy_since;  // on a call since
 };
 
@@ -468,7 +468,7 @@ int run_agent(const GlobalOptions& settings, const std::string& socket, int work
   UniqueFd listener = listen_at(socket, lock);
   if (!listener) return 2;
   (void)::fcntl(listener.get(), F_SETFL, ::fcntl(listener.get(), F_GETFL) | O_NONBLOCK);
-  struct sigaction sa{};
+  struct sigaction sa {};
   sa.sa_handler = on_stop_signal;
   ::sigemptyset(&sa.sa_mask);
   ::sigaction(SIGINT, &sa, nullptr);

@@ -21,18 +21,19 @@ std::string not_owned(const std::string& what, const struct stat& st, uid_t uid)
   if (st.st_uid != uid && st.st_uid != 0)
     return what + " belongs to uid " + std::to_string(st.st_uid) + ", not to this user (uid " + std::to_string(uid) +
            ") or root";
-  if (st.st_mode & (S_IWGRP | S_IWOTH)) return what + " is writable by other users (mode " + mode_text(st.st_mode) + ")";
+  if (st.st_mode & (S_IWGRP | S_IWOTH))
+    return what + " is writable by other users (mode " + mode_text(st.st_mode) + ")";
   return {};
 }
 
 }  // namespace
 
 std::string untrusted_socket_path(const std::string& path, uid_t uid) {
-  struct stat socket_st{};
+  struct stat socket_st {};
   if (::lstat(path.c_str(), &socket_st) != 0) return {};  // nothing there: nothing listens
   const auto slash = path.rfind('/');
   const std::string folder = slash == std::string::npos ? "." : slash == 0 ? "/" : path.substr(0, slash);
-  struct stat folder_st{};
+  struct stat folder_st {};
   if (::stat(folder.c_str(), &folder_st) != 0)
     return "its folder " + folder + " cannot be examined (" + std::strerror(errno) + ")";
   // A folder others may write to lets them put a socket of theirs at the path, or replace ours.

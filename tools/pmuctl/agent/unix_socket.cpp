@@ -82,8 +82,10 @@ bool receive(int socket, std::string& bytes, std::vector<UniqueFd>* fds) {
       }
     }
   if (n <= 0 || (msg.msg_flags & (MSG_TRUNC | MSG_CTRUNC))) {
-    if (n == 0) errno = ECONNRESET;
-    else if (n > 0) errno = EMSGSIZE;
+    if (n == 0)
+      errno = ECONNRESET;
+    else if (n > 0)
+      errno = EMSGSIZE;
     return false;
   }
   bytes.resize(static_cast<std::size_t>(n));

@@ -37,9 +37,8 @@ const char* result_name(pmu::v5::CommandResult r) {
 std::string request_id() {
   char host[64] = "host";
   ::gethostname(host, sizeof host - 1);
-  const auto ns = std::chrono::duration_cast<std::chrono::nanoseconds>(
-                      std::chrono::system_clock::now().time_since_epoch())
-                      .count();
+  const auto ns =
+      std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::system_clock::now().time_since_epoch()).count();
   return "pmuctl-" + std::string(host).substr(0, 24) + "-" + std::to_string(::getpid()) + "-" + std::to_string(ns);
 }
 
@@ -70,7 +69,8 @@ std::optional<int> resolve_target(const GlobalOptions& o, const std::string& veh
       heard = true;
       if (!info.valid_data) {
         // Disposed: a PMU that moved to another address is not a second PMU.
-        if (auto it = handles.find(info.instance_handle); it != handles.end() && info.instance_state != ALIVE_INSTANCE_STATE)
+        if (auto it = handles.find(info.instance_handle);
+            it != handles.end() && info.instance_state != ALIVE_INSTANCE_STATE)
           search.gone(it->second);
         continue;
       }
@@ -198,7 +198,8 @@ bool CommandChannel::recalled_target_gone(const Outcome& out, const std::string&
 
 CommandChannel::Outcome CommandChannel::send(const CommandSpec& spec, const std::string& bus, std::uint16_t address,
                                              double timeout, std::uint64_t expires_at_ns) {
-  const auto deadline = Clock::now() + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(timeout));
+  const auto deadline =
+      Clock::now() + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(timeout));
   pmu::v5::Command c;
   Outcome out;
   out.request_id = spec.request_id.empty() ? request_id() : spec.request_id;

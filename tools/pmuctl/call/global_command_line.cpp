@@ -33,8 +33,10 @@ bool setup_security(GlobalOptions& g, std::string dir, std::string identity) {
     return true;
   }
   if (identity.empty()) {
-    std::fprintf(stderr, "pmuctl: --security-dir %s needs --identity NAME (or PMU_SECURITY_IDENTITY), "
-                         "e.g. ground-station to command, mission-computer to watch\n", dir.c_str());
+    std::fprintf(stderr,
+                 "pmuctl: --security-dir %s needs --identity NAME (or PMU_SECURITY_IDENTITY), "
+                 "e.g. ground-station to command, mission-computer to watch\n",
+                 dir.c_str());
     return false;
   }
   g.security = pmu::dds::security_files_in(dir, identity);
@@ -42,8 +44,8 @@ bool setup_security(GlobalOptions& g, std::string dir, std::string identity) {
   options.domain = g.domain;
   const auto issues = pmu::dds::check_security_files(g.security, options);
   for (const auto& i : issues)
-    std::fprintf(stderr, "pmuctl: %s%s\n", i.level == pmu::dds::SecurityIssue::Level::Error ? "" : "warning: ",
-                 i.message.c_str());
+    std::fprintf(stderr, "pmuctl: %s%s\n",
+                 i.level == pmu::dds::SecurityIssue::Level::Error ? "" : "warning: ", i.message.c_str());
   return !pmu::dds::has_errors(issues);
 }
 
@@ -81,7 +83,9 @@ void add_global_options(CLI::App& app, GlobalOptions& g, GlobalOptionText& text)
   app.add_flag("--json", g.json, "Machine-readable output: one JSON object per line");
   app.add_option("--timeout", text.timeout, "Seconds to wait (state verbs: default 3; commands: 5; watch: forever)")
       ->type_name("S");
-  app.add_option("--qos-file", g.qos_file, "QoS profiles (default: $PMU_QOS_FILE, else " PMU_SYSCONFDIR "/qos.xml, else " PMU_DATADIR "/qos.xml)");
+  app.add_option("--qos-file", g.qos_file,
+                 "QoS profiles (default: $PMU_QOS_FILE, else " PMU_SYSCONFDIR "/qos.xml, else " PMU_DATADIR
+                 "/qos.xml)");
   app.add_option("--security-dir", text.security_dir,
                  "DDS-Security: the folder deploy/security/make_pki.sh made (default: $PMU_SECURITY_DIR; "
                  "none: no security)");

@@ -62,7 +62,8 @@ std::optional<std::vector<dds::Address>> addresses(const std::vector<std::string
     }
     out.push_back(std::move(a));
   }
-  if (empty_keeps_position && std::all_of(out.begin(), out.end(), [](const dds::Address& a) { return a.host.empty(); })) {
+  if (empty_keeps_position &&
+      std::all_of(out.begin(), out.end(), [](const dds::Address& a) { return a.host.empty(); })) {
     std::fprintf(stderr, "pmuctl: %s names no server (an empty entry only leaves its id unused)\n", where.c_str());
     return std::nullopt;
   }
@@ -86,8 +87,9 @@ bool resolve_network_options(const NetworkOptions& o, const dds::NetworkLookup& 
   if (peers.empty() && servers.empty()) {
     const std::string env_peers = env("PMU_DDS_PEERS"), env_servers = env("PMU_DISCOVERY_SERVER");
     if (!env_peers.empty() && !env_servers.empty()) {
-      std::fprintf(stderr, "pmuctl: PMU_DDS_PEERS (unicast discovery) and PMU_DISCOVERY_SERVER are both set: "
-                           "unset one, or give --peer or --discovery-server\n");
+      std::fprintf(stderr,
+                   "pmuctl: PMU_DDS_PEERS (unicast discovery) and PMU_DISCOVERY_SERVER are both set: "
+                   "unset one, or give --peer or --discovery-server\n");
       return false;
     }
     if (!env_peers.empty()) {

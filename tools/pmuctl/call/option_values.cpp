@@ -27,7 +27,8 @@ Parsed<double> parse_seconds(std::string_view option, std::string_view text) {
   char max[32];
   std::snprintf(max, sizeof max, "%g", kMaxSeconds);
   const std::string range = " is not a number of seconds (more than 0, at most " + std::string(max) + ")";
-  if (s.empty() || std::isspace(static_cast<unsigned char>(s.front())) || *end != '\0' || errno == ERANGE || !std::isfinite(v) || v <= 0 || v > kMaxSeconds)
+  if (s.empty() || std::isspace(static_cast<unsigned char>(s.front())) || *end != '\0' || errno == ERANGE ||
+      !std::isfinite(v) || v <= 0 || v > kMaxSeconds)
     return quoted(option, text) + range;
   return v;
 }
@@ -37,8 +38,8 @@ Parsed<long> parse_count(std::string_view option, std::string_view text) {
   char* end = nullptr;
   errno = 0;
   const long v = s.empty() ? 0 : std::strtol(s.c_str(), &end, 10);
-  if (s.empty() || *end != '\0' || errno == ERANGE || v < 1 || v > kMaxCount ||
-      s.front() == '+' || std::isspace(static_cast<unsigned char>(s.front())))
+  if (s.empty() || *end != '\0' || errno == ERANGE || v < 1 || v > kMaxCount || s.front() == '+' ||
+      std::isspace(static_cast<unsigned char>(s.front())))
     return quoted(option, text) + " is not a whole number 1.." + std::to_string(kMaxCount);
   return v;
 }

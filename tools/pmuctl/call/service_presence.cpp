@@ -44,8 +44,8 @@ std::map<int, std::set<std::string>> other_contracts_on_domain(const pmu::dds::D
 std::string other_contracts_text(const std::map<int, std::set<std::string>>& others) {
   std::string text;
   for (const auto& [contract, vehicles] : others)
-    text += (text.empty() ? "" : ", ") + ("pmu-service of " + pmu::dds::contract_text(contract)) + " (vehicles: " +
-            vehicles_list(vehicles) + ")";
+    text += (text.empty() ? "" : ", ") + ("pmu-service of " + pmu::dds::contract_text(contract)) +
+            " (vehicles: " + vehicles_list(vehicles) + ")";
   if (text.empty()) return text;
   return text + "; this pmuctl reads " + pmu::dds::contract_text(pmu::dds::contract_major()) +
          " only (docs/interface.md section 10 says what to do at the upgrade)";

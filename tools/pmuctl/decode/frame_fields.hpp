@@ -13,7 +13,7 @@ namespace pmu::tools {
 
 struct FieldValue {
   enum class Kind : std::uint8_t { Number, Integer, Boolean } kind = Kind::Number;
-  double number = 0;       // Number; NaN means "no value" (JSON null)
+  double number = 0;  // Number; NaN means "no value" (JSON null)
   std::int64_t integer = 0;
   bool boolean = false;
 

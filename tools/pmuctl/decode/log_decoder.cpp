@@ -160,8 +160,7 @@ void LogDecoder::decode_line(std::string_view line, std::string& out) {
   const auto m = codec::decode(l.frame, fw);
   if (!m) return report_error(m.error().describe());
   ++counts_.frames;
-  if (const auto* info = std::get_if<codec::FirmwareInfo>(&m->payload))
-    learned_[m->address] = info->version();
+  if (const auto* info = std::get_if<codec::FirmwareInfo>(&m->payload)) learned_[m->address] = info->version();
 
   std::string note;
   if (m->unsupported_by_firmware)

@@ -80,8 +80,9 @@ int run_decode_mcap(const std::string& log, const std::string& out, std::optiona
     const auto parsed = codec::parse_candump_line(std::string_view(line, n));
     if (!parsed) {
       if (errors++ < 10)
-        std::fprintf(stderr, "pmuctl decode --mcap: %s:%llu: %.*s\n", log.c_str(), static_cast<unsigned long long>(lines),
-                     static_cast<int>(parsed.error().reason.size()), parsed.error().reason.data());
+        std::fprintf(stderr, "pmuctl decode --mcap: %s:%llu: %.*s\n", log.c_str(),
+                     static_cast<unsigned long long>(lines), static_cast<int>(parsed.error().reason.size()),
+                     parsed.error().reason.data());
       continue;
     }
     const auto& l = *parsed;
@@ -119,17 +120,17 @@ int run_decode_mcap(const std::string& log, const std::string& out, std::optiona
   }
   std::free(line);
   if (std::ferror(in.get())) return give_up("error reading " + log);
-  if (errors > 10) std::fprintf(stderr, "pmuctl decode --mcap: ... %llu lines not decoded in all\n",
-                                static_cast<unsigned long long>(errors));
+  if (errors > 10)
+    std::fprintf(stderr, "pmuctl decode --mcap: ... %llu lines not decoded in all\n",
+                 static_cast<unsigned long long>(errors));
   if (const auto why = rec.close(); !why.empty()) return give_up(why);
   if (const auto why = rec.commit(); !why.empty()) return give_up(why);
   std::fprintf(stderr,
                "pmuctl decode --mcap: %llu lines, %llu telemetry samples written to %s (%llu bytes), %llu frames not "
                "telemetry, %llu without a timestamp (screen format: take logs with candump -L), %llu errors\n",
                static_cast<unsigned long long>(lines), static_cast<unsigned long long>(written), rec.name().c_str(),
-               static_cast<unsigned long long>(rec.bytes()),
-               static_cast<unsigned long long>(skipped), static_cast<unsigned long long>(untimed),
-               static_cast<unsigned long long>(errors));
+               static_cast<unsigned long long>(rec.bytes()), static_cast<unsigned long long>(skipped),
+               static_cast<unsigned long long>(untimed), static_cast<unsigned long long>(errors));
   return 0;
 }
 

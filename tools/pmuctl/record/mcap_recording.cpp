@@ -8,15 +8,19 @@ namespace pmu::tools {
 
 std::string human_bytes(std::uint64_t n) {
   char buf[32];
-  if (n < 1000) std::snprintf(buf, sizeof buf, "%llu B", static_cast<unsigned long long>(n));
-  else if (n < 1000000) std::snprintf(buf, sizeof buf, "%.1f kB", static_cast<double>(n) / 1e3);
-  else std::snprintf(buf, sizeof buf, "%.1f MB", static_cast<double>(n) / 1e6);
+  if (n < 1000)
+    std::snprintf(buf, sizeof buf, "%llu B", static_cast<unsigned long long>(n));
+  else if (n < 1000000)
+    std::snprintf(buf, sizeof buf, "%.1f kB", static_cast<double>(n) / 1e3);
+  else
+    std::snprintf(buf, sizeof buf, "%.1f MB", static_cast<double>(n) / 1e6);
   return buf;
 }
 
 std::string McapRecording::open(const std::string& path, const std::vector<const RecordedTopic*>& topics) {
   if (auto why = out_.open(path); !why.empty()) return why;
-  writer_ = std::make_unique<pmu::mcap::Writer>(out_.sink(), pmu::mcap::WriterOptions{"", "pmuctl (pmu-dds)", 256 * 1024});
+  writer_ =
+      std::make_unique<pmu::mcap::Writer>(out_.sink(), pmu::mcap::WriterOptions{"", "pmuctl (pmu-dds)", 256 * 1024});
   if (!writer_->open()) return error();
   for (const auto* t : topics) add_topic(t);
   // The schemas and channels reach the file at once: a recording stopped before its first
@@ -27,7 +31,8 @@ std::string McapRecording::open(const std::string& path, const std::vector<const
 std::size_t McapRecording::add_topic(const RecordedTopic* t) {
   auto it = schemas_.find(t->schema());
   if (it == schemas_.end())
-    it = schemas_.emplace(t->schema(), writer_->add_schema(t->schema(), t->schema_encoding(), std::string(t->idl))).first;
+    it =
+        schemas_.emplace(t->schema(), writer_->add_schema(t->schema(), t->schema_encoding(), std::string(t->idl))).first;
   channels_.push_back(writer_->add_channel(it->second, t->channel_name(), "cdr"));
   topics_.push_back(t);
   counts_.push_back(0);
@@ -49,8 +54,7 @@ std::string McapRecording::close() {
   const bool was_failed = writer_->failed();
   const bool ok = writer_->close();
   std::string why = ok ? std::string() : error();
-  if (const int e = out_.close(); e != 0 && why.empty())
-    why = "closing " + out_.name() + ": " + std::strerror(e);
+  if (const int e = out_.close(); e != 0 && why.empty()) why = "closing " + out_.name() + ": " + std::strerror(e);
   if (was_failed)
     why += std::string(out_.streaming() ? " (it got" : " (the file holds") + " the chunks written before it, " +
            human_bytes(writer_->bytes_written()) + ")";

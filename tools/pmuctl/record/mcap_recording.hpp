@@ -59,7 +59,7 @@ class McapRecording {
   const std::string& name() const { return out_.name(); }
   // Bytes written so far; after close(), the size of what was written.
   std::uint64_t bytes() const { return writer_ ? writer_->bytes_written() : 0; }
-  std::string error() const;  // "" or what failed and where
+  std::string error() const;     // "" or what failed and where
   std::string progress() const;  // "1234 messages, 56.7 kB (voltages 200, currents 200, ...)"
   std::uint64_t messages() const { return writer_ ? writer_->message_count() : 0; }
 

@@ -94,8 +94,10 @@ bool forwarded_topics(const GlobalOptions& o, const std::vector<std::string>& na
                       std::vector<const RecordedTopic*>& topics) {
   if (!o.bus.empty() || o.address) {
     // Selecting would mean reading the bytes pmuctl forwards unread; a vehicle is a partition.
-    std::fprintf(stderr, "pmuctl %s: forwards every device of the vehicle(s) it reads; --bus and --address do not "
-                         "apply (--vehicle does)\n", verb);
+    std::fprintf(stderr,
+                 "pmuctl %s: forwards every device of the vehicle(s) it reads; --bus and --address do not "
+                 "apply (--vehicle does)\n",
+                 verb);
     return false;
   }
   std::string unknown;
@@ -109,7 +111,8 @@ bool forwarded_topics(const GlobalOptions& o, const std::vector<std::string>& na
   std::vector<std::string> contract;
   for (const auto& n : names) {
     if (auto r = ros2_topic_named(n)) {
-      if (std::none_of(ros2.named.begin(), ros2.named.end(), [&](const auto& x) { return x.dds_topic == r->dds_topic; }))
+      if (std::none_of(ros2.named.begin(), ros2.named.end(),
+                       [&](const auto& x) { return x.dds_topic == r->dds_topic; }))
         ros2.named.push_back(*r);
     } else {
       contract.push_back(n);

@@ -29,8 +29,8 @@ namespace pmu::tools {
 
 // What a reader knows of a sample besides its bytes.
 struct RawSampleInfo {
-  std::size_t topic = 0;                   // index into the list given to RawTopicReaders::open
-  std::uint64_t time_ns = 0;               // the DDS source timestamp, ns since the Unix epoch
+  std::size_t topic = 0;                    // index into the list given to RawTopicReaders::open
+  std::uint64_t time_ns = 0;                // the DDS source timestamp, ns since the Unix epoch
   std::array<std::uint8_t, 16> instance{};  // the DDS instance (the sample's keys: one device)
 };
 // The sink may take (move from) `sample.bytes`.

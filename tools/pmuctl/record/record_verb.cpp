@@ -56,8 +56,8 @@ int run_record(const GlobalOptions& o, const std::string& path, const std::vecto
     s.rec.write(info.topic, info.time_ns, sample.bytes.data(), sample.bytes.size());
   });
   {
-    pmu::dds::DdsContext dds(o.domain, o.qos_file, "pmuctl-record", o.security, pmu::dds::Transport::Default,
-                             o.network, partitions_for(o));
+    pmu::dds::DdsContext dds(o.domain, o.qos_file, "pmuctl-record", o.security, pmu::dds::Transport::Default, o.network,
+                             partitions_for(o));
     readers.open(dds, topics);
     // A ROS 2 topic's channel is added before its reader exists, so before its first message.
     Ros2Readers ros2_readers(std::move(ros2), o.vehicle, "record");
@@ -108,13 +108,15 @@ class RecordVerb : public Verb {
   explicit RecordVerb(CLI::App& app) {
     record_ = app.add_subcommand(
         "record", "Record the topics into an MCAP file (Foxglove, Lichtblick, PlotJuggler) until Ctrl-C or SIGTERM");
-    record_->add_option("file", path_,
-                        "The MCAP file (a regular file is replaced when the recording ends), a FIFO or a "
-                        "character device (written in place), or - for standard output")
+    record_
+        ->add_option("file", path_,
+                     "The MCAP file (a regular file is replaced when the recording ends), a FIFO or a "
+                     "character device (written in place), or - for standard output")
         ->required();
-    record_->add_option("--topic", topics_,
-                        "Only this topic (pmu/voltages or voltages; also low_rate/..., command, command_reply); "
-                        "repeat for more (default: telemetry, state, health, battery and MPPT topics)")
+    record_
+        ->add_option("--topic", topics_,
+                     "Only this topic (pmu/voltages or voltages; also low_rate/..., command, command_reply); "
+                     "repeat for more (default: telemetry, state, health, battery and MPPT topics)")
         ->allow_extra_args(false);
   }
   bool chosen() const override { return record_->parsed(); }

@@ -27,9 +27,12 @@ std::vector<std::string_view> segments(std::string_view s) {
 
 std::optional<Ros2TopicName> ros2_topic_named(std::string_view name) {
   std::string_view ros;  // the ROS 2 name without its leading '/'
-  if (name.substr(0, 3) == "rt/") ros = name.substr(3);
-  else if (name.substr(0, 1) == "/") ros = name.substr(1);
-  else return std::nullopt;
+  if (name.substr(0, 3) == "rt/")
+    ros = name.substr(3);
+  else if (name.substr(0, 1) == "/")
+    ros = name.substr(1);
+  else
+    return std::nullopt;
   if (ros == "diagnostics") return Ros2TopicName{"rt/diagnostics", kRos2DiagnosticsType};
   const auto parts = segments(ros);
   // <bus>/<device>/<battery> at least, no empty token

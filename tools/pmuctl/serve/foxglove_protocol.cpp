@@ -26,8 +26,7 @@ std::string shown(const json& value) {
 }
 
 // A u32 field of an object; false with `why` set when absent or not an unsigned 32-bit integer.
-bool u32_field(const json& object, const char* name, const std::string& where, std::uint32_t& out,
-               std::string& why) {
+bool u32_field(const json& object, const char* name, const std::string& where, std::uint32_t& out, std::string& why) {
   const auto it = object.find(name);
   if (it == object.end()) {
     why = where + "." + name + " is missing";
@@ -45,9 +44,9 @@ bool u32_field(const json& object, const char* name, const std::string& where, s
 // Ops of the spec this server does not offer (its only capability is time): named, so a client
 // hears that they exist but are not served, rather than "unknown".
 bool is_spec_op(std::string_view op) {
-  for (const char* known : {"advertise", "unadvertise", "getParameters", "setParameters", "subscribeParameterUpdates",
-                            "unsubscribeParameterUpdates", "subscribeConnectionGraph", "unsubscribeConnectionGraph",
-                            "fetchAsset"})
+  for (const char* known :
+       {"advertise", "unadvertise", "getParameters", "setParameters", "subscribeParameterUpdates",
+        "unsubscribeParameterUpdates", "subscribeConnectionGraph", "unsubscribeConnectionGraph", "fetchAsset"})
     if (op == known) return true;
   return false;
 }
@@ -77,8 +76,8 @@ ClientRequest parse_unsubscribe(const json& message) {
   for (std::size_t i = 0; i < list->size(); ++i) {
     const json& id = (*list)[i];
     if (!id.is_number_unsigned() || id.get<std::uint64_t>() > 0xFFFFFFFFu)
-      return BadRequest{"unsubscribe: subscriptionIds[" + std::to_string(i) + "] must be an integer 0..4294967295, not " +
-                        shown(id)};
+      return BadRequest{"unsubscribe: subscriptionIds[" + std::to_string(i) +
+                        "] must be an integer 0..4294967295, not " + shown(id)};
     request.ids.push_back(static_cast<std::uint32_t>(id.get<std::uint64_t>()));
   }
   return request;
@@ -142,9 +141,11 @@ std::string time_message(std::uint64_t time_ns) {
 ClientRequest parse_client_text(std::string_view text) {
   const json message = json::parse(text.begin(), text.end(), nullptr, /*allow_exceptions=*/false);
   if (message.is_discarded()) return BadRequest{"not JSON: " + quote_text(text)};
-  if (!message.is_object()) return BadRequest{"a client message must be a JSON object with \"op\", not " + quote_text(text)};
+  if (!message.is_object())
+    return BadRequest{"a client message must be a JSON object with \"op\", not " + quote_text(text)};
   const auto op = message.find("op");
-  if (op == message.end() || !op->is_string()) return BadRequest{"message without a string \"op\": " + quote_text(text)};
+  if (op == message.end() || !op->is_string())
+    return BadRequest{"message without a string \"op\": " + quote_text(text)};
   const auto& name = op->get_ref<const std::string&>();
   if (name == "subscribe") return parse_subscribe(message);
   if (name == "unsubscribe") return parse_unsubscribe(message);

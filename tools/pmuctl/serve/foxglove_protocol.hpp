@@ -40,9 +40,9 @@ std::string_view choose_subprotocol(const std::vector<std::string>& offered);
 // What the server advertises: encoding `cdr`, schema encoding `omgidl` for every channel.
 struct Channel {
   std::uint32_t id = 0;
-  std::string topic;        // the DDS topic name, "pmu/voltages"
-  std::string schema_name;  // the DDS type name, "pmu::v5::Voltages"
-  std::string_view schema;  // the IDL text (static storage: pmu::idl_text)
+  std::string topic;                            // the DDS topic name, "pmu/voltages"
+  std::string schema_name;                      // the DDS type name, "pmu::v5::Voltages"
+  std::string_view schema;                      // the IDL text (static storage: pmu::idl_text)
   std::string_view schema_encoding = "omgidl";  // "ros2msg" for a ROS 2 topic (pmu::ros2_msg_text)
 };
 
@@ -102,8 +102,8 @@ class ClientSubscriptions {
   void add_channel() { by_channel_.emplace_back(); }
 
  private:
-  std::map<std::uint32_t, std::uint32_t> by_id_;             // subscription id -> channel
-  std::vector<std::optional<std::uint32_t>> by_channel_;     // channel -> subscription id
+  std::map<std::uint32_t, std::uint32_t> by_id_;          // subscription id -> channel
+  std::vector<std::optional<std::uint32_t>> by_channel_;  // channel -> subscription id
 };
 
 }  // namespace pmu::tools::foxglove

@@ -134,8 +134,13 @@ struct Endpoint final : FoxgloveServer::Impl {
   using Counters = FoxgloveServer::Counters;
 
   Endpoint(std::vector<foxglove::Channel> c, std::vector<bool> l, ServeOptions o, std::string n, TlsPem t)
-      : channels(std::move(c)), latched(std::move(l)), options(std::move(o)), name(std::move(n)), tls(std::move(t)),
-        server_info(foxglove::server_info_json(name)), advertise(foxglove::advertise_json(channels)) {}
+      : channels(std::move(c)),
+        latched(std::move(l)),
+        options(std::move(o)),
+        name(std::move(n)),
+        tls(std::move(t)),
+        server_info(foxglove::server_info_json(name)),
+        advertise(foxglove::advertise_json(channels)) {}
   ~Endpoint() override { stop(); }
 
   std::vector<foxglove::Channel> channels;
@@ -219,8 +224,8 @@ struct Endpoint final : FoxgloveServer::Impl {
     const auto con = connection(h);
     if (!con) return;
     const std::string label = con->get_remote_endpoint();
-    clients.emplace(h, Client{label, foxglove::ClientSubscriptions(channels.size()),
-                              ClientBacklog(options.client_queue)});
+    clients.emplace(h,
+                    Client{label, foxglove::ClientSubscriptions(channels.size()), ClientBacklog(options.client_queue)});
     client_count = clients.size();
     // The spec's first messages; not subject to the queue limit (the queue is empty).
     con->send(server_info, websocketpp::frame::opcode::text);
@@ -234,7 +239,8 @@ struct Endpoint final : FoxgloveServer::Impl {
     if (it == clients.end()) return;  // a refused handshake never became a client
     const auto& c = it->second;
     if (c.backlog.dropping())
-      std::fprintf(stderr, "pmuctl serve: client %s disconnected; %llu messages were dropped for it (it did not read)\n",
+      std::fprintf(stderr,
+                   "pmuctl serve: client %s disconnected; %llu messages were dropped for it (it did not read)\n",
                    c.label.c_str(), static_cast<unsigned long long>(c.backlog.episode_dropped()));
     else
       std::fprintf(stderr, "pmuctl serve: client %s disconnected\n", c.label.c_str());
@@ -290,8 +296,7 @@ struct Endpoint final : FoxgloveServer::Impl {
     for (auto& p : batch) {
       for (auto& [h, client] : clients)
         if (const auto con = connection(h)) send_to(client, con, p, p.time_ns);
-      if (p.channel < latched.size() && latched[p.channel])
-        last_state[{p.channel, p.instance}] = std::move(p);
+      if (p.channel < latched.size() && latched[p.channel]) last_state[{p.channel, p.instance}] = std::move(p);
     }
   }
 
@@ -311,8 +316,10 @@ struct Endpoint final : FoxgloveServer::Impl {
     const std::string frame = foxglove::message_data(*sub, time_ns, p.payload.data(), p.payload.size());
     const auto v = client.backlog.offer(con->get_buffered_amount(), frame.size());
     if (v.change == ClientBacklog::Change::Began)
-      std::fprintf(stderr, "pmuctl serve: client %s is not reading (%s queued): dropping its messages until it "
-                           "catches up\n", client.label.c_str(), human_bytes(con->get_buffered_amount()).c_str());
+      std::fprintf(stderr,
+                   "pmuctl serve: client %s is not reading (%s queued): dropping its messages until it "
+                   "catches up\n",
+                   client.label.c_str(), human_bytes(con->get_buffered_amount()).c_str());
     if (!v.send) {
       ++dropped;
       return;
@@ -320,10 +327,10 @@ struct Endpoint final : FoxgloveServer::Impl {
     if (v.change == ClientBacklog::Change::Ended) {
       std::fprintf(stderr, "pmuctl serve: client %s reads again; %llu messages were dropped for it\n",
                    client.label.c_str(), static_cast<unsigned long long>(v.dropped));
-      con->send(foxglove::status_json(StatusLevel::Warning,
-                                      std::to_string(v.dropped) + " messages were dropped for this client: it did "
-                                      "not read them in time (pmuctl serve holds " +
-                                          human_bytes(options.client_queue) + " per client)"),
+      con->send(foxglove::status_json(StatusLevel::Warning, std::to_string(v.dropped) +
+                                                                " messages were dropped for this client: it did "
+                                                                "not read them in time (pmuctl serve holds " +
+                                                                human_bytes(options.client_queue) + " per client)"),
                 websocketpp::frame::opcode::text);
     }
     send_time(client, con);
@@ -334,9 +341,7 @@ struct Endpoint final : FoxgloveServer::Impl {
   void publish(std::uint32_t channel, std::uint64_t time_ns, const Instance& instance,
                std::vector<std::uint8_t>&& payload) override;
   void add_channel(foxglove::Channel channel, bool state) override;
-  Counters counters() const override {
-    return Counters{client_count.load(), forwarded.load(), dropped.load()};
-  }
+  Counters counters() const override { return Counters{client_count.load(), forwarded.load(), dropped.load()}; }
   void stop() override;
   // wss:// only: the context every connection shares.
   void set_tls_handler();
@@ -396,7 +401,7 @@ std::string Endpoint<Config>::start() {
     for (;;) {
       try {
         m.server.run();
-        return;  // stop()
+        return;                            // stop()
       } catch (const std::exception& e) {  // not expected: say it and keep serving
         std::fprintf(stderr, "pmuctl serve: server thread: %s\n", e.what());
       }
@@ -457,11 +462,11 @@ void Endpoint<Config>::stop() {
 
 }  // namespace
 
-FoxgloveServer::FoxgloveServer(std::vector<foxglove::Channel> channels, std::vector<bool> latched,
-                               ServeOptions options, std::string name, TlsPem tls) {
+FoxgloveServer::FoxgloveServer(std::vector<foxglove::Channel> channels, std::vector<bool> latched, ServeOptions options,
+                               std::string name, TlsPem tls) {
   if (options.tls())
-    impl_ = std::make_unique<Endpoint<websocketpp::config::asio_tls>>(std::move(channels), std::move(latched),
-                                                                      std::move(options), std::move(name), std::move(tls));
+    impl_ = std::make_unique<Endpoint<websocketpp::config::asio_tls>>(
+        std::move(channels), std::move(latched), std::move(options), std::move(name), std::move(tls));
   else
     impl_ = std::make_unique<Endpoint<websocketpp::config::asio>>(std::move(channels), std::move(latched),
                                                                   std::move(options), std::move(name), TlsPem{});

@@ -45,9 +45,9 @@ std::string check_tls(const TlsPem& pem);
 class FoxgloveServer {
  public:
   struct Counters {
-    std::size_t clients = 0;       // connected now
-    std::uint64_t forwarded = 0;   // MessageData frames handed to clients' queues
-    std::uint64_t dropped = 0;     // for clients that did not read, and samples the server thread had no room for
+    std::size_t clients = 0;      // connected now
+    std::uint64_t forwarded = 0;  // MessageData frames handed to clients' queues
+    std::uint64_t dropped = 0;    // for clients that did not read, and samples the server thread had no room for
   };
 
   // `latched[i]`: channel i carries state (TRANSIENT_LOCAL in DDS): the server keeps the last

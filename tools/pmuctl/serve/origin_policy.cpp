@@ -13,7 +13,8 @@ constexpr std::string_view kLocalHosts[] = {"localhost", "127.0.0.1", "[::1]"};
 
 std::string lower(std::string_view s) {
   std::string out(s);
-  std::transform(out.begin(), out.end(), out.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  std::transform(out.begin(), out.end(), out.begin(),
+                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
   return out;
 }
 
@@ -54,7 +55,8 @@ std::string add_allowed_origin(const std::string& text, OriginPolicy& policy) {
     policy.any = true;
     return {};
   }
-  const std::string bad = "--allow-origin '" + text + "' is not an origin scheme://host[:port] (e.g. "
+  const std::string bad = "--allow-origin '" + text +
+                          "' is not an origin scheme://host[:port] (e.g. "
                           "https://viz.example.com:8443; http or https, no path, not even a final /; or '*' for "
                           "every origin)";
   const std::string o = lower(text);

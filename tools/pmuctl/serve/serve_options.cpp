@@ -28,14 +28,15 @@ std::string parse_serve_options(const std::string& listen, const std::string& po
                                 ServeOptions& out) {
   in_addr a4{};
   if (::inet_pton(AF_INET, listen.c_str(), &a4) != 1 && !is_ipv6(listen))
-    return "--listen '" + listen + "' is not an IP address (e.g. 127.0.0.1 for this host only, 0.0.0.0 for every "
+    return "--listen '" + listen +
+           "' is not an IP address (e.g. 127.0.0.1 for this host only, 0.0.0.0 for every "
            "interface, ::1; not a host name)";
   long p = 0;
   if (!whole_number(port, 1, 65535, p)) return "--port '" + port + "' is not a port number 1..65535";
   long kb = 0;
   if (!whole_number(client_queue_kb, kMinClientQueueKb, kMaxClientQueueKb, kb))
-    return "--client-queue '" + client_queue_kb + "' is not a size in kB " + std::to_string(kMinClientQueueKb) +
-           ".." + std::to_string(kMaxClientQueueKb);
+    return "--client-queue '" + client_queue_kb + "' is not a size in kB " + std::to_string(kMinClientQueueKb) + ".." +
+           std::to_string(kMaxClientQueueKb);
   out.address = listen;
   out.port = static_cast<std::uint16_t>(p);
   out.client_queue = static_cast<std::size_t>(kb) * 1024;

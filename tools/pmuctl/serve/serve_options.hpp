@@ -21,11 +21,11 @@
 namespace pmu::tools {
 
 struct ServeOptions {
-  std::string address = "127.0.0.1";         // an IPv4 or IPv6 address literal
-  std::uint16_t port = 8765;                  // Foxglove's default
-  std::size_t client_queue = 1024 * 1024;     // bytes held for a client that does not read
-  OriginPolicy origins;                       // pages that may connect
-  std::string tls_cert;                       // PEM files; both empty: plain ws://
+  std::string address = "127.0.0.1";       // an IPv4 or IPv6 address literal
+  std::uint16_t port = 8765;               // Foxglove's default
+  std::size_t client_queue = 1024 * 1024;  // bytes held for a client that does not read
+  OriginPolicy origins;                    // pages that may connect
+  std::string tls_cert;                    // PEM files; both empty: plain ws://
   std::string tls_key;
 
   bool tls() const { return !tls_cert.empty(); }

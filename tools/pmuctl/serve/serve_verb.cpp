@@ -27,8 +27,8 @@ constexpr std::size_t kMaxPemBytes = 1024 * 1024;
 
 // --tls-cert's and --tls-key's files read and checked; "" or what is wrong and which file.
 std::string load_tls(const ServeOptions& serve, TlsPem& pem) {
-  for (const auto& [option, path, text] : {std::tuple{"--tls-cert", &serve.tls_cert, &pem.cert},
-                                           std::tuple{"--tls-key", &serve.tls_key, &pem.key}}) {
+  for (const auto& [option, path, text] :
+       {std::tuple{"--tls-cert", &serve.tls_cert, &pem.cert}, std::tuple{"--tls-key", &serve.tls_key, &pem.key}}) {
     auto file = pmu::files::read_bounded_file(*path, kMaxPemBytes);
     if (!file.ok()) return std::string(option) + " " + *path + " cannot be read: " + file.error;
     *text = std::move(file.text);
@@ -80,8 +80,8 @@ int run_serve(const GlobalOptions& o, const ServeOptions& serve, const std::vect
     server.publish(static_cast<std::uint32_t>(info.topic), info.time_ns, info.instance, std::move(sample.bytes));
   });
   {
-    pmu::dds::DdsContext dds(o.domain, o.qos_file, "pmuctl-serve", o.security, pmu::dds::Transport::Default,
-                             o.network, partitions_for(o));
+    pmu::dds::DdsContext dds(o.domain, o.qos_file, "pmuctl-serve", o.security, pmu::dds::Transport::Default, o.network,
+                             partitions_for(o));
     readers.open(dds, topics);
     // A ROS 2 topic, found in discovery, becomes a channel advertised to every client. Its
     // writer keeps its last message (TRANSIENT_LOCAL, keyless): latched, as the state topics,
@@ -122,29 +122,31 @@ class ServeVerb : public Verb {
     serve_ = app.add_subcommand(
         "serve",
         "Serve the topics live to Foxglove or Lichtblick (Foxglove WebSocket protocol) until Ctrl-C or SIGTERM");
-    serve_->add_option("--listen", listen_,
-                       "IP address to listen on (0.0.0.0: every interface; there is no authentication; a web page "
-                       "served over https needs --tls-cert for a remote address)")
+    serve_
+        ->add_option("--listen", listen_,
+                     "IP address to listen on (0.0.0.0: every interface; there is no authentication; a web page "
+                     "served over https needs --tls-cert for a remote address)")
         ->type_name("ADDR")
         ->capture_default_str();
     serve_->add_option("--port", port_, "TCP port (Foxglove's default)")->type_name("N")->capture_default_str();
-    serve_->add_option("--client-queue", queue_,
-                       "kB held for a client that does not read; beyond, its messages are dropped")
+    serve_
+        ->add_option("--client-queue", queue_,
+                     "kB held for a client that does not read; beyond, its messages are dropped")
         ->type_name("KB")
         ->capture_default_str();
     serve_->add_option("--topic", topics_, "Only this topic, as for record; repeat for more (default: record's)")
         ->type_name("NAME")
         ->allow_extra_args(false);
-    serve_->add_option("--allow-origin", origins_,
-                       "Also let pages of this origin connect (scheme://host[:port], exactly; '*': every page); "
-                       "repeat for more (default: the Foxglove app, the Foxglove and Lichtblick desktop apps, pages "
-                       "on localhost, and clients that send no Origin)")
+    serve_
+        ->add_option("--allow-origin", origins_,
+                     "Also let pages of this origin connect (scheme://host[:port], exactly; '*': every page); "
+                     "repeat for more (default: the Foxglove app, the Foxglove and Lichtblick desktop apps, pages "
+                     "on localhost, and clients that send no Origin)")
         ->type_name("ORIGIN")
         ->allow_extra_args(false);
     serve_->add_option("--tls-cert", cert_, "Serve wss:// with this certificate (chain), PEM; with --tls-key")
         ->type_name("FILE");
-    serve_->add_option("--tls-key", key_, "The certificate's private key, PEM, without a passphrase")
-        ->type_name("FILE");
+    serve_->add_option("--tls-key", key_, "The certificate's private key, PEM, without a passphrase")->type_name("FILE");
   }
   bool chosen() const override { return serve_->parsed(); }
   std::optional<int> check(const GlobalOptions&) override {

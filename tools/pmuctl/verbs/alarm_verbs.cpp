@@ -48,7 +48,9 @@ std::string utc(std::uint64_t ns) {
 
 void print(const GlobalOptions& o, const AlarmEntry& a) {
   if (o.json) {
-    std::printf("%s\n", alarm_json(a, pmu::dds::contract_major()).dump(-1, ' ', false, nlohmann::ordered_json::error_handler_t::replace).c_str());
+    std::printf("%s\n", alarm_json(a, pmu::dds::contract_major())
+                            .dump(-1, ' ', false, nlohmann::ordered_json::error_handler_t::replace)
+                            .c_str());
     return;
   }
   std::printf("%-18s %-8s %-22s %-28s since %s  %s\n", alarm_source(a).c_str(), a.critical ? "CRITICAL" : "WARNING",
@@ -60,15 +62,15 @@ void print(const GlobalOptions& o, const AlarmEntry& a) {
 int run_alarms(const GlobalOptions& o) {
   ContextLease lease(o, kPmuctlParticipant);
   pmu::dds::DdsContext& dds = *lease;
-  DataReader& reader = dds.reader(
-      dds.topic(topics::kAlarms, TypeSupport(new idl::Guarded<pmu::v5::AlarmPubSubType>())), qos_profiles::kAlarms);
+  DataReader& reader = dds.reader(dds.topic(topics::kAlarms, TypeSupport(new idl::Guarded<pmu::v5::AlarmPubSubType>())),
+                                  qos_profiles::kAlarms);
   // A service with no alarm sends nothing on pmu/alarms, nor does one that is dead but still
   // matched (a participant that knew it holds it until its lease ends): its pmu/readiness,
   // which a live service sends a reader at once, tells them apart. No all-clear is said
   // unless a service answered (docs/safety.md H6).
-  DataReader& readiness = dds.reader(
-      dds.topic(topics::kReadiness, TypeSupport(new idl::Guarded<pmu::v5::ReadinessPubSubType>())),
-      qos_profiles::kState);
+  DataReader& readiness =
+      dds.reader(dds.topic(topics::kReadiness, TypeSupport(new idl::Guarded<pmu::v5::ReadinessPubSubType>())),
+                 qos_profiles::kState);
   std::set<InstanceHandle_t> answered;  // readiness writers heard
   const auto deadline = wait_end(o, 3.0);
   // A service with no alarm that ever left NORMAL has nothing in its history, so the wait

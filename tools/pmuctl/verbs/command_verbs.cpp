@@ -57,17 +57,16 @@ int run_alarm_ack(const GlobalOptions& o, const std::string& code, const std::st
     source = pmu::v5::SOURCE_BUS;
   else if (kind != "pmu")
     return fail(o, ExitStatus::BadUsage, "--kind '" + pmu::service::printable(kind) + "': pmu, battery, mppt or bus");
-  if (source == pmu::v5::SOURCE_BUS && o.bus.empty())
-    return fail(o, ExitStatus::BadUsage, "a bus alarm needs --bus");
+  if (source == pmu::v5::SOURCE_BUS && o.bus.empty()) return fail(o, ExitStatus::BadUsage, "a bus alarm needs --bus");
   if ((source == pmu::v5::SOURCE_BATTERY || source == pmu::v5::SOURCE_MPPT) && (o.bus.empty() || !o.address))
-    return fail(o, ExitStatus::BadUsage, "a " + kind + " alarm needs --bus and --address (the " +
-                                             (source == pmu::v5::SOURCE_BATTERY ? "CANopen node" : "MPPT device id") +
-                                             ")");
+    return fail(o, ExitStatus::BadUsage,
+                "a " + kind + " alarm needs --bus and --address (the " +
+                    (source == pmu::v5::SOURCE_BATTERY ? "CANopen node" : "MPPT device id") + ")");
   ContextLease lease(o, kPmuctlParticipant);
   pmu::dds::DdsContext& dds = *lease;
-  DataReader& replies = dds.reader(
-      dds.topic(topics::kAlarmAckReply, TypeSupport(new idl::Guarded<pmu::v5::AlarmAckReplyPubSubType>())),
-      qos_profiles::kCommand);
+  DataReader& replies =
+      dds.reader(dds.topic(topics::kAlarmAckReply, TypeSupport(new idl::Guarded<pmu::v5::AlarmAckReplyPubSubType>())),
+                 qos_profiles::kCommand);
   DataWriter& writer =
       dds.writer(dds.topic(topics::kAlarmAck, TypeSupport(new pmu::v5::AlarmAckPubSubType())), qos_profiles::kCommand);
   std::string bus = o.bus;
@@ -128,9 +127,9 @@ int run_alarm_ack(const GlobalOptions& o, const std::string& code, const std::st
   const std::string message = waited + id + ")";
   std::fprintf(stderr, "pmuctl: %s\n", message.c_str());
   if (o.json) {
-    Json j{{"request_id", id}, {"vehicle", vehicle}, {"bus", bus}, {"kind", kind}, {"device", device},
-           {"code", code},     {"result", nullptr},  {"reason", message},
-           {"exit_status", static_cast<int>(ExitStatus::NoAnswer)}};
+    Json j{{"request_id", id},  {"vehicle", vehicle}, {"bus", bus},
+           {"kind", kind},      {"device", device},   {"code", code},
+           {"result", nullptr}, {"reason", message},  {"exit_status", static_cast<int>(ExitStatus::NoAnswer)}};
     std::printf("%s\n", j.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace).c_str());
   }
   return static_cast<int>(ExitStatus::NoAnswer);
@@ -210,12 +209,9 @@ int run_command(const GlobalOptions& o, const CommandSpec& spec) {
             ? ExitStatus::BadUsage
             : ExitStatus::NotDone;
     if (o.json) {
-      Json j{{"request_id", out.request_id},
-             {"vehicle", r->vehicle().to_string()},
-             {"bus", r->bus().to_string()},
-             {"address", r->address()},
-             {"result", result_name(r->result())},
-             {"reason", r->reason().to_string()}};
+      Json j{{"request_id", out.request_id},       {"vehicle", r->vehicle().to_string()},
+             {"bus", r->bus().to_string()},        {"address", r->address()},
+             {"result", result_name(r->result())}, {"reason", r->reason().to_string()}};
       if (r->has_value()) j["value"] = r->value();
       if (!(r->value_text().size() == 0)) j["value_text"] = r->value_text().to_string();
       // A failure of status 2 or 3 carries its status on its line (interface.md 3.2).
@@ -227,7 +223,8 @@ int run_command(const GlobalOptions& o, const CommandSpec& spec) {
       else
         std::printf("%g\n", r->value());
     }
-    std::fprintf(stderr, "%s%s%s\n", result_name(r->result()), (r->reason().size() == 0) ? "" : ": ", r->reason().c_str());
+    std::fprintf(stderr, "%s%s%s\n", result_name(r->result()), (r->reason().size() == 0) ? "" : ": ",
+                 r->reason().c_str());
     return static_cast<int>(status);
   }
   char waited[96];
@@ -236,8 +233,12 @@ int run_command(const GlobalOptions& o, const CommandSpec& spec) {
   std::fprintf(stderr, "pmuctl: %s\n", message.c_str());
   if (o.json) {
     // The line of a reply that never came: the same keys, a null result.
-    Json j{{"request_id", out.request_id}, {"vehicle", channel.vehicle()}, {"bus", bus},
-           {"address", address},           {"result", nullptr},           {"reason", message},
+    Json j{{"request_id", out.request_id},
+           {"vehicle", channel.vehicle()},
+           {"bus", bus},
+           {"address", address},
+           {"result", nullptr},
+           {"reason", message},
            {"exit_status", static_cast<int>(ExitStatus::NoAnswer)}};
     std::printf("%s\n", j.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace).c_str());
   }

@@ -409,7 +409,8 @@ int snapshot(const GlobalOptions& o, const std::string& file, bool force) {
   // wrote): such a file could never be applied, so it is not written.
   if (const auto back = baseline::read_config_file(text); !back)
     return fail(o, ExitStatus::NotDone,
-                device_label(vehicle, t->bus, t->address) + " holds a value no set can write, so a snapshot could not be " +
+                device_label(vehicle, t->bus, t->address) +
+                    " holds a value no set can write, so a snapshot could not be " +
                     "applied: " + baseline::describe(back.error(), file == "-" ? "(stdout)" : file) +
                     "; the snapshot was not written");
   // The recordings' output file: a temporary file beside FILE, renamed over it only when
@@ -446,8 +447,7 @@ int diff(const GlobalOptions& o, const std::string& path) {
   std::string file = path;
   if (!f) {
     switch (device.await_baseline(t->bus, t->address, view.deadline())) {
-      case DeviceReader::Said::Baseline:
-        break;
+      case DeviceReader::Said::Baseline: break;
       case DeviceReader::Said::NoBaseline:
         return fail(o, ExitStatus::BadUsage,
                     "no baseline configured for PMU " + device_label(vehicle, t->bus, t->address) +
@@ -475,9 +475,9 @@ int diff(const GlobalOptions& o, const std::string& path) {
   const bool serial_differs = other_unit && path.empty();
   const bool equal = diffs.empty() && !serial_differs;
   if (o.json) {
-    Json j{{"vehicle", vehicle},  {"bus", t->bus},         {"address", t->address}, {"file", file},
-           {"equal", equal},      {"compared", compared},  {"differences", Json::array()},
-           {"not_in_file", Json::array()}};
+    Json j{
+        {"vehicle", vehicle}, {"bus", t->bus},        {"address", t->address},        {"file", file},
+        {"equal", equal},     {"compared", compared}, {"differences", Json::array()}, {"not_in_file", Json::array()}};
     if (serial_differs)
       j["differences"].push_back({{"name", "serial"},
                                   {"line", 0},
@@ -499,7 +499,8 @@ int diff(const GlobalOptions& o, const std::string& path) {
   if (equal)
     std::fprintf(stderr, "%s matches %s (%zu settings)\n", label.c_str(), file.c_str(), compared);
   else if (diffs.empty())
-    std::fprintf(stderr, "%s differs from %s: it is another unit (serial %u, the baseline's %u); its %zu settings match\n",
+    std::fprintf(stderr,
+                 "%s differs from %s: it is another unit (serial %u, the baseline's %u); its %zu settings match\n",
                  label.c_str(), file.c_str(), unsigned{info.serial_number()}, unsigned{*f->header.serial}, compared);
   else
     std::fprintf(stderr, "%s differs from %s in %zu of %zu settings%s\n", label.c_str(), file.c_str(), diffs.size(),
@@ -679,8 +680,14 @@ int apply(const GlobalOptions& o, const std::string& file, bool dry_run, bool co
         (ok == applied.size() ? "" : ": THE DEVICE IS PARTLY CHANGED, see the lines above");
     std::fprintf(stderr, "%s: %s\n", label.c_str(), summary.c_str());
     if (o.json) {
-      Json j{{"vehicle", channel.vehicle()}, {"bus", bus},          {"address", address}, {"file", file},
-             {"applied", false},             {"changes", changes},  {"restored", restored}, {"reason", summary},
+      Json j{{"vehicle", channel.vehicle()},
+             {"bus", bus},
+             {"address", address},
+             {"file", file},
+             {"applied", false},
+             {"changes", changes},
+             {"restored", restored},
+             {"reason", summary},
              {"exit_status", static_cast<int>(ExitStatus::NotDone)}};
       std::printf("%s\n", j.dump(-1, ' ', false, Json::error_handler_t::replace).c_str());
     }
@@ -707,8 +714,13 @@ int apply(const GlobalOptions& o, const std::string& file, bool dry_run, bool co
     std::fprintf(stderr, "%s: %zu change(s) applied and verified, but it still differs from %s in %zu setting(s)\n",
                  final_label.c_str(), plan.size(), file.c_str(), left.size());
   if (o.json) {
-    Json j{{"vehicle", channel.vehicle()}, {"bus", bus},         {"address", at}, {"file", file},
-           {"applied", left.empty()},      {"changes", changes}, {"differences", Json::array()}};
+    Json j{{"vehicle", channel.vehicle()},
+           {"bus", bus},
+           {"address", at},
+           {"file", file},
+           {"applied", left.empty()},
+           {"changes", changes},
+           {"differences", Json::array()}};
     for (const auto& d : left) j["differences"].push_back(difference_json(d));
     std::printf("%s\n", j.dump(-1, ' ', false, Json::error_handler_t::replace).c_str());
   }

@@ -56,7 +56,8 @@ struct Latest {
       writers.insert(info.publication_handle);
       if (!info.valid_data) {
         // Disposed (a PMU that moved to another address): its figures are gone with it.
-        if (auto it = handles.find(info.instance_handle); it != handles.end() && info.instance_state != ALIVE_INSTANCE_STATE) {
+        if (auto it = handles.find(info.instance_handle);
+            it != handles.end() && info.instance_state != ALIVE_INSTANCE_STATE) {
           by_key.erase(it->second);
           handles.erase(it);
         }
@@ -78,9 +79,8 @@ std::size_t matched(DataReader& reader) {
 int run(const GlobalOptions& o) {
   ContextLease lease(o, kPmuctlParticipant);
   pmu::dds::DdsContext& dds = *lease;
-  DataReader& pmus =
-      dds.reader(dds.topic(topics::kEnergy, TypeSupport(new idl::Guarded<pmu::v5::EnergyPubSubType>())),
-                 qos_profiles::kState);
+  DataReader& pmus = dds.reader(dds.topic(topics::kEnergy, TypeSupport(new idl::Guarded<pmu::v5::EnergyPubSubType>())),
+                                qos_profiles::kState);
   DataReader& batteries =
       dds.reader(dds.topic(topics::kBmsEnergy, TypeSupport(new idl::Guarded<pmu::v5::BmsEnergyPubSubType>())),
                  qos_profiles::kState);
@@ -117,9 +117,8 @@ int run(const GlobalOptions& o) {
 int run_energy(const GlobalOptions& o) { return energy_verb::run(o); }
 
 std::unique_ptr<Verb> add_energy_verb(CLI::App& app) {
-  return add_state_reading_verb(app, "energy",
-                                "Power per output, generator power, energy used and endurance of each battery",
-                                run_energy);
+  return add_state_reading_verb(
+      app, "energy", "Power per output, generator power, energy used and endurance of each battery", run_energy);
 }
 
 }  // namespace pmu::tools

@@ -48,13 +48,13 @@ void print(const GlobalOptions& o, const pmu::v5::Readiness& r) {
                          {"message", x.message().to_string()},
                          {"description", x.description().to_string()}});
     nlohmann::json j{{"topic", "readiness"},
-           {"vehicle", vehicle},
-           {"ready", r.ready()},
-           {"level", level_name(r.level())},
-           {"since", static_cast<double>(r.since()) / 1e9},
-           {"reasons", reasons},
-           {"reasons_total", r.reasons_total()},
-           {"contract", pmu::dds::contract_major()}};
+                     {"vehicle", vehicle},
+                     {"ready", r.ready()},
+                     {"level", level_name(r.level())},
+                     {"since", static_cast<double>(r.since()) / 1e9},
+                     {"reasons", reasons},
+                     {"reasons_total", r.reasons_total()},
+                     {"contract", pmu::dds::contract_major()}};
     std::printf("%s\n", j.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace).c_str());
     return;
   }
@@ -64,7 +64,8 @@ void print(const GlobalOptions& o, const pmu::v5::Readiness& r) {
   for (const auto& x : r.reasons()) {
     std::string where = x.bus().to_string();
     if (x.kind() != pmu::v5::SOURCE_BUS)
-      where += "/" + std::string(x.kind() == pmu::v5::SOURCE_PMU ? "" : alarm_source_name(x.kind())) + std::to_string(x.device());
+      where += "/" + std::string(x.kind() == pmu::v5::SOURCE_PMU ? "" : alarm_source_name(x.kind())) +
+               std::to_string(x.device());
     std::printf("  %-8s %-24s %-14s %s\n           %s\n",
                 x.severity() == pmu::v5::SEVERITY_CRITICAL ? "CRITICAL" : "WARNING", x.code().c_str(), where.c_str(),
                 x.message().c_str(), x.description().c_str());

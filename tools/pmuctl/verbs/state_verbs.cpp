@@ -127,7 +127,8 @@ template <class T, class PubSub>
 class StateCollector {
  public:
   StateCollector(pmu::dds::DdsContext& dds, const char* topic)
-      : topic_(topic), reader_(dds.reader(dds.topic(topic, TypeSupport(new idl::Guarded<PubSub>())), qos_profiles::kState)) {}
+      : topic_(topic),
+        reader_(dds.reader(dds.topic(topic, TypeSupport(new idl::Guarded<PubSub>())), qos_profiles::kState)) {}
 
   void poll(const GlobalOptions& o) {
     T sample;
@@ -326,7 +327,8 @@ int run_watch(const GlobalOptions& o, long count) {
           std::make_unique<TypedTelemetryReader<pmu::v5::Battery, pmu::v5::BatteryPubSubType>>(dds, topics::kBattery));
       readers.push_back(std::make_unique<TypedTelemetryReader<pmu::v5::BatteryCells, pmu::v5::BatteryCellsPubSubType>>(
           dds, topics::kBatteryCells));
-      readers.push_back(std::make_unique<TypedTelemetryReader<pmu::v5::Mppt, pmu::v5::MpptPubSubType>>(dds, topics::kMppt));
+      readers.push_back(
+          std::make_unique<TypedTelemetryReader<pmu::v5::Mppt, pmu::v5::MpptPubSubType>>(dds, topics::kMppt));
     } catch (const pmu::dds::DdsError& e) {
       std::fprintf(stderr, "pmuctl: not showing batteries and MPPTs: %s\n", e.what());
     }
@@ -336,8 +338,8 @@ int run_watch(const GlobalOptions& o, long count) {
   // pmu/alarms existed do not grant it: then watch shows the telemetry and says what it leaves out.
   DataReader* alarm_reader = nullptr;
   try {
-    alarm_reader = &dds.reader(
-        dds.topic(topics::kAlarms, TypeSupport(new idl::Guarded<pmu::v5::AlarmPubSubType>())), qos_profiles::kAlarms);
+    alarm_reader = &dds.reader(dds.topic(topics::kAlarms, TypeSupport(new idl::Guarded<pmu::v5::AlarmPubSubType>())),
+                               qos_profiles::kAlarms);
   } catch (const pmu::dds::DdsError& e) {
     std::fprintf(stderr, "pmuctl: not showing alarms: %s\n", e.what());
   }
@@ -393,8 +395,9 @@ int run_watch(const GlobalOptions& o, long count) {
       any = true;
       // Not counted by --count, which counts telemetry samples.
       if (o.json) {
-        std::printf("%s\n",
-                    alarm_json(a, pmu::dds::contract_major()).dump(-1, ' ', false, Json::error_handler_t::replace).c_str());
+        std::printf(
+            "%s\n",
+            alarm_json(a, pmu::dds::contract_major()).dump(-1, ' ', false, Json::error_handler_t::replace).c_str());
       } else if (!refresh) {
         std::printf("%s %s alarms %s %s %s %s\n", clock_text(static_cast<double>(a.since) / 1e9).c_str(),
                     alarm_source(a).c_str(), a.critical ? "CRITICAL" : "WARNING", to_string(a.state), a.code.c_str(),
@@ -427,7 +430,8 @@ int run_watch(const GlobalOptions& o, long count) {
       // Topics in the contract's order (the readers'), devices in order within each.
       for (const auto& r : readers)
         for (const auto& [key, l] : latest)
-          if (l.topic == r->name()) rows.push_back({label(l.device), l.topic, health_of(l.device), now - l.time, l.values});
+          if (l.topic == r->name())
+            rows.push_back({label(l.device), l.topic, health_of(l.device), now - l.time, l.values});
       for (const auto& r : watch_table(rows, alarm_list())) std::printf("%s\n", r.c_str());
       std::fflush(stdout);
     }
@@ -449,7 +453,8 @@ int run_watch(const GlobalOptions& o, long count) {
 // "v5", or "v5, v4" for a vehicle whose service also serves contract 4's consumers.
 std::string contracts_cell(const std::set<int>& contracts) {
   std::string cell;
-  for (auto it = contracts.rbegin(); it != contracts.rend(); ++it) cell += (cell.empty() ? "v" : ", v") + std::to_string(*it);
+  for (auto it = contracts.rbegin(); it != contracts.rend(); ++it)
+    cell += (cell.empty() ? "v" : ", v") + std::to_string(*it);
   return cell;
 }
 
@@ -461,7 +466,8 @@ template <typename Latest>
 std::vector<std::string> remember_only_pmus(const Latest& latest, TargetMemory& memory) {
   std::map<std::string, std::vector<Target>> pmus;
   for (const auto& entry : latest)
-    if (entry.first.kind == pmu::v5::KIND_PMU) pmus[entry.first.vehicle].push_back({entry.first.bus, entry.first.address});
+    if (entry.first.kind == pmu::v5::KIND_PMU)
+      pmus[entry.first.vehicle].push_back({entry.first.bus, entry.first.address});
   const auto now = TargetMemory::Clock::now();
   std::vector<std::string> remembered;
   for (const auto& [vehicle, found] : pmus) {
@@ -523,10 +529,11 @@ static int list_once(const GlobalOptions& o, std::vector<std::string>& one_pmu) 
     } else {
       const SampleField age = *find_field(fields_of(h), "last_frame_age");  // "never", or the age
       // A battery or MPPT shows its kind with its number ("battery2"): it has no serial or firmware.
-      const std::string number =
-          key.kind == pmu::v5::KIND_PMU ? std::to_string(key.address) : to_string(key.kind) + std::to_string(key.address);
+      const std::string number = key.kind == pmu::v5::KIND_PMU ? std::to_string(key.address)
+                                                               : to_string(key.kind) + std::to_string(key.address);
       rows.push_back({key.vehicle.empty() ? "-" : key.vehicle, key.bus, number, serial, fw, to_string(h.state()),
-                      to_string(h.bus_state()), age.json.is_null() ? age.text : age_text(age.json.get<double>()) + " ago",
+                      to_string(h.bus_state()),
+                      age.json.is_null() ? age.text : age_text(age.json.get<double>()) + " ago",
                       contracts_cell(served)});
     }
   }
@@ -545,10 +552,12 @@ static int list_once(const GlobalOptions& o, std::vector<std::string>& one_pmu) 
       j["error"] = "serves " + pmu::dds::contract_text(*served.rbegin()) + ", which this pmuctl cannot read";
       std::printf("%s\n", j.dump().c_str());
     } else {
-      rows.push_back({vehicle.empty() ? "-" : vehicle, "?", "?", "-", "-", "UNREADABLE", "-", "-", contracts_cell(served)});
+      rows.push_back(
+          {vehicle.empty() ? "-" : vehicle, "?", "?", "-", "-", "UNREADABLE", "-", "-", contracts_cell(served)});
     }
   }
-  if (!o.json) for (const auto& line : aligned_columns(rows)) std::printf("%s\n", line.c_str());
+  if (!o.json)
+    for (const auto& line : aligned_columns(rows)) std::printf("%s\n", line.c_str());
   if (!unreadable.empty()) std::fprintf(stderr, "pmuctl: UNREADABLE: %s\n", other_contracts_text(unreadable).c_str());
   return 0;
 }
@@ -571,8 +580,7 @@ int run_config_get(const GlobalOptions& o, const std::string& parameter) {
   if (!parameter.empty() && !codec::parameter_from_name(parameter) && parameter != "outputs" &&
       parameter != "generation_enabled") {
     return fail(o, ExitStatus::BadUsage,
-                "unknown parameter '" + service::printable(parameter) + "'" +
-                    " (parameters: " + config_names() + ")");
+                "unknown parameter '" + service::printable(parameter) + "'" + " (parameters: " + config_names() + ")");
   }
   ContextLease lease(o, kPmuctlParticipant);
   pmu::dds::DdsContext& dds = *lease;

@@ -6,7 +6,9 @@
 namespace pmu::tools {
 namespace {
 
-nlohmann::ordered_json number_or_null(float v) { return std::isfinite(v) ? nlohmann::ordered_json(v) : nlohmann::ordered_json(nullptr); }
+nlohmann::ordered_json number_or_null(float v) {
+  return std::isfinite(v) ? nlohmann::ordered_json(v) : nlohmann::ordered_json(nullptr);
+}
 
 // Larger is worse (alarm_marker's order); the code breaks ties the other way round, so that
 // one device's marker does not flip between equal alarms as their samples come.
@@ -46,18 +48,18 @@ std::string alarm_source(const AlarmEntry& a) {
 
 nlohmann::ordered_json alarm_json(const AlarmEntry& a, int contract) {
   return nlohmann::ordered_json{{"topic", "alarms"},
-              {"vehicle", a.vehicle},
-              {"bus", a.bus},
-              {"kind", a.kind},
-              {"device", a.device},
-              {"code", a.code},
-              {"severity", a.critical ? "critical" : "warning"},
-              {"state", to_string(a.state)},
-              {"value", number_or_null(a.value)},
-              {"limit", number_or_null(a.limit)},
-              {"since", static_cast<double>(a.since) / 1e9},
-              {"message", a.message},
-              {"contract", contract}};
+                                {"vehicle", a.vehicle},
+                                {"bus", a.bus},
+                                {"kind", a.kind},
+                                {"device", a.device},
+                                {"code", a.code},
+                                {"severity", a.critical ? "critical" : "warning"},
+                                {"state", to_string(a.state)},
+                                {"value", number_or_null(a.value)},
+                                {"limit", number_or_null(a.limit)},
+                                {"since", static_cast<double>(a.since) / 1e9},
+                                {"message", a.message},
+                                {"contract", contract}};
 }
 
 std::string alarm_marker(const std::vector<AlarmEntry>& alarms) {

@@ -25,11 +25,11 @@ struct AlarmEntry {
   std::string kind;          // "pmu", "battery", "mppt", "bus"
   std::uint16_t device = 0;  // the PMU's address, battery's node, MPPT's id; 0 for the bus
   std::string code;
-  bool critical = false;     // else a warning
+  bool critical = false;  // else a warning
   AlarmStatus state = AlarmStatus::Normal;
   float value = std::numeric_limits<float>::quiet_NaN();  // NaN for a flag
   float limit = std::numeric_limits<float>::quiet_NaN();
-  std::uint64_t since = 0;   // ns since the Unix epoch
+  std::uint64_t since = 0;  // ns since the Unix epoch
   std::string message;
 };
 

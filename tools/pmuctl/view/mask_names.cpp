@@ -87,7 +87,8 @@ ConfigValue parse_config_value(std::string_view parameter, std::string_view text
     out = parse_mask(*m, text);
   } else {
     const auto v = number(text);
-    if (!v || !std::isfinite(*v)) return refused(std::string(parameter) + ": '" + std::string(text) + "' is not a number");
+    if (!v || !std::isfinite(*v))
+      return refused(std::string(parameter) + ": '" + std::string(text) + "' is not a number");
     out = {*v, {}};
   }
   // The spec's range, step and mask, as the service would judge them, so a value out of

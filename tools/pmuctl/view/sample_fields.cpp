@@ -64,8 +64,8 @@ struct Collect final : FieldSink {
 // A battery's or MPPT's value in slot `bit` of the service's table (its `received` bit):
 // "-"/null unless received; a float without a unit is a raw count, shown as an integer.
 template <std::size_t N>
-SampleField canopen_value(const service::CanOpenValue (&table)[N], std::size_t bit, std::uint32_t received,
-                          double v, bool is_float, bool is_bool) {
+SampleField canopen_value(const service::CanOpenValue (&table)[N], std::size_t bit, std::uint32_t received, double v,
+                          bool is_float, bool is_bool) {
   const auto& c = table[bit];
   if (!((received >> bit) & 1u) || std::isnan(v)) return none(c.name, kNotReceived);
   if (is_bool) return flag(c.name, v != 0);
@@ -104,7 +104,7 @@ std::string text_with_unit(const SampleField& f, bool compact) {
 
 SampleFields fields_of(const pmu::v5::Voltages& s) {
   return measured<codec::Voltages>(std::array<double, 7>{s.avionics(), s.output_28v(), s.payload(), s.servo(),
-                                                          s.battery_a(), s.battery_b(), s.generator()},
+                                                         s.battery_a(), s.battery_b(), s.generator()},
                                    kNoReading);
 }
 
@@ -193,16 +193,18 @@ SampleFields fields_of(const pmu::v5::DeviceInfo& s) {
     features.push_back(std::string(f));
     text += (text.empty() ? "" : ",") + std::string(f);
   }
-  return {integer("serial_number", s.serial_number()), integer("firmware_major", s.firmware_major()),
-          integer("firmware_minor", s.firmware_minor()), integer("build_year", s.build_year()),
-          integer("build_month", s.build_month()),     integer("build_day", s.build_day()),
+  return {integer("serial_number", s.serial_number()),
+          integer("firmware_major", s.firmware_major()),
+          integer("firmware_minor", s.firmware_minor()),
+          integer("build_year", s.build_year()),
+          integer("build_month", s.build_month()),
+          integer("build_day", s.build_day()),
           {"features", features, text.empty() ? "none" : text, ""}};
 }
 
 SampleFields fields_of(const pmu::v5::Health& s) {
-  SampleField age = std::isnan(s.last_frame_age())
-                        ? none("last_frame_age", kNever)
-                        : real("last_frame_age", s.last_frame_age(), "s", kNever);
+  SampleField age = std::isnan(s.last_frame_age()) ? none("last_frame_age", kNever)
+                                                   : real("last_frame_age", s.last_frame_age(), "s", kNever);
   if (age.json.is_number()) {
     char tenths[32];  // the service's clock, not a measurement: 0.1 s is enough
     std::snprintf(tenths, sizeof tenths, "%.1f", age.json.get<double>());
@@ -223,11 +225,22 @@ SampleFields fields_of(const pmu::v5::Health& s) {
 
 SampleFields fields_of(const pmu::v5::Battery& s) {
   // In the order of service::kBatteryValues (= IDL order = `received` bits).
-  const std::array<double, service::kBatteryValueCount> v{
-      s.voltage(),          s.current(),           s.current_discharge(),     s.current_charge(),
-      s.state_of_charge(),  s.time_to_go(),        s.cell_temperature_high(), s.cell_temperature_low(),
-      s.cell_voltage_high(), s.cell_voltage_low(), s.bms_state(),         s.temperature_1(),
-      s.temperature_2(),    s.temperature_3(),     s.temperature_4(),         s.power_level()};
+  const std::array<double, service::kBatteryValueCount> v{s.voltage(),
+                                                          s.current(),
+                                                          s.current_discharge(),
+                                                          s.current_charge(),
+                                                          s.state_of_charge(),
+                                                          s.time_to_go(),
+                                                          s.cell_temperature_high(),
+                                                          s.cell_temperature_low(),
+                                                          s.cell_voltage_high(),
+                                                          s.cell_voltage_low(),
+                                                          s.bms_state(),
+                                                          s.temperature_1(),
+                                                          s.temperature_2(),
+                                                          s.temperature_3(),
+                                                          s.temperature_4(),
+                                                          s.power_level()};
   SampleFields out;
   for (std::size_t i = 0; i < v.size(); ++i) {
     const bool is_integer = service::kBatteryValues[i].name == "bms_state";
@@ -261,12 +274,12 @@ SampleFields fields_of(const pmu::v5::BatteryCells& s) {
 SampleFields fields_of(const pmu::v5::Mppt& s) {
   // In the order of service::kMpptValues (= IDL order = `received` bits).
   const std::array<double, service::kMpptValueCount> v{
-      s.voltage_output_raw(),  s.current_output_raw(),  s.voltage_out_sw_raw(), s.mppt_state(),
-      s.safety_enabled(),      s.pwm_enabled(),         s.temperature(),
-      s.voltage_panel_1_raw(), s.current_panel_1_raw(), s.duty_cycle_panel_1(), s.channel_1_active(),
-      s.voltage_panel_2_raw(), s.current_panel_2_raw(), s.duty_cycle_panel_2(), s.channel_2_active(),
-      s.voltage_panel_3_raw(), s.current_panel_3_raw(), s.duty_cycle_panel_3(), s.channel_3_active(),
-      s.voltage_panel_4_raw(), s.current_panel_4_raw(), s.duty_cycle_panel_4(), s.channel_4_active()};
+      s.voltage_output_raw(),  s.current_output_raw(), s.voltage_out_sw_raw(), s.mppt_state(),
+      s.safety_enabled(),      s.pwm_enabled(),        s.temperature(),        s.voltage_panel_1_raw(),
+      s.current_panel_1_raw(), s.duty_cycle_panel_1(), s.channel_1_active(),   s.voltage_panel_2_raw(),
+      s.current_panel_2_raw(), s.duty_cycle_panel_2(), s.channel_2_active(),   s.voltage_panel_3_raw(),
+      s.current_panel_3_raw(), s.duty_cycle_panel_3(), s.channel_3_active(),   s.voltage_panel_4_raw(),
+      s.current_panel_4_raw(), s.duty_cycle_panel_4(), s.channel_4_active()};
   SampleFields out;
   for (std::size_t i = 0; i < v.size(); ++i) {
     const std::string_view name = service::kMpptValues[i].name;

@@ -29,7 +29,7 @@ struct WatchRow {
   std::string label;  // "can0/1"
   std::string topic;  // "voltages"
   std::optional<pmu::v5::HealthState> state;
-  double age = 0;     // s since the sample's source time
+  double age = 0;  // s since the sample's source time
   SampleFields values;
 };
 // The refreshing table: per topic, in the order the rows come, a "topic:" line, then one

@@ -13,15 +13,14 @@ inline constexpr std::uint32_t kMaxStandardId = 0x7FFu;       // 11 bits
 inline constexpr std::uint8_t kMaxDataLength = 8;
 
 struct CanFrame {
-  std::uint32_t id = 0;       // 11-bit or 29-bit identifier, without any flag bits
-  bool extended = false;      // true for a 29-bit identifier (CAN 2.0B)
-  bool remote = false;        // remote transmission request (the PMU never uses these)
-  std::uint8_t length = 0;    // data length code, 0..8
+  std::uint32_t id = 0;     // 11-bit or 29-bit identifier, without any flag bits
+  bool extended = false;    // true for a 29-bit identifier (CAN 2.0B)
+  bool remote = false;      // remote transmission request (the PMU never uses these)
+  std::uint8_t length = 0;  // data length code, 0..8
   std::array<std::uint8_t, kMaxDataLength> data{};
 
   friend bool operator==(const CanFrame& a, const CanFrame& b) noexcept {
-    if (a.id != b.id || a.extended != b.extended || a.remote != b.remote || a.length != b.length)
-      return false;
+    if (a.id != b.id || a.extended != b.extended || a.remote != b.remote || a.length != b.length) return false;
     for (std::uint8_t i = 0; i < a.length && i < kMaxDataLength; ++i)
       if (a.data[i] != b.data[i]) return false;
     return true;

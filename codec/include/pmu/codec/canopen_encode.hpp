@@ -62,11 +62,25 @@ inline constexpr std::uint8_t kBatteryValueCount = 12;
 // The MPPT's single values, in the document's order; the first fifteen on the device's base
 // id, the duty cycles on base + 1. The channel map has its own encoder.
 enum class MpptValue : std::uint8_t {
-  VoltageOutputRaw, CurrentOutputRaw, VoltageOutSwRaw, MpptState, SafetyEnabled, PwmEnabled,
+  VoltageOutputRaw,
+  CurrentOutputRaw,
+  VoltageOutSwRaw,
+  MpptState,
+  SafetyEnabled,
+  PwmEnabled,
   Temperature,
-  VoltagePanel1Raw, CurrentPanel1Raw, VoltagePanel2Raw, CurrentPanel2Raw,
-  VoltagePanel3Raw, CurrentPanel3Raw, VoltagePanel4Raw, CurrentPanel4Raw,
-  DutyCyclePanel1, DutyCyclePanel2, DutyCyclePanel3, DutyCyclePanel4,
+  VoltagePanel1Raw,
+  CurrentPanel1Raw,
+  VoltagePanel2Raw,
+  CurrentPanel2Raw,
+  VoltagePanel3Raw,
+  CurrentPanel3Raw,
+  VoltagePanel4Raw,
+  CurrentPanel4Raw,
+  DutyCyclePanel1,
+  DutyCyclePanel2,
+  DutyCyclePanel3,
+  DutyCyclePanel4,
 };
 inline constexpr std::uint8_t kMpptValueCount = 19;
 
@@ -78,8 +92,7 @@ Encoded encode_battery(BatteryValue v, double value, std::uint8_t node = kBatter
 // 0x482, index 0x2000, subindex = cell number; volts.
 Encoded encode_cell_voltage(std::uint8_t cell, double volts, std::uint8_t node = kBatteryNode) noexcept;
 // 0x402/0x0F: four uint8 sensors, degC (0..255).
-Encoded encode_temperature_collection(const std::array<double, 4>& celsius,
-                                      std::uint8_t node = kBatteryNode) noexcept;
+Encoded encode_temperature_collection(const std::array<double, 4>& celsius, std::uint8_t node = kBatteryNode) noexcept;
 
 Encoded encode_mppt(std::uint8_t device, MpptValue v, double value) noexcept;
 // base + 1, subindex 0x05: one uint8 per channel (1 active, 0 not; the document says no more).

@@ -21,22 +21,22 @@
 namespace pmu::codec {
 
 enum class EncodeErrorKind : std::uint8_t {
-  NotANumber,    // NaN or infinity
-  OutOfRange,    // outside [min, max]
-  NotOnStep,     // between two representable values (e.g. 12.05 V with 0.1 V steps)
-  InvalidBits,   // a mask with bits the packet does not define
-  Unsupported,   // the device's firmware lacks the feature
-  NotAGet,       // zero-length get requested for a packet that has none
-  EmptyMask,     // enable/disable with no output named
+  NotANumber,   // NaN or infinity
+  OutOfRange,   // outside [min, max]
+  NotOnStep,    // between two representable values (e.g. 12.05 V with 0.1 V steps)
+  InvalidBits,  // a mask with bits the packet does not define
+  Unsupported,  // the device's firmware lacks the feature
+  NotAGet,      // zero-length get requested for a packet that has none
+  EmptyMask,    // enable/disable with no output named
 };
 
 struct EncodeError {
   EncodeErrorKind kind = EncodeErrorKind::OutOfRange;
-  std::string_view field;  // parameter or field name, e.g. "avionics_voltage"
-  std::string_view unit;   // "V", "s", "" ...
-  double value = 0;        // the offending value
-  double min = 0, max = 0; // allowed range (OutOfRange, NotOnStep)
-  std::uint32_t bits = 0;  // allowed bits (InvalidBits, Unsupported)
+  std::string_view field;   // parameter or field name, e.g. "avionics_voltage"
+  std::string_view unit;    // "V", "s", "" ...
+  double value = 0;         // the offending value
+  double min = 0, max = 0;  // allowed range (OutOfRange, NotOnStep)
+  std::uint32_t bits = 0;   // allowed bits (InvalidBits, Unsupported)
   std::optional<FirmwareVersion> firmware;
   std::optional<FirmwareVersion> needs;  // first firmware with the feature (Unsupported)
 

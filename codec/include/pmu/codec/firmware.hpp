@@ -24,13 +24,9 @@ struct FirmwareVersion {
   std::uint8_t minor = 0;
 
   constexpr int ordinal() const noexcept { return major * 100 + minor; }
-  friend constexpr bool operator==(FirmwareVersion a, FirmwareVersion b) noexcept {
-    return a.ordinal() == b.ordinal();
-  }
+  friend constexpr bool operator==(FirmwareVersion a, FirmwareVersion b) noexcept { return a.ordinal() == b.ordinal(); }
   friend constexpr bool operator!=(FirmwareVersion a, FirmwareVersion b) noexcept { return !(a == b); }
-  friend constexpr bool operator<(FirmwareVersion a, FirmwareVersion b) noexcept {
-    return a.ordinal() < b.ordinal();
-  }
+  friend constexpr bool operator<(FirmwareVersion a, FirmwareVersion b) noexcept { return a.ordinal() < b.ordinal(); }
   friend constexpr bool operator>=(FirmwareVersion a, FirmwareVersion b) noexcept { return !(a < b); }
 };
 
@@ -62,8 +58,8 @@ enum class Feature : std::uint8_t {
 FirmwareVersion first_firmware_with(Feature f) noexcept;
 std::string_view feature_name(Feature f) noexcept;
 inline constexpr Feature kAllFeatures[] = {
-    Feature::ExternalTemperatures, Feature::StarterReadyFlag,  Feature::MeasurementRequest,
-    Feature::BatteryDisconnectDetect, Feature::SoaManagement, Feature::SoaShutdownFlag,
+    Feature::ExternalTemperatures,    Feature::StarterReadyFlag, Feature::MeasurementRequest,
+    Feature::BatteryDisconnectDetect, Feature::SoaManagement,    Feature::SoaShutdownFlag,
     Feature::MultipleBaudRates,
 };
 

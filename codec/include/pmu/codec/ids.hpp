@@ -67,16 +67,13 @@ struct PmuId {
 
 // The identifier of a frame to or from `address` carrying `packet`.
 constexpr std::uint32_t make_id(PacketId packet, std::uint16_t address) noexcept {
-  return (std::uint32_t{kGroupId} << 24) | (std::uint32_t{static_cast<std::uint8_t>(packet)} << 16) |
-         address;
+  return (std::uint32_t{kGroupId} << 24) | (std::uint32_t{static_cast<std::uint8_t>(packet)} << 16) | address;
 }
 
 // Bits 15..0 of an identifier, the address field. Readable without parse_id: a frame whose
 // packet byte is unknown still says which device it is for, and a log line needs the
 // address (to pick that device's firmware) before it can be decoded.
-constexpr std::uint16_t address_of_id(std::uint32_t id) noexcept {
-  return static_cast<std::uint16_t>(id & 0xFFFFu);
-}
+constexpr std::uint16_t address_of_id(std::uint32_t id) noexcept { return static_cast<std::uint16_t>(id & 0xFFFFu); }
 
 enum class IdError : std::uint8_t {
   NotExtended,    // an 11-bit identifier: never a PMU frame

@@ -62,8 +62,7 @@ inline constexpr std::array<NamedBit, 5> kGroupNames{{
 
 // "payload" -> output_bit::Payload; nullopt for a name the table lacks.
 template <std::size_t N>
-constexpr std::optional<std::uint8_t> bit_named(const std::array<NamedBit, N>& table,
-                                                std::string_view name) noexcept {
+constexpr std::optional<std::uint8_t> bit_named(const std::array<NamedBit, N>& table, std::string_view name) noexcept {
   for (const auto& b : table)
     if (b.name == name) return b.bit;
   return std::nullopt;
@@ -129,8 +128,7 @@ static_assert(kOutputNames[0].bit == power_up_bit::AvionicsServo && kOutputNames
 inline constexpr double kNoSensor = std::numeric_limits<double>::quiet_NaN();
 
 struct Voltages {  // 0x00, table 2
-  double avionics = 0, output_28v = 0, payload = 0, servo = 0, battery_a = 0, battery_b = 0,
-         generator = 0;
+  double avionics = 0, output_28v = 0, payload = 0, servo = 0, battery_a = 0, battery_b = 0, generator = 0;
 };
 
 struct Currents {  // 0x01, table 3
@@ -142,8 +140,7 @@ struct BatteryEnergy {  // 0x02, table 4
 };
 
 struct Temperatures {  // 0x03, table 5; NaN = "no sensor" (-128 on the wire)
-  double internal = 0, battery_a = kNoSensor, battery_b = kNoSensor, generator = kNoSensor,
-         starter = 0;
+  double internal = 0, battery_a = kNoSensor, battery_b = kNoSensor, generator = kNoSensor, starter = 0;
 };
 
 struct Status {  // 0x04 "Miscellaneous", table 6
@@ -198,8 +195,8 @@ struct FirmwareInfo {  // 0x31, table 24
 // data-less commands 0x24..0x26.
 struct NoPayload {};
 
-using Payload = std::variant<NoPayload, Voltages, Currents, BatteryEnergy, Temperatures, Status,
-                             MeasurementRequest, ParameterValue, OutputStates, EnableOutputs,
-                             DisableOutputs, GenerationState, SerialNumber, FirmwareInfo>;
+using Payload =
+    std::variant<NoPayload, Voltages, Currents, BatteryEnergy, Temperatures, Status, MeasurementRequest, ParameterValue,
+                 OutputStates, EnableOutputs, DisableOutputs, GenerationState, SerialNumber, FirmwareInfo>;
 
 }  // namespace pmu::codec

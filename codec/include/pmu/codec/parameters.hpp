@@ -41,7 +41,7 @@ struct ParameterSpec {
   double divisor;         // raw = value * divisor (1 for Integer and Mask)
   std::uint32_t raw_min;  // inclusive range a set may carry, in raw units
   std::uint32_t raw_max;
-  std::uint8_t width;     // bytes on the wire: 1, or 2 for CA
+  std::uint8_t width;  // bytes on the wire: 1, or 2 for CA
 };
 
 inline constexpr std::size_t kParameterCount = 11;

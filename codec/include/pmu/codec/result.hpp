@@ -26,13 +26,25 @@ class [[nodiscard]] Result {
   bool ok() const noexcept { return value_.has_value(); }
   explicit operator bool() const noexcept { return ok(); }
 
-  const T& value() const& { assert(ok()); return *value_; }
-  T& value() & { assert(ok()); return *value_; }
-  T&& value() && { assert(ok()); return std::move(*value_); }
+  const T& value() const& {
+    assert(ok());
+    return *value_;
+  }
+  T& value() & {
+    assert(ok());
+    return *value_;
+  }
+  T&& value() && {
+    assert(ok());
+    return std::move(*value_);
+  }
   const T& operator*() const& { return value(); }
   const T* operator->() const { return &*value_; }
 
-  const E& error() const& { assert(!ok()); return error_; }
+  const E& error() const& {
+    assert(!ok());
+    return error_;
+  }
 
  private:
   // Both members, not a variant: E is a small aggregate and GCC's -Wnull-dereference

@@ -36,8 +36,8 @@ inline constexpr std::int8_t kNoSensorRaw = -128;
 
 template <class Packet, class Value = double>
 struct FieldSpec {
-  std::string_view name;          // interface.md's field name; also EncodeError::field
-  std::uint8_t offset;            // first data byte
+  std::string_view name;  // interface.md's field name; also EncodeError::field
+  std::uint8_t offset;    // first data byte
   WireType wire;
   double divisor;                 // value = raw / divisor; the resolution is 1 / divisor
   std::int32_t raw_min, raw_max;  // what a reading can be (the spec's "Range"), raw units

@@ -225,7 +225,7 @@ class DdsContext {
   RemoteWriters remote_writers_;  // the participant's listener: outlives it
   eprosima::fastdds::dds::DomainParticipant* participant_ = nullptr;
   eprosima::fastdds::dds::Publisher* publisher_ = nullptr;
-  eprosima::fastdds::dds::Publisher* default_publisher_ = nullptr;  // made by the first default_partition_writer()
+  eprosima::fastdds::dds::Publisher* default_publisher_ = nullptr;    // made by the first default_partition_writer()
   eprosima::fastdds::dds::Subscriber* default_subscriber_ = nullptr;  // made by the first default_partition_reader()
   eprosima::fastdds::dds::Subscriber* subscriber_ = nullptr;
   std::map<std::string, eprosima::fastdds::dds::Topic*> topics_;
@@ -236,8 +236,8 @@ class DdsContext {
   struct Kept {
     std::string topic;
     std::string profile;
-    std::vector<std::string> partitions;  // its publisher's or subscriber's now
-    eprosima::fastdds::dds::Publisher* publisher = nullptr;    // a writer's
+    std::vector<std::string> partitions;                     // its publisher's or subscriber's now
+    eprosima::fastdds::dds::Publisher* publisher = nullptr;  // a writer's
     eprosima::fastdds::dds::DataWriter* writer = nullptr;
     eprosima::fastdds::dds::Subscriber* subscriber = nullptr;  // a reader's
     eprosima::fastdds::dds::DataReader* reader = nullptr;

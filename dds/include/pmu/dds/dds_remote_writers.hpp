@@ -57,7 +57,7 @@ class RemoteWriters final : public eprosima::fastdds::dds::DomainParticipantList
   };
   // Called from Fast DDS's discovery thread; read from any thread.
   mutable std::mutex mutex_;
-  std::map<std::string, Writer> writers_;  // GUID text -> what it announced
+  std::map<std::string, Writer> writers_;            // GUID text -> what it announced
   std::map<std::string, std::string> participants_;  // GUID prefix text -> participant name
 };
 

@@ -14,8 +14,8 @@ inline constexpr std::uint16_t kCrcInit = 0xFFFF;
 constexpr std::uint16_t crc_accumulate(std::uint8_t byte, std::uint16_t crc) noexcept {
   auto tmp = static_cast<std::uint8_t>(byte ^ static_cast<std::uint8_t>(crc & 0xFFU));
   tmp = static_cast<std::uint8_t>(tmp ^ static_cast<std::uint8_t>(tmp << 4));
-  return static_cast<std::uint16_t>((crc >> 8) ^ (static_cast<unsigned>(tmp) << 8) ^
-                                    (static_cast<unsigned>(tmp) << 3) ^ (static_cast<unsigned>(tmp) >> 4));
+  return static_cast<std::uint16_t>((crc >> 8) ^ (static_cast<unsigned>(tmp) << 8) ^ (static_cast<unsigned>(tmp) << 3) ^
+                                    (static_cast<unsigned>(tmp) >> 4));
 }
 
 std::uint16_t crc_accumulate(const std::uint8_t* data, std::size_t size, std::uint16_t crc) noexcept;

@@ -20,8 +20,7 @@ inline constexpr std::size_t kHeaderLength = 10;  // start marker to message id
 inline constexpr std::size_t kChecksumLength = 2;
 inline constexpr std::size_t kSignatureLength = 13;
 inline constexpr std::size_t kMaxPayloadLength = 255;
-inline constexpr std::size_t kMaxFrameLength =
-    kHeaderLength + kMaxPayloadLength + kChecksumLength + kSignatureLength;
+inline constexpr std::size_t kMaxFrameLength = kHeaderLength + kMaxPayloadLength + kChecksumLength + kSignatureLength;
 // The only incompat flag MAVLink 2 defines; a frame with any other incompat bit is refused
 // (the spec: a library must drop a frame with an incompat flag it does not understand).
 inline constexpr std::uint8_t kIncompatSigned = 0x01;

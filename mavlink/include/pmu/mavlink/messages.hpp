@@ -117,12 +117,12 @@ struct BatteryStatus {
   std::uint8_t id = 0;
   std::uint8_t battery_function = mav_battery_function::kUnknown;
   std::uint8_t type = mav_battery_type::kUnknown;
-  std::int16_t temperature = not_provided::kTemperature;  // cdegC
+  std::int16_t temperature = not_provided::kTemperature;                            // cdegC
   std::array<std::uint16_t, 10> voltages = filled<10>(not_provided::kCellVoltage);  // mV
-  std::int16_t current_battery = not_provided::kBatteryCurrent;  // cA
-  std::int32_t current_consumed = not_provided::kCurrentConsumed;  // mAh
-  std::int32_t energy_consumed = not_provided::kEnergyConsumed;  // hJ
-  std::int8_t battery_remaining = not_provided::kBatteryRemaining;  // %
+  std::int16_t current_battery = not_provided::kBatteryCurrent;                     // cA
+  std::int32_t current_consumed = not_provided::kCurrentConsumed;                   // mAh
+  std::int32_t energy_consumed = not_provided::kEnergyConsumed;                     // hJ
+  std::int8_t battery_remaining = not_provided::kBatteryRemaining;                  // %
   // Extensions.
   std::int32_t time_remaining = not_provided::kTimeRemaining;  // s
   std::uint8_t charge_state = mav_battery_charge_state::kUndefined;
@@ -149,16 +149,16 @@ struct Statustext {
 
 struct GeneratorStatus {
   static constexpr std::uint32_t kId = msgid::kGeneratorStatus;
-  std::uint64_t status = 0;  // mav_generator_status_flag bits
-  std::uint16_t generator_speed = not_provided::kGeneratorSpeed;  // rpm
-  float battery_current = not_provided::kFloat;  // A, positive out
-  float load_current = not_provided::kFloat;  // A
-  float power_generated = not_provided::kFloat;  // W
-  float bus_voltage = 0.0F;  // V (the definition gives no "not provided" value)
+  std::uint64_t status = 0;                                         // mav_generator_status_flag bits
+  std::uint16_t generator_speed = not_provided::kGeneratorSpeed;    // rpm
+  float battery_current = not_provided::kFloat;                     // A, positive out
+  float load_current = not_provided::kFloat;                        // A
+  float power_generated = not_provided::kFloat;                     // W
+  float bus_voltage = 0.0F;                                         // V (the definition gives no "not provided" value)
   std::int16_t rectifier_temperature = not_provided::kTemperature;  // degC
-  float bat_current_setpoint = not_provided::kFloat;  // A
+  float bat_current_setpoint = not_provided::kFloat;                // A
   std::int16_t generator_temperature = not_provided::kTemperature;  // degC
-  std::uint32_t runtime = not_provided::kRuntime;  // s
+  std::uint32_t runtime = not_provided::kRuntime;                   // s
   std::int32_t time_until_maintenance = not_provided::kTimeUntilMaintenance;  // s
 
   void pack(Payload& out) const;

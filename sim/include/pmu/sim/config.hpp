@@ -84,8 +84,8 @@ struct Plant {
   double battery_b_temperature = 25.0;
   double generator_temperature = codec::kNoSensor;
 
-  std::uint16_t engine_rpm = 6000;    // generator speed while running with generation on
-  std::uint16_t cranking_rpm = 300;   // generator speed while the starter turns the engine
+  std::uint16_t engine_rpm = 6000;   // generator speed while running with generation on
+  std::uint16_t cranking_rpm = 300;  // generator speed while the starter turns the engine
   // How long cranking takes before the engine fires; nullopt = it never starts (a flooded
   // engine), so only CT or 0x25 ends the cranking.
   std::optional<Duration> engine_starts_after = std::chrono::seconds(2);

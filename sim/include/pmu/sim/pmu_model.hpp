@@ -45,16 +45,16 @@ enum class EngineState : std::uint8_t {
 // in exactly one of the "in" buckets after frames_in.
 struct Counters {
   std::uint64_t frames_in = 0;
-  std::uint64_t handled = 0;        // a get answered, a set stored, a command carried out
-  std::uint64_t not_pmu = 0;        // 11-bit id, or a group other than 0x1E
-  std::uint64_t other_address = 0;  // a PMU frame for another unit
-  std::uint64_t unknown_packet = 0; // to us, packet id not in table 1
-  std::uint64_t wrong_length = 0;   // to us, data length not allowed for the packet
-  std::uint64_t malformed = 0;      // to us, remote frame or length code above 8
-  std::uint64_t rejected_sets = 0;  // out of range / undefined bits: stored value kept
-  std::uint64_t ignored_sets = 0;   // valid, but Faults::ignored_set: stored value kept
-  std::uint64_t unsupported = 0;    // packet this firmware lacks (0x0F before 1.14)
-  std::uint64_t not_commands = 0;   // data-carrying telemetry or replies (another unit's)
+  std::uint64_t handled = 0;           // a get answered, a set stored, a command carried out
+  std::uint64_t not_pmu = 0;           // 11-bit id, or a group other than 0x1E
+  std::uint64_t other_address = 0;     // a PMU frame for another unit
+  std::uint64_t unknown_packet = 0;    // to us, packet id not in table 1
+  std::uint64_t wrong_length = 0;      // to us, data length not allowed for the packet
+  std::uint64_t malformed = 0;         // to us, remote frame or length code above 8
+  std::uint64_t rejected_sets = 0;     // out of range / undefined bits: stored value kept
+  std::uint64_t ignored_sets = 0;      // valid, but Faults::ignored_set: stored value kept
+  std::uint64_t unsupported = 0;       // packet this firmware lacks (0x0F before 1.14)
+  std::uint64_t not_commands = 0;      // data-carrying telemetry or replies (another unit's)
   std::uint64_t ignored_commands = 0;  // 0x24 while cranking/running or starter not ready
   std::uint64_t ignored_silent = 0;    // to us while the silence fault is on
 
@@ -111,7 +111,7 @@ class PmuModel {
   std::uint16_t address() const noexcept;
   codec::FirmwareVersion firmware() const noexcept;
   std::uint32_t parameter(codec::Parameter p) const noexcept;  // stored raw value
-  std::uint8_t outputs() const noexcept;                        // output_bit::*
+  std::uint8_t outputs() const noexcept;                       // output_bit::*
   bool generation_enabled() const noexcept;
   bool thermal_shutdown() const noexcept;
   EngineState engine_state() const noexcept;

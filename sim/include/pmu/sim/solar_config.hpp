@@ -18,8 +18,8 @@ struct BatterySimConfig {
   // (3.0..4.2 V), so 15 is the most whose full pack voltage fits 0x302's uint16 mV.
   int cells = 12;
   double capacity_ah = 20.0;
-  double initial_soc = 0.8;         // 0..1
-  double cell_resistance = 0.002;   // ohm per cell: the pack's voltage drop under current
+  double initial_soc = 0.8;        // 0..1
+  double cell_resistance = 0.002;  // ohm per cell: the pack's voltage drop under current
   // Empty: each cell's voltage follows the state of charge and the current. Otherwise one
   // value per cell (cell 1 first, `cells` of them), read as given whatever the charge and
   // current: a bench setting for a pack the curve cannot produce (an unbalanced or
@@ -30,9 +30,9 @@ struct BatterySimConfig {
 struct MpptSimConfig {
   std::uint8_t device = 0;  // 0..7, set on the PCB: COB-ID 0x4E6 + 8 * device
   std::chrono::milliseconds period{1000};
-  int panels = 4;            // panels connected to channels 1..panels (0..4)
-  double panel_vmp = 30.0;   // V at the maximum power point at 1000 W/m2
-  double panel_imp = 8.0;    // A at the maximum power point at 1000 W/m2
+  int panels = 4;           // panels connected to channels 1..panels (0..4)
+  double panel_vmp = 30.0;  // V at the maximum power point at 1000 W/m2
+  double panel_imp = 8.0;   // A at the maximum power point at 1000 W/m2
 };
 
 // What the batteries and MPPTs on one bus share. The irradiance follows a slow sine
@@ -41,7 +41,7 @@ struct SolarWorld {
   double irradiance_mean = 600.0;   // W/m2
   double irradiance_swing = 300.0;  // W/m2
   std::chrono::seconds irradiance_cycle{600};
-  double load_current = 5.0;        // A drawn from the batteries (shared equally)
+  double load_current = 5.0;          // A drawn from the batteries (shared equally)
   double ambient_temperature = 25.0;  // degC
 };
 

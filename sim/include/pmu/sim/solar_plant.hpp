@@ -73,10 +73,10 @@ struct MpptReading {
   std::uint8_t state = mppt_state::Idle;
   bool safety_enabled = true;
   bool pwm_enabled = false;
-  double temperature = 0;  // degC
+  double temperature = 0;                                  // degC
   std::array<double, 4> panel_voltage{}, panel_current{};  // V, A per channel
-  std::array<double, 4> duty_cycle{};                       // % (boost: 1 - Vpanel / Vout)
-  std::array<std::uint8_t, 4> channel_active{};             // 1 while the panel delivers
+  std::array<double, 4> duty_cycle{};                      // % (boost: 1 - Vpanel / Vout)
+  std::array<std::uint8_t, 4> channel_active{};            // 1 while the panel delivers
 };
 
 class SolarPlant {
@@ -105,10 +105,10 @@ class SolarPlant {
 
   // ---- observation, at the last advance() ----
   const SolarWorld& world() const noexcept { return world_; }
-  double irradiance() const noexcept;                                  // W/m2
+  double irradiance() const noexcept;                                       // W/m2
   std::optional<double> state_of_charge(std::uint8_t node) const noexcept;  // 0..1, unrounded
-  BatteryReading battery(std::uint8_t node) const noexcept;  // all zero for an unknown node
-  MpptReading mppt(std::uint8_t device) const noexcept;      // all zero for an unknown device
+  BatteryReading battery(std::uint8_t node) const noexcept;                 // all zero for an unknown node
+  MpptReading mppt(std::uint8_t device) const noexcept;                     // all zero for an unknown device
 
  private:
   struct Battery {

@@ -67,9 +67,17 @@ Json name_of(std::uint32_t v, const char* const (&names)[N]) {
 }
 const char* const kHealthStates[] = {"UNKNOWN", "ONLINE", "STALE", "OFFLINE"};
 const char* const kBusStates[] = {"UP", "ERROR_WARNING", "ERROR_PASSIVE", "BUS_OFF", "DOWN"};
-const char* const kCommandKinds[] = {"GET",           "SET_PARAMETER", "SET_OUTPUTS",  "ENABLE_OUTPUTS",
-                                     "DISABLE_OUTPUTS", "SET_GENERATION", "REQUEST_MEASUREMENTS",
-                                     "ENGINE_START",  "ENGINE_STOP",   "RESET",        "GET_SERIAL",
+const char* const kCommandKinds[] = {"GET",
+                                     "SET_PARAMETER",
+                                     "SET_OUTPUTS",
+                                     "ENABLE_OUTPUTS",
+                                     "DISABLE_OUTPUTS",
+                                     "SET_GENERATION",
+                                     "REQUEST_MEASUREMENTS",
+                                     "ENGINE_START",
+                                     "ENGINE_STOP",
+                                     "RESET",
+                                     "GET_SERIAL",
                                      "GET_FIRMWARE"};
 const char* const kResults[] = {"COMPLETED", "REJECTED", "DENIED", "UNSUPPORTED", "TIMEOUT", "FAILED", "IN_PROGRESS"};
 #if PMU_OLD_CONTRACT >= 3
@@ -77,7 +85,9 @@ const char* const kDeviceKinds[] = {"KIND_PMU", "KIND_BATTERY", "KIND_MPPT"};
 #endif
 
 Json to_json(const idl::Health& h) {
-  Json j{{"topic", "pmu/health"}, {"vehicle", h.vehicle().to_string()}, {"bus", h.bus().to_string()},
+  Json j{{"topic", "pmu/health"},
+         {"vehicle", h.vehicle().to_string()},
+         {"bus", h.bus().to_string()},
          {"address", h.address()}};
 #if PMU_OLD_CONTRACT >= 3
   j["kind"] = name_of(h.kind(), kDeviceKinds);
@@ -97,15 +107,21 @@ Json to_json(const idl::Health& h) {
 }
 
 Json to_json(const idl::Voltages& v) {
-  return {{"topic", "pmu/voltages"}, {"vehicle", v.vehicle().to_string()}, {"bus", v.bus().to_string()},
-          {"address", v.address()},  {"avionics", v.avionics()},           {"output_28v", v.output_28v()},
-          {"payload", v.payload()},  {"servo", v.servo()},                 {"battery_a", v.battery_a()},
-          {"battery_b", v.battery_b()}, {"generator", v.generator()}};
+  return {{"topic", "pmu/voltages"},    {"vehicle", v.vehicle().to_string()},
+          {"bus", v.bus().to_string()}, {"address", v.address()},
+          {"avionics", v.avionics()},   {"output_28v", v.output_28v()},
+          {"payload", v.payload()},     {"servo", v.servo()},
+          {"battery_a", v.battery_a()}, {"battery_b", v.battery_b()},
+          {"generator", v.generator()}};
 }
 
 Json to_json(const idl::Status& s) {
-  return {{"topic", "pmu/status"},          {"vehicle", s.vehicle().to_string()}, {"bus", s.bus().to_string()},
-          {"address", s.address()},         {"generator_rpm", s.generator_rpm()}, {"payload_on", s.payload_on()},
+  return {{"topic", "pmu/status"},
+          {"vehicle", s.vehicle().to_string()},
+          {"bus", s.bus().to_string()},
+          {"address", s.address()},
+          {"generator_rpm", s.generator_rpm()},
+          {"payload_on", s.payload_on()},
           {"generation_enabled", s.generation_enabled()}};
 }
 
@@ -162,7 +178,8 @@ class Discovery : public DomainParticipantListener {
   }
   // The participant property a pmu-service announces its contract in: what a tool of any
   // contract can read before it matches anything (the participant's own announcement).
-  void on_participant_discovery(DomainParticipant*, eprosima::fastrtps::rtps::ParticipantDiscoveryInfo&& info) override {
+  void on_participant_discovery(DomainParticipant*,
+                                eprosima::fastrtps::rtps::ParticipantDiscoveryInfo&& info) override {
     if (info.status != eprosima::fastrtps::rtps::ParticipantDiscoveryInfo::DISCOVERED_PARTICIPANT ||
         info.info.m_participantName.to_string() != "pmu-service")
       return;
@@ -246,10 +263,10 @@ int consume(DomainParticipant* p, const Options& o, const Discovery& discovery) 
   Publisher* pub = p->create_publisher(PUBLISHER_QOS_DEFAULT);
   if (!sub || !pub) return 2;
   std::map<std::string, DataReader*> readers{
-      {"pmu/health", sub->create_datareader_with_profile(
-                         topic(p, "pmu/health", TypeSupport(new idl::HealthPubSubType())), "state")},
-      {"pmu/config", sub->create_datareader_with_profile(
-                         topic(p, "pmu/config", TypeSupport(new idl::ConfigPubSubType())), "state")},
+      {"pmu/health",
+       sub->create_datareader_with_profile(topic(p, "pmu/health", TypeSupport(new idl::HealthPubSubType())), "state")},
+      {"pmu/config",
+       sub->create_datareader_with_profile(topic(p, "pmu/config", TypeSupport(new idl::ConfigPubSubType())), "state")},
       {"pmu/voltages", sub->create_datareader_with_profile(
                            topic(p, "pmu/voltages", TypeSupport(new idl::VoltagesPubSubType())), "telemetry")},
       {"pmu/status", sub->create_datareader_with_profile(
@@ -258,8 +275,8 @@ int consume(DomainParticipant* p, const Options& o, const Discovery& discovery) 
   if (!o.command.empty()) {
     readers["pmu/command_reply"] = sub->create_datareader_with_profile(
         topic(p, "pmu/command_reply", TypeSupport(new idl::CommandReplyPubSubType())), "command");
-    commands = pub->create_datawriter_with_profile(
-        topic(p, "pmu/command", TypeSupport(new idl::CommandPubSubType())), "command");
+    commands = pub->create_datawriter_with_profile(topic(p, "pmu/command", TypeSupport(new idl::CommandPubSubType())),
+                                                   "command");
     if (!commands) return 2;
   }
   for (const auto& [name, r] : readers)
@@ -326,7 +343,8 @@ int consume(DomainParticipant* p, const Options& o, const Discovery& discovery) 
         for (const auto& [name, r] : readers) done = done && types.count(name);
         done = done && (!commands || types.count("reader:pmu/command"));
       }
-      if (done) stop_at = Clock::now() + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(o.linger));
+      if (done)
+        stop_at = Clock::now() + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(o.linger));
     }
     std::this_thread::sleep_for(std::chrono::milliseconds(10));
   }
@@ -343,8 +361,15 @@ int consume(DomainParticipant* p, const Options& o, const Discovery& discovery) 
     matched["pmu/command"] = s.total_count;
   }
   for (const auto& [name, types] : discovery.types()) discovered[name] = types;
-  print({{"final", true}, {"contract", PMU_OLD_CONTRACT}, {"matched", matched}, {"discovered", discovered},
-         {"service_contracts", discovery.service_contracts()}, {"samples", samples}, {"command_sent", sent}, {"replies", replies}, {"request_id", request_id}});
+  print({{"final", true},
+         {"contract", PMU_OLD_CONTRACT},
+         {"matched", matched},
+         {"discovered", discovered},
+         {"service_contracts", discovery.service_contracts()},
+         {"samples", samples},
+         {"command_sent", sent},
+         {"replies", replies},
+         {"request_id", request_id}});
   return 0;
 }
 
@@ -358,16 +383,26 @@ bool parse(int argc, char** argv, Options& o) {
     }
     if (!v) return false;
     ++i;
-    if (a == "--domain") o.domain = std::atoi(v);
-    else if (a == "--seconds") o.seconds = std::atof(v);
-    else if (a == "--until") o.until = v;
-    else if (a == "--linger") o.linger = std::atof(v);
-    else if (a == "--command") o.command = v;
-    else if (a == "--parameter") o.parameter = v;
-    else if (a == "--bus") o.bus = v;
-    else if (a == "--address") o.address = static_cast<unsigned short>(std::atoi(v));
-    else if (a == "--vehicle") o.vehicle = v;
-    else return false;
+    if (a == "--domain")
+      o.domain = std::atoi(v);
+    else if (a == "--seconds")
+      o.seconds = std::atof(v);
+    else if (a == "--until")
+      o.until = v;
+    else if (a == "--linger")
+      o.linger = std::atof(v);
+    else if (a == "--command")
+      o.command = v;
+    else if (a == "--parameter")
+      o.parameter = v;
+    else if (a == "--bus")
+      o.bus = v;
+    else if (a == "--address")
+      o.address = static_cast<unsigned short>(std::atoi(v));
+    else if (a == "--vehicle")
+      o.vehicle = v;
+    else
+      return false;
   }
   return o.until.empty() || o.until == "decoded" || o.until == "discovered";
 }

@@ -59,8 +59,8 @@ Meaning interpret(const mavlink::CommandLong& c, const CommandConfig& config) {
   const auto& p = c.param;
   const auto pmu_of = [&](Meaning m) {
     if (!whole(p[6], 0, static_cast<long>(config.pmu_count)))
-      return refused(result::kDenied, "param7 names no PMU of this bridge (0 or 1.." +
-                                          std::to_string(config.pmu_count) + ")");
+      return refused(result::kDenied,
+                     "param7 names no PMU of this bridge (0 or 1.." + std::to_string(config.pmu_count) + ")");
     m.pmu = p[6] == 0 ? 0 : static_cast<std::size_t>(p[6]) - 1;
     return m;
   };
@@ -99,20 +99,17 @@ Meaning interpret(const mavlink::CommandLong& c, const CommandConfig& config) {
         return refused(result::kUnsupported, "reboot: param4 names another component");
       m.action = service::action::Reset{};
       return pmu_of(m);
-    case cmd::kRunPrearmChecks:
-      m.prearm = true;
-      return m;
+    case cmd::kRunPrearmChecks: m.prearm = true; return m;
     case cmd::kSetMessageInterval: {
-      const bool known = whole(p[0], 0, 0xFFFFFF) &&
-                         std::find(config.schedulable.begin(), config.schedulable.end(),
-                                   static_cast<std::uint32_t>(p[0])) != config.schedulable.end();
+      const bool known =
+          whole(p[0], 0, 0xFFFFFF) && std::find(config.schedulable.begin(), config.schedulable.end(),
+                                                static_cast<std::uint32_t>(p[0])) != config.schedulable.end();
       if (!known) return refused(result::kDenied, "message interval: not a message this component sends");
       if (!whole(p[1], -1, 100000000)) return refused(result::kDenied, "message interval: -1, 0 or microseconds");
       m.interval = MessageInterval{static_cast<std::uint32_t>(p[0]), static_cast<std::int64_t>(p[1])};
       return m;
     }
-    default:
-      return refused(result::kUnsupported, "");
+    default: return refused(result::kUnsupported, "");
   }
 }
 
@@ -165,8 +162,8 @@ std::size_t CommandHandler::running() const {
 void CommandHandler::remember(Entry e) {
   entries_.push_back(std::move(e));
   // Answered commands beyond the bound go, oldest first; running ones stay until answered.
-  std::size_t answered = static_cast<std::size_t>(
-      std::count_if(entries_.begin(), entries_.end(), [](const Entry& x) { return x.final; }));
+  std::size_t answered =
+      static_cast<std::size_t>(std::count_if(entries_.begin(), entries_.end(), [](const Entry& x) { return x.final; }));
   for (auto it = entries_.begin(); answered > config_.max_remembered && it != entries_.end();) {
     if (it->final) {
       it = entries_.erase(it);
@@ -188,8 +185,7 @@ Output CommandHandler::answer_here(Sender from, const mavlink::CommandLong& m, s
   e.answered_at = now;
   Output out;
   out.acks.push_back(ack(e));
-  if (!why.empty())
-    out.texts = mavlink_params::status_text(mavlink::mav_severity::kWarning, why, next_text_id_++);
+  if (!why.empty()) out.texts = mavlink_params::status_text(mavlink::mav_severity::kWarning, why, next_text_id_++);
   if (next_text_id_ == 0) next_text_id_ = 1;
   remember(std::move(e));
   return out;
@@ -280,9 +276,9 @@ Output CommandHandler::on_reply(std::uint64_t tag, CommandResult r, std::string_
   e->answered_at = now;
   out.acks.push_back(ack(*e));
   if (r != CommandResult::Completed) {
-    out.texts = mavlink_params::status_text(mavlink::mav_severity::kWarning,
-                                            std::string(service::to_string(r)) + ": " + std::string(reason),
-                                            next_text_id_++);
+    out.texts =
+        mavlink_params::status_text(mavlink::mav_severity::kWarning,
+                                    std::string(service::to_string(r)) + ": " + std::string(reason), next_text_id_++);
     if (next_text_id_ == 0) next_text_id_ = 1;
   }
   return out;
@@ -308,11 +304,10 @@ Output CommandHandler::poll(Time now) {
       out.texts.push_back(std::move(t));
     if (next_text_id_ == 0) next_text_id_ = 1;
   }
-  entries_.erase(std::remove_if(entries_.begin(), entries_.end(),
-                                [&](const Entry& e) {
-                                  return e.final && now - e.answered_at > config_.retransmission_window;
-                                }),
-                 entries_.end());
+  entries_.erase(
+      std::remove_if(entries_.begin(), entries_.end(),
+                     [&](const Entry& e) { return e.final && now - e.answered_at > config_.retransmission_window; }),
+      entries_.end());
   return out;
 }
 

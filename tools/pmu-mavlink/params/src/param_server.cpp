@@ -37,8 +37,9 @@ void ParamServer::set_device(std::size_t pmu, const baseline::Settings& settings
     const auto s = static_cast<Setting>(i);
     const auto& before = devices_[pmu][s];
     // A value a set of ours changed is sent by that set's answer, not a second time.
-    const bool ours = std::any_of(pending_.begin(), pending_.end(),
-                                  [&](const auto& entry) { return entry.second.param == ParamRef{pmu, s}; });
+    const bool ours = std::any_of(pending_.begin(), pending_.end(), [&](const auto& entry) {
+      return entry.second.param == ParamRef{pmu, s};
+    });
     if (before && settings[s] && *before != *settings[s] && !ours) urgent_[param_index({pmu, s})] = true;
   }
   devices_[pmu] = settings;

@@ -15,18 +15,12 @@ using S = Setting;
 // service know it by (interface.md 2.6), which a ground station's "load parameter file" would
 // do without a word; `pmuctl --confirm config set can_address` is the way.
 constexpr ParamSpec kTable[kSettingCount] = {
-    {S::AvionicsVoltage, "AVION_V", "V", true},
-    {S::PayloadVoltage, "PAYLD_V", "V", true},
-    {S::ServoVoltage, "SERVO_V", "V", true},
-    {S::BatteryVoltage, "BATT_V", "V", true},
-    {S::PacketPeriod, "PKT_PERIOD", "s", true},
-    {S::PacketsStreamed, "PKT_STREAM", "", true},
-    {S::TemperatureOffset, "TEMP_OFFSET", "", true},
-    {S::UpperTemperatureLimit, "TEMP_UPPER", "degC", true},
-    {S::PowerUpState, "POWERUP", "", true},
-    {S::CrankingTime, "CRANK_TIME", "s", true},
-    {S::CanAddress, "CAN_ADDR", "", false},
-    {S::Outputs, "OUTPUTS", "", true},
+    {S::AvionicsVoltage, "AVION_V", "V", true},      {S::PayloadVoltage, "PAYLD_V", "V", true},
+    {S::ServoVoltage, "SERVO_V", "V", true},         {S::BatteryVoltage, "BATT_V", "V", true},
+    {S::PacketPeriod, "PKT_PERIOD", "s", true},      {S::PacketsStreamed, "PKT_STREAM", "", true},
+    {S::TemperatureOffset, "TEMP_OFFSET", "", true}, {S::UpperTemperatureLimit, "TEMP_UPPER", "degC", true},
+    {S::PowerUpState, "POWERUP", "", true},          {S::CrankingTime, "CRANK_TIME", "s", true},
+    {S::CanAddress, "CAN_ADDR", "", false},          {S::Outputs, "OUTPUTS", "", true},
     {S::GenerationEnabled, "GEN_ENABLE", "", true},
 };
 

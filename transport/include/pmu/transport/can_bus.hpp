@@ -91,10 +91,10 @@ enum class BusEventKind : std::uint8_t {
 
 struct BusEvent {
   BusEventKind kind = BusEventKind::StateChanged;
-  BusState state = BusState::Up;     // the state after this event
-  BusState previous = BusState::Up;  // the state before it
-  int error = 0;                     // errno, for SocketError
-  std::uint32_t error_class = 0;     // can_id & CAN_ERR_MASK (linux/can/error.h), for ErrorFrame
+  BusState state = BusState::Up;             // the state after this event
+  BusState previous = BusState::Up;          // the state before it
+  int error = 0;                             // errno, for SocketError
+  std::uint32_t error_class = 0;             // can_id & CAN_ERR_MASK (linux/can/error.h), for ErrorFrame
   std::array<std::uint8_t, 8> error_data{};  // the error frame's payload, for ErrorFrame
   std::chrono::system_clock::time_point time;
 };

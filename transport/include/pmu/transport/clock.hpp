@@ -33,8 +33,7 @@ class ManualClock final : public Clock {
  public:
   // Starts at an arbitrary but fixed wall time so tests can print readable timestamps.
   ManualClock() noexcept = default;
-  explicit ManualClock(std::chrono::system_clock::time_point wall_start) noexcept
-      : wall_start_(wall_start) {}
+  explicit ManualClock(std::chrono::system_clock::time_point wall_start) noexcept : wall_start_(wall_start) {}
 
   std::chrono::steady_clock::time_point steady_now() const noexcept override {
     return std::chrono::steady_clock::time_point{
@@ -46,9 +45,7 @@ class ManualClock final : public Clock {
   void advance(std::chrono::nanoseconds step) noexcept { elapsed_ns_.fetch_add(step.count()); }
 
  private:
-  std::chrono::nanoseconds elapsed() const noexcept {
-    return std::chrono::nanoseconds{elapsed_ns_.load()};
-  }
+  std::chrono::nanoseconds elapsed() const noexcept { return std::chrono::nanoseconds{elapsed_ns_.load()}; }
   // 2023-11-14T22:13:20Z, the epoch second of the sample candump logs.
   std::chrono::system_clock::time_point wall_start_{std::chrono::seconds{1700000000}};
   std::atomic<std::chrono::nanoseconds::rep> elapsed_ns_{0};

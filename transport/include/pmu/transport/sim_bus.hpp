@@ -85,8 +85,7 @@ class SimBus final : public CanBus {
 
  public:
   // Public for make_unique; use SimulatedNetwork::attach().
-  SimBus(Private, std::shared_ptr<detail::SimShared> shared, std::string name,
-         SimBusOptions options);
+  SimBus(Private, std::shared_ptr<detail::SimShared> shared, std::string name, SimBusOptions options);
   ~SimBus() override;
 
   const std::string& name() const noexcept override { return name_; }

@@ -64,11 +64,11 @@ struct SocketCanOptions {
 
 // What the socket set-up obtained, for the start-up log line.
 struct SocketCanReport {
-  int receive_buffer_bytes = 0;     // SO_RCVBUF as read back (the kernel doubles requests)
+  int receive_buffer_bytes = 0;        // SO_RCVBUF as read back (the kernel doubles requests)
   bool receive_buffer_forced = false;  // SO_RCVBUFFORCE was permitted
-  bool kernel_filters = false;      // CAN_RAW_FILTER and CAN_RAW_ERR_FILTER are installed
-  bool kernel_timestamps = false;   // SO_TIMESTAMPNS is on
-  bool drop_counting = false;       // SO_RXQ_OVFL is on
+  bool kernel_filters = false;         // CAN_RAW_FILTER and CAN_RAW_ERR_FILTER are installed
+  bool kernel_timestamps = false;      // SO_TIMESTAMPNS is on
+  bool drop_counting = false;          // SO_RXQ_OVFL is on
 };
 
 class SocketCanBus final : public CanBus {
@@ -83,21 +83,19 @@ class SocketCanBus final : public CanBus {
   // binds it by name when it appears. Other failures throw std::system_error naming the
   // interface and the failing step, e.g. "can0: socket(PF_CAN, SOCK_RAW, CAN_RAW): Address
   // family not supported by protocol" on a kernel without CAN.
-  static std::unique_ptr<SocketCanBus> open(const std::string& interface,
-                                            const SocketCanOptions& options, const Clock& clock,
-                                            SocketOps& ops = system_socket_ops());
+  static std::unique_ptr<SocketCanBus> open(const std::string& interface, const SocketCanOptions& options,
+                                            const Clock& clock, SocketOps& ops = system_socket_ops());
 
   // Wraps an fd that already carries struct can_frame records. Socket options are applied
   // where the fd accepts them (report() says which); there is no interface to reopen, so
   // after ENODEV or end-of-stream the bus stays DOWN. Throws std::system_error only when
   // the EventLoop set-up (epoll, eventfd) fails or `fd` is not open.
-  static std::unique_ptr<SocketCanBus> adopt(UniqueFd fd, const std::string& name,
-                                             const SocketCanOptions& options, const Clock& clock,
-                                             SocketOps& ops = system_socket_ops());
+  static std::unique_ptr<SocketCanBus> adopt(UniqueFd fd, const std::string& name, const SocketCanOptions& options,
+                                             const Clock& clock, SocketOps& ops = system_socket_ops());
 
   // Public for make_unique; only the factories above can make a Private.
-  SocketCanBus(Private, std::string name, std::string interface, const SocketCanOptions& options,
-               const Clock& clock, SocketOps& ops);
+  SocketCanBus(Private, std::string name, std::string interface, const SocketCanOptions& options, const Clock& clock,
+               SocketOps& ops);
   ~SocketCanBus() override;
 
   const std::string& name() const noexcept override { return name_; }
@@ -116,7 +114,7 @@ class SocketCanBus final : public CanBus {
   struct Delivery;  // the handler and tally of the drain() in progress
   struct Opened {
     UniqueFd socket;
-    int error = 0;           // errno of the failed step, 0 on success
+    int error = 0;          // errno of the failed step, 0 on success
     const char* step = "";  // what failed, for messages
   };
 
@@ -130,8 +128,7 @@ class SocketCanBus final : public CanBus {
   void lose_socket(int error, Delivery* out);
   void handle_receive_error(int error, Delivery& out);
   void handle_record(std::size_t index, Delivery& out);
-  void handle_error_frame(const struct can_frame& raw, std::chrono::system_clock::time_point time,
-                          Delivery& out);
+  void handle_error_frame(const struct can_frame& raw, std::chrono::system_clock::time_point time, Delivery& out);
   void count_drops(std::uint32_t kernel_total) noexcept;
   SendResult fail_send(SendStatus status, int error) noexcept;
   BusEvent make_event(BusEventKind kind) const noexcept;

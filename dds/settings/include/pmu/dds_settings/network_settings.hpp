@@ -52,15 +52,15 @@ const char* to_string(DiscoveryMode mode) noexcept;
 
 // One entry as written: an IPv4 address or a host name, and a UDP port (0: none given).
 struct Address {
-  std::string text;   // as written, for messages
-  std::string host;   // "10.0.0.7", "gcs.local"
+  std::string text;  // as written, for messages
+  std::string host;  // "10.0.0.7", "gcs.local"
   std::uint16_t port = 0;
   std::string where;  // "FILE:LINE", "--peer", "PMU_DDS_PEERS": where it came from
 };
 
 struct NetworkConfig {
   DiscoveryMode mode = DiscoveryMode::Multicast;
-  std::vector<Address> peers;       // Unicast: at least one
+  std::vector<Address> peers;  // Unicast: at least one
   // Server: the position is the server id; an entry with an empty host leaves its id unused
   // (a server of id 1 alone: ["", "10.0.0.2"]), and at least one names a server.
   std::vector<Address> servers;
@@ -120,8 +120,8 @@ struct ResolvedServer {
 // NetworkConfig with every name replaced by its addresses: what the participant QoS needs.
 struct ResolvedNetwork {
   DiscoveryMode mode = DiscoveryMode::Multicast;
-  std::vector<Ipv4Endpoint> peers;            // Unicast
-  std::vector<ResolvedServer> servers;        // Server; index = server id
+  std::vector<Ipv4Endpoint> peers;      // Unicast
+  std::vector<ResolvedServer> servers;  // Server; index = server id
   // Empty: every interface. Otherwise the allowed addresses, 127.0.0.1 always among them
   // (same-host traffic; resolve_network says why).
   std::vector<std::string> interface_addresses;

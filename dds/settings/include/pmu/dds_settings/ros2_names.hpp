@@ -38,8 +38,8 @@ std::string ros2_device_token(Ros2Device kind, std::uint16_t address);
 
 // "/<ns>/<vehicle>/<bus>/<device>": the ROS 2 namespace of one device's topics. An empty
 // namespace or vehicle is left out.
-std::string ros2_device_namespace(std::string_view ns, std::string_view vehicle, std::string_view bus,
-                                  Ros2Device kind, std::uint16_t address);
+std::string ros2_device_namespace(std::string_view ns, std::string_view vehicle, std::string_view bus, Ros2Device kind,
+                                  std::uint16_t address);
 
 // The DDS topic of the ROS 2 topic `ros_name` (absolute): "rt" + ros_name.
 std::string ros2_dds_topic(std::string_view ros_name);

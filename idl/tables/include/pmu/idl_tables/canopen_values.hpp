@@ -41,29 +41,14 @@ inline constexpr std::size_t kBatteryValueCount = std::size(kBatteryValues);
 // pmu::v5::Mppt's values, in IDL order. Voltages and currents are raw counts: the document gives
 // them no resolution.
 inline constexpr CanOpenValue kMpptValues[] = {
-    {"voltage_output_raw", 1, ""},
-    {"current_output_raw", 1, ""},
-    {"voltage_out_sw_raw", 1, ""},
-    {"mppt_state", 1, ""},
-    {"safety_enabled", 1, ""},
-    {"pwm_enabled", 1, ""},
-    {"temperature", 1, "degC"},
-    {"voltage_panel_1_raw", 1, ""},
-    {"current_panel_1_raw", 1, ""},
-    {"duty_cycle_panel_1", 1, "%"},
-    {"channel_1_active", 1, ""},
-    {"voltage_panel_2_raw", 1, ""},
-    {"current_panel_2_raw", 1, ""},
-    {"duty_cycle_panel_2", 1, "%"},
-    {"channel_2_active", 1, ""},
-    {"voltage_panel_3_raw", 1, ""},
-    {"current_panel_3_raw", 1, ""},
-    {"duty_cycle_panel_3", 1, "%"},
-    {"channel_3_active", 1, ""},
-    {"voltage_panel_4_raw", 1, ""},
-    {"current_panel_4_raw", 1, ""},
-    {"duty_cycle_panel_4", 1, "%"},
-    {"channel_4_active", 1, ""},
+    {"voltage_output_raw", 1, ""},  {"current_output_raw", 1, ""},  {"voltage_out_sw_raw", 1, ""},
+    {"mppt_state", 1, ""},          {"safety_enabled", 1, ""},      {"pwm_enabled", 1, ""},
+    {"temperature", 1, "degC"},     {"voltage_panel_1_raw", 1, ""}, {"current_panel_1_raw", 1, ""},
+    {"duty_cycle_panel_1", 1, "%"}, {"channel_1_active", 1, ""},    {"voltage_panel_2_raw", 1, ""},
+    {"current_panel_2_raw", 1, ""}, {"duty_cycle_panel_2", 1, "%"}, {"channel_2_active", 1, ""},
+    {"voltage_panel_3_raw", 1, ""}, {"current_panel_3_raw", 1, ""}, {"duty_cycle_panel_3", 1, "%"},
+    {"channel_3_active", 1, ""},    {"voltage_panel_4_raw", 1, ""}, {"current_panel_4_raw", 1, ""},
+    {"duty_cycle_panel_4", 1, "%"}, {"channel_4_active", 1, ""},
 };
 inline constexpr std::size_t kMpptValueCount = std::size(kMpptValues);
 

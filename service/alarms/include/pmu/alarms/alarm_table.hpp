@@ -60,10 +60,10 @@ struct AlarmSpec {
   DeviceKind device;
   Severity severity;
   Condition condition;
-  double limit;              // in `unit`; 0 and unused for a flag
-  std::string_view unit;     // "V", "degC", "%", "" for a flag
-  int decimals;              // digits after the point in messages
-  double deadband;           // in `unit`, >= 0: how far past the limit the value must come back
+  double limit;                         // in `unit`; 0 and unused for a flag
+  std::string_view unit;                // "V", "degC", "%", "" for a flag
+  int decimals;                         // digits after the point in messages
+  double deadband;                      // in `unit`, >= 0: how far past the limit the value must come back
   std::chrono::milliseconds on_delay;   // the condition must hold this long to raise
   std::chrono::milliseconds off_delay;  // ... and be gone this long to clear
   Basis basis;

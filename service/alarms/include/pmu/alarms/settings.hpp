@@ -23,9 +23,7 @@ struct AlarmOverride {
   std::optional<Severity> severity;
   std::optional<bool> enabled;
 
-  bool empty() const noexcept {
-    return !limit && !deadband && !on_delay_s && !off_delay_s && !severity && !enabled;
-  }
+  bool empty() const noexcept { return !limit && !deadband && !on_delay_s && !off_delay_s && !severity && !enabled; }
 };
 
 // One device's overrides, by code.

@@ -27,7 +27,7 @@ struct Change {
   Setting setting;
   std::uint32_t from = 0;  // the device's value before: what an undo sets
   std::uint32_t to = 0;
-  int line = 0;            // the file's line
+  int line = 0;                                 // the file's line
   std::optional<service::ConfirmRule> confirm;  // the rule that makes it need --confirm
 };
 

@@ -48,8 +48,8 @@ struct Header {
 
 struct ConfigFile {
   Header header;
-  Settings settings;                       // what the file sets; empty = not in the file
-  std::array<int, kSettingCount> line{};   // where each setting is (1-based); 0 = not in the file
+  Settings settings;                      // what the file sets; empty = not in the file
+  std::array<int, kSettingCount> line{};  // where each setting is (1-based); 0 = not in the file
   int serial_line = 0;
   int min_firmware_line = 0;
   int line_of(Setting s) const noexcept { return line[static_cast<std::size_t>(s)]; }

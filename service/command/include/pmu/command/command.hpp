@@ -97,11 +97,21 @@ struct SetParameter {
   codec::Parameter parameter;
   std::uint32_t raw;  // exactly what goes on the wire
 };
-struct SetOutputs { std::uint8_t mask; };
-struct EnableOutputs { std::uint8_t mask; };   // non-empty
-struct DisableOutputs { std::uint8_t mask; };  // non-empty
-struct SetGeneration { bool enable; };
-struct RequestMeasurements { std::uint8_t groups; };  // non-empty (0 on the wire means all)
+struct SetOutputs {
+  std::uint8_t mask;
+};
+struct EnableOutputs {
+  std::uint8_t mask;
+};  // non-empty
+struct DisableOutputs {
+  std::uint8_t mask;
+};  // non-empty
+struct SetGeneration {
+  bool enable;
+};
+struct RequestMeasurements {
+  std::uint8_t groups;
+};  // non-empty (0 on the wire means all)
 struct EngineStart {};
 struct EngineStop {};
 struct Reset {};

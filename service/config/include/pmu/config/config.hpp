@@ -97,11 +97,11 @@ struct MpptConfig {
 };
 
 struct BusConfig {
-  std::string name;       // the DDS key `bus`; at most 15 bytes
-  std::string interface;  // SocketCAN interface, or "sim" for the built-in simulated PMU
+  std::string name;                 // the DDS key `bus`; at most 15 bytes
+  std::string interface;            // SocketCAN interface, or "sim" for the built-in simulated PMU
   std::uint32_t bitrate = 1000000;  // what the link runs at (checked against the firmware)
   std::vector<DeviceConfig> devices;
-  bool discover = false;  // find PMUs by a broadcast firmware request at start
+  bool discover = false;             // find PMUs by a broadcast firmware request at start
   DeviceConfig discovered_defaults;  // settings for PMUs found by discovery
   std::vector<BatteryConfig> batteries;
   std::vector<MpptConfig> mppts;
@@ -115,17 +115,17 @@ struct BusConfig {
   // canopen_publish_period, the same for every bus.
   std::chrono::milliseconds canopen_publish_period{200};
   bool wants_canopen() const noexcept { return listen_canopen || !batteries.empty() || !mppts.empty(); }
-  std::string source_line;           // "FILE:LINE" of the bus entry, for later messages
+  std::string source_line;  // "FILE:LINE" of the bus entry, for later messages
   // The devices' `sim:` mappings (sim_settings.hpp); only on an `interface: sim` bus.
   BusSimSettings sim;
 };
 
 struct Timeouts {
-  std::chrono::milliseconds reply{250};     // wait for an answer to one get
-  unsigned retries = 2;                     // extra tries of an idempotent get
-  double stale_periods = 3;                 // no frame for this many periods -> STALE
-  double offline_periods = 10;              // -> OFFLINE (and re-read info/config on return)
-  std::chrono::milliseconds send{100};      // wait for room in the transmit queue
+  std::chrono::milliseconds reply{250};  // wait for an answer to one get
+  unsigned retries = 2;                  // extra tries of an idempotent get
+  double stale_periods = 3;              // no frame for this many periods -> STALE
+  double offline_periods = 10;           // -> OFFLINE (and re-read info/config on return)
+  std::chrono::milliseconds send{100};   // wait for room in the transmit queue
 };
 
 // DDS-Security (the `security:` section). All six files or none; relative paths are taken

@@ -28,7 +28,7 @@ struct PmuSimSettings {
   std::optional<bool> starter_ready;
   std::optional<bool> soa_shutdown;
   std::optional<bool> payload_shed;
-  bool silent = false;  // off the bus: answers and streams nothing
+  bool silent = false;                             // off the bus: answers and streams nothing
   std::optional<codec::FirmwareVersion> firmware;  // the firmware it behaves as
   std::optional<std::uint16_t> serial;             // its serial number
   std::optional<codec::Parameter> ignores_set;     // a stored parameter its memory does not take

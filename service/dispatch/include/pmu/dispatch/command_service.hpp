@@ -56,8 +56,8 @@ inline constexpr std::size_t kRememberedRequests = 16384;
 class CommandService {
  public:
   // `reply` publishes a reply; it is called from bus worker threads and the caller's thread.
-  CommandService(std::vector<BusWorker*> workers, PolicyConfig policy, Timeouts timeouts,
-                 const transport::Clock& clock, ReplyFn reply);
+  CommandService(std::vector<BusWorker*> workers, PolicyConfig policy, Timeouts timeouts, const transport::Clock& clock,
+                 ReplyFn reply);
 
   void submit(const CommandSample& sample);
 

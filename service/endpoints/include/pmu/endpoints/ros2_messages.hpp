@@ -33,7 +33,7 @@ struct PmuBatteryView {
   double temperature = kUnknown;  // NaN: no sensor, or firmware before 1.12
   std::optional<std::uint16_t> pmu_serial;
   HealthState health = HealthState::Unknown;
-  std::vector<AlarmReport> active;  // the PMU's active alarms
+  std::vector<AlarmReport> active;                // the PMU's active alarms
   std::chrono::system_clock::time_point stamp{};  // receive time of the pmu/voltages frame
   std::string frame_id;                           // ros2_status_name of the PMU
 };

@@ -63,8 +63,7 @@ class Ros2Publisher final : public StateSink {
   void on_alarm(const AlarmReport& alarm) override;
   void on_readiness(const ReadinessReport&) override {}
   void on_energy(const DeviceKey&, const energy::Figures&, std::chrono::system_clock::time_point) override {}
-  void on_bms_energy(const DeviceKey&, const energy::BmsFigures&,
-                     std::chrono::system_clock::time_point) override {}
+  void on_bms_energy(const DeviceKey&, const energy::BmsFigures&, std::chrono::system_clock::time_point) override {}
 
   // Writes Fast DDS refused (logged at most every few seconds too). Any thread.
   std::uint64_t write_failures() const;

@@ -15,7 +15,7 @@
 namespace pmu::files {
 
 struct FileText {
-  std::string text;   // the whole file when error is empty
+  std::string text;  // the whole file when error is empty
   // Why not, to follow "FILE cannot be read: ": the system's reason ("No such file or
   // directory"), "it is a FIFO, not a regular file", "it is 2 MiB, larger than the 1 MiB bound".
   std::string error;

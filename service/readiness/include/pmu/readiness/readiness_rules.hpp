@@ -71,7 +71,7 @@ std::optional<codec::FirmwareVersion> min_firmware(const DeviceView& d);
 
 struct ReadinessInput {
   std::map<std::tuple<std::string, DeviceKind, std::uint16_t>, DeviceView> devices;  // (bus, kind, address)
-  std::vector<AlarmReport> alarms;  // the latest report of each alarm
+  std::vector<AlarmReport> alarms;                                                   // the latest report of each alarm
   std::chrono::steady_clock::time_point now{};  // what `received` is judged against
 };
 

@@ -63,8 +63,8 @@ struct SecurityIssue {
 };
 
 struct SecurityCheckOptions {
-  int warn_days = 30;             // a certificate or grant that ends within this many days: warning
-  std::optional<int> domain;      // when set: governance and the grant must cover this DDS domain
+  int warn_days = 30;         // a certificate or grant that ends within this many days: warning
+  std::optional<int> domain;  // when set: governance and the grant must cover this DDS domain
   std::chrono::system_clock::time_point now = std::chrono::system_clock::now();
 };
 

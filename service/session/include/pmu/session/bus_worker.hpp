@@ -88,9 +88,9 @@ class BusWorker final : private transport::BusHandler {
   struct Moved {
     std::string bus;
     std::uint16_t from = 0, to = 0;
-    std::uint16_t first = 0;                  // where it started: the config's address, or discovery's
+    std::uint16_t first = 0;  // where it started: the config's address, or discovery's
     std::optional<std::uint16_t> serial;
-    std::string config_line;                  // "FILE:LINE" of its `address:`; empty when not configured
+    std::string config_line;  // "FILE:LINE" of its `address:`; empty when not configured
   };
   // Called on the worker's thread after every move. Set before run().
   void on_moved(std::function<void(const Moved&)> fn) { moved_ = std::move(fn); }
@@ -137,7 +137,7 @@ class BusWorker final : private transport::BusHandler {
   DeviceSession* on_stranger(const codec::PmuId& id, const transport::ReceivedFrame& rx);
   DeviceSession* session_with_serial(std::uint16_t serial);  // not one mid-way through our own move
   bool any_silent_known(HealthState at_least) const;
-  void search();  // the broadcast serial request while a known session is OFFLINE (a loop timer)
+  void search();    // the broadcast serial request while a known session is OFFLINE (a loop timer)
   void end_turn();  // ticks every session; the watchdog's progress
 
   BusConfig config_;

@@ -48,8 +48,7 @@ class CanOpenSession {
  public:
   // `key.kind` is Battery or Mppt; `alarms` the device's alarm settings (its config entry's).
   CanOpenSession(DeviceKey key, std::chrono::milliseconds period, std::chrono::milliseconds publish_period,
-                 const Timeouts& timeouts, StateSink& sink, SteadyTime now,
-                 const alarms::DeviceSettings& alarms = {});
+                 const Timeouts& timeouts, StateSink& sink, SteadyTime now, const alarms::DeviceSettings& alarms = {});
 
   const DeviceKey& key() const noexcept { return key_; }
   // A frame whose id canopen_device() gave this session's key.
@@ -73,8 +72,8 @@ class CanOpenSession {
  private:
   // One published topic's schedule.
   struct Schedule {
-    bool dirty = false;        // values arrived since the last sample
-    WallTime newest{};         // receive time of the newest frame in the state
+    bool dirty = false;         // values arrived since the last sample
+    WallTime newest{};          // receive time of the newest frame in the state
     SteadyTime next_allowed{};  // rate limit
   };
   bool due(Schedule& s, SteadyTime now) const noexcept;

@@ -216,11 +216,11 @@ class DeviceSession {
   AlarmFeed alarms_;
   // What the alarms derived from more than one packet last heard; forgotten at OFFLINE.
   struct EngineView {
-    std::optional<codec::Status> status;   // the latest 0x04
+    std::optional<codec::Status> status;                                // the latest 0x04
     double generator_volts = std::numeric_limits<double>::quiet_NaN();  // the latest 0x00's
-    bool running = false;                  // the speed was at or above running_rpm
-    bool stop_commanded = false;           // an engine stop was sent since it last came up to speed
-    bool stopped_by_itself = false;        // it fell below running speed with no stop sent
+    bool running = false;                                               // the speed was at or above running_rpm
+    bool stop_commanded = false;     // an engine stop was sent since it last came up to speed
+    bool stopped_by_itself = false;  // it fell below running speed with no stop sent
   };
   EngineView engine_;
   struct Latest {
@@ -228,7 +228,7 @@ class DeviceSession {
     SteadyTime at{};
   };
   std::optional<Latest> internal_temperature_;  // from the latest 0x03
-  SteadyTime now_{};  // the latest time any call brought
+  SteadyTime now_{};                            // the latest time any call brought
   SteadyTime next_poll_{};
 };
 

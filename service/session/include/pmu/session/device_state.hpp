@@ -72,14 +72,14 @@ struct HealthReport {
 struct AlarmReport {
   std::string bus;
   alarms::DeviceKind source = alarms::DeviceKind::Pmu;  // Pmu, Battery, Mppt, or Bus for the bus's own
-  std::uint16_t device = 0;  // the device's address, node or MPPT device id; 0 for the bus
+  std::uint16_t device = 0;                             // the device's address, node or MPPT device id; 0 for the bus
   alarms::Code code{};
   alarms::Severity severity = alarms::Severity::Warning;
   alarms::AlarmState state = alarms::AlarmState::Normal;
   double value = 0;  // at the last change, in the table's unit; NaN for a flag or unknown
   double limit = 0;
   std::chrono::system_clock::time_point since{};  // the last change of state
-  std::string message;                           // at most 42 characters
+  std::string message;                            // at most 42 characters
 };
 
 // The vehicle's readiness (interface.md 1.7): made by the ReadinessTracker from health,
@@ -87,16 +87,16 @@ struct AlarmReport {
 struct ReadinessReason {
   std::string code;  // an alarm's code, or a readiness code (device_not_online, ...)
   alarms::Severity severity = alarms::Severity::Critical;
-  std::string bus;   // "" for the service's own
+  std::string bus;  // "" for the service's own
   alarms::DeviceKind source = alarms::DeviceKind::Pmu;
   std::uint16_t device = 0;
   std::string message;      // at most 42 characters
   std::string description;  // at most 127 characters: what to do about it
 };
 struct ReadinessReport {
-  bool ready = true;                               // no critical reason
+  bool ready = true;                              // no critical reason
   std::chrono::system_clock::time_point since{};  // the last change of `ready`
-  std::vector<ReadinessReason> reasons;            // critical first, then by bus, device, code
+  std::vector<ReadinessReason> reasons;           // critical first, then by bus, device, code
   bool warnings() const noexcept { return !reasons.empty(); }
 };
 

@@ -64,12 +64,12 @@ class OutputFile {
   enum class Kind { None, Replace, Stream };
   std::string open_stream(bool fifo);
   std::string open_replacement(const struct stat* replaced);  // nullptr: a new file
-  std::string shown() const;  // "NAME", or "NAME (-> TARGET)" for a symlink
+  std::string shown() const;                                  // "NAME", or "NAME (-> TARGET)" for a symlink
 
   FileSink sink_;
   Kind kind_ = Kind::None;
   std::string name_;
-  std::string target_;   // the file commit() renames onto (symlinks followed)
+  std::string target_;  // the file commit() renames onto (symlinks followed)
   std::string writing_;
   bool temporary_ = false;  // writing_ is our temporary file, not yet renamed or removed
   bool keep_ = false;       // a commit() failed: the destructor leaves the temporary file

@@ -83,7 +83,8 @@ void append_message_index(Bytes& out, std::uint16_t channel_id,
                           const std::vector<std::pair<std::uint64_t, std::uint64_t>>& entries);
 void append_chunk_index(Bytes& out, const ChunkIndex& c);
 void append_statistics(Bytes& out, const Statistics& s);
-void append_summary_offset(Bytes& out, std::uint8_t group_opcode, std::uint64_t group_start, std::uint64_t group_length);
+void append_summary_offset(Bytes& out, std::uint8_t group_opcode, std::uint64_t group_start,
+                           std::uint64_t group_length);
 void append_data_end(Bytes& out, std::uint32_t data_section_crc);
 // The Footer's summary_crc covers the summary up to and including summary_offset_start, so
 // the caller passes the CRC of the summary sections so far; the footer adds its own part.

@@ -28,8 +28,8 @@
 namespace pmu::mcap {
 
 struct WriterOptions {
-  std::string profile;   // "" (no well-known profile)
-  std::string library;   // e.g. "pmuctl 0.1.0"
+  std::string profile;                  // "" (no well-known profile)
+  std::string library;                  // e.g. "pmuctl 0.1.0"
   std::size_t chunk_size = 256 * 1024;  // a chunk is written when its records reach this
 };
 
@@ -71,8 +71,8 @@ class Writer {
   bool torn_ = false;  // a failed write could not be cut off: the sink ends in part of a block
   bool opened_ = false;
   bool closed_ = false;
-  std::uint64_t offset_ = 0;     // bytes the sink took
-  std::uint32_t data_crc_ = 0;   // of every byte from the magic to the chunk before DataEnd
+  std::uint64_t offset_ = 0;    // bytes the sink took
+  std::uint32_t data_crc_ = 0;  // of every byte from the magic to the chunk before DataEnd
   std::vector<Schema> schemas_;
   std::vector<Channel> channels_;
   std::vector<std::uint32_t> sequences_;  // per channel id - 1

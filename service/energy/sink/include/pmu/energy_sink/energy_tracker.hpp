@@ -47,7 +47,7 @@ class EnergyTracker final : public ForwardingSink {
   // handed to it go on as they are.
 
  private:
-  using Key = std::tuple<std::string, std::uint16_t>;  // (bus, PMU address or battery node)
+  using Key = std::tuple<std::string, std::uint16_t>;      // (bus, PMU address or battery node)
   energy::PmuEnergy& energy_of(const DeviceKey& key);      // with mutex_ held
   energy::BmsEnergy& bms_energy_of(const DeviceKey& key);  // with mutex_ held
   std::chrono::nanoseconds max_gap(std::chrono::milliseconds period) const;

@@ -82,7 +82,7 @@ struct Output {
 struct CommandConfig {
   std::size_t pmu_count = 1;
   ConfirmSet confirm{};
-  std::uint8_t own_component = 180;  // PREFLIGHT_REBOOT_SHUTDOWN's param4 names it (or 0)
+  std::uint8_t own_component = 180;        // PREFLIGHT_REBOOT_SHUTDOWN's param4 names it (or 0)
   std::vector<std::uint32_t> schedulable;  // message ids SET_MESSAGE_INTERVAL may set
   // How long a command waits for the service's final reply: its default lifetime (10 s,
   // interface.md 2.3) and a margin; an engine start the longest verification (25.5 s of
@@ -101,8 +101,8 @@ struct CommandCounters {
   std::uint64_t sent = 0;             // service commands handed out
   std::uint64_t stops = 0;
   std::uint64_t unsupported = 0;
-  std::uint64_t denied = 0;           // here: bad params, rule not confirmed, no such PMU
-  std::uint64_t flood_rejected = 0;   // TEMPORARILY_REJECTED: max_pending
+  std::uint64_t denied = 0;          // here: bad params, rule not confirmed, no such PMU
+  std::uint64_t flood_rejected = 0;  // TEMPORARILY_REJECTED: max_pending
   std::uint64_t timed_out = 0;
   std::uint64_t replies_unmatched = 0;
 };

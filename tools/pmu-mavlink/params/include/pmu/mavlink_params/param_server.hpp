@@ -144,9 +144,9 @@ class ParamServer {
 
   ParamServerConfig config_;
   std::vector<baseline::Settings> devices_;
-  std::vector<bool> urgent_;    // reads and changed values, sent first
-  std::vector<bool> listed_;    // a list's entries still to send
-  std::size_t cursor_ = 0;      // where the list goes on
+  std::vector<bool> urgent_;  // reads and changed values, sent first
+  std::vector<bool> listed_;  // a list's entries still to send
+  std::size_t cursor_ = 0;    // where the list goes on
   std::vector<Sender> list_senders_;
   double tokens_ = 1;
   std::optional<Time> last_refill_;

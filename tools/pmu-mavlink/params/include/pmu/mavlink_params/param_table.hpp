@@ -27,8 +27,8 @@
 
 namespace pmu::mavlink_params {
 
-using baseline::Setting;
 using baseline::kSettingCount;
+using baseline::Setting;
 
 // PMUs one bridge serves through parameters: the prefix has room for one digit.
 inline constexpr std::size_t kMaxPmus = 9;
