@@ -42,6 +42,8 @@ run_packages=(
 )
 test_only_packages=(
   ccache
+  # scripts/format.sh and its check (tests/rooms): the layout .clang-format describes
+  clang-format-14
   clang-14 libclang-rt-14-dev lld-14
   libgtest-dev libgmock-dev libbenchmark-dev
   # fastdds: the Discovery Server of the discovery tests; openssl: the DDS-Security PKI
