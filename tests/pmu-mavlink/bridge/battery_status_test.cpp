@@ -6,6 +6,7 @@
 #include <limits>
 
 namespace pmu::mavlink_bridge {
+namespace battery_status_test {  // named: the unity build joins this file with others of its target
 namespace {
 
 namespace nm = pmu::mavlink;
@@ -62,7 +63,7 @@ TEST(PmuBatteryStatus, ChargingInputAndItsUnknowns) {
 
 // Every way the service says "not known" ends as the field's sentinel, never 0.
 TEST(PmuBatteryStatus, EveryUnknownIsTheSentinel) {
-  struct Case {
+  struct BatteryCase {
     const char* name;
     PmuView view;
   };
@@ -77,7 +78,8 @@ TEST(PmuBatteryStatus, EveryUnknownIsTheSentinel) {
   stale.online = false;
   PmuView nothing;
   nothing.online = true;
-  const Case cases[] = {{"NaN in every sample", nan_values}, {"not ONLINE (H7)", stale}, {"no sample yet", nothing}};
+  const BatteryCase cases[] = {
+      {"NaN in every sample", nan_values}, {"not ONLINE (H7)", stale}, {"no sample yet", nothing}};
   for (const auto& c : cases) {
     const auto m = pmu_battery_status(c.view, BatteryInput::a, 12);
     EXPECT_EQ(m.id, 12) << c.name;
@@ -160,4 +162,5 @@ TEST(BmsBatteryStatus, EveryUnknownIsTheSentinel) {
 }
 
 }  // namespace
+}  // namespace battery_status_test
 }  // namespace pmu::mavlink_bridge

@@ -6,6 +6,7 @@
 #include <limits>
 
 namespace pmu::mavlink_bridge {
+namespace generator_status_test {  // named: the unity build joins this file with others of its target
 namespace {
 
 namespace flag = pmu::mavlink::mav_generator_status_flag;
@@ -45,7 +46,7 @@ TEST(GeneratorStatus, RunningGeneratorCharging) {
 }
 
 TEST(GeneratorStatus, StatusFlags) {
-  struct Case {
+  struct GeneratorCase {
     const char* name;
     bool enabled;
     float rpm;
@@ -54,7 +55,7 @@ TEST(GeneratorStatus, StatusFlags) {
     bool shed;
     std::uint64_t flags;
   };
-  const Case cases[] = {
+  const GeneratorCase cases[] = {
       {"generation disabled", false, 0.0F, false, false, false, flag::kOff},
       {"enabled, engine stopped", true, 0.0F, false, false, false, flag::kReady},
       {"enabled, no rpm reading", true, kNaN, false, false, false, flag::kReady},
@@ -101,4 +102,5 @@ TEST(GeneratorStatus, EveryUnknownIsTheSentinel) {
 }
 
 }  // namespace
+}  // namespace generator_status_test
 }  // namespace pmu::mavlink_bridge

@@ -10,6 +10,7 @@
 #include "pmu/mavlink_params/param_server.hpp"
 
 namespace pmu::mavlink_params {
+namespace param_file_test {  // named: the unity build joins this file with others of its target
 namespace {
 
 using namespace std::chrono_literals;
@@ -94,4 +95,5 @@ TEST(ConfirmSet, NamesTheRulesAndRefusesUnknownOnes) {
 }
 
 }  // namespace
+}  // namespace param_file_test
 }  // namespace pmu::mavlink_params

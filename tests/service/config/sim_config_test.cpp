@@ -8,6 +8,7 @@
 #include "pmu/config/config.hpp"
 
 namespace pmu::service {
+namespace sim_config_test {  // named: the unity build joins this file with others of its target
 namespace {
 
 using std::chrono::milliseconds;
@@ -254,4 +255,5 @@ TEST(SimConfig, BusOverrideToARealBusDropsTheSimulatorSettings) {
 }
 
 }  // namespace
+}  // namespace sim_config_test
 }  // namespace pmu::service

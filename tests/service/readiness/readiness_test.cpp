@@ -191,7 +191,7 @@ DeviceView fed(std::uint8_t monitored, std::uint8_t received, std::chrono::milli
 // is not monitored, not received or stale is a critical reason of its own (docs/safety.md H6,
 // H3).
 TEST(ReadinessRules, APacketTheRulesReadThatIsNotFreshIsNotReady) {
-  struct Case {
+  struct ReadinessCase {
     const char* what;
     DeviceView device;
     DeviceKind kind;
@@ -201,7 +201,7 @@ TEST(ReadinessRules, APacketTheRulesReadThatIsNotFreshIsNotReady) {
     d.state = s;
     return d;
   };
-  const Case cases[] = {
+  const ReadinessCase cases[] = {
       {"everything the rules read, fresh", fed(V | C | T | S, V | C | T | S), DeviceKind::Pmu, {}},
       {"fresh at the limit of its age", fed(V | T | S, V | T | S, 3000ms), DeviceKind::Pmu, {}},
       {"polled for voltages and currents only",
@@ -296,7 +296,7 @@ DeviceView pinned_pmu(const std::string& file) {
 }
 
 TEST(ReadinessRules, ABaselineMakesDriftAReplacedUnitAndItsFirmwarePinReasons) {
-  struct Case {
+  struct ReadinessCase {
     const char* what;
     DeviceView device;
     std::vector<std::string> codes;
@@ -315,7 +315,7 @@ TEST(ReadinessRules, ABaselineMakesDriftAReplacedUnitAndItsFirmwarePinReasons) {
     d.serial = sn;
     return d;
   };
-  const Case cases[] = {
+  const ReadinessCase cases[] = {
       {"every setting as the file says", pinned_pmu("parameters:\n  avionics_voltage: 12.0\noutputs: 15\n"), {}, ""},
       {"12.04 V is the 12.0 V the wire carries", pinned_pmu("parameters:\n  avionics_voltage: 12.04\n"), {}, ""},
       {"one setting differs",
@@ -412,12 +412,12 @@ TEST(ReadinessRules, DriftTextsFitTheirBoundsAndSayHowToFix) {
       "outputs avionics_servo,payload,charger_a,charger_b (0x0F)->payload (0x02). pmuctl config diff / apply pmu1.yaml");
 
   // A mask whose names do not fit is said by its numbers: the values are always shown.
-  struct Case {
+  struct ReadinessCase {
     const char* what;
     std::string file;
     std::string description;
   };
-  const Case masks[] = {
+  const ReadinessCase masks[] = {
       {"outputs alone", "outputs: [avionics_servo, payload, charger_a]\n",
        "outputs 0x0F->0x07. pmuctl config diff / apply pmu1.yaml"},
       {"power_up_state alone",

@@ -11,7 +11,7 @@ namespace nm = pmu::mavlink;
 
 namespace {
 
-constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
+constexpr float kUnknown = std::numeric_limits<float>::quiet_NaN();
 
 // Wh to hJ (1 Wh = 3600 J = 36 hJ). The energy used is discharge less charge since the
 // service started; a net charge is sent as 0 consumed, not as a negative the field does not
@@ -42,7 +42,7 @@ nm::BatteryStatus pmu_battery_status(const PmuView& pmu, BatteryInput input, std
   const bool a = input == BatteryInput::a;
   // The PMU measures the pack, not its cells: the devguide puts the pack voltage in cell 0.
   if (pmu.voltages) m.voltages[0] = millivolts(a ? pmu.voltages->battery_a() : pmu.voltages->battery_b());
-  const float current_in = pmu.currents ? (a ? pmu.currents->battery_a() : pmu.currents->battery_b()) : kNaN;
+  const float current_in = pmu.currents ? (a ? pmu.currents->battery_a() : pmu.currents->battery_b()) : kUnknown;
   m.current_battery = centiamperes(-current_in);
   m.charge_state = charge_state(current_in);
   if (pmu.temperatures) m.temperature = centidegrees(a ? pmu.temperatures->battery_a() : pmu.temperatures->battery_b());

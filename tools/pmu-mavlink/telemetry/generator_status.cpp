@@ -12,9 +12,9 @@ namespace flag = pmu::mavlink::mav_generator_status_flag;
 
 namespace {
 
-constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
+constexpr float kNotKnown = std::numeric_limits<float>::quiet_NaN();
 
-float sum_or_nan(float x, float y) noexcept { return std::isfinite(x) && std::isfinite(y) ? x + y : kNaN; }
+float sum_or_nan(float x, float y) noexcept { return std::isfinite(x) && std::isfinite(y) ? x + y : kNotKnown; }
 
 }  // namespace
 
@@ -22,15 +22,15 @@ nm::GeneratorStatus generator_status(const PmuView& pmu) {
   nm::GeneratorStatus m;
   if (!pmu.online) {
     m.status = flag::kCommunicationWarning;
-    m.bus_voltage = kNaN;
+    m.bus_voltage = kNotKnown;
     return m;
   }
   // The field defines no "not provided" value; NaN says it as the message's other floats do.
-  m.bus_voltage = pmu.voltages ? pmu.voltages->generator() : kNaN;
+  m.bus_voltage = pmu.voltages ? pmu.voltages->generator() : kNotKnown;
   if (pmu.currents) {
     // Positive out of the batteries, as the field says; the contract's are positive into them.
     const float into = sum_or_nan(pmu.currents->battery_a(), pmu.currents->battery_b());
-    m.battery_current = std::isfinite(into) ? -into : kNaN;
+    m.battery_current = std::isfinite(into) ? -into : kNotKnown;
   }
   if (pmu.energy) m.power_generated = pmu.energy->generator_power();
   if (pmu.temperatures) m.generator_temperature = whole_degrees(pmu.temperatures->generator());
