@@ -101,6 +101,8 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "pmu_bench: DDS domains %d..%d\n", s.domain_base, s.domain_base + kDomainsPerRun - 1);
     s.self_exe = std::filesystem::read_symlink("/proc/self/exe").string();
     s.service_exe = std::filesystem::absolute(s.service_exe).string();
+    // The service reads it from a config file in the work folder: a relative path would not hold.
+    s.qos_file = std::filesystem::absolute(s.qos_file).string();
     char tmpl[] = "/tmp/pmu-bench-XXXXXX";
     if (!::mkdtemp(tmpl)) throw std::runtime_error("mkdtemp failed");
     s.workdir = tmpl;
