@@ -1,6 +1,7 @@
 // pmu_bench: the service benchmarks (bench/run.sh runs them with the rest), and the bare
 // Fast DDS peers they are compared with.
 //   pmu_bench run --service PATH [--quick] [--domain-base N]   result rows on stdout
+//   pmu_bench mavlink-latency --service PATH --bridge PATH [--seconds N]   CAN frame -> MAVLink rows
 //   pmu_bench peer-writer|peer-echo|peer-pong|peer-telemetry|peer-reader ...   started by `run`
 // PMU_BENCH_DEBUG=1 lists the numbers of injected frames whose samples never arrived.
 
@@ -14,6 +15,7 @@
 
 #include "benchmarks.hpp"
 #include "domain_pick.hpp"
+#include "mavlink_latency.hpp"
 #include "peers.hpp"
 #include "scale_peers.hpp"
 #include "pmu/dds/dds_context.hpp"
@@ -42,6 +44,15 @@ int main(int argc, char** argv) {
   run->add_option("--realistic-seconds", s.realistic_seconds,
                   "length of each realistic-rate run (one PMU, 5 packets every 0.1 s; default 60, quick 2)")
       ->check(CLI::Range(1.0, 3600.0));
+
+  MavlinkLatencyOptions mav;
+  auto* mavlink = app.add_subcommand("mavlink-latency",
+                                     "CAN frame -> BATTERY_STATUS at pmu-mavlink's UDP peer, beside its DDS sample");
+  mavlink->add_option("--service", s.service_exe, "pmu-service binary")->required()->check(CLI::ExistingFile);
+  mavlink->add_option("--bridge", mav.bridge_exe, "pmu-mavlink binary")->required()->check(CLI::ExistingFile);
+  mavlink->add_option("--seconds", mav.seconds, "how long numbered frames are written (default 60)")
+      ->check(CLI::Range(1.0, 3600.0));
+  mavlink->add_option("--qos", s.qos_file, "QoS profiles (deploy/qos.xml)");
 
   PeerOptions p;
   std::string transport = "default";
@@ -90,10 +101,12 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "pmu_bench: DDS domains %d..%d\n", s.domain_base, s.domain_base + kDomainsPerRun - 1);
     s.self_exe = std::filesystem::read_symlink("/proc/self/exe").string();
     s.service_exe = std::filesystem::absolute(s.service_exe).string();
+    // The service reads it from a config file in the work folder: a relative path would not hold.
+    s.qos_file = std::filesystem::absolute(s.qos_file).string();
     char tmpl[] = "/tmp/pmu-bench-XXXXXX";
     if (!::mkdtemp(tmpl)) throw std::runtime_error("mkdtemp failed");
     s.workdir = tmpl;
-    const Rows rows = run_all(s);
+    const Rows rows = *mavlink ? mavlink_latency_rows(s, mav, s.domain_base) : run_all(s);
     for (const auto& r : rows) std::printf("%s\n", r.dump().c_str());
     std::filesystem::remove_all(s.workdir);
     return 0;
