@@ -14,7 +14,8 @@
 #include "pmu/mavlink/writer.hpp"
 
 namespace pmu::mavlink_bridge {
-namespace {
+// A named namespace: the unity builds put this file beside others of the target.
+namespace signing_gate_test {
 
 namespace nm = pmu::mavlink;
 
@@ -210,5 +211,5 @@ TEST(SigningGate, MessagesOfAnUnclassedKindCountAsAddressed) {
   EXPECT_FALSE(addressed_to(f, kSystem, kComponent));
 }
 
-}  // namespace
+}  // namespace signing_gate_test
 }  // namespace pmu::mavlink_bridge

@@ -12,7 +12,8 @@
 #include <string>
 
 namespace pmu::mavlink_bridge {
-namespace {
+// A named namespace: the unity builds put this file beside others of the target.
+namespace signing_key_file_test {
 
 // A folder of its own for each test's files, removed at the end.
 class KeyFolder {
@@ -115,5 +116,5 @@ TEST(SigningKeyFile, AShortPassphraseIsAWarning) {
   EXPECT_NE(file.issues[0].message.find("has 3 characters"), std::string::npos) << file.issues[0].message;
 }
 
-}  // namespace
+}  // namespace signing_key_file_test
 }  // namespace pmu::mavlink_bridge
