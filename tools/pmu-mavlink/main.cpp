@@ -6,6 +6,7 @@
 #include <CLI/CLI.hpp>
 #include <poll.h>
 
+#include <chrono>
 #include <csignal>
 #include <cstdio>
 #include <memory>
@@ -20,6 +21,7 @@
 #include "program/bridge.hpp"
 #include "program/dds_inputs.hpp"
 #include "program/settings.hpp"
+#include "signing/signing_key_file.hpp"
 
 namespace {
 
@@ -33,7 +35,7 @@ int main(int argc, char** argv) {
   CLI::App app{"pmu-mavlink: pmu-service's power system as a MAVLink 2 component"};
   std::string config_file, udp_text, serial_text, vehicle_text;
   std::optional<int> system_id, component_id, domain, pmu_id, bms_id;
-  std::optional<std::string> vehicle, qos_file, security_dir, identity;
+  std::optional<std::string> vehicle, qos_file, security_dir, identity, signing_key;
   std::vector<std::string> rates;
   app.add_option("--config", config_file, "YAML file with any of the settings below (the options win)");
   app.add_option("--udp", udp_text, "UDP client endpoint HOST:PORT (sends there, takes what comes back)");
@@ -47,6 +49,8 @@ int main(int argc, char** argv) {
   app.add_option("--qos-file", qos_file, "QoS profiles (default: $PMU_QOS_FILE, then the installed qos.xml)");
   app.add_option("--security-dir", security_dir, "DDS-Security folder (deploy/security/make_pki.sh)");
   app.add_option("--identity", identity, "DDS-Security identity in that folder");
+  app.add_option("--signing-key", signing_key,
+                 "MAVLink 2 signing: file holding the passphrase the ground stations use (one line, chmod 600)");
   app.add_option("--battery-id-pmu", pmu_id, "BATTERY_STATUS id of the first PMU's battery A (default 10)")
       ->check(CLI::Range(0, 253));
   app.add_option("--battery-id-bms", bms_id, "BATTERY_STATUS id of the first BMS (default 20)")
@@ -86,6 +90,7 @@ int main(int argc, char** argv) {
   if (qos_file) settings.qos_file = *qos_file;
   if (security_dir) settings.security_dir = *security_dir;
   if (identity) settings.identity = *identity;
+  if (signing_key) settings.signing_key = *signing_key;
   if (pmu_id) settings.pmu_battery_id = static_cast<std::uint8_t>(*pmu_id);
   if (bms_id) settings.bms_battery_id = static_cast<std::uint8_t>(*bms_id);
   for (const auto& r : rates)
@@ -104,6 +109,20 @@ int main(int argc, char** argv) {
       std::fprintf(stderr, "pmu-mavlink: %s%s\n",
                    i.level == pmu::dds::SecurityIssue::Level::Error ? "" : "warning: ", i.message.c_str());
     if (pmu::dds::has_errors(issues)) return 2;
+  }
+
+  // Checked before any endpoint or participant opens, like the DDS-Security files.
+  std::optional<Bridge::Signing> signing;
+  if (!settings.signing_key.empty()) {
+    const auto key_file = read_signing_key_file(settings.signing_key);
+    for (const auto& i : key_file.issues)
+      std::fprintf(stderr, "pmu-mavlink: %s%s\n", i.error ? "" : "warning: ", i.message.c_str());
+    if (!key_file.key) return 2;
+    signing = Bridge::Signing{*key_file.key, [] {
+                                const auto since_epoch = std::chrono::system_clock::now().time_since_epoch();
+                                const auto us = std::chrono::duration_cast<std::chrono::microseconds>(since_epoch);
+                                return pmu::mavlink::signing_timestamp(static_cast<std::uint64_t>(us.count()));
+                              }};
   }
 
   std::vector<std::unique_ptr<Endpoint>> endpoints;
@@ -130,7 +149,7 @@ int main(int argc, char** argv) {
 
   std::vector<Endpoint*> raw;
   for (auto& e : endpoints) raw.push_back(e.get());
-  Bridge bridge(settings, raw, *inputs);
+  Bridge bridge(settings, raw, *inputs, signing);
   // The parameter and command protocol plugs in here: bridge.set_frame_handler(...).
 
   struct sigaction sa {};
@@ -142,6 +161,16 @@ int main(int argc, char** argv) {
   for (const auto& e : endpoints)
     std::fprintf(stderr, "pmu-mavlink: %s, component %u\n", e->describe().c_str(),
                  static_cast<unsigned>(settings.component_id));
+  if (signing) {
+    std::fprintf(stderr,
+                 "pmu-mavlink: MAVLink signing on (%s): frames out signed; commands and parameter messages "
+                 "addressed to this component taken only signed with that key\n",
+                 settings.signing_key.c_str());
+  } else {
+    std::fprintf(stderr,
+                 "pmu-mavlink: MAVLink signing off (no --signing-key): any sender that reaches an endpoint, anyone in "
+                 "range of a radio link among them, can command the power system\n");
+  }
   int status = 0;
   std::vector<pollfd> fds;
   for (const auto& e : endpoints) fds.push_back({e->fd(), POLLIN, 0});
@@ -162,6 +191,15 @@ int main(int argc, char** argv) {
                static_cast<unsigned long long>(p.unknown_message), static_cast<unsigned long long>(p.mavlink1_frames),
                static_cast<unsigned long long>(p.unsupported_incompat_flags),
                static_cast<unsigned long long>(p.garbage_bytes), static_cast<unsigned long long>(bridge.frames_sent()));
+  if (const auto* c = bridge.signing_counters()) {
+    std::fprintf(stderr,
+                 "pmu-mavlink: signing: frames signed %llu, accepted %llu; refused: unsigned %llu, bad signature %llu, "
+                 "replayed %llu, stale %llu, too many streams %llu\n",
+                 static_cast<unsigned long long>(c->signed_out), static_cast<unsigned long long>(c->accepted),
+                 static_cast<unsigned long long>(c->unsigned_frames), static_cast<unsigned long long>(c->bad_signature),
+                 static_cast<unsigned long long>(c->replayed), static_cast<unsigned long long>(c->stale),
+                 static_cast<unsigned long long>(c->too_many_streams));
+  }
   for (const auto& e : endpoints) {
     const auto& c = e->counters();
     std::fprintf(stderr, "pmu-mavlink: %s: bytes in %llu, out %llu, send failures %llu, read failures %llu\n",

@@ -29,6 +29,7 @@ TEST(Settings, EveryKey) {
       "domain: 7\n"
       "vehicle: uav1\n"
       "qos_file: /etc/pmu-dds/qos.xml\n"
+      "signing_key: /etc/pmu-dds/mavlink-signing.key\n"
       "battery_ids: {pmu: 30, bms: 40}\n"
       "rates: {battery_status: 1, generator_status: 0, heartbeat: 2}\n",
       "m.yaml", s);
@@ -40,6 +41,7 @@ TEST(Settings, EveryKey) {
   EXPECT_EQ(s.component_id, 191);
   EXPECT_EQ(s.domain, 7);
   EXPECT_EQ(s.vehicle, "uav1");
+  EXPECT_EQ(s.signing_key, "/etc/pmu-dds/mavlink-signing.key");
   EXPECT_EQ(s.pmu_battery_id, 30);
   EXPECT_EQ(s.bms_battery_id, 40);
   EXPECT_EQ(s.intervals.at(id::kBatteryStatus), 1s);
@@ -60,6 +62,8 @@ TEST(Settings, ErrorsNameFileAndLine) {
       {"sysid: 1\n", "m.yaml:1: unknown key 'sysid'"},
       {"battery_ids: {pmu: 254}\n", "m.yaml:1: battery_ids.pmu: '254' is not a whole number 0..253"},
       {"udp: [\n", "m.yaml:"},
+      {"udp: 127.0.0.1:14550\nsigning_key: [a, b]\n", "m.yaml:2: signing_key: expected a value"},
+      {"signing_key: ''\n", "m.yaml:1: signing_key: expected the key file's path"},
   };
   for (const auto& c : cases) {
     Settings s;

@@ -17,7 +17,8 @@ constexpr std::uint8_t kSystemIdUntilHeard = 1;
 
 }  // namespace
 
-Bridge::Bridge(const Settings& settings, std::vector<Endpoint*> endpoints, DdsInputs& inputs)
+Bridge::Bridge(const Settings& settings, std::vector<Endpoint*> endpoints, DdsInputs& inputs,
+               std::optional<Signing> signing)
     : settings_(settings),
       endpoints_(std::move(endpoints)),
       inputs_(inputs),
@@ -25,6 +26,10 @@ Bridge::Bridge(const Settings& settings, std::vector<Endpoint*> endpoints, DdsIn
       system_id_fixed_(settings.system_id.has_value()),
       writer_(std::make_unique<nm::FrameWriter>(system_id_, settings.component_id)),
       scheduler_(settings.intervals) {
+  if (signing) {
+    gate_ = SigningGate(signing->key);
+    signing_clock_ = std::move(signing->clock);
+  }
   other_frames_ = [this](const nm::Frame& frame, const Send& send) {
     const auto command = nm::decode<nm::CommandLong>(frame);
     if (!command) return;
@@ -40,7 +45,7 @@ Bridge::Bridge(const Settings& settings, std::vector<Endpoint*> endpoints, DdsIn
 }
 
 void Bridge::send_payload(std::uint32_t msgid, const nm::Payload& payload) {
-  const auto frame = writer_->encode(msgid, payload, nullptr, 0);
+  const auto frame = writer_->encode(msgid, payload, gate_.outgoing(), signing_now_);
   for (Endpoint* e : endpoints_) e->send(frame);
   ++frames_sent_;
 }
@@ -52,6 +57,7 @@ ServiceReadiness Bridge::readiness() const {
 }
 
 bool Bridge::step(Clock::time_point now) {
+  if (signing_clock_) signing_now_ = signing_clock_();
   bool alive = true;
   for (Endpoint* e : endpoints_) {
     inbound_.clear();
@@ -79,9 +85,15 @@ bool Bridge::step(Clock::time_point now) {
 
 void Bridge::on_frame(const nm::Frame& frame, Clock::time_point now) {
   if (frame.sysid == system_id_ && frame.compid == settings_.component_id) return;  // our own, looped back
+  // With a key, a frame addressed to this component that is unsigned, wrongly signed or
+  // replayed goes no further: neither this bridge nor the frame handler sees it.
+  if (!gate_.admits(frame, system_id_, settings_.component_id, signing_now_)) return;
   if (const auto hb = nm::decode<nm::Heartbeat>(frame)) {
     // The autopilot: a flight controller's HEARTBEAT (not a GCS, not another peripheral).
-    if (!system_id_fixed_ && hb->autopilot != nm::mav_autopilot::kInvalid && hb->type != nm::mav_type::kGcs) {
+    // With a key, only a signed one: an unsigned HEARTBEAT from anyone in radio range would
+    // otherwise move the component to another system id, away from its ground station.
+    if (!system_id_fixed_ && hb->autopilot != nm::mav_autopilot::kInvalid && hb->type != nm::mav_type::kGcs &&
+        gate_.authentic(frame, signing_now_)) {
       system_id_fixed_ = true;
       if (frame.sysid != system_id_) {
         system_id_ = frame.sysid;

@@ -18,6 +18,7 @@
 #include "program/dds_inputs.hpp"
 #include "program/settings.hpp"
 #include "schedule/rate_scheduler.hpp"
+#include "signing/signing_gate.hpp"
 #include "status/status_texts.hpp"
 #include "telemetry/heartbeat.hpp"
 
@@ -35,7 +36,16 @@ class Bridge {
   using Send = std::function<void(std::uint32_t msgid, const pmu::mavlink::Payload& payload)>;
   using FrameHandler = std::function<void(const pmu::mavlink::Frame& frame, const Send& send)>;
 
-  Bridge(const Settings& settings, std::vector<Endpoint*> endpoints, DdsInputs& inputs);
+  // Message signing (interface.md 12.6): the key, and the clock as a signing timestamp
+  // (pmu::mavlink::signing_timestamp of the wall clock), read once per step().
+  struct Signing {
+    pmu::mavlink::SecretKey key;
+    std::function<std::uint64_t()> clock;
+  };
+
+  // Without `signing`: nothing signed, every frame taken as it comes.
+  Bridge(const Settings& settings, std::vector<Endpoint*> endpoints, DdsInputs& inputs,
+         std::optional<Signing> signing = std::nullopt);
 
   void set_frame_handler(FrameHandler handler) { other_frames_ = std::move(handler); }
 
@@ -48,6 +58,8 @@ class Bridge {
   // Frames written since start; each went to every endpoint (their counters say what each
   // could send).
   std::uint64_t frames_sent() const noexcept { return frames_sent_; }
+  // Frames signed, accepted and refused by kind; null without signing.
+  const pmu::mavlink::SigningCounters* signing_counters() const noexcept { return gate_.counters(); }
 
  private:
   template <class Message>
@@ -77,6 +89,9 @@ class Bridge {
   std::map<DeviceKey, std::uint8_t> pmu_slots_;
   std::map<DeviceKey, std::uint8_t> bms_slots_;
   FrameHandler other_frames_;
+  SigningGate gate_;
+  std::function<std::uint64_t()> signing_clock_;
+  std::uint64_t signing_now_ = 0;
   std::uint64_t frames_sent_ = 0;
   std::vector<std::uint8_t> inbound_;
 };

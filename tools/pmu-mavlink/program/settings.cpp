@@ -129,6 +129,9 @@ void read_settings(const std::string& text, const std::string& source, Settings&
       into.security_dir = c.text(v, "security_dir");
     } else if (key == "identity") {
       into.identity = c.text(v, "identity");
+    } else if (key == "signing_key") {
+      into.signing_key = c.text(v, "signing_key");
+      if (into.signing_key.empty()) c.fail(v, "signing_key: expected the key file's path");
     } else if (key == "battery_ids") {
       if (!v.IsMap()) c.fail(v, "battery_ids: expected pmu: and bms:");
       for (const auto& b : v) {
@@ -154,7 +157,7 @@ void read_settings(const std::string& text, const std::string& source, Settings&
     } else {
       c.fail(kv.first, "unknown key '" + key +
                            "' (udp, serial, system_id, component_id, domain, vehicle, qos_file, security_dir, "
-                           "identity, battery_ids, rates)");
+                           "identity, signing_key, battery_ids, rates)");
     }
   }
 }

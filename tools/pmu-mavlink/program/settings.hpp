@@ -41,6 +41,8 @@ struct Settings {
   std::string qos_file;
   std::string security_dir;
   std::string identity;
+  // The message-signing key file (signing/signing_key_file.hpp); empty: signing off.
+  std::string signing_key;
   // PMU n (in the order first heard, from 0): battery A id pmu_battery_id + 2n, B + 2n + 1.
   std::uint8_t pmu_battery_id = kDefaultPmuBatteryId;
   // BMS n (in the order first heard): bms_battery_id + n.
