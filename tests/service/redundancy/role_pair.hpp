@@ -9,14 +9,21 @@
 #include <functional>
 #include <memory>
 #include <optional>
+#include <ostream>
 #include <string>
 #include <vector>
 
 #include "pmu/redundancy/role_machine.hpp"
 
-namespace pmu::redundancy::pair_test {
+namespace pmu::redundancy {
 
-using namespace std::chrono_literals;
+// A failed expectation names the role and the alarm, not their bytes.
+inline void PrintTo(Role role, std::ostream* os) { *os << role_name(role); }
+inline void PrintTo(PeerAlarm alarm, std::ostream* os) { *os << alarm_name(alarm); }
+
+}  // namespace pmu::redundancy
+
+namespace pmu::redundancy::pair_test {
 
 inline constexpr Duration kTick{5};
 
