@@ -172,17 +172,37 @@ TEST(RolePair, ANetworkCutMakesNoSecondOwnerAndAnAlarmOnBoth) {
   EXPECT_TRUE(p.violations().empty()) << violations_of(p);
 }
 
-TEST(RolePair, TheOwnerDyingDuringANetworkCutIsTakenOverOnceTheBusIsQuiet) {
-  Pair p(2, 1);
-  settle(p);
-  p.dds_up = false;
-  p.run_for(std::chrono::seconds(2));
-  ASSERT_EQ(p.role(1), Role::Fenced);
-  p.kill(0);
-  const auto takeover = p.run_until([&] { return p.role(1) == Role::Active; }, std::chrono::seconds(3));
-  ASSERT_TRUE(takeover.has_value());
-  EXPECT_LE(*takeover, Settings{}.can_silence + claim_window(Settings{}) + 2 * kTick);
-  EXPECT_TRUE(p.violations().empty()) << violations_of(p);
+// Cut off on DDS, the standby learns of the owner's end from the bus alone.
+TEST(RolePair, TheOwnerEndingDuringANetworkCutIsTakenOverOnceTheBusIsQuiet) {
+  const Settings s;
+  struct Case {
+    Fault fault;
+    Duration bound;
+  };
+  const Case cases[] = {
+      {Fault::Kill, s.can_silence + claim_window(s) + 2 * kTick},
+      {Fault::BusOff, s.can_silence + claim_window(s) + 2 * kTick},
+      {Fault::Stop, claim_window(s) + 2 * kTick},  // its release frame
+  };
+  for (const auto& c : cases) {
+    SCOPED_TRACE(fault_name(c.fault));
+    Pair p(2, 1);
+    settle(p);
+    p.dds_up = false;
+    p.run_for(std::chrono::seconds(2));
+    ASSERT_EQ(p.role(1), Role::Fenced);
+    switch (c.fault) {
+      case Fault::Kill: p.kill(0); break;
+      case Fault::BusOff: p.set_bus(0, BusState::BusOff); break;
+      case Fault::Stop: p.machine(0).leave(p.now()); break;
+      case Fault::Freeze:
+      case Fault::BusDown: break;
+    }
+    const auto takeover = p.run_until([&] { return p.role(1) == Role::Active; }, std::chrono::seconds(3));
+    ASSERT_TRUE(takeover.has_value());
+    EXPECT_LE(*takeover, c.bound);
+    EXPECT_TRUE(p.violations().empty()) << violations_of(p);
+  }
 }
 
 TEST(RolePair, AMoveHandsTheBusToTheStandbyWhichKeepsIt) {
