@@ -21,7 +21,7 @@ import room_map  # noqa: E402
 
 LINK_MAP = pathlib.Path(os.environ.get("PMU_LINK_MAP", ROOT / "build/dev/tests/rooms/link_map.tsv"))
 CONFIG_ROW = ("| `pmu::codec`, `pmu::command`, `pmu::security`, `pmu::alarms`, `pmu::baseline`, "
-              "`pmu::dds_settings` / `pmu::files`, `pmu::version` |")
+              "`pmu::dds_settings`, `pmu::redundancy` / `pmu::files`, `pmu::version` |")
 
 
 def edit(name, old, new):
@@ -48,7 +48,7 @@ CASES = [
      edit("map", CONFIG_ROW, CONFIG_ROW.replace("`pmu::files`, ", "")), 1,
      ["pmu::config: the build links pmu::files PRIVATE, the map does not",
       "pmu::config: write its links cell as `pmu::codec`, `pmu::command`, `pmu::security`, "
-      "`pmu::alarms`, `pmu::baseline`, `pmu::dds_settings` / `pmu::files`, `pmu::version`"]),
+      "`pmu::alarms`, `pmu::baseline`, `pmu::dds_settings`, `pmu::redundancy` / `pmu::files`, `pmu::version`"]),
     ("a link the build lacks",
      edit("map", "| `pmu::session`, `pmu::command` |", "| `pmu::session`, `pmu::command`, `pmu::dds` |"), 1,
      ["pmu::dispatch: the map says it links pmu::dds PUBLIC, the build does not"]),

@@ -421,6 +421,60 @@ void parse_timeouts(const Ctx& c, const YAML::Node& n, Timeouts& t) {
     c.fail(n["offline_periods"] ? n["offline_periods"] : n, "offline_periods must be greater than stale_periods");
 }
 
+// ---- `redundancy:` (pmu/redundancy/settings.hpp, docs/interface.md section 4.7) ----
+
+// A period in seconds, in whole milliseconds: what the role machine counts in.
+redundancy::Duration redundancy_period(const Ctx& c, const YAML::Node& n, const char* name, redundancy::Duration lo,
+                                       redundancy::Duration hi) {
+  const double s = c.number(n, name, static_cast<double>(lo.count()) / 1000, static_cast<double>(hi.count()) / 1000);
+  const double ms = s * 1000;
+  if (std::fabs(ms - std::round(ms)) > 1e-6)
+    c.fail(n, std::string(name) + " " + n.Scalar() + " is not whole milliseconds");
+  return redundancy::Duration(std::lround(ms));
+}
+
+// The instance names of pmu/role's key: what a host name may hold.
+bool is_instance_name(const std::string& name) {
+  return !name.empty() && name.size() <= 63 && std::all_of(name.begin(), name.end(), [](char ch) {
+    return std::isalnum(static_cast<unsigned char>(ch)) != 0 || ch == '-' || ch == '_' || ch == '.';
+  });
+}
+
+redundancy::Settings parse_redundancy(const Ctx& c, const YAML::Node& n) {
+  if (!n.IsMap()) c.fail(n, "redundancy must be a map: {priority: 2, peer: mc-b}");
+  c.only_keys(n, "redundancy", {"priority", "peer", "heartbeat_period", "lease", "can_silence"});
+  redundancy::Settings r;
+  const auto priority = n["priority"];
+  if (!priority) c.fail(n, "redundancy needs priority (1..255; the higher wins when neither instance owns the bus)");
+  r.priority = static_cast<std::uint8_t>(c.integer(priority, "redundancy priority", redundancy::kMinPriority, 255));
+  const auto peer = n["peer"];
+  if (!peer) c.fail(n, "redundancy needs peer (the other instance's name)");
+  r.peer = peer.IsNull() ? std::string() : c.scalar<std::string>(peer, "redundancy peer", "a name");
+  if (!is_instance_name(r.peer)) {
+    // `peer:` with nothing after it is YAML null, whose mark is the next line: name the key's.
+    const auto key = [&]() -> YAML::Node {
+      for (const auto& kv : n)
+        if (kv.first.Scalar() == "peer") return kv.first;
+      return peer;
+    };
+    c.fail(peer.IsNull() ? key() : peer,
+           "redundancy peer " + quoted(r.peer) +
+               " is not an instance name (1..63 letters, digits, '-', '_' or '.', as a host name)");
+  }
+  if (const auto v = n["heartbeat_period"])
+    r.heartbeat_period = redundancy_period(c, v, "redundancy heartbeat_period", redundancy::kMinHeartbeatPeriod,
+                                           redundancy::kMaxHeartbeatPeriod);
+  if (const auto v = n["lease"])
+    r.lease = redundancy_period(c, v, "redundancy lease", redundancy::Duration{1}, redundancy::kMaxLease);
+  if (const auto v = n["can_silence"])
+    r.can_silence =
+        redundancy_period(c, v, "redundancy can_silence", redundancy::kMinCanSilence, redundancy::kMaxCanSilence);
+  // The lease against the heartbeat period: at the line of whichever of the two is written.
+  if (const auto why = redundancy::settings_problem(r); !why.empty())
+    c.fail(n["lease"] ? n["lease"] : n["heartbeat_period"] ? n["heartbeat_period"] : n, "redundancy " + why);
+  return r;
+}
+
 void parse_ros2(const Ctx& c, const YAML::Node& n, dds::Ros2Settings& r) {
   if (!n.IsMap()) c.fail(n, "ros2 must be a map: {enabled: true, namespace: /fleet}");
   c.only_keys(n, "ros2", {"enabled", "namespace"});
@@ -741,7 +795,7 @@ Config parse_config(const std::string& text, const std::string& source, const Co
   c.only_keys(root, "the top level",
               {"domain", "vehicle", "low_rate_period", "qos_file", "dds_transport", "log_level", "buses", "timeouts",
                "policy", "security", "discovery", "interfaces", "canopen_publish_period", "dds_statistics",
-               "dds_type_objects", "also_serve_contract", "ros2", "link"});
+               "dds_type_objects", "also_serve_contract", "ros2", "link", "redundancy"});
   if (const auto v = root["domain"]) cfg.domain = static_cast<int>(c.integer(v, "domain", 0, 232));
   if (const auto v = root["vehicle"]) {
     // `vehicle:` with nothing after it is YAML null: the unnamed vehicle, like no key.
@@ -806,6 +860,11 @@ Config parse_config(const std::string& text, const std::string& source, const Co
   }
   if (const auto v = root["timeouts"]) parse_timeouts(c, v, cfg.timeouts);
   if (const auto v = root["ros2"]) parse_ros2(c, v, cfg.ros2);
+  for (const auto& kv : root)
+    if (kv.first.as<std::string>() == "redundancy") {
+      cfg.redundancy = parse_redundancy(c, kv.second);
+      cfg.redundancy_line = c.line_of(kv.first);
+    }
   if (const auto v = root["link"]) {
     parse_link(c, v, cfg.network.link);
     cfg.network.link.low_rate_period_given = static_cast<bool>(root["low_rate_period"]);

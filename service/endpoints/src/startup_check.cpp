@@ -55,6 +55,17 @@ void check_qos(const Config& cfg, StartupCheck& out) {
   for (const auto& p : dds::qos_file_problems(out.qos_file, service_profiles())) out.errors.push_back(where + p);
 }
 
+// A `redundancy:` section makes this service one of a hot-standby pair, and this pmu-service
+// does not run the role machine: beside its peer it would own the bus too, and both would poll
+// and send every command (docs/safety.md H8). Refused, not ignored.
+void check_redundancy(const Config& cfg, StartupCheck& out) {
+  if (!cfg.redundancy) return;
+  out.errors.push_back(cfg.redundancy_line +
+                       ": redundancy: this pmu-service does not run as one of a hot-standby pair "
+                       "(docs/interface.md 4.7): beside its peer both would own the bus and send every command; "
+                       "remove the section");
+}
+
 }  // namespace
 
 // Fast DDS would only log a statistics writer the permissions refuse; DdsContext refuses to
@@ -72,6 +83,7 @@ StartupCheck check_startup(const Config& cfg) {
   check_security(cfg, out);
   check_statistics_grants(cfg, out);
   check_qos(cfg, out);
+  check_redundancy(cfg, out);
   return out;
 }
 

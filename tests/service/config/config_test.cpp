@@ -124,7 +124,7 @@ const BadCase kBad[] = {
     {"domain: 0\n", "bad.yaml:1: no buses: the service needs at least one bus"},
     {"domian: 0\nbuses: []\n",
      "bad.yaml:1: unknown key 'domian' in the top level (known: domain, vehicle, low_rate_period, qos_file, dds_transport, log_level, "
-     "buses, timeouts, policy, security, discovery, interfaces, canopen_publish_period, dds_statistics, dds_type_objects, also_serve_contract, ros2, link)"},
+     "buses, timeouts, policy, security, discovery, interfaces, canopen_publish_period, dds_statistics, dds_type_objects, also_serve_contract, ros2, link, redundancy)"},
     {"domain: 0\nvehicle: uav*\nbuses: []\n",
      "bad.yaml:2: vehicle 'uav*' contains '*'; a vehicle name is letters, digits, '_', '-' and '.' (it is also a DDS "
      "partition name, where other characters are patterns)"},

@@ -54,6 +54,17 @@ TEST(StartupCheck, TheShippedQosFileHasEveryProfileTheServiceUses) {
   EXPECT_EQ(c.qos_file, kShippedQos);
 }
 
+// Two services that each own the bus would both send every command (docs/safety.md H8).
+TEST(StartupCheck, ARedundancySectionIsRefusedAtItsLine) {
+  const auto c = check("qos_file: " + kShippedQos + "\nredundancy:\n  priority: 2\n  peer: mc-b\n" + kBus,
+                       "/etc/pmu-dds/pmu-service.yaml");
+  ASSERT_EQ(c.errors.size(), 1u);
+  EXPECT_EQ(c.errors[0],
+            "/etc/pmu-dds/pmu-service.yaml:2: redundancy: this pmu-service does not run as one of a hot-standby pair "
+            "(docs/interface.md 4.7): beside its peer both would own the bus and send every command; remove the "
+            "section");
+}
+
 TEST(StartupCheck, MissingQosFileIsNamedAtTheConfigLine) {
   const auto c = check(std::string(kBus) + "qos_file: /nonexistent/qos.xml\n", "/etc/pmu-dds/pmu-service.yaml");
   ASSERT_EQ(c.errors.size(), 1u);

@@ -21,6 +21,7 @@
 #include "pmu/dds_settings/ros2_names.hpp"
 #include "pmu/config/sim_settings.hpp"
 #include "pmu/dds_settings/transport_choice.hpp"
+#include "pmu/redundancy/settings.hpp"
 #include "pmu/security/security_files.hpp"
 
 namespace pmu::service {
@@ -182,6 +183,11 @@ struct Config {
   // `ros2`: sensor_msgs/BatteryState and diagnostic_msgs/DiagnosticArray in ROS 2's own
   // names and types (ros2_names.hpp, docs/interface.md section 11).
   dds::Ros2Settings ros2;
+  // `redundancy`: this instance of a hot-standby pair (docs/interface.md section 4.7,
+  // docs/design.md "Hot standby"); none: a service alone on its buses. Checked by
+  // redundancy::settings_problem; `redundancy_line` is the section's FILE:LINE.
+  std::optional<redundancy::Settings> redundancy;
+  std::string redundancy_line;
   std::string log_level = "info";
   std::vector<BusConfig> buses;
   Timeouts timeouts;

@@ -4,7 +4,9 @@
 // (security_files.hpp: present, readable, valid, not expired, one CA not reused) and that their
 // permissions let the service publish its dds_statistics topics, and the QoS
 // profile file (dds_qos_file.hpp: found, well-formed, loaded by Fast DDS, holding every
-// profile the service makes endpoints with, each with the declared capacity). The config's
+// profile the service makes endpoints with, each with the declared capacity), and that the
+// config does not ask for a hot-standby pair (`redundancy:`), which this service does not run
+// as. The config's
 // own checks (keys, values, documents, paths, credentials) ran when it was parsed.
 // Start-up only; loads the QoS file into Fast DDS's process-wide registry.
 
