@@ -78,6 +78,7 @@ class Bridge {
   std::map<DeviceKey, std::uint8_t> bms_slots_;
   FrameHandler other_frames_;
   std::uint64_t frames_sent_ = 0;
+  std::optional<Clock::time_point> started_;  // the first step: RELAY_STATUS's time_boot_ms counts from it
   std::vector<std::uint8_t> inbound_;
 };
 
