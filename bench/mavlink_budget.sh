@@ -33,7 +33,7 @@ s = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
 s.bind(("127.0.0.1", 0))
 open(sys.argv[1], "w").write(str(s.getsockname()[1]))
 window = float(sys.argv[2])
-names = {0: "HEARTBEAT", 147: "BATTERY_STATUS", 373: "GENERATOR_STATUS", 253: "STATUSTEXT", 77: "COMMAND_ACK"}
+names = {0: "HEARTBEAT", 147: "BATTERY_STATUS", 373: "GENERATOR_STATUS", 376: "RELAY_STATUS", 253: "STATUSTEXT", 77: "COMMAND_ACK"}
 batteries, start, by_id = set(), None, {}
 while True:
     d = s.recv(65536)

@@ -1,8 +1,9 @@
 // pmu-mavlink: the power system on the aircraft's MAVLink network (interface.md
 // "pmu-mavlink"). A DDS client of pmu-service like any ground station (same vehicle,
 // partitions and DDS-Security identity; it never touches the bus) and a MAVLink 2 component
-// with its own id: HEARTBEAT, BATTERY_STATUS and GENERATOR_STATUS at their rates, alarms and
-// readiness as STATUSTEXT, SET_MESSAGE_INTERVAL and RUN_PREARM_CHECKS answered.
+// with its own id: HEARTBEAT, BATTERY_STATUS, GENERATOR_STATUS and RELAY_STATUS at their
+// rates, alarms and readiness as STATUSTEXT, SET_MESSAGE_INTERVAL and RUN_PREARM_CHECKS
+// answered.
 #include <CLI/CLI.hpp>
 #include <poll.h>
 
@@ -55,7 +56,7 @@ int main(int argc, char** argv) {
       ->check(CLI::Range(0, 253));
   app.add_option("--battery-id-bms", bms_id, "BATTERY_STATUS id of the first BMS (default 20)")
       ->check(CLI::Range(0, 254));
-  app.add_option("--rate", rates, "NAME=HZ: heartbeat, battery_status, generator_status (0: off)");
+  app.add_option("--rate", rates, "NAME=HZ: heartbeat, battery_status, generator_status, relay_status (0: off)");
   CLI11_PARSE(app, argc, argv);
 
   Settings settings;

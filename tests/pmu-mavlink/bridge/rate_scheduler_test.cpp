@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include "pmu/mavlink/constants.hpp"
+#include "program/settings.hpp"
 
 namespace pmu::mavlink_bridge {
 namespace {
@@ -32,6 +33,19 @@ TEST(RateScheduler, LateLoopKeepsTheRateWithoutBurst) {
   EXPECT_EQ(s.due(t0 + 10s), (Ids{0, 147})) << "far behind: once";
   EXPECT_EQ(s.due(t0 + 10500ms), Ids{});
   EXPECT_EQ(s.due(t0 + 11s), (Ids{0}));
+}
+
+// The program's streams are its settings' intervals: RELAY_STATUS at 1 Hz by default, and
+// SET_MESSAGE_INTERVAL reaches it as any other stream.
+TEST(RateScheduler, RelayStatusStreamedByDefault) {
+  RateScheduler s(Settings{}.intervals);
+  EXPECT_EQ(s.interval_us(376), 1000000);
+  EXPECT_EQ(s.set_interval(376, 200000, t0), result::kAccepted);
+  EXPECT_EQ(s.interval_us(376), 200000);
+  EXPECT_EQ(s.set_interval(376, -1, t0), result::kAccepted);
+  EXPECT_EQ(s.interval_us(376), 0) << "stopped";
+  EXPECT_EQ(s.set_interval(376, 0, t0), result::kAccepted);
+  EXPECT_EQ(s.interval_us(376), 1000000) << "the default again";
 }
 
 TEST(RateScheduler, SetMessageInterval) {

@@ -17,6 +17,7 @@ TEST(Settings, Defaults) {
   EXPECT_EQ(s.intervals.at(id::kHeartbeat), 1s);
   EXPECT_EQ(s.intervals.at(id::kBatteryStatus), 2s);
   EXPECT_EQ(s.intervals.at(id::kGeneratorStatus), 1s);
+  EXPECT_EQ(s.intervals.at(id::kRelayStatus), 1s);
 }
 
 TEST(Settings, EveryKey) {
@@ -31,7 +32,7 @@ TEST(Settings, EveryKey) {
       "qos_file: /etc/pmu-dds/qos.xml\n"
       "signing_key: /etc/pmu-dds/mavlink-signing.key\n"
       "battery_ids: {pmu: 30, bms: 40}\n"
-      "rates: {battery_status: 1, generator_status: 0, heartbeat: 2}\n",
+      "rates: {battery_status: 1, generator_status: 0, heartbeat: 2, relay_status: 0.2}\n",
       "m.yaml", s);
   ASSERT_TRUE(s.udp);
   EXPECT_EQ(s.udp->port, 14550);
@@ -47,6 +48,7 @@ TEST(Settings, EveryKey) {
   EXPECT_EQ(s.intervals.at(id::kBatteryStatus), 1s);
   EXPECT_EQ(s.intervals.at(id::kGeneratorStatus), 0s) << "0 Hz: off";
   EXPECT_EQ(s.intervals.at(id::kHeartbeat), 500ms);
+  EXPECT_EQ(s.intervals.at(id::kRelayStatus), 5s);
 }
 
 TEST(Settings, ErrorsNameFileAndLine) {
@@ -80,6 +82,8 @@ TEST(Settings, RateOption) {
   Settings s;
   EXPECT_FALSE(apply_rate_option("battery_status=0.2", s));
   EXPECT_EQ(s.intervals.at(id::kBatteryStatus), 5s);
+  EXPECT_FALSE(apply_rate_option("relay_status=0", s));
+  EXPECT_EQ(s.intervals.at(id::kRelayStatus), 0s) << "off";
   for (const char* bad : {"battery_status", "battery_status=fast", "battery_status=-1", "efi_status=1", "heartbeat=1x"})
     EXPECT_TRUE(apply_rate_option(bad, s)) << bad;
 }

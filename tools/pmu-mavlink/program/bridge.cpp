@@ -3,6 +3,7 @@
 #include "pmu/mavlink/messages.hpp"
 #include "telemetry/battery_status.hpp"
 #include "telemetry/generator_status.hpp"
+#include "telemetry/relay_status.hpp"
 
 namespace pmu::mavlink_bridge {
 
@@ -58,6 +59,7 @@ ServiceReadiness Bridge::readiness() const {
 
 bool Bridge::step(Clock::time_point now) {
   if (signing_clock_) signing_now_ = signing_clock_();
+  if (!started_) started_ = now;
   bool alive = true;
   for (Endpoint* e : endpoints_) {
     inbound_.clear();
@@ -184,6 +186,13 @@ void Bridge::send_due(Clock::time_point now) {
       }
     } else if (msgid == nm::msgid::kGeneratorStatus) {
       for (const auto& [key, view] : inputs_.pmus()) send(generator_status(view));
+    } else if (msgid == nm::msgid::kRelayStatus) {
+      // One message for every PMU, also with none known: silence would leave a ground
+      // station showing the outputs' last state (docs/safety.md H7).
+      std::vector<std::pair<unsigned, const PmuView*>> numbered;
+      for (const auto& [key, view] : inputs_.pmus()) numbered.emplace_back(pmu_slot(key), &view);
+      const auto ms = std::chrono::duration_cast<std::chrono::milliseconds>(now - started_.value_or(now)).count();
+      send(relay_status(numbered, static_cast<std::uint32_t>(ms)));
     }
   }
 }

@@ -93,6 +93,7 @@ class Bridge {
   std::function<std::uint64_t()> signing_clock_;
   std::uint64_t signing_now_ = 0;
   std::uint64_t frames_sent_ = 0;
+  std::optional<Clock::time_point> started_;  // the first step: RELAY_STATUS's time_boot_ms counts from it
   std::vector<std::uint8_t> inbound_;
 };
 

@@ -57,6 +57,7 @@ const std::map<std::string, std::uint32_t>& rate_names() {
       {"heartbeat", pmu::mavlink::msgid::kHeartbeat},
       {"battery_status", pmu::mavlink::msgid::kBatteryStatus},
       {"generator_status", pmu::mavlink::msgid::kGeneratorStatus},
+      {"relay_status", pmu::mavlink::msgid::kRelayStatus},
   };
   return names;
 }
@@ -80,7 +81,7 @@ std::optional<std::string> apply_rate_option(const std::string& text, Settings& 
   const auto eq = text.find('=');
   const std::string name = eq == std::string::npos ? text : text.substr(0, eq);
   const auto id = rate_message(name);
-  if (!id) return "--rate " + text + ": NAME is one of heartbeat, battery_status, generator_status";
+  if (!id) return "--rate " + text + ": NAME is one of heartbeat, battery_status, generator_status, relay_status";
   double hz = NAN;
   try {
     std::size_t used = 0;
@@ -149,7 +150,9 @@ void read_settings(const std::string& text, const std::string& source, Settings&
       for (const auto& r : v) {
         const std::string name = r.first.as<std::string>();
         const auto id = rate_message(name);
-        if (!id) c.fail(r.first, "rates: unknown message '" + name + "' (heartbeat, battery_status, generator_status)");
+        if (!id)
+          c.fail(r.first,
+                 "rates: unknown message '" + name + "' (heartbeat, battery_status, generator_status, relay_status)");
         const auto interval = interval_of(c.number(r.second, name.c_str()));
         if (!interval) c.fail(r.second, "rates." + name + ": 0 (off) or 0.01..50 Hz");
         into.intervals[*id] = *interval;

@@ -48,11 +48,14 @@ struct Settings {
   // BMS n (in the order first heard): bms_battery_id + n.
   std::uint8_t bms_battery_id = kDefaultBmsBatteryId;
   // Message id -> interval; zero: not sent. HEARTBEAT 1 Hz (the devguide's rate),
-  // BATTERY_STATUS 0.5 Hz per battery (the devguide's battery service), GENERATOR_STATUS 1 Hz.
+  // BATTERY_STATUS 0.5 Hz per battery (the devguide's battery service), GENERATOR_STATUS 1 Hz,
+  // RELAY_STATUS 1 Hz: a DO_SET_RELAY shows within a second for 19 bytes/s, 0.33 % of a
+  // 57.6 kbit/s radio (bench/results/2026-12-06-mavlink-budget.md).
   std::map<std::uint32_t, std::chrono::microseconds> intervals{
       {pmu::mavlink::msgid::kHeartbeat, std::chrono::seconds(1)},
       {pmu::mavlink::msgid::kBatteryStatus, std::chrono::seconds(2)},
       {pmu::mavlink::msgid::kGeneratorStatus, std::chrono::seconds(1)},
+      {pmu::mavlink::msgid::kRelayStatus, std::chrono::seconds(1)},
   };
 };
 
