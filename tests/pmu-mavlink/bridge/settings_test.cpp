@@ -30,7 +30,8 @@ TEST(Settings, EveryKey) {
       "vehicle: uav1\n"
       "qos_file: /etc/pmu-dds/qos.xml\n"
       "battery_ids: {pmu: 30, bms: 40}\n"
-      "rates: {battery_status: 1, generator_status: 0, heartbeat: 2}\n",
+      "rates: {battery_status: 1, generator_status: 0, heartbeat: 2}\n"
+      "confirm: [engine_start, reset]\n",
       "m.yaml", s);
   ASSERT_TRUE(s.udp);
   EXPECT_EQ(s.udp->port, 14550);
@@ -45,6 +46,11 @@ TEST(Settings, EveryKey) {
   EXPECT_EQ(s.intervals.at(id::kBatteryStatus), 1s);
   EXPECT_EQ(s.intervals.at(id::kGeneratorStatus), 0s) << "0 Hz: off";
   EXPECT_EQ(s.intervals.at(id::kHeartbeat), 500ms);
+  using service::ConfirmRule;
+  for (std::size_t i = 0; i < s.confirm.size(); ++i) {
+    const auto rule = static_cast<ConfirmRule>(i);
+    EXPECT_EQ(s.confirm[i], rule == ConfirmRule::EngineStart || rule == ConfirmRule::Reset) << i;
+  }
 }
 
 TEST(Settings, ErrorsNameFileAndLine) {
@@ -60,6 +66,9 @@ TEST(Settings, ErrorsNameFileAndLine) {
       {"sysid: 1\n", "m.yaml:1: unknown key 'sysid'"},
       {"battery_ids: {pmu: 254}\n", "m.yaml:1: battery_ids.pmu: '254' is not a whole number 0..253"},
       {"udp: [\n", "m.yaml:"},
+      {"udp: 127.0.0.1:14550\nconfirm:\n  - reset\n  - start_engine\n",
+       "m.yaml:4: confirm: unknown confirm rule 'start_engine' (rules: "},
+      {"confirm: engine_start\n", "m.yaml:1: confirm: expected a list of rule names"},
   };
   for (const auto& c : cases) {
     Settings s;
@@ -70,6 +79,18 @@ TEST(Settings, ErrorsNameFileAndLine) {
       EXPECT_EQ(std::string(e.what()).rfind(c.expected, 0), 0U) << e.what();
     }
   }
+}
+
+TEST(Settings, ConfirmOptionAddsToTheFilesRules) {
+  Settings s;
+  EXPECT_FALSE(s.confirm[static_cast<std::size_t>(service::ConfirmRule::EngineStart)]) << "none by default";
+  read_settings("confirm: [reset]\n", "m.yaml", s);
+  EXPECT_FALSE(apply_confirm_option("engine_start", s));
+  EXPECT_TRUE(s.confirm[static_cast<std::size_t>(service::ConfirmRule::EngineStart)]);
+  EXPECT_TRUE(s.confirm[static_cast<std::size_t>(service::ConfirmRule::Reset)]);
+  const auto e = apply_confirm_option("everything", s);
+  ASSERT_TRUE(e);
+  EXPECT_EQ(e->rfind("--confirm: unknown confirm rule 'everything'", 0), 0U) << *e;
 }
 
 TEST(Settings, RateOption) {
