@@ -142,6 +142,8 @@ else:
     answers = [m["fields"] for m in got("PARAM_VALUE", first_set, second_set) if m["fields"]["paramId"].startswith("PMU1_SERVO_V")]
     if len(answers) != 1 or abs(answers[0]["paramValue"] - set_value) > 1e-3:
         problems.append(f"the set of PMU1_SERVO_V to {set_value}: answered by {answers}, want exactly one PARAM_VALUE with it")
+    said = [m["fields"]["text"] for m in got("STATUSTEXT", first_set, second_set) if "SERVO_V" in m["fields"]["text"]]
+    if said: problems.append(f"the set of PMU1_SERVO_V to {set_value} was verified, yet: {said}")
     if abs(after.get("servo_voltage", -1) - set_value) > 1e-3:
         problems.append(f"pmuctl shows servo_voltage {after.get('servo_voltage')} after the set to {set_value}")
     if second_set is None: problems.append("the out-of-range set was not sent")
