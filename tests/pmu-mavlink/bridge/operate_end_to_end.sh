@@ -4,6 +4,7 @@
 # something to do), pmu-mavlink with --udp to a node-mavlink ground station (operator.mjs).
 # Checks, against the service and pmuctl:
 #   - the parameter list: every parameter, each value the one `pmuctl config snapshot` writes;
+#   - a set of PMU1_SERVO_V addressed to the autopilot neither answered nor carried out;
 #   - a set of PMU1_SERVO_V answered by exactly one PARAM_VALUE with the new value, which
 #     pmuctl then shows; a set out of range answered with the old value and a STATUSTEXT
 #     saying why;
@@ -84,6 +85,8 @@ run start start --confirm engine_start
 # The service writes the audit line before it sends the final reply the operator waited for.
 grep 'audit: command .*engine_start' "$work/service.log" >"$work/starts"
 
+grep -q "not addressed to us 1$" "$work/operate.log" ||
+  fail "the set addressed to the autopilot is not counted: $(grep 'parameters:' "$work/operate.log")"
 for log in operate start; do
   grep -q "pmu-mavlink: parameters: list requests" "$work/$log.log" &&
     grep -q "pmu-mavlink: commands: received" "$work/$log.log" &&
@@ -137,8 +140,12 @@ else:
         if key is None or key not in before: problems.append(f"{name}: not in pmuctl's snapshot {sorted(before)}"); continue
         if abs(f["paramValue"] - before[key]) > 1e-3: problems.append(f"{name} = {f['paramValue']}, pmuctl {key}: {before[key]}")
 
+    if msgs[first_set]["fields"]["targetComponent"] != 1: problems.append("the set addressed to the autopilot was not sent first")
+    first_set = sent_at(lambda m: m["sent"] == "PARAM_SET" and m["fields"]["targetComponent"] == 180)
     set_value = msgs[first_set]["fields"]["paramValue"]
     second_set = sent_at(lambda m: m["sent"] == "PARAM_SET" and m["fields"]["paramValue"] == 30.0)
+    if any(m["fields"]["paramValue"] == 9.0 for m in got("PARAM_VALUE")):
+        problems.append("the set addressed to the autopilot (9.0) was answered")
     answers = [m["fields"] for m in got("PARAM_VALUE", first_set, second_set) if m["fields"]["paramId"].startswith("PMU1_SERVO_V")]
     if len(answers) != 1 or abs(answers[0]["paramValue"] - set_value) > 1e-3:
         problems.append(f"the set of PMU1_SERVO_V to {set_value}: answered by {answers}, want exactly one PARAM_VALUE with it")

@@ -8,7 +8,8 @@
 // operate_end_to_end.sh bounds the wait and checks OUTFILE.
 //   operate: the parameter list as a ground station gets it (PARAM_REQUEST_LIST to every
 //            component, what is missing asked again by index every 3 s), a set of
-//            PMU1_SERVO_V to another value, a set of it out of range, DO_SET_RELAY payload
+//            PMU1_SERVO_V addressed to the autopilot (component 1), then to pmu-mavlink
+//            to another value, a set of it out of range, DO_SET_RELAY payload
 //            off, DO_ENGINE_CONTROL start (DENIED without --confirm engine_start).
 //   start:   once PMU1 is known (a read of PMU1_SERVO_V answered), DO_ENGINE_CONTROL start,
 //            the same COMMAND_LONG again with confirmation 1 at its first IN_PROGRESS (a
@@ -82,6 +83,8 @@ function operate(name, data) {
         step = 'set'
         const now = [...values.values()].find((v) => v.name === servoName()).value
         servo = Math.abs(now - 7.5) < 0.01 ? 8.0 : 7.5
+        // The autopilot's: not pmu-mavlink's to answer or carry out.
+        send(common.ParamSet, { targetSystem: target[0], targetComponent: 1, paramId: servoName(), paramValue: 9.0, paramType: 9 })
         paramSet(servoName(), servo)
       }
     } else if (step === 'set' && data.paramId === servoName()) {
