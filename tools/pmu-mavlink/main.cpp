@@ -3,7 +3,8 @@
 // partitions and DDS-Security identity; it never touches the bus) and a MAVLink 2 component
 // with its own id: HEARTBEAT, BATTERY_STATUS, GENERATOR_STATUS and RELAY_STATUS at their
 // rates, alarms and readiness as STATUSTEXT, SET_MESSAGE_INTERVAL and RUN_PREARM_CHECKS
-// answered.
+// answered, the PMUs' settings as parameters and COMMAND_LONG as the service's commands (its
+// one DDS writer).
 #include <CLI/CLI.hpp>
 #include <poll.h>
 
@@ -16,11 +17,14 @@
 #include "link/serial_endpoint.hpp"
 #include "link/udp_endpoint.hpp"
 #include "pmu/dds_settings/vehicle.hpp"
+#include "pmu/dds/command_sample.hpp"
 #include "pmu/dds/dds_context.hpp"
 #include "pmu/files/bounded_file.hpp"
 #include "pmu/security/security_files.hpp"
 #include "program/bridge.hpp"
 #include "program/dds_inputs.hpp"
+#include "program/operations.hpp"
+#include "program/service_link.hpp"
 #include "program/settings.hpp"
 #include "signing/signing_key_file.hpp"
 
@@ -37,7 +41,7 @@ int main(int argc, char** argv) {
   std::string config_file, udp_text, serial_text, vehicle_text;
   std::optional<int> system_id, component_id, domain, pmu_id, bms_id;
   std::optional<std::string> vehicle, qos_file, security_dir, identity, signing_key;
-  std::vector<std::string> rates;
+  std::vector<std::string> rates, confirms;
   app.add_option("--config", config_file, "YAML file with any of the settings below (the options win)");
   app.add_option("--udp", udp_text, "UDP client endpoint HOST:PORT (sends there, takes what comes back)");
   app.add_option("--serial", serial_text, "serial endpoint DEVICE:BAUD (the autopilot's TELEM port)");
@@ -57,6 +61,9 @@ int main(int argc, char** argv) {
   app.add_option("--battery-id-bms", bms_id, "BATTERY_STATUS id of the first BMS (default 20)")
       ->check(CLI::Range(0, 254));
   app.add_option("--rate", rates, "NAME=HZ: heartbeat, battery_status, generator_status, relay_status (0: off)");
+  app.add_option("--confirm", confirms,
+                 "RULE: commands and parameter sets under this confirm rule go to the service confirmed "
+                 "(repeatable; added to the config's confirm: list)");
   CLI11_PARSE(app, argc, argv);
 
   Settings settings;
@@ -96,6 +103,8 @@ int main(int argc, char** argv) {
   if (bms_id) settings.bms_battery_id = static_cast<std::uint8_t>(*bms_id);
   for (const auto& r : rates)
     if (auto e = apply_rate_option(r, settings)) return fail(*e);
+  for (const auto& r : confirms)
+    if (auto e = apply_confirm_option(r, settings)) return fail(*e);
   if (!settings.udp && !settings.serial) return fail("no endpoint: give --udp HOST:PORT or --serial DEVICE:BAUD");
   if (settings.security_dir.empty() != settings.identity.empty())
     return fail("--security-dir and --identity go together");
@@ -136,6 +145,7 @@ int main(int argc, char** argv) {
 
   std::unique_ptr<pmu::dds::DdsContext> dds;
   std::unique_ptr<DdsInputs> inputs;
+  std::unique_ptr<ServiceLink> link;
   try {
     const auto partitions = pmu::dds::vehicle_partitions(settings.vehicle);
     const std::string qos = settings.qos_file.empty() ? pmu::dds::default_qos_file() : settings.qos_file;
@@ -144,6 +154,7 @@ int main(int argc, char** argv) {
                                                  pmu::dds::Transport::Default, pmu::dds::ResolvedNetwork{},
                                                  pmu::dds::Partitions{partitions, partitions});
     inputs = std::make_unique<DdsInputs>(*dds);
+    link = std::make_unique<ServiceLink>(*dds, settings.vehicle);
   } catch (const std::exception& e) {
     return fail(e.what());
   }
@@ -151,7 +162,13 @@ int main(int argc, char** argv) {
   std::vector<Endpoint*> raw;
   for (auto& e : endpoints) raw.push_back(e.get());
   Bridge bridge(settings, raw, *inputs, signing);
-  // The parameter and command protocol plugs in here: bridge.set_frame_handler(...).
+  // Request ids "pmu-mavlink-HOST-PID-N", N from the start's ns: at most 57 bytes (the
+  // contract allows 63) and never one a restart with the same pid used.
+  const auto start_ns = static_cast<std::uint64_t>(
+      std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::system_clock::now().time_since_epoch()).count());
+  Operations operations(settings, bridge, *inputs, *link, pmu::dds::request_id_prefix("pmu-mavlink", 16), start_ns);
+  bridge.set_frame_handler([&operations](const pmu::mavlink::Frame& frame, const Bridge::Send& send,
+                                         Bridge::Clock::time_point now) { operations.on_frame(frame, send, now); });
 
   struct sigaction sa {};
   sa.sa_handler = on_signal;
@@ -178,11 +195,13 @@ int main(int argc, char** argv) {
   while (!g_stop) {
     // 20 ms: DDS samples are taken on this loop, so this bounds how late an alarm is said.
     ::poll(fds.data(), fds.size(), 20);
-    if (!bridge.step(Bridge::Clock::now())) {
+    const auto now = Bridge::Clock::now();
+    if (!bridge.step(now)) {
       std::fprintf(stderr, "pmu-mavlink: an endpoint is gone\n");
       status = 1;
       break;
     }
+    operations.step(now);
   }
   const auto& p = bridge.parser_counters();
   std::fprintf(stderr,
@@ -201,6 +220,7 @@ int main(int argc, char** argv) {
                  static_cast<unsigned long long>(c->replayed), static_cast<unsigned long long>(c->stale),
                  static_cast<unsigned long long>(c->too_many_streams));
   }
+  for (const auto& line : operations.report()) std::fprintf(stderr, "pmu-mavlink: %s\n", line.c_str());
   for (const auto& e : endpoints) {
     const auto& c = e->counters();
     std::fprintf(stderr, "pmu-mavlink: %s: bytes in %llu, out %llu, send failures %llu, read failures %llu\n",

@@ -32,7 +32,8 @@ TEST(Settings, EveryKey) {
       "qos_file: /etc/pmu-dds/qos.xml\n"
       "signing_key: /etc/pmu-dds/mavlink-signing.key\n"
       "battery_ids: {pmu: 30, bms: 40}\n"
-      "rates: {battery_status: 1, generator_status: 0, heartbeat: 2, relay_status: 0.2}\n",
+      "rates: {battery_status: 1, generator_status: 0, heartbeat: 2, relay_status: 0.2}\n"
+      "confirm: [engine_start, reset]\n",
       "m.yaml", s);
   ASSERT_TRUE(s.udp);
   EXPECT_EQ(s.udp->port, 14550);
@@ -49,6 +50,11 @@ TEST(Settings, EveryKey) {
   EXPECT_EQ(s.intervals.at(id::kGeneratorStatus), 0s) << "0 Hz: off";
   EXPECT_EQ(s.intervals.at(id::kHeartbeat), 500ms);
   EXPECT_EQ(s.intervals.at(id::kRelayStatus), 5s);
+  using service::ConfirmRule;
+  for (std::size_t i = 0; i < s.confirm.size(); ++i) {
+    const auto rule = static_cast<ConfirmRule>(i);
+    EXPECT_EQ(s.confirm[i], rule == ConfirmRule::EngineStart || rule == ConfirmRule::Reset) << i;
+  }
 }
 
 TEST(Settings, ErrorsNameFileAndLine) {
@@ -66,6 +72,9 @@ TEST(Settings, ErrorsNameFileAndLine) {
       {"udp: [\n", "m.yaml:"},
       {"udp: 127.0.0.1:14550\nsigning_key: [a, b]\n", "m.yaml:2: signing_key: expected a value"},
       {"signing_key: ''\n", "m.yaml:1: signing_key: expected the key file's path"},
+      {"udp: 127.0.0.1:14550\nconfirm:\n  - reset\n  - start_engine\n",
+       "m.yaml:4: confirm: unknown confirm rule 'start_engine' (rules: "},
+      {"confirm: engine_start\n", "m.yaml:1: confirm: expected a list of rule names"},
   };
   for (const auto& c : cases) {
     Settings s;
@@ -76,6 +85,18 @@ TEST(Settings, ErrorsNameFileAndLine) {
       EXPECT_EQ(std::string(e.what()).rfind(c.expected, 0), 0U) << e.what();
     }
   }
+}
+
+TEST(Settings, ConfirmOptionAddsToTheFilesRules) {
+  Settings s;
+  EXPECT_FALSE(s.confirm[static_cast<std::size_t>(service::ConfirmRule::EngineStart)]) << "none by default";
+  read_settings("confirm: [reset]\n", "m.yaml", s);
+  EXPECT_FALSE(apply_confirm_option("engine_start", s));
+  EXPECT_TRUE(s.confirm[static_cast<std::size_t>(service::ConfirmRule::EngineStart)]);
+  EXPECT_TRUE(s.confirm[static_cast<std::size_t>(service::ConfirmRule::Reset)]);
+  const auto e = apply_confirm_option("everything", s);
+  ASSERT_TRUE(e);
+  EXPECT_EQ(e->rfind("--confirm: unknown confirm rule 'everything'", 0), 0U) << *e;
 }
 
 TEST(Settings, RateOption) {

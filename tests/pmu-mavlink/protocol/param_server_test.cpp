@@ -147,6 +147,26 @@ TEST(ParamList, ValuesNotKnownAreNotSent) {
   EXPECT_TRUE(run(s, t0 + 6s, 3000ms).empty());
 }
 
+TEST(ParamList, APmuHeardLaterAddsItsParametersAfterTheFirstsWhoseIndicesStay) {
+  auto s = server(1);
+  s.poll(t0);
+  s.grow(0);  // a smaller count changes nothing
+  s.grow(2);
+  s.set_device(1, device());
+  s.grow(1);
+  s.on_request_list(qgc, t0);
+  const auto sent = run(s, t0, 5000ms);
+  ASSERT_EQ(sent.size(), 2 * kSettingCount);
+  EXPECT_EQ(s.param_count(), 2 * kSettingCount);
+  for (const auto& [t, v] : sent) {
+    EXPECT_EQ(v.param_count, 2 * kSettingCount);
+    EXPECT_EQ(param_from_index(v.param_index, 2), param_from_name(v.param_id, 2)) << v.param_id;
+  }
+  // Ten PMUs heard: the tenth has no parameters (the prefix has one digit).
+  s.grow(10);
+  EXPECT_EQ(s.param_count(), kMaxPmus * kSettingCount);
+}
+
 TEST(ParamList, AFloodFromManySendersOfListsAndReadsIsCountedAndCarriedAtThePace) {
   auto s = server(9);
   s.poll(t0);

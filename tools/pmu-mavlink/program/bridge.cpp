@@ -31,7 +31,7 @@ Bridge::Bridge(const Settings& settings, std::vector<Endpoint*> endpoints, DdsIn
     gate_ = SigningGate(signing->key);
     signing_clock_ = std::move(signing->clock);
   }
-  other_frames_ = [this](const nm::Frame& frame, const Send& send) {
+  other_frames_ = [](const nm::Frame& frame, const Send& send, Clock::time_point) {
     const auto command = nm::decode<nm::CommandLong>(frame);
     if (!command) return;
     nm::CommandAck ack;
@@ -71,6 +71,9 @@ bool Bridge::step(Clock::time_point now) {
     }
   }
   inputs_.take();
+  // Numbered when first heard, so the parameters and commands know a PMU before its first
+  // BATTERY_STATUS; the map's order numbers PMUs heard at once.
+  for (const auto& [key, view] : inputs_.pmus()) (void)pmu_slot(key);
   for (const auto& a : inputs_.alarms()) {
     if (a.disposed) {
       alarm_texts_.forget(a.alarm);
@@ -115,7 +118,7 @@ void Bridge::on_frame(const nm::Frame& frame, Clock::time_point now) {
     // A broadcast command is the autopilot's to answer; only one addressed to us is ours.
     if (command->target_component == 0) return;
   }
-  other_frames_(frame, [this](std::uint32_t msgid, const nm::Payload& payload) { send_payload(msgid, payload); });
+  other_frames_(frame, sender(), now);
 }
 
 void Bridge::on_command(const nm::Frame& frame, const nm::CommandLong& command, Clock::time_point now) {

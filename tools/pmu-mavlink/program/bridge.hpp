@@ -29,12 +29,12 @@ class Bridge {
   using Clock = RateScheduler::Clock;
 
   // What another part of the program answers: a frame the bridge does not handle itself
-  // (parameters, and every command but SET_MESSAGE_INTERVAL and RUN_PREARM_CHECKS) goes
-  // here with a function that sends a message's frame on every endpoint. The parameter and
-  // command protocol (tools/pmu-mavlink/params, commands) plugs in here; without it a
-  // COMMAND_LONG addressed to this component gets MAV_RESULT_UNSUPPORTED.
+  // (parameters, and every command but SET_MESSAGE_INTERVAL and RUN_PREARM_CHECKS, which
+  // are the bridge's alone) goes here with a function that sends a message's frame on every
+  // endpoint. The parameter and command protocols plug in here (program/operations.hpp);
+  // without them a COMMAND_LONG addressed to this component gets MAV_RESULT_UNSUPPORTED.
   using Send = std::function<void(std::uint32_t msgid, const pmu::mavlink::Payload& payload)>;
-  using FrameHandler = std::function<void(const pmu::mavlink::Frame& frame, const Send& send)>;
+  using FrameHandler = std::function<void(const pmu::mavlink::Frame& frame, const Send& send, Clock::time_point now)>;
 
   // Message signing (interface.md 12.6): the key, and the clock as a signing timestamp
   // (pmu::mavlink::signing_timestamp of the wall clock), read once per step().
@@ -48,12 +48,20 @@ class Bridge {
          std::optional<Signing> signing = std::nullopt);
 
   void set_frame_handler(FrameHandler handler) { other_frames_ = std::move(handler); }
+  // Sends a message's frame on every endpoint, for what the other parts send unasked.
+  Send sender() {
+    return [this](std::uint32_t msgid, const pmu::mavlink::Payload& payload) { send_payload(msgid, payload); };
+  }
 
   // Reads every endpoint, takes the DDS samples, says alarm and readiness changes, and sends
   // what the scheduler says is due at `now`. False when an endpoint is gone for good.
   bool step(Clock::time_point now);
 
   std::uint8_t system_id() const noexcept { return system_id_; }
+  std::uint8_t component_id() const noexcept { return settings_.component_id; }
+  // Each PMU's number, from 0 in the order first heard (interface.md 12.2): its
+  // BATTERY_STATUS ids, and PMU n + 1 of the parameters and commands. Never reused.
+  const std::map<DeviceKey, std::uint8_t>& pmu_slots() const noexcept { return pmu_slots_; }
   const pmu::mavlink::ParserCounters& parser_counters() const noexcept { return parser_.counters(); }
   // Frames written since start; each went to every endpoint (their counters say what each
   // could send).

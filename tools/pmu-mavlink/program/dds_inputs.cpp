@@ -3,6 +3,7 @@
 #include <fastdds/dds/subscriber/SampleInfo.hpp>
 #include <fastdds/dds/topic/TypeSupport.hpp>
 
+#include "pmu/dds/baseline_sample.hpp"
 #include "pmu/idl/alarmsPubSubTypes.h"
 #include "pmu/idl/canopenPubSubTypes.h"
 #include "pmu/idl/energyPubSubTypes.h"
@@ -60,6 +61,7 @@ DdsInputs::DdsInputs(pmu::dds::DdsContext& dds)
       status_(reader<pmu::v5::StatusPubSubType>(dds, topics::kStatus, qos_profiles::kTelemetry)),
       energy_(reader<pmu::v5::EnergyPubSubType>(dds, topics::kEnergy, qos_profiles::kState)),
       health_(reader<pmu::v5::HealthPubSubType>(dds, topics::kHealth, qos_profiles::kState)),
+      config_(reader<pmu::v5::ConfigPubSubType>(dds, topics::kConfig, qos_profiles::kState)),
       battery_(reader<pmu::v5::BatteryPubSubType>(dds, topics::kBattery, qos_profiles::kTelemetry)),
       cells_(reader<pmu::v5::BatteryCellsPubSubType>(dds, topics::kBatteryCells, qos_profiles::kTelemetry)),
       bms_energy_(reader<pmu::v5::BmsEnergyPubSubType>(dds, topics::kBmsEnergy, qos_profiles::kState)),
@@ -101,6 +103,11 @@ void DdsInputs::take() {
         if (h.kind() == pmu::v5::KIND_PMU) pmus_.erase(key);
         if (h.kind() == pmu::v5::KIND_BATTERY) batteries_.erase(key);
       });
+  // A PMU's settings as its service read them (interface.md 4.6); its parameters
+  // (program/operations.cpp) are known while this and its ONLINE health say so.
+  take_all<pmu::v5::Config>(
+      config_, [&](const pmu::v5::Config& c) { configs_[pmu_key(c)] = pmu::service::settings_of(c); },
+      [&](const pmu::v5::Config& c) { configs_.erase(pmu_key(c)); });
   alarms_.clear();
   take_all<pmu::v5::Alarm>(
       alarm_reader_,

@@ -1,7 +1,8 @@
 #pragma once
 // The contract topics pmu-mavlink reads (interface.md 1.2, 1.4, 1.6, 1.7, 1.8), taken into
-// one PmuView per PMU and one BmsView per BMS, and the alarm and readiness samples since the
-// last take. A DDS client like any ground station: it reads, never writes a device.
+// one PmuView per PMU and one BmsView per BMS, each PMU's pmu/config as its settings, and the
+// alarm and readiness samples since the last take. Readers only: the commands that change a
+// device go through the service (service_link.hpp).
 // Lifetime: the DdsContext outlives this. Threads: take() on the program's loop only (the
 // readers are polled, no listener runs on Fast DDS's threads).
 #include <fastdds/dds/subscriber/DataReader.hpp>
@@ -13,6 +14,7 @@
 #include <tuple>
 #include <vector>
 
+#include "pmu/baseline/settings.hpp"
 #include "pmu/dds/dds_context.hpp"
 #include "pmu/idl/alarms.h"
 #include "telemetry/device_views.hpp"
@@ -35,6 +37,8 @@ class DdsInputs {
 
   const std::map<DeviceKey, PmuView>& pmus() const noexcept { return pmus_; }
   const std::map<DeviceKey, BmsView>& batteries() const noexcept { return batteries_; }
+  // Each PMU's latest pmu/config sample as its settings; a disposed instance is gone.
+  const std::map<DeviceKey, pmu::baseline::Settings>& configs() const noexcept { return configs_; }
   // The alarm samples taken by the last take(), in order.
   const std::vector<AlarmSample>& alarms() const noexcept { return alarms_; }
   // The newest readiness sample, and whether the last take() brought one.
@@ -48,6 +52,7 @@ class DdsInputs {
   eprosima::fastdds::dds::DataReader* status_;
   eprosima::fastdds::dds::DataReader* energy_;
   eprosima::fastdds::dds::DataReader* health_;
+  eprosima::fastdds::dds::DataReader* config_;
   eprosima::fastdds::dds::DataReader* battery_;
   eprosima::fastdds::dds::DataReader* cells_;
   eprosima::fastdds::dds::DataReader* bms_energy_;
@@ -56,6 +61,7 @@ class DdsInputs {
 
   std::map<DeviceKey, PmuView> pmus_;
   std::map<DeviceKey, BmsView> batteries_;
+  std::map<DeviceKey, pmu::baseline::Settings> configs_;
   std::vector<AlarmSample> alarms_;
   std::optional<pmu::v5::Readiness> readiness_;
 };

@@ -77,6 +77,13 @@ std::optional<std::uint32_t> rate_message(const std::string& name) {
   return it->second;
 }
 
+std::optional<std::string> apply_confirm_option(const std::string& rule, Settings& into) {
+  const auto set = pmu::mavlink_params::confirm_set({rule});
+  if (!set) return "--confirm: " + set.error();
+  for (std::size_t i = 0; i < set->size(); ++i) into.confirm[i] = into.confirm[i] || (*set)[i];
+  return std::nullopt;
+}
+
 std::optional<std::string> apply_rate_option(const std::string& text, Settings& into) {
   const auto eq = text.find('=');
   const std::string name = eq == std::string::npos ? text : text.substr(0, eq);
@@ -157,10 +164,17 @@ void read_settings(const std::string& text, const std::string& source, Settings&
         if (!interval) c.fail(r.second, "rates." + name + ": 0 (off) or 0.01..50 Hz");
         into.intervals[*id] = *interval;
       }
+    } else if (key == "confirm") {
+      if (!v.IsSequence()) c.fail(v, "confirm: expected a list of rule names ([engine_start, reset])");
+      for (const auto& rule : v) {
+        const auto set = pmu::mavlink_params::confirm_set({c.text(rule, "confirm")});
+        if (!set) c.fail(rule, "confirm: " + set.error());
+        for (std::size_t i = 0; i < set->size(); ++i) into.confirm[i] = into.confirm[i] || (*set)[i];
+      }
     } else {
       c.fail(kv.first, "unknown key '" + key +
                            "' (udp, serial, system_id, component_id, domain, vehicle, qos_file, security_dir, "
-                           "identity, signing_key, battery_ids, rates)");
+                           "identity, signing_key, battery_ids, rates, confirm)");
     }
   }
 }

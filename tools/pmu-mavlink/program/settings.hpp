@@ -11,6 +11,7 @@
 #include "link/endpoint_address.hpp"
 #include "pmu/mavlink/constants.hpp"
 #include "pmu/mavlink/message_table.hpp"
+#include "pmu/mavlink_params/confirm_set.hpp"
 
 namespace pmu::mavlink_bridge {
 
@@ -57,11 +58,18 @@ struct Settings {
       {pmu::mavlink::msgid::kGeneratorStatus, std::chrono::seconds(1)},
       {pmu::mavlink::msgid::kRelayStatus, std::chrono::seconds(1)},
   };
+  // The confirm rules (interface.md 2.2) whose commands and sets go to the service with
+  // `confirm` (`confirm:` in the file and every --confirm RULE): the ground station's own
+  // dialog is the confirmation. None by default: such a command is DENIED, naming its rule.
+  pmu::mavlink_params::ConfirmSet confirm{};
 };
 
 // The config file's text into `into` (keys it does not set keep their value). `source`
 // names the file in errors: "FILE:LINE: what".
 void read_settings(const std::string& text, const std::string& source, Settings& into);
+
+// --confirm RULE into `into` (added to the file's rules); the error when RULE is none.
+std::optional<std::string> apply_confirm_option(const std::string& rule, Settings& into);
 
 // The rate names of the config's `rates:` and of --rate NAME=HZ.
 std::optional<std::uint32_t> rate_message(const std::string& name);

@@ -1,7 +1,5 @@
 #include "pmuctl/call/command_channel.hpp"
 
-#include <unistd.h>
-
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
@@ -27,20 +25,6 @@ namespace {
 using namespace eprosima::fastdds::dds;
 using Clock = std::chrono::steady_clock;
 }  // namespace
-
-// The service's names for its results; pmu::v5::CommandResult has the same order (static_assert
-// in service/endpoints/src/dds_commands.cpp). The names are literals, so data() ends in NUL.
-const char* result_name(pmu::v5::CommandResult r) {
-  return pmu::service::to_string(static_cast<pmu::service::CommandResult>(r)).data();
-}
-
-std::string request_id() {
-  char host[64] = "host";
-  ::gethostname(host, sizeof host - 1);
-  const auto ns =
-      std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::system_clock::now().time_since_epoch()).count();
-  return "pmuctl-" + std::string(host).substr(0, 24) + "-" + std::to_string(::getpid()) + "-" + std::to_string(ns);
-}
 
 // Finds the PMU the command is for: --bus/--address when both are given, else the only PMU
 // (Health.kind: batteries and MPPTs take no commands) the service of `vehicle` knows.
@@ -134,12 +118,6 @@ std::optional<int> wait_for_match(const GlobalOptions& o, pmu::dds::DdsContext& 
     }
     std::this_thread::sleep_for(std::chrono::milliseconds(10));
   }
-}
-
-std::uint64_t epoch_ns_at(std::chrono::steady_clock::time_point deadline) {
-  const auto left = std::chrono::duration_cast<std::chrono::system_clock::duration>(deadline - Clock::now());
-  const auto t = std::chrono::system_clock::now() + left;
-  return static_cast<std::uint64_t>(std::chrono::duration_cast<std::chrono::nanoseconds>(t.time_since_epoch()).count());
 }
 
 CommandChannel::CommandChannel(const GlobalOptions& o)

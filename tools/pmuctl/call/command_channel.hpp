@@ -12,6 +12,7 @@
 #include <string>
 #include <vector>
 
+#include "pmu/dds/command_sample.hpp"
 #include "pmu/dds/dds_context.hpp"
 #include "pmu/idl/command.h"
 #include "pmuctl/verbs/command_verbs.hpp"
@@ -20,10 +21,10 @@
 namespace pmu::tools {
 
 // "COMPLETED", "REJECTED", ...: the service's names of its results.
-const char* result_name(pmu::v5::CommandResult r);
+using pmu::dds::result_name;
 
 // A request id unique per sender: "pmuctl-HOST-PID-NANOSECONDS".
-std::string request_id();
+inline std::string request_id() { return pmu::dds::request_id("pmuctl"); }
 
 // Finds the PMU a command is for: --bus/--address when both are given, else the only PMU
 // (Health.kind: batteries and MPPTs take no commands) the service of `vehicle` knows.
@@ -52,7 +53,7 @@ void open_command_channels(const GlobalOptions& o, const std::vector<std::string
 // `deadline`, the end of pmuctl's own wait, as ns since the Unix epoch: a request's
 // expires_at (interface.md 2.3). The service sends nothing of a request after it, so nothing
 // is carried out once pmuctl has given up on it (docs/safety.md H9).
-std::uint64_t epoch_ns_at(std::chrono::steady_clock::time_point deadline);
+using pmu::dds::epoch_ns_at;
 
 class CommandChannel {
  public:

@@ -24,6 +24,7 @@
 #include "pmu/baseline/config_file.hpp"
 #include "pmu/command/command.hpp"
 #include "pmu/dds/baseline_sample.hpp"
+#include "pmu/dds/command_sample.hpp"
 #include "pmu/dds/dds_context.hpp"
 #include "pmu/files/bounded_file.hpp"
 #include "pmu/idl/guarded_type.hpp"
@@ -285,21 +286,15 @@ Json difference_json(const baseline::Difference& d) {
 // The plan's own action as a command sample, so what is sent is what its confirm rule was
 // judged on.
 CommandSpec command_for(Setting s, std::uint32_t raw, bool confirm) {
+  pmu::v5::Command c;
+  pmu::dds::put_action(baseline::action_for(s, raw), c);
   CommandSpec spec;
+  spec.kind = static_cast<int>(c.kind());
+  spec.parameter = c.parameter().to_string();
+  spec.value = c.value();
+  spec.outputs = c.outputs();
+  spec.enable = c.enable();
   spec.confirm = confirm;
-  const auto action = baseline::action_for(s, raw);
-  if (const auto* o = std::get_if<service::action::SetOutputs>(&action)) {
-    spec.kind = pmu::v5::SET_OUTPUTS;
-    spec.outputs = o->mask;
-  } else if (const auto* g = std::get_if<service::action::SetGeneration>(&action)) {
-    spec.kind = pmu::v5::SET_GENERATION;
-    spec.enable = g->enable;
-  } else {
-    const auto& p = std::get<service::action::SetParameter>(action);
-    spec.kind = pmu::v5::SET_PARAMETER;
-    spec.parameter = std::string(codec::spec_of(p.parameter).name);
-    spec.value = codec::parameter_value(p.parameter, p.raw);
-  }
   return spec;
 }
 

@@ -42,8 +42,6 @@ std::uint8_t ack_result(CommandResult r) {
 struct Meaning {
   std::optional<service::CommandAction> action;
   std::size_t pmu = 0;
-  bool prearm = false;
-  std::optional<MessageInterval> interval;
   std::uint8_t result = result::kAccepted;  // when answered here
   std::string why;
 };
@@ -99,16 +97,6 @@ Meaning interpret(const mavlink::CommandLong& c, const CommandConfig& config) {
         return refused(result::kUnsupported, "reboot: param4 names another component");
       m.action = service::action::Reset{};
       return pmu_of(m);
-    case cmd::kRunPrearmChecks: m.prearm = true; return m;
-    case cmd::kSetMessageInterval: {
-      const bool known =
-          whole(p[0], 0, 0xFFFFFF) && std::find(config.schedulable.begin(), config.schedulable.end(),
-                                                static_cast<std::uint32_t>(p[0])) != config.schedulable.end();
-      if (!known) return refused(result::kDenied, "message interval: not a message this component sends");
-      if (!whole(p[1], -1, 100000000)) return refused(result::kDenied, "message interval: -1, 0 or microseconds");
-      m.interval = MessageInterval{static_cast<std::uint32_t>(p[0]), static_cast<std::int64_t>(p[1])};
-      return m;
-    }
     default: return refused(result::kUnsupported, "");
   }
 }
@@ -210,10 +198,7 @@ Output CommandHandler::on_command_long(Sender from, const mavlink::CommandLong& 
   if (!meaning.action) {
     if (meaning.result == result::kUnsupported) ++counters_.unsupported;
     if (meaning.result == result::kDenied) ++counters_.denied;
-    Output out = answer_here(from, m, meaning.result, meaning.why, now);
-    out.prearm = meaning.prearm;
-    out.interval = meaning.interval;
-    return out;
+    return answer_here(from, m, meaning.result, meaning.why, now);
   }
   bool confirm = false;
   if (!stop) {

@@ -49,6 +49,15 @@ void ParamServer::forget_device(std::size_t pmu) {
   if (pmu < devices_.size()) devices_[pmu] = {};
 }
 
+void ParamServer::grow(std::size_t pmu_count) {
+  const std::size_t n = std::min(pmu_count, kMaxPmus);
+  if (n <= config_.pmu_count) return;
+  config_.pmu_count = n;
+  devices_.resize(n);
+  urgent_.resize(mavlink_params::param_count(n));
+  listed_.resize(mavlink_params::param_count(n));
+}
+
 std::optional<std::uint32_t> ParamServer::value(ParamRef p) const { return devices_[p.pmu][p.setting]; }
 
 mavlink::ParamValue ParamServer::param_value(ParamRef p, std::uint32_t raw) const {

@@ -8,7 +8,9 @@
 //   MAV_CMD_PREFLIGHT_REBOOT_SHUTDOWN (param3 1 for this component: RESET) become service
 //   commands for the program to send to PMU `pmu` (param7: PMU number 1..9, 0 for PMU 1),
 //   answered from the service's replies with on_reply(tag, ...).
-//   MAV_CMD_RUN_PREARM_CHECKS and MAV_CMD_SET_MESSAGE_INTERVAL are the program's own.
+//   MAV_CMD_RUN_PREARM_CHECKS and MAV_CMD_SET_MESSAGE_INTERVAL are the bridge's own
+//   (program/bridge.cpp answers them from its readiness and its scheduler before a command
+//   comes here); this handler knows neither.
 // - Acks: an engine start is answered IN_PROGRESS at once and with each of the service's
 //   IN_PROGRESS replies (progress from its "cranking: E s of up to CT s"), then ACCEPTED only
 //   when the service's start is COMPLETED (the engine runs, interface.md 2.7), FAILED
@@ -64,26 +66,16 @@ struct ServiceCommand {
   bool confirm = false;
 };
 
-// SET_MESSAGE_INTERVAL for the program's scheduler: param1 the message id, param2 the
-// interval in microseconds (-1 off, 0 the default), as the command defines them.
-struct MessageInterval {
-  std::uint32_t message_id = 0;
-  std::int64_t interval_us = 0;
-};
-
 struct Output {
   std::vector<mavlink::CommandAck> acks;  // each addressed to its command's sender
   std::vector<mavlink::Statustext> texts;
   std::optional<ServiceCommand> command;
-  bool prearm = false;  // RUN_PREARM_CHECKS: the program reports go/no-go (STATUSTEXT) now
-  std::optional<MessageInterval> interval;
 };
 
 struct CommandConfig {
   std::size_t pmu_count = 1;
   ConfirmSet confirm{};
-  std::uint8_t own_component = 180;        // PREFLIGHT_REBOOT_SHUTDOWN's param4 names it (or 0)
-  std::vector<std::uint32_t> schedulable;  // message ids SET_MESSAGE_INTERVAL may set
+  std::uint8_t own_component = 180;  // PREFLIGHT_REBOOT_SHUTDOWN's param4 names it (or 0)
   // How long a command waits for the service's final reply: its default lifetime (10 s,
   // interface.md 2.3) and a margin; an engine start the longest verification (25.5 s of
   // cranking, the hold, 1 s) and the lifetime of its check.

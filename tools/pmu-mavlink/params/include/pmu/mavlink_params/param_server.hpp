@@ -78,7 +78,7 @@ struct Output {
 };
 
 struct ParamServerConfig {
-  std::size_t pmu_count = 1;  // 1..kMaxPmus
+  std::size_t pmu_count = 1;  // 1..kMaxPmus; grow() adds more
   double messages_per_second = 10;
   // How long a set waits for the service's final reply: the service's default command
   // lifetime (10 s, interface.md 2.3) and its read-back.
@@ -115,6 +115,11 @@ class ParamServer {
   void set_device(std::size_t pmu, const baseline::Settings& settings);
   // Every value of `pmu` unknown (its PMU went OFFLINE or its config sample was disposed).
   void forget_device(std::size_t pmu);
+  // The bridge's PMUs are now `pmu_count` (at most kMaxPmus): the program numbers PMUs as it
+  // first hears them, so the count only grows, and each PMU's parameters keep their index
+  // (PMU by PMU). PARAM_VALUEs from then on carry the new param_count, from which a ground
+  // station learns to ask for the rest. A smaller count changes nothing.
+  void grow(std::size_t pmu_count);
 
   void on_request_list(Sender from, Time now);
   void on_request_read(Sender from, const mavlink::ParamRequestRead& m, Time now);
