@@ -25,13 +25,16 @@ inline constexpr const char* kTypeName = "liveliness_probe::Counter";
 // The writers' and the reader's liveliness lease, the period of Fast DDS's announcements for
 // AUTOMATIC and MANUAL_BY_PARTICIPANT writers, and how often a writer writes (each write
 // asserts its liveliness, whatever the kind).
-inline constexpr int kLeaseMs = 500;
+inline constexpr int kLeaseMs = 1000;
 inline constexpr int kAnnouncementMs = 100;
 inline constexpr int kWritePeriodMs = 100;
+// The liveliness lease is ten announcements and ten writes, so that a loaded machine does not
+// make the live writer miss it (Fast DDS's own liveliness tests use 1 to 1.5 s).
+//
 // The participant lease: a killed writer's participant is dropped, and its writer unmatched,
-// once this passes without a word from it; 12 liveliness leases, so that a reader which tracks
-// liveliness says the writer is not alive long before.
-inline constexpr int kParticipantLeaseMs = 6000;
+// once this passes without a word from it; ten liveliness leases, so that a reader which
+// tracks liveliness says the writer is not alive long before.
+inline constexpr int kParticipantLeaseMs = 10000;
 inline constexpr int kParticipantAnnouncementMs = 1000;
 
 // The liveliness kind by its name on the writer program's command line.

@@ -21,7 +21,7 @@
 //
 // Nothing here measures a duration: each row waits for events with a generous bound and asserts
 // their order as C's listener saw them (not alive before unmatched, or unmatched with no not
-// alive before it). The participant lease is 12 liveliness leases, so the order is never close.
+// alive before it). The participant lease is ten liveliness leases, so the order is never close.
 #include <fastdds/dds/domain/DomainParticipant.hpp>
 #include <fastdds/dds/domain/DomainParticipantFactory.hpp>
 #include <fastdds/dds/subscriber/DataReader.hpp>
