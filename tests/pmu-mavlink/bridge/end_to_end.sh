@@ -18,20 +18,7 @@
 set -uo pipefail
 svc=$1 bridge=$2 ctl=$3 src=$4 link=${5:-udp}
 case "$link" in udp | serial) ;; *) echo "link: udp or serial, not '$link'" >&2; exit 2 ;; esac
-here="$src/tests/pmu-mavlink/bridge"
-if ! command -v node >/dev/null; then echo "SKIP: node is not installed (scripts/setup.sh installs it)"; exit 77; fi
-if [ ! -d "$src/tests/mavlink/node_modules/node-mavlink" ]; then
-  echo "SKIP: node-mavlink is not installed (scripts/setup.sh runs npm ci in tests/mavlink)"; exit 77
-fi
-. "$src/tests/support/dds_domain.sh"
-pmu_test_dds_domain || exit 1
-domain=$PMU_TEST_DDS_DOMAIN
-export PMU_QOS_FILE="$src/deploy/qos.xml"
-work=$(mktemp -d)
-pids=()
-trap 'for p in "${pids[@]}"; do kill "$p" 2>/dev/null; done; wait 2>/dev/null; rm -rf "$work"' EXIT
-failures=0
-fail() { echo "FAIL: $*" >&2; failures=$((failures + 1)); }
+. "$src/tests/pmu-mavlink/bridge/ground_station_setup.sh"
 # pmu-mavlink ARGS... logging to $1, to the ground station whose port is in $work/port: over
 # UDP, or (serial) on a pty's slave whose master pty_relay.py relays to that port.
 start_bridge() {

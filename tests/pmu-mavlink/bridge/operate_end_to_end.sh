@@ -22,20 +22,7 @@
 #   operate_end_to_end.sh PMU-SERVICE PMU-MAVLINK PMUCTL SOURCE-DIR
 set -uo pipefail
 svc=$1 bridge=$2 ctl=$3 src=$4
-here="$src/tests/pmu-mavlink/bridge"
-if ! command -v node >/dev/null; then echo "SKIP: node is not installed (scripts/setup.sh installs it)"; exit 77; fi
-if [ ! -d "$src/tests/mavlink/node_modules/node-mavlink" ]; then
-  echo "SKIP: node-mavlink is not installed (scripts/setup.sh runs npm ci in tests/mavlink)"; exit 77
-fi
-. "$src/tests/support/dds_domain.sh"
-pmu_test_dds_domain || exit 1
-domain=$PMU_TEST_DDS_DOMAIN
-export PMU_QOS_FILE="$src/deploy/qos.xml"
-work=$(mktemp -d)
-pids=()
-trap 'for p in "${pids[@]}"; do kill "$p" 2>/dev/null; done; wait 2>/dev/null; rm -rf "$work"' EXIT
-failures=0
-fail() { echo "FAIL: $*" >&2; failures=$((failures + 1)); }
+. "$src/tests/pmu-mavlink/bridge/ground_station_setup.sh"
 
 # The demo's PMU with its engine stopped; it fires after 1 s of cranking.
 sed 's/^      - address: 1$/      - address: 1\n        sim: {engine: stopped, engine_starts_after: 1}/' \

@@ -12,20 +12,7 @@
 #   signing_end_to_end.sh PMU-MAVLINK SOURCE-DIR
 set -uo pipefail
 bridge=$1 src=$2
-here="$src/tests/pmu-mavlink/bridge"
-if ! command -v node >/dev/null; then echo "SKIP: node is not installed (scripts/setup.sh installs it)"; exit 77; fi
-if [ ! -d "$src/tests/mavlink/node_modules/node-mavlink" ]; then
-  echo "SKIP: node-mavlink is not installed (scripts/setup.sh runs npm ci in tests/mavlink)"; exit 77
-fi
-. "$src/tests/support/dds_domain.sh"
-pmu_test_dds_domain || exit 1
-domain=$PMU_TEST_DDS_DOMAIN
-export PMU_QOS_FILE="$src/deploy/qos.xml"
-work=$(mktemp -d)
-pids=()
-trap 'for p in "${pids[@]}"; do kill "$p" 2>/dev/null; done; wait 2>/dev/null; rm -rf "$work"' EXIT
-failures=0
-fail() { echo "FAIL: $*" >&2; failures=$((failures + 1)); }
+. "$src/tests/pmu-mavlink/bridge/ground_station_setup.sh"
 
 passphrase="pmu-dds signing end to end"
 (umask 077 && printf '%s\n' "$passphrase" >"$work/signing.key")
