@@ -3,6 +3,7 @@
 // "Hot standby"), and the heartbeat each instance sends on DDS (pmu/role).
 
 #include <cstdint>
+#include <string>
 #include <string_view>
 
 namespace pmu::redundancy {
@@ -35,6 +36,24 @@ struct DdsBeat {
   std::uint32_t term = 0;
   std::uint8_t priority = 0;
   bool hands_over = false;  // a STANDBY that has just handed the bus over asks its peer to take it
+};
+
+// One instance's pmu/role sample as the holder writes it and a reader takes it, without DDS
+// types: the endpoint adds the vehicle and turns it into the contract's type and back.
+struct RoleReport {
+  std::string name;  // this instance (the config's redundancy.name)
+  std::string peer;  // the instance it pairs with
+  DdsBeat beat;
+  BusState bus = BusState::Ok;
+  PeerAlarm alarm = PeerAlarm::None;
+};
+
+// A request to move the role (pmuctl): the instance asked to hand the bus over, who asked and
+// the request's id, for the audit line and the reply.
+struct MoveRequest {
+  std::string request_id;
+  std::string instance;
+  std::string requester;
 };
 
 }  // namespace pmu::redundancy

@@ -12,6 +12,7 @@ using Duration = std::chrono::milliseconds;
 
 struct Settings {
   std::uint8_t priority = 1;  // 1..255; the higher wins when neither instance owns the bus
+  std::string name;           // this instance's name, pmu/role's key; empty: the host's name
   std::string peer;           // the peer instance's name: whose pmu/role samples are the peer's
   Duration heartbeat_period{100};
   Duration lease{300};
