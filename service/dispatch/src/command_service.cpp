@@ -54,6 +54,7 @@ std::size_t CommandService::recorded() const {
 void CommandService::peer_reply(const CommandReplyData& reply) {
   if (executes_now()) return;  // this instance writes the replies: nobody else's count
   std::lock_guard<std::mutex> lock(mutex_);
+  ++counters_.peer_replies;
   record_.peer_reply(reply, clock_.steady_now());
 }
 

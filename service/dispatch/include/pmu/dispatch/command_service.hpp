@@ -81,6 +81,8 @@ class CommandService {
     std::uint64_t received = 0, duplicates = 0, reused_ids = 0, completed = 0, refused = 0, failed = 0;
     // Duplicates that arrived SlowLinkHint::kReplyOut or longer after their final reply.
     std::uint64_t resends_after_reply = 0;
+    // Hot standby: the bus owner's replies kept while this instance did not execute.
+    std::uint64_t peer_replies = 0;
   };
   Counters counters() const;
   // Request ids currently remembered for duplicate detection (at most kRememberedRequests).
