@@ -244,14 +244,23 @@ TEST(Failover, WithoutAGateTheServiceExecutesAsAlways) {
   EXPECT_EQ(service.recorded(), 0u);
 }
 
-TEST(Failover, AStandbyAnswersNoAlarmAcknowledgement) {
-  Harness h(sim_bus({device(1)}), {pmu(1)});
+TEST(Failover, AStandbyNeitherAppliesNorAnswersAnAlarmAcknowledgement) {
+  // A PMU streaming every 0.5 s whose internal temperature raises thermal_shutdown.
+  Harness h(sim_bus({device(1, TelemetryMode::Streaming, 500ms)}), {pmu(1, codec::kCurrentFirmware, 5)});
   std::vector<AlarmAckReplyData> replies;
-  bool owner = false;
+  std::atomic<bool> owner{false};
   AlarmAckService acks({&h.worker()}, "", Lifetimes{}, h.clock(),
                        [&](const AlarmAckReplyData& r) { replies.push_back(r); });
-  acks.set_role_gate([&] { return owner; });
-  h.run_for(300ms);
+  acks.set_role_gate([&] { return owner.load(); });
+  h.run_for(2s);
+  h.pmus().with_model(1, [&](sim::PmuModel& m) {
+    sim::Plant p = m.plant();
+    p.internal_temperature = 90;
+    m.set_plant(p, h.clock().steady_now());
+  });
+  h.run_for(600ms);
+  const auto state = [&] { return h.worker().session(1)->alarms().find(alarms::Code::ThermalShutdown)->state(); };
+  ASSERT_EQ(state(), alarms::AlarmState::ActiveUnacknowledged);
   AlarmAckSample s;
   s.sender = "guid-1";
   s.request_id = "a-1";
@@ -262,12 +271,14 @@ TEST(Failover, AStandbyAnswersNoAlarmAcknowledgement) {
   acks.submit(s);
   h.run_for(100ms);
   EXPECT_TRUE(replies.empty());
+  EXPECT_EQ(state(), alarms::AlarmState::ActiveUnacknowledged) << "not applied by the standby";
   EXPECT_EQ(acks.remembered(), 0u);
   owner = true;
-  acks.submit(s);
+  acks.submit(s);  // the resend reaches the new owner
   h.run_for(100ms);
   ASSERT_EQ(replies.size(), 1u);
   EXPECT_EQ(replies[0].result, AckReplyResult::Completed);
+  EXPECT_EQ(state(), alarms::AlarmState::ActiveAcknowledged);
 }
 
 }  // namespace
