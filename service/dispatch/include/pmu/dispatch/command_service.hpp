@@ -41,10 +41,10 @@
 // Shutdown does both.
 // The gate is read on the caller's thread and the worker's, never under `mutex_`: it must
 // not call into the service.
-// Threads: submit(), counters(), remembered(), peer_reply(), heard_on_can() and took_over()
-// from any thread (in the daemon, a Fast DDS
-// listener thread calls submit()); `mutex_` guards what they share. The stages after
-// BusWorker::post run on that worker's thread. `reply` is called from both, never under
+// Threads: submit(), counters(), remembered(), recorded(), peer_reply(), heard_on_can() and
+// took_over() from any thread (in the daemon, a Fast DDS listener thread calls submit() and
+// peer_reply(), the bus worker heard_on_can()); `mutex_` guards what they share. The stages
+// after BusWorker::post run on that worker's thread. `reply` is called from both, never under
 // `mutex_`.
 
 #include <chrono>
@@ -102,7 +102,9 @@ class CommandService {
   void heard_on_can(const std::string& bus, const codec::CanFrame& frame, SteadyTime at);
   // This instance owns the bus now (the gate says so): every recorded request is settled once
   // (failover_record.hpp). The first submit() after the gate opens does it too, so no request
-  // runs ahead of the ones recorded before it; a second call finds nothing to do.
+  // runs ahead of the ones recorded before it; a later call finds nothing to do, unless a
+  // request arrived as the gate opened and was recorded after the first: the holder calls it on
+  // each of its ticks while ACTIVE, which costs a lock when there is nothing.
   void took_over(SteadyTime now);
   // Requests held for a takeover.
   std::size_t recorded() const;
