@@ -223,6 +223,24 @@ TEST(Failover, ARequestRunningWhenTheGateClosesIsNotAnsweredHereButRecorded) {
   EXPECT_EQ(p.frames_with(0x10), 0u);
 }
 
+TEST(Failover, ARequestWhoseFramesWentOutBeforeTheGateClosedIsNotAnsweredHere) {
+  Pair p(true);
+  p.service.submit(p.set_avionics("half-done", 20.0));
+  p.h.worker().run_once(0ms);  // the worker takes it and sends its set
+  ASSERT_FALSE(p.h.sent_frames().empty());
+  p.owner = false;
+  p.h.run_for(2s);  // the device answers the read-back; the reply is the new owner's to give
+  EXPECT_TRUE(p.replies.empty());
+  EXPECT_EQ(p.service.recorded(), 1u);
+  p.h.clear_sent();
+  p.take_over();
+  const auto r = p.replies_to("half-done");
+  ASSERT_EQ(r.size(), 1u);
+  EXPECT_EQ(r[0].result, CommandResult::Failed);
+  EXPECT_EQ(r[0].reason, FailoverRecord::kHeardReason);
+  EXPECT_TRUE(p.h.sent_frames().empty()) << "not run again";
+}
+
 TEST(Failover, WithoutAGateTheServiceExecutesAsAlways) {
   Harness h(sim_bus({device(1)}), {pmu(1)});
   std::vector<CommandReplyData> replies;
