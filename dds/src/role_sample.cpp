@@ -103,9 +103,12 @@ ReadRole read_role_heartbeat(const pmu::v5::RoleHeartbeat& sample) {
   const auto role = role_of(sample.role());
   const auto bus = bus_of(sample.bus_state());
   const auto alarm = alarm_of(sample.alarm());
-  if (!role) out.problem = "role " + number_of(sample.role()) + " is not an InstanceRole";
-  else if (!bus) out.problem = "bus_state " + number_of(sample.bus_state()) + " is not a RoleBusState";
-  else if (!alarm) out.problem = "alarm " + number_of(sample.alarm()) + " is not a PeerAlarm";
+  if (!role)
+    out.problem = "role " + number_of(sample.role()) + " is not an InstanceRole";
+  else if (!bus)
+    out.problem = "bus_state " + number_of(sample.bus_state()) + " is not a RoleBusState";
+  else if (!alarm)
+    out.problem = "alarm " + number_of(sample.alarm()) + " is not a PeerAlarm";
   out.vehicle = sample.vehicle().to_string();
   if (!out.ok()) return out;
   out.report.name = sample.name().to_string();

@@ -17,7 +17,7 @@ using redundancy::PeerAlarm;
 using redundancy::Role;
 
 TEST(RoleSample, EveryValueReadsBackAsWritten) {
-  const std::vector<Role> roles{Role::Joining, Role::Standby, Role::Fenced,  Role::Claiming,
+  const std::vector<Role> roles{Role::Joining, Role::Standby, Role::Fenced, Role::Claiming,
                                 Role::Active,  Role::NoBus,   Role::Leaving};
   const std::vector<BusState> buses{BusState::Ok, BusState::BusOff, BusState::Down};
   const std::vector<PeerAlarm> alarms{PeerAlarm::None, PeerAlarm::PeerUnreachable, PeerAlarm::Partition,

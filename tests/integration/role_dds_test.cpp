@@ -206,8 +206,8 @@ TEST(RoleOverDds, AMoveForThisInstanceIsAskedOnceAndAnsweredAndAResendAlike) {
   });
   b.start();
   MoveClient client(vehicle_partitions(kVehicle));
-  ASSERT_TRUE(pmu::test::wait_until([&] { return writer_matched(*client.writer) && reader_matched(*client.reader); },
-                                    20s));
+  ASSERT_TRUE(
+      pmu::test::wait_until([&] { return writer_matched(*client.writer) && reader_matched(*client.reader); }, 20s));
   // Reliable, one writer, in order: each request arrives after the one before it, so the last
   // one's reply says every earlier request was judged.
   client.send("for-peer", "mc-a");

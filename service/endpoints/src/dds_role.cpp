@@ -83,11 +83,15 @@ struct DdsRoleEndpoint::Impl {
 
   struct RoleListener final : DataReaderListener {
     Impl* impl = nullptr;
-    void on_data_available(DataReader* r) override { impl->guard("pmu/role", [&] { impl->take_roles(r); }); }
+    void on_data_available(DataReader* r) override {
+      impl->guard("pmu/role", [&] { impl->take_roles(r); });
+    }
   } role_listener;
   struct MoveListener final : DataReaderListener {
     Impl* impl = nullptr;
-    void on_data_available(DataReader* r) override { impl->guard("pmu/role_move", [&] { impl->take_moves(r); }); }
+    void on_data_available(DataReader* r) override {
+      impl->guard("pmu/role_move", [&] { impl->take_moves(r); });
+    }
   } move_listener;
 
   Impl(dds::DdsContext& d, std::string v, Clocks c) : dds(d), vehicle(std::move(v)), clocks(std::move(c)) {
@@ -157,16 +161,16 @@ struct DdsRoleEndpoint::Impl {
       if (!info.valid_data || !running || !move_fn) continue;
       if (s.vehicle().to_string() != vehicle || s.instance().to_string() != name) continue;  // the peer's
       const auto partitions = dds.remote_writers().partitions_of(info);
-      redundancy::MoveRequest request{s.request_id().to_string(), s.instance().to_string(),
-                                      s.requester().to_string()};
+      redundancy::MoveRequest request{s.request_id().to_string(), s.instance().to_string(), s.requester().to_string()};
       const std::string sender = writer_guid_text(info);
       // As commands: a request not written in this vehicle's partition alone may reach every
       // vehicle's instances at once.
       if (!partitions || !dds::partitions_address_only(*partitions, vehicle)) {
         not_ours.fetch_add(1, std::memory_order_relaxed);
-        spdlog::warn("audit: role move {} from {} ({}) was not written in this vehicle's partition alone: not moved, "
-                     "not answered",
-                     printable(request.request_id), printable(request.requester), printable(sender));
+        spdlog::warn(
+            "audit: role move {} from {} ({}) was not written in this vehicle's partition alone: not moved, "
+            "not answered",
+            printable(request.request_id), printable(request.requester), printable(sender));
         continue;
       }
       if (s.expires_at() != 0 && s.expires_at() < clocks.wall_ns()) {
@@ -237,9 +241,9 @@ void DdsRoleEndpoint::start() {
   if (impl_->report_fn && !impl_->role_reader)
     impl_->role_reader = &impl_->dds.reader(*impl_->role_topic, qos_profiles::kRole, &impl_->role_listener);
   if (impl_->move_fn && !impl_->move_reader)
-    impl_->move_reader =
-        &impl_->dds.reader(impl_->dds.topic(topics::kRoleMove, TypeSupport(new idl::Guarded<pmu::v5::RoleMovePubSubType>())),
-                           qos_profiles::kCommand, &impl_->move_listener);
+    impl_->move_reader = &impl_->dds.reader(
+        impl_->dds.topic(topics::kRoleMove, TypeSupport(new idl::Guarded<pmu::v5::RoleMovePubSubType>())),
+        qos_profiles::kCommand, &impl_->move_listener);
 }
 
 void DdsRoleEndpoint::stop() {
