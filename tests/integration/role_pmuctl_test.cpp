@@ -34,7 +34,10 @@ class Instance {
              pmu::dds::Transport::Default, pmu::dds::ResolvedNetwork{},
              pmu::dds::Partitions{pmu::dds::vehicle_partitions("uav7"), pmu::dds::vehicle_partitions("uav7")}),
         endpoint_(dds_, "uav7"),
-        report_{name, peer, {role, 4, name == "mc-a" ? std::uint8_t{2} : std::uint8_t{1}, false}, BusState::Ok,
+        report_{name,
+                peer,
+                {role, 4, name == "mc-a" ? std::uint8_t{2} : std::uint8_t{1}, false},
+                BusState::Ok,
                 PeerAlarm::None} {
     endpoint_.on_move(name, [](const pmu::redundancy::MoveRequest&) {
       return pmu::redundancy::MoveResult{false, "the peer is not a live STANDBY with its bus up"};

@@ -27,7 +27,8 @@ TEST(RoleView, ASilentInstanceIsShownSilentWhateverItLastSaid) {
     std::chrono::milliseconds age;
     const char* shown;
   };
-  for (const auto& c : std::vector<Case>{{0ms, "ACTIVE"}, {1500ms, "ACTIVE"}, {1501ms, "SILENT"}, {60000ms, "SILENT"}}) {
+  for (const auto& c :
+       std::vector<Case>{{0ms, "ACTIVE"}, {1500ms, "ACTIVE"}, {1501ms, "SILENT"}, {60000ms, "SILENT"}}) {
     const auto s = seen("mc-a", Role::Active, c.age);
     EXPECT_EQ(role_shown(s), c.shown) << c.age.count();
     const auto j = role_json(s, 5);
@@ -58,8 +59,8 @@ TEST(RoleView, OnlyOneHeardOwnerAndNoAlarmIsAPairThatMayFlyOn) {
        {seen("mc-a", Role::Active), seen("mc-b", Role::Standby, 2000ms)},
        {"mc-b silent for 2.0 s (last STANDBY)"}},
       {"an alarm",
-       {seen("mc-a", Role::Active, 100ms, PeerAlarm::PeerUnreachable), seen("mc-b", Role::Fenced, 100ms,
-                                                                               PeerAlarm::Partition)},
+       {seen("mc-a", Role::Active, 100ms, PeerAlarm::PeerUnreachable),
+        seen("mc-b", Role::Fenced, 100ms, PeerAlarm::Partition)},
        {"mc-a raises peer_unreachable", "mc-b raises partition"}},
       {"a priority clash",
        {seen("mc-a", Role::Active, 100ms, PeerAlarm::PriorityClash), seen("mc-b", Role::Standby)},

@@ -93,9 +93,9 @@ int run_role_move(const GlobalOptions& o, const std::string& instance) {
   const std::string vehicle = o.vehicle.value_or(std::string());
   ContextLease lease(o, kPmuctlParticipant);
   pmu::dds::DdsContext& dds = *lease;
-  DataReader& replies = dds.reader(
-      dds.topic(topics::kRoleMoveReply, TypeSupport(new idl::Guarded<pmu::v5::RoleMoveReplyPubSubType>())),
-      qos_profiles::kCommand);
+  DataReader& replies =
+      dds.reader(dds.topic(topics::kRoleMoveReply, TypeSupport(new idl::Guarded<pmu::v5::RoleMoveReplyPubSubType>())),
+                 qos_profiles::kCommand);
   DataWriter& writer =
       dds.writer(dds.topic(topics::kRoleMove, TypeSupport(new pmu::v5::RoleMovePubSubType())), qos_profiles::kCommand);
   if (const auto failed = wait_for_match(o, dds, writer, replies, vehicle, deadline, "answers role moves"))
@@ -150,7 +150,7 @@ int run_role_move(const GlobalOptions& o, const std::string& instance) {
                               "): no such instance, or it is not one of a pair (pmuctl list shows the pair)";
   std::fprintf(stderr, "pmuctl: %s\n", message.c_str());
   if (o.json) {
-    Json j{{"request_id", id},   {"vehicle", vehicle}, {"instance", instance},
+    Json j{{"request_id", id},  {"vehicle", vehicle}, {"instance", instance},
            {"result", nullptr}, {"reason", message},  {"exit_status", static_cast<int>(ExitStatus::NoAnswer)}};
     std::printf("%s\n", j.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace).c_str());
   }

@@ -11,7 +11,8 @@ namespace {
 
 std::string upper(std::string_view text) {
   std::string out(text);
-  std::transform(out.begin(), out.end(), out.begin(), [](unsigned char c) { return static_cast<char>(std::toupper(c)); });
+  std::transform(out.begin(), out.end(), out.begin(),
+                 [](unsigned char c) { return static_cast<char>(std::toupper(c)); });
   return out;
 }
 
@@ -93,18 +94,19 @@ std::vector<std::vector<std::string>> role_rows(const std::vector<SeenInstance>&
 
 nlohmann::ordered_json role_json(const SeenInstance& s, int contract) {
   std::string shown = role_shown(s);
-  std::transform(shown.begin(), shown.end(), shown.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  std::transform(shown.begin(), shown.end(), shown.begin(),
+                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
   nlohmann::ordered_json values{{"name", s.report.name},
-                        {"peer", s.report.peer},
-                        {"role", shown},
-                        {"last_role", std::string(redundancy::role_name(s.report.beat.role))},
-                        {"term", s.report.beat.term},
-                        {"priority", s.report.beat.priority},
-                        {"hands_over", s.report.beat.hands_over},
-                        {"bus_state", bus_text(s.report.bus)},
-                        {"alarm", std::string(redundancy::alarm_name(s.report.alarm))},
-                        {"age", seconds(s.age)},
-                        {"silent", role_silent(s)}};
+                                {"peer", s.report.peer},
+                                {"role", shown},
+                                {"last_role", std::string(redundancy::role_name(s.report.beat.role))},
+                                {"term", s.report.beat.term},
+                                {"priority", s.report.beat.priority},
+                                {"hands_over", s.report.beat.hands_over},
+                                {"bus_state", bus_text(s.report.bus)},
+                                {"alarm", std::string(redundancy::alarm_name(s.report.alarm))},
+                                {"age", seconds(s.age)},
+                                {"silent", role_silent(s)}};
   return nlohmann::ordered_json{{"topic", "role"}, {"vehicle", s.vehicle}, {"values", values}, {"contract", contract}};
 }
 
