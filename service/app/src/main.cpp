@@ -34,6 +34,7 @@
 #include "pmu/endpoints/dds_alarm_acks.hpp"
 #include "pmu/endpoints/dds_commands.hpp"
 #include "pmu/endpoints/dds_publisher.hpp"
+#include "pmu/endpoints/dds_role.hpp"
 #include "pmu/endpoints/ros2_publisher.hpp"
 #include "pmu/endpoints/startup_check.hpp"
 #include "pmu/session/bus_worker.hpp"
@@ -181,13 +182,17 @@ int run(const service::Config& cfg, const pmu::dds::ResolvedNetwork& network) {
   service::EnergyTracker state_sink(cfg.buses, cfg.timeouts.stale_periods, readiness);
 
   std::unique_ptr<standby::RoleHolder> holder;
+  // pmu/role and pmu/role_move, on the service's own participant (the current contract's).
+  std::unique_ptr<service::DdsRoleEndpoint> role_topics;
   // Hot standby: whether this instance executes and answers commands (it owns the bus), for
   // the command and acknowledgement services' gates; set on the bus thread at each change of
   // role, before what the new role does. `commands` exists once the workers do, before they run.
   std::atomic<bool> executing{false};
   service::CommandService* commands_ptr = nullptr;
   if (cfg.redundancy) {
+    role_topics = std::make_unique<service::DdsRoleEndpoint>(participant, cfg.vehicle);
     standby::RoleHolder::Outputs outputs;
+    outputs.publish = [&role_topics](const redundancy::RoleReport& r) { role_topics->publish(r); };
     outputs.changed = [&gate, &systemd, &holder, &executing, &commands_ptr, &clock](const standby::RoleChange& c) {
       if (c.to == redundancy::Role::Active) {
         gate->open();
@@ -208,6 +213,13 @@ int run(const service::Config& cfg, const pmu::dds::ResolvedNetwork& network) {
       if (holder) systemd.status(holder->status());
     };
     holder = std::make_unique<standby::RoleHolder>(*cfg.redundancy, clock.steady_now(), std::move(outputs));
+    role_topics->on_report([&holder](const redundancy::RoleReport& r, std::chrono::steady_clock::time_point arrived) {
+      holder->on_report(r, arrived);
+    });
+    role_topics->on_move(cfg.redundancy->name, [&holder, &clock](const redundancy::MoveRequest& m) {
+      return holder->hand_over(clock.steady_now(), m.requester);
+    });
+    role_topics->start();
     spdlog::info("hot standby: instance {}, priority {}, peer {}; CAN heartbeat id 0x{:08X}", cfg.redundancy->name,
                  cfg.redundancy->priority, cfg.redundancy->peer, redundancy::can_beat_id(cfg.redundancy->priority));
   }

@@ -70,7 +70,7 @@ class RoleHolder {
   void on_report(const redundancy::RoleReport& report, Time arrival);
   // SIGTERM: the machine stops transmitting at once; the release goes out at the next tick.
   void leave(Time now);
-  // A move of the role asked by `who` (pmuctl): accepted or refused with the reason; audited.
+  // A move of the role asked by `who` (pmuctl): accepted or refused with the reason.
   redundancy::MoveResult hand_over(Time now, const std::string& who);
   redundancy::Role role() const;
   bool executes() const;
