@@ -198,7 +198,8 @@ frames_of() { awk -v i="$(vx_of "$1")" -v a="$2" -v b="${3:-1e18}" '{ t = $1; gs
 pmu_frames_of() { frames_of "$@" | awk '$2 ~ /^1E/'; }
 # The CAN heartbeats (interface.md 4.7: 0x1FFFFF00 + priority, layout 1, claim 1 claiming,
 # 2 active, 3 released) of HOST after K whose claim is CLAIM.
-beats_of() { frames_of "$1" "$2" "${4:-1e18}" | awk -v c="0$3" '$2 ~ /^1FFFFF0[0-9A-F]#01/ && substr($2, 13, 2) == c'; }
+# In candump's ID#DATA the claim is characters 12-13: after "1FFFFFPP#" and the layout "01".
+beats_of() { frames_of "$1" "$2" "${4:-1e18}" | awk -v c="0$3" '$2 ~ /^1FFFFF[0-9A-F][0-9A-F]#01/ && substr($2, 12, 2) == c'; }
 # The kernel time of HOST's first ACTIVE beat after K.
 first_active_beat() { beats_of "$1" "$2" 2 | awk '{ print $1; exit }'; }
 # The set frame of payload_voltage to V (protocol: 0x11, one byte in 0.1 V) sent by anyone.

@@ -60,8 +60,7 @@ class TopicListener : public DataReaderListener {
   explicit TopicListener(std::string topic) : topic_(std::move(topic)) {}
   void on_subscription_matched(DataReader*, const SubscriptionMatchedStatus& s) override {
     std::lock_guard<std::mutex> lock(g_print);
-    std::printf("matched %.3f %s %d %d\n", standby_boottime(), topic_.c_str(), s.current_count,
-                s.current_count_change);
+    std::printf("matched %.3f %s %d %d\n", standby_boottime(), topic_.c_str(), s.current_count, s.current_count_change);
     std::fflush(stdout);
   }
 
