@@ -22,6 +22,7 @@ std::string_view to_string(SendStatus status) noexcept {
     case SendStatus::BusOff: return "bus off";
     case SendStatus::NoDevice: return "no device";
     case SendStatus::Error: return "error";
+    case SendStatus::Fenced: return "not the bus owner";
   }
   return "unknown";
 }

@@ -10,6 +10,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
+#include <future>
 #include <cstdlib>
 #include <memory>
 #include <optional>
@@ -37,6 +38,9 @@
 #include "pmu/session/bus_worker.hpp"
 #include "pmu/session/moved_addresses.hpp"
 #include "pmu/session/receive_filters.hpp"
+#include "pmu/standby/fenced_bus.hpp"
+#include "pmu/standby/role_gate.hpp"
+#include "pmu/standby/role_holder.hpp"
 #include "pmu/sysconf_dir.hpp"
 #include "pmu/transport/socketcan_bus.hpp"
 #include "pmu/transport/stop_signals.hpp"
@@ -58,10 +62,12 @@ struct BusRuntime {
 };
 
 std::unique_ptr<transport::CanBus> open_bus(const service::BusConfig& bus, const transport::Clock& clock,
-                                            BusRuntime& rt) {
+                                            BusRuntime& rt, bool standby_pair) {
   if (bus.interface != "sim") {
     transport::SocketCanOptions options;
     options.filters = service::receive_filters(bus);
+    // The peer's CAN heartbeats (docs/design.md, "The CAN heartbeat frame").
+    if (standby_pair) options.filters.push_back({redundancy::kCanBeatIdBase, 0x1FFFFF00u, true});
     auto b = bus.interface.rfind("fd:", 0) == 0
                  ? transport::SocketCanBus::adopt(transport::UniqueFd(std::stoi(bus.interface.substr(3))), bus.name,
                                                   options, clock)
@@ -159,17 +165,48 @@ int run(const service::Config& cfg, const pmu::dds::ResolvedNetwork& network) {
                  cfg.ros2.name_space.empty() ? "/" : cfg.ros2.name_space);
   }
   service::StateFanout fanout(sinks);
+  // One of a hot-standby pair: the state topics are written only while this instance owns the
+  // bus (docs/design.md, "Hot standby"); the trackers behind the gate keep running.
+  std::unique_ptr<standby::RoleGate> gate;
+  if (cfg.redundancy)
+    gate = std::make_unique<standby::RoleGate>(fanout, [&publisher, &previous_publisher] {
+      publisher.clear_histories();
+      if (previous_publisher) previous_publisher->clear_histories();
+    });
+  service::StateSink& published = gate ? static_cast<service::StateSink&>(*gate) : fanout;
   // In front of the publishers: pmu/readiness from what the sessions report.
-  service::ReadinessTracker readiness(cfg.buses, cfg.timeouts.stale_periods, fanout, clock);
+  service::ReadinessTracker readiness(cfg.buses, cfg.timeouts.stale_periods, published, clock);
   // In front of readiness: pmu/energy from each PMU's voltages and currents.
   service::EnergyTracker state_sink(cfg.buses, cfg.timeouts.stale_periods, readiness);
 
+  std::unique_ptr<standby::RoleHolder> holder;
+  if (cfg.redundancy) {
+    standby::RoleHolder::Outputs outputs;
+    outputs.changed = [&gate, &systemd, &holder](const standby::RoleChange& c) {
+      if (c.to == redundancy::Role::Active) gate->open();
+      if (c.from == redundancy::Role::Active) gate->close();
+      if (c.from != c.to)
+        spdlog::warn(
+            "role: {} -> {} (term {}{})", redundancy::role_name(c.from), redundancy::role_name(c.to), c.term,
+            c.alarm == redundancy::PeerAlarm::None ? "" : ", alarm " + std::string(redundancy::alarm_name(c.alarm)));
+      else
+        spdlog::warn("role: {}, alarm {}", redundancy::role_name(c.to), redundancy::alarm_name(c.alarm));
+      if (holder) systemd.status(holder->status());
+    };
+    holder = std::make_unique<standby::RoleHolder>(*cfg.redundancy, clock.steady_now(), std::move(outputs));
+    spdlog::info("hot standby: instance {}, priority {}, peer {}; CAN heartbeat id 0x{:08X}", cfg.redundancy->name,
+                 cfg.redundancy->priority, cfg.redundancy->peer, redundancy::can_beat_id(cfg.redundancy->priority));
+  }
   service::MovedAddressStore moved(service::moved_addresses_path(std::getenv("STATE_DIRECTORY")), cfg);
   std::vector<BusRuntime> buses(cfg.buses.size());
   for (std::size_t i = 0; i < cfg.buses.size(); ++i) {
-    auto bus = open_bus(cfg.buses[i], clock, buses[i]);
+    auto bus = open_bus(cfg.buses[i], clock, buses[i], holder != nullptr);
+    if (holder) bus = std::make_unique<standby::FencedBus>(std::move(bus), *holder, clock);
     buses[i].worker =
         std::make_unique<service::BusWorker>(cfg.buses[i], std::move(bus), clock, cfg.timeouts, state_sink);
+    if (holder)
+      buses[i].worker->every(std::chrono::duration_cast<milliseconds>(redundancy::poll_period(holder->settings())),
+                             [&holder](std::chrono::steady_clock::time_point t) { holder->tick(t); });
     // Only a device from the config file has an `address:` that can go stale.
     buses[i].worker->on_moved([&moved](const service::BusWorker::Moved& m) {
       if (!m.config_line.empty()) moved.record(m.bus, m.first, m.to, m.serial);
@@ -259,9 +296,23 @@ int run(const service::Config& cfg, const pmu::dds::ResolvedNetwork& network) {
       last[i] = now;
     }
     if (progressing) systemd.watchdog();
-    systemd.status(summary(buses) + ", " + std::to_string(publisher.samples_written()) + " samples published");
+    systemd.status((holder ? holder->status() + "; " : std::string()) + summary(buses) + ", " +
+                   std::to_string(publisher.samples_written()) + " samples published");
   }
 
+  // The bus owner hands over: its release on CAN and its LEAVING heartbeat, sent on the bus's
+  // thread before the workers stop, so the peer claims at once (docs/design.md, "Hand-over").
+  if (holder) {
+    std::promise<void> left;
+    auto done = left.get_future();
+    buses.front().worker->post_urgent([&holder, &clock, &left] {
+      holder->leave(clock.steady_now());
+      holder->tick(clock.steady_now());
+      left.set_value();
+    });
+    if (done.wait_for(milliseconds(500)) != std::future_status::ready)
+      spdlog::warn("hot standby: the release was not sent within 500 ms; the peer takes over after can_silence");
+  }
   systemd.stopping();
   return 0;
 }

@@ -4,6 +4,8 @@
 #include <yaml-cpp/eventhandler.h>
 #include <yaml-cpp/yaml.h>
 
+#include <unistd.h>
+
 #include <algorithm>
 #include <cctype>
 #include <cerrno>
@@ -440,9 +442,20 @@ bool is_instance_name(const std::string& name) {
   });
 }
 
+// Without `name:`, the host's name up to its first dot, cut to an instance name's 63
+// characters; "pmu-service" where the host has none an instance name can hold.
+std::string host_instance_name() {
+  char buf[256] = {};
+  if (::gethostname(buf, sizeof buf - 1) != 0) return "pmu-service";
+  std::string h(buf);
+  h = h.substr(0, h.find('.'));
+  if (h.size() > 63) h.resize(63);
+  return is_instance_name(h) ? h : "pmu-service";
+}
+
 redundancy::Settings parse_redundancy(const Ctx& c, const YAML::Node& n) {
   if (!n.IsMap()) c.fail(n, "redundancy must be a map: {priority: 2, peer: mc-b}");
-  c.only_keys(n, "redundancy", {"priority", "peer", "heartbeat_period", "lease", "can_silence"});
+  c.only_keys(n, "redundancy", {"priority", "peer", "name", "heartbeat_period", "lease", "can_silence"});
   redundancy::Settings r;
   const auto priority = n["priority"];
   if (!priority) c.fail(n, "redundancy needs priority (1..255; the higher wins when neither instance owns the bus)");
@@ -460,6 +473,14 @@ redundancy::Settings parse_redundancy(const Ctx& c, const YAML::Node& n) {
     c.fail(peer.IsNull() ? key() : peer,
            "redundancy peer " + quoted(r.peer) +
                " is not an instance name (1..63 letters, digits, '-', '_' or '.', as a host name)");
+  }
+  if (const auto v = n["name"]) {
+    r.name = v.IsNull() ? std::string() : c.scalar<std::string>(v, "redundancy name", "a name");
+    if (!is_instance_name(r.name))
+      c.fail(v, "redundancy name " + quoted(r.name) +
+                    " is not an instance name (1..63 letters, digits, '-', '_' or '.', as a host name)");
+  } else {
+    r.name = host_instance_name();
   }
   if (const auto v = n["heartbeat_period"])
     r.heartbeat_period = redundancy_period(c, v, "redundancy heartbeat_period", redundancy::kMinHeartbeatPeriod,

@@ -202,6 +202,23 @@ DdsPublisher::DdsPublisher(dds::DdsContext& dds, std::chrono::milliseconds telem
 
 DdsPublisher::~DdsPublisher() = default;
 
+void DdsPublisher::clear_histories() {
+  std::lock_guard<std::mutex> lock(w_->mutex);
+  std::vector<DataWriter*> writers{w_->voltages,   w_->currents,  w_->energy,         w_->temperatures,
+                                   w_->status,     w_->config,    w_->info,           w_->health,
+                                   w_->low_health, w_->battery,   w_->battery_cells,  w_->mppt,
+                                   w_->alarms,     w_->readiness, w_->derived_energy, w_->bms_energy};
+  writers.insert(writers.end(), w_->low.begin(), w_->low.end());
+  for (auto* writer : writers) {
+    if (writer == nullptr) continue;
+    std::size_t removed = 0;
+    if (writer->clear_history(&removed) != ReturnCode_t::RETCODE_OK)
+      spdlog::warn("{}: its history could not be cleared", writer->get_topic()->get_name());
+  }
+  // What pmu/low_rate/health last said is gone with its history: the next owner writes anew.
+  w_->low_health_last.clear();
+}
+
 bool DdsPublisher::admit(const DeviceKey& key) {
   const auto id = std::make_tuple(key.bus, key.kind, key.address);
   if (w_->admitted.count(id)) return true;

@@ -55,15 +55,23 @@ void check_qos(const Config& cfg, StartupCheck& out) {
   for (const auto& p : dds::qos_file_problems(out.qos_file, service_profiles())) out.errors.push_back(where + p);
 }
 
-// A `redundancy:` section makes this service one of a hot-standby pair, and this pmu-service
-// does not run the role machine: beside its peer it would own the bus too, and both would poll
-// and send every command (docs/safety.md H8). Refused, not ignored.
+// A `redundancy:` section makes this service one of a hot-standby pair on one shared CAN bus
+// (docs/design.md, "Hot standby"): the CAN heartbeat that fences the pair runs on one bus, so a
+// pair serves exactly one, and a real one: the built-in simulator is this process's own, which
+// its peer cannot hear.
 void check_redundancy(const Config& cfg, StartupCheck& out) {
   if (!cfg.redundancy) return;
-  out.errors.push_back(cfg.redundancy_line +
-                       ": redundancy: this pmu-service does not run as one of a hot-standby pair "
-                       "(docs/interface.md 4.7): beside its peer both would own the bus and send every command; "
-                       "remove the section");
+  const auto& r = *cfg.redundancy;
+  if (cfg.buses.size() != 1)
+    out.errors.push_back(cfg.redundancy_line + ": redundancy: a hot-standby pair shares one CAN bus; this config has " +
+                         std::to_string(cfg.buses.size()) + " buses");
+  else if (cfg.buses.front().interface == "sim")
+    out.errors.push_back(cfg.redundancy_line + ": redundancy: bus " + cfg.buses.front().name +
+                         " is the built-in simulator (interface sim), which only this process hears: a pair needs a "
+                         "CAN bus both hosts are on (socketcan:IFACE)");
+  if (r.name == r.peer)
+    out.errors.push_back(cfg.redundancy_line + ": redundancy: name " + r.name +
+                         " is the peer's name too: each instance of a pair needs its own");
 }
 
 }  // namespace

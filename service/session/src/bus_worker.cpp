@@ -271,6 +271,10 @@ void BusWorker::post(std::function<void()> fn) { loop_.post(std::move(fn)); }
 
 void BusWorker::post_urgent(std::function<void()> fn) { loop_.post_urgent(std::move(fn)); }
 
+void BusWorker::every(milliseconds period, std::function<void(std::chrono::steady_clock::time_point)> fn) {
+  loop_.add_timer(clock_.steady_now(), period, std::move(fn));
+}
+
 std::size_t BusWorker::run_once(milliseconds max_wait) {
   turn_frames_ = 0;
   loop_.run_once(std::min(max_wait, kTick));

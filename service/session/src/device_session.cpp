@@ -79,10 +79,17 @@ void DeviceSession::start_reading(SteadyTime now) {
 
 void DeviceSession::on_reading_done(const RequestOutcome& o, std::uint64_t round) {
   const auto retry_delay = std::max(period() * 2, milliseconds(1000));
+  bool heard = false;
   switch (reading_.on_result(round, o.status == RequestStatus::Answered, now_, retry_delay)) {
     case ReadingMachine::Progress::Ignored:
     case ReadingMachine::Progress::Pending: return;
-    case ReadingMachine::Progress::Failed: queue_.drop(kReadingTag); return;
+    case ReadingMachine::Progress::Failed:
+      queue_.drop(kReadingTag);
+      // Not the bus owner: the round is what was heard of the owner's own reading, if whole.
+      if (o.send.status != transport::SendStatus::Fenced || !reading_.heard_all()) return;
+      reading_.complete_from_heard();
+      heard = true;
+      break;
     case ReadingMachine::Progress::Done: break;
   }
   const auto& info = reading_.info();
@@ -92,7 +99,8 @@ void DeviceSession::on_reading_done(const RequestOutcome& o, std::uint64_t round
   next_poll_ = now_;
   if (info) sink_.on_info(key_, *info);
   sink_.on_config(key_, reading_.config());
-  if (settings_.mode == TelemetryMode::Streaming && settings_.configure_streaming) configure_streaming();
+  // Streaming is set up by the owner that read the unit, not by one that only listened.
+  if (!heard && settings_.mode == TelemetryMode::Streaming && settings_.configure_streaming) configure_streaming();
 }
 
 void DeviceSession::configure_streaming() {
@@ -167,6 +175,7 @@ void DeviceSession::on_frame(const codec::PmuId& id, const codec::CanFrame& fram
   if (was_offline) {
     // Back after OFFLINE: the unit may have been reset or replaced; read everything again.
     health_.on_reconnect();
+    reading_.forget_heard();
     if (reading_.running() || reading_.failed()) start_reading(now);
   } else if (reading_.failed()) {
     start_reading(now);  // a failed round need not wait for its retry: the device speaks

@@ -40,8 +40,15 @@ std::optional<codec::FirmwareVersion> ReadingMachine::firmware() const noexcept 
   return info_->firmware.version();
 }
 
+std::uint32_t ReadingMachine::all_heard() noexcept {
+  return static_cast<std::uint32_t>((std::uint64_t{1} << packets().size()) - 1);
+}
+
 ReadingMachine::Changes ReadingMachine::absorb(const codec::PmuMessage& m) {
   Changes c;
+  const auto& round = packets();
+  for (std::size_t i = 0; i < round.size(); ++i)
+    if (round[i] == m.packet) heard_ |= std::uint32_t{1} << i;
   auto set = [&c](auto& slot, auto value) {
     if (slot != value) {
       slot = value;

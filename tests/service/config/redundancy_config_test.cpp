@@ -1,5 +1,7 @@
 // The `redundancy:` section (interface.md 4.7): absent, nothing changes; its values read into
 // the role machine's settings; every bad value refused at its line.
+#include <unistd.h>
+
 #include <gtest/gtest.h>
 
 #include <string>
@@ -41,6 +43,27 @@ TEST(RedundancyConfig, ItsValuesAndTheDefaults) {
   EXPECT_EQ(all.redundancy_line, "c.yaml:2");
 }
 
+TEST(RedundancyConfig, TheInstanceNameIsWrittenOrTheHosts) {
+  const auto named =
+      parse_config(std::string("redundancy:\n  priority: 2\n  peer: mc-b\n  name: mc-a\n") + kBusesAfter, "c.yaml");
+  EXPECT_EQ(named.redundancy->name, "mc-a");
+  char host[256] = {};
+  ASSERT_EQ(::gethostname(host, sizeof host - 1), 0);
+  std::string expected(host);
+  expected = expected.substr(0, expected.find('.'));
+  const auto unnamed = parse_config(std::string("redundancy:\n  priority: 2\n  peer: mc-b\n") + kBusesAfter, "c.yaml");
+  EXPECT_EQ(unnamed.redundancy->name, expected);
+  try {
+    (void)parse_config(std::string("redundancy:\n  priority: 2\n  peer: mc-b\n  name: 'mc a'\n") + kBusesAfter,
+                       "bad.yaml");
+    ADD_FAILURE() << "a name with a space was taken";
+  } catch (const ConfigError& e) {
+    EXPECT_STREQ(e.what(),
+                 "bad.yaml:4: redundancy name 'mc a' is not an instance name (1..63 letters, digits, '-', '_' or '.', "
+                 "as a host name)");
+  }
+}
+
 TEST(RedundancyConfig, EveryBadValueIsRefusedWithItsLine) {
   struct Case {
     const char* section;
@@ -49,7 +72,7 @@ TEST(RedundancyConfig, EveryBadValueIsRefusedWithItsLine) {
   const Case cases[] = {
       {"redundancy: yes\n", "bad.yaml:1: redundancy must be a map: {priority: 2, peer: mc-b}"},
       {"redundancy:\n  priority: 2\n  peer: b\n  leese: 1\n",
-       "bad.yaml:4: unknown key 'leese' in redundancy (known: priority, peer, heartbeat_period, lease, can_silence)"},
+       "bad.yaml:4: unknown key 'leese' in redundancy (known: priority, peer, name, heartbeat_period, lease, can_silence)"},
       {"redundancy:\n  peer: b\n",
        "bad.yaml:2: redundancy needs priority (1..255; the higher wins when neither instance owns the bus)"},
       {"redundancy:\n  priority: 2\n", "bad.yaml:2: redundancy needs peer (the other instance's name)"},

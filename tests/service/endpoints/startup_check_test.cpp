@@ -54,15 +54,37 @@ TEST(StartupCheck, TheShippedQosFileHasEveryProfileTheServiceUses) {
   EXPECT_EQ(c.qos_file, kShippedQos);
 }
 
-// Two services that each own the bus would both send every command (docs/safety.md H8).
-TEST(StartupCheck, ARedundancySectionIsRefusedAtItsLine) {
-  const auto c = check("qos_file: " + kShippedQos + "\nredundancy:\n  priority: 2\n  peer: mc-b\n" + kBus,
-                       "/etc/pmu-dds/pmu-service.yaml");
-  ASSERT_EQ(c.errors.size(), 1u);
-  EXPECT_EQ(c.errors[0],
-            "/etc/pmu-dds/pmu-service.yaml:2: redundancy: this pmu-service does not run as one of a hot-standby pair "
-            "(docs/interface.md 4.7): beside its peer both would own the bus and send every command; remove the "
-            "section");
+// A hot-standby pair is fenced by its CAN heartbeat on the one bus both hosts are on: a second
+// bus, or the process's own simulator, would leave a bus with two owners or one nobody else
+// hears (docs/safety.md H8).
+TEST(StartupCheck, ARedundancySectionNeedsOneSharedBus) {
+  const std::string section = "redundancy:\n  priority: 2\n  peer: mc-b\n  name: mc-a\n";
+  const std::string can0 = "buses:\n  - name: can0\n    interface: can0\n    discover: true\n";
+  const std::string two = can0 + "  - name: can1\n    interface: can1\n    discover: true\n";
+  struct Case {
+    std::string config;
+    std::string error;  // empty: accepted
+  };
+  const Case cases[] = {
+      {"qos_file: " + kShippedQos + "\n" + section + can0, ""},
+      {"qos_file: " + kShippedQos + "\n" + section + kBus,
+       "/etc/pmu-dds/pmu-service.yaml:2: redundancy: bus sim is the built-in simulator (interface sim), which only "
+       "this process hears: a pair needs a CAN bus both hosts are on (socketcan:IFACE)"},
+      {"qos_file: " + kShippedQos + "\n" + section + two,
+       "/etc/pmu-dds/pmu-service.yaml:2: redundancy: a hot-standby pair shares one CAN bus; this config has 2 buses"},
+      {"qos_file: " + kShippedQos + "\nredundancy:\n  priority: 2\n  peer: mc-b\n  name: mc-b\n" + can0,
+       "/etc/pmu-dds/pmu-service.yaml:2: redundancy: name mc-b is the peer's name too: each instance of a pair needs "
+       "its own"},
+  };
+  for (const auto& c : cases) {
+    const auto r = check(c.config, "/etc/pmu-dds/pmu-service.yaml");
+    if (c.error.empty()) {
+      EXPECT_TRUE(r.errors.empty()) << c.config << (r.errors.empty() ? "" : r.errors[0]);
+    } else {
+      ASSERT_EQ(r.errors.size(), 1u) << c.config;
+      EXPECT_EQ(r.errors[0], c.error);
+    }
+  }
 }
 
 TEST(StartupCheck, MissingQosFileIsNamedAtTheConfigLine) {

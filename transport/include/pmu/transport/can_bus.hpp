@@ -122,8 +122,10 @@ enum class SendStatus : std::uint8_t {
   BusOff,        // the simulated bus is BUS_OFF
   NoDevice,      // the interface is gone (ENODEV); maintain() reopens it when it returns
   Error,         // any other failure; `error` holds the errno
+  Fenced,        // not sent: this instance of a hot-standby pair does not own the bus
 };
-// "sent", "invalid frame", "timeout", "bus down", "bus off", "no device", "error".
+// "sent", "invalid frame", "timeout", "bus down", "bus off", "no device", "error",
+// "not the bus owner".
 std::string_view to_string(SendStatus status) noexcept;
 
 struct SendResult {

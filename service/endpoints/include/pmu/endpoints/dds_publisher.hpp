@@ -72,6 +72,12 @@ class DdsPublisher final : public StateSink {
   // start.
   void publish_baselines(const std::vector<BusConfig>& buses);
 
+  // Empties every writer's history but pmu/baseline's (the config's, the same on both
+  // instances of a hot-standby pair): a late joiner gets nothing of this service until it
+  // writes again. A standby calls it when it stops owning the bus (docs/design.md, "Hot
+  // standby"). Thread-safe.
+  void clear_histories();
+
   // A write to another of the service's topics (pmu/command_reply) failed: counted in
   // publish_failures and logged like the publisher's own. Thread-safe.
   void count_failed_write(const char* topic, const DeviceKey& key, const char* why);

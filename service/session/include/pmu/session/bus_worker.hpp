@@ -94,6 +94,10 @@ class BusWorker final : private transport::BusHandler {
   };
   // Called on the worker's thread after every move. Set before run().
   void on_moved(std::function<void(const Moved&)> fn) { moved_ = std::move(fn); }
+  // Runs `fn` on the worker's thread every `period` from the first turn on, with the loop's
+  // reading of the clock: work that must share the bus's thread (a hot-standby pair's
+  // heartbeat). Before run().
+  void every(std::chrono::milliseconds period, std::function<void(std::chrono::steady_clock::time_point)> fn);
 
   // Worker thread only (or before run()):
   // The session serving `address` now (a session that moved this turn included).

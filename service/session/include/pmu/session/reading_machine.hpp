@@ -54,6 +54,17 @@ class ReadingMachine {
   };
   Changes absorb(const codec::PmuMessage& m);
 
+  // Every packet of a round has been heard answered since the last forget_heard(), to
+  // whoever asked: a standby of a hot-standby pair, whose own gets never go out, knows the
+  // device from its peer's reading (docs/design.md, "Hot standby").
+  bool heard_all() const noexcept { return heard_ == all_heard(); }
+  void forget_heard() noexcept { heard_ = 0; }
+  // The round ends as if answered: RUNNING, from what was heard.
+  void complete_from_heard() noexcept {
+    phase_ = Phase::Running;
+    failed_ = false;
+  }
+
   // The unit answers at `address` now (a verified or observed CAN address change): its
   // stored CA is that, whatever was last read.
   void set_address(std::uint16_t address) noexcept {
@@ -75,6 +86,8 @@ class ReadingMachine {
   std::chrono::steady_clock::time_point retry_at_{};
   ConfigState config_;
   std::optional<InfoState> info_;
+  std::uint32_t heard_ = 0;  // bit i: packets()[i] heard answered
+  static std::uint32_t all_heard() noexcept;
 };
 
 }  // namespace pmu::service
