@@ -7,8 +7,10 @@
 # final reply), p50 and max over the runs, beside the PMU's packet period. Goals
 # (docs/design.md, "Periods and the failover budget"): first sample within 0.5 s, gap at most
 # 1 s, a command accepted within 1 s. Each run's own checks (one owner, one stream per
-# device, each command answered and executed once) are the suite's: a run whose scenario
-# failed is listed and left out of the figures.
+# device, each command answered and executed once) are the suite's: the table says how many
+# runs of each fault passed them, and the failures are printed after it. A run's figures are
+# measured before those checks, so they count whether it passed or not; the command column
+# counts only runs whose command COMPLETED.
 #   bench/standby_failover.sh [--build-dir DIR] [--runs N] [--faults "kill freeze ..."] [--log FILE]
 set -uo pipefail
 src="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
@@ -37,14 +39,16 @@ status=$?
 
 # Each scenario's RESULT line follows its FIGURES line; a run counts when it PASSED.
 awk -v faults="$faults" '
-  /^FIGURES / { name = $2; fig = $0; next }
-  /^RESULT / && $2 == name {
-    if ($3 == "PASS") {
-      for (i = 3; i <= split(fig, f, " "); i++) { split(f[i], kv, "="); v[name, kv[1], ++n[name, kv[1]]] = kv[2] }
-      pp[name] = v[name, "period", 1]
-    } else failed[name] = failed[name] + 1
-    name = ""
+  /^FIGURES / {
+    set[$2] = ""
+    for (i = 3; i <= split($0, parts, " "); i++) {
+      split(parts[i], kv, "=")
+      if (kv[2] != "-") v[$2, kv[1], ++n[$2, kv[1]]] = kv[2]
+      if (kv[1] == "period" || kv[1] == "lease" || kv[1] == "can_silence") set[$2] = set[$2] " " kv[1] " " kv[2]
+    }
+    next
   }
+  /^RESULT / { runs[$2]++; if ($3 == "PASS") passed[$2]++ }
   function pct(name, key, p,   k, m, a, i, j, t, r) {
     m = n[name, key]; if (m == 0) return "-"
     for (i = 1; i <= m; i++) a[i] = v[name, key, i] + 0
@@ -54,14 +58,14 @@ awk -v faults="$faults" '
   }
   function mark(x, goal) { return x == "-" ? x : (x + 0 <= goal ? x : x " (over " goal ")") }
   END {
-    print "| fault | runs passed | takeover s p50 / max (goal 0.5) | telemetry gap s p50 / max (goal 1.0) | command answered s p50 / max (goal 1.0) | packet period s |"
+    print "| fault | runs measured / passed | takeover s p50 / max (goal 0.5) | telemetry gap s p50 / max (goal 1.0) | command accepted s p50 / max (goal 1.0), runs | settings (s) |"
     print "|---|---|---|---|---|---|"
     k = split(faults, fs, " ")
     for (i = 1; i <= k; i++) {
       f = fs[i]
-      printf "| %s | %d of %d | %s / %s | %s / %s | %s / %s | %s |\n", f, n[f, "takeover"], n[f, "takeover"] + failed[f],
+      printf "| %s | %d of %d / %d | %s / %s | %s / %s | %s / %s, %d | %s |\n", f, n[f, "takeover"], runs[f], passed[f],
         pct(f, "takeover", 50), mark(pct(f, "takeover", 100), 0.5), pct(f, "gap", 50), mark(pct(f, "gap", 100), 1.0),
-        pct(f, "command", 50), mark(pct(f, "command", 100), 1.0), (pp[f] == "" ? "-" : pp[f])
+        pct(f, "command", 50), mark(pct(f, "command", 100), 1.0), n[f, "command"], substr(set[f], 2)
     }
   }' "$log"
 grep -E '^RESULT ' "$log" | grep -v ' PASS ' | sed 's/^/failed: /' >&2

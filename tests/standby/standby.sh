@@ -280,6 +280,7 @@ pair_up() {
 # handed to the ground station, which sends it once the first has its final reply. T_FAULT is
 # when WHAT was done, mark 1 its place in the capture.
 fault_at() {
+  mark 0
   _t=$(calc "$(now) + 1.0")
   batch_line "$SCEN-f" "$_t" "$3" >&3
   sleep_until "$_t"
@@ -307,6 +308,9 @@ check_takeover() {  # OLD V1 V2
   _new=$(other_of "$1")
   wait_until "$TAKEOVER_BOUND" took_over "$T_FAULT" "$WRITER_A" ||
     fail "no telemetry from another writer within $TAKEOVER_BOUND s of the fault ($(tail -n 2 "$WORK/$SCEN.$_new.log" | tr '\n' ' '))"
+  # A claim before the fault is a takeover nobody caused (an owner whose heartbeat paused).
+  _early=$(frames_of "$_new" 0 "$(mark_time 0)" | head -n 3)
+  [ -z "$_early" ] || fail "$_new claimed the bus before the fault: $(echo "$_early" | tr '\n' ' ')"
   set -- "$1" "$2" "$3" $(first_other_after "$T_FAULT" "$WRITER_A")
   TAKEOVER=$(calc "$4 - $T_FAULT")
   WRITER_NEW=$5
@@ -359,6 +363,9 @@ check_command() {  # TAG SUMMARY VALUE WANT
   _sets=$(set_frames "$3" | wc -l)
   if [ "$_done" = 1 ]; then
     [ "$_sets" = 1 ] || fail "$1 COMPLETED with $_sets set frames of payload_voltage $3 on the bus (one execution sends one): $(set_frames "$3" | tr '\n' ' ')"
+  elif [ "$_first" = REJECTED ]; then
+    # REJECTED says the command was not executed: nothing of it may be on the bus.
+    [ "$_sets" = 0 ] || fail "$1 was answered REJECTED, yet its set frame is on the bus ($_sets): $(set_frames "$3" | tr '\n' ' '); the audit trails: $(audit_of "$1-1")"
   else
     [ "$_sets" -le 1 ] || fail "$1 ($_res) sent $_sets set frames of payload_voltage $3: $(set_frames "$3" | tr '\n' ' ')"
   fi
