@@ -186,8 +186,9 @@ samples_after() { awk -v a="$1" -v tp="${2:-}" '$1 == "sample" && $2 >= a && (tp
 has_samples_after() { [ -n "$(samples_after "$1" | head -n1)" ]; }
 # The writer of the last voltages sample before uptime T.
 writer_before() { awk -v a="$1" '$1 == "sample" && $2 < a && $3 == "voltages" { w = $6 } END { print w }' "$CONSUMER"; }
-# The first sample at or after T from a writer other than W: "T WRITER", or nothing.
-first_other_after() { awk -v a="$1" -v w="$2" '$1 == "sample" && $2 >= a && $6 != w { print $2, $6; exit }' "$CONSUMER"; }
+# The first voltages sample at or after T from a writer other than W (a voltages writer):
+# "T WRITER", or nothing. (Each topic has its own writer: only one topic's are compared.)
+first_other_after() { awk -v a="$1" -v w="$2" '$1 == "sample" && $2 >= a && $3 == "voltages" && $6 != w { print $2, $6; exit }' "$CONSUMER"; }
 took_over() { [ -n "$(first_other_after "$1" "$2")" ]; }
 # One stream per device at any time, from uptime T on: for each topic and device, the
 # writers' samples form runs that never interleave (a writer that hands over never writes
@@ -483,7 +484,7 @@ scenario_freeze() {
   [ -z "$late" ] || fail "A sent PMU frames after SIGCONT: $(echo "$late" | head -n 3 | tr '\n' ' ')"
   [ -z "$(beats_of A "$k4" 2)$(beats_of A "$k4" 1)" ] || fail "A claimed the bus after SIGCONT: $(beats_of A "$k4" 2 | head -n 2 | tr '\n' ' ')"
   check_streams "$T_UP" 2
-  [ -z "$(awk -v a="$t_cont" -v w="$WRITER_A" '$1 == "sample" && $2 >= a && $6 == w' "$CONSUMER" | head -n1)" ] ||
+  [ -z "$(awk -v a="$t_cont" -v w="$WRITER_A" '$1 == "sample" && $2 >= a && $3 == "voltages" && $6 == w' "$CONSUMER" | head -n1)" ] ||
     fail "A wrote telemetry after SIGCONT"
   check_one_owner B
   detail "after SIGCONT A sent nothing on CAN and wrote no sample"
@@ -561,8 +562,7 @@ scenario_return() {
   alive "$PID_A" || fail "A ended after its restart: $(tail -n 3 "$WORK/$SCEN.A.log" | tr '\n' ' ')"
   k4=$(mark_time 4)
   [ -z "$(frames_of A "$k4")" ] || fail "the restarted A sent on CAN: $(frames_of A "$k4" | head -n 3 | tr '\n' ' ')"
-  [ -z "$(awk -v a="$t_back" -v w="$WRITER_NEW" '$1 == "sample" && $2 >= a && $6 != w' "$CONSUMER" | head -n1)" ] ||
-    fail "a writer other than B's after A's restart"
+  [ -z "$(first_other_after "$t_back" "$WRITER_NEW")" ] || fail "a writer other than B's after A's restart: $(first_other_after "$t_back" "$WRITER_NEW")"
   check_one_owner B
   detail "A restarted: 6 s later it had sent nothing on CAN and written nothing; B the owner"
   check_commands 13.2 13.3
