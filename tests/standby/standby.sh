@@ -475,8 +475,8 @@ scenario_freeze() {
   fault_at A stop 12.3 12.4
   check_takeover A 12.3 12.4
   mark 4
+  t_cont=$(now)   # before the signal: what A does on its first instant awake counts
   kill -CONT "$PID_A"
-  t_cont=$(now)
   sleep 4
   alive "$PID_A" || fail "A ended after SIGCONT: $(tail -n 3 "$WORK/$SCEN.A.log" | tr '\n' ' ')"
   k4=$(mark_time 4)
