@@ -17,7 +17,8 @@
 # PMU_IDL_FILES: the contract's IDL files (absolute paths), for every caller.
 get_filename_component(_pmu_idl_dir "${CMAKE_CURRENT_LIST_DIR}/../idl" ABSOLUTE)
 set(PMU_IDL_FILES ${_pmu_idl_dir}/telemetry.idl ${_pmu_idl_dir}/state.idl ${_pmu_idl_dir}/command.idl
-                  ${_pmu_idl_dir}/canopen.idl ${_pmu_idl_dir}/alarms.idl ${_pmu_idl_dir}/energy.idl)
+                  ${_pmu_idl_dir}/canopen.idl ${_pmu_idl_dir}/alarms.idl ${_pmu_idl_dir}/energy.idl
+                  ${_pmu_idl_dir}/role.idl)
 
 function(pmu_idl_generate sources_var)
   cmake_parse_arguments(PARSE_ARGV 1 arg "" "COMPILER;DESTINATION;INCLUDE" "IDL")

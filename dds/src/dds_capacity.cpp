@@ -35,6 +35,10 @@ std::string capacity_shortfall(const std::string& profile, EndpointKind kind, co
     need = kind == EndpointKind::Writer
                ? Need{kMaxAlarmsPerService, 1, "alarms per service, pmu::dds::kMaxAlarmsPerService"}
                : Need{kFleetAlarms, 1, "alarms of a fleet, pmu::dds::kFleetAlarms"};
+  } else if (profile == qos_profiles::kRole) {
+    need = kind == EndpointKind::Writer
+               ? Need{kRoleWriterInstances, 1, "an instance's own name, pmu::dds::kRoleWriterInstances"}
+               : Need{kFleetServices, 1, "service instances of a fleet, pmu::dds::kFleetServices"};
   } else if (profile == qos_profiles::kCommand) {
     // pmu/command and pmu/command_reply have no key: one instance holds the whole queue.
     need = Need{1, kCommandQueueDepth, "commands queued, pmu::dds::kCommandQueueDepth"};

@@ -6,6 +6,7 @@
 #include "pmu/idl/canopenTypeObject.h"
 #include "pmu/idl/commandTypeObject.h"
 #include "pmu/idl/energyTypeObject.h"
+#include "pmu/idl/roleTypeObject.h"
 #include "pmu/idl/stateTypeObject.h"
 #include "pmu/idl/telemetryTypeObject.h"
 
@@ -53,6 +54,7 @@ void register_type_objects() {
     registercanopenTypes();
     registeralarmsTypes();
     registerenergyTypes();
+    registerroleTypes();
   });
 }
 

@@ -343,16 +343,19 @@ permissions() {  # permissions NAME ROLE VEHICLES -> the permissions XML of NAME
         <domains>$domains_xml</domains>
 XML
   case "$role" in
-    pmu-service)  # publishes telemetry, state and replies; reads commands and acknowledgements
-      rule_xml publish "$parts" "${telemetry[@]}" "${state[@]}" pmu/command_reply pmu/alarm_ack_reply
-      rule_xml subscribe "$parts" pmu/command pmu/alarm_ack
+    pmu-service)  # publishes telemetry, state and replies; reads commands and acknowledgements;
+                  # as one of a hot-standby pair, writes and reads pmu/role and answers moves
+      rule_xml publish "$parts" "${telemetry[@]}" "${state[@]}" pmu/command_reply pmu/alarm_ack_reply \
+        pmu/role pmu/role_move_reply
+      rule_xml subscribe "$parts" pmu/command pmu/alarm_ack pmu/role pmu/role_move
       ;;
-    ground-station)  # the only one that may command or acknowledge; reads everything the service publishes
-      rule_xml publish "$parts" pmu/command pmu/alarm_ack
-      rule_xml subscribe "$parts" "${telemetry[@]}" "${state[@]}" pmu/command_reply pmu/alarm_ack_reply
+    ground-station)  # the only one that may command, acknowledge or move a role; reads everything the service publishes
+      rule_xml publish "$parts" pmu/command pmu/alarm_ack pmu/role_move
+      rule_xml subscribe "$parts" "${telemetry[@]}" "${state[@]}" pmu/command_reply pmu/alarm_ack_reply \
+        pmu/role pmu/role_move_reply
       ;;
-    mission-computer)  # listens to telemetry and state, nothing else: an alarm is the operator's to acknowledge
-      rule_xml subscribe "$parts" "${telemetry[@]}" "${state[@]}"
+    mission-computer)  # listens to telemetry, state and the pair's roles, nothing else: an alarm is the operator's to acknowledge
+      rule_xml subscribe "$parts" "${telemetry[@]}" "${state[@]}" pmu/role
       ;;
   esac
   cat <<XML

@@ -21,12 +21,13 @@ using eprosima::fastdds::dds::TypeSupport;
 TEST(TypeObjects, SelfContainedAreExactlyTheTypesWithoutMembersNamedByHash) {
   register_type_objects();
   register_type_objects();  // idempotent
-  for (const char* t : {"pmu::v5::Voltages", "pmu::v5::Currents", "pmu::v5::BatteryEnergy", "pmu::v5::Temperatures",
-                        "pmu::v5::Status", "pmu::v5::Config", "pmu::v5::DeviceInfo", "pmu::v5::Battery",
-                        "pmu::v5::Mppt", "pmu::v5::BatteryCell", "pmu::v5::Baseline", "pmu::v5::BmsEnergy"})
+  for (const char* t :
+       {"pmu::v5::Voltages", "pmu::v5::Currents", "pmu::v5::BatteryEnergy", "pmu::v5::Temperatures", "pmu::v5::Status",
+        "pmu::v5::Config", "pmu::v5::DeviceInfo", "pmu::v5::Battery", "pmu::v5::Mppt", "pmu::v5::BatteryCell",
+        "pmu::v5::Baseline", "pmu::v5::BmsEnergy", "pmu::v5::RoleMove", "pmu::v5::RoleMoveReply"})
     EXPECT_TRUE(type_object_is_self_contained(t)) << t;
   for (const char* t : {"pmu::v5::Health", "pmu::v5::BatteryCells", "pmu::v5::Command", "pmu::v5::CommandReply",
-                        "pmu::v5::DeviceKind", "pmu::v5::Energy", "pmu::NoSuchType"})
+                        "pmu::v5::DeviceKind", "pmu::v5::Energy", "pmu::v5::RoleHeartbeat", "pmu::NoSuchType"})
     EXPECT_FALSE(type_object_is_self_contained(t)) << t;
 }
 

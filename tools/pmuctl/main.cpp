@@ -34,6 +34,7 @@
 #include "pmuctl/verbs/config_file_verbs.hpp"
 #include "pmuctl/verbs/energy_verb.hpp"
 #include "pmuctl/verbs/preflight_verb.hpp"
+#include "pmuctl/verbs/role_verbs.hpp"
 #include "pmuctl/verbs/state_verbs.hpp"
 
 namespace {
@@ -142,6 +143,7 @@ int run_cli(int argc, char** argv, const AgentCall* served) {
   verbs.push_back(pmu::tools::add_state_verbs(app, g));
   verbs.push_back(pmu::tools::add_alarm_verbs(app));
   verbs.push_back(pmu::tools::add_preflight_verb(app));
+  verbs.push_back(pmu::tools::add_role_verbs(app));
   verbs.push_back(pmu::tools::add_energy_verb(app));
   auto* config = app.add_subcommand("config", "Stored parameters");
   config->require_subcommand(1);

@@ -8,6 +8,7 @@
 
 #include <CLI/CLI.hpp>
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <cstdio>
 #include <future>
@@ -180,11 +181,24 @@ int run(const service::Config& cfg, const pmu::dds::ResolvedNetwork& network) {
   service::EnergyTracker state_sink(cfg.buses, cfg.timeouts.stale_periods, readiness);
 
   std::unique_ptr<standby::RoleHolder> holder;
+  // Hot standby: whether this instance executes and answers commands (it owns the bus), for
+  // the command and acknowledgement services' gates; set on the bus thread at each change of
+  // role, before what the new role does. `commands` exists once the workers do, before they run.
+  std::atomic<bool> executing{false};
+  service::CommandService* commands_ptr = nullptr;
   if (cfg.redundancy) {
     standby::RoleHolder::Outputs outputs;
-    outputs.changed = [&gate, &systemd, &holder](const standby::RoleChange& c) {
-      if (c.to == redundancy::Role::Active) gate->open();
-      if (c.from == redundancy::Role::Active) gate->close();
+    outputs.changed = [&gate, &systemd, &holder, &executing, &commands_ptr, &clock](const standby::RoleChange& c) {
+      if (c.to == redundancy::Role::Active) {
+        gate->open();
+        executing.store(true);
+        // What the former owner left: each recorded request settled once (failover_record.hpp).
+        if (commands_ptr) commands_ptr->took_over(clock.steady_now());
+      }
+      if (c.from == redundancy::Role::Active) {
+        executing.store(false);
+        gate->close();
+      }
       if (c.from != c.to)
         spdlog::warn(
             "role: {} -> {} (term {}{})", redundancy::role_name(c.from), redundancy::role_name(c.to), c.term,
@@ -201,12 +215,22 @@ int run(const service::Config& cfg, const pmu::dds::ResolvedNetwork& network) {
   std::vector<BusRuntime> buses(cfg.buses.size());
   for (std::size_t i = 0; i < cfg.buses.size(); ++i) {
     auto bus = open_bus(cfg.buses[i], clock, buses[i], holder != nullptr);
-    if (holder) bus = std::make_unique<standby::FencedBus>(std::move(bus), *holder, clock);
+    // What a standby hears of its peer's commands on the bus, for the takeover.
+    if (holder)
+      bus = std::make_unique<standby::FencedBus>(
+          std::move(bus), *holder, clock,
+          [&commands_ptr, &clock](const std::string& name, const transport::ReceivedFrame& rx) {
+            if (commands_ptr) commands_ptr->heard_on_can(name, rx.frame, clock.steady_now());
+          });
     buses[i].worker =
         std::make_unique<service::BusWorker>(cfg.buses[i], std::move(bus), clock, cfg.timeouts, state_sink);
     if (holder)
       buses[i].worker->every(std::chrono::duration_cast<milliseconds>(redundancy::poll_period(holder->settings())),
-                             [&holder](std::chrono::steady_clock::time_point t) { holder->tick(t); });
+                             [&holder, &executing, &commands_ptr](std::chrono::steady_clock::time_point t) {
+                               holder->tick(t);
+                               // A request recorded just as the gate opened is settled here.
+                               if (executing.load() && commands_ptr) commands_ptr->took_over(t);
+                             });
     // Only a device from the config file has an `address:` that can go stale.
     buses[i].worker->on_moved([&moved](const service::BusWorker::Moved& m) {
       if (!m.config_line.empty()) moved.record(m.bus, m.first, m.to, m.serial);
@@ -230,6 +254,10 @@ int run(const service::Config& cfg, const pmu::dds::ResolvedNetwork& network) {
     if (previous_command_topics) previous_command_topics->publish(r);
   });
   if (network.link.profile != pmu::dds::LinkProfile::None || network.link.round_trip.set()) commands.link_configured();
+  if (holder) {
+    commands.set_role_gate([&executing] { return executing.load(); });
+    commands_ptr = &commands;
+  }
   // Acknowledgements, like commands, in both contracts (they exist from contract v4 on, and
   // no version since changed their types), each reply in both.
   service::DdsAlarmAckEndpoint ack_topics(participant, cfg.vehicle);
@@ -241,6 +269,7 @@ int run(const service::Config& cfg, const pmu::dds::ResolvedNetwork& network) {
                                   ack_topics.publish(r);
                                   if (previous_ack_topics) previous_ack_topics->publish(r);
                                 });
+  if (holder) acks.set_role_gate([&executing] { return executing.load(); });
   // Declared after everything the running threads use, so it is destroyed first, on every
   // way out of this function: commands stop first (no new request reaches `commands`, and
   // the bus workers are still there to finish the ones in flight), then the worker threads
@@ -270,6 +299,8 @@ int run(const service::Config& cfg, const pmu::dds::ResolvedNetwork& network) {
     b.thread = std::thread([w = b.worker.get()] { w->run(); });
   }
   command_topics.start(commands);
+  // The owner's replies, for a standby's record of what it answered.
+  if (holder) command_topics.follow_peer_replies();
   if (previous_command_topics) previous_command_topics->start(commands);
   ack_topics.start(acks);
   if (previous_ack_topics) previous_ack_topics->start(acks);

@@ -2,6 +2,8 @@
 
 #include <spdlog/spdlog.h>
 
+#include <algorithm>
+
 #include "sender_key.hpp"
 
 namespace pmu::service {
@@ -84,7 +86,26 @@ std::size_t AlarmAckService::remembered() const {
   return seen_.size();
 }
 
+void AlarmAckService::set_role_gate(std::function<bool()> applies_now) { applies_now_ = std::move(applies_now); }
+
+void AlarmAckService::let_go(const std::string& key, const AlarmAckSample& s) {
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    auto it = seen_.find(key);
+    if (it == seen_.end() || it->second.final) return;
+    seen_.erase(it);
+    if (auto at = std::find(order_.begin(), order_.end(), key); at != order_.end()) order_.erase(at);
+  }
+  spdlog::warn("audit: alarm ack {} from {}: {}: not answered here: this instance stopped owning the bus",
+               printable(s.request_id), printable(s.sender), where(s));
+}
+
 void AlarmAckService::submit(const AlarmAckSample& s) {
+  if (!applies_now()) {
+    spdlog::info("audit: alarm ack {} from {}: {} -> not applied, not answered: this instance does not own the bus",
+                 printable(s.request_id), printable(s.sender), where(s));
+    return;
+  }
   const std::string key = sender_key(s.sender, s.request_id);
   // Without an id nothing can be matched to a resend: answered, never remembered.
   if (!s.request_id.empty() && !first_time(key, s)) return;
@@ -97,6 +118,7 @@ void AlarmAckService::submit(const AlarmAckSample& s) {
         if (clock_.steady_now() > r.expires)
           return finish(sender_key(r.sender, r.request_id), s,
                         reply_to(s, AckReplyResult::Rejected, "expired before the bus worker took it"));
+        if (!applies_now()) return let_go(sender_key(r.sender, r.request_id), s);
         apply(*w, r);
       });
   finish(key, s, reply_to(s, AckReplyResult::Rejected, "bus " + printable(r.bus) + " is not served"));
@@ -187,6 +209,7 @@ void AlarmAckService::apply(BusWorker& worker, const AlarmAckRequest& r) {
 }
 
 void AlarmAckService::finish(const std::string& key, const AlarmAckSample& s, AlarmAckReplyData reply) {
+  if (!applies_now()) return let_go(key, s);
   unsigned copies = 1;
   if (!s.request_id.empty()) {
     std::lock_guard<std::mutex> lock(mutex_);

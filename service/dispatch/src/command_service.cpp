@@ -2,6 +2,7 @@
 
 #include <spdlog/spdlog.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <memory>
 
@@ -15,7 +16,12 @@ namespace pmu::service {
 
 CommandService::CommandService(std::vector<BusWorker*> workers, PolicyConfig policy, Timeouts timeouts,
                                const transport::Clock& clock, ReplyFn reply)
-    : workers_(std::move(workers)), policy_(policy), timeouts_(timeouts), clock_(clock), reply_(std::move(reply)) {}
+    : workers_(std::move(workers)),
+      policy_(policy),
+      timeouts_(timeouts),
+      clock_(clock),
+      reply_(std::move(reply)),
+      record_(policy.lifetimes) {}
 
 BusWorker* CommandService::worker_for(const std::string& bus) const {
   for (auto* w : workers_)
@@ -36,6 +42,106 @@ std::size_t CommandService::remembered() const {
 void CommandService::link_configured() {
   std::lock_guard<std::mutex> lock(mutex_);
   slow_link_.quiet();
+}
+
+void CommandService::set_role_gate(std::function<bool()> executes_now) { executes_now_ = std::move(executes_now); }
+
+std::size_t CommandService::recorded() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return record_.size();
+}
+
+void CommandService::peer_reply(const CommandReplyData& reply) {
+  if (executes_now()) return;  // this instance writes the replies: nobody else's count
+  std::lock_guard<std::mutex> lock(mutex_);
+  ++counters_.peer_replies;
+  record_.peer_reply(reply, clock_.steady_now());
+}
+
+void CommandService::heard_on_can(const std::string& bus, const codec::CanFrame& frame, SteadyTime at) {
+  if (executes_now()) return;
+  std::lock_guard<std::mutex> lock(mutex_);
+  record_.heard(bus, frame, at);
+}
+
+namespace {
+
+std::string sender_of_key(const std::string& key) { return key.substr(0, key.find('\0')); }
+
+std::string recorded_what(const CommandReplyData& r) {
+  return std::string(to_string(r.kind)) + " to " + printable(r.bus) + "/" + std::to_string(r.address);
+}
+
+}  // namespace
+
+void CommandService::took_over(SteadyTime now) {
+  std::vector<FailoverRecord::Verdict> verdicts;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (record_.empty()) return;
+    verdicts = record_.take_over(now);
+    for (auto& v : verdicts) {
+      // Taken here before (this instance owned the bus earlier): its own memory answers it.
+      if (seen_.count(v.key)) {
+        v.key.clear();
+        continue;
+      }
+      Entry e{v.fingerprint, std::nullopt, {}, 0};
+      if (v.action == FailoverRecord::Action::Answered) {
+        e.final = v.reply;
+        e.final_at = now;
+      }
+      seen_.emplace(v.key, std::move(e));
+      order_.push_back(v.key);
+      while (order_.size() > kRememberedRequests) {
+        seen_.erase(order_.front());
+        order_.pop_front();
+      }
+    }
+  }
+  // Stops first: none waits behind the others' replies (docs/safety.md H4).
+  std::stable_partition(verdicts.begin(), verdicts.end(), [](const FailoverRecord::Verdict& v) {
+    return v.action == FailoverRecord::Action::Run && v.reply.kind == CommandKind::EngineStop;
+  });
+  for (const auto& v : verdicts) {
+    if (v.key.empty()) continue;
+    const std::string sender = sender_of_key(v.key);
+    switch (v.action) {
+      case FailoverRecord::Action::Answered:
+        spdlog::info("audit: command {} from {}: {} -> {} by the former bus owner; not executed here",
+                     printable(v.reply.request_id), printable(sender), recorded_what(v.reply),
+                     to_string(v.reply.result));
+        break;
+      case FailoverRecord::Action::Unknown:
+      case FailoverRecord::Action::Expired: finish(v.key, sender, recorded_what(v.reply), v.reply); break;
+      case FailoverRecord::Action::Run:
+        if (v.reply.kind == CommandKind::EngineStop) {
+          // Whatever its expiry: a late stop only ends cranking, a lost one is H4.
+          CommandSample stop = *v.sample;
+          stop.expires_at = 0;
+          admit(v.key, stop, Now{clock_.system_now(), clock_.steady_now()});
+        } else {
+          admit(v.key, *v.sample, v.arrived);
+        }
+        break;
+    }
+  }
+}
+
+void CommandService::relinquish(const std::string& key, const CommandReplyData& reply) {
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    auto it = seen_.find(key);
+    if (it == seen_.end() || it->second.final) return;
+    const auto fingerprint = it->second.fingerprint;
+    seen_.erase(it);
+    if (auto at = std::find(order_.begin(), order_.end(), key); at != order_.end()) order_.erase(at);
+    record_.relinquished(key, fingerprint, reply, clock_.steady_now());
+  }
+  spdlog::warn(
+      "audit: command {} from {}: {}: not answered here: this instance stopped owning the bus while it ran; the "
+      "new owner answers it",
+      printable(reply.request_id), printable(sender_of_key(key)), recorded_what(reply));
 }
 
 CommandService::Seen CommandService::remember(const std::string& key, const CommandSample& s,
@@ -71,6 +177,7 @@ CommandService::Seen CommandService::remember(const std::string& key, const Comm
 
 void CommandService::finish(const std::string& key, const std::string& sender, const std::string& what,
                             const CommandReplyData& reply) {
+  if (!executes_now()) return relinquish(key, reply);
   if (!is_final(reply.result)) {
     // Progress of a long command (an engine start): passed on, neither recorded as the
     // answer to resends nor counted; the audit line is the final reply's.
@@ -114,11 +221,28 @@ void CommandService::refuse(const CommandRequest& r, const Refusal& refusal) {
 // one final reply, published outside the lock, with nothing sent to a bus.
 
 void CommandService::submit(const CommandSample& s) {
+  const Now now{clock_.system_now(), clock_.steady_now()};
+  if (!executes_now()) {
+    // The bus owner executes and answers it; kept for a takeover (failover_record.hpp).
+    if (s.request_id.empty()) return;
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      record_.request(sender_key(s.sender, s.request_id), s, now);
+    }
+    spdlog::info("audit: command {} from {}: {} -> not executed, not answered: this instance does not own the bus",
+                 printable(s.request_id), printable(s.sender), describe(s));
+    return;
+  }
+  took_over(now.steady);  // nothing to do unless the gate has just opened
   if (s.request_id.empty()) return reject_without_id(s);
   const std::string key = sender_key(s.sender, s.request_id);
   if (!first_time(key, s)) return;
+  admit(key, s, now);
+}
+
+void CommandService::admit(const std::string& key, const CommandSample& s, const Now& now) {
   // Values, ranges and the expiry: parse_command checks them all.
-  auto parsed = parse_command(s, Now{clock_.system_now(), clock_.steady_now()}, policy_.lifetimes);
+  auto parsed = parse_command(s, now, policy_.lifetimes);
   if (!parsed) return finish(key, s.sender, describe(s), make_reply(s, CommandResult::Rejected, parsed.error()));
   const CommandRequest& r = *parsed;
   // parse_command lets only engine_stop through to the broadcast address; a stop is never
@@ -208,6 +332,9 @@ std::optional<CommandService::Refusal> CommandService::limit_rate(const CommandR
 }
 
 void CommandService::run_on_worker(BusWorker& worker, const CommandRequest& r) {
+  // The gate closed since it was posted: the new owner has it (and this instance's record, if
+  // it takes the bus back).
+  if (!executes_now()) return relinquish(sender_key(r.sender, r.request_id), make_reply(r, CommandResult::Failed, {}));
   if (r.address == codec::kBroadcastAddress) return broadcast(worker, r);
   DeviceSession* session = worker.session(r.address);
   // A stop to the address a unit has just left follows the unit (interface.md 2.6): whoever

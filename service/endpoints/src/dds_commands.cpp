@@ -6,6 +6,7 @@
 
 #include <atomic>
 #include <chrono>
+#include <cstring>
 #include <optional>
 #include <map>
 #include <mutex>
@@ -18,6 +19,7 @@
 #include "pmu/endpoints/dds_publisher.hpp"
 #include "pmu/idl/command.h"
 #include "pmu/idl/commandPubSubTypes.h"
+#include "pmu/idl/guarded_type.hpp"
 #include "pmu/idl/topics.hpp"
 #include "pmu/session/log_throttle.hpp"
 #include "writer_guid.hpp"
@@ -37,6 +39,36 @@ std::string partition_list(const std::vector<std::string>& names) {
   std::string out;
   for (const auto& n : names) out += (out.empty() ? "'" : ", '") + printable(n) + "'";
   return "partition(s) " + out;
+}
+
+// The reply topic's type: written zero-padded (zero_padded_type.hpp) and, for the standby's
+// reader, read guarded (guarded_type.hpp): one type serves both, as a topic has one.
+class ZeroPaddedCommandReply : public pmu::v5::CommandReplyPubSubType {
+ public:
+  bool serialize(void* data, eprosima::fastrtps::rtps::SerializedPayload_t* payload) override {
+    std::memset(payload->data, 0, payload->max_size);
+    return pmu::v5::CommandReplyPubSubType::serialize(data, payload);
+  }
+};
+using CommandReplyTopicType = idl::Guarded<ZeroPaddedCommandReply>;
+
+// A reply as another instance wrote it, in the service's terms; nullopt for values outside the
+// IDL's enums (no instance of this service writes them).
+std::optional<CommandReplyData> peer_reply_data(const pmu::v5::CommandReply& s) {
+  const auto kind = static_cast<std::uint32_t>(s.kind());
+  const auto result = static_cast<std::uint32_t>(s.result());
+  if (kind >= kCommandKindCount || result > static_cast<std::uint32_t>(CommandResult::InProgress)) return std::nullopt;
+  CommandReplyData d;
+  d.request_id = s.request_id();
+  d.bus = s.bus();
+  d.address = s.address();
+  d.kind = static_cast<CommandKind>(kind);
+  d.result = static_cast<CommandResult>(result);
+  d.reason = s.reason();
+  d.has_value = s.has_value();
+  d.value = s.value();
+  d.value_text = s.value_text();
+  return d;
 }
 
 }  // namespace
@@ -87,6 +119,27 @@ struct DdsCommandEndpoint::Impl final : public DataReaderListener {
           *held ? ", " + std::to_string(*held) + " not logged since the last message" : std::string());
     return false;
   }
+
+  // The bus owner's replies, read on the standby (follow_peer_replies).
+  struct PeerReplies final : public DataReaderListener {
+    Impl& impl;
+    explicit PeerReplies(Impl& i) : impl(i) {}
+    void on_data_available(DataReader* r) override {
+      std::lock_guard<std::mutex> lock(impl.service_mutex);
+      if (!impl.service) return;
+      const auto own = impl.dds.participant().guid().guidPrefix;
+      pmu::v5::CommandReply reply;
+      SampleInfo info;
+      while (r->take_next_sample(&reply, &info) == ReturnCode_t::RETCODE_OK) {
+        // This instance's own replies are no peer's; another vehicle's are another pair's.
+        if (!info.valid_data || info.sample_identity.writer_guid().guidPrefix == own) continue;
+        if (reply.vehicle() != impl.vehicle) continue;
+        if (auto d = peer_reply_data(reply)) impl.service->peer_reply(*d);
+      }
+    }
+  };
+  PeerReplies peer_replies{*this};
+  DataReader* reply_reader = nullptr;
 
   void on_data_available(DataReader* r) override {
     std::lock_guard<std::mutex> lock(service_mutex);
@@ -141,8 +194,8 @@ struct DdsCommandEndpoint::Impl final : public DataReaderListener {
 
 DdsCommandEndpoint::DdsCommandEndpoint(dds::DdsContext& dds, DdsPublisher* failures, std::string vehicle)
     : impl_(std::make_unique<Impl>(dds, failures, std::move(vehicle))) {
-  impl_->writer = &dds.writer(dds.topic(topics::kCommandReply, dds::zero_padded<pmu::v5::CommandReplyPubSubType>()),
-                              qos_profiles::kCommand);
+  impl_->writer =
+      &dds.writer(dds.topic(topics::kCommandReply, TypeSupport(new CommandReplyTopicType())), qos_profiles::kCommand);
 }
 
 void DdsCommandEndpoint::stop() {
@@ -152,6 +205,7 @@ void DdsCommandEndpoint::stop() {
   }
   // Outside the lock: Fast DDS may wait here for a callback that waits for the lock.
   if (impl_->reader) impl_->reader->set_listener(nullptr);
+  if (impl_->reply_reader) impl_->reply_reader->set_listener(nullptr);
 }
 
 DdsCommandEndpoint::~DdsCommandEndpoint() { stop(); }
@@ -165,6 +219,12 @@ void DdsCommandEndpoint::start(CommandService& service) {
   impl_->type = type;
   impl_->reader =
       &impl_->dds.reader(impl_->dds.topic(topics::kCommand, TypeSupport(type)), qos_profiles::kCommand, impl_.get());
+}
+
+void DdsCommandEndpoint::follow_peer_replies() {
+  impl_->reply_reader =
+      &impl_->dds.reader(impl_->dds.topic(topics::kCommandReply, TypeSupport(new CommandReplyTopicType())),
+                         qos_profiles::kCommand, &impl_->peer_replies);
 }
 
 void DdsCommandEndpoint::publish(const CommandReplyData& reply) { impl_->publish(reply); }

@@ -23,6 +23,16 @@ const std::vector<dds::ProfileUse>& service_profiles() {
   return uses;
 }
 
+// One of a hot-standby pair also writes and reads pmu/role and answers moves (DdsRoleEndpoint);
+// a service alone needs none of these, so a QoS file made before them still starts it.
+const std::vector<dds::ProfileUse>& pair_profiles() {
+  static const std::vector<dds::ProfileUse> uses{
+      {qos_profiles::kRole, dds::EndpointKind::Writer, "the pmu/role writer"},
+      {qos_profiles::kRole, dds::EndpointKind::Reader, "the pmu/role reader"},
+  };
+  return uses;
+}
+
 void check_security(const Config& cfg, StartupCheck& out) {
   if (cfg.security.files.empty()) return;
   dds::SecurityCheckOptions options;
@@ -52,7 +62,9 @@ void check_qos(const Config& cfg, StartupCheck& out) {
     }
     if (const char* env = std::getenv("PMU_QOS_FILE"); env && *env) where = "$PMU_QOS_FILE: ";
   }
-  for (const auto& p : dds::qos_file_problems(out.qos_file, service_profiles())) out.errors.push_back(where + p);
+  auto uses = service_profiles();
+  if (cfg.redundancy) uses.insert(uses.end(), pair_profiles().begin(), pair_profiles().end());
+  for (const auto& p : dds::qos_file_problems(out.qos_file, uses)) out.errors.push_back(where + p);
 }
 
 // A `redundancy:` section makes this service one of a hot-standby pair on one shared CAN bus

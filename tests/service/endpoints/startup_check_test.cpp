@@ -6,6 +6,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cstdlib>
 #include <fstream>
 #include <regex>
@@ -141,6 +142,20 @@ TEST(StartupCheck, AMissingProfileIsNamed) {
   ASSERT_EQ(c.errors.size(), 1u);
   EXPECT_EQ(c.errors[0], "a.yaml:1: qos_file: " + qos +
                              ": no <data_reader profile_name=\"command\">, needed for the pmu/command reader");
+}
+
+// Only one of a hot-standby pair writes and reads pmu/role: a service alone starts with a QoS
+// file made before the profile existed, an instance of a pair is told what it lacks.
+TEST(StartupCheck, TheRoleProfileIsNeededByAnInstanceOfAPairOnly) {
+  const std::string dir = scratch("role");
+  const std::string qos =
+      edited_qos(dir, "<data_reader profile_name=\"role\">", "<data_reader profile_name=\"roles\">");
+  EXPECT_TRUE(check("qos_file: " + qos + "\n" + kBus, "a.yaml").ok());
+  const auto c = check("qos_file: " + qos + "\nredundancy:\n  priority: 2\n  peer: mc-b\n" + kBus, "a.yaml");
+  const std::string lacks =
+      "a.yaml:1: qos_file: " + qos + ": no <data_reader profile_name=\"role\">, needed for the pmu/role reader";
+  EXPECT_NE(std::find(c.errors.begin(), c.errors.end(), lacks), c.errors.end())
+      << (c.errors.empty() ? "" : c.errors.front());
 }
 
 TEST(StartupCheck, AProfileShortOfTheCapacityIsNamedAtItsLine) {

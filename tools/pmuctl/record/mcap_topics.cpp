@@ -11,8 +11,9 @@ const std::vector<RecordedTopic>& recorded_topics() {
   using namespace pmu::topics;
   namespace q = pmu::qos_profiles;
   namespace t = pmu::idl_text;
-  // The low-rate topics repeat the full-rate samples, and commands and acknowledgements are
-  // the operators' own: recorded only when named.
+  // The low-rate topics repeat the full-rate samples, commands, acknowledgements and role moves
+  // are the operators' own, and pmu/role is a hot-standby pair's (ten samples a second from
+  // each instance): recorded only when named.
   static const std::vector<RecordedTopic> all = {
       {kVoltages, "pmu::v5::Voltages", t::k_Voltages, q::kTelemetry, true},
       {kCurrents, "pmu::v5::Currents", t::k_Currents, q::kTelemetry, true},
@@ -40,6 +41,9 @@ const std::vector<RecordedTopic>& recorded_topics() {
       {kCommandReply, "pmu::v5::CommandReply", t::k_CommandReply, q::kCommand, false},
       {kAlarmAck, "pmu::v5::AlarmAck", t::k_AlarmAck, q::kCommand, false},
       {kAlarmAckReply, "pmu::v5::AlarmAckReply", t::k_AlarmAckReply, q::kCommand, false},
+      {kRole, "pmu::v5::RoleHeartbeat", t::k_RoleHeartbeat, q::kRole, false},
+      {kRoleMove, "pmu::v5::RoleMove", t::k_RoleMove, q::kCommand, false},
+      {kRoleMoveReply, "pmu::v5::RoleMoveReply", t::k_RoleMoveReply, q::kCommand, false},
   };
   return all;
 }

@@ -11,6 +11,7 @@
 #include "pmu/idl/canopenPubSubTypes.h"
 #include "pmu/idl/commandPubSubTypes.h"
 #include "pmu/idl/energyPubSubTypes.h"
+#include "pmu/idl/rolePubSubTypes.h"
 #include "pmu/idl/statePubSubTypes.h"
 #include "pmu/idl/telemetryPubSubTypes.h"
 #include "sensor_msgs/msg/BatteryStatePubSubTypes.h"
@@ -64,6 +65,9 @@ TypeSupport raw_type_support(const std::string& type_name) {
   if (type_name == "pmu::v5::Command") return TypeSupport(new RawSampleType<pmu::v5::CommandPubSubType>());
   if (type_name == "pmu::v5::AlarmAck") return TypeSupport(new RawSampleType<pmu::v5::AlarmAckPubSubType>());
   if (type_name == "pmu::v5::AlarmAckReply") return TypeSupport(new RawSampleType<pmu::v5::AlarmAckReplyPubSubType>());
+  if (type_name == "pmu::v5::RoleHeartbeat") return TypeSupport(new RawSampleType<pmu::v5::RoleHeartbeatPubSubType>());
+  if (type_name == "pmu::v5::RoleMove") return TypeSupport(new RawSampleType<pmu::v5::RoleMovePubSubType>());
+  if (type_name == "pmu::v5::RoleMoveReply") return TypeSupport(new RawSampleType<pmu::v5::RoleMoveReplyPubSubType>());
   if (type_name == kRos2BatteryType) return TypeSupport(new RawSampleType<sensor_msgs::msg::BatteryStatePubSubType>());
   if (type_name == kRos2DiagnosticsType)
     return TypeSupport(new RawSampleType<diagnostic_msgs::msg::DiagnosticArrayPubSubType>());

@@ -9,6 +9,7 @@
 #include <nlohmann/json.hpp>
 #include <set>
 #include <thread>
+#include <vector>
 
 #include "pmu/dds/contract_names.hpp"
 #include "pmu/idl/alarmsPubSubTypes.h"
@@ -19,6 +20,8 @@
 #include "pmuctl/call/service_presence.hpp"
 #include "pmuctl/call/state_settle.hpp"
 #include "pmuctl/call/context_lease.hpp"
+#include "pmuctl/verbs/role_verbs.hpp"
+#include "pmuctl/view/role_view.hpp"
 
 namespace pmu::tools {
 namespace {
@@ -35,33 +38,56 @@ const char* level_name(pmu::v5::ReadinessLevel l) {
   return "READY";
 }
 
-void print(const GlobalOptions& o, const pmu::v5::Readiness& r) {
-  const std::string vehicle = r.vehicle().to_string();
+// A vehicle's readiness as its service says it, or none (a pair with no bus owner writes no
+// state), and what its hot-standby pair is short of (role_view.hpp): a pair with no owner, two
+// owners, a silent instance or an alarm is NOT READY whatever the readiness says (docs/safety.md
+// H6). `pair`: the vehicle's instances seen on pmu/role, empty when it runs alone.
+void print(const GlobalOptions& o, const std::string& vehicle, const pmu::v5::Readiness* r,
+           const std::vector<SeenInstance>& pair) {
+  const auto problems = pair.empty() ? std::vector<std::string>() : pair_problems(pair);
+  const bool ready = r && r->ready() && problems.empty();
+  const std::uint32_t total = (r ? r->reasons_total() : 0) + static_cast<std::uint32_t>(problems.size());
   if (o.json) {
-    nlohmann::json reasons = nlohmann::json::array();
-    for (const auto& x : r.reasons())
-      reasons.push_back({{"code", x.code().to_string()},
-                         {"severity", x.severity() == pmu::v5::SEVERITY_CRITICAL ? "critical" : "warning"},
-                         {"bus", x.bus().to_string()},
-                         {"kind", alarm_source_name(x.kind())},
-                         {"device", x.device()},
-                         {"message", x.message().to_string()},
-                         {"description", x.description().to_string()}});
-    nlohmann::json j{{"topic", "readiness"},
-                     {"vehicle", vehicle},
-                     {"ready", r.ready()},
-                     {"level", level_name(r.level())},
-                     {"since", static_cast<double>(r.since()) / 1e9},
-                     {"reasons", reasons},
-                     {"reasons_total", r.reasons_total()},
-                     {"contract", pmu::dds::contract_major()}};
+    nlohmann::ordered_json reasons = nlohmann::ordered_json::array();
+    if (r)
+      for (const auto& x : r->reasons())
+        reasons.push_back({{"code", x.code().to_string()},
+                           {"severity", x.severity() == pmu::v5::SEVERITY_CRITICAL ? "critical" : "warning"},
+                           {"bus", x.bus().to_string()},
+                           {"kind", alarm_source_name(x.kind())},
+                           {"device", x.device()},
+                           {"message", x.message().to_string()},
+                           {"description", x.description().to_string()}});
+    nlohmann::ordered_json j{
+        {"topic", "readiness"},
+        {"vehicle", vehicle},
+        {"ready", ready},
+        {"level", r && problems.empty() ? level_name(r->level()) : "NOT_READY"},
+        {"since", r ? nlohmann::ordered_json(static_cast<double>(r->since()) / 1e9) : nlohmann::ordered_json(nullptr)},
+        {"reasons", reasons},
+        {"reasons_total", r ? r->reasons_total() : 0}};
+    if (!pair.empty()) {
+      nlohmann::ordered_json instances = nlohmann::ordered_json::array();
+      for (const auto& s : pair) instances.push_back(role_json(s, pmu::dds::contract_major())["values"]);
+      j["pair"] = {{"instances", instances}, {"problems", problems}};
+    }
+    j["contract"] = pmu::dds::contract_major();
     std::printf("%s\n", j.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace).c_str());
     return;
   }
-  std::printf("%s: %s", vehicle.empty() ? "(unnamed vehicle)" : vehicle.c_str(),
-              r.ready() ? (r.level() == pmu::v5::LEVEL_WARNING ? "READY, with warnings" : "READY") : "NOT READY");
-  std::printf(r.reasons_total() ? " (%u reason%s)\n" : "\n", r.reasons_total(), r.reasons_total() == 1 ? "" : "s");
-  for (const auto& x : r.reasons()) {
+  const char* verdict =
+      !ready ? "NOT READY" : (r->level() == pmu::v5::LEVEL_WARNING ? "READY, with warnings" : "READY");
+  std::printf("%s: %s", vehicle.empty() ? "(unnamed vehicle)" : vehicle.c_str(), verdict);
+  std::printf(total ? " (%u reason%s)\n" : "\n", total, total == 1 ? "" : "s");
+  for (const auto& p : problems)
+    std::printf("  %-8s %-24s %-14s %s\n           %s\n", "CRITICAL", "hot_standby", "pair", p.c_str(),
+                "one instance of the pair must own the bus, the other stand by, neither raise an alarm "
+                "(pmuctl list shows the pair)");
+  if (!r) {
+    std::printf("  %-8s %-24s %-14s %s\n", "CRITICAL", "no_readiness", "-", "no pmu/readiness from this vehicle");
+    return;
+  }
+  for (const auto& x : r->reasons()) {
     std::string where = x.bus().to_string();
     if (x.kind() != pmu::v5::SOURCE_BUS)
       where += "/" + std::string(x.kind() == pmu::v5::SOURCE_PMU ? "" : alarm_source_name(x.kind())) +
@@ -70,8 +96,8 @@ void print(const GlobalOptions& o, const pmu::v5::Readiness& r) {
                 x.severity() == pmu::v5::SEVERITY_CRITICAL ? "CRITICAL" : "WARNING", x.code().c_str(), where.c_str(),
                 x.message().c_str(), x.description().c_str());
   }
-  if (r.reasons_total() > r.reasons().size())
-    std::printf("  ... and %zu more\n", static_cast<std::size_t>(r.reasons_total() - r.reasons().size()));
+  if (r->reasons_total() > r->reasons().size())
+    std::printf("  ... and %zu more\n", static_cast<std::size_t>(r->reasons_total() - r->reasons().size()));
 }
 
 }  // namespace
@@ -82,6 +108,7 @@ int run_preflight(const GlobalOptions& o) {
   DataReader& reader =
       dds.reader(dds.topic(topics::kReadiness, TypeSupport(new idl::Guarded<pmu::v5::ReadinessPubSubType>())),
                  qos_profiles::kState);
+  RoleCollector roles(o, dds);
   const auto deadline = wait_end(o, 3.0);
   StateSettle settle(std::chrono::milliseconds(300));
   std::map<std::string, pmu::v5::Readiness> latest;
@@ -97,7 +124,10 @@ int run_preflight(const GlobalOptions& o) {
     if (settle.settled(Clock::now())) break;
     std::this_thread::sleep_for(std::chrono::milliseconds(20));
   }
-  if (latest.empty()) {
+  roles.wait_for_peers(deadline);
+  std::map<std::string, std::vector<SeenInstance>> pairs;
+  for (auto& s : roles.seen()) pairs[s.vehicle].push_back(std::move(s));
+  if (latest.empty() && pairs.empty()) {
     SubscriptionMatchedStatus st;
     reader.get_subscription_matched_status(st);
     if (st.current_count == 0) return no_service(o, dds);
@@ -106,10 +136,16 @@ int run_preflight(const GlobalOptions& o) {
                 "no readiness from " + (o.vehicle ? vehicle_text(*o.vehicle) : std::string("any vehicle")) +
                     " within the timeout");
   }
+  std::set<std::string> vehicles;
+  for (const auto& [vehicle, r] : latest) vehicles.insert(vehicle);
+  for (const auto& [vehicle, pair] : pairs) vehicles.insert(vehicle);
   bool ready = true;
-  for (const auto& [vehicle, r] : latest) {
-    print(o, r);
-    ready = ready && r.ready();
+  for (const auto& vehicle : vehicles) {
+    const auto r = latest.find(vehicle);
+    const auto p = pairs.find(vehicle);
+    const auto& pair = p == pairs.end() ? std::vector<SeenInstance>() : p->second;
+    print(o, vehicle, r == latest.end() ? nullptr : &r->second, pair);
+    ready = ready && r != latest.end() && r->second.ready() && (pair.empty() || pair_problems(pair).empty());
   }
   return static_cast<int>(ready ? ExitStatus::Ok : ExitStatus::NotDone);
 }

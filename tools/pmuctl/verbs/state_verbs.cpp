@@ -29,6 +29,7 @@
 #include "pmu/idl/topics.hpp"
 #include "pmu/transport/stop_signals.hpp"
 #include "pmuctl/verbs/alarm_sample.hpp"
+#include "pmuctl/verbs/role_verbs.hpp"
 #include "pmuctl/call/command_channel.hpp"
 #include "pmuctl/call/exit_status.hpp"
 #include "pmuctl/call/option_values.hpp"
@@ -482,6 +483,21 @@ std::vector<std::string> remember_only_pmus(const Latest& latest, TargetMemory& 
   return remembered;
 }
 
+// The instances of hot-standby pairs seen on pmu/role (interface.md 1.10): a table after the
+// devices' (a blank line between), or a JSON line each. Nothing when no service is one of a pair.
+static void print_pairs(const GlobalOptions& o, const std::vector<SeenInstance>& instances) {
+  if (instances.empty()) return;
+  if (o.json) {
+    for (const auto& s : instances)
+      std::printf("%s\n", role_json(s, pmu::dds::contract_major())
+                              .dump(-1, ' ', false, nlohmann::json::error_handler_t::replace)
+                              .c_str());
+    return;
+  }
+  std::printf("\n");
+  for (const auto& line : aligned_columns(role_rows(instances))) std::printf("%s\n", line.c_str());
+}
+
 // The list itself; `one_pmu`: the vehicles it found one PMU of, in a call the agent serves.
 static int list_once(const GlobalOptions& o, std::vector<std::string>& one_pmu);
 
@@ -498,7 +514,15 @@ static int list_once(const GlobalOptions& o, std::vector<std::string>& one_pmu) 
   pmu::dds::DdsContext& dds = *lease;
   StateCollector<pmu::v5::Health, pmu::v5::HealthPubSubType> health(dds, topics::kHealth);
   StateCollector<pmu::v5::DeviceInfo, pmu::v5::DeviceInfoPubSubType> info(dds, topics::kInfo);
-  if (int rc = collect(o, dds, health, 3.0)) return rc;
+  RoleCollector roles(o, dds);
+  const auto deadline = wait_end(o, 3.0);
+  const int collected = collect(o, dds, health, 3.0);
+  roles.wait_for_peers(deadline);
+  if (int rc = collected) {
+    // A pair with no bus owner writes no state, but its instances say so on pmu/role.
+    print_pairs(o, roles.seen());
+    return rc;
+  }
   info.poll(o);
   if (o.pool && o.bus.empty() && !o.address) one_pmu = remember_only_pmus(health.latest(), o.pool->targets());
   // Every contract each vehicle's services serve; those of other contracts only discovery sees.
@@ -559,6 +583,7 @@ static int list_once(const GlobalOptions& o, std::vector<std::string>& one_pmu) 
   if (!o.json)
     for (const auto& line : aligned_columns(rows)) std::printf("%s\n", line.c_str());
   if (!unreadable.empty()) std::fprintf(stderr, "pmuctl: UNREADABLE: %s\n", other_contracts_text(unreadable).c_str());
+  print_pairs(o, roles.seen());
   return 0;
 }
 

@@ -41,6 +41,11 @@ inline constexpr const char* kAlarmAck = "pmu/alarm_ack";
 inline constexpr const char* kAlarmAckReply = "pmu/alarm_ack_reply";
 inline constexpr const char* kCommand = "pmu/command";
 inline constexpr const char* kCommandReply = "pmu/command_reply";
+// Hot standby: each instance's role heartbeat (QoS profile `role`), and the request that moves
+// the role with its reply (QoS profile `command`): docs/interface.md 1.10.
+inline constexpr const char* kRole = "pmu/role";
+inline constexpr const char* kRoleMove = "pmu/role_move";
+inline constexpr const char* kRoleMoveReply = "pmu/role_move_reply";
 
 }  // namespace pmu::topics
 
@@ -51,5 +56,6 @@ inline constexpr const char* kTelemetry = "telemetry";
 inline constexpr const char* kState = "state";
 inline constexpr const char* kCommand = "command";
 inline constexpr const char* kAlarms = "alarms";
+inline constexpr const char* kRole = "role";
 
 }  // namespace pmu::qos_profiles

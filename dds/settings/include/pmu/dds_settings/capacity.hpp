@@ -25,5 +25,8 @@ inline constexpr std::size_t kCommandQueueDepth = 4096;
 // holds at most every code of the table.
 inline constexpr std::size_t kMaxAlarmsPerService = kMaxDevicesPerService * alarms::kCodeCount;
 inline constexpr std::size_t kFleetAlarms = kMaxAlarmsPerService * kFleetServices;
+// pmu/role (profile `role`): a service instance writes one instance, its own name; a reader
+// holds every instance of the fleet's services (kFleetServices).
+inline constexpr std::size_t kRoleWriterInstances = 1;
 
 }  // namespace pmu::dds

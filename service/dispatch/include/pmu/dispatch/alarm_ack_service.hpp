@@ -9,6 +9,11 @@
 // applied twice, the same id with other content is REJECTED, every request and its result is
 // an `audit:` line with network text through printable().
 //
+// Hot standby (design.md "Hot standby"): with a role gate set, only the instance that owns the
+// bus applies and answers acknowledgements; the other neither applies nor answers one, and one
+// still on its way when the gate closes is not answered here (a resend reaches the new owner,
+// where acknowledging again is harmless: "nothing to acknowledge").
+//
 // Lifetime: every BusWorker in `workers`, `clock` and what `reply` refers to outlive the
 // service; the source (DdsAlarmAckEndpoint::stop) is stopped and the workers joined before it
 // is destroyed, as for CommandService.
@@ -85,6 +90,11 @@ class AlarmAckService {
 
   void submit(const AlarmAckSample& sample);
 
+  // Hot standby: whether this instance applies and answers acknowledgements now. Unset, it
+  // always does. Call before the first submit(); read on the caller's thread and the worker's,
+  // never under the service's lock.
+  void set_role_gate(std::function<bool()> applies_now);
+
   // Request ids remembered for duplicate detection (at most kRememberedRequests).
   std::size_t remembered() const;
 
@@ -98,6 +108,10 @@ class AlarmAckService {
   bool first_time(const std::string& key, const AlarmAckSample& s);
   void apply(BusWorker& worker, const AlarmAckRequest& r);
   void finish(const std::string& key, const AlarmAckSample& s, AlarmAckReplyData reply);
+  bool applies_now() const { return !applies_now_ || applies_now_(); }
+  // Not answered here: the gate closed while it was on its way. Forgotten, so that a resend
+  // after this instance takes the bus back is applied.
+  void let_go(const std::string& key, const AlarmAckSample& s);
 
   std::vector<BusWorker*> workers_;
   std::string vehicle_;
@@ -107,7 +121,8 @@ class AlarmAckService {
 
   mutable std::mutex mutex_;
   std::unordered_map<std::string, Entry> seen_;
-  std::deque<std::string> order_;  // oldest first, to bound seen_
+  std::deque<std::string> order_;      // oldest first, to bound seen_
+  std::function<bool()> applies_now_;  // set before start, then only read
 };
 
 }  // namespace pmu::service

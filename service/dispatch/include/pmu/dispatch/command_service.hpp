@@ -20,6 +20,16 @@
 // Resends that came long after their reply was out say the clients' link is slow: the
 // service logs once that a link profile exists (slow_link_hint.hpp, interface.md 7.3).
 //
+// Hot standby (design.md "Hot standby", interface.md 2.4): with a role gate set, the service
+// executes and answers only while the gate says this instance owns the bus. Otherwise a
+// request is recorded, neither executed nor answered, and so are the owner's replies
+// (peer_reply) and the command frames heard on CAN (heard_on_can) in a FailoverRecord; on
+// took_over() each recorded request is answered from the owner's reply, answered FAILED
+// "outcome unknown" when its frames were heard but no reply, run when it was never seen on the
+// bus and has not expired, and an ENGINE_STOP always runs (docs/safety.md H4, H8). A request
+// still running when the gate closes is not answered here: its reply is the new owner's
+// (relinquished to the record, in case this instance takes the bus back).
+//
 // Memory: at most kRememberedRequests ids are kept (oldest forgotten first); no request
 // lives longer than policy.lifetimes.max_lifetime, so at any rate below
 // kRememberedRequests per max_lifetime no live request's id is ever forgotten.
@@ -29,13 +39,17 @@
 // it posts to a worker refers to the service, so the command source is stopped
 // (DdsCommandEndpoint::stop) and the worker threads joined before it is destroyed: main.cpp's
 // Shutdown does both.
-// Threads: submit(), counters() and remembered() from any thread (in the daemon, a Fast DDS
-// listener thread calls submit()); `mutex_` guards what they share. The stages after
-// BusWorker::post run on that worker's thread. `reply` is called from both, never under
+// The gate is read on the caller's thread and the worker's, never under `mutex_`: it must
+// not call into the service.
+// Threads: submit(), counters(), remembered(), recorded(), peer_reply(), heard_on_can() and
+// took_over() from any thread (in the daemon, a Fast DDS listener thread calls submit() and
+// peer_reply(), the bus worker heard_on_can()); `mutex_` guards what they share. The stages
+// after BusWorker::post run on that worker's thread. `reply` is called from both, never under
 // `mutex_`.
 
 #include <chrono>
 #include <deque>
+#include <functional>
 #include <map>
 #include <mutex>
 #include <string>
@@ -45,7 +59,9 @@
 #include "pmu/command/command.hpp"
 #include "pmu/command/config_holds.hpp"
 #include "pmu/command/policy.hpp"
+#include "pmu/codec/can_frame.hpp"
 #include "pmu/dispatch/command_executor.hpp"
+#include "pmu/dispatch/failover_record.hpp"
 #include "pmu/dispatch/slow_link_hint.hpp"
 #include "pmu/session/bus_worker.hpp"
 
@@ -65,6 +81,8 @@ class CommandService {
     std::uint64_t received = 0, duplicates = 0, reused_ids = 0, completed = 0, refused = 0, failed = 0;
     // Duplicates that arrived SlowLinkHint::kReplyOut or longer after their final reply.
     std::uint64_t resends_after_reply = 0;
+    // Hot standby: the bus owner's replies kept while this instance did not execute.
+    std::uint64_t peer_replies = 0;
   };
   Counters counters() const;
   // Request ids currently remembered for duplicate detection (at most kRememberedRequests).
@@ -72,6 +90,24 @@ class CommandService {
   // The config names the link (a profile or a round trip): no slow-link hint. Call before
   // the first submit().
   void link_configured();
+
+  // Hot standby: whether this instance executes and answers commands now (it owns the bus).
+  // Unset, it always does. Call before the first submit().
+  void set_role_gate(std::function<bool()> executes_now);
+  // A reply the bus owner wrote on pmu/command_reply (not this service's own), kept while
+  // this instance does not execute.
+  void peer_reply(const CommandReplyData& reply);
+  // Every frame this instance's bus `bus` delivers, with its receive time; kept while this
+  // instance does not execute.
+  void heard_on_can(const std::string& bus, const codec::CanFrame& frame, SteadyTime at);
+  // This instance owns the bus now (the gate says so): every recorded request is settled once
+  // (failover_record.hpp). The first submit() after the gate opens does it too, so no request
+  // runs ahead of the ones recorded before it; a later call finds nothing to do, unless a
+  // request arrived as the gate opened and was recorded after the first: the holder calls it on
+  // each of its ticks while ACTIVE, which costs a lock when there is nothing.
+  void took_over(SteadyTime now);
+  // Requests held for a takeover.
+  std::size_t recorded() const;
 
  private:
   struct Entry {
@@ -90,6 +126,12 @@ class CommandService {
 
   // The stages of submit(), in order (each answers or lets the command on):
   void reject_without_id(const CommandSample& s);
+  bool executes_now() const { return !executes_now_ || executes_now_(); }
+  // submit()'s stages after duplicate detection: parse (at `now`), route, limit, post.
+  void admit(const std::string& key, const CommandSample& s, const Now& now);
+  // The request under `key` ran while the gate closed: not answered here (its reply is the new
+  // owner's), held as heard in the record.
+  void relinquish(const std::string& key, const CommandReplyData& reply);
   // Duplicate detection: false when `s` is a resend (answered again) or reuses an id.
   bool first_time(const std::string& key, const CommandSample& s);
   // `slow_link`: this resend makes the slow-link hint due (log it, outside the lock), with the
@@ -137,6 +179,8 @@ class CommandService {
   ConfigHolds holds_;
   SlowLinkHint slow_link_;
   Counters counters_;
+  std::function<bool()> executes_now_;  // set before start, then only read
+  FailoverRecord record_;
 };
 
 }  // namespace pmu::service

@@ -12,6 +12,8 @@
 // Threads: start() and stop() on one thread (main.cpp's main thread); the reader's listener
 // runs on Fast DDS's threads and calls CommandService::submit() there; publish() from any
 // thread (a mutex serialises the writer); malformed() and not_ours() from any thread.
+// With follow_peer_replies(), a second reader's listener runs on Fast DDS's threads and calls
+// CommandService::peer_reply() there, under the same detach guard as submit().
 
 #include <memory>
 #include <string>
@@ -34,6 +36,12 @@ class DdsCommandEndpoint {
   ~DdsCommandEndpoint();
   // Starts reading commands into `service` (which must outlive this endpoint's reader).
   void start(CommandService& service);
+  // Hot standby (design.md "Hot standby"): also reads pmu/command_reply and hands every reply
+  // written for this vehicle by another participant (the bus owner) to the service's
+  // peer_reply(), which keeps it while this instance does not own the bus. Call after start(),
+  // on the same thread; throws dds::DdsError at start-up. The listener runs on Fast DDS's
+  // threads and is detached by stop() as the command reader's is.
+  void follow_peer_replies();
   // Stops reading commands (before the service is torn down): when it returns no callback
   // is running in, or will enter, the service. Idempotent.
   void stop();
