@@ -230,9 +230,12 @@ role_of() { last_role_line "$1" | sed 's/.*-> //; s/[ ,(].*//'; }
 alarm_of() { _l=$(last_role_line "$1"); case $_l in *"alarm "*) echo "$_l" | sed 's/.*alarm //; s/[^a-z_].*//' ;; *) echo none ;; esac; }
 role_is() { [ "$(role_of "$1")" = "$2" ]; }
 
-# ---- the audit trail (command_service.cpp `finish`: one final line per decided command) -
-executions() {  # ID: final audit lines of ID in both instances' logs, not the resends'
-  cat "$WORK/$SCEN.A.log" "$WORK/$SCEN.B.log" 2>/dev/null | grep "audit: command $1 " | grep -v 'reuses that id'
+# ---- the audit trail (command_service.cpp: one final line per decided command) ----------
+# ID: the audit lines of ID in both instances' logs that decided it: not a resend answered
+# again, not a standby's "not executed" (it saw the request, or answered it with the former
+# owner's result, without executing it).
+executions() {
+  cat "$WORK/$SCEN.A.log" "$WORK/$SCEN.B.log" 2>/dev/null | grep "audit: command $1 " | grep -v 'reuses that id' | grep -v 'not executed'
 }
 audit_of() {  # ID: every audit line of ID, each with its instance, on one line
   for _h in A B; do grep "audit: .*command $1 " "$WORK/$SCEN.$_h.log" 2>/dev/null | sed "s/.*audit: /$_h: /; s/ from [^ ]*:/:/"; done | tr '\n' '|' | cut -c1-500
