@@ -7,8 +7,11 @@
 # veth, bridge and sch_netem, iproute2's ip and tc, pmu-service, pmuctl, lab_ground,
 # fast-discovery-server, a DDS-Security PKI (make_pki.sh) and tests/lab/lab.sh, whose
 # scenarios print the same RESULT lines.
+# --suite standby boots it with the hot-standby suite (tests/standby/README.md): vcan, vxcan,
+# can-gw, veth and bridge, can-utils' cangw, pmu-service, pmu-sim, pmuctl, lab_ground,
+# standby_consumer and tests/standby/standby.sh: two instances of a pair in two hosts on one bus.
 #
-#   run_vm_tests.sh [--suite system|lab] [--build-dir DIR] [--source-dir DIR] [--scenario NAME]...
+#   run_vm_tests.sh [--suite system|lab|standby] [--build-dir DIR] [--source-dir DIR] [--scenario NAME]...
 #                   [--list] [--timeout S] [--log FILE] [--keep] [--verbose] [--service-log-level L]
 #                   [--capture]
 # --capture (lab): tcpdump on the ground link during the fleet8 scenario, which then prints on
@@ -46,7 +49,7 @@ note() { echo "run_vm_tests: $*" >&2; }
 . "$(dirname "${BASH_SOURCE[0]}")/vm_host_lib.sh"
 
 usage() {
-  sed -n '2,20p' "${BASH_SOURCE[0]}" | sed 's/^# \{0,1\}//'
+  sed -n '2,24p' "${BASH_SOURCE[0]}" | sed 's/^# \{0,1\}//'
   exit "${1:-0}"
 }
 
@@ -70,7 +73,7 @@ done
 # What differs between the suites: the scenario script, the kernel modules (each with what it
 # depends on), and which scenarios may SKIP. Both share the kernel, the cache and the verdict.
 # Every module of either suite is extracted into the one cache.
-all_modules="can can-raw can-dev vcan veth bridge sch_netem"
+all_modules="can can-raw can-dev vcan vxcan can-gw veth bridge sch_netem"
 case "$suite" in
   system)
     suite_script="$script_dir/scenarios.sh"
@@ -85,7 +88,14 @@ case "$suite" in
     suite_label="network lab"
     skip_allowed=" "
     ;;
-  *) echo "run_vm_tests: unknown suite '$suite' (system or lab)" >&2; usage 2 ;;
+  standby)
+    suite_script="$script_dir/../standby/standby.sh"
+    suite_modules="can can-raw can-dev vcan vxcan can-gw veth bridge"
+    suite_title="hot standby (two hosts on one CAN bus in a VM"
+    suite_label="hot standby"
+    skip_allowed=" "
+    ;;
+  *) echo "run_vm_tests: unknown suite '$suite' (system, lab or standby)" >&2; usage 2 ;;
 esac
 [ -f "$suite_script" ] || die "$suite_script not found"
 suite_script=$(cd "$(dirname "$suite_script")" && pwd)/$(basename "$suite_script")
@@ -122,8 +132,13 @@ for b in /bin/busybox /usr/bin/busybox; do
 done
 [ -n "$busybox_bin" ] || die "system tests need busybox-static (scripts/setup.sh installs it)"
 can_utils=()
-if [ "$suite" = system ]; then
-  for t in candump cansend cangen; do
+can_tools=""
+case "$suite" in
+  system) can_tools="candump cansend cangen" ;;
+  standby) can_tools="candump cansend cangw" ;;
+esac
+if [ -n "$can_tools" ]; then
+  for t in $can_tools; do
     p=$(command -v "$t" || true)
     [ -n "$p" ] || die "system tests need can-utils ($t not found; scripts/setup.sh installs it)"
     can_utils+=("$p")
@@ -159,11 +174,15 @@ find_binary() {  # NAME EXPECTED-RELATIVE-PATH
 }
 svc_bin=$(find_binary pmu-service service/pmu-service)
 ctl_bin=$(find_binary pmuctl tools/pmuctl)
-if [ "$suite" = system ]; then
-  sim_bin=$(find_binary pmu-sim tools/pmu-sim)
-else
-  ground_bin=$(find_binary lab_ground tests/lab/lab_ground)
-fi
+case "$suite" in
+  system) sim_bin=$(find_binary pmu-sim tools/pmu-sim) ;;
+  lab) ground_bin=$(find_binary lab_ground tests/lab/lab_ground) ;;
+  standby)
+    sim_bin=$(find_binary pmu-sim tools/pmu-sim)
+    ground_bin=$(find_binary lab_ground tests/lab/lab_ground)
+    consumer_bin=$(find_binary standby_consumer tests/standby/standby_consumer)
+    ;;
+esac
 qos_file="$source_dir/deploy/qos.xml"
 [ -f "$qos_file" ] || die "$qos_file not found (--source-dir?)"
 
@@ -333,6 +352,10 @@ copy_with_libs "$svc_bin" opt/pmu/bin/pmu-service
 copy_with_libs "$ctl_bin" opt/pmu/bin/pmuctl
 if [ "$suite" = system ]; then
   copy_with_libs "$sim_bin" opt/pmu/bin/pmu-sim
+elif [ "$suite" = standby ]; then
+  copy_with_libs "$sim_bin" opt/pmu/bin/pmu-sim
+  copy_with_libs "$ground_bin" opt/pmu/bin/lab_ground
+  copy_with_libs "$consumer_bin" opt/pmu/bin/standby_consumer
 else
   copy_with_libs "$ground_bin" opt/pmu/bin/lab_ground
   copy_with_libs "$tc_bin" usr/sbin/tc   # busybox's tc knows no netem
@@ -364,7 +387,7 @@ echo "pmu-vm" >"$root/etc/hostname"
 cat >"$root/init" <<'EOF'
 #!/bin/sh
 # PID 1 of the test VM: mount, load the modules, then either create vcan0 and run the system
-# scenarios, or run the network lab (/lab.sh); power off.
+# scenarios, or run the network lab (/lab.sh) or the hot-standby suite (/standby.sh); power off.
 # Debian's busybox runs its own applets before PATH: iproute2's ip is called by path.
 export PATH=/opt/pmu/bin:/usr/sbin:/usr/bin:/sbin:/bin HOME=/root
 mount -t proc proc /proc
@@ -382,7 +405,15 @@ while read -r m; do
   if ! insmod "/lib/modules/$m.ko"; then echo "VM: insmod $m.ko failed"; ok=0; fi
 done </lib/modules/load-order
 /usr/sbin/ip link set lo up
-if [ -f /lab.sh ]; then
+if [ -f /standby.sh ]; then
+  # The hot-standby suite builds its bus, gateway and hosts itself (standby.sh standby_up).
+  if [ $ok = 1 ]; then
+    echo "VM: standby modules loaded: $(tr '\n' ' ' </lib/modules/load-order), $(/usr/sbin/ip -V)"
+    sh /standby.sh all
+  else
+    echo "RESULT setup FAIL could not load the standby suite's modules (vcan, vxcan, can-gw, veth, bridge)"
+  fi
+elif [ -f /lab.sh ]; then
   # The network lab builds its namespaces, bridge and ground link itself (lab.sh lab_up).
   if [ $ok = 1 ]; then
     echo "VM: lab modules loaded: $(tr '\n' ' ' </lib/modules/load-order), $(/usr/sbin/ip -V)"
