@@ -233,9 +233,11 @@ role_is() { [ "$(role_of "$1")" = "$2" ]; }
 # ---- the audit trail (command_service.cpp: one final line per decided command) ----------
 # ID: the audit lines of ID in both instances' logs that decided it: not a resend answered
 # again, not a standby's "not executed" (it saw the request, or answered it with the former
-# owner's result, without executing it).
+# owner's result, without executing it), not a former owner's "not answered here" (it stopped
+# owning the bus while the command ran and left the answer to the new owner, whose line decides).
 executions() {
-  cat "$WORK/$SCEN.A.log" "$WORK/$SCEN.B.log" 2>/dev/null | grep "audit: command $1 " | grep -v 'reuses that id' | grep -v 'not executed'
+  cat "$WORK/$SCEN.A.log" "$WORK/$SCEN.B.log" 2>/dev/null | grep "audit: command $1 " | grep -v 'reuses that id' |
+    grep -v 'not executed' | grep -v 'not answered here'
 }
 audit_of() {  # ID: every audit line of ID, each with its instance, on one line
   for _h in A B; do grep "audit: .*command $1 " "$WORK/$SCEN.$_h.log" 2>/dev/null | sed "s/.*audit: /$_h: /; s/ from [^ ]*:/:/"; done | tr '\n' '|' | cut -c1-500

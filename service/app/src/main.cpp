@@ -189,10 +189,17 @@ int run(const service::Config& cfg, const pmu::dds::ResolvedNetwork& network) {
   // role, before what the new role does. `commands` exists once the workers do, before they run.
   std::atomic<bool> executing{false};
   service::CommandService* commands_ptr = nullptr;
+  service::BusWorker* pair_worker = nullptr;  // the pair's one bus, once its worker exists
   if (cfg.redundancy) {
     role_topics = std::make_unique<service::DdsRoleEndpoint>(participant, cfg.vehicle);
     standby::RoleHolder::Outputs outputs;
     outputs.publish = [&role_topics](const redundancy::RoleReport& r) { role_topics->publish(r); };
+    // A peer that joins while this instance owns the bus hears the devices' stored values
+    // answered, so its configuration is warm (docs/design.md, "Hot standby"). Posted: the
+    // holder may be in the middle of a session's send.
+    outputs.peer_joined = [&pair_worker] {
+      if (pair_worker) pair_worker->post([w = pair_worker] { w->repeat_readings(); });
+    };
     outputs.changed = [&gate, &systemd, &holder, &executing, &commands_ptr, &clock](const standby::RoleChange& c) {
       if (c.to == redundancy::Role::Active) {
         gate->open();
@@ -236,6 +243,7 @@ int run(const service::Config& cfg, const pmu::dds::ResolvedNetwork& network) {
           });
     buses[i].worker =
         std::make_unique<service::BusWorker>(cfg.buses[i], std::move(bus), clock, cfg.timeouts, state_sink);
+    if (holder) pair_worker = buses[i].worker.get();
     if (holder)
       buses[i].worker->every(std::chrono::duration_cast<milliseconds>(redundancy::poll_period(holder->settings())),
                              [&holder, &executing, &commands_ptr](std::chrono::steady_clock::time_point t) {

@@ -271,6 +271,11 @@ void BusWorker::post(std::function<void()> fn) { loop_.post(std::move(fn)); }
 
 void BusWorker::post_urgent(std::function<void()> fn) { loop_.post_urgent(std::move(fn)); }
 
+void BusWorker::repeat_readings() {
+  const auto now = clock_.steady_now();
+  for (auto& entry : sessions_) entry.second->repeat_reading_gets(now);
+}
+
 void BusWorker::every(milliseconds period, std::function<void(std::chrono::steady_clock::time_point)> fn) {
   loop_.add_timer(clock_.steady_now(), period, std::move(fn));
 }

@@ -77,6 +77,19 @@ void DeviceSession::start_reading(SteadyTime now) {
   queue_.append(std::move(gets), now);
 }
 
+void DeviceSession::repeat_reading_gets(SteadyTime now) {
+  now_ = now;
+  queue_.drop(kRepeatTag);
+  for (const auto p : ReadingMachine::packets()) {
+    Request r;
+    r.frame = *codec::encode_get(p, key_.address);
+    r.reply = p;
+    r.retries = timeouts_.retries;
+    r.tag = kRepeatTag;
+    submit(std::move(r), now);
+  }
+}
+
 void DeviceSession::on_reading_done(const RequestOutcome& o, std::uint64_t round) {
   const auto retry_delay = std::max(period() * 2, milliseconds(1000));
   bool heard = false;

@@ -13,6 +13,9 @@ FencedBus::FencedBus(std::unique_ptr<transport::CanBus> inner, RoleHolder& holde
 }
 
 transport::DrainResult FencedBus::drain(transport::BusHandler& handler) {
+  // Before any frame reaches a session: a holder that was frozen while it owned the bus learns
+  // it here and closes its gates, so nothing it decodes now is published beside the new owner's.
+  holder_.tick(clock_.steady_now());
   handler_ = &handler;
   beats_ = 0;
   auto result = inner_->drain(*this);

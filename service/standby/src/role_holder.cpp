@@ -47,6 +47,8 @@ RoleHolder::Due RoleHolder::collect(Time now) {
     due.report = std::move(r);
   }
   due.can = actions.can;
+  if (peer_joined_ && machine_.role() == Role::Active) due.peer_joined = true;
+  if (machine_.role() == Role::Active || machine_.role() == Role::Claiming) peer_joined_ = false;
   if (machine_.role() != reported_role_ || machine_.alarm() != reported_alarm_) {
     due.change = RoleChange{reported_role_, machine_.role(), machine_.term(), machine_.alarm()};
     reported_role_ = machine_.role();
@@ -70,6 +72,7 @@ void RoleHolder::act(const Due& due) {
     (void)bus_->send(f, std::chrono::milliseconds(0));
   }
   if (due.report && outputs_.publish) outputs_.publish(*due.report);
+  if (due.peer_joined && outputs_.peer_joined) outputs_.peer_joined();
 }
 
 void RoleHolder::tick(Time now) {
@@ -123,6 +126,7 @@ void RoleHolder::on_report(const redundancy::RoleReport& report, Time arrival) {
   if (report.name != settings_.peer) return;
   std::lock_guard<std::mutex> lock(mutex_);
   machine_.on_peer_heartbeat(arrival, report.beat);
+  if (!peer_ || arrival - peer_seen_ >= settings_.lease) peer_joined_ = true;
   peer_ = report;
   peer_seen_ = arrival;
 }
@@ -139,7 +143,8 @@ redundancy::MoveResult RoleHolder::hand_over(Time now, const std::string& who) {
     result = machine_.hand_over(now);
   }
   // The audit line is the move endpoint's, with the request's id and its writer.
-  spdlog::debug("role move asked by {}: {}", who, result.accepted ? "handing the bus over to " + settings_.peer : result.reason);
+  spdlog::debug("role move asked by {}: {}", who,
+                result.accepted ? "handing the bus over to " + settings_.peer : result.reason);
   return result;
 }
 

@@ -44,6 +44,7 @@ class Instance {
     out.publish = [&outbox, &link](const redundancy::RoleReport& r) {
       if (!link.cut) outbox.push_back(r);
     };
+    out.peer_joined = [this] { worker->post([this] { worker->repeat_readings(); }); };
     out.changed = [this](const standby::RoleChange& c) {
       if (c.to == Role::Active) gate->open();
       if (c.from == Role::Active) gate->close();
@@ -172,6 +173,22 @@ TEST_F(StandbyPair, KilledOwnerTheStandbyTakesOverWithItsWarmState) {
   EXPECT_GT(b_->telemetry_published(), before) << "the new owner publishes the PMU's stream";
 }
 
+// A standby that starts after the owner read the devices cannot ask them itself: the owner asks
+// again when it hears the newcomer, and the newcomer takes over with the configuration known.
+TEST_F(StandbyPair, AStandbyThatJoinsLateHearsTheOwnerReadTheDevicesAgain) {
+  b_->running = false;
+  run_for(3s);
+  ASSERT_EQ(a_->holder->role(), Role::Active);
+  link_.to_b.clear();
+  b_ = std::make_unique<Instance>("mc-b", 1, "mc-a", network_, clock_, link_.to_a, link_);
+  run_for(3s);
+  ASSERT_EQ(b_->holder->role(), Role::Standby);
+  a_->running = false;
+  until_active(*b_, 2s);
+  EXPECT_FALSE(b_->sink.configs.empty()) << "the configuration at the takeover, from the owner's repeated gets";
+  EXPECT_FALSE(b_->sink.infos.empty()) << "serial and firmware too";
+}
+
 TEST_F(StandbyPair, NetworkCutNobodyTakesOverWhileTheOwnerIsHeardOnCan) {
   run_for(2s);
   link_.cut = true;
@@ -193,9 +210,11 @@ TEST_F(StandbyPair, FrozenOwnerStepsDownOnItsFirstCallAndSendsNothingStale) {
   run_for(1s);
   const auto a_frames = a_->pmu_frames();
   const auto clears = a_->clears;
-  a_->running = true;  // SIGCONT: its timers are all due at once
+  const auto a_samples = a_->telemetry_published();
+  a_->running = true;  // SIGCONT: its timers are all due at once, its socket full of frames
   run_for(1s);
   EXPECT_EQ(a_->pmu_frames(), a_frames) << "the resumed former owner sent a PMU frame";
+  EXPECT_EQ(a_->telemetry_published(), a_samples) << "the resumed former owner published beside the new one";
   EXPECT_NE(a_->holder->role(), Role::Active);
   EXPECT_EQ(b_->holder->role(), Role::Active) << "it takes nothing back";
   EXPECT_EQ(a_->clears, clears + 1) << "its state topics' histories are cleared";

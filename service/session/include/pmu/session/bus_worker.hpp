@@ -94,6 +94,9 @@ class BusWorker final : private transport::BusHandler {
   };
   // Called on the worker's thread after every move. Set before run().
   void on_moved(std::function<void(const Moved&)> fn) { moved_ = std::move(fn); }
+  // Every PMU session's reading gets asked again (DeviceSession::repeat_reading_gets), for a
+  // hot-standby peer that has just joined. Worker thread.
+  void repeat_readings();
   // Runs `fn` on the worker's thread every `period` from the first turn on, with the loop's
   // reading of the clock: work that must share the bus's thread (a hot-standby pair's
   // heartbeat). Before run().

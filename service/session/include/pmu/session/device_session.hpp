@@ -99,6 +99,10 @@ class DeviceSession {
   static constexpr std::chrono::seconds kStopFollowsFor{30};
   // Reads identity and every stored value again (after a reset).
   void reread(SteadyTime now) { start_reading(now); }
+  // The reading round's gets asked again without starting a round: the answers keep the stored
+  // values current as any answer does, and nothing this session serves pauses. A bus owner does
+  // it for a hot-standby peer that has just joined and cannot ask itself.
+  void repeat_reading_gets(SteadyTime now);
 
   // Calls `fn` from tick() once `at` has come (within the worker's tick, 20 ms). A command
   // that waits on the device's behaviour rather than on one answer (an engine start, which
@@ -173,6 +177,7 @@ class DeviceSession {
  private:
   static constexpr int kReadingTag = 1;
   static constexpr int kPollTag = 2;
+  static constexpr int kRepeatTag = 3;
 
   transport::SendResult send_one(const codec::CanFrame& frame);  // counted in the health when sent
   void start_reading(SteadyTime now);

@@ -45,6 +45,10 @@ class RoleHolder {
   struct Outputs {
     std::function<void(const redundancy::RoleReport&)> publish;  // pmu/role, when the machine says it is due
     std::function<void(const RoleChange&)> changed;              // after a change of role or alarm
+    // While this instance owns the bus, its peer was heard on DDS after a lease or more of
+    // silence (it started, or came back): the devices' stored values are to be asked again, so
+    // that the peer, which cannot ask, hears them answered.
+    std::function<void()> peer_joined;
   };
 
   // `settings.name` must be set (the config fills it with the host's name when absent).
@@ -85,6 +89,7 @@ class RoleHolder {
     std::optional<redundancy::RoleReport> report;
     std::optional<redundancy::CanBeat> can;
     std::optional<RoleChange> change;
+    bool peer_joined = false;
   };
   Due collect(Time now);  // with mutex_ held
   void act(const Due& due);
@@ -98,6 +103,7 @@ class RoleHolder {
   redundancy::BusState bus_state_ = redundancy::BusState::Ok;
   std::optional<redundancy::RoleReport> peer_;
   Time peer_seen_{};
+  bool peer_joined_ = false;  // the peer heard after a lease of silence, not yet handed on
   std::uint64_t bad_beats_ = 0;
   transport::CanBus* bus_ = nullptr;  // bus thread only
 };
