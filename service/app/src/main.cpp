@@ -201,13 +201,13 @@ int run(const service::Config& cfg, const pmu::dds::ResolvedNetwork& network) {
       if (pair_worker) pair_worker->post([w = pair_worker] { w->repeat_readings(); });
     };
     outputs.changed = [&gate, &systemd, &holder, &executing, &commands_ptr, &clock](const standby::RoleChange& c) {
-      if (c.to == redundancy::Role::Active) {
+      if (c.took_bus()) {
         gate->open();
         executing.store(true);
         // What the former owner left: each recorded request settled once (failover_record.hpp).
         if (commands_ptr) commands_ptr->took_over(clock.steady_now());
       }
-      if (c.from == redundancy::Role::Active) {
+      if (c.left_bus()) {
         executing.store(false);
         gate->close();
       }

@@ -38,6 +38,9 @@ struct RoleChange {
   redundancy::Role to = redundancy::Role::Joining;
   std::uint32_t term = 0;
   redundancy::PeerAlarm alarm = redundancy::PeerAlarm::None;
+  // What the gates follow: the bus taken or given up. A change of alarm alone is neither.
+  bool took_bus() const noexcept { return to == redundancy::Role::Active && from != redundancy::Role::Active; }
+  bool left_bus() const noexcept { return from == redundancy::Role::Active && to != redundancy::Role::Active; }
 };
 
 class RoleHolder {
