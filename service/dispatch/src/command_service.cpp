@@ -87,7 +87,10 @@ void CommandService::took_over(SteadyTime now) {
         continue;
       }
       Entry e{v.fingerprint, std::nullopt, {}, 0};
-      if (v.action == FailoverRecord::Action::Answered) {
+      // "Outcome unknown" waits for the client to ask again: the former owner's own reply may
+      // have reached the client and not this instance (it stopped between the two), and a
+      // second final reply that contradicts the first is worse than one that comes on a resend.
+      if (v.action == FailoverRecord::Action::Answered || v.action == FailoverRecord::Action::Unknown) {
         e.final = v.reply;
         e.final_at = now;
       }
@@ -113,6 +116,10 @@ void CommandService::took_over(SteadyTime now) {
                      to_string(v.reply.result));
         break;
       case FailoverRecord::Action::Unknown:
+        spdlog::warn("audit: command {} from {}: {} -> {}: {}; answered when it is sent again",
+                     printable(v.reply.request_id), printable(sender), recorded_what(v.reply),
+                     to_string(v.reply.result), v.reply.reason);
+        break;
       case FailoverRecord::Action::Expired: finish(v.key, sender, recorded_what(v.reply), v.reply); break;
       case FailoverRecord::Action::Run:
         if (v.reply.kind == CommandKind::EngineStop) {

@@ -30,6 +30,9 @@ void FencedBus::on_frame(const transport::ReceivedFrame& frame) {
     holder_.on_can_frame(clock_.steady_now(), frame.frame);
     return;
   }
+  // Every frame, not only every drain: a process stopped in the middle of a drain resumes in
+  // it, with the frames queued while it was stopped still to come.
+  holder_.tick(clock_.steady_now());
   if (tap_) tap_(inner_->name(), frame);
   handler_->on_frame(frame);
 }
