@@ -14,7 +14,10 @@
 #include "pmu/dds_settings/vehicle.hpp"
 #include "pmu/dispatch/command_service.hpp"
 #include "pmu/endpoints/dds_commands.hpp"
+#include "pmu/idl/commandPubSubTypes.h"
+#include "pmu/idl/topics.hpp"
 #include "pmu/transport/clock.hpp"
+#include "support/answered.hpp"
 #include "support/domain.hpp"
 #include "support/wait.hpp"
 
@@ -83,6 +86,51 @@ TEST(PeerReplies, AStandbyAnswersAResendAfterTakingOverWithTheOwnersReply) {
   ASSERT_EQ(answered.size(), 1u) << "only the resend is answered, and not run";
   EXPECT_EQ(answered[0].reason, "reset by the owner");
   EXPECT_EQ(answered[0].result, CommandResult::Completed);
+}
+
+// A reply written on the listener's thread (a request refused at once, a resend answered again)
+// comes back to that same participant's reply reader, which Fast DDS may call on the writing
+// thread: the two readers' callbacks must not share a lock the writer's caller holds.
+TEST(PeerReplies, AReplyWrittenFromTheCommandListenerReachesTheClient) {
+  using namespace eprosima::fastdds::dds;
+  const int domain = pmu::test::exclusive_dds_domain();
+  transport::SystemClock clock;
+  dds::DdsContext service_dds(domain, "", "pmu-service-pair");
+  dds::DdsContext client_dds(domain, "", "client");
+  auto& writer =
+      client_dds.writer(client_dds.topic(topics::kCommand, TypeSupport(new pmu::v5::CommandPubSubType())),
+                        qos_profiles::kCommand);
+  auto& replies =
+      client_dds.reader(client_dds.topic(topics::kCommandReply, TypeSupport(new pmu::v5::CommandReplyPubSubType())),
+                        qos_profiles::kCommand);
+  DdsCommandEndpoint* endpoint_ptr = nullptr;
+  // No bus: every request is refused on the listener's thread, and its reply written there.
+  CommandService service({}, PolicyConfig{}, Timeouts{}, clock,
+                         [&](const CommandReplyData& r) { endpoint_ptr->publish(r); });
+  service.set_role_gate([] { return true; });
+  DdsCommandEndpoint endpoint(service_dds);
+  endpoint_ptr = &endpoint;
+  endpoint.start(service);
+  endpoint.follow_peer_replies();
+
+  pmu::v5::Command c;
+  c.request_id("listener-1");
+  c.bus("can0");
+  c.address(1);
+  c.kind(pmu::v5::RESET);
+  const bool answered = pmu::test::until_answered([&] { writer.write(&c); },
+                                                  [&] {
+                                                    pmu::v5::CommandReply r;
+                                                    SampleInfo info;
+                                                    bool got = false;
+                                                    while (replies.take_next_sample(&r, &info) ==
+                                                           ReturnCode_t::RETCODE_OK)
+                                                      got = got || (info.valid_data && r.request_id() == "listener-1");
+                                                    return got;
+                                                  },
+                                                  20s);
+  EXPECT_TRUE(answered) << "the reply written on the command listener's thread never came";
+  endpoint.stop();
 }
 
 }  // namespace
