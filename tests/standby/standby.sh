@@ -76,6 +76,7 @@ diagnose() {
   [ -f "$WORK/$SCEN.can" ] && log "diag: last frames: $(tail -n 6 "$WORK/$SCEN.can" | tr '\n' ' ')"
   for _h in A B; do
     [ -f "$WORK/$SCEN.$_h.log" ] && log "diag: $_h: $(grep -E 'role: |hot standby|--- start' "$WORK/$SCEN.$_h.log" | cut -c12-200 | tr '\n' ';' | cut -c1-900)"
+    [ -f "$WORK/$SCEN.$_h.log" ] && log "diag: $_h: commands: $(grep -E 'audit: ' "$WORK/$SCEN.$_h.log" | tail -n 12 | cut -c12-220 | tr '\n' ';')"
   done
   return 0
 }
@@ -356,7 +357,7 @@ check_streams() {  # T MOST
 # final reply (a resend answered again says the same), one decision in the two instances'
 # audit trails, and at most one set frame of its value on the bus (one when COMPLETED).
 check_command() {  # TAG SUMMARY VALUE WANT
-  [ "$(jv "$2" final_replies)" = 1 ] || fail "$1: $(jv "$2" final_replies) final replies ($2)"
+  [ "$(jv "$2" final_replies)" = 1 ] || fail "$1: $(jv "$2" final_replies) final replies ($2); the audit trails: $(audit_of "$1-1")"
   _res=$(printf '%s' "$2" | sed -n 's/.*"results":{\([^}]*\)}.*/\1/p')
   _done=$(jv "$2" COMPLETED)
   [ "$4" = any ] || [ "$_done" = 1 ] || fail "$1 was not COMPLETED: $_res"
