@@ -97,9 +97,8 @@ TEST(PeerReplies, AReplyWrittenFromTheCommandListenerReachesTheClient) {
   transport::SystemClock clock;
   dds::DdsContext service_dds(domain, "", "pmu-service-pair");
   dds::DdsContext client_dds(domain, "", "client");
-  auto& writer =
-      client_dds.writer(client_dds.topic(topics::kCommand, TypeSupport(new pmu::v5::CommandPubSubType())),
-                        qos_profiles::kCommand);
+  auto& writer = client_dds.writer(client_dds.topic(topics::kCommand, TypeSupport(new pmu::v5::CommandPubSubType())),
+                                   qos_profiles::kCommand);
   auto& replies =
       client_dds.reader(client_dds.topic(topics::kCommandReply, TypeSupport(new pmu::v5::CommandReplyPubSubType())),
                         qos_profiles::kCommand);
@@ -118,17 +117,17 @@ TEST(PeerReplies, AReplyWrittenFromTheCommandListenerReachesTheClient) {
   c.bus("can0");
   c.address(1);
   c.kind(pmu::v5::RESET);
-  const bool answered = pmu::test::until_answered([&] { writer.write(&c); },
-                                                  [&] {
-                                                    pmu::v5::CommandReply r;
-                                                    SampleInfo info;
-                                                    bool got = false;
-                                                    while (replies.take_next_sample(&r, &info) ==
-                                                           ReturnCode_t::RETCODE_OK)
-                                                      got = got || (info.valid_data && r.request_id() == "listener-1");
-                                                    return got;
-                                                  },
-                                                  20s);
+  const bool answered =
+      pmu::test::until_answered([&] { writer.write(&c); },
+                                [&] {
+                                  pmu::v5::CommandReply r;
+                                  SampleInfo info;
+                                  bool got = false;
+                                  while (replies.take_next_sample(&r, &info) == ReturnCode_t::RETCODE_OK)
+                                    got = got || (info.valid_data && r.request_id() == "listener-1");
+                                  return got;
+                                },
+                                20s);
   EXPECT_TRUE(answered) << "the reply written on the command listener's thread never came";
   endpoint.stop();
 }
