@@ -165,17 +165,22 @@ inline const char* const kContractTopics[] = {"pmu/voltages",
                                               "pmu/command",
                                               "pmu/command_reply",
                                               "pmu/alarm_ack",
-                                              "pmu/alarm_ack_reply"};
+                                              "pmu/alarm_ack_reply",
+                                              "pmu/role",
+                                              "pmu/role_move",
+                                              "pmu/role_move_reply"};
 
-// Only the ground station commands and acknowledges alarms; the service publishes telemetry,
-// state and replies; the mission computer only reads telemetry and state.
+// Only the ground station commands, acknowledges alarms and moves a hot-standby pair's role; the
+// service publishes telemetry, state, replies and its role, and reads its peer's role; the
+// mission computer only reads telemetry, state and the pair's roles.
 inline bool allowed(const std::string& identity, const std::string& topic, bool publish) {
   const bool data = kTelemetryAndState.count(topic) > 0;
-  const bool request = topic == "pmu/command" || topic == "pmu/alarm_ack";
-  const bool reply = topic == "pmu/command_reply" || topic == "pmu/alarm_ack_reply";
-  if (identity == "pmu-service") return publish ? data || reply : request;
-  if (identity == "ground-station") return publish ? request : data || reply;
-  if (identity == "mission-computer") return !publish && data;
+  const bool role = topic == "pmu/role";
+  const bool request = topic == "pmu/command" || topic == "pmu/alarm_ack" || topic == "pmu/role_move";
+  const bool reply = topic == "pmu/command_reply" || topic == "pmu/alarm_ack_reply" || topic == "pmu/role_move_reply";
+  if (identity == "pmu-service") return publish ? data || reply || role : request || role;
+  if (identity == "ground-station") return publish ? request : data || reply || role;
+  if (identity == "mission-computer") return !publish && (data || role);
   return false;
 }
 
