@@ -8,7 +8,6 @@
 
 #include <CLI/CLI.hpp>
 #include <algorithm>
-#include <atomic>
 #include <chrono>
 #include <cstdio>
 #include <future>
@@ -41,6 +40,7 @@
 #include "pmu/session/moved_addresses.hpp"
 #include "pmu/session/receive_filters.hpp"
 #include "pmu/standby/fenced_bus.hpp"
+#include "pmu/standby/ownership.hpp"
 #include "pmu/standby/role_gate.hpp"
 #include "pmu/standby/role_holder.hpp"
 #include "pmu/sysconf_dir.hpp"
@@ -184,13 +184,15 @@ int run(const service::Config& cfg, const pmu::dds::ResolvedNetwork& network) {
   std::unique_ptr<standby::RoleHolder> holder;
   // pmu/role and pmu/role_move, on the service's own participant (the current contract's).
   std::unique_ptr<service::DdsRoleEndpoint> role_topics;
-  // Hot standby: whether this instance executes and answers commands (it owns the bus), for
-  // the command and acknowledgement services' gates; set on the bus thread at each change of
-  // role, before what the new role does. `commands` exists once the workers do, before they run.
-  std::atomic<bool> executing{false};
+  // `commands` exists once the workers do, before they run.
   service::CommandService* commands_ptr = nullptr;
+  std::unique_ptr<standby::Ownership> ownership;
   service::BusWorker* pair_worker = nullptr;  // the pair's one bus, once its worker exists
   if (cfg.redundancy) {
+    // What the former owner left: each recorded request settled once (failover_record.hpp).
+    ownership = std::make_unique<standby::Ownership>(*gate, [&commands_ptr, &clock] {
+      if (commands_ptr) commands_ptr->took_over(clock.steady_now());
+    });
     role_topics = std::make_unique<service::DdsRoleEndpoint>(participant, cfg.vehicle);
     standby::RoleHolder::Outputs outputs;
     outputs.publish = [&role_topics](const redundancy::RoleReport& r) { role_topics->publish(r); };
@@ -200,17 +202,8 @@ int run(const service::Config& cfg, const pmu::dds::ResolvedNetwork& network) {
     outputs.peer_joined = [&pair_worker] {
       if (pair_worker) pair_worker->post([w = pair_worker] { w->repeat_readings(); });
     };
-    outputs.changed = [&gate, &systemd, &holder, &executing, &commands_ptr, &clock](const standby::RoleChange& c) {
-      if (c.took_bus()) {
-        gate->open();
-        executing.store(true);
-        // What the former owner left: each recorded request settled once (failover_record.hpp).
-        if (commands_ptr) commands_ptr->took_over(clock.steady_now());
-      }
-      if (c.left_bus()) {
-        executing.store(false);
-        gate->close();
-      }
+    outputs.changed = [&ownership, &systemd, &holder](const standby::RoleChange& c) {
+      ownership->on_change(c);
       if (c.from != c.to)
         spdlog::warn(
             "role: {} -> {} (term {}{})", redundancy::role_name(c.from), redundancy::role_name(c.to), c.term,
@@ -223,8 +216,8 @@ int run(const service::Config& cfg, const pmu::dds::ResolvedNetwork& network) {
     role_topics->on_report([&holder](const redundancy::RoleReport& r, std::chrono::steady_clock::time_point arrived) {
       holder->on_report(r, arrived);
     });
-    role_topics->on_move(cfg.redundancy->name, [&holder, &clock](const redundancy::MoveRequest& m) {
-      return holder->hand_over(clock.steady_now(), m.requester);
+    role_topics->on_move(cfg.redundancy->name, [&holder, &clock](const redundancy::MoveRequest&) {
+      return holder->hand_over(clock.steady_now());
     });
     role_topics->start();
     spdlog::info("hot standby: instance {}, priority {}, peer {}; CAN heartbeat id 0x{:08X}", cfg.redundancy->name,
@@ -243,14 +236,15 @@ int run(const service::Config& cfg, const pmu::dds::ResolvedNetwork& network) {
           });
     buses[i].worker =
         std::make_unique<service::BusWorker>(cfg.buses[i], std::move(bus), clock, cfg.timeouts, state_sink);
-    if (holder) pair_worker = buses[i].worker.get();
-    if (holder)
+    if (holder) {
+      pair_worker = buses[i].worker.get();
       buses[i].worker->every(std::chrono::duration_cast<milliseconds>(redundancy::poll_period(holder->settings())),
-                             [&holder, &executing, &commands_ptr](std::chrono::steady_clock::time_point t) {
+                             [&holder, &ownership, &commands_ptr](std::chrono::steady_clock::time_point t) {
                                holder->tick(t);
                                // A request recorded just as the gate opened is settled here.
-                               if (executing.load() && commands_ptr) commands_ptr->took_over(t);
+                               if (ownership->executing() && commands_ptr) commands_ptr->took_over(t);
                              });
+    }
     // Only a device from the config file has an `address:` that can go stale.
     buses[i].worker->on_moved([&moved](const service::BusWorker::Moved& m) {
       if (!m.config_line.empty()) moved.record(m.bus, m.first, m.to, m.serial);
@@ -274,8 +268,8 @@ int run(const service::Config& cfg, const pmu::dds::ResolvedNetwork& network) {
     if (previous_command_topics) previous_command_topics->publish(r);
   });
   if (network.link.profile != pmu::dds::LinkProfile::None || network.link.round_trip.set()) commands.link_configured();
-  if (holder) {
-    commands.set_role_gate([&executing] { return executing.load(); });
+  if (ownership) {
+    commands.set_role_gate([&ownership] { return ownership->executing(); });
     commands_ptr = &commands;
   }
   // Acknowledgements, like commands, in both contracts (they exist from contract v4 on, and
@@ -289,7 +283,7 @@ int run(const service::Config& cfg, const pmu::dds::ResolvedNetwork& network) {
                                   ack_topics.publish(r);
                                   if (previous_ack_topics) previous_ack_topics->publish(r);
                                 });
-  if (holder) acks.set_role_gate([&executing] { return executing.load(); });
+  if (ownership) acks.set_role_gate([&ownership] { return ownership->executing(); });
   // Declared after everything the running threads use, so it is destroyed first, on every
   // way out of this function: commands stop first (no new request reaches `commands`, and
   // the bus workers are still there to finish the ones in flight), then the worker threads

@@ -1,7 +1,5 @@
 #include "pmu/standby/role_holder.hpp"
 
-#include <spdlog/spdlog.h>
-
 #include <utility>
 
 namespace pmu::standby {
@@ -101,10 +99,7 @@ void RoleHolder::on_can_frame(Time now, const codec::CanFrame& frame) {
   {
     std::lock_guard<std::mutex> lock(mutex_);
     const auto beat = redundancy::decode_can_beat(frame.id, frame.extended, frame.data.data(), frame.length);
-    if (!beat) {
-      ++bad_beats_;
-      return;
-    }
+    if (!beat) return;
     machine_.on_peer_can(now, *beat);
     due = collect(now);
   }
@@ -136,26 +131,14 @@ void RoleHolder::leave(Time now) {
   machine_.leave(now);
 }
 
-redundancy::MoveResult RoleHolder::hand_over(Time now, const std::string& who) {
-  redundancy::MoveResult result;
-  {
-    std::lock_guard<std::mutex> lock(mutex_);
-    result = machine_.hand_over(now);
-  }
-  // The audit line is the move endpoint's, with the request's id and its writer.
-  spdlog::debug("role move asked by {}: {}", who,
-                result.accepted ? "handing the bus over to " + settings_.peer : result.reason);
-  return result;
+redundancy::MoveResult RoleHolder::hand_over(Time now) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return machine_.hand_over(now);
 }
 
 Role RoleHolder::role() const {
   std::lock_guard<std::mutex> lock(mutex_);
   return machine_.role();
-}
-
-bool RoleHolder::executes() const {
-  std::lock_guard<std::mutex> lock(mutex_);
-  return machine_.executes_commands();
 }
 
 std::string RoleHolder::status() const {
@@ -167,11 +150,6 @@ std::string RoleHolder::status() const {
   s += peer_ ? ", peer " + settings_.peer + " " + std::string(redundancy::role_name(peer_->beat.role))
              : ", peer " + settings_.peer + " not heard";
   return s;
-}
-
-std::uint64_t RoleHolder::bad_beats() const {
-  std::lock_guard<std::mutex> lock(mutex_);
-  return bad_beats_;
 }
 
 }  // namespace pmu::standby

@@ -13,6 +13,7 @@
 #include "support/harness.hpp"
 #include "pmu/redundancy/can_beat.hpp"
 #include "pmu/standby/fenced_bus.hpp"
+#include "pmu/standby/ownership.hpp"
 #include "pmu/standby/role_gate.hpp"
 #include "pmu/standby/role_holder.hpp"
 
@@ -45,12 +46,10 @@ class Instance {
       if (!link.cut) outbox.push_back(r);
     };
     out.peer_joined = [this] { worker->post([this] { worker->repeat_readings(); }); };
-    out.changed = [this](const standby::RoleChange& c) {
-      if (c.took_bus()) gate->open();
-      if (c.left_bus()) gate->close();
-    };
+    out.changed = [this](const standby::RoleChange& c) { ownership->on_change(c); };
     holder = std::make_unique<RoleHolder>(s, clock.steady_now(), std::move(out));
     gate = std::make_unique<RoleGate>(sink, [this] { ++clears; });
+    ownership = std::make_unique<standby::Ownership>(*gate, [this] { ++takeovers; });
     transport::SimBusOptions options;
     options.filters = transport::default_filters(false);
     options.filters.push_back({redundancy::kCanBeatIdBase, 0x1FFFFF00u, true});
@@ -76,10 +75,12 @@ class Instance {
   RecordingSink sink;
   std::unique_ptr<RoleHolder> holder;
   std::unique_ptr<RoleGate> gate;
+  std::unique_ptr<standby::Ownership> ownership;
   RecordingBus* wire = nullptr;
   FencedBus* fence = nullptr;
   std::unique_ptr<BusWorker> worker;
   int clears = 0;
+  int takeovers = 0;    // Ownership's took_over: the commands' settling
   bool running = true;  // false: killed or frozen, the test no longer runs it
 
  private:
@@ -164,6 +165,8 @@ TEST_F(StandbyPair, KilledOwnerTheStandbyTakesOverWithItsWarmState) {
   a_->running = false;  // SIGKILL: nothing of it runs, on CAN or DDS
   const auto took = until_active(*b_, 2s);
   EXPECT_LE(took, 500ms) << "lease 0.3 s and can_silence 0.15 s, claim window 0.1 s";
+  EXPECT_TRUE(b_->ownership->executing());
+  EXPECT_EQ(b_->takeovers, 1) << "what the former owner left is settled once";
   // Its kept state goes out at once, before any new frame: health ONLINE, config, info.
   ASSERT_FALSE(b_->sink.healths.empty());
   EXPECT_EQ(b_->sink.healths.front().second.state, HealthState::Online);
@@ -198,6 +201,8 @@ TEST_F(StandbyPair, NetworkCutNobodyTakesOverWhileTheOwnerIsHeardOnCan) {
   EXPECT_EQ(a_->holder->role(), Role::Active);
   EXPECT_GT(a_->telemetry_published(), before) << "the owner's alarm changed, not its role: it still publishes";
   EXPECT_EQ(a_->clears, 0);
+  EXPECT_TRUE(a_->ownership->executing()) << "and it still executes commands";
+  EXPECT_FALSE(b_->ownership->executing());
   EXPECT_EQ(b_->holder->role(), Role::Fenced);
   EXPECT_EQ(b_->pmu_frames(), 0u);
   EXPECT_NE(b_->holder->status().find("partition"), std::string::npos) << b_->holder->status();
@@ -220,6 +225,7 @@ TEST_F(StandbyPair, FrozenOwnerStepsDownOnItsFirstCallAndSendsNothingStale) {
   EXPECT_EQ(a_->pmu_frames(), a_frames) << "the resumed former owner sent a PMU frame";
   EXPECT_EQ(a_->telemetry_published(), a_samples) << "the resumed former owner published beside the new one";
   EXPECT_NE(a_->holder->role(), Role::Active);
+  EXPECT_FALSE(a_->ownership->executing());
   EXPECT_EQ(b_->holder->role(), Role::Active) << "it takes nothing back";
   EXPECT_EQ(a_->clears, clears + 1) << "its state topics' histories are cleared";
 }
@@ -260,8 +266,8 @@ TEST_F(StandbyPair, TheOldOwnerReturnsAsStandby) {
 
 TEST_F(StandbyPair, AMoveHandsTheBusToTheStandby) {
   run_for(2s);
-  EXPECT_FALSE(b_->holder->hand_over(clock_.steady_now(), "test").accepted) << "a standby has nothing to hand over";
-  const auto moved = a_->holder->hand_over(clock_.steady_now(), "test");
+  EXPECT_FALSE(b_->holder->hand_over(clock_.steady_now()).accepted) << "a standby has nothing to hand over";
+  const auto moved = a_->holder->hand_over(clock_.steady_now());
   ASSERT_TRUE(moved.accepted) << moved.reason;
   until_active(*b_, 1s);
   run_for(2s);

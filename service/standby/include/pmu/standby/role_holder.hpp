@@ -9,7 +9,7 @@
 // on_bus_state(); those ask the machine what to do now and do it: the CAN heartbeat goes out
 // on that thread (one thread uses a bus at a time), and `Outputs::changed` is called on it, so
 // every change of role is seen in order on one thread. Any thread may call on_report(),
-// leave(), hand_over(), role(), executes() and status(): they only tell the machine, and what
+// leave(), hand_over(), role() and status(): they only tell the machine, and what
 // follows is done at the bus thread's next call (at most the tick period later).
 //
 // Lifetime: the bus given to attach() must outlive the holder's last call from the bus
@@ -68,7 +68,7 @@ class RoleHolder {
   // machine the time, so that a holder frozen while ACTIVE stops on its first frame.
   bool may_transmit(Time now);
   // A frame on a heartbeat identifier (redundancy::is_can_beat_id): the peer's. Anything that
-  // does not decode as a heartbeat is counted and dropped.
+  // does not decode as a heartbeat is dropped.
   void on_can_frame(Time now, const codec::CanFrame& frame);
   void on_bus_state(Time now, transport::BusState state);
 
@@ -77,15 +77,13 @@ class RoleHolder {
   void on_report(const redundancy::RoleReport& report, Time arrival);
   // SIGTERM: the machine stops transmitting at once; the release goes out at the next tick.
   void leave(Time now);
-  // A move of the role asked by `who` (pmuctl): accepted or refused with the reason.
-  redundancy::MoveResult hand_over(Time now, const std::string& who);
+  // A move of the role (pmuctl): accepted or refused with the reason. The move's endpoint
+  // audits it.
+  redundancy::MoveResult hand_over(Time now);
   redundancy::Role role() const;
-  bool executes() const;
   // "ACTIVE, term 3" or "STANDBY (peer mc-b ACTIVE)": systemd's STATUS= and the log.
   std::string status() const;
   const redundancy::Settings& settings() const noexcept { return settings_; }
-  // Heartbeat-range frames that were not a heartbeat; frames held back while not the owner.
-  std::uint64_t bad_beats() const;
 
  private:
   struct Due {
@@ -106,8 +104,7 @@ class RoleHolder {
   redundancy::BusState bus_state_ = redundancy::BusState::Ok;
   std::optional<redundancy::RoleReport> peer_;
   Time peer_seen_{};
-  bool peer_joined_ = false;  // the peer heard after a lease of silence, not yet handed on
-  std::uint64_t bad_beats_ = 0;
+  bool peer_joined_ = false;          // the peer heard after a lease of silence, not yet handed on
   transport::CanBus* bus_ = nullptr;  // bus thread only
 };
 
