@@ -13,9 +13,6 @@ FencedBus::FencedBus(std::unique_ptr<transport::CanBus> inner, RoleHolder& holde
 }
 
 transport::DrainResult FencedBus::drain(transport::BusHandler& handler) {
-  // Before any frame reaches a session: a holder that was frozen while it owned the bus learns
-  // it here and closes its gates, so nothing it decodes now is published beside the new owner's.
-  holder_.tick(clock_.steady_now());
   handler_ = &handler;
   beats_ = 0;
   auto result = inner_->drain(*this);
@@ -30,8 +27,9 @@ void FencedBus::on_frame(const transport::ReceivedFrame& frame) {
     holder_.on_can_frame(clock_.steady_now(), frame.frame);
     return;
   }
-  // Every frame, not only every drain: a process stopped in the middle of a drain resumes in
-  // it, with the frames queued while it was stopped still to come.
+  // Before the frame reaches a session: a holder frozen while it owned the bus (also one stopped
+  // in the middle of a drain) learns it here and closes its gates, so nothing it decodes now is
+  // published beside the new owner's.
   holder_.tick(clock_.steady_now());
   if (tap_) tap_(inner_->name(), frame);
   handler_->on_frame(frame);

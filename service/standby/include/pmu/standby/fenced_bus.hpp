@@ -7,8 +7,8 @@
 // further; every other frame and event goes to the worker as it came, and each frame also to
 // `tap` (what a standby hears of its peer's commands), and each change of bus state to the
 // holder too. The holder's own CAN heartbeat goes out on the bus underneath, past the fence.
-// Each drain() and each frame first tick the holder: after a freeze, the role is judged before
-// the next frame is decoded, also when the process was stopped in the middle of a drain.
+// Each frame first ticks the holder: after a freeze, the role is judged before the next frame is
+// decoded, also when the process was stopped in the middle of a drain.
 //
 // Lifetime: owns the bus underneath; `holder` and `clock` must outlive it. The holder is
 // attached to the bus underneath at construction and must not be used from the bus's thread
