@@ -60,34 +60,32 @@ std::optional<double> DeviceSession::internal_temperature(SteadyTime now) const 
   return internal_temperature_->value;
 }
 
-void DeviceSession::start_reading(SteadyTime now) {
-  now_ = now;
-  const std::uint64_t round = reading_.start();
-  queue_.drop(kReadingTag);
+std::vector<Request> DeviceSession::reading_gets(int tag) const {
   std::vector<Request> gets;
   for (const auto p : ReadingMachine::packets()) {
     Request r;
     r.frame = *codec::encode_get(p, key_.address);
     r.reply = p;
     r.retries = timeouts_.retries;
-    r.tag = kReadingTag;
-    r.done = [this, round](const RequestOutcome& o) { on_reading_done(o, round); };
+    r.tag = tag;
     gets.push_back(std::move(r));
   }
+  return gets;
+}
+
+void DeviceSession::start_reading(SteadyTime now) {
+  now_ = now;
+  const std::uint64_t round = reading_.start();
+  queue_.drop(kReadingTag);
+  auto gets = reading_gets(kReadingTag);
+  for (auto& r : gets) r.done = [this, round](const RequestOutcome& o) { on_reading_done(o, round); };
   queue_.append(std::move(gets), now);
 }
 
 void DeviceSession::repeat_reading_gets(SteadyTime now) {
   now_ = now;
   queue_.drop(kRepeatTag);
-  for (const auto p : ReadingMachine::packets()) {
-    Request r;
-    r.frame = *codec::encode_get(p, key_.address);
-    r.reply = p;
-    r.retries = timeouts_.retries;
-    r.tag = kRepeatTag;
-    submit(std::move(r), now);
-  }
+  queue_.append(reading_gets(kRepeatTag), now);
 }
 
 void DeviceSession::on_reading_done(const RequestOutcome& o, std::uint64_t round) {

@@ -181,6 +181,7 @@ class DeviceSession {
 
   transport::SendResult send_one(const codec::CanFrame& frame);  // counted in the health when sent
   void start_reading(SteadyTime now);
+  std::vector<Request> reading_gets(int tag) const;  // one get per packet of a reading round
   void on_reading_done(const RequestOutcome& outcome, std::uint64_t round);
   void configure_streaming();
   void poll(SteadyTime now);
