@@ -88,9 +88,9 @@ TEST(PeerReplies, AStandbyAnswersAResendAfterTakingOverWithTheOwnersReply) {
   EXPECT_EQ(answered[0].result, CommandResult::Completed);
 }
 
-// A reply written on the listener's thread (a request refused at once, a resend answered again)
-// comes back to that same participant's reply reader, which Fast DDS may call on the writing
-// thread: the two readers' callbacks must not share a lock the writer's caller holds.
+// A reply written on the command listener's thread (a request refused at once, a resend
+// answered again) also reaches this participant's own reply reader, whose listener takes the
+// lock the command listener holds while it writes: the reply still reaches the client.
 TEST(PeerReplies, AReplyWrittenFromTheCommandListenerReachesTheClient) {
   using namespace eprosima::fastdds::dds;
   const int domain = pmu::test::exclusive_dds_domain();

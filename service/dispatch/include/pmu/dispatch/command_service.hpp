@@ -25,7 +25,8 @@
 // request is recorded, neither executed nor answered, and so are the owner's replies
 // (peer_reply) and the command frames heard on CAN (heard_on_can) in a FailoverRecord; on
 // took_over() each recorded request is answered from the owner's reply, answered FAILED
-// "outcome unknown" when its frames were heard but no reply, run when it was never seen on the
+// "outcome unknown" when its frames were heard but no reply (when the client sends it again:
+// the owner's reply may have reached the client already), run when it was never seen on the
 // bus and has not expired, and an ENGINE_STOP always runs (docs/safety.md H4, H8). A request
 // still running when the gate closes is not answered here: its reply is the new owner's
 // (relinquished to the record, in case this instance takes the bus back).

@@ -77,7 +77,7 @@ class FailoverRecord {
 
   enum class Action : std::uint8_t {
     Answered,  // the owner's final reply, `reply`: not executed, a resend gets it
-    Unknown,   // FAILED, `reply.reason` says why its outcome is unknown: not executed
+    Unknown,   // FAILED, `reply.reason` says why its outcome is unknown: not executed, a resend gets it
     Expired,   // REJECTED: it expired here before anybody could run it
     Run,       // execute `sample` (its deadline from `arrived`; an ENGINE_STOP's at least `now` + default lifetime)
   };
