@@ -130,13 +130,14 @@ trap - EXIT
 cat "$vm_log"
 
 step "arm64 packages (tests under qemu-user), beside the release tests that do not use them"
-# The release tests (all but the VM suites, which ran above, and the package tests, which use
-# the arm64 packages) run at -j twice the CPUs: they mostly wait (discovery, replies, a
+# The release tests (all but the VM suites, which ran above or, for the hot-standby suite
+# (label standby), are run on their own, and the package tests, which use the arm64 packages)
+# run at -j twice the CPUs: they mostly wait (discovery, replies, a
 # service's start), and at one per CPU the CPUs were 97 % idle. The longest carry a COST so
 # that they start first. package.sh builds at nice 10, so the tests have the CPUs first and
 # the cross build takes what they leave.
 release_log="$root/build/release/release-tests.log"
-ctest --preset release -LE '^(system|package)$' -j"$((2 * jobs))" >"$release_log" 2>&1 &
+ctest --preset release -LE '^(system|package|standby)$' -j"$((2 * jobs))" >"$release_log" 2>&1 &
 tests_pid=$!
 trap 'kill "$tests_pid" 2>/dev/null || true' EXIT
 env "${no_debug[@]}" DEB_BUILD_OPTIONS=noautodbgsym "$root/scripts/package.sh" --arch arm64
