@@ -4,8 +4,7 @@
 
 namespace pmu::standby {
 
-Ownership::Ownership(RoleGate& gate, std::function<void()> took_over)
-    : gate_(gate), took_over_(std::move(took_over)) {}
+Ownership::Ownership(RoleGate& gate, std::function<void()> took_over) : gate_(gate), took_over_(std::move(took_over)) {}
 
 void Ownership::on_change(const RoleChange& change) {
   if (change.took_bus()) {
