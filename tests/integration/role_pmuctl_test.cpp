@@ -90,7 +90,9 @@ TEST(RoleWithPmuctl, AMoveRefusedIsPrintedWithItsReasonAndAnUnknownInstanceIsNoA
   EXPECT_EQ(refused.status, 1) << refused.out;
   EXPECT_NE(refused.out.find("REFUSED: the peer is not a live STANDBY with its bus up"), std::string::npos)
       << refused.out;
-  const auto unknown = pmu::test::run_capture(pmuctl("--timeout 2 role move mc-x"));
+  // The timeout bounds the match with the pair too; a shorter one on a loaded machine ends in
+  // "no pmu-service" before the instances are discovered, which is not the answer looked for.
+  const auto unknown = pmu::test::run_capture(pmuctl("--timeout 8 role move mc-x"));
   EXPECT_EQ(unknown.status, 3) << unknown.out;
   EXPECT_NE(unknown.out.find("no reply from instance mc-x of"), std::string::npos) << unknown.out;
 }
