@@ -2,9 +2,13 @@
 // (DdsCommandEndpoint::follow_peer_replies, design.md "Commands across a failover"): the
 // owner's reply settles the request it recorded, so after taking over a resend is answered with
 // that reply and nothing runs; its own reply writer's samples are no peer's.
+#include <fastrtps/xmlparser/XMLProfileManager.h>
 #include <gtest/gtest.h>
 
 #include <atomic>
+#include <cstdio>
+#include <cstdlib>
+#include <future>
 #include <chrono>
 #include <mutex>
 #include <string>
@@ -89,11 +93,31 @@ TEST(PeerReplies, AStandbyAnswersAResendAfterTakingOverWithTheOwnersReply) {
   EXPECT_EQ(answered[0].result, CommandResult::Completed);
 }
 
+// Fast DDS's in-process delivery on, as pmu-service runs (this program's main turns it off,
+// gtest_main_through_transport.cpp), for one test: restored when it ends.
+class InProcessDelivery {
+ public:
+  InProcessDelivery() : before_(eprosima::fastrtps::xmlparser::XMLProfileManager::library_settings()) {
+    auto on = before_;
+    on.intraprocess_delivery = eprosima::fastrtps::INTRAPROCESS_FULL;
+    eprosima::fastrtps::xmlparser::XMLProfileManager::library_settings(on);
+  }
+  ~InProcessDelivery() { eprosima::fastrtps::xmlparser::XMLProfileManager::library_settings(before_); }
+  InProcessDelivery(const InProcessDelivery&) = delete;
+  InProcessDelivery& operator=(const InProcessDelivery&) = delete;
+
+ private:
+  eprosima::fastrtps::LibrarySettingsAttributes before_;
+};
+
 // A reply written on the command listener's thread (a request refused at once, a resend
-// answered again) also reaches this participant's own reply reader, whose listener takes the
-// lock the command listener holds while it writes: the reply still reaches the client.
+// answered again) also reaches this participant's own reply reader. With in-process delivery
+// (pmu-service's) Fast DDS hands it over on the writing thread, inside the write, so a
+// reply listener that waited there for the command listener's lock would never return: the
+// reply never leaves, and the process cannot be stopped.
 TEST(PeerReplies, AReplyWrittenFromTheCommandListenerReachesTheClient) {
   using namespace eprosima::fastdds::dds;
+  InProcessDelivery in_process;
   const int domain = pmu::test::exclusive_dds_domain();
   transport::SystemClock clock;
   dds::DdsContext service_dds(domain, "", "pmu-service-pair");
@@ -118,25 +142,34 @@ TEST(PeerReplies, AReplyWrittenFromTheCommandListenerReachesTheClient) {
   c.bus("can0");
   c.address(1);
   c.kind(pmu::v5::RESET);
-  const bool answered =
-      pmu::test::until_answered([&] { writer.write(&c); },
-                                [&] {
-                                  pmu::v5::CommandReply r;
-                                  SampleInfo info;
-                                  bool got = false;
-                                  while (replies.take_next_sample(&r, &info) == ReturnCode_t::RETCODE_OK)
-                                    got = got || (info.valid_data && r.request_id() == "listener-1");
-                                  return got;
-                                },
-                                20s);
-  ASSERT_TRUE(answered) << "the reply written on the command listener's thread never came";
+  // Each write on a thread of its own: in process, a write runs the service's command listener
+  // on the writing thread, and a listener stuck there must not keep the test from saying so.
+  std::vector<std::future<void>> sends;
+  const auto send = [&] { sends.push_back(std::async(std::launch::async, [&] { writer.write(&c); })); };
+  const bool answered = pmu::test::until_answered(
+      send,
+      [&] {
+        pmu::v5::CommandReply r;
+        SampleInfo info;
+        bool got = false;
+        while (replies.take_next_sample(&r, &info) == ReturnCode_t::RETCODE_OK)
+          got = got || (info.valid_data && r.request_id() == "listener-1");
+        return got;
+      },
+      20s);
+  if (!answered) {
+    // The listener is stuck inside the write: tearing the endpoint down would wait for it.
+    ADD_FAILURE() << "the reply written on the command listener's thread never came (its write is stuck)";
+    std::fflush(stdout);
+    std::_Exit(1);
+  }
   // Once the service's own reply reader has matched its writer too: the same request again is
   // answered again, on the listener's thread, and so is the one after it.
   std::this_thread::sleep_for(1s);
   for (int again = 0; again < 2; ++again) {
-    writer.write(&c);
+    send();
     bool got = false;
-    ASSERT_TRUE(pmu::test::wait_until(
+    const bool answered_again = pmu::test::wait_until(
         [&] {
           pmu::v5::CommandReply r;
           SampleInfo info;
@@ -144,9 +177,14 @@ TEST(PeerReplies, AReplyWrittenFromTheCommandListenerReachesTheClient) {
             got = got || (info.valid_data && r.request_id() == "listener-1");
           return got;
         },
-        10s, 10ms))
-        << "resend " << again << ": no reply";
+        10s, 10ms);
+    if (!answered_again) {
+      ADD_FAILURE() << "resend " << again << ": no reply (the listener's write is stuck)";
+      std::fflush(stdout);
+      std::_Exit(1);  // as above: the endpoint cannot stop
+    }
   }
+  for (auto& f : sends) f.wait();
   endpoint.stop();
 }
 

@@ -120,22 +120,32 @@ struct DdsCommandEndpoint::Impl final : public DataReaderListener {
     return false;
   }
 
-  // The bus owner's replies, read on the standby (follow_peer_replies).
+  // The bus owner's replies, read on the standby (follow_peer_replies). Its own lock and its
+  // own pointer to the service, never service_mutex: the command listener holds that lock
+  // while it writes a reply, and Fast DDS may deliver the reply to this participant's own
+  // reader, on the writing thread or on a receive thread that the write then waits for.
+  // This instance's own replies are dropped before any lock is taken.
   struct PeerReplies final : public DataReaderListener {
     Impl& impl;
+    // Held while a callback hands replies to the service and while stop() detaches it.
+    std::mutex mutex;
+    CommandService* service = nullptr;
     explicit PeerReplies(Impl& i) : impl(i) {}
     void on_data_available(DataReader* r) override {
-      std::lock_guard<std::mutex> lock(impl.service_mutex);
-      if (!impl.service) return;
       const auto own = impl.dds.participant().guid().guidPrefix;
+      std::vector<CommandReplyData> peers;
       pmu::v5::CommandReply reply;
       SampleInfo info;
       while (r->take_next_sample(&reply, &info) == ReturnCode_t::RETCODE_OK) {
         // This instance's own replies are no peer's; another vehicle's are another pair's.
         if (!info.valid_data || info.sample_identity.writer_guid().guidPrefix == own) continue;
         if (reply.vehicle() != impl.vehicle) continue;
-        if (auto d = peer_reply_data(reply)) impl.service->peer_reply(*d);
+        if (auto d = peer_reply_data(reply)) peers.push_back(std::move(*d));
       }
+      if (peers.empty()) return;
+      std::lock_guard<std::mutex> lock(mutex);
+      if (!service) return;
+      for (const auto& d : peers) service->peer_reply(d);
     }
   };
   PeerReplies peer_replies{*this};
@@ -203,6 +213,10 @@ void DdsCommandEndpoint::stop() {
     std::lock_guard<std::mutex> lock(impl_->service_mutex);  // waits for a callback inside
     impl_->service = nullptr;
   }
+  {
+    std::lock_guard<std::mutex> lock(impl_->peer_replies.mutex);
+    impl_->peer_replies.service = nullptr;
+  }
   // Outside the lock: Fast DDS may wait here for a callback that waits for the lock.
   if (impl_->reader) impl_->reader->set_listener(nullptr);
   if (impl_->reply_reader) impl_->reply_reader->set_listener(nullptr);
@@ -222,6 +236,11 @@ void DdsCommandEndpoint::start(CommandService& service) {
 }
 
 void DdsCommandEndpoint::follow_peer_replies() {
+  {
+    std::lock_guard<std::mutex> lock(impl_->peer_replies.mutex);
+    std::lock_guard<std::mutex> service_lock(impl_->service_mutex);
+    impl_->peer_replies.service = impl_->service;
+  }
   impl_->reply_reader =
       &impl_->dds.reader(impl_->dds.topic(topics::kCommandReply, TypeSupport(new CommandReplyTopicType())),
                          qos_profiles::kCommand, &impl_->peer_replies);

@@ -13,7 +13,8 @@
 // runs on Fast DDS's threads and calls CommandService::submit() there; publish() from any
 // thread (a mutex serialises the writer); malformed() and not_ours() from any thread.
 // With follow_peer_replies(), a second reader's listener runs on Fast DDS's threads and calls
-// CommandService::peer_reply() there, under the same detach guard as submit().
+// CommandService::peer_reply() there, under a detach guard of its own (stop() detaches both):
+// the command listener holds its guard while it writes a reply, which this reader may receive.
 
 #include <memory>
 #include <string>
