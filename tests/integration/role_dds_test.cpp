@@ -11,8 +11,11 @@
 #include <fastdds/dds/core/status/PublicationMatchedStatus.hpp>
 #include <fastdds/dds/core/status/SubscriptionMatchedStatus.hpp>
 #include <fastdds/dds/subscriber/SampleInfo.hpp>
+#include <cstdio>
+#include <cstdlib>
 #include <mutex>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "pmu/dds/dds_context.hpp"
@@ -238,6 +241,65 @@ TEST(RoleOverDds, AMoveForThisInstanceIsAskedOnceAndAnsweredAndAResendAlike) {
   EXPECT_EQ(at_b.moves[0].instance, "mc-b");
   EXPECT_EQ(at_b.moves[0].requester, "op@ground");
   EXPECT_EQ(at_b.moves[1].request_id, "move-2");
+}
+
+// In one process (Fast DDS's in-process delivery, as pmu-service runs) an instance's own
+// heartbeat comes back to its own reader on the thread that writes it, inside the write. Moves
+// answered while heartbeats are written as fast as they can be: every move is answered and the
+// heartbeats go on, so neither waits for the other's lock.
+TEST(RoleOverDds, MovesAreAnsweredWhileTheInstanceWritesItsHeartbeats) {
+  auto b_dds = participant("mc-b", vehicle_partitions(kVehicle));
+  DdsRoleEndpoint b(*b_dds, kVehicle, test_clocks());
+  std::atomic<int> reports{0};
+  b.on_report([&](const RoleReport&, std::chrono::steady_clock::time_point) { ++reports; });
+  b.on_move("mc-b", [](const pmu::redundancy::MoveRequest&) {
+    return pmu::redundancy::MoveResult{false, "not active"};
+  });
+  b.start();
+  MoveClient client(vehicle_partitions(kVehicle));
+  ASSERT_TRUE(
+      pmu::test::wait_until([&] { return writer_matched(*client.writer) && reader_matched(*client.reader); }, 20s));
+  const RoleReport beat{"mc-b", "mc-a", {Role::Active, 2, 100, false}, BusState::Ok, PeerAlarm::None};
+  ASSERT_TRUE(pmu::test::wait_until(
+      [&] {
+        b.publish(beat);
+        return b.own() > 0;
+      },
+      20s, 50ms))
+      << "its own heartbeat never came back to its reader";
+
+  constexpr int kMoves = 300;
+  std::atomic<bool> stop{false};
+  std::atomic<long> written{0};
+  std::thread beats([&] {
+    while (!stop) {
+      b.publish(beat);
+      ++written;
+    }
+  });
+  std::thread moves([&] {
+    for (int i = 0; i < kMoves; ++i) client.send("move-" + std::to_string(i), "mc-b");
+  });
+  const bool answered = pmu::test::wait_until(
+      [&] {
+        client.take();
+        return client.replies.size() >= static_cast<std::size_t>(kMoves);
+      },
+      30s);
+  const long written_then = written;
+  const bool beats_go_on = pmu::test::wait_until([&] { return written > written_then; }, 5s);
+  if (!answered || !beats_go_on) {
+    // A writer and a callback waiting for each other: the threads cannot be joined.
+    ADD_FAILURE() << client.replies.size() << " of " << kMoves << " moves answered, heartbeats "
+                  << (beats_go_on ? "go on" : "stopped") << " after " << written_then;
+    std::fflush(stdout);
+    std::_Exit(1);
+  }
+  stop = true;
+  beats.join();
+  moves.join();
+  EXPECT_EQ(client.replies.size(), static_cast<std::size_t>(kMoves));
+  EXPECT_EQ(reports.load(), 0) << "its own heartbeats are no peer's";
 }
 
 TEST(RoleOverDds, AMoveFromAWriterInEveryPartitionIsNotMoved) {

@@ -9,6 +9,7 @@
 #include <deque>
 #include <mutex>
 #include <utility>
+#include <vector>
 
 #include "pmu/command/command.hpp"
 #include "pmu/dds/role_sample.hpp"
@@ -78,7 +79,7 @@ struct DdsRoleEndpoint::Impl {
   std::mutex write_mutex;
   std::atomic<std::uint64_t> own{0}, not_ours{0}, malformed{0}, expired{0};
   LogThrottle malformed_reports{std::chrono::seconds(10)};
-  std::uint64_t malformed_logged = 0;
+  std::atomic<std::uint64_t> malformed_seen{0};  // the type's undecodable count last added to `malformed`
   std::deque<role_endpoint::Answered> answered;  // under callback_mutex
 
   struct RoleListener final : DataReaderListener {
@@ -115,8 +116,13 @@ struct DdsRoleEndpoint::Impl {
     return info.sample_identity.writer_guid().guidPrefix == dds.participant().guid().guidPrefix;
   }
 
+  // The samples are taken before callback_mutex, and this instance's own dropped there: a
+  // heartbeat written while write_mutex is held can come back to this reader on the writing
+  // thread (Fast DDS's delivery within a process), and waiting there for callback_mutex, which
+  // a move's callback holds while it waits for write_mutex, would close a cycle.
   void take_roles(DataReader* r) {
-    std::lock_guard<std::mutex> lock(callback_mutex);
+    std::vector<std::pair<redundancy::RoleReport, std::chrono::steady_clock::time_point>> reports;
+    std::vector<std::string> problems;
     pmu::v5::RoleHeartbeat s;
     SampleInfo info;
     while (r->take_next_sample(&s, &info) == ReturnCode_t::RETCODE_OK) {
@@ -129,20 +135,25 @@ struct DdsRoleEndpoint::Impl {
       const auto read = dds::read_role_heartbeat(s);
       if (!read.ok()) {
         malformed.fetch_add(1, std::memory_order_relaxed);
-        report_malformed(read.problem + " (from " + printable(writer_guid_text(info)) + ")");
+        problems.push_back(read.problem + " (from " + printable(writer_guid_text(info)) + ")");
         continue;
       }
       if (read.vehicle != vehicle) {
         not_ours.fetch_add(1, std::memory_order_relaxed);
         continue;
       }
-      if (running && report_fn) report_fn(read.report, arrived);
+      reports.emplace_back(read.report, arrived);
     }
-    // A payload that is not a RoleHeartbeat at all never reaches take: counted by its type.
     const auto undecodable = role_type ? role_type->undecodable.load(std::memory_order_relaxed) : 0;
-    if (undecodable != malformed_logged) {
-      malformed.fetch_add(undecodable - malformed_logged, std::memory_order_relaxed);
-      malformed_logged = undecodable;
+    if (reports.empty() && problems.empty() && undecodable == malformed_seen.load(std::memory_order_relaxed)) return;
+    std::lock_guard<std::mutex> lock(callback_mutex);
+    for (const auto& p : problems) report_malformed(p);
+    if (running && report_fn)
+      for (const auto& [report, arrived] : reports) report_fn(report, arrived);
+    // A payload that is not a RoleHeartbeat at all never reaches take: counted by its type.
+    const auto before = malformed_seen.exchange(undecodable, std::memory_order_relaxed);
+    if (undecodable != before) {
+      malformed.fetch_add(undecodable - before, std::memory_order_relaxed);
       report_malformed("a payload that is not a pmu::v5::RoleHeartbeat as idl/role.idl defines it");
     }
   }
@@ -153,8 +164,17 @@ struct DdsRoleEndpoint::Impl {
                    malformed.load(std::memory_order_relaxed));
   }
 
+  // The replies are written once callback_mutex is released (take_roles says why).
   void take_moves(DataReader* r) {
-    std::lock_guard<std::mutex> lock(callback_mutex);
+    std::vector<std::pair<redundancy::MoveRequest, redundancy::MoveResult>> replies;
+    {
+      std::lock_guard<std::mutex> lock(callback_mutex);
+      decide_moves(r, replies);
+    }
+    for (const auto& [request, result] : replies) reply(request, result);
+  }
+
+  void decide_moves(DataReader* r, std::vector<std::pair<redundancy::MoveRequest, redundancy::MoveResult>>& replies) {
     pmu::v5::RoleMove s;
     SampleInfo info;
     while (r->take_next_sample(&s, &info) == ReturnCode_t::RETCODE_OK) {
@@ -194,7 +214,7 @@ struct DdsRoleEndpoint::Impl {
                      printable(request.requester), printable(sender), result.accepted ? "accepted" : "refused",
                      result.reason.empty() ? "" : ": ", printable(result.reason));
       }
-      reply(request, result);
+      replies.emplace_back(std::move(request), std::move(result));
     }
   }
 
