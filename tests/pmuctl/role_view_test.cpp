@@ -89,5 +89,38 @@ TEST(RoleView, ListRows) {
   EXPECT_EQ(rows[2][7], "5.0s ago");
 }
 
+// watch prints a line when an instance's shown role or term changes, and only then: a dead
+// owner's line says SILENT once its samples stop, never ACTIVE again (H7).
+TEST(RoleView, WatchPrintsAnInstanceOnlyWhenItsShownRoleOrTermChanges) {
+  struct Step {
+    std::vector<SeenInstance> seen;
+    std::vector<std::string> lines;
+  };
+  auto term = [](SeenInstance s, std::uint32_t t) {
+    s.report.beat.term = t;
+    return s;
+  };
+  const std::vector<Step> steps{
+      {{seen("mc-a", Role::Active), seen("mc-b", Role::Standby)},
+       {"uav7/mc-a role ACTIVE term 3", "uav7/mc-b role STANDBY term 3"}},
+      {{seen("mc-a", Role::Active, 900ms), seen("mc-b", Role::Standby)}, {}},
+      {{seen("mc-a", Role::Active, 1600ms), seen("mc-b", Role::Claiming)},
+       {"uav7/mc-a role SILENT term 3 (was ACTIVE)", "uav7/mc-b role CLAIMING term 3 (was STANDBY)"}},
+      {{seen("mc-a", Role::Active, 5000ms), term(seen("mc-b", Role::Active), 4)},
+       {"uav7/mc-b role ACTIVE term 4 (was CLAIMING)"}},
+      {{term(seen("mc-a", Role::Standby), 4), term(seen("mc-b", Role::Active), 4)},
+       {"uav7/mc-a role STANDBY term 4 (was SILENT)"}},
+  };
+  std::map<std::pair<std::string, std::string>, std::string> printed;
+  for (std::size_t i = 0; i < steps.size(); ++i) {
+    std::vector<std::string> lines;
+    for (const auto& c : shown_role_changes(steps[i].seen, printed)) lines.push_back(role_change_text(c));
+    EXPECT_EQ(lines, steps[i].lines) << "step " << i;
+  }
+  SeenInstance unnamed = seen("mc-a", Role::Standby);
+  unnamed.vehicle.clear();
+  EXPECT_EQ(role_change_text({unnamed, ""}), "mc-a role STANDBY term 3");
+}
+
 }  // namespace
 }  // namespace pmu::tools

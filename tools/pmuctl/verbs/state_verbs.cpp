@@ -353,6 +353,11 @@ int run_watch(const GlobalOptions& o, long count) {
     return list;
   };
 
+  // The instances of hot-standby pairs (interface.md 1.10): a line when an instance's role or
+  // term changes (a takeover, a silent owner), and a `pair:` section atop the table.
+  RoleCollector roles(o, dds);
+  std::map<std::pair<std::string, std::string>, std::string> roles_printed;
+
   // Every row says its device's health and its values' age: a device gone OFFLINE keeps
   // its last row, which must not look live (docs/safety.md H7). --low-rate reads the state
   // from pmu/low_rate/health, which the service writes when it changes: pmu/health's sample a
@@ -405,6 +410,17 @@ int run_watch(const GlobalOptions& o, long count) {
                     a.message.c_str());
       }
     }
+    const auto instances = roles.seen();
+    for (const auto& c : shown_role_changes(instances, roles_printed)) {
+      any = true;
+      // Not counted by --count either.
+      if (o.json)
+        std::printf(
+            "%s\n",
+            role_json(c.now, pmu::dds::contract_major()).dump(-1, ' ', false, Json::error_handler_t::replace).c_str());
+      else if (!refresh)
+        std::printf("%s %s\n", clock_text(now_s()).c_str(), role_change_text(c).c_str());
+    }
     TelemetryLine line;
     for (auto& r : readers) {
       while ((count <= 0 || seen < count) && r->take(o, line)) {
@@ -433,6 +449,10 @@ int run_watch(const GlobalOptions& o, long count) {
         for (const auto& [key, l] : latest)
           if (l.topic == r->name())
             rows.push_back({label(l.device), l.topic, health_of(l.device), now - l.time, l.values});
+      if (!instances.empty()) {
+        std::printf("pair:\n");
+        for (const auto& l : aligned_columns(role_rows(instances))) std::printf("%s\n", l.c_str());
+      }
       for (const auto& r : watch_table(rows, alarm_list())) std::printf("%s\n", r.c_str());
       std::fflush(stdout);
     }

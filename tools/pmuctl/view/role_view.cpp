@@ -92,6 +92,28 @@ std::vector<std::vector<std::string>> role_rows(const std::vector<SeenInstance>&
   return rows;
 }
 
+std::vector<ShownRoleChange> shown_role_changes(const std::vector<SeenInstance>& instances,
+                                                std::map<std::pair<std::string, std::string>, std::string>& printed) {
+  std::vector<ShownRoleChange> changes;
+  for (const auto& s : instances) {
+    const std::string shown = role_shown(s);
+    const std::string record = shown + " term " + std::to_string(s.report.beat.term);
+    auto& last = printed[{s.vehicle, s.report.name}];
+    if (last == record) continue;
+    changes.push_back({s, last.substr(0, last.find(' '))});
+    last = record;
+  }
+  return changes;
+}
+
+std::string role_change_text(const ShownRoleChange& change) {
+  const auto& s = change.now;
+  std::string text = (s.vehicle.empty() ? std::string() : s.vehicle + "/") + name_of(s) + " role " + role_shown(s) +
+                     " term " + std::to_string(s.report.beat.term);
+  if (!change.was.empty()) text += " (was " + change.was + ")";
+  return text;
+}
+
 nlohmann::ordered_json role_json(const SeenInstance& s, int contract) {
   std::string shown = role_shown(s);
   std::transform(shown.begin(), shown.end(), shown.begin(),

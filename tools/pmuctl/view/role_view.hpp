@@ -10,8 +10,10 @@
 // lets a reliable repair of a lost sample through before a live instance is called silent.
 
 #include <chrono>
+#include <map>
 #include <nlohmann/json.hpp>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "pmu/redundancy/role.hpp"
@@ -44,6 +46,20 @@ std::vector<std::string> pair_problems(const std::vector<SeenInstance>& instance
 // The rows of list's pair table, a header first: VEHICLE INSTANCE ROLE TERM PRIORITY BUS ALARM
 // LAST HEARD; the caller aligns them.
 std::vector<std::vector<std::string>> role_rows(const std::vector<SeenInstance>& instances);
+
+// What `watch` prints of pairs: an instance whose shown role (role_shown, SILENT included) or
+// term differs from what was last printed of it, with what that was ("" when first heard).
+struct ShownRoleChange {
+  SeenInstance now;
+  std::string was;  // role_shown of the line printed before, "" for none
+};
+// The changes since the last call; `printed` (by vehicle and name: "ROLE term N") is the
+// caller's record of what was printed, updated here.
+std::vector<ShownRoleChange> shown_role_changes(const std::vector<SeenInstance>& instances,
+                                                std::map<std::pair<std::string, std::string>, std::string>& printed);
+// A watch line's words after its time: "uav7/mc-b role ACTIVE term 3 (was STANDBY)"; the
+// unnamed vehicle's instance is "mc-b", and an instance first heard has no "(was ...)".
+std::string role_change_text(const ShownRoleChange& change);
 
 // One JSON line's object: topic "role", vehicle, values {name, peer, role (role_shown in lower
 // case), last_role, term, priority, hands_over, bus_state, alarm, age (s), silent}, contract.
