@@ -53,6 +53,8 @@ test_only_packages=(
   # The VM of the system tests and the network lab (tests/lab: iproute2's ip and tc with
   # netem's distribution tables go into it; its kernel is downloaded, not installed)
   qemu-system-x86 busybox-static cpio kmod
+  # eu-stack: the hot-standby suite prints each live instance's thread stacks on a failure
+  elfutils
   # Debian packages (scripts/package.sh): debhelper, lintian; arm64 cross-built, its tests
   # under qemu-user
   debhelper dpkg-dev lintian crossbuild-essential-arm64 qemu-user-static

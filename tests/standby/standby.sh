@@ -78,6 +78,15 @@ diagnose() {
     [ -f "$WORK/$SCEN.$_h.log" ] && log "diag: $_h: $(grep -E 'role: |hot standby|--- start' "$WORK/$SCEN.$_h.log" | cut -c12-200 | tr '\n' ';' | cut -c1-900)"
     [ -f "$WORK/$SCEN.$_h.log" ] && log "diag: $_h: commands: $(grep -E 'audit: ' "$WORK/$SCEN.$_h.log" | tail -n 12 | cut -c12-220 | tr '\n' ';')"
   done
+  # Where each live, running instance's threads are: a reply that never comes is a thread
+  # waiting somewhere.
+  if command -v eu-stack >/dev/null; then
+    for _h in A B; do
+      _p=$(eval echo "\${PID_$_h:-}")
+      [ -n "$_p" ] && running "$_p" || continue
+      eu-stack -p "$_p" 2>&1 | sed "s/^/diag: $_h stack: /"
+    done
+  fi
   return 0
 }
 
@@ -331,6 +340,13 @@ check_takeover() {  # OLD V1 V2
   detail "takeover $TAKEOVER s (the fault to the first sample of B's writer; goal 0.5), largest gap $GAP s (goal 1, PP $PERIOD), the command sent after the fault COMPLETED $CMD_S s after it (goal 1)"
   check_streams "$T_UP" 2
   check_one_owner "$_new"
+  check_watch "$_new" active
+}
+# The operator's watch in C shows the pair as it is: INSTANCE's last role line there says ROLE.
+watch_role() { grep '"topic":"role"' "$WORK/$SCEN.watch" 2>/dev/null | grep "\"name\":\"$(name_of "$1")\"" | tail -n1 | sed -n 's/.*"role":"\([a-z_]*\)".*/\1/p'; }
+check_watch() {  # HOST ROLE
+  [ "$(watch_role "$1")" = "$2" ] || fail "pmuctl watch last showed $1 as '$(watch_role "$1")', not $2: $(grep -c '"topic":"role"' "$WORK/$SCEN.watch" 2>/dev/null) role line(s)"
+  detail "pmuctl watch shows $1 $2 (its role lines: $(grep '"topic":"role"' "$WORK/$SCEN.watch" | sed -n 's/.*"name":"\([^"]*\)".*"role":"\([a-z_]*\)".*"term":\([0-9]*\).*/\1 \2 \3/p' | tr '\n' ',' | cut -c1-200))"
 }
 # The two commands of the fault (check_command), checked last in a scenario, when every
 # frame and audit line they could cause is in.
@@ -477,6 +493,7 @@ scenario_kill() {
   pair_up
   fault_at A kill 12.1 12.2
   check_takeover A 12.1 12.2
+  check_watch A silent
   check_commands 12.1 12.2
 }
 

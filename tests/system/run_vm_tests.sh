@@ -356,6 +356,8 @@ elif [ "$suite" = standby ]; then
   copy_with_libs "$sim_bin" opt/pmu/bin/pmu-sim
   copy_with_libs "$ground_bin" opt/pmu/bin/lab_ground
   copy_with_libs "$consumer_bin" opt/pmu/bin/standby_consumer
+  eu_stack=$(command -v eu-stack || true)
+  [ -z "$eu_stack" ] || copy_with_libs "$eu_stack" usr/bin/eu-stack
 else
   copy_with_libs "$ground_bin" opt/pmu/bin/lab_ground
   copy_with_libs "$tc_bin" usr/sbin/tc   # busybox's tc knows no netem
