@@ -213,6 +213,7 @@ int run(const service::Config& cfg, const pmu::dds::ResolvedNetwork& network) {
       if (holder) systemd.status(holder->status());
     };
     holder = std::make_unique<standby::RoleHolder>(*cfg.redundancy, clock.steady_now(), std::move(outputs));
+    ownership->judge_with(*holder, clock);
     role_topics->on_report([&holder](const redundancy::RoleReport& r, std::chrono::steady_clock::time_point arrived) {
       holder->on_report(r, arrived);
     });

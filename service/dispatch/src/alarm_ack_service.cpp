@@ -149,13 +149,13 @@ bool AlarmAckService::first_time(const std::string& key, const AlarmAckSample& s
   if (reused) {
     spdlog::warn("audit: alarm ack {} from {} reuses that id for another acknowledgement: {} -> REJECTED",
                  printable(s.request_id), printable(s.sender), where(s));
-    reply_(reply_to(s, AckReplyResult::Rejected,
-                    "request id was already used by this sender for another acknowledgement (use a new id)"));
+    send_reply(reply_to(s, AckReplyResult::Rejected,
+                        "request id was already used by this sender for another acknowledgement (use a new id)"));
     return false;
   }
   spdlog::info("audit: duplicate alarm ack {} from {}: answered again, not applied", printable(s.request_id),
                printable(s.sender));
-  if (again) reply_(*again);  // else owed: sent with the first one's reply
+  if (again) send_reply(*again);  // else owed: sent with the first one's reply
   return false;
 }
 
@@ -222,7 +222,18 @@ void AlarmAckService::finish(const std::string& key, const AlarmAckSample& s, Al
   }
   spdlog::info("audit: alarm ack {} from {}: {} -> {}: {}", printable(s.request_id), printable(s.sender), where(s),
                to_string(reply.result), reply.reason);
-  for (unsigned i = 0; i < copies; ++i) reply_(reply);
+  for (unsigned i = 0; i < copies; ++i) send_reply(reply);
+}
+
+void AlarmAckService::send_reply(const AlarmAckReplyData& reply) {
+  if (!applies_now()) {
+    spdlog::warn(
+        "audit: the reply to alarm ack {} was not sent: this instance stopped owning the bus before it went out; the "
+        "new owner answers the client's resend",
+        printable(reply.request_id));
+    return;
+  }
+  reply_(reply);
 }
 
 }  // namespace pmu::service

@@ -190,7 +190,7 @@ void CommandService::finish(const std::string& key, const std::string& sender, c
     // answer to resends nor counted; the audit line is the final reply's.
     spdlog::debug("command {} from {}: {} -> {}: {}", printable(reply.request_id), printable(sender), what,
                   to_string(reply.result), reply.reason);
-    reply_(reply);
+    send_reply(reply);
     return;
   }
   unsigned copies = 1;
@@ -213,7 +213,18 @@ void CommandService::finish(const std::string& key, const std::string& sender, c
   // Reasons quote network text only through printable(); ids and senders are escaped here.
   spdlog::info("audit: command {} from {}: {} -> {}{}{}", printable(reply.request_id), printable(sender), what,
                to_string(reply.result), reply.reason.empty() ? "" : ": ", reply.reason);
-  for (unsigned i = 0; i < copies; ++i) reply_(reply);
+  for (unsigned i = 0; i < copies; ++i) send_reply(reply);
+}
+
+void CommandService::send_reply(const CommandReplyData& reply) {
+  if (!executes_now()) {
+    spdlog::warn(
+        "audit: the reply {} to command {} was not sent: this instance stopped owning the bus before it went out; "
+        "the new owner answers the client's resend",
+        to_string(reply.result), printable(reply.request_id));
+    return;
+  }
+  reply_(reply);
 }
 
 void CommandService::answer(const CommandRequest& r, CommandResult result, std::string reason) {
@@ -272,7 +283,7 @@ void CommandService::reject_without_id(const CommandSample& s) {
     ++counters_.refused;
   }
   spdlog::warn("audit: command without request_id from {}: {} -> REJECTED", printable(s.sender), describe(s));
-  reply_(make_reply(s, CommandResult::Rejected, "request_id is empty"));
+  send_reply(make_reply(s, CommandResult::Rejected, "request_id is empty"));
 }
 
 bool CommandService::first_time(const std::string& key, const CommandSample& s) {
@@ -289,14 +300,14 @@ bool CommandService::first_time(const std::string& key, const CommandSample& s) 
             "before it: their link has a round trip or a loss a LAN does not have. On a radio link, `link: {{profile: "
             "radio}}` here and `--link radio` on the ground set what it needs (interface.md 7.3)",
             std::chrono::duration<double>(*slow_link).count());
-      if (again) reply_(*again);  // else owed: sent with the first one's final reply
+      if (again) send_reply(*again);  // else owed: sent with the first one's final reply
       return false;
     case Seen::Reused:
       spdlog::warn("audit: command {} from {} reuses that id for another command: {} -> REJECTED",
                    printable(s.request_id), printable(s.sender), describe(s));
-      reply_(make_reply(s, CommandResult::Rejected,
-                        "request id '" + printable(s.request_id) +
-                            "' was already used by this sender for another command; not executed (use a new id)"));
+      send_reply(make_reply(s, CommandResult::Rejected,
+                            "request id '" + printable(s.request_id) +
+                                "' was already used by this sender for another command; not executed (use a new id)"));
       return false;
   }
   return false;

@@ -6,6 +6,16 @@ namespace pmu::standby {
 
 Ownership::Ownership(RoleGate& gate, std::function<void()> took_over) : gate_(gate), took_over_(std::move(took_over)) {}
 
+void Ownership::judge_with(const RoleHolder& holder, const transport::Clock& clock) {
+  holder_ = &holder;
+  clock_ = &clock;
+}
+
+bool Ownership::executing() const {
+  if (!executing_.load()) return false;
+  return holder_ == nullptr || holder_->owns_bus(clock_->steady_now());
+}
+
 void Ownership::on_change(const RoleChange& change) {
   if (change.took_bus()) {
     // The state first, so that the takeover's first writes follow what was kept; then the

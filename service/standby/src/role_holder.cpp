@@ -141,6 +141,11 @@ Role RoleHolder::role() const {
   return machine_.role();
 }
 
+bool RoleHolder::owns_bus(Time now) const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return machine_.owns_at(now);
+}
+
 std::string RoleHolder::status() const {
   std::lock_guard<std::mutex> lock(mutex_);
   std::string s(redundancy::role_name(machine_.role()));

@@ -91,6 +91,17 @@ TEST(RoleMachine, APauseLongerThanTheGapStopsTheOwnerOnItsFirstCall) {
   EXPECT_TRUE(short_pause.machine.may_transmit());
 }
 
+// Asked from another thread, without a call: the owner owns the bus only while its last call
+// is within the gap; past it, its next call would drop the role.
+TEST(RoleMachine, AskedWithoutACallItOwnsTheBusOnlyWithinTheGapOfItsLastCall) {
+  LoneOwner o;
+  EXPECT_TRUE(o.machine.owns_at(o.now));
+  EXPECT_TRUE(o.machine.owns_at(o.now + freeze_gap(o.settings)));
+  EXPECT_FALSE(o.machine.owns_at(o.now + freeze_gap(o.settings) + 1ms));
+  RoleMachine standby{o.settings, o.now};
+  EXPECT_FALSE(standby.owns_at(o.now));
+}
+
 TEST(RoleMachine, ItNeverClaimsWhileThePeerIsHeardOnCanWhateverDdsSays) {
   Settings s = settings_with_priority(200);
   Time now{std::chrono::hours(1)};

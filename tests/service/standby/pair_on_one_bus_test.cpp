@@ -50,6 +50,7 @@ class Instance {
     holder = std::make_unique<RoleHolder>(s, clock.steady_now(), std::move(out));
     gate = std::make_unique<RoleGate>(sink, [this] { ++clears; });
     ownership = std::make_unique<standby::Ownership>(*gate, [this] { ++takeovers; });
+    ownership->judge_with(*holder, clock);
     transport::SimBusOptions options;
     options.filters = transport::default_filters(false);
     options.filters.push_back({redundancy::kCanBeatIdBase, 0x1FFFFF00u, true});
@@ -220,6 +221,10 @@ TEST_F(StandbyPair, FrozenOwnerStepsDownOnItsFirstCallAndSendsNothingStale) {
   const auto a_frames = a_->pmu_frames();
   const auto clears = a_->clears;
   const auto a_samples = a_->telemetry_published();
+  // On SIGCONT its DDS listeners may run before its bus thread: a resend they take now finds
+  // the role still ACTIVE in the machine, and must not be answered on it.
+  EXPECT_EQ(a_->holder->role(), Role::Active) << "its bus thread has not run since the freeze";
+  EXPECT_FALSE(a_->ownership->executing()) << "a listener woken with the frozen owner would act as the owner";
   a_->running = true;  // SIGCONT: its timers are all due at once, its socket full of frames
   run_for(1s);
   EXPECT_EQ(a_->pmu_frames(), a_frames) << "the resumed former owner sent a PMU frame";

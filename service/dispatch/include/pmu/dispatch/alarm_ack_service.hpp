@@ -109,6 +109,8 @@ class AlarmAckService {
   void apply(BusWorker& worker, const AlarmAckRequest& r);
   void finish(const std::string& key, const AlarmAckSample& s, AlarmAckReplyData reply);
   bool applies_now() const { return !applies_now_ || applies_now_(); }
+  // Every reply goes out here, the gate asked once more right before it (command_service.hpp).
+  void send_reply(const AlarmAckReplyData& reply);
   // Not answered here: the gate closed while it was on its way. Forgotten, so that a resend
   // after this instance takes the bus back is applied.
   void let_go(const std::string& key, const AlarmAckSample& s);

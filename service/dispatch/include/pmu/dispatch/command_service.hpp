@@ -128,6 +128,9 @@ class CommandService {
   // The stages of submit(), in order (each answers or lets the command on):
   void reject_without_id(const CommandSample& s);
   bool executes_now() const { return !executes_now_ || executes_now_(); }
+  // Every reply goes out here, the gate asked once more right before it: an owner frozen after
+  // it decided and woken after its peer took over writes nothing the new owner contradicts.
+  void send_reply(const CommandReplyData& reply);
   // submit()'s stages after duplicate detection: parse (at `now`), route, limit, post.
   void admit(const std::string& key, const CommandSample& s, const Now& now);
   // The request under `key` ran while the gate closed: not answered here (its reply is the new

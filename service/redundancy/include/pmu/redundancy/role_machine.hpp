@@ -62,6 +62,11 @@ class RoleMachine {
   // PMU frames on CAN and command execution: the bus owner only.
   bool may_transmit() const noexcept { return role_ == Role::Active; }
   bool executes_commands() const noexcept { return role_ == Role::Active; }
+  // Whether the machine, asked at `now` from another thread than its caller's, still owns the
+  // bus: ACTIVE, and called within freeze_gap. Longer without a call, its next call drops the
+  // role, and what the instance does outside that call (a DDS listener answering a request)
+  // must not act on a role it may have lost while it was frozen.
+  bool owns_at(Time now) const noexcept { return role_ == Role::Active && now - last_call_ <= freeze_gap(settings_); }
   // The contract's state topics: the bus owner only; every instance writes pmu/role.
   bool publishes_state() const noexcept { return role_ == Role::Active; }
   std::uint32_t term() const noexcept { return term_; }

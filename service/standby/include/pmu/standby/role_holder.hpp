@@ -81,6 +81,8 @@ class RoleHolder {
   // audits it.
   redundancy::MoveResult hand_over(Time now);
   redundancy::Role role() const;
+  // The machine's owns_at(now): ACTIVE and judged by the bus's thread within freeze_gap.
+  bool owns_bus(Time now) const;
   // "ACTIVE, term 3" or "STANDBY (peer mc-b ACTIVE)": systemd's STATUS= and the log.
   std::string status() const;
   const redundancy::Settings& settings() const noexcept { return settings_; }
