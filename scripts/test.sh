@@ -3,8 +3,9 @@
 #   1. release build (-Werror): unit, CLI, transport, simulator, service, DDS integration and
 #      deploy tests, benchmark smoke runs, and the VM suites (label system): real SocketCAN on
 #      vcan in a qemu VM booting Debian's kernel (tests/system), the network lab in the same
-#      kind of VM (tests/lab: hosts in namespaces, a netem-impaired ground link) and the amd64
-#      packages under a real systemd (tests/systemd)
+#      kind of VM (tests/lab: hosts in namespaces, a netem-impaired ground link), a hot-standby
+#      pair on one CAN bus in it (tests/standby) and the amd64 packages under a real systemd
+#      (tests/systemd)
 #   2. ASan+UBSan build: unit, CLI, transport, simulator and service tests under the sanitizers
 #      (the DDS integration tests run in the release build: Fast DDS itself is not built with ASan)
 #   3. ThreadSanitizer build: transport, simulator, service and DDS integration tests (threads:
@@ -130,14 +131,13 @@ trap - EXIT
 cat "$vm_log"
 
 step "arm64 packages (tests under qemu-user), beside the release tests that do not use them"
-# The release tests (all but the VM suites, which ran above or, for the hot-standby suite
-# (label standby), are run on their own, and the package tests, which use the arm64 packages)
-# run at -j twice the CPUs: they mostly wait (discovery, replies, a
+# The release tests (all but the VM suites, which ran above, and the package tests, which use
+# the arm64 packages) run at -j twice the CPUs: they mostly wait (discovery, replies, a
 # service's start), and at one per CPU the CPUs were 97 % idle. The longest carry a COST so
 # that they start first. package.sh builds at nice 10, so the tests have the CPUs first and
 # the cross build takes what they leave.
 release_log="$root/build/release/release-tests.log"
-ctest --preset release -LE '^(system|package|standby)$' -j"$((2 * jobs))" >"$release_log" 2>&1 &
+ctest --preset release -LE '^(system|package)$' -j"$((2 * jobs))" >"$release_log" 2>&1 &
 tests_pid=$!
 trap 'kill "$tests_pid" 2>/dev/null || true' EXIT
 env "${no_debug[@]}" DEB_BUILD_OPTIONS=noautodbgsym "$root/scripts/package.sh" --arch arm64
