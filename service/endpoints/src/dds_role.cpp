@@ -76,7 +76,8 @@ struct DdsRoleEndpoint::Impl {
   DataReader* move_reader = nullptr;
   std::mutex callback_mutex;  // held while a callback runs and while stop() detaches them
   bool running = false;
-  std::mutex write_mutex;
+  std::mutex role_write_mutex;   // the heartbeat's writer
+  std::mutex reply_write_mutex;  // a move's reply, written by a callback
   std::atomic<std::uint64_t> own{0}, not_ours{0}, malformed{0}, expired{0};
   LogThrottle malformed_reports{std::chrono::seconds(10)};
   std::atomic<std::uint64_t> malformed_seen{0};  // the type's undecodable count last added to `malformed`
@@ -117,9 +118,10 @@ struct DdsRoleEndpoint::Impl {
   }
 
   // The samples are taken before callback_mutex, and this instance's own dropped there: a
-  // heartbeat written while write_mutex is held can come back to this reader on the writing
-  // thread (Fast DDS's delivery within a process), and waiting there for callback_mutex, which
-  // a move's callback holds while it waits for write_mutex, would close a cycle.
+  // heartbeat comes back to this reader on the thread that writes it, inside write() (Fast
+  // DDS's delivery within a process), and a peer's sample taken in the same call makes that
+  // thread wait for callback_mutex while it holds role_write_mutex. So no callback holds
+  // role_write_mutex: a move's reply has its own.
   void take_roles(DataReader* r) {
     std::vector<std::pair<redundancy::RoleReport, std::chrono::steady_clock::time_point>> reports;
     std::vector<std::string> problems;
@@ -164,17 +166,10 @@ struct DdsRoleEndpoint::Impl {
                    malformed.load(std::memory_order_relaxed));
   }
 
-  // The replies are written once callback_mutex is released (take_roles says why).
+  // A move's reply is written under callback_mutex (so that stop() waits for it) and under
+  // reply_write_mutex, which the heartbeat's writer never holds (take_roles says why).
   void take_moves(DataReader* r) {
-    std::vector<std::pair<redundancy::MoveRequest, redundancy::MoveResult>> replies;
-    {
-      std::lock_guard<std::mutex> lock(callback_mutex);
-      decide_moves(r, replies);
-    }
-    for (const auto& [request, result] : replies) reply(request, result);
-  }
-
-  void decide_moves(DataReader* r, std::vector<std::pair<redundancy::MoveRequest, redundancy::MoveResult>>& replies) {
+    std::lock_guard<std::mutex> lock(callback_mutex);
     pmu::v5::RoleMove s;
     SampleInfo info;
     while (r->take_next_sample(&s, &info) == ReturnCode_t::RETCODE_OK) {
@@ -214,7 +209,7 @@ struct DdsRoleEndpoint::Impl {
                      printable(request.requester), printable(sender), result.accepted ? "accepted" : "refused",
                      result.reason.empty() ? "" : ": ", printable(result.reason));
       }
-      replies.emplace_back(std::move(request), std::move(result));
+      reply(request, result);
     }
   }
 
@@ -227,7 +222,7 @@ struct DdsRoleEndpoint::Impl {
     s.reason(result.reason.substr(0, 127));
     bool ok = false;
     {
-      std::lock_guard<std::mutex> lock(write_mutex);
+      std::lock_guard<std::mutex> lock(reply_write_mutex);
       ok = reply_writer && reply_writer->write(&s);
     }
     if (!ok) spdlog::warn("pmu/role_move_reply: reply to {} not sent", printable(request.request_id));
@@ -279,7 +274,7 @@ bool DdsRoleEndpoint::publish(const redundancy::RoleReport& report) {
   auto sample = dds::role_heartbeat_sample(impl_->vehicle, report);
   bool ok = false;
   {
-    std::lock_guard<std::mutex> lock(impl_->write_mutex);
+    std::lock_guard<std::mutex> lock(impl_->role_write_mutex);
     ok = impl_->role_writer->write(&sample);
   }
   if (!ok) spdlog::warn("pmu/role: heartbeat of {} not written", printable(report.name));
